@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages sweetspot needs to build, run and test.
+# Idempotent: runs `apt-get update` and `apt-get install` only when a package
+# is missing, and does nothing at all when everything is present.
+# Must run as root (or with sudo available) on Debian 12 (bookworm).
+#
+#   scripts/install-deps.sh            build, test and run (the default)
+#   scripts/install-deps.sh --runtime  only what the built executables need
+set -euo pipefail
+
+if [ "${1:-}" = "--runtime" ]; then
+  packages=(ca-certificates curl libnlopt-cxx0 coinor-libipopt1v5 libcpp-httplib0.11)
+else
+  packages=(
+    cmake g++ make pkg-config ca-certificates curl
+    libeigen3-dev libnlopt-cxx-dev coinor-libipopt-dev
+    libcpp-httplib-dev nlohmann-json3-dev
+    libgtest-dev libgmock-dev libbenchmark-dev libboost-dev
+  )
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present" >&2
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}" >&2
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  sudo_cmd=(sudo)
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,220 @@
+#include "server/config.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+namespace sweetspot::server {
+namespace {
+
+// One option: flag name, environment variable, help text, and a setter that
+// parses the text into the config (returns false with a rule on bad text).
+struct Option {
+  const char* flag;
+  const char* env;
+  const char* help;
+  bool takes_value;
+  std::function<bool(ServerConfig*, const std::string&, std::string* rule)> set;
+};
+
+bool ParseLong(const std::string& text, long long lo, long long hi, long long* out,
+               std::string* rule) {
+  errno = 0;
+  char* end = nullptr;
+  const long long value = std::strtoll(text.c_str(), &end, 10);
+  if (text.empty() || end == nullptr || *end != '\0' || errno != 0 || value < lo || value > hi) {
+    *rule = "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    return false;
+  }
+  *out = value;
+  return true;
+}
+
+bool ParseSeconds(const std::string& text, double* out, std::string* rule) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end == nullptr || *end != '\0' || !std::isfinite(value) || value <= 0 ||
+      value > 3600) {
+    *rule = "must be a number of seconds in (0, 3600]";
+    return false;
+  }
+  *out = value;
+  return true;
+}
+
+bool ParseBool(const std::string& text, bool* out, std::string* rule) {
+  if (text == "1" || text == "true" || text == "yes" || text == "on") {
+    *out = true;
+  } else if (text == "0" || text == "false" || text == "no" || text == "off") {
+    *out = false;
+  } else {
+    *rule = "must be one of 1, 0, true, false, yes, no, on, off";
+    return false;
+  }
+  return true;
+}
+
+const std::vector<Option>& Options() {
+  static const std::vector<Option> options = {
+      {"--host", "SWEETSPOT_HOST", "address to bind (default 127.0.0.1; 0.0.0.0 for all)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         if (v.empty()) {
+           *rule = "must not be empty";
+           return false;
+         }
+         c->host = v;
+         return true;
+       }},
+      {"--port", "SWEETSPOT_PORT", "TCP port (default 8080; 0 = pick a free port)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long p = 0;
+         if (!ParseLong(v, 0, 65535, &p, rule)) return false;
+         c->port = static_cast<int>(p);
+         return true;
+       }},
+      {"--threads", "SWEETSPOT_THREADS", "request worker threads (default 8)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1, 256, &n, rule)) return false;
+         c->threads = static_cast<int>(n);
+         return true;
+       }},
+      {"--max-body-bytes", "SWEETSPOT_MAX_BODY_BYTES",
+       "largest request body in bytes (default 1048576)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1, 1LL << 30, &n, rule)) return false;
+         c->max_body_bytes = static_cast<std::size_t>(n);
+         return true;
+       }},
+      {"--read-timeout-s", "SWEETSPOT_READ_TIMEOUT_S", "socket read timeout in s (default 10)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseSeconds(v, &c->read_timeout_s, rule);
+       }},
+      {"--write-timeout-s", "SWEETSPOT_WRITE_TIMEOUT_S", "socket write timeout in s (default 10)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseSeconds(v, &c->write_timeout_s, rule);
+       }},
+      {"--keep-alive-timeout-s", "SWEETSPOT_KEEP_ALIVE_TIMEOUT_S",
+       "idle keep-alive timeout in s (default 5)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseSeconds(v, &c->keep_alive_timeout_s, rule);
+       }},
+      {"--keep-alive-max-requests", "SWEETSPOT_KEEP_ALIVE_MAX_REQUESTS",
+       "requests per keep-alive connection (default 10000)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1, 1000000000, &n, rule)) return false;
+         c->keep_alive_max_requests = static_cast<int>(n);
+         return true;
+       }},
+      {"--access-log", "SWEETSPOT_ACCESS_LOG",
+       "one JSON line per request on stderr, 1 or 0 (default 1)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseBool(v, &c->access_log, rule);
+       }},
+  };
+  return options;
+}
+
+}  // namespace
+
+bool ServerConfig::IsValid(std::string* why) const {
+  auto fail = [why](const std::string& text) {
+    if (why != nullptr) *why = text;
+    return false;
+  };
+  if (host.empty()) return fail("host = \"\": must not be empty");
+  if (port < 0 || port > 65535) return fail("port = " + std::to_string(port) + ": must be in [0, 65535]");
+  if (threads < 1 || threads > 256) {
+    return fail("threads = " + std::to_string(threads) + ": must be in [1, 256]");
+  }
+  if (max_body_bytes < 1) return fail("max_body_bytes = 0: must be at least 1");
+  for (const auto& [name, value] : {std::pair{"read_timeout_s", read_timeout_s},
+                                    std::pair{"write_timeout_s", write_timeout_s},
+                                    std::pair{"keep_alive_timeout_s", keep_alive_timeout_s}}) {
+    if (!std::isfinite(value) || value <= 0 || value > 3600) {
+      std::ostringstream text;
+      text << name << " = " << value << ": must be in (0, 3600]";
+      return fail(text.str());
+    }
+  }
+  if (keep_alive_max_requests < 1) {
+    return fail("keep_alive_max_requests = " + std::to_string(keep_alive_max_requests) +
+                ": must be at least 1");
+  }
+  return true;
+}
+
+ParsedCommandLine ParseCommandLine(
+    const std::vector<std::string>& args,
+    const std::function<std::optional<std::string>(const std::string&)>& getenv) {
+  ParsedCommandLine out;
+  std::string rule;
+  for (const Option& option : Options()) {
+    if (auto value = getenv(option.env)) {
+      if (!option.set(&out.config, *value, &rule)) {
+        out.error = std::string("environment ") + option.env + " = \"" + *value + "\": " + rule;
+        return out;
+      }
+    }
+  }
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (arg == "--help" || arg == "-h") {
+      out.show_help = true;
+      continue;
+    }
+    std::string name = arg;
+    std::optional<std::string> value;
+    if (const auto eq = arg.find('='); eq != std::string::npos) {
+      name = arg.substr(0, eq);
+      value = arg.substr(eq + 1);
+    }
+    if (name == "--no-access-log" && !value) {
+      out.config.access_log = false;
+      continue;
+    }
+    const Option* match = nullptr;
+    for (const Option& option : Options()) {
+      if (name == option.flag) match = &option;
+    }
+    if (match == nullptr) {
+      out.error = "unknown option " + arg + " (see --help)";
+      return out;
+    }
+    if (!value) {
+      if (i + 1 >= args.size()) {
+        out.error = "option " + name + " needs a value";
+        return out;
+      }
+      value = args[++i];
+    }
+    if (!match->set(&out.config, *value, &rule)) {
+      out.error = "option " + name + " = \"" + *value + "\": " + rule;
+      return out;
+    }
+  }
+  if (!out.config.IsValid(&rule)) out.error = rule;
+  return out;
+}
+
+std::string Usage(const std::string& program) {
+  std::ostringstream text;
+  text << "Usage: " << program << " [OPTIONS]\n"
+       << "Serves the sweetspot HTTP JSON API in the foreground; logs to stderr;\n"
+       << "stops cleanly on SIGTERM or SIGINT. Flags override environment variables.\n\n"
+       << "Options:\n";
+  for (const Option& option : Options()) {
+    text << "  " << option.flag << " VALUE\n      " << option.help << "\n      env: " << option.env
+         << "\n";
+  }
+  text << "  --no-access-log\n      same as --access-log 0\n"
+       << "  -h, --help\n      this text\n";
+  return text.str();
+}
+
+}  // namespace sweetspot::server

@@ -1,0 +1,45 @@
+// Server configuration: defaults, command-line flags and environment variables.
+// Precedence: flag > environment > default.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace sweetspot::server {
+
+/// Everything the HTTP service can be configured with.
+struct ServerConfig {
+  std::string host = "127.0.0.1";        ///< Address to bind (--host, SWEETSPOT_HOST). Loopback by default.
+  int port = 8080;                       ///< TCP port, 0 = ephemeral (--port, SWEETSPOT_PORT).
+  int threads = 8;                       ///< Worker threads for requests (--threads, SWEETSPOT_THREADS), 1..256.
+  std::size_t max_body_bytes = 1 << 20;  ///< Largest request body, bytes (--max-body-bytes, SWEETSPOT_MAX_BODY_BYTES).
+  double read_timeout_s = 10.0;          ///< Socket read timeout, s (--read-timeout-s, SWEETSPOT_READ_TIMEOUT_S).
+  double write_timeout_s = 10.0;         ///< Socket write timeout, s (--write-timeout-s, SWEETSPOT_WRITE_TIMEOUT_S).
+  double keep_alive_timeout_s = 5.0;     ///< Idle keep-alive timeout, s (--keep-alive-timeout-s, SWEETSPOT_KEEP_ALIVE_TIMEOUT_S).
+  int keep_alive_max_requests = 10000;   ///< Requests per keep-alive connection (--keep-alive-max-requests, SWEETSPOT_KEEP_ALIVE_MAX_REQUESTS).
+  bool access_log = true;                ///< One JSON line per request on stderr (--no-access-log, SWEETSPOT_ACCESS_LOG=0).
+
+  /// True when every field is in range; otherwise "field = value: rule" in *why.
+  bool IsValid(std::string* why) const;
+};
+
+/// What parsing the command line produced.
+struct ParsedCommandLine {
+  ServerConfig config;    ///< The configuration (valid when error is empty).
+  bool show_help = false; ///< --help was given.
+  std::string error;      ///< Non-empty on a bad flag, value or environment variable.
+};
+
+/// Reads the environment through `getenv` (injectable for tests), then the
+/// flags in `args` (without the program name). Never throws.
+ParsedCommandLine ParseCommandLine(
+    const std::vector<std::string>& args,
+    const std::function<std::optional<std::string>(const std::string&)>& getenv);
+
+/// The --help text: every option, its environment variable and default.
+std::string Usage(const std::string& program);
+
+}  // namespace sweetspot::server

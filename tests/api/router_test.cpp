@@ -1,0 +1,50 @@
+#include "api/router.hpp"
+
+#include <gtest/gtest.h>
+
+namespace sweetspot::api {
+namespace {
+
+TEST(RouterTest, HealthAnswersOk) {
+  std::string route;
+  const Response response = Dispatch({"GET", "/health", ""}, &route);
+  EXPECT_EQ(response.status, 200);
+  EXPECT_EQ(response.body, nlohmann::json({{"status", "ok"}}));
+  EXPECT_EQ(route, "/health");
+}
+
+TEST(RouterTest, UnknownPathIs404WithEnvelope) {
+  std::string route;
+  const Response response = Dispatch({"GET", "/nope", ""}, &route);
+  EXPECT_EQ(response.status, 404);
+  EXPECT_EQ(response.body["code"], "NotFound");
+  EXPECT_EQ(response.body["message"], "no endpoint at path /nope");
+  EXPECT_TRUE(response.body["field"].is_null());
+  EXPECT_EQ(route, "unmatched");
+}
+
+TEST(RouterTest, WrongMethodIs405) {
+  const Response response = Dispatch({"POST", "/health", "{}"});
+  EXPECT_EQ(response.status, 405);
+  EXPECT_EQ(response.body["code"], "MethodNotAllowed");
+  EXPECT_EQ(response.body["message"], "method POST is not allowed on /health");
+}
+
+TEST(RouterTest, TrailingSlashAndPrefixesDoNotMatch) {
+  EXPECT_EQ(Dispatch({"GET", "/health/", ""}).status, 404);
+  EXPECT_EQ(Dispatch({"GET", "/healthz", ""}).status, 404);
+  EXPECT_EQ(Dispatch({"GET", "", ""}).status, 404);
+}
+
+TEST(RouterTest, RoutesAreUniqueByMethodAndPath) {
+  const auto& routes = Routes();
+  for (std::size_t i = 0; i < routes.size(); ++i) {
+    for (std::size_t j = i + 1; j < routes.size(); ++j) {
+      EXPECT_FALSE(routes[i].method == routes[j].method && routes[i].path == routes[j].path)
+          << routes[i].method << " " << routes[i].path;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sweetspot::api

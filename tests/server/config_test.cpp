@@ -1,0 +1,74 @@
+#include "server/config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+namespace sweetspot::server {
+namespace {
+
+ParsedCommandLine Parse(const std::vector<std::string>& args,
+                        const std::map<std::string, std::string>& env = {}) {
+  return ParseCommandLine(args, [&env](const std::string& name) -> std::optional<std::string> {
+    const auto it = env.find(name);
+    if (it == env.end()) return std::nullopt;
+    return it->second;
+  });
+}
+
+TEST(ConfigTest, DefaultsAreValidAndLoopback) {
+  const ServerConfig config;
+  std::string why;
+  EXPECT_TRUE(config.IsValid(&why)) << why;
+  EXPECT_EQ(config.host, "127.0.0.1");
+  EXPECT_EQ(config.port, 8080);
+  EXPECT_EQ(config.threads, 8);
+  EXPECT_EQ(config.max_body_bytes, 1u << 20);
+}
+
+TEST(ConfigTest, EnvironmentThenFlagsOverride) {
+  const auto parsed = Parse({"--port", "9000", "--threads=3"},
+                            {{"SWEETSPOT_HOST", "0.0.0.0"}, {"SWEETSPOT_PORT", "8500"}});
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_EQ(parsed.config.host, "0.0.0.0");
+  EXPECT_EQ(parsed.config.port, 9000);
+  EXPECT_EQ(parsed.config.threads, 3);
+}
+
+TEST(ConfigTest, BadValuesNameFlagValueAndRule) {
+  EXPECT_EQ(Parse({"--port", "70000"}).error,
+            "option --port = \"70000\": must be an integer in [0, 65535]");
+  EXPECT_EQ(Parse({"--threads", "0"}).error,
+            "option --threads = \"0\": must be an integer in [1, 256]");
+  EXPECT_EQ(Parse({"--read-timeout-s", "nan"}).error,
+            "option --read-timeout-s = \"nan\": must be a number of seconds in (0, 3600]");
+  EXPECT_EQ(Parse({}, {{"SWEETSPOT_PORT", "80x"}}).error,
+            "environment SWEETSPOT_PORT = \"80x\": must be an integer in [0, 65535]");
+  EXPECT_EQ(Parse({"--bogus"}).error, "unknown option --bogus (see --help)");
+  EXPECT_EQ(Parse({"--port"}).error, "option --port needs a value");
+}
+
+TEST(ConfigTest, IsValidRefusesOutOfRange) {
+  ServerConfig config;
+  config.threads = 0;
+  std::string why;
+  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_EQ(why, "threads = 0: must be in [1, 256]");
+  config = ServerConfig{};
+  config.read_timeout_s = -1;
+  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_EQ(why, "read_timeout_s = -1: must be in (0, 3600]");
+}
+
+TEST(ConfigTest, HelpListsEveryOptionAndEnvironmentVariable) {
+  EXPECT_TRUE(Parse({"--help"}).show_help);
+  const std::string usage = Usage("sweetspot-server");
+  for (const char* name : {"--host", "SWEETSPOT_HOST", "--port", "SWEETSPOT_PORT", "--threads",
+                           "SWEETSPOT_THREADS", "--max-body-bytes", "--read-timeout-s",
+                           "--write-timeout-s", "--keep-alive-timeout-s", "--access-log"}) {
+    EXPECT_NE(usage.find(name), std::string::npos) << name;
+  }
+}
+
+}  // namespace
+}  // namespace sweetspot::server

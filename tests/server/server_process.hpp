@@ -1,0 +1,109 @@
+// Test helper: runs the real sweetspot-server executable on 127.0.0.1 with an
+// ephemeral port, captures its stderr, and stops it with a signal.
+#pragma once
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <mutex>
+#include <regex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace sweetspot::testing {
+
+class ServerProcess {
+ public:
+  ServerProcess() = default;
+  ~ServerProcess() {
+    if (pid_ > 0) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+    if (reader_.joinable()) reader_.join();
+  }
+
+  /// Starts the server with `args` (port 0 and host 127.0.0.1 are added) and
+  /// waits up to 20 s for its "listening on" line. Returns false on failure.
+  bool Start(std::vector<std::string> args = {}) {
+    int fds[2];
+    if (pipe(fds) != 0) return false;
+    const std::string binary = std::string(SWEETSPOT_BINARY_DIR) + "/server/sweetspot-server";
+    args.insert(args.begin(), {binary, "--host", "127.0.0.1", "--port", "0"});
+    pid_ = fork();
+    if (pid_ == 0) {
+      dup2(fds[1], STDERR_FILENO);
+      close(fds[0]);
+      close(fds[1]);
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(binary.c_str(), argv.data());
+      _exit(127);
+    }
+    close(fds[1]);
+    reader_ = std::thread([this, fd = fds[0]] {
+      char buffer[4096];
+      ssize_t n;
+      while ((n = read(fd, buffer, sizeof buffer)) > 0) {
+        std::lock_guard<std::mutex> lock(mutex_);
+        log_.append(buffer, static_cast<size_t>(n));
+      }
+      close(fd);
+    });
+    const std::regex listening("listening on 127\\.0\\.0\\.1:([0-9]+)");
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (std::chrono::steady_clock::now() < deadline) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        std::smatch match;
+        if (std::regex_search(log_, match, listening)) {
+          port_ = std::stoi(match[1]);
+          return true;
+        }
+      }
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        pid_ = -1;
+        return false;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  }
+
+  /// Sends `signal_number` and waits up to 20 s; returns the exit status
+  /// (or -1 if it did not exit normally, -2 on time-out).
+  int Stop(int signal_number = SIGTERM) {
+    if (pid_ <= 0) return -1;
+    kill(pid_, signal_number);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    int status = 0;
+    while (waitpid(pid_, &status, WNOHANG) == 0) {
+      if (std::chrono::steady_clock::now() > deadline) return -2;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    pid_ = -1;
+    if (reader_.joinable()) reader_.join();
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+  int port() const { return port_; }
+  std::string log() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return log_;
+  }
+
+ private:
+  pid_t pid_ = -1;
+  int port_ = -1;
+  std::thread reader_;
+  std::mutex mutex_;
+  std::string log_;
+};
+
+}  // namespace sweetspot::testing
