@@ -9,7 +9,6 @@
 
 #include <chrono>
 #include <mutex>
-#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -55,15 +54,19 @@ class ServerProcess {
       }
       close(fd);
     });
-    const std::regex listening("listening on 127\\.0\\.0\\.1:([0-9]+)");
+    const std::string listening = "listening on 127.0.0.1:";
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
     while (std::chrono::steady_clock::now() < deadline) {
       {
         std::lock_guard<std::mutex> lock(mutex_);
-        std::smatch match;
-        if (std::regex_search(log_, match, listening)) {
-          port_ = std::stoi(match[1]);
-          return true;
+        const auto at = log_.find(listening);
+        if (at != std::string::npos) {
+          const auto digits = at + listening.size();
+          const auto end = log_.find_first_not_of("0123456789", digits);
+          if (end != std::string::npos && end > digits) {
+            port_ = std::stoi(log_.substr(digits, end - digits));
+            return true;
+          }
         }
       }
       int status = 0;
