@@ -1,6 +1,25 @@
 // The bat: a solid of revolution along x, from the knob (x = 0) to the barrel
 // tip (x = L), with a piecewise-linear outer radius, a material, an optional
 // hollow shell and an optional fill bored from the barrel end.
+//
+// Geometry conventions (everything SI, positions from the knob):
+// - Outer radius: linear between knots; knots strictly increasing in x from 0
+//   to L. A step in the radius is two knots a tiny distance apart (1e-12 m
+//   works: the mass properties integrate each segment without dividing by its
+//   length, so a short segment costs no accuracy).
+// - Hollow shell (wall_thickness_m = t > 0): the inner radius is r(x) - t at
+//   every x (the wall is measured radially, not normal to the surface), and
+//   the shell is an OPEN tube: both ends are open, no end cap and no solid
+//   knob plug are modelled (a real metal bat's end cap and knob add a few tens
+//   of grams; put them into the profile or the wall if they matter). The
+//   cavity holds nothing unless a fill is given. t = 0 is a solid bat; t must
+//   be less than the smallest outer radius.
+// - Fill: a coaxial cylinder of radius diameter_m / 2 occupying
+//   [L - depth_m, L]. In a solid bat it is bored out of the bat's material and
+//   holds the fill material (density 0 = left empty, e.g. a cupped end); in a
+//   hollow bat it sits inside the cavity, so it must fit inside the inner
+//   radius. Either way it must lie strictly inside the material around it
+//   over its whole depth, and depth_m <= L.
 #pragma once
 
 #include <optional>
@@ -20,41 +39,77 @@ struct ProfileKnot {
 /// The paper's three-segment shape: handle cylinder r1 on [0, x1], linear
 /// taper to r2 on [x1, x2], barrel cylinder r2 on [x2, L].
 struct ThreeSegmentShape {
-  double length_m = 0.0;         ///< L, m.
-  double handle_radius_m = 0.0;  ///< r1, m.
-  double barrel_radius_m = 0.0;  ///< r2, m.
+  double length_m = 0.0;         ///< L, m (> 0).
+  double handle_radius_m = 0.0;  ///< r1, m (> 0).
+  double barrel_radius_m = 0.0;  ///< r2, m (> 0).
   double taper_start_m = 0.0;    ///< x1 from the knob, m (0 <= x1 <= x2).
   double taper_end_m = 0.0;      ///< x2 from the knob, m (x2 <= L).
 
-  /// True when the shape is well formed; otherwise "field = value: rule" in *why.
+  /// Width of the step that stands for a zero-length taper (0 < x1 = x2 < L,
+  /// r1 != r2), relative to L: the two knots sit at x1 -+ L * kStepWidth / 2.
+  /// The mass properties then differ from the ideal step's by less than
+  /// kStepWidth / 6 relative (the exact integrals of the short taper).
+  static constexpr double kStepWidth = 1e-12;
+
+  /// True when the shape is well formed (finite; L, r1, r2 > 0;
+  /// 0 <= x1 <= x2 <= L); otherwise "field = value: rule" in *why (if non-null).
   bool IsValid(std::string* why) const;
-  /// The knots of this shape (3 or 4 knots; coincident knots are merged).
+  /// The knots of this shape, x strictly increasing: (0, r1), (x1, r1),
+  /// (x2, r2), (L, r2) with coincident knots merged (x1 = 0: no handle knot;
+  /// x2 = L: no barrel knot; x1 = x2 with r1 = r2: one knot; x1 = x2 = 0 or
+  /// x1 = x2 = L: the bat is all barrel or all handle; 0 < x1 = x2 < L with
+  /// r1 != r2: a step of width L * kStepWidth). 2 to 4 knots.
   std::vector<ProfileKnot> Knots() const;
 };
 
 /// A cylinder bored from the barrel end along the axis and filled.
 struct Fill {
-  Material material;        ///< What fills the bore (density 0 = left empty).
-  double diameter_m = 0.0;  ///< Bore diameter, m.
-  double depth_m = 0.0;     ///< Bore depth from the barrel tip towards the knob, m.
+  /// What fills the bore (density 0 = left empty; see EmptyFillMaterial()).
+  Material material;
+  double diameter_m = 0.0;  ///< Bore diameter, m (>= 0).
+  /// Bore depth from the barrel tip towards the knob, m (0 <= depth_m <= L).
+  double depth_m = 0.0;
+
+  /// Bore radius, m.
+  double RadiusM() const { return 0.5 * diameter_m; }
+  /// True when the bore holds nothing (material density 0).
+  bool IsEmpty() const { return material.density_kg_m3 == 0.0; }
 };
 
 /// A complete bat.
 struct Bat {
-  std::vector<ProfileKnot> knots;  ///< Outer radius; x strictly increasing from 0 to L (a step is two knots at nearly the same x).
-  Material material;               ///< The bat's material.
-  double wall_thickness_m = 0.0;   ///< Hollow shell wall, m; 0 = solid.
-  std::optional<Fill> fill;        ///< Optional fill.
+  /// Outer radius; x strictly increasing from 0 to L (a step is two knots at
+  /// nearly the same x).
+  std::vector<ProfileKnot> knots;
+  Material material;              ///< The bat's material.
+  double wall_thickness_m = 0.0;  ///< Hollow shell wall, m; 0 = solid (see the file comment).
+  std::optional<Fill> fill;       ///< Optional fill.
 
-  /// True when the bat is physically valid; otherwise "field = value: rule" in *why.
+  /// True when the bat is physically valid; otherwise "field = value: rule"
+  /// in *why (if non-null), e.g. "knots[3].x_m = 0.2: must be greater than
+  /// knots[2].x_m = 0.3". Refuses: fewer than 2 knots, non-finite numbers,
+  /// first knot not at 0, x not strictly increasing, radius <= 0, an invalid
+  /// material, wall < 0 or >= the smallest outer radius, a fill deeper than
+  /// the bat, negative fill dimensions, a bore not strictly inside the
+  /// material around it (outer radius, or inner radius of a hollow bat) over
+  /// the fill's depth, an invalid non-empty fill material.
+  /// Does not allocate when why is null and the bat is valid.
   bool IsValid(std::string* why) const;
-  /// L, m.
+  /// L, m (the last knot's x; 0 without knots).
   double LengthM() const;
   /// Outer radius at x (from the knob), m; 0 outside [0, L].
   double RadiusAtM(double x_m) const;
+  /// True for a hollow shell (wall_thickness_m > 0).
+  bool IsHollow() const { return wall_thickness_m > 0.0; }
+  /// Inner radius of the shell at x, m: RadiusAtM(x) - wall for a hollow bat,
+  /// 0 for a solid bat or outside [0, L].
+  double InnerRadiusAtM(double x_m) const;
+  /// Smallest outer radius over the bat, m (0 without knots).
+  double MinRadiusM() const;
 };
 
-/// A bat of the paper's three-segment shape.
+/// A bat of the paper's three-segment shape (knots from shape.Knots()),
+/// solid, without fill.
 Bat MakeThreeSegmentBat(const ThreeSegmentShape& shape, const Material& material);
 
 }  // namespace sweetspot::core

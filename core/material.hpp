@@ -8,28 +8,41 @@
 
 namespace sweetspot::core {
 
-/// An isotropic material. All values SI.
+/// An isotropic material (for wood: the longitudinal modulus and the
+/// longitudinal-radial shear modulus and Poisson's ratio). All values SI.
 struct Material {
-  std::string name;                 ///< Catalogue name ("ash") or "custom".
-  double density_kg_m3 = 0.0;       ///< Density, kg/m³ (> 0; 0 allowed only for an empty fill).
-  double youngs_modulus_pa = 0.0;   ///< Young's modulus along the bat's axis, Pa (> 0).
-  double shear_modulus_pa = 0.0;    ///< Shear modulus, Pa; 0 = derive from Poisson's ratio.
-  double poissons_ratio = 0.3;      ///< Poisson's ratio, dimensionless, in (-1, 0.5).
-  std::optional<double> cor;        ///< Default coefficient of restitution against a baseball, if known.
-  double density_min_kg_m3 = 0.0;   ///< Lower end of the density range the source gives (0 = none).
-  double density_max_kg_m3 = 0.0;   ///< Upper end of the density range the source gives (0 = none).
-  std::string source;               ///< Where the numbers come from (citation).
+  std::string name;  ///< Catalogue name ("ash") or "custom".
+  /// Density, kg/m³ (> 0; 0 only as a fill's material, meaning an empty bore).
+  double density_kg_m3 = 0.0;
+  double youngs_modulus_pa = 0.0;  ///< Young's modulus along the bat's axis, Pa (> 0).
+  double shear_modulus_pa = 0.0;   ///< Shear modulus, Pa (>= 0); 0 = derive from Poisson's ratio.
+  double poissons_ratio = 0.3;     ///< Poisson's ratio, dimensionless, in (-1, 0.5).
+  /// Default coefficient of restitution against a baseball, in [0, 1], if known.
+  std::optional<double> cor;
+  /// Lower end of the density range the source gives, kg/m³ (0 = none; informational).
+  double density_min_kg_m3 = 0.0;
+  /// Upper end of the density range the source gives, kg/m³ (0 = none; informational).
+  double density_max_kg_m3 = 0.0;
+  std::string source;  ///< Where the numbers come from (citation).
 
   /// True when every field is finite and in its physical range; otherwise
-  /// writes "field = value: rule" to *why (if non-null).
+  /// writes "field = value: rule" to *why (if non-null). Rules: density > 0,
+  /// E > 0, G >= 0, -1 < nu < 0.5, 0 <= cor <= 1, range bounds >= 0 and
+  /// min <= max when both are given. The density range is informational: a
+  /// density outside it is accepted (sweeps and custom materials use that).
   bool IsValid(std::string* why) const;
   /// Shear modulus in Pa: shear_modulus_pa if set, else E / (2 (1 + nu)).
   double EffectiveShearModulusPa() const;
 };
 
-/// The built-in catalogue (immutable, thread-safe to read).
+/// The built-in catalogue (immutable, thread-safe to read). Entries: "ash",
+/// "hard-maple", "yellow-birch", "paper-wood", "aluminium-7046",
+/// "aluminium-7050", "cork", "rubber"; each with its source.
 const std::vector<Material>& MaterialCatalogue();
 /// The catalogue entry called `name`, or nullopt.
 std::optional<Material> FindMaterial(std::string_view name);
+/// The "material" of an empty bore (name "empty", every number 0). It is not
+/// a valid Material on its own; Bat::IsValid accepts it as a fill's material.
+Material EmptyFillMaterial();
 
 }  // namespace sweetspot::core

@@ -27,4 +27,12 @@ constexpr double KgM2ToOzIn2(double kg_m2) {
   return kg_m2 / (kKilogramsPerOunce * kMetresPerInch * kMetresPerInch);
 }
 
+/// oz·in² to kg·m².
+constexpr double OzIn2ToKgM2(double oz_in2) {
+  return oz_in2 * (kKilogramsPerOunce * kMetresPerInch * kMetresPerInch);
+}
+/// A bat's drop: length in inches minus weight in ounces (3 for a 33-in, 30-oz
+/// bat, which the industry labels "-3").
+constexpr double BatDrop(double length_in, double weight_oz) { return length_in - weight_oz; }
+
 }  // namespace sweetspot::core

@@ -1,0 +1,236 @@
+#include "core/bat.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/geometry_format.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+bool Refuse(std::string* why, std::string_view field, double value, std::string_view rule) {
+  if (why != nullptr) *why = RefusalMessage(field, value, rule);
+  return false;
+}
+
+// Checks a material and prefixes its refusal with `prefix` ("material.").
+bool CheckMaterial(const Material& m, std::string_view prefix, std::string* why) {
+  if (why == nullptr) return m.IsValid(nullptr);
+  std::string inner;
+  if (m.IsValid(&inner)) return true;
+  *why = std::string(prefix) + inner;
+  return false;
+}
+
+// Outer radius of a valid knot list at x in [x_0, x_last].
+double Interpolate(const std::vector<ProfileKnot>& knots, double x) {
+  const auto it = std::upper_bound(knots.begin(), knots.end(), x,
+                                   [](double v, const ProfileKnot& k) { return v < k.x_m; });
+  if (it == knots.begin()) return knots.front().radius_m;
+  if (it == knots.end()) return knots.back().radius_m;
+  const ProfileKnot& b = *it;
+  const ProfileKnot& a = *(it - 1);
+  const double t = (x - a.x_m) / (b.x_m - a.x_m);  // in [0, 1): bounded even for a step
+  return a.radius_m + (b.radius_m - a.radius_m) * t;
+}
+
+}  // namespace
+
+bool ThreeSegmentShape::IsValid(std::string* why) const {
+  const struct {
+    const char* name;
+    double value;
+  } fields[] = {{"length_m", length_m},
+                {"handle_radius_m", handle_radius_m},
+                {"barrel_radius_m", barrel_radius_m},
+                {"taper_start_m", taper_start_m},
+                {"taper_end_m", taper_end_m}};
+  for (const auto& f : fields) {
+    if (!std::isfinite(f.value)) return Refuse(why, f.name, f.value, "must be finite");
+  }
+  if (!(length_m > 0.0)) return Refuse(why, "length_m", length_m, "must be positive");
+  if (!(handle_radius_m > 0.0)) {
+    return Refuse(why, "handle_radius_m", handle_radius_m, "must be positive");
+  }
+  if (!(barrel_radius_m > 0.0)) {
+    return Refuse(why, "barrel_radius_m", barrel_radius_m, "must be positive");
+  }
+  if (taper_start_m < 0.0) {
+    return Refuse(why, "taper_start_m", taper_start_m, "must be non-negative");
+  }
+  if (taper_start_m > taper_end_m) {
+    if (why != nullptr) {
+      *why = RefusalMessage("taper_start_m", taper_start_m,
+                            "must not exceed taper_end_m = " + FormatNumber(taper_end_m));
+    }
+    return false;
+  }
+  if (taper_end_m > length_m) {
+    if (why != nullptr) {
+      *why = RefusalMessage("taper_end_m", taper_end_m,
+                            "must not exceed length_m = " + FormatNumber(length_m));
+    }
+    return false;
+  }
+  return true;
+}
+
+std::vector<ProfileKnot> ThreeSegmentShape::Knots() const {
+  const double length = length_m;
+  const double r1 = handle_radius_m;
+  const double r2 = barrel_radius_m;
+  double x1 = taper_start_m;
+  double x2 = taper_end_m;
+  std::vector<ProfileKnot> out;
+  out.reserve(4);
+  if (x1 == x2) {
+    if (x1 <= 0.0) return {{0.0, r2}, {length, r2}};     // all barrel
+    if (x1 >= length) return {{0.0, r1}, {length, r1}};  // all handle
+    if (r1 == r2) return {{0.0, r1}, {x1, r1}, {length, r1}};
+    // A zero-length taper is a step: two knots a tiny distance apart.
+    const double half_width = 0.5 * kStepWidth * length;
+    x1 = std::max(x1 - half_width, 0.0);
+    x2 = std::min(x2 + half_width, length);
+  }
+  out.push_back({0.0, r1});
+  if (x1 > 0.0) out.push_back({x1, r1});
+  out.push_back({x2, r2});
+  if (x2 < length) out.push_back({length, r2});
+  return out;
+}
+
+bool Bat::IsValid(std::string* why) const {
+  const std::size_t n = knots.size();
+  if (n < 2) {
+    return Refuse(why, "knots.size()", static_cast<double>(n), "must be at least 2");
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(knots[i].x_m)) {
+      return why == nullptr
+                 ? false
+                 : Refuse(why, IndexedField("knots", i, "x_m"), knots[i].x_m, "must be finite");
+    }
+    if (!std::isfinite(knots[i].radius_m)) {
+      return why == nullptr ? false
+                            : Refuse(why, IndexedField("knots", i, "radius_m"), knots[i].radius_m,
+                                     "must be finite");
+    }
+  }
+  if (knots[0].x_m != 0.0) {
+    return Refuse(why, "knots[0].x_m", knots[0].x_m,
+                  "must be 0 (positions are measured from the knob)");
+  }
+  for (std::size_t i = 1; i < n; ++i) {
+    if (!(knots[i].x_m > knots[i - 1].x_m)) {
+      if (why != nullptr) {
+        *why = RefusalMessage(IndexedField("knots", i, "x_m"), knots[i].x_m,
+                              "must be greater than " + IndexedField("knots", i - 1, "x_m") +
+                                  " = " + FormatNumber(knots[i - 1].x_m));
+      }
+      return false;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(knots[i].radius_m > 0.0)) {
+      return why == nullptr ? false
+                            : Refuse(why, IndexedField("knots", i, "radius_m"), knots[i].radius_m,
+                                     "must be positive");
+    }
+  }
+  if (!CheckMaterial(material, "material.", why)) return false;
+
+  if (!std::isfinite(wall_thickness_m)) {
+    return Refuse(why, "wall_thickness_m", wall_thickness_m, "must be finite");
+  }
+  if (wall_thickness_m < 0.0) {
+    return Refuse(why, "wall_thickness_m", wall_thickness_m, "must be non-negative (0 = solid)");
+  }
+  const double min_radius = MinRadiusM();
+  if (wall_thickness_m >= min_radius) {
+    if (why != nullptr) {
+      *why =
+          RefusalMessage("wall_thickness_m", wall_thickness_m,
+                         "must be less than the smallest outer radius " + FormatNumber(min_radius));
+    }
+    return false;
+  }
+
+  if (fill.has_value()) {
+    const Fill& f = *fill;
+    if (!std::isfinite(f.material.density_kg_m3)) {
+      return Refuse(why, "fill.material.density_kg_m3", f.material.density_kg_m3, "must be finite");
+    }
+    if (f.material.density_kg_m3 < 0.0) {
+      return Refuse(why, "fill.material.density_kg_m3", f.material.density_kg_m3,
+                    "must be non-negative (0 = empty bore)");
+    }
+    if (!f.IsEmpty() && !CheckMaterial(f.material, "fill.material.", why)) return false;
+    if (!std::isfinite(f.diameter_m)) {
+      return Refuse(why, "fill.diameter_m", f.diameter_m, "must be finite");
+    }
+    if (f.diameter_m < 0.0)
+      return Refuse(why, "fill.diameter_m", f.diameter_m, "must be non-negative");
+    if (!std::isfinite(f.depth_m)) return Refuse(why, "fill.depth_m", f.depth_m, "must be finite");
+    if (f.depth_m < 0.0) return Refuse(why, "fill.depth_m", f.depth_m, "must be non-negative");
+    const double length = LengthM();
+    if (f.depth_m > length) {
+      if (why != nullptr) {
+        *why = RefusalMessage("fill.depth_m", f.depth_m,
+                              "must not exceed the bat's length " + FormatNumber(length));
+      }
+      return false;
+    }
+    // The material around the bore is thinnest at a knot inside the fill's
+    // range or at the bore's bottom (the profile is piecewise linear).
+    const double start = length - f.depth_m;
+    double worst_x = start;
+    double worst_r = Interpolate(knots, start);
+    for (const ProfileKnot& k : knots) {
+      if (k.x_m > start && k.radius_m < worst_r) {
+        worst_r = k.radius_m;
+        worst_x = k.x_m;
+      }
+    }
+    const double around = worst_r - wall_thickness_m;  // wall is 0 for a solid bat
+    if (!(f.RadiusM() < around)) {
+      if (why != nullptr) {
+        *why = RefusalMessage(
+            "fill.diameter_m", f.diameter_m,
+            "the bore radius " + FormatNumber(f.RadiusM()) + " must be less than the " +
+                (IsHollow() ? "inner" : "outer") + " radius " + FormatNumber(around) +
+                " at x_m = " + FormatNumber(worst_x) + " (over the fill's depth)");
+      }
+      return false;
+    }
+  }
+  return true;
+}
+
+double Bat::LengthM() const { return knots.empty() ? 0.0 : knots.back().x_m; }
+
+double Bat::RadiusAtM(double x_m) const {
+  if (knots.empty() || !(x_m >= knots.front().x_m && x_m <= knots.back().x_m)) return 0.0;
+  return Interpolate(knots, x_m);
+}
+
+double Bat::InnerRadiusAtM(double x_m) const {
+  if (!IsHollow()) return 0.0;
+  return std::max(RadiusAtM(x_m) - wall_thickness_m, 0.0);
+}
+
+double Bat::MinRadiusM() const {
+  if (knots.empty()) return 0.0;
+  double r = std::numeric_limits<double>::infinity();
+  for (const ProfileKnot& k : knots) r = std::min(r, k.radius_m);
+  return r;
+}
+
+Bat MakeThreeSegmentBat(const ThreeSegmentShape& shape, const Material& material) {
+  Bat bat;
+  bat.knots = shape.Knots();
+  bat.material = material;
+  return bat;
+}
+
+}  // namespace sweetspot::core
