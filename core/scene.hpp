@@ -1,0 +1,174 @@
+// A scene (bat, ball, swing, COR, the outputs wanted) and the two entry points the API
+// wires to HTTP: EvaluateScene (the sweet spots) and Collide (one impact). Both are
+// value-in/value-out, never throw, and run only the models the request needs: each output
+// declares its models (ModelsFor), mass properties are computed once per request, and the
+// result lists models_used, an error estimate per output and the time spent per model.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/bat.hpp"
+#include "core/collision/free_bat.hpp"
+#include "core/collision/hertz_contact.hpp"
+#include "core/collision/rigid_pivot.hpp"
+#include "core/mass_properties.hpp"
+#include "core/nlopt_search.hpp"
+#include "core/summary.hpp"
+#include "core/sweet_spot.hpp"
+
+namespace sweetspot::core {
+
+/// Default ball stiffness k in F = k delta^p, N/m^1.5 (see docs/models.md for its calibration).
+inline constexpr double kDefaultBallStiffness = 4.0e7;
+/// Default ball stiffness exponent p (dimensionless).
+inline constexpr double kDefaultBallStiffnessExponent = 1.5;
+
+/// The ball. Defaults: a regulation baseball and the paper's Table 3 speed.
+struct Ball {
+  double mass_kg = 0.145;                    ///< Mass, kg (> 0).
+  double radius_m = 0.0366;                  ///< Radius, m (> 0).
+  double speed_mps = 27.7;                   ///< Incoming speed towards the bat, m/s (>= 0).
+  double stiffness = kDefaultBallStiffness;  ///< Contact models: k in F = k delta^p, N/m^p (> 0).
+  double stiffness_exponent = kDefaultBallStiffnessExponent;  ///< Contact models: p, in [1, 3].
+
+  /// True when every field is in range; otherwise "ball.field = value: rule" in *why.
+  bool IsValid(std::string* why) const;
+};
+
+/// The swing just before impact. Defaults: the paper's Table 3 and the standard grip.
+struct Swing {
+  double angular_speed_rad_s = 17.288;  ///< Angular speed about the pivot, rad/s (>= 0).
+  double pivot_from_knob_m = 0.0;     ///< The pivot, m from the knob (negative = behind the knob).
+  double hands_from_knob_m = 0.1524;  ///< The hands, m from the knob (within the bat).
+
+  /// True when every field is finite and in range; otherwise "swing.field = value: rule".
+  bool IsValid(std::string* why) const;
+};
+
+/// A scene: what is hit, how, and what is wanted.
+struct Scene {
+  std::optional<Bat> bat;  ///< The bat (needed for the contact model's surface stiffness).
+  std::optional<MassProperties>
+      mass_properties;    ///< Precomputed properties; used instead of computing them from `bat`.
+  double length_m = 0.0;  ///< Bat length, m; needed only when `bat` is absent.
+  InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< When computing from `bat`.
+  Ball ball;                                              ///< The ball.
+  Swing swing;                                            ///< The swing.
+  std::optional<double> cor;  ///< COR in [0, 1]; unset = the bat material's default.
+  std::vector<SceneOutput> outputs = {
+      SceneOutput::kMaxExitSpeed};  ///< What to compute (duplicates ignored).
+
+  /// True when the scene is well formed; otherwise "field = value: rule" in *why.
+  bool IsValid(std::string* why) const;
+};
+
+/// A collision model.
+enum class CollisionModel {
+  kAuto,        ///< The cheapest adequate model; the result says which and why.
+  kRigidPivot,  ///< The paper's pivoted rigid bat (closed form).
+  kFreeBat,     ///< The free rigid bat, collision efficiency (closed form).
+  kHertz,       ///< The contact model (ODE).
+  kFlexible,    ///< The flexible beam (not available yet: a named refusal).
+};
+
+/// Stable name: "auto", "rigid_pivot", "free_bat", "hertz", "flexible".
+const char* CollisionModelName(CollisionModel model);
+/// The model called `name`, or nullopt.
+std::optional<CollisionModel> ParseCollisionModel(std::string_view name);
+
+/// The models an output needs with `exit_model` as the exit-speed model, in run order
+/// (e.g. {"mass_properties", "rigid_pivot"}; vibration_node: {"flexible_beam"}).
+std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model);
+
+/// How the sweet spot is found.
+enum class SweetSpotMethod {
+  kClosedForm,  ///< Closed form where the model has one (rigid_pivot, free_bat), NLopt otherwise.
+  kNlopt,       ///< Always the NLopt search (the independent path).
+};
+
+/// The unit of the sweet-zone tolerance.
+enum class ToleranceUnit {
+  kMetersPerSecond,  ///< Absolute, m/s.
+  kPercent,          ///< Percent of the maximum exit speed.
+};
+
+/// Options of EvaluateScene.
+struct SceneOptions {
+  CollisionModel model =
+      CollisionModel::kRigidPivot;  ///< Exit-speed model for max/zone/curve (kAuto = rigid_pivot).
+  SweetSpotMethod method = SweetSpotMethod::kClosedForm;  ///< Closed form or NLopt.
+  ScalarSearchOptions nlopt;          ///< The NLopt search (algorithm, tolerances, budget).
+  double sweet_zone_tolerance = 1.0;  ///< Sweet-zone tolerance (>= 0), in `sweet_zone_unit`.
+  ToleranceUnit sweet_zone_unit = ToleranceUnit::kMetersPerSecond;  ///< m/s or percent.
+  int curve_samples = 41;  ///< Evenly spaced curve samples from knob to tip (2..10000).
+  std::vector<double> curve_positions_from_knob_m;  ///< Explicit curve positions, m (overrides
+                                                    ///< curve_samples; at most 10000).
+  HertzOptions hertz;                               ///< Contact-model settings (model = kHertz).
+
+  /// True when every field is in range; otherwise "field = value: rule" in *why.
+  bool IsValid(std::string* why) const;
+};
+
+/// Time spent in one model during a request.
+struct ModelTiming {
+  std::string model;    ///< e.g. "mass_properties", "rigid_pivot", "hertz".
+  double time_s = 0.0;  ///< Wall time, s.
+  int calls = 0;        ///< Evaluations.
+};
+
+/// The answer of EvaluateScene. Outputs not requested (or not computed) are empty.
+struct SceneResult {
+  Summary summary;                 ///< Overall: termination, message, models_used, total time.
+  std::string missing_model;       ///< Set (e.g. "flexible_beam") when refused for a missing model.
+  std::string refused_field;       ///< The request field the refusal is about (e.g. "outputs").
+  double cor = 0.0;                ///< The COR used.
+  std::string cor_source;          ///< "scene" or "material:<name>".
+  MassProperties mass_properties;  ///< The properties used.
+  double length_m = 0.0;           ///< The bat length used, m.
+  std::string exit_speed_model;    ///< The exit-speed model used ("" when none was needed).
+  std::string model_reason;        ///< Why that model (auto).
+  std::optional<MaxExitSpeedResult> max_exit_speed;              ///< max_exit_speed.
+  std::optional<CenterOfPercussionResult> center_of_percussion;  ///< center_of_percussion.
+  std::optional<SweetZoneResult> sweet_zone;                     ///< sweet_zone.
+  std::optional<ExitSpeedCurveResult> exit_speed_curve;          ///< exit_speed_curve.
+  std::vector<ModelTiming> timings;  ///< Time per model, in first-use order.
+};
+
+/// Computes the requested outputs. Never throws.
+SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options);
+
+/// Options of Collide.
+struct CollisionOptions {
+  bool want_contact_details = false;  ///< kAuto: contact time / peak force wanted (selects hertz).
+  HertzOptions hertz;                 ///< Contact-model settings.
+
+  /// True when every field is in range; otherwise "field = value: rule" in *why.
+  bool IsValid(std::string* why) const;
+};
+
+/// The answer of Collide.
+struct CollisionResult {
+  Summary summary;            ///< termination, message, backend, models_used, time.
+  std::string missing_model;  ///< Set when refused for a missing model.
+  CollisionModel model = CollisionModel::kRigidPivot;  ///< The model that ran.
+  std::string model_reason;                            ///< Why (auto) or "requested".
+  double impact_from_knob_m = 0.0;                     ///< m from the knob.
+  double approach_speed_mps = 0.0;                     ///< u + bat speed at the impact point, m/s.
+  double exit_speed_mps = 0.0;                         ///< m/s, positive away from the bat.
+  double error_estimate_mps = 0.0;                     ///< Estimated error of the exit speed, m/s.
+  double cor = 0.0;                                    ///< The COR used.
+  MassProperties mass_properties;                      ///< The properties used.
+  std::optional<RigidPivotImpact> rigid_pivot;         ///< Details when model = rigid_pivot.
+  std::optional<FreeBatImpact> free_bat;               ///< Details when model = free_bat.
+  std::optional<HertzImpact> hertz;                    ///< Details when model = hertz.
+  std::vector<ModelTiming> timings;                    ///< Time per model.
+};
+
+/// One impact at `impact_from_knob_m` with `model`. Never throws.
+CollisionResult Collide(const Scene& scene, double impact_from_knob_m, CollisionModel model,
+                        const CollisionOptions& options = {});
+
+}  // namespace sweetspot::core

@@ -1,0 +1,114 @@
+// The sweet spots the paper names (maximum exit speed, centre of percussion, node of the
+// fundamental bending mode), the sweet zone and the exit-speed curve: result types and
+// the closed forms. The orchestration (which model, which method) is in core/scene.hpp.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/collision/exit_speed_profile.hpp"
+#include "core/mass_properties.hpp"
+#include "core/summary.hpp"
+
+namespace sweetspot::core {
+
+/// What a scene can be asked for.
+enum class SceneOutput {
+  kMaxExitSpeed,        ///< The impact position of maximum exit speed, and that speed.
+  kCenterOfPercussion,  ///< The impact position leaving no reaction impulse at the hands.
+  kVibrationNode,   ///< The node of the fundamental bending mode (needs the flexible beam model).
+  kSweetZone,       ///< Positions whose exit speed is within a tolerance of the maximum.
+  kExitSpeedCurve,  ///< Exit speed along the bat.
+};
+
+/// Stable name: "max_exit_speed", "center_of_percussion", "vibration_node", "sweet_zone",
+/// "exit_speed_curve".
+const char* SceneOutputName(SceneOutput output);
+/// The output called `name`, or nullopt.
+std::optional<SceneOutput> ParseSceneOutput(std::string_view name);
+
+/// The refusal for vibration_node until the flexible beam model exists.
+inline constexpr char kVibrationNodeRefusal[] =
+    "vibration_node needs the flexible beam model, which is not available yet";
+/// The name of the missing model in that refusal.
+inline constexpr char kFlexibleBeamModel[] = "flexible_beam";
+
+/// Where an optimum lies relative to the bat.
+enum class Placement {
+  kOnBat,       ///< Inside [0, L].
+  kBeyondTip,   ///< The unconstrained optimum is beyond the tip: the tip is reported.
+  kBeforeKnob,  ///< The unconstrained optimum is before the knob: the knob is reported.
+};
+
+/// Stable name: "on_bat", "beyond_tip", "before_knob".
+const char* PlacementName(Placement placement);
+
+/// The max_exit_speed output.
+struct MaxExitSpeedResult {
+  double position_from_knob_m = 0.0;        ///< The sweet spot on the bat, m from the knob.
+  double exit_speed_mps = 0.0;              ///< The exit speed there, m/s.
+  Placement placement = Placement::kOnBat;  ///< kBeyondTip / kBeforeKnob: clamped to the bat.
+  double unconstrained_position_from_knob_m =
+      0.0;  ///< The unconstrained maximiser (closed form), m; equals position_from_knob_m for
+            ///< searches.
+  double error_estimate_m = 0.0;    ///< Estimated error of the position, m.
+  double error_estimate_mps = 0.0;  ///< Estimated error of the speed, m/s.
+  std::string model;                ///< The exit-speed model, e.g. "rigid_pivot".
+  std::string method;               ///< "closed_form" or "nlopt:<ALGORITHM>".
+  Summary summary;                  ///< The solve's report (NLopt counts for searches).
+};
+
+/// The center_of_percussion output: for a pivot at the hands h,
+/// CoP = h + I_h / (M (C - h)), I_h the moment of inertia about the hands.
+struct CenterOfPercussionResult {
+  double position_from_knob_m = 0.0;  ///< The centre of percussion, m from the knob.
+  double hands_from_knob_m = 0.0;     ///< The hands it refers to, m from the knob.
+  double moi_hands_kg_m2 = 0.0;       ///< I_h, kg m^2.
+  Placement placement =
+      Placement::kOnBat;          ///< kBeyondTip when CoP > L (the value is still reported).
+  double error_estimate_m = 0.0;  ///< Rounding bound, m.
+};
+
+/// The sweet_zone output.
+struct SweetZoneResult {
+  double from_knob_m = 0.0;       ///< Start of the zone, m from the knob.
+  double to_knob_m = 0.0;         ///< End of the zone, m from the knob.
+  double tolerance_mps = 0.0;     ///< The tolerance applied, m/s (percentages converted).
+  double threshold_mps = 0.0;     ///< max exit speed - tolerance, m/s.
+  bool clipped_at_knob = false;   ///< The zone would extend before the knob.
+  bool clipped_at_tip = false;    ///< The zone would extend beyond the tip.
+  double error_estimate_m = 0.0;  ///< Estimated error of each end, m.
+  std::string method;             ///< "closed_form" or "root_finding".
+};
+
+/// One point of the exit-speed curve.
+struct CurvePoint {
+  double position_from_knob_m = 0.0;  ///< Impact position, m from the knob.
+  double exit_speed_mps = 0.0;        ///< Exit speed, m/s.
+};
+
+/// The exit_speed_curve output.
+struct ExitSpeedCurveResult {
+  std::vector<CurvePoint> points;   ///< In the order requested (samples: knob to tip).
+  double error_estimate_mps = 0.0;  ///< Largest estimated error over the points, m/s.
+  std::string model;                ///< The exit-speed model.
+};
+
+/// The closed-form sweet spot of `profile` over the bat [0, length_m] (candidates: the clamped
+/// unconstrained maximiser and both ends, so it is the maximum over the bat in every case).
+MaxExitSpeedResult ClosedFormMaxExitSpeed(const ExitSpeedProfile& profile, double length_m);
+
+/// The closed-form sweet zone: the connected interval around `max.position_from_knob_m` where
+/// the exit speed is >= max.exit_speed_mps - tolerance_mps, clipped to [0, length_m].
+SweetZoneResult ClosedFormSweetZone(const ExitSpeedProfile& profile, double length_m,
+                                    const MaxExitSpeedResult& max, double tolerance_mps);
+
+/// The centre of percussion relative to the hands, or nullopt with the reason in *why when it
+/// does not exist (the balance point is not beyond the hands).
+std::optional<CenterOfPercussionResult> CenterOfPercussion(const MassProperties& mass_properties,
+                                                           double hands_from_knob_m,
+                                                           double length_m, std::string* why);
+
+}  // namespace sweetspot::core

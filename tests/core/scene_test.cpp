@@ -1,0 +1,343 @@
+// Scenes: validation, "model only what is needed", NLopt backend mapping and algorithms,
+// auto model choice, refusals, determinism across threads.
+#include "core/scene.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "core/nlopt_search.hpp"
+#include "core/presets.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+Scene PaperWood(std::vector<SceneOutput> outputs = {SceneOutput::kMaxExitSpeed}) {
+  Scene s;
+  s.bat = FindPreset("paper-wood")->bat;
+  s.outputs = std::move(outputs);
+  return s;
+}
+
+TEST(SceneDefaults, AreValidAndMatchTheContract) {
+  std::string why;
+  EXPECT_TRUE(Ball{}.IsValid(&why)) << why;
+  EXPECT_TRUE(Swing{}.IsValid(&why)) << why;
+  EXPECT_TRUE(SceneOptions{}.IsValid(&why)) << why;
+  EXPECT_TRUE(CollisionOptions{}.IsValid(&why)) << why;
+  EXPECT_TRUE(ScalarSearchOptions{}.IsValid(&why)) << why;
+  EXPECT_TRUE(PaperWood().IsValid(&why)) << why;
+  EXPECT_EQ(Ball{}.mass_kg, 0.145);
+  EXPECT_EQ(Ball{}.radius_m, 0.0366);
+  EXPECT_EQ(Ball{}.speed_mps, 27.7);
+  EXPECT_EQ(Swing{}.angular_speed_rad_s, 17.288);
+  EXPECT_EQ(Swing{}.pivot_from_knob_m, 0.0);
+  EXPECT_EQ(Swing{}.hands_from_knob_m, 0.1524);
+}
+
+TEST(SceneValidation, ExactMessages) {
+  std::string why;
+  Scene s;
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_EQ(why, "bat: missing (give a bat or precomputed mass_properties)");
+  s = PaperWood();
+  s.ball.speed_mps = -3;
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_EQ(why, "ball.speed_mps = -3: must be >= 0");
+  s = PaperWood();
+  s.cor = 1.5;
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_EQ(why, "cor = 1.5: must be in [0, 1]");
+  s = PaperWood();
+  s.outputs.clear();
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_EQ(why, "outputs: empty: name at least one output");
+  s = PaperWood();
+  s.ball.stiffness_exponent = 4;
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_EQ(why, "ball.stiffness_exponent = 4: must be in [1, 3]");
+  SceneOptions o;
+  o.curve_samples = 1;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_EQ(why, "curve_samples = 1: must be in [2, 10000]");
+  o = SceneOptions{};
+  o.sweet_zone_tolerance = -1;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_EQ(why, "sweet_zone_tolerance = -1: must be >= 0");
+  o = SceneOptions{};
+  o.nlopt.x_tolerance_m = 0;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_EQ(why, "nlopt.x_tolerance_m = 0: must be finite and > 0");
+  o = SceneOptions{};
+  o.hertz.hands_stiffness_n_m = -1;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_EQ(why, "hertz.hands_stiffness_n_m = -1: must be finite and >= 0");
+  // An invalid scene still returns a summary.
+  s = PaperWood();
+  s.swing.hands_from_knob_m = 2.0;
+  const SceneResult r = EvaluateScene(s, SceneOptions{});
+  EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
+  EXPECT_EQ(r.summary.message,
+            "swing.hands_from_knob_m = 2: must be within the bat [0, 0.85499999999999998]");
+}
+
+TEST(SceneCor, FromTheMaterialOrTheScene) {
+  SceneResult r = EvaluateScene(PaperWood(), {});
+  EXPECT_EQ(r.cor, 0.5);
+  EXPECT_EQ(r.cor_source, "material:paper-wood");
+  Scene s = PaperWood();
+  s.cor = 0.45;
+  r = EvaluateScene(s, {});
+  EXPECT_EQ(r.cor, 0.45);
+  EXPECT_EQ(r.cor_source, "scene");
+  s = PaperWood();
+  s.bat->material.cor.reset();
+  r = EvaluateScene(s, {});
+  EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
+  EXPECT_EQ(r.summary.message, "cor: not given, and material 'paper-wood' has no default COR");
+}
+
+TEST(SceneModels, EachOutputRunsOnlyWhatItNeeds) {
+  EXPECT_EQ(ModelsFor(SceneOutput::kCenterOfPercussion, CollisionModel::kHertz),
+            std::vector<std::string>{"mass_properties"});
+  EXPECT_EQ(ModelsFor(SceneOutput::kMaxExitSpeed, CollisionModel::kAuto),
+            (std::vector<std::string>{"mass_properties", "rigid_pivot"}));
+  EXPECT_EQ(ModelsFor(SceneOutput::kVibrationNode, CollisionModel::kRigidPivot),
+            std::vector<std::string>{"flexible_beam"});
+  SceneResult r = EvaluateScene(PaperWood({SceneOutput::kCenterOfPercussion}), {});
+  EXPECT_EQ(r.summary.models_used, std::vector<std::string>{"mass_properties"});
+  EXPECT_TRUE(r.exit_speed_model.empty());
+  r = EvaluateScene(PaperWood({SceneOutput::kMaxExitSpeed, SceneOutput::kSweetZone,
+                               SceneOutput::kExitSpeedCurve, SceneOutput::kCenterOfPercussion}),
+                    {});
+  EXPECT_EQ(r.summary.models_used, (std::vector<std::string>{"mass_properties", "rigid_pivot"}));
+  // Mass properties are computed once per request, shared by every output.
+  ASSERT_EQ(r.timings.size(), 2u);
+  EXPECT_EQ(r.timings[0].model, "mass_properties");
+  EXPECT_EQ(r.timings[0].calls, 1);
+  EXPECT_GE(r.timings[0].time_s, 0.0);
+  EXPECT_GT(r.timings[1].calls, 1);
+  EXPECT_GE(r.summary.solve_time_s, 0.0);
+  // Precomputed properties: nothing is recomputed.
+  Scene given = PaperWood({SceneOutput::kMaxExitSpeed});
+  given.mass_properties = r.mass_properties;
+  const SceneResult g = EvaluateScene(given, {});
+  EXPECT_EQ(g.summary.models_used, std::vector<std::string>{"rigid_pivot"});
+  EXPECT_EQ(g.max_exit_speed->position_from_knob_m, r.max_exit_speed->position_from_knob_m);
+}
+
+TEST(SceneModels, PerOutputErrorEstimates) {
+  SceneOptions o;
+  const SceneResult r =
+      EvaluateScene(PaperWood({SceneOutput::kMaxExitSpeed, SceneOutput::kSweetZone,
+                               SceneOutput::kExitSpeedCurve, SceneOutput::kCenterOfPercussion}),
+                    o);
+  // Closed forms: rounding only (a few ulps of ~0.7 m and ~23 m/s).
+  EXPECT_GT(r.max_exit_speed->error_estimate_m, 0.0);
+  EXPECT_LT(r.max_exit_speed->error_estimate_m, 1e-14);
+  EXPECT_LT(r.max_exit_speed->error_estimate_mps, 1e-12);  // 8 eps (u + peak) ~ 1.4e-13
+  EXPECT_LT(r.sweet_zone->error_estimate_m, 1e-12);
+  EXPECT_LT(r.exit_speed_curve->error_estimate_mps, 1e-13);
+  EXPECT_LT(r.center_of_percussion->error_estimate_m, 1e-14);
+  // NLopt: its tolerance.
+  o.method = SweetSpotMethod::kNlopt;
+  const SceneResult n = EvaluateScene(PaperWood(), o);
+  EXPECT_EQ(n.max_exit_speed->method, "nlopt:LD_SLSQP");
+  EXPECT_GE(n.max_exit_speed->error_estimate_m, o.nlopt.x_tolerance_m);
+  EXPECT_LT(n.max_exit_speed->error_estimate_m, 1e-9);
+}
+
+TEST(SceneModels, HertzSweetSpotByDerivativeFreeSearch) {
+  Scene s = PaperWood({SceneOutput::kMaxExitSpeed});
+  SceneOptions o;
+  o.model = CollisionModel::kHertz;
+  o.hertz.hands_stiffness_n_m = 0.0;  // the free-bat limit has a closed form to compare with
+  o.hertz.solver.relative_tolerance = 1e-9;
+  const SceneResult h = EvaluateScene(s, o);
+  ASSERT_EQ(h.summary.termination, Termination::kConverged) << h.summary.message;
+  EXPECT_EQ(h.max_exit_speed->method, "nlopt:LN_BOBYQA");
+  EXPECT_EQ(h.summary.models_used, (std::vector<std::string>{"mass_properties", "hertz"}));
+  o.model = CollisionModel::kFreeBat;
+  const SceneResult f = EvaluateScene(s, o);
+  // Derivative-free on an ODE whose values carry ~1e-9 relative noise: the flat maximum is
+  // resolvable to ~sqrt(2 x 3e-8 / |f''|) ~ 1e-4 m; the speed to 1e-7 relative.
+  EXPECT_NEAR(h.max_exit_speed->position_from_knob_m, f.max_exit_speed->position_from_knob_m, 2e-4);
+  EXPECT_NEAR(h.max_exit_speed->exit_speed_mps, f.max_exit_speed->exit_speed_mps,
+              1e-7 * f.max_exit_speed->exit_speed_mps);
+  // A gradient algorithm on a model without derivatives is refused, naming both.
+  o.model = CollisionModel::kHertz;
+  o.nlopt.algorithm = NloptAlgorithm::kLdSlsqp;
+  const SceneResult bad = EvaluateScene(s, o);
+  EXPECT_EQ(bad.summary.termination, Termination::kInvalidInput);
+  EXPECT_EQ(bad.summary.message,
+            "max_exit_speed: nlopt.algorithm = LD_SLSQP: needs the objective's derivative, which "
+            "this model does not provide; use an LN_ or GN_ algorithm");
+}
+
+TEST(SceneModels, FlexibleIsANamedRefusal) {
+  SceneOptions o;
+  o.model = CollisionModel::kFlexible;
+  const SceneResult r = EvaluateScene(PaperWood(), o);
+  EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
+  EXPECT_EQ(r.summary.message,
+            "model = flexible: needs the flexible beam model, which is not available yet");
+  EXPECT_EQ(r.missing_model, "flexible_beam");
+  const CollisionResult c = Collide(PaperWood(), 0.7, CollisionModel::kFlexible);
+  EXPECT_EQ(c.summary.termination, Termination::kInvalidInput);
+  EXPECT_EQ(c.missing_model, "flexible_beam");
+}
+
+TEST(Collide, AutoPicksTheCheapestAdequateModelAndSaysWhy) {
+  CollisionResult c = Collide(PaperWood(), 0.7, CollisionModel::kAuto);
+  EXPECT_EQ(c.model, CollisionModel::kRigidPivot);
+  EXPECT_NE(c.model_reason.find("cheapest adequate"), std::string::npos);
+  EXPECT_TRUE(c.rigid_pivot.has_value());
+  EXPECT_EQ(c.summary.models_used, (std::vector<std::string>{"mass_properties", "rigid_pivot"}));
+  CollisionOptions o;
+  o.want_contact_details = true;
+  c = Collide(PaperWood(), 0.7, CollisionModel::kAuto, o);
+  EXPECT_EQ(c.model, CollisionModel::kHertz);
+  EXPECT_TRUE(c.hertz.has_value());
+  EXPECT_NE(c.model_reason.find("contact time"), std::string::npos);
+  for (CollisionModel m :
+       {CollisionModel::kAuto, CollisionModel::kRigidPivot, CollisionModel::kFreeBat,
+        CollisionModel::kHertz, CollisionModel::kFlexible}) {
+    EXPECT_EQ(ParseCollisionModel(CollisionModelName(m)), m);
+  }
+}
+
+TEST(Collide, WithoutBatGeometryTheSurfaceIsRigidAndSaysSo) {
+  Scene s = PaperWood();
+  const SceneResult r = EvaluateScene(s, {});
+  Scene props;
+  props.mass_properties = r.mass_properties;
+  props.length_m = 0.855;
+  props.cor = 0.5;
+  const CollisionResult c = Collide(props, 0.7, CollisionModel::kHertz);
+  ASSERT_EQ(c.summary.termination, Termination::kConverged);
+  EXPECT_EQ(c.hertz->problem.surface_stiffness, 0.0);
+  ASSERT_FALSE(c.summary.warnings.empty());
+  EXPECT_EQ(c.summary.warnings[0],
+            "no bat geometry in the scene: the bat surface is taken as rigid");
+}
+
+TEST(NloptBackend, EveryResultCodeMapsToATermination) {
+  EXPECT_EQ(TerminationFromNloptResult(1), Termination::kConverged);      // SUCCESS
+  EXPECT_EQ(TerminationFromNloptResult(2), Termination::kConverged);      // STOPVAL_REACHED
+  EXPECT_EQ(TerminationFromNloptResult(3), Termination::kConverged);      // FTOL_REACHED
+  EXPECT_EQ(TerminationFromNloptResult(4), Termination::kConverged);      // XTOL_REACHED
+  EXPECT_EQ(TerminationFromNloptResult(5), Termination::kNoConvergence);  // MAXEVAL_REACHED
+  EXPECT_EQ(TerminationFromNloptResult(6), Termination::kNoConvergence);  // MAXTIME_REACHED
+  EXPECT_EQ(TerminationFromNloptResult(-1), Termination::kFailure);       // FAILURE
+  EXPECT_EQ(TerminationFromNloptResult(-2), Termination::kInvalidInput);  // INVALID_ARGS
+  EXPECT_EQ(TerminationFromNloptResult(-3), Termination::kFailure);       // OUT_OF_MEMORY
+  EXPECT_EQ(TerminationFromNloptResult(-4),
+            Termination::kNoConvergence);                            // ROUNDOFF_LIMITED: point kept
+  EXPECT_EQ(TerminationFromNloptResult(-5), Termination::kFailure);  // FORCED_STOP
+  EXPECT_EQ(TerminationFromNloptResult(42), Termination::kFailure);  // unknown
+  EXPECT_STREQ(NloptResultName(-4), "ROUNDOFF_LIMITED");
+  EXPECT_STREQ(NloptResultName(7), "UNKNOWN");
+}
+
+TEST(NloptBackend, NewuoaIsNotOfferedIn1D) {
+  std::string why;
+  EXPECT_FALSE(ParseNloptAlgorithm("LN_NEWUOA", &why).has_value());
+  EXPECT_EQ(why,
+            "nlopt.algorithm = LN_NEWUOA: not offered for 1-D searches (NLopt refuses "
+            "NEWUOA in one dimension)");
+  EXPECT_FALSE(ParseNloptAlgorithm("LD_FOO", &why).has_value());
+  EXPECT_EQ(why.rfind("nlopt.algorithm = LD_FOO: must be one of LD_SLSQP, ", 0), 0u);
+  for (NloptAlgorithm a : OfferedNloptAlgorithms()) {
+    EXPECT_EQ(ParseNloptAlgorithm(NloptAlgorithmName(a), nullptr), a);
+  }
+}
+
+TEST(NloptBackend, EveryOfferedAlgorithmFindsThePaperSweetSpot) {
+  const SceneResult ref = EvaluateScene(PaperWood(), {});
+  const double x0 = ref.max_exit_speed->position_from_knob_m;
+  for (NloptAlgorithm a : OfferedNloptAlgorithms()) {
+    SCOPED_TRACE(NloptAlgorithmName(a));
+    SceneOptions o;
+    o.method = SweetSpotMethod::kNlopt;
+    o.nlopt.algorithm = a;
+    const SceneResult r = EvaluateScene(PaperWood(), o);
+    ASSERT_TRUE(r.summary.IsSolutionUsable()) << r.summary.message;
+    // With the exact derivative the first-order selection resolves ~eps |x| (1e-9 m is the
+    // issue's bar); derivative-free methods are limited by the flat maximum to
+    // ~sqrt(eps |f| / |f''|) ~ 1e-8 m; 1e-6 m leaves room for their stopping rules.
+    const double tol = a == NloptAlgorithm::kLdSlsqp                                 ? 1e-9 * x0
+                       : NloptAlgorithmNeedsGradient(a) || NloptAlgorithmIsGlobal(a) ? 1e-8
+                                                                                     : 1e-6;
+    EXPECT_NEAR(r.max_exit_speed->position_from_knob_m, x0, tol);
+    EXPECT_NEAR(r.max_exit_speed->exit_speed_mps, ref.max_exit_speed->exit_speed_mps, 1e-10);
+    EXPECT_EQ(r.max_exit_speed->method, std::string("nlopt:") + NloptAlgorithmName(a));
+  }
+}
+
+TEST(NloptBackend, ObjectiveFailuresAreReportedNotThrown) {
+  ScalarSearchOptions o;
+  auto throws = [](double x, double*) -> double {
+    if (x > 0.5) throw std::runtime_error("boom");
+    return -x * x;
+  };
+  ScalarSearchResult r = MaximizeScalar(throws, false, 0.0, 1.0, o);
+  EXPECT_EQ(r.summary.termination, Termination::kFailure);
+  EXPECT_EQ(r.summary.message, "the objective threw: boom");
+  auto nan = [](double, double*) { return std::nan(""); };
+  r = MaximizeScalar(nan, false, 0.0, 1.0, o);
+  EXPECT_EQ(r.summary.termination, Termination::kFailure);
+  EXPECT_EQ(r.summary.message, "the objective returned a non-finite value at x = 0");
+  r = MaximizeScalar(nan, false, 1.0, 0.0, o);
+  EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
+  // A tiny budget stops with the best point kept and says so.
+  o.max_evaluations = 10;
+  o.start_samples = 9;
+  auto f = [](double x, double* g) {
+    if (g) *g = -2 * (x - 0.3);
+    return -(x - 0.3) * (x - 0.3);
+  };
+  r = MaximizeScalar(f, true, 0.0, 1.0, o);
+  EXPECT_TRUE(r.summary.IsSolutionUsable());
+  EXPECT_EQ(r.summary.raw_status, 5);  // MAXEVAL_REACHED
+  EXPECT_EQ(r.summary.termination, Termination::kNoConvergence);
+}
+
+TEST(NloptBackend, StochasticAlgorithmsAreReproducibleWithTheirSeed) {
+  SceneOptions o;
+  o.method = SweetSpotMethod::kNlopt;
+  o.nlopt.algorithm = NloptAlgorithm::kGnCrs2Lm;
+  o.nlopt.polish = false;
+  o.nlopt.seed = 7;
+  const SceneResult a = EvaluateScene(PaperWood(), o);
+  const SceneResult b = EvaluateScene(PaperWood(), o);
+  EXPECT_EQ(a.max_exit_speed->position_from_knob_m, b.max_exit_speed->position_from_knob_m);
+}
+
+TEST(SceneThreads, ManySolvesOnManyThreadsGiveIdenticalResults) {
+  SceneOptions o;
+  o.method = SweetSpotMethod::kNlopt;
+  o.nlopt.algorithm = NloptAlgorithm::kGnCrs2Lm;
+  o.nlopt.seed = 3;
+  const Scene s = PaperWood({SceneOutput::kMaxExitSpeed, SceneOutput::kSweetZone});
+  const SceneResult ref = EvaluateScene(s, o);
+  std::vector<std::thread> threads;
+  std::vector<int> mismatches(8, 0);
+  for (int t = 0; t < 8; ++t) {
+    threads.emplace_back([&, t] {
+      for (int i = 0; i < 20; ++i) {
+        const SceneResult r = EvaluateScene(s, o);
+        if (r.max_exit_speed->position_from_knob_m != ref.max_exit_speed->position_from_knob_m ||
+            r.sweet_zone->to_knob_m != ref.sweet_zone->to_knob_m) {
+          ++mismatches[t];
+        }
+      }
+    });
+  }
+  for (auto& th : threads) th.join();
+  for (int m : mismatches) EXPECT_EQ(m, 0);
+}
+
+}  // namespace
+}  // namespace sweetspot::core
