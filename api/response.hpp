@@ -1,15 +1,33 @@
-// What every api handler returns: an HTTP-style status and a JSON body.
-// The api layer is pure functions (body -> Response); it never includes httplib.
+// What every api handler returns: an HTTP-style status and a JSON body (or,
+// for /metrics, a text body). The api layer is pure functions (body ->
+// Response); it never includes httplib.
 #pragma once
 
 #include <nlohmann/json.hpp>
 
+#include <string>
+#include <utility>
+
 namespace sweetspot::api {
 
-/// A handler's answer: HTTP status code and JSON body.
+/// A handler's answer: HTTP status code and body.
 struct Response {
-  int status = 200;     ///< HTTP status code.
-  nlohmann::json body;  ///< JSON body (never contains NaN or Infinity).
+  Response() = default;
+  /// A JSON answer.
+  Response(int status_code, nlohmann::json json_body)
+      : status(status_code), body(std::move(json_body)) {}
+  /// A text answer (e.g. Prometheus metrics).
+  static Response Text(int status_code, std::string text_body, std::string type) {
+    Response out(status_code, nullptr);
+    out.text = std::move(text_body);
+    out.content_type = std::move(type);
+    return out;
+  }
+
+  int status = 200;          ///< HTTP status code.
+  nlohmann::json body;       ///< JSON body (never contains NaN or Infinity).
+  std::string text;          ///< A non-JSON body, used when content_type is set.
+  std::string content_type;  ///< Empty = application/json with `body`.
 };
 
 /// GET /health: {"status": "ok"}.

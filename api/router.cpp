@@ -1,24 +1,28 @@
 #include "api/router.hpp"
 
+#include <exception>
 #include <utility>
+
+#include "api/handlers.hpp"
 
 namespace sweetspot::api {
 namespace {
 
-// True when `path` matches `pattern` segment by segment ("{x}" matches one segment).
-bool PathMatches(std::string_view pattern, std::string_view path) {
+// True when `path` matches `pattern` segment by segment ("{x}" matches one
+// non-empty segment). If `parameter` is non-null it gets the "{x}" segment.
+bool PathMatches(std::string_view pattern, std::string_view path,
+                 std::string* parameter = nullptr) {
   while (!pattern.empty() || !path.empty()) {
     if (pattern.empty() || path.empty()) return false;
     if (pattern.front() != '/' || path.front() != '/') return false;
     pattern.remove_prefix(1);
     path.remove_prefix(1);
-    const auto pattern_end = pattern.find('/');
-    const auto path_end = path.find('/');
-    const std::string_view pattern_seg = pattern.substr(0, pattern_end);
-    const std::string_view path_seg = path.substr(0, path_end);
+    const std::string_view pattern_seg = pattern.substr(0, pattern.find('/'));
+    const std::string_view path_seg = path.substr(0, path.find('/'));
     const bool wildcard = pattern_seg.size() >= 2 && pattern_seg.front() == '{' &&
                           pattern_seg.back() == '}';
     if (wildcard ? path_seg.empty() : pattern_seg != path_seg) return false;
+    if (wildcard && parameter != nullptr) *parameter = std::string(path_seg);
     pattern.remove_prefix(pattern_seg.size());
     path.remove_prefix(path_seg.size());
   }
@@ -30,7 +34,37 @@ bool PathMatches(std::string_view pattern, std::string_view path) {
 const std::vector<Route>& Routes() {
   static const std::vector<Route> routes = {
       {"GET", "/health", "Liveness: {\"status\": \"ok\"}.",
-       [](const Request&) { return HandleHealth(); }},
+       [](const Request&, const Context&) { return HandleHealth(); }},
+      {"GET", "/openapi.json", "The OpenAPI 3 document of every endpoint.", HandleOpenApi},
+      {"GET", "/metrics", "Prometheus text: requests by route and status, latency, jobs.",
+       HandleMetrics},
+      {"GET", "/v1/version", "Versions of sweetspot and of the libraries it was built with.",
+       HandleVersion},
+      {"GET", "/v1/materials", "The material catalogue with properties and sources.",
+       HandleMaterials},
+      {"GET", "/v1/presets", "The preset bats with their properties and sources.",
+       HandlePresets},
+      {"POST", "/v1/bat/properties",
+       "Exact mass properties: mass, balance point, moments of inertia, volume.",
+       HandleBatProperties, true},
+      {"POST", "/v1/bat/fit",
+       "Solve unknown dimensions from a target mass and balance point (422 with the closest bat).",
+       HandleBatFit, true},
+      {"POST", "/v1/sweet-spot",
+       "The sweet spot(s) of a scene: max exit speed, centre of percussion, sweet zone, curve.",
+       HandleSweetSpot, true},
+      {"POST", "/v1/collision", "One impact with a chosen model (auto, rigid_pivot, free_bat, hertz).",
+       HandleCollision, true},
+      {"POST", "/v1/compare", "A baseline bat against variants: properties, sweet spot, deltas.",
+       HandleCompare, true},
+      {"POST", "/v1/optimize", "Ipopt bat design (not available yet: 501).", HandleOptimize,
+       true},
+      {"POST", "/v1/explore", "Design sweeps (not available yet: 501).", HandleExplore, true},
+      {"POST", "/v1/jobs", "Run a long request as a job: {\"path\", \"body\"} -> 202 with its id.",
+       HandleJobSubmit},
+      {"GET", "/v1/jobs/{id}", "A job's state and progress (0-1).", HandleJobStatus},
+      {"GET", "/v1/jobs/{id}/result", "A finished job's result.", HandleJobResult},
+      {"DELETE", "/v1/jobs/{id}", "Cancel a job (or forget a finished one).", HandleJobCancel},
   };
   return routes;
 }
@@ -43,19 +77,33 @@ std::vector<const Route*> MatchRoutes(std::string_view path) {
   return matches;
 }
 
-Response Dispatch(const Request& request, std::string* route_pattern) {
+std::string PathParameter(std::string_view pattern, std::string_view path) {
+  std::string parameter;
+  PathMatches(pattern, path, &parameter);
+  return parameter;
+}
+
+Response Dispatch(const Request& request, const Context& context, std::string* route_pattern) {
   bool path_known = false;
+  std::string allowed;
   for (const Route& route : Routes()) {
     if (!PathMatches(route.path, request.path)) continue;
     path_known = true;
+    allowed += (allowed.empty() ? "" : ", ") + route.method;
     if (route.method != request.method) continue;
     if (route_pattern != nullptr) *route_pattern = route.path;
-    return route.handler(request);
+    try {
+      return route.handler(request, context);
+    } catch (...) {
+      // The one place an unexpected exception becomes a 500, without details.
+      return ErrorResponse(500, "InternalError", "internal error");
+    }
   }
-  if (route_pattern != nullptr) *route_pattern = "unmatched";
+  if (route_pattern != nullptr) *route_pattern = path_known ? "method_not_allowed" : "unmatched";
   if (path_known) {
     return ErrorResponse(405, "MethodNotAllowed",
-                         "method " + request.method + " is not allowed on " + request.path);
+                         "method " + request.method + " is not allowed on " + request.path +
+                             " (allowed: " + allowed + ")");
   }
   return ErrorResponse(404, "NotFound", "no endpoint at path " + request.path);
 }

@@ -7,9 +7,13 @@
 #include <string_view>
 #include <vector>
 
+#include "api/limits.hpp"
 #include "api/response.hpp"
+#include "core/progress.hpp"
 
 namespace sweetspot::api {
+
+class JobManager;
 
 /// A request as the handlers see it.
 struct Request {
@@ -18,13 +22,23 @@ struct Request {
   std::string body;    ///< Raw body (JSON for POST).
 };
 
+/// What handlers may use besides the request: limits, and what only a
+/// running server has (jobs, metrics). Null members mean "not available here".
+struct Context {
+  ApiLimits limits;                          ///< Request limits (configuration).
+  JobManager* jobs = nullptr;                ///< The job manager (server only).
+  std::function<std::string()> metrics_text; ///< Prometheus text (server only).
+  core::Progress* progress = nullptr;        ///< Cancel flag and progress (inside a job).
+};
+
 /// One endpoint: method, path pattern and handler. A pattern segment "{id}"
 /// matches any one path segment.
 struct Route {
-  std::string method;                                   ///< HTTP method.
-  std::string path;                                     ///< Path pattern.
-  std::string summary;                                  ///< One line for --help and OpenAPI.
-  std::function<Response(const Request&)> handler;      ///< The handler.
+  std::string method;   ///< HTTP method.
+  std::string path;     ///< Path pattern.
+  std::string summary;  ///< One line for --help and OpenAPI.
+  std::function<Response(const Request&, const Context&)> handler;  ///< The handler.
+  bool jobbable = false;  ///< True when POST /v1/jobs may run it.
 };
 
 /// Every route the service answers, in a stable order.
@@ -33,10 +47,15 @@ const std::vector<Route>& Routes();
 /// The routes whose pattern matches `path` (any method), in table order.
 std::vector<const Route*> MatchRoutes(std::string_view path);
 
+/// The path segment that "{id}" matched in `path` for `pattern` ("" if none).
+std::string PathParameter(std::string_view pattern, std::string_view path);
+
 /// Routes `request`: 404 NotFound for an unknown path, 405 MethodNotAllowed
 /// for a known path with another method. `route_pattern`, if non-null, gets
-/// the matched pattern (or "unmatched") for metrics and logs.
-Response Dispatch(const Request& request, std::string* route_pattern = nullptr);
+/// the matched pattern (or "unmatched") for metrics and logs. Never throws:
+/// an escaping exception becomes a 500 InternalError without details.
+Response Dispatch(const Request& request, const Context& context,
+                  std::string* route_pattern = nullptr);
 
 /// The error envelope {"code", "message", "field"} with `status`.
 Response ErrorResponse(int status, std::string_view code, std::string message,

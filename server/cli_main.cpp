@@ -9,12 +9,14 @@
 #include <vector>
 
 #include "api/router.hpp"
+#include "server/run.hpp"
 
 namespace {
 
 std::string Usage() {
   std::ostringstream text;
   text << "Usage: sweetspot [-X METHOD] PATH [FILE|-]\n"
+       << "       sweetspot serve [SERVER OPTIONS]   (as sweetspot-server; see its --help)\n"
        << "  PATH  an endpoint path without the leading /v1/ (e.g. bat/properties);\n"
        << "        health, openapi.json and metrics name the top-level paths\n"
        << "  FILE  the JSON request body of a POST endpoint; - or no FILE reads\n"
@@ -45,6 +47,9 @@ int ExitCode(int status) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
+  if (!args.empty() && args[0] == "serve") {
+    return sweetspot::server::RunServerMain(std::vector<std::string>(args.begin() + 1, args.end()));
+  }
   if (!args.empty() && (args[0] == "--help" || args[0] == "-h")) {
     std::cout << Usage();
     return 0;
@@ -90,7 +95,13 @@ int main(int argc, char** argv) {
       body.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
   }
-  const auto response = sweetspot::api::Dispatch({method, full_path, body});
-  std::cout << response.body.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  const sweetspot::api::Context context;  // default limits; no jobs, no metrics
+  const auto response = sweetspot::api::Dispatch({method, full_path, body}, context);
+  if (!response.content_type.empty()) {
+    std::cout << response.text;
+  } else {
+    std::cout << response.body.dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+              << "\n";
+  }
   return ExitCode(response.status);
 }

@@ -55,6 +55,13 @@ bool ParseBool(const std::string& text, bool* out, std::string* rule) {
   return true;
 }
 
+bool SetSize(std::size_t* out, const std::string& text, std::string* rule) {
+  long long n = 0;
+  if (!ParseLong(text, 1, 100000000, &n, rule)) return false;
+  *out = static_cast<std::size_t>(n);
+  return true;
+}
+
 const std::vector<Option>& Options() {
   static const std::vector<Option> options = {
       {"--host", "SWEETSPOT_HOST", "address to bind (default 127.0.0.1; 0.0.0.0 for all)", true,
@@ -111,6 +118,75 @@ const std::vector<Option>& Options() {
          c->keep_alive_max_requests = static_cast<int>(n);
          return true;
        }},
+      {"--max-json-depth", "SWEETSPOT_MAX_JSON_DEPTH", "deepest JSON nesting in a body (default 32)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 2, 512, &n, rule)) return false;
+         c->limits.max_json_depth = static_cast<int>(n);
+         return true;
+       }},
+      {"--max-array-length", "SWEETSPOT_MAX_ARRAY_LENGTH",
+       "longest array anywhere in a body (default 4096)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_array_length, v, rule);
+       }},
+      {"--max-string-length", "SWEETSPOT_MAX_STRING_LENGTH",
+       "longest string value or key in a body, bytes (default 256)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_string_length, v, rule);
+       }},
+      {"--max-knots", "SWEETSPOT_MAX_KNOTS", "knots of a profile (default 256)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_knots, v, rule);
+       }},
+      {"--max-variants", "SWEETSPOT_MAX_VARIANTS", "variants in /v1/compare (default 64)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_variants, v, rule);
+       }},
+      {"--max-curve-samples", "SWEETSPOT_MAX_CURVE_SAMPLES",
+       "points of an exit-speed curve (default 10001)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_curve_samples, v, rule);
+       }},
+      {"--max-samples", "SWEETSPOT_MAX_SAMPLES", "designs in one /v1/explore request (default 100000)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_samples, v, rule);
+       }},
+      {"--max-iterations", "SWEETSPOT_MAX_ITERATIONS",
+       "solver iterations a request may ask for (default 10000)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1, 100000000, &n, rule)) return false;
+         c->limits.max_iterations = static_cast<int>(n);
+         return true;
+       }},
+      {"--max-time-s", "SWEETSPOT_MAX_TIME_S", "solver wall time a request may ask for, s (default 60)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseSeconds(v, &c->limits.max_time_s, rule);
+       }},
+      {"--job-workers", "SWEETSPOT_JOB_WORKERS", "threads running jobs (default 2)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1, 64, &n, rule)) return false;
+         c->jobs.workers = static_cast<int>(n);
+         return true;
+       }},
+      {"--job-queue", "SWEETSPOT_JOB_QUEUE", "queued jobs before 429 (default 64)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->jobs.max_queued, v, rule);
+       }},
+      {"--jobs-kept", "SWEETSPOT_JOBS_KEPT", "finished jobs kept (default 1000)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->jobs.max_kept, v, rule);
+       }},
+      {"--job-keep-s", "SWEETSPOT_JOB_KEEP_S", "how long a finished job's result is kept, s (default 3600)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseSeconds(v, &c->jobs.keep_results_s, rule);
+       }},
       {"--access-log", "SWEETSPOT_ACCESS_LOG",
        "one JSON line per request on stderr, 1 or 0 (default 1)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
@@ -142,6 +218,8 @@ bool ServerConfig::IsValid(std::string* why) const {
       return fail(text.str());
     }
   }
+  if (std::string limits_why; !limits.IsValid(&limits_why)) return fail("limits." + limits_why);
+  if (std::string jobs_why; !jobs.IsValid(&jobs_why)) return fail("jobs." + jobs_why);
   if (keep_alive_max_requests < 1) {
     return fail("keep_alive_max_requests = " + std::to_string(keep_alive_max_requests) +
                 ": must be at least 1");

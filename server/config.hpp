@@ -8,6 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "api/jobs.hpp"
+#include "api/limits.hpp"
+
 namespace sweetspot::server {
 
 /// Everything the HTTP service can be configured with.
@@ -21,6 +24,8 @@ struct ServerConfig {
   double keep_alive_timeout_s = 5.0;     ///< Idle keep-alive timeout, s (--keep-alive-timeout-s, SWEETSPOT_KEEP_ALIVE_TIMEOUT_S).
   int keep_alive_max_requests = 10000;   ///< Requests per keep-alive connection (--keep-alive-max-requests, SWEETSPOT_KEEP_ALIVE_MAX_REQUESTS).
   bool access_log = true;                ///< One JSON line per request on stderr (--no-access-log, SWEETSPOT_ACCESS_LOG=0).
+  api::ApiLimits limits;                 ///< Request limits (--max-json-depth, --max-knots, ...; see Usage()).
+  api::JobConfig jobs;                   ///< Job pool (--job-workers, --job-queue, --job-keep-s, --jobs-kept).
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;

@@ -7,7 +7,9 @@
 #include <iostream>
 #include <mutex>
 
+#include "api/jobs.hpp"
 #include "api/router.hpp"
+#include "server/metrics.hpp"
 
 namespace sweetspot::server {
 namespace {
@@ -19,7 +21,11 @@ std::string Serialize(const nlohmann::json& body) {
 
 void WriteApiResponse(const api::Response& response, httplib::Response& res) {
   res.status = response.status;
-  res.set_content(Serialize(response.body) + "\n", "application/json");
+  if (!response.content_type.empty()) {
+    res.set_content(response.text, response.content_type.c_str());
+  } else {
+    res.set_content(Serialize(response.body) + "\n", "application/json");
+  }
 }
 
 // The code of the error envelope for an HTTP status httplib produced itself.
@@ -48,8 +54,18 @@ time_t WholeSeconds(double s) { return static_cast<time_t>(s < 1.0 ? 1.0 : s); }
 
 struct Server::Impl {
   httplib::Server http;
+  api::Context context;
+  Metrics metrics;
+  std::unique_ptr<api::JobManager> jobs;
   std::mutex log_mutex;
 };
+
+namespace {
+// Set by the route handler on its worker thread, read by the logger that
+// httplib calls on the same thread right after: requests httplib answered
+// itself (413, 411, malformed) are counted there.
+thread_local bool request_was_routed = false;
+}  // namespace
 
 Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::make_unique<Impl>()) {
   httplib::Server& http = impl_->http;
@@ -83,14 +99,31 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     return httplib::Server::HandlerResponse::Unhandled;
   });
 
+  impl_->context.limits = config_.limits;
+  // Jobs run the same router with the job's cancel flag and progress.
+  impl_->jobs = std::make_unique<api::JobManager>(
+      config_.jobs, [impl = impl_.get()](const api::Request& inner, core::Progress* progress) {
+        api::Context context = impl->context;
+        context.progress = progress;
+        return api::Dispatch(inner, context);
+      });
+  impl_->context.jobs = impl_->jobs.get();
+  impl_->context.metrics_text = [impl = impl_.get()] {
+    return impl->metrics.Render(impl->jobs->CountsByState());
+  };
+
   auto handle = [this](const httplib::Request& req, httplib::Response& res) {
     const auto start = std::chrono::steady_clock::now();
+    impl_->metrics.Begin();
     std::string route;
-    const api::Response response = api::Dispatch({req.method, req.path, req.body}, &route);
+    const api::Response response =
+        api::Dispatch({req.method, req.path, req.body}, impl_->context, &route);
     WriteApiResponse(response, res);
+    const double duration_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    impl_->metrics.End(route, req.method, response.status, duration_s);
+    request_was_routed = true;
     if (config_.access_log) {
-      const double duration_s =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       const nlohmann::json line{{"method", req.method},   {"path", req.path},
                                 {"route", route},         {"status", response.status},
                                 {"duration_s", duration_s}, {"bytes_in", req.body.size()}};
@@ -117,6 +150,21 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     WriteApiResponse(api::ErrorResponse(res.status, CodeForStatus(res.status), message), res);
     return httplib::Server::HandlerResponse::Handled;
   }));
+  http.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
+    if (request_was_routed) {
+      request_was_routed = false;
+      return;
+    }
+    impl_->metrics.Begin();
+    impl_->metrics.End("unrouted", req.method, res.status, 0.0);
+    if (config_.access_log) {
+      const nlohmann::json line{{"method", req.method}, {"path", req.path},
+                                {"route", "unrouted"},  {"status", res.status},
+                                {"duration_s", 0.0},    {"bytes_in", req.body.size()}};
+      std::lock_guard<std::mutex> lock(impl_->log_mutex);
+      std::cerr << Serialize(line) << "\n";
+    }
+  });
   // Never send an exception's text to the client (pitfalls.md).
   http.set_exception_handler(
       [](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
@@ -124,7 +172,10 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
       });
 }
 
-Server::~Server() { Stop(); }
+Server::~Server() {
+  Stop();
+  impl_->jobs->Shutdown();
+}
 
 bool Server::Bind(std::string* error) {
   const int bound = config_.port == 0 ? impl_->http.bind_to_any_port(config_.host)

@@ -1,71 +1,10 @@
 // sweetspot-server: the HTTP service in the foreground. Logs to stderr; stops
 // cleanly on SIGTERM or SIGINT (in-flight requests are answered first).
-#include <pthread.h>
-#include <signal.h>
+#include <string>
+#include <vector>
 
-#include <atomic>
-#include <chrono>
-#include <cstdlib>
-#include <iostream>
-#include <thread>
-
-#include "core/version.hpp"
-#include "server/config.hpp"
-#include "server/server.hpp"
+#include "server/run.hpp"
 
 int main(int argc, char** argv) {
-  using sweetspot::server::ParseCommandLine;
-  const std::vector<std::string> args(argv + 1, argv + argc);
-  const auto parsed = ParseCommandLine(args, [](const std::string& name) -> std::optional<std::string> {
-    const char* value = std::getenv(name.c_str());
-    if (value == nullptr) return std::nullopt;
-    return std::string(value);
-  });
-  if (parsed.show_help) {
-    std::cout << sweetspot::server::Usage("sweetspot-server");
-    return 0;
-  }
-  if (!parsed.error.empty()) {
-    std::cerr << "sweetspot-server: " << parsed.error << "\n";
-    return 2;
-  }
-
-  // Block the stop signals in every thread; one thread waits for them.
-  sigset_t stop_signals;
-  sigemptyset(&stop_signals);
-  sigaddset(&stop_signals, SIGTERM);
-  sigaddset(&stop_signals, SIGINT);
-  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
-  signal(SIGPIPE, SIG_IGN);  // a client that disconnects must not kill the server
-
-  sweetspot::server::Server server(parsed.config);
-  std::string error;
-  if (!server.Bind(&error)) {
-    std::cerr << "sweetspot-server: " << error << "\n";
-    return 1;
-  }
-  std::atomic<bool> run_returned{false};
-  std::thread signal_thread([&] {
-    int signal_number = 0;
-    sigwait(&stop_signals, &signal_number);
-    if (run_returned.load()) return;
-    std::cerr << "sweetspot-server: received " << (signal_number == SIGTERM ? "SIGTERM" : "SIGINT")
-              << ", stopping\n";
-    // Stop() is a no-op before the listen loop starts: repeat until it returns.
-    while (!run_returned.load()) {
-      server.Stop();
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-  });
-
-  std::cerr << "sweetspot-server " << sweetspot::core::SweetspotVersion() << " listening on "
-            << parsed.config.host << ":" << server.port() << " with " << parsed.config.threads
-            << " threads" << std::endl;
-  const bool ok = server.Run();
-  run_returned.store(true);
-  // Wake the signal thread if the loop ended for another reason.
-  pthread_kill(signal_thread.native_handle(), SIGTERM);
-  signal_thread.join();
-  std::cerr << "sweetspot-server: stopped" << std::endl;
-  return ok ? 0 : 1;
+  return sweetspot::server::RunServerMain(std::vector<std::string>(argv + 1, argv + argc));
 }

@@ -7,7 +7,7 @@ namespace {
 
 TEST(RouterTest, HealthAnswersOk) {
   std::string route;
-  const Response response = Dispatch({"GET", "/health", ""}, &route);
+  const Response response = Dispatch({"GET", "/health", ""}, Context{}, &route);
   EXPECT_EQ(response.status, 200);
   EXPECT_EQ(response.body, nlohmann::json({{"status", "ok"}}));
   EXPECT_EQ(route, "/health");
@@ -15,7 +15,7 @@ TEST(RouterTest, HealthAnswersOk) {
 
 TEST(RouterTest, UnknownPathIs404WithEnvelope) {
   std::string route;
-  const Response response = Dispatch({"GET", "/nope", ""}, &route);
+  const Response response = Dispatch({"GET", "/nope", ""}, Context{}, &route);
   EXPECT_EQ(response.status, 404);
   EXPECT_EQ(response.body["code"], "NotFound");
   EXPECT_EQ(response.body["message"], "no endpoint at path /nope");
@@ -24,16 +24,16 @@ TEST(RouterTest, UnknownPathIs404WithEnvelope) {
 }
 
 TEST(RouterTest, WrongMethodIs405) {
-  const Response response = Dispatch({"POST", "/health", "{}"});
+  const Response response = Dispatch({"POST", "/health", "{}"}, Context{});
   EXPECT_EQ(response.status, 405);
   EXPECT_EQ(response.body["code"], "MethodNotAllowed");
-  EXPECT_EQ(response.body["message"], "method POST is not allowed on /health");
+  EXPECT_EQ(response.body["message"], "method POST is not allowed on /health (allowed: GET)");
 }
 
 TEST(RouterTest, TrailingSlashAndPrefixesDoNotMatch) {
-  EXPECT_EQ(Dispatch({"GET", "/health/", ""}).status, 404);
-  EXPECT_EQ(Dispatch({"GET", "/healthz", ""}).status, 404);
-  EXPECT_EQ(Dispatch({"GET", "", ""}).status, 404);
+  EXPECT_EQ(Dispatch({"GET", "/health/", ""}, Context{}).status, 404);
+  EXPECT_EQ(Dispatch({"GET", "/healthz", ""}, Context{}).status, 404);
+  EXPECT_EQ(Dispatch({"GET", "", ""}, Context{}).status, 404);
 }
 
 TEST(RouterTest, RoutesAreUniqueByMethodAndPath) {

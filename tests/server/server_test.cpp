@@ -104,3 +104,161 @@ TEST(ServerBindTest, PortInUseIsReported) {
 
 }  // namespace
 }  // namespace sweetspot::server
+
+namespace sweetspot::server {
+namespace {
+
+TEST_F(ServerTest, MetricsCountRequestsByRouteAndStatus) {
+  auto client = Client();
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(client.Get("/health"));
+  ASSERT_TRUE(client.Get("/v1/nowhere"));
+  ASSERT_TRUE(client.Post("/health", std::string(4096, 'x'), "application/json"));  // 413
+  const auto res = client.Get("/metrics");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_EQ(res->get_header_value("Content-Type"), "text/plain; version=0.0.4; charset=utf-8");
+  const std::string& text = res->body;
+  EXPECT_NE(text.find("sweetspot_requests_total{route=\"/health\",method=\"GET\",status=\"200\"} 3"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("sweetspot_requests_total{route=\"unmatched\",method=\"GET\",status=\"404\"} 1"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("sweetspot_requests_total{route=\"unrouted\",method=\"POST\",status=\"413\"} 1"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("sweetspot_request_duration_seconds_count{route=\"/health\"} 3"),
+            std::string::npos);
+  EXPECT_NE(text.find("sweetspot_requests_in_flight 1"), std::string::npos);  // this request
+  EXPECT_NE(text.find("sweetspot_jobs{state=\"queued\"} 0"), std::string::npos);
+}
+
+TEST_F(ServerTest, JobRunsARequestAndGivesItsResult) {
+  auto client = Client();
+  const std::string inner = R"({"bat": {"preset": "paper-wood"}})";
+  const auto direct = client.Post("/v1/bat/properties", inner, "application/json");
+  ASSERT_TRUE(direct);
+  const auto submitted = client.Post(
+      "/v1/jobs", R"({"path": "/v1/bat/properties", "body": )" + inner + "}", "application/json");
+  ASSERT_TRUE(submitted);
+  ASSERT_EQ(submitted->status, 202) << submitted->body;
+  const std::string id = nlohmann::json::parse(submitted->body)["id"];
+  std::string state;
+  for (int i = 0; i < 500 && state != "done"; ++i) {  // bounded: 500 x 10 ms
+    const auto status = client.Get("/v1/jobs/" + id);
+    ASSERT_TRUE(status);
+    state = nlohmann::json::parse(status->body)["state"];
+    if (state != "done") std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(state, "done");
+  const auto result = client.Get("/v1/jobs/" + id + "/result");
+  ASSERT_TRUE(result);
+  EXPECT_EQ(result->status, 200);
+  auto a = nlohmann::json::parse(result->body);
+  auto b = nlohmann::json::parse(direct->body);
+  a.erase("timing_s");
+  b.erase("timing_s");
+  EXPECT_EQ(a, b);
+  const auto deleted = client.Delete("/v1/jobs/" + id);
+  ASSERT_TRUE(deleted);
+  EXPECT_EQ(deleted->status, 200);
+  EXPECT_EQ(client.Get("/v1/jobs/" + id)->status, 404);
+}
+
+TEST_F(ServerTest, JobForAnUnknownPathIsRefused) {
+  auto client = Client();
+  const auto res =
+      client.Post("/v1/jobs", R"({"path": "/v1/nowhere", "body": {}})", "application/json");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 400);
+  const auto body = nlohmann::json::parse(res->body);
+  EXPECT_EQ(body["field"], "path");
+  EXPECT_EQ(body["message"].get<std::string>().rfind(
+                "path = \"/v1/nowhere\": must name an endpoint that can run as a job: ", 0),
+            0u);
+}
+
+}  // namespace
+}  // namespace sweetspot::server
+
+namespace sweetspot::server {
+namespace {
+
+TEST(ServerLimitsTest, HostileBodiesGet4xxAndTheServerKeepsServing) {
+  ServerConfig config;
+  config.port = 0;
+  config.threads = 4;
+  config.access_log = false;
+  config.max_body_bytes = 512 * 1024;
+  Server server(config);
+  std::string error;
+  ASSERT_TRUE(server.Bind(&error)) << error;
+  std::thread thread([&] { server.Run(); });
+  httplib::Client client("127.0.0.1", server.port());
+  struct Case {
+    std::string body;
+    int status;
+    const char* code;
+  };
+  const std::vector<Case> cases = {
+      {std::string(200000, '[') + std::string(200000, ']'), 413, "TooBig"},  // depth bomb
+      {"{\"bat\": {\"preset\": \"paper-wood\"}, \"cor\": NaN}", 400, "InvalidJson"},
+      {"{\"bat\": {\"preset\": \"paper-wood\"}, \"cor\": 1e400}", 400, "InvalidValue"},
+      {"{\"bat\": {\"preset\": \"paper-wood\"}, \"cor\": \"\xff\xfe\"}", 400, "InvalidJson"},
+      {"\"just a string\"", 400, "InvalidValue"},
+      {"", 400, "MissingField"},
+      {std::string(600 * 1024, ' '), 413, "TooBig"},  // over max_body_bytes
+  };
+  for (const Case& c : cases) {
+    const auto res = client.Post("/v1/sweet-spot", c.body, "application/json");
+    ASSERT_TRUE(res) << c.body.substr(0, 40);
+    EXPECT_EQ(res->status, c.status) << c.body.substr(0, 40) << " -> " << res->body;
+    const auto body = nlohmann::json::parse(res->body, nullptr, false);
+    ASSERT_FALSE(body.is_discarded()) << res->body;
+    EXPECT_EQ(body["code"], c.code) << res->body;
+  }
+  const auto ok = client.Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"}})",
+                              "application/json");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200);
+  server.Stop();
+  thread.join();
+}
+
+TEST(ServerLimitsTest, ConcurrentSweetSpotRequestsAllAgree) {
+  ServerConfig config;
+  config.port = 0;
+  config.threads = 8;
+  config.access_log = false;
+  Server server(config);
+  std::string error;
+  ASSERT_TRUE(server.Bind(&error)) << error;
+  std::thread thread([&] { server.Run(); });
+  std::atomic<int> agree{0};
+  std::vector<std::thread> clients;
+  for (int t = 0; t < 8; ++t) {
+    clients.emplace_back([&, t] {
+      httplib::Client client("127.0.0.1", server.port());
+      for (int i = 0; i < 25; ++i) {
+        const double cor = 0.4 + 0.01 * t;
+        const auto res = client.Post(
+            "/v1/sweet-spot",
+            nlohmann::json{{"bat", {{"preset", "paper-wood"}}}, {"cor", cor}}.dump(),
+            "application/json");
+        if (!res || res->status != 200) continue;
+        const auto body = nlohmann::json::parse(res->body);
+        // x* does not depend on e; v2max = e u + (1+e) w x*/2 (paper-notes.md §3).
+        const double x = body["max_exit_speed"]["position_from_knob_m"];
+        const double v = body["max_exit_speed"]["exit_speed_mps"];
+        if (std::abs(v - (cor * 27.7 + (1 + cor) * 17.288 * x / 2)) < 1e-9) ++agree;
+      }
+    });
+  }
+  for (auto& c : clients) c.join();
+  EXPECT_EQ(agree.load(), 200);
+  server.Stop();
+  thread.join();
+}
+
+}  // namespace
+}  // namespace sweetspot::server

@@ -1,0 +1,267 @@
+#include "api/bat_json.hpp"
+
+#include <utility>
+
+#include "core/presets.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+std::optional<core::ThreeSegmentShape> ParseThreeSegment(const Json& value,
+                                                         const std::string& path,
+                                                         ApiError* error) {
+  ObjectReader reader(value, path, error);
+  core::ThreeSegmentShape shape;
+  const NumberRule length = Positive(100.0);  // m; a 100 m bat is already absurd
+  const NumberRule radius = Positive(10.0);
+  const NumberRule position = NonNegative(100.0);
+  reader.Number("length_m", length, &shape.length_m);
+  reader.Number("handle_radius_m", radius, &shape.handle_radius_m);
+  reader.Number("barrel_radius_m", radius, &shape.barrel_radius_m);
+  reader.Number("taper_start_m", position, &shape.taper_start_m);
+  reader.Number("taper_end_m", position, &shape.taper_end_m);
+  if (!reader.Finish()) return std::nullopt;
+  std::string why;
+  if (!shape.IsValid(&why)) {
+    CoreRefusal(why, path, error);
+    return std::nullopt;
+  }
+  return shape;
+}
+
+std::optional<std::vector<core::ProfileKnot>> ParseProfile(const Json& value,
+                                                           const std::string& path,
+                                                           const ApiLimits& limits,
+                                                           ApiError* error) {
+  ObjectReader reader(value, path, error);
+  const Json* knots = reader.Get("knots");
+  if (!reader.ok()) return std::nullopt;
+  if (knots == nullptr) {
+    reader.Missing("knots");
+    return std::nullopt;
+  }
+  const std::string knots_path = JoinPath(path, "knots");
+  if (!knots->is_array()) {
+    SetError(error, "InvalidValue", knots_path, knots, "must be an array of {x_m, radius_m}");
+    return std::nullopt;
+  }
+  if (knots->size() < 2) {
+    SetError(error, "InvalidValue", knots_path, knots, "must have at least 2 knots");
+    return std::nullopt;
+  }
+  if (knots->size() > limits.max_knots) {
+    SetError(error, "TooBig", knots_path, nullptr,
+             "has " + std::to_string(knots->size()) + " knots, over the limit max_knots = " +
+                 std::to_string(limits.max_knots),
+             413);
+    return std::nullopt;
+  }
+  std::vector<core::ProfileKnot> out;
+  out.reserve(knots->size());
+  for (std::size_t i = 0; i < knots->size(); ++i) {
+    ObjectReader knot((*knots)[i], knots_path + "[" + std::to_string(i) + "]", error);
+    core::ProfileKnot k;
+    knot.Number("x_m", NonNegative(100.0), &k.x_m);
+    knot.Number("radius_m", Positive(10.0), &k.radius_m);
+    if (!knot.Finish()) return std::nullopt;
+    out.push_back(k);
+  }
+  if (!reader.Finish()) return std::nullopt;
+  return out;
+}
+
+std::optional<core::Fill> ParseFill(const Json& value, const std::string& path, ApiError* error) {
+  ObjectReader reader(value, path, error);
+  core::Fill fill;
+  const Json* material = reader.Get("material");
+  if (material == nullptr) {
+    reader.Missing("material");
+    return std::nullopt;
+  }
+  auto parsed = ParseMaterial(*material, JoinPath(path, "material"), /*allow_empty=*/true, error);
+  if (!parsed) return std::nullopt;
+  fill.material = *parsed;
+  reader.Number("diameter_m", NonNegative(10.0), &fill.diameter_m);
+  reader.Number("depth_m", NonNegative(100.0), &fill.depth_m);
+  if (!reader.Finish()) return std::nullopt;
+  return fill;
+}
+
+}  // namespace
+
+std::optional<core::Material> ParseMaterial(const Json& value, const std::string& path,
+                                            bool allow_empty, ApiError* error) {
+  if (value.is_string()) {
+    const std::string name = value.get<std::string>();
+    if (allow_empty && name == "empty") return core::EmptyFillMaterial();
+    if (auto material = core::FindMaterial(name)) return material;
+    std::string names;
+    for (const auto& m : core::MaterialCatalogue()) names += (names.empty() ? "" : ", ") + m.name;
+    if (allow_empty) names += ", empty";
+    SetError(error, "InvalidValue", path, &value,
+             "is not a catalogue material (GET /v1/materials lists: " + names + ")");
+    return std::nullopt;
+  }
+  ObjectReader reader(value, path, error);
+  core::Material material;
+  material.name = "custom";
+  material.source = "given in the request";
+  reader.OptionalString("name", &material.name);
+  reader.Number("density_kg_m3", Positive(1e5), &material.density_kg_m3);
+  reader.Number("youngs_modulus_pa", Positive(1e13), &material.youngs_modulus_pa);
+  reader.OptionalNumber("shear_modulus_pa", NonNegative(1e13), &material.shear_modulus_pa);
+  reader.OptionalNumber("poissons_ratio", NumberRule{-1.0, 0.5, true, true, false},
+                        &material.poissons_ratio);
+  if (auto cor = reader.MaybeNumber("cor", Between(0.0, 1.0))) material.cor = *cor;
+  if (!reader.Finish()) return std::nullopt;
+  std::string why;
+  if (!material.IsValid(&why)) {
+    CoreRefusal(why, path, error);
+    return std::nullopt;
+  }
+  return material;
+}
+
+std::optional<BatSpec> ParseBat(const Json& value, const std::string& path,
+                                const ApiLimits& limits, ApiError* error) {
+  ObjectReader reader(value, path, error);
+  if (!reader.ok()) return std::nullopt;
+  BatSpec spec;
+  spec.request_form = value;
+  std::optional<core::BatPreset> preset;
+  if (const Json* name = reader.Get("preset")) {
+    if (!name->is_string()) {
+      reader.Fail("preset", "must be a string");
+      return std::nullopt;
+    }
+    preset = core::FindPreset(name->get<std::string>());
+    if (!preset) {
+      std::string names;
+      for (const auto& p : core::BatPresets()) names += (names.empty() ? "" : ", ") + p.name;
+      reader.Fail("preset", "is not a preset (GET /v1/presets lists: " + names + ")");
+      return std::nullopt;
+    }
+    spec.bat = preset->bat;
+    spec.shape_form = "preset";
+  }
+  const bool has_three = reader.Has("three_segment");
+  const bool has_profile = reader.Has("profile");
+  if (has_three && has_profile) {
+    reader.Fail("profile", "cannot be given together with three_segment (choose one shape)");
+    return std::nullopt;
+  }
+  if (!preset && !has_three && !has_profile) {
+    SetError(error, "MissingField", path, nullptr,
+             "needs a shape: one of preset, three_segment or profile");
+    return std::nullopt;
+  }
+  if (has_three) {
+    auto shape = ParseThreeSegment(*reader.Get("three_segment"), JoinPath(path, "three_segment"),
+                                   error);
+    if (!shape) return std::nullopt;
+    spec.bat.knots = shape->Knots();
+    spec.three_segment = shape;
+    spec.shape_form = "three_segment";
+  } else if (has_profile) {
+    auto knots = ParseProfile(*reader.Get("profile"), JoinPath(path, "profile"), limits, error);
+    if (!knots) return std::nullopt;
+    spec.bat.knots = std::move(*knots);
+    spec.shape_form = "profile";
+  }
+  if (const Json* material = reader.Get("material")) {
+    auto parsed = ParseMaterial(*material, JoinPath(path, "material"), false, error);
+    if (!parsed) return std::nullopt;
+    spec.bat.material = *parsed;
+  } else if (!preset) {
+    spec.bat.material = *core::FindMaterial("paper-wood");
+  }
+  reader.OptionalNumber("wall_thickness_m", NonNegative(10.0), &spec.bat.wall_thickness_m);
+  if (const Json* fill = reader.Get("fill")) {
+    if (fill->is_null()) {
+      spec.bat.fill.reset();
+    } else {
+      auto parsed = ParseFill(*fill, JoinPath(path, "fill"), error);
+      if (!parsed) return std::nullopt;
+      spec.bat.fill = *parsed;
+    }
+  }
+  if (!reader.Finish()) return std::nullopt;
+  std::string why;
+  if (!spec.bat.IsValid(&why)) {
+    // Knot refusals belong under the profile (or the preset's/three-segment's knots).
+    const std::string prefix =
+        why.rfind("knots[", 0) == 0 && spec.shape_form == "profile" ? JoinPath(path, "profile")
+                                                                     : path;
+    CoreRefusal(why, prefix, error);
+    return std::nullopt;
+  }
+  return spec;
+}
+
+Json MaterialToJson(const core::Material& material) {
+  Json out{{"name", material.name},
+           {"density_kg_m3", material.density_kg_m3},
+           {"youngs_modulus_pa", material.youngs_modulus_pa},
+           {"shear_modulus_pa", material.EffectiveShearModulusPa()},
+           {"poissons_ratio", material.poissons_ratio},
+           {"source", material.source}};
+  out["cor"] = material.cor ? Json(*material.cor) : Json(nullptr);
+  if (material.density_min_kg_m3 > 0 || material.density_max_kg_m3 > 0) {
+    out["density_range_kg_m3"] = {{"min", material.density_min_kg_m3},
+                                  {"max", material.density_max_kg_m3}};
+  }
+  return out;
+}
+
+Json BatToJson(const core::Bat& bat) {
+  Json knots = Json::array();
+  for (const auto& k : bat.knots) knots.push_back({{"x_m", k.x_m}, {"radius_m", k.radius_m}});
+  Json out{{"profile", {{"knots", std::move(knots)}}}, {"material", bat.material.name}};
+  if (bat.material.name == "custom" || !core::FindMaterial(bat.material.name)) {
+    out["material"] = MaterialToJson(bat.material);
+    out["material"].erase("source");
+    out["material"].erase("density_range_kg_m3");
+    if (out["material"]["cor"].is_null()) out["material"].erase("cor");
+  }
+  if (bat.wall_thickness_m > 0) out["wall_thickness_m"] = bat.wall_thickness_m;
+  if (bat.fill) {
+    out["fill"] = {{"material", bat.fill->IsEmpty() ? Json("empty") : Json(bat.fill->material.name)},
+                   {"diameter_m", bat.fill->diameter_m},
+                   {"depth_m", bat.fill->depth_m}};
+  }
+  return out;
+}
+
+const char* InertiaModelName(core::InertiaModel model) {
+  return model == core::InertiaModel::kSlenderRod ? "slender_rod" : "rigid_body";
+}
+
+Json PropertiesToJson(const core::MassProperties& p, double length_m,
+                      std::optional<double> pivot_from_knob_m) {
+  const core::ImperialProperties imperial = core::ToImperial(p, length_m);
+  Json out{{"mass_kg", p.mass_kg},
+           {"balance_point_m", p.balance_point_m},
+           {"moi_knob_kg_m2", p.moi_knob_kg_m2},
+           {"moi_six_inch_kg_m2", p.MoiSixInchKgM2()},
+           {"moi_centroid_kg_m2", p.moi_centroid_kg_m2},
+           {"volume_m3", p.volume_m3},
+           {"length_m", length_m},
+           {"inertia_model", InertiaModelName(p.inertia_model)},
+           {"imperial",
+            {{"length_in", imperial.length_in},
+             {"weight_oz", imperial.weight_oz},
+             {"drop", imperial.drop},
+             {"balance_point_in", imperial.balance_point_in},
+             {"moi_knob_oz_in2", imperial.moi_knob_oz_in2},
+             {"moi_six_inch_oz_in2", imperial.moi_six_inch_oz_in2},
+             {"moi_centroid_oz_in2", imperial.moi_centroid_oz_in2}}}};
+  if (pivot_from_knob_m) {
+    out["pivot_from_knob_m"] = *pivot_from_knob_m;
+    out["moi_pivot_kg_m2"] = p.MoiAboutKgM2(*pivot_from_knob_m);
+  }
+  return out;
+}
+
+}  // namespace sweetspot::api

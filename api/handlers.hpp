@@ -1,0 +1,59 @@
+// The endpoint handlers: pure functions (request, context) -> Response.
+// Each parses and validates strictly, calls core, and renders the result.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+
+#include "api/json_reader.hpp"
+#include "api/router.hpp"
+
+namespace sweetspot::api {
+
+/// GET /openapi.json: the OpenAPI 3 document (docs/openapi.json, embedded).
+Response HandleOpenApi(const Request& request, const Context& context);
+/// GET /metrics: Prometheus text from the server (501 where there is no server).
+Response HandleMetrics(const Request& request, const Context& context);
+/// GET /v1/version: versions of sweetspot and its libraries.
+Response HandleVersion(const Request& request, const Context& context);
+/// GET /v1/materials: the material catalogue with sources.
+Response HandleMaterials(const Request& request, const Context& context);
+/// GET /v1/presets: the preset bats with their properties and sources.
+Response HandlePresets(const Request& request, const Context& context);
+/// POST /v1/bat/properties: exact mass properties of a bat.
+Response HandleBatProperties(const Request& request, const Context& context);
+/// POST /v1/bat/fit: unknown dimensions from target mass and balance point.
+Response HandleBatFit(const Request& request, const Context& context);
+/// POST /v1/sweet-spot: the requested sweet-spot outputs of a scene.
+Response HandleSweetSpot(const Request& request, const Context& context);
+/// POST /v1/collision: one impact with a chosen model.
+Response HandleCollision(const Request& request, const Context& context);
+/// POST /v1/compare: a baseline bat against variants in one scene.
+Response HandleCompare(const Request& request, const Context& context);
+/// POST /v1/optimize: Ipopt bat design (501 until the optimisation issue lands).
+Response HandleOptimize(const Request& request, const Context& context);
+/// POST /v1/explore: design sweeps (501 until the optimisation issue lands).
+Response HandleExplore(const Request& request, const Context& context);
+/// POST /v1/jobs: run a long request as a job.
+Response HandleJobSubmit(const Request& request, const Context& context);
+/// GET /v1/jobs/{id}: a job's state and progress.
+Response HandleJobStatus(const Request& request, const Context& context);
+/// GET /v1/jobs/{id}/result: a finished job's result.
+Response HandleJobResult(const Request& request, const Context& context);
+/// DELETE /v1/jobs/{id}: cancel (or forget) a job.
+Response HandleJobCancel(const Request& request, const Context& context);
+
+/// A hash of a request's canonical JSON (sorted keys, compact): "fnv1a64:<16 hex>".
+std::string InputHash(const nlohmann::json& canonical_input);
+
+/// The provenance block of a solver result: versions, input hash, options, seed.
+nlohmann::json Provenance(const nlohmann::json& input, const nlohmann::json& options,
+                          std::optional<unsigned long long> seed = std::nullopt);
+
+/// Parses a POST body into a JSON object; on failure the error response.
+std::optional<nlohmann::json> ParseObjectBody(const Request& request, const Context& context,
+                                              Response* error_response);
+
+}  // namespace sweetspot::api

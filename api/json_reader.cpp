@@ -1,0 +1,311 @@
+#include "api/json_reader.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+// A DOM-building SAX parser that enforces depth, array and string limits as
+// it reads, so a hostile body never builds a deep or huge value (pitfalls.md:
+// destroying a value nested ~100,000 levels deep crashes nlohmann-json).
+class LimitedSax : public nlohmann::detail::json_sax_dom_parser<Json> {
+ public:
+  using Base = nlohmann::detail::json_sax_dom_parser<Json>;
+  LimitedSax(Json& target, const ApiLimits& limits, ApiError* error)
+      : Base(target, /*allow_exceptions=*/false), limits_(limits), error_(error) {}
+
+  bool null() { return Value() && Base::null(); }
+  bool boolean(bool b) { return Value() && Base::boolean(b); }
+  bool number_integer(Json::number_integer_t n) { return Value() && Base::number_integer(n); }
+  bool number_unsigned(Json::number_unsigned_t n) { return Value() && Base::number_unsigned(n); }
+  bool number_float(Json::number_float_t n, const Json::string_t& s) {
+    if (!std::isfinite(n)) return Refuse(400, "InvalidValue", "number " + s + " is out of range");
+    return Value() && Base::number_float(n, s);
+  }
+  bool string(Json::string_t& s) {
+    if (s.size() > limits_.max_string_length) return TooLong("string", s.size());
+    return Value() && Base::string(s);
+  }
+  bool binary(Json::binary_t& b) { return Value() && Base::binary(b); }
+  bool key(Json::string_t& k) {
+    if (k.size() > limits_.max_string_length) return TooLong("key", k.size());
+    return Base::key(k);
+  }
+  bool start_object(std::size_t n) { return Open(false) && Base::start_object(n); }
+  bool end_object() {
+    containers_.pop_back();
+    return Base::end_object();
+  }
+  bool start_array(std::size_t n) { return Open(true) && Base::start_array(n); }
+  bool end_array() {
+    containers_.pop_back();
+    return Base::end_array();
+  }
+  bool parse_error(std::size_t position, const std::string& last_token,
+                   const nlohmann::detail::exception& ex) {
+    if (!error_->code.empty()) return false;
+    std::string what = ex.what();
+    // "[json.exception.parse_error.101] parse error at line 1, column 2: ..." -> after "] ".
+    if (const auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
+    if (ex.id == 406) {
+      return Refuse(400, "InvalidValue", "number " + last_token + " is out of range of a double");
+    }
+    return Refuse(400, "InvalidJson",
+                  "body is not valid JSON at byte " + std::to_string(position) + ": " + what);
+  }
+
+ private:
+  struct Container {
+    bool is_array;
+    std::size_t count;
+  };
+
+  bool Refuse(int status, const char* code, std::string message) {
+    if (error_->code.empty()) *error_ = ApiError{status, code, std::move(message), ""};
+    return false;
+  }
+  bool TooLong(const char* what, std::size_t size) {
+    return Refuse(413, "TooBig",
+                  std::string("a ") + what + " of " + std::to_string(size) +
+                      " bytes exceeds the limit max_string_length = " +
+                      std::to_string(limits_.max_string_length));
+  }
+  // Counts one value in the enclosing array.
+  bool Value() {
+    if (!containers_.empty() && containers_.back().is_array &&
+        ++containers_.back().count > limits_.max_array_length) {
+      return Refuse(413, "TooBig",
+                    "an array exceeds the limit max_array_length = " +
+                        std::to_string(limits_.max_array_length));
+    }
+    return true;
+  }
+  bool Open(bool is_array) {
+    if (!Value()) return false;
+    if (static_cast<int>(containers_.size()) >= limits_.max_json_depth) {
+      return Refuse(413, "TooBig",
+                    "nesting exceeds the limit max_json_depth = " +
+                        std::to_string(limits_.max_json_depth));
+    }
+    containers_.push_back({is_array, 0});
+    return true;
+  }
+
+  const ApiLimits& limits_;
+  ApiError* error_;
+  std::vector<Container> containers_;
+};
+
+std::string FormatNumber(double value) {
+  std::ostringstream out;
+  out.precision(15);
+  out << value;
+  return out.str();
+}
+
+}  // namespace
+
+Response ToResponse(const ApiError& error) {
+  nlohmann::json body{{"code", error.code}, {"message", error.message}};
+  body["field"] = error.field.empty() ? nlohmann::json(nullptr) : nlohmann::json(error.field);
+  return {error.status, std::move(body)};
+}
+
+std::optional<nlohmann::json> ParseBody(std::string_view body, const ApiLimits& limits,
+                                        ApiError* error) {
+  const auto first = body.find_first_not_of(" \t\r\n");
+  if (first == std::string_view::npos) return nlohmann::json::object();
+  Json root;
+  LimitedSax sax(root, limits, error);
+  const bool ok = Json::sax_parse(body.begin(), body.end(), &sax);
+  if (!ok || !error->code.empty()) {
+    if (error->code.empty()) *error = ApiError{400, "InvalidJson", "body is not valid JSON", ""};
+    return std::nullopt;
+  }
+  return root;
+}
+
+std::string NumberRule::Describe() const {
+  const bool has_min = min > -1e299;
+  const bool has_max = max < 1e299;
+  std::string kind = integer ? "an integer" : "a number";
+  if (has_min && has_max) {
+    return "must be " + kind + " in " + (min_exclusive ? "(" : "[") + FormatNumber(min) + ", " +
+           FormatNumber(max) + (max_exclusive ? ")" : "]");
+  }
+  if (has_min) return "must be " + kind + (min_exclusive ? " > " : " >= ") + FormatNumber(min);
+  if (has_max) return "must be " + kind + (max_exclusive ? " < " : " <= ") + FormatNumber(max);
+  return "must be " + kind;
+}
+
+bool NumberRule::Accepts(double value) const {
+  if (!std::isfinite(value)) return false;
+  if (integer && std::floor(value) != value) return false;
+  if (min_exclusive ? !(value > min) : !(value >= min)) return false;
+  if (max_exclusive ? !(value < max) : !(value <= max)) return false;
+  return true;
+}
+
+NumberRule Positive(double max) { return NumberRule{0.0, max, true, false, false}; }
+NumberRule NonNegative(double max) { return NumberRule{0.0, max, false, false, false}; }
+NumberRule Between(double min, double max) { return NumberRule{min, max, false, false, false}; }
+NumberRule IntegerBetween(double min, double max) {
+  return NumberRule{min, max, false, false, true};
+}
+
+std::string Show(const nlohmann::json& value) {
+  std::string text = value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  if (text.size() > 60) text = text.substr(0, 57) + "...";
+  return text;
+}
+
+std::string JoinPath(std::string_view parent, std::string_view key) {
+  if (parent.empty()) return std::string(key);
+  return std::string(parent) + "." + std::string(key);
+}
+
+bool CoreRefusal(const std::string& why, const std::string& prefix, ApiError* error) {
+  const auto eq = why.find(" = ");
+  const std::string field = eq == std::string::npos ? std::string() : why.substr(0, eq);
+  const std::string full_field = field.empty() ? prefix : JoinPath(prefix, field);
+  const std::string message =
+      field.empty() ? (prefix.empty() ? why : prefix + ": " + why) : JoinPath(prefix, why);
+  if (error->code.empty()) *error = ApiError{400, "InvalidValue", message, full_field};
+  return false;
+}
+
+bool SetError(ApiError* error, std::string code, const std::string& path,
+              const nlohmann::json* value, const std::string& rule, int status) {
+  if (!error->code.empty()) return false;
+  if (code == "TooBig") status = 413;
+  std::string message = path.empty() ? "body" : path;
+  if (value != nullptr) message += " = " + Show(*value);
+  message += value != nullptr ? ": " + rule : " " + rule;
+  *error = ApiError{status, std::move(code), std::move(message), path};
+  return false;
+}
+
+ObjectReader::ObjectReader(const nlohmann::json& value, std::string path, ApiError* error)
+    : value_(&value), path_(std::move(path)), error_(error) {
+  if (!value.is_object()) {
+    SetError(error_, "InvalidValue", path_, &value, "must be an object");
+  }
+}
+
+bool ObjectReader::Has(std::string_view key) {
+  if (!value_->is_object()) return false;
+  known_.insert(std::string(key));
+  return value_->contains(key);
+}
+
+const nlohmann::json* ObjectReader::Get(std::string_view key) {
+  if (!Has(key)) return nullptr;
+  return &(*value_)[std::string(key)];
+}
+
+bool ObjectReader::Fail(std::string_view key, const std::string& rule, std::string code) {
+  const nlohmann::json* value = value_->is_object() && value_->contains(key)
+                                    ? &(*value_)[std::string(key)]
+                                    : nullptr;
+  return SetError(error_, std::move(code), PathOf(key), value, rule);
+}
+
+bool ObjectReader::Missing(std::string_view key) {
+  return SetError(error_, "MissingField", PathOf(key), nullptr, "is required");
+}
+
+bool ObjectReader::Number(std::string_view key, const NumberRule& rule, double* out) {
+  if (!ok()) return false;
+  if (!Has(key)) return Missing(key);
+  return OptionalNumber(key, rule, out);
+}
+
+bool ObjectReader::OptionalNumber(std::string_view key, const NumberRule& rule, double* out) {
+  if (!ok()) return false;
+  const nlohmann::json* value = Get(key);
+  if (value == nullptr) return true;
+  if (!value->is_number()) {
+    return Fail(key, rule.integer ? "must be an integer" : "must be a number");
+  }
+  const double number = value->get<double>();
+  if (!rule.Accepts(number)) return Fail(key, rule.Describe());
+  *out = number;
+  return true;
+}
+
+std::optional<double> ObjectReader::MaybeNumber(std::string_view key, const NumberRule& rule) {
+  double value = 0.0;
+  if (!Has(key) || !OptionalNumber(key, rule, &value)) return std::nullopt;
+  return value;
+}
+
+bool ObjectReader::OptionalInteger(std::string_view key, long long min, long long max,
+                                   long long* out) {
+  if (!ok()) return false;
+  const nlohmann::json* value = Get(key);
+  if (value == nullptr) return true;
+  const NumberRule rule = IntegerBetween(static_cast<double>(min), static_cast<double>(max));
+  // 2.0 is accepted as 2; 2.7 and -1 for an unsigned field are refused (pitfalls.md).
+  if (!value->is_number()) return Fail(key, "must be an integer");
+  const double number = value->get<double>();
+  if (!rule.Accepts(number)) return Fail(key, rule.Describe());
+  *out = static_cast<long long>(number);
+  return true;
+}
+
+bool ObjectReader::String(std::string_view key, std::string* out,
+                          const std::vector<std::string>& allowed) {
+  if (!ok()) return false;
+  if (!Has(key)) return Missing(key);
+  return OptionalString(key, out, allowed);
+}
+
+bool ObjectReader::OptionalString(std::string_view key, std::string* out,
+                                  const std::vector<std::string>& allowed) {
+  if (!ok()) return false;
+  const nlohmann::json* value = Get(key);
+  if (value == nullptr) return true;
+  if (!value->is_string()) return Fail(key, "must be a string");
+  const std::string text = value->get<std::string>();
+  if (!allowed.empty()) {
+    bool found = false;
+    std::string list;
+    for (const auto& a : allowed) {
+      found = found || a == text;
+      list += (list.empty() ? "" : ", ") + a;
+    }
+    if (!found) return Fail(key, "must be one of " + list);
+  }
+  *out = text;
+  return true;
+}
+
+bool ObjectReader::OptionalBool(std::string_view key, bool* out) {
+  if (!ok()) return false;
+  const nlohmann::json* value = Get(key);
+  if (value == nullptr) return true;
+  if (!value->is_boolean()) return Fail(key, "must be true or false");
+  *out = value->get<bool>();
+  return true;
+}
+
+bool ObjectReader::Finish() {
+  if (!ok() || !value_->is_object()) return ok();
+  for (const auto& item : value_->items()) {
+    if (known_.count(item.key()) == 0) {
+      std::string list;
+      for (const auto& k : known_) list += (list.empty() ? "" : ", ") + k;
+      return SetError(error_, "UnknownField", PathOf(item.key()), nullptr,
+                      "is not a known field" +
+                          (list.empty() ? std::string(" (this object takes no fields)")
+                                        : " (known: " + list + ")"));
+    }
+  }
+  return true;
+}
+
+}  // namespace sweetspot::api

@@ -1,0 +1,126 @@
+// Strict JSON reading: a depth-limited parser that never throws, and a field
+// reader that checks types, ranges, required and unknown fields, and reports
+// the first problem as an ApiError naming the field, the value and the rule.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "api/limits.hpp"
+#include "api/response.hpp"
+
+namespace sweetspot::api {
+
+/// A client error (or, with status 500, an internal one) in the contract's envelope.
+struct ApiError {
+  int status = 400;     ///< HTTP status.
+  std::string code;     ///< InvalidJson, InvalidValue, UnknownField, MissingField, TooBig, ...
+  std::string message;  ///< Names the field, the value and the rule.
+  std::string field;    ///< Dotted path of the field ("" = none).
+};
+
+/// The envelope {"code", "message", "field"} with the error's status.
+Response ToResponse(const ApiError& error);
+
+/// Parses `body` as one JSON value. Refuses (never throws): invalid JSON
+/// (InvalidJson, with the parser's position), nesting deeper than
+/// limits.max_json_depth (TooBig), arrays longer than max_array_length and
+/// strings longer than max_string_length (TooBig), numbers out of double range
+/// (InvalidValue). An empty body is read as {}.
+std::optional<nlohmann::json> ParseBody(std::string_view body, const ApiLimits& limits,
+                                        ApiError* error);
+
+/// A numeric rule: the closed or open interval a value must lie in.
+struct NumberRule {
+  double min = -1e300;         ///< Lower bound.
+  double max = 1e300;          ///< Upper bound.
+  bool min_exclusive = false;  ///< True: value must be > min.
+  bool max_exclusive = false;  ///< True: value must be < max.
+  bool integer = false;        ///< True: value must be an integer.
+
+  /// "must be > 0", "must be in [0, 1]", ... ; empty when unbounded.
+  std::string Describe() const;
+  /// True when `value` satisfies the rule.
+  bool Accepts(double value) const;
+};
+
+/// A value > 0 with an optional upper bound.
+NumberRule Positive(double max = 1e300);
+/// A value >= 0 with an optional upper bound.
+NumberRule NonNegative(double max = 1e300);
+/// A value in [min, max].
+NumberRule Between(double min, double max);
+/// An integer in [min, max].
+NumberRule IntegerBetween(double min, double max);
+
+/// Formats a JSON value for an error message (compact, strings quoted, long values cut).
+std::string Show(const nlohmann::json& value);
+/// Joins a parent path and a key: ("bat", "material") -> "bat.material".
+std::string JoinPath(std::string_view parent, std::string_view key);
+
+/// Reads one JSON object field by field. The first problem is recorded in
+/// *error; later calls then do nothing and return false/nullopt. Finish()
+/// refuses any field that was not read (a typo must not fall back silently).
+class ObjectReader {
+ public:
+  /// `path` is where `value` sits in the request ("" for the body itself).
+  ObjectReader(const nlohmann::json& value, std::string path, ApiError* error);
+
+  /// True while no error has been recorded (by this reader or another).
+  bool ok() const { return error_->code.empty(); }
+  /// The error this reader records into (share it with sub-readers).
+  ApiError* error() const { return error_; }
+  /// The path of `key` in this object.
+  std::string PathOf(std::string_view key) const { return JoinPath(path_, key); }
+  /// True when the object has `key` (marks it as known).
+  bool Has(std::string_view key);
+  /// The raw value of `key` (marks it as known), or nullptr.
+  const nlohmann::json* Get(std::string_view key);
+
+  /// A required number obeying `rule`.
+  bool Number(std::string_view key, const NumberRule& rule, double* out);
+  /// An optional number obeying `rule`; `*out` untouched when absent.
+  bool OptionalNumber(std::string_view key, const NumberRule& rule, double* out);
+  /// An optional number; nullopt when absent or invalid (check ok()).
+  std::optional<double> MaybeNumber(std::string_view key, const NumberRule& rule);
+  /// An optional integer in [min, max]; `*out` untouched when absent.
+  bool OptionalInteger(std::string_view key, long long min, long long max, long long* out);
+  /// A required string; if `allowed` is non-empty it must be one of them.
+  bool String(std::string_view key, std::string* out, const std::vector<std::string>& allowed = {});
+  /// An optional string; `*out` untouched when absent.
+  bool OptionalString(std::string_view key, std::string* out,
+                      const std::vector<std::string>& allowed = {});
+  /// An optional boolean; `*out` untouched when absent.
+  bool OptionalBool(std::string_view key, bool* out);
+  /// Marks `key` as read without reading it (the caller reads it itself).
+  void Skip(std::string_view key) { known_.insert(std::string(key)); }
+  /// Records an error about `key` with `rule`, quoting its value.
+  bool Fail(std::string_view key, const std::string& rule, std::string code = "InvalidValue");
+  /// Records MissingField for `key`.
+  bool Missing(std::string_view key);
+  /// Refuses unread fields (UnknownField, listing the known ones). Returns ok().
+  bool Finish();
+
+ private:
+  const nlohmann::json* value_;
+  std::string path_;
+  ApiError* error_;
+  std::set<std::string, std::less<>> known_;
+};
+
+/// Records a core validation message ("field = value: rule") as an
+/// InvalidValue error with the field re-rooted at `prefix` (e.g. "bat").
+bool CoreRefusal(const std::string& why, const std::string& prefix, ApiError* error);
+
+/// Records an error at `path` ("field = value: rule") unless one is recorded.
+/// The status is 413 for code TooBig, else `status`.
+bool SetError(ApiError* error, std::string code, const std::string& path,
+              const nlohmann::json* value, const std::string& rule, int status = 400);
+
+}  // namespace sweetspot::api

@@ -1,0 +1,35 @@
+#include "api/limits.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace sweetspot::api {
+
+bool ApiLimits::IsValid(std::string* why) const {
+  auto fail = [why](const std::string& text) {
+    if (why != nullptr) *why = text;
+    return false;
+  };
+  if (max_json_depth < 2 || max_json_depth > 512) {
+    return fail("max_json_depth = " + std::to_string(max_json_depth) + ": must be in [2, 512]");
+  }
+  const std::pair<const char*, std::size_t> sizes[] = {
+      {"max_array_length", max_array_length},   {"max_string_length", max_string_length},
+      {"max_knots", max_knots},                 {"max_variants", max_variants},
+      {"max_curve_samples", max_curve_samples}, {"max_samples", max_samples}};
+  for (const auto& [name, value] : sizes) {
+    if (value < 1) return fail(std::string(name) + " = 0: must be at least 1");
+  }
+  if (max_knots < 2) return fail("max_knots = " + std::to_string(max_knots) + ": must be at least 2");
+  if (max_iterations < 1) {
+    return fail("max_iterations = " + std::to_string(max_iterations) + ": must be at least 1");
+  }
+  if (!std::isfinite(max_time_s) || max_time_s <= 0) {
+    std::ostringstream text;
+    text << "max_time_s = " << max_time_s << ": must be > 0";
+    return fail(text.str());
+  }
+  return true;
+}
+
+}  // namespace sweetspot::api

@@ -1,0 +1,26 @@
+// Limits on what a request may ask for. Configuration, not constants: the
+// server sets them from flags/environment; every limit has a test that hits it.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+namespace sweetspot::api {
+
+/// Request limits with their defaults.
+struct ApiLimits {
+  int max_json_depth = 32;                 ///< Deepest nesting of arrays/objects in a body.
+  std::size_t max_array_length = 4096;     ///< Longest array anywhere in a body (elements).
+  std::size_t max_string_length = 256;     ///< Longest string value or key (bytes).
+  std::size_t max_knots = 256;             ///< Knots of a profile.
+  std::size_t max_variants = 64;           ///< Variants in /v1/compare.
+  std::size_t max_curve_samples = 10001;   ///< Points of an exit-speed curve.
+  std::size_t max_samples = 100000;        ///< Designs in one /v1/explore request.
+  int max_iterations = 10000;              ///< Solver iterations a request may ask for.
+  double max_time_s = 60.0;                ///< Solver wall time a request may ask for, s.
+
+  /// True when every limit is positive and sane; otherwise "field = value: rule" in *why.
+  bool IsValid(std::string* why) const;
+};
+
+}  // namespace sweetspot::api

@@ -1,0 +1,358 @@
+#include "api/scene_json.hpp"
+
+#include <algorithm>
+
+#include "api/router.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+bool ReadBall(const Json& value, const std::string& path, core::Ball* ball, ApiError* error) {
+  ObjectReader reader(value, path, error);
+  reader.OptionalNumber("mass_kg", Positive(1e3), &ball->mass_kg);
+  reader.OptionalNumber("radius_m", Positive(10.0), &ball->radius_m);
+  reader.OptionalNumber("speed_mps", NonNegative(1e3), &ball->speed_mps);
+  reader.OptionalNumber("stiffness_n_m_p", Positive(1e15), &ball->stiffness);
+  reader.OptionalNumber("stiffness_exponent", Between(1.0, 3.0), &ball->stiffness_exponent);
+  return reader.Finish();
+}
+
+bool ReadSwing(const Json& value, const std::string& path, core::Swing* swing, ApiError* error) {
+  ObjectReader reader(value, path, error);
+  reader.OptionalNumber("angular_speed_rad_s", NonNegative(1e4), &swing->angular_speed_rad_s);
+  reader.OptionalNumber("pivot_from_knob_m", Between(-100.0, 100.0), &swing->pivot_from_knob_m);
+  reader.OptionalNumber("hands_from_knob_m", Between(-100.0, 100.0), &swing->hands_from_knob_m);
+  return reader.Finish();
+}
+
+// Core validation messages read "field = value: rule" with the request's own
+// field names ("ball.mass_kg", "swing.hands_from_knob_m", ...).
+std::string FieldOf(const std::string& message) {
+  const auto eq = message.find(" = ");
+  return eq == std::string::npos ? std::string() : message.substr(0, eq);
+}
+
+Json PlacementJson(core::Placement placement) { return core::PlacementName(placement); }
+
+}  // namespace
+
+bool ReadSceneCommon(ObjectReader& reader, core::Scene* scene) {
+  if (const Json* ball = reader.Get("ball")) {
+    if (!ReadBall(*ball, reader.PathOf("ball"), &scene->ball, reader.error())) return false;
+  }
+  if (const Json* swing = reader.Get("swing")) {
+    if (!ReadSwing(*swing, reader.PathOf("swing"), &scene->swing, reader.error())) return false;
+  }
+  if (auto cor = reader.MaybeNumber("cor", Between(0.0, 1.0))) scene->cor = *cor;
+  std::string inertia = "rigid_body";
+  reader.OptionalString("inertia_model", &inertia, {"rigid_body", "slender_rod"});
+  scene->inertia_model =
+      inertia == "slender_rod" ? core::InertiaModel::kSlenderRod : core::InertiaModel::kRigidBody;
+  return reader.ok();
+}
+
+bool ReadOutputs(ObjectReader& reader, core::Scene* scene) {
+  const Json* outputs = reader.Get("outputs");
+  if (outputs == nullptr || !reader.ok()) return reader.ok();
+  if (!outputs->is_array() || outputs->empty()) {
+    return reader.Fail("outputs", "must be a non-empty array of output names");
+  }
+  scene->outputs.clear();
+  for (std::size_t i = 0; i < outputs->size(); ++i) {
+    const Json& item = (*outputs)[i];
+    const auto parsed = item.is_string() ? core::ParseSceneOutput(item.get<std::string>())
+                                         : std::nullopt;
+    if (!parsed) {
+      return reader.Fail("outputs",
+                         "outputs[" + std::to_string(i) + "] = " + Show(item) +
+                             " is not one of max_exit_speed, center_of_percussion, "
+                             "vibration_node, sweet_zone, exit_speed_curve");
+    }
+    if (std::find(scene->outputs.begin(), scene->outputs.end(), *parsed) == scene->outputs.end()) {
+      scene->outputs.push_back(*parsed);
+    }
+  }
+  return true;
+}
+
+bool ReadHertzOptions(const Json& value, const std::string& path, core::HertzOptions* options,
+                      ApiError* error) {
+  ObjectReader reader(value, path, error);
+  std::string law = core::ContactLawName(options->law);
+  reader.OptionalString("law", &law, {"ball_power_law", "paper_constants"});
+  options->law = law == "paper_constants" ? core::ContactLaw::kPaperConstants
+                                          : core::ContactLaw::kBallPowerLaw;
+  if (const Json* paper = reader.Get("paper_constants")) {
+    ObjectReader k(*paper, reader.PathOf("paper_constants"), error);
+    k.OptionalNumber("k1", Positive(1e20), &options->paper.k1);
+    k.OptionalNumber("k2", NonNegative(1e20), &options->paper.k2);
+    k.OptionalNumber("k3", NonNegative(1e20), &options->paper.k3);
+    if (!k.Finish()) return false;
+  }
+  reader.OptionalNumber("hands_stiffness_n_m", NonNegative(1e12), &options->hands_stiffness_n_m);
+  reader.OptionalNumber("hands_damping_n_s_m", NonNegative(1e12), &options->hands_damping_n_s_m);
+  reader.OptionalBool("bat_surface_compliance", &options->bat_surface_compliance);
+  reader.OptionalNumber("relative_tolerance", Between(1e-13, 1e-2),
+                        &options->solver.relative_tolerance);
+  long long max_steps = options->solver.max_steps;
+  reader.OptionalInteger("max_steps", 10, 10000000, &max_steps);
+  options->solver.max_steps = static_cast<int>(max_steps);
+  reader.OptionalBool("refine_check", &options->solver.refine_check);
+  return reader.Finish();
+}
+
+bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOptions* options) {
+  const Json* value = top.Get("options");
+  if (value == nullptr || !top.ok()) return top.ok();
+  ObjectReader reader(*value, top.PathOf("options"), top.error());
+  std::string model = "rigid_pivot";
+  reader.OptionalString("model", &model, {"auto", "rigid_pivot", "free_bat", "hertz", "flexible"});
+  options->model = *core::ParseCollisionModel(model);
+  std::string method = "closed_form";
+  reader.OptionalString("method", &method, {"closed_form", "nlopt"});
+  options->method =
+      method == "nlopt" ? core::SweetSpotMethod::kNlopt : core::SweetSpotMethod::kClosedForm;
+  if (const Json* nlopt = reader.Get("nlopt")) {
+    ObjectReader n(*nlopt, reader.PathOf("nlopt"), top.error());
+    std::string algorithm;
+    n.OptionalString("algorithm", &algorithm);
+    if (n.ok() && !algorithm.empty()) {
+      std::string why;
+      const auto parsed = core::ParseNloptAlgorithm(algorithm, &why);
+      if (!parsed) {
+        std::string names;
+        for (const auto a : core::OfferedNloptAlgorithms()) {
+          names += (names.empty() ? "" : ", ") + std::string(core::NloptAlgorithmName(a));
+        }
+        n.Fail("algorithm", "must be one of " + names);
+        return false;
+      }
+      options->nlopt.algorithm = parsed;
+    }
+    n.OptionalNumber("x_tolerance_m", NumberRule{0.0, 1.0, true, false, false},
+                     &options->nlopt.x_tolerance_m);
+    long long evaluations = options->nlopt.max_evaluations;
+    n.OptionalInteger("max_evaluations", 10, limits.max_iterations, &evaluations);
+    options->nlopt.max_evaluations = static_cast<int>(evaluations);
+    n.OptionalNumber("max_time_s", Positive(limits.max_time_s), &options->nlopt.max_time_s);
+    long long seed = options->nlopt.seed;
+    n.OptionalInteger("seed", 0, 4294967295LL, &seed);
+    options->nlopt.seed = static_cast<unsigned>(seed);
+    if (!n.Finish()) return false;
+  }
+  const bool has_mps = reader.Has("sweet_zone_tolerance_mps");
+  const bool has_percent = reader.Has("sweet_zone_tolerance_percent");
+  if (has_mps && has_percent) {
+    return reader.Fail("sweet_zone_tolerance_percent",
+                       "cannot be given with sweet_zone_tolerance_mps (choose one unit)");
+  }
+  if (has_percent) {
+    reader.OptionalNumber("sweet_zone_tolerance_percent", NonNegative(100.0),
+                          &options->sweet_zone_tolerance);
+    options->sweet_zone_unit = core::ToleranceUnit::kPercent;
+  } else {
+    reader.OptionalNumber("sweet_zone_tolerance_mps", NonNegative(1e3),
+                          &options->sweet_zone_tolerance);
+  }
+  const double max_samples = static_cast<double>(std::min<std::size_t>(limits.max_curve_samples, 10000));
+  long long samples = options->curve_samples;
+  reader.OptionalInteger("curve_samples", 2, static_cast<long long>(max_samples), &samples);
+  options->curve_samples = static_cast<int>(samples);
+  if (const Json* positions = reader.Get("curve_positions_from_knob_m")) {
+    if (!positions->is_array() || positions->empty()) {
+      return reader.Fail("curve_positions_from_knob_m", "must be a non-empty array of numbers");
+    }
+    if (static_cast<double>(positions->size()) > max_samples) {
+      return reader.Fail("curve_positions_from_knob_m",
+                         "has " + std::to_string(positions->size()) +
+                             " positions, over the limit max_curve_samples = " +
+                             std::to_string(static_cast<long long>(max_samples)),
+                         "TooBig");
+    }
+    for (std::size_t i = 0; i < positions->size(); ++i) {
+      const Json& p = (*positions)[i];
+      if (!p.is_number()) {
+        return reader.Fail("curve_positions_from_knob_m",
+                           "curve_positions_from_knob_m[" + std::to_string(i) + "] = " + Show(p) +
+                               " must be a number");
+      }
+      options->curve_positions_from_knob_m.push_back(p.get<double>());
+    }
+  }
+  if (const Json* hertz = reader.Get("hertz")) {
+    if (!ReadHertzOptions(*hertz, reader.PathOf("hertz"), &options->hertz, top.error())) {
+      return false;
+    }
+  }
+  if (!reader.Finish()) return false;
+  std::string why;
+  if (!options->IsValid(&why)) return CoreRefusal(why, top.PathOf("options"), top.error());
+  return true;
+}
+
+Response CoreFailure(const core::Summary& summary, const std::string& missing_model,
+                     const std::string& field) {
+  if (!missing_model.empty()) {
+    return ErrorResponse(501, "NotImplemented", summary.message, field);
+  }
+  if (summary.termination == core::Termination::kInvalidInput) {
+    const std::string core_field = FieldOf(summary.message);
+    return ErrorResponse(400, "InvalidValue", summary.message,
+                         core_field.empty() ? field : core_field);
+  }
+  return ErrorResponse(500, "InternalError", "the model failed: " + summary.message);
+}
+
+Json SummaryToJson(const core::Summary& s) {
+  return {{"termination", core::TerminationName(s.termination)},
+          {"message", s.message},
+          {"backend", s.backend},
+          {"raw_status", s.raw_status},
+          {"iterations", s.iterations},
+          {"evaluations", s.evaluations},
+          {"error_estimate", s.error_estimate},
+          {"solve_time_s", s.solve_time_s},
+          {"models_used", s.models_used},
+          {"warnings", s.warnings}};
+}
+
+Json SceneResultToJson(const core::SceneResult& r) {
+  Json out = Json::object();
+  Json errors = Json::object();
+  if (r.max_exit_speed) {
+    const auto& m = *r.max_exit_speed;
+    out["max_exit_speed"] = {{"position_from_knob_m", m.position_from_knob_m},
+                             {"exit_speed_mps", m.exit_speed_mps},
+                             {"placement", PlacementJson(m.placement)},
+                             {"unconstrained_position_from_knob_m",
+                              m.unconstrained_position_from_knob_m},
+                             {"model", m.model},
+                             {"method", m.method}};
+    if (m.method != "closed_form") out["max_exit_speed"]["summary"] = SummaryToJson(m.summary);
+    errors["max_exit_speed"] = {{"position_m", m.error_estimate_m},
+                                {"exit_speed_mps", m.error_estimate_mps}};
+  }
+  if (r.center_of_percussion) {
+    const auto& c = *r.center_of_percussion;
+    out["center_of_percussion"] = {{"position_from_knob_m", c.position_from_knob_m},
+                                   {"hands_from_knob_m", c.hands_from_knob_m},
+                                   {"moi_hands_kg_m2", c.moi_hands_kg_m2},
+                                   {"placement", PlacementJson(c.placement)}};
+    errors["center_of_percussion"] = {{"position_m", c.error_estimate_m}};
+  }
+  if (r.sweet_zone) {
+    const auto& z = *r.sweet_zone;
+    out["sweet_zone"] = {{"from_knob_m", z.from_knob_m},
+                         {"to_knob_m", z.to_knob_m},
+                         {"tolerance_mps", z.tolerance_mps},
+                         {"threshold_mps", z.threshold_mps},
+                         {"clipped_at_knob", z.clipped_at_knob},
+                         {"clipped_at_tip", z.clipped_at_tip},
+                         {"method", z.method}};
+    errors["sweet_zone"] = {{"ends_m", z.error_estimate_m}};
+  }
+  if (r.exit_speed_curve) {
+    Json points = Json::array();
+    for (const auto& p : r.exit_speed_curve->points) {
+      points.push_back(
+          {{"position_from_knob_m", p.position_from_knob_m}, {"exit_speed_mps", p.exit_speed_mps}});
+    }
+    out["exit_speed_curve"] = std::move(points);
+    errors["exit_speed_curve"] = {{"exit_speed_mps", r.exit_speed_curve->error_estimate_mps}};
+  }
+  out["error_estimate"] = std::move(errors);
+  out["models_used"] = r.summary.models_used;
+  out["exit_speed_model"] = r.exit_speed_model.empty() ? Json(nullptr) : Json(r.exit_speed_model);
+  if (!r.model_reason.empty()) out["model_reason"] = r.model_reason;
+  out["cor"] = r.cor;
+  out["cor_source"] = r.cor_source;
+  Json timings = Json::array();
+  for (const auto& t : r.timings) {
+    timings.push_back({{"model", t.model}, {"time_s", t.time_s}, {"calls", t.calls}});
+  }
+  out["timings"] = std::move(timings);
+  if (!r.summary.warnings.empty()) out["warnings"] = r.summary.warnings;
+  return out;
+}
+
+Json CollisionResultToJson(const core::CollisionResult& r) {
+  Json out{{"model", core::CollisionModelName(r.model)},
+           {"model_reason", r.model_reason},
+           {"impact_from_knob_m", r.impact_from_knob_m},
+           {"approach_speed_mps", r.approach_speed_mps},
+           {"exit_speed_mps", r.exit_speed_mps},
+           {"error_estimate", {{"exit_speed_mps", r.error_estimate_mps}}},
+           {"cor", r.cor},
+           {"models_used", r.summary.models_used}};
+  if (r.rigid_pivot) {
+    const auto& p = *r.rigid_pivot;
+    out["rigid_pivot"] = {{"x_from_pivot_m", p.x_from_pivot_m},
+                          {"bat_speed_at_impact_mps", p.bat_speed_at_impact_mps},
+                          {"collision_efficiency", p.collision_efficiency},
+                          {"ball_impulse_n_s", p.ball_impulse_n_s},
+                          {"pivot_impulse_n_s", p.pivot_impulse_n_s},
+                          {"angular_speed_after_rad_s", p.angular_speed_after_rad_s}};
+  }
+  if (r.free_bat) {
+    const auto& f = *r.free_bat;
+    out["free_bat"] = {{"recoil_factor", f.recoil_factor},
+                       {"collision_efficiency", f.collision_efficiency},
+                       {"bat_speed_at_impact_mps", f.bat_speed_at_impact_mps},
+                       {"ball_impulse_n_s", f.ball_impulse_n_s},
+                       {"hands_velocity_change_mps", f.hands_velocity_change_mps}};
+    Json bbcor{{"applies", f.bbcor.applies}};
+    if (f.bbcor.applies) {
+      bbcor["pivot_from_knob_m"] = f.bbcor.pivot_from_knob_m;
+      bbcor["moi_pivot_kg_m2"] = f.bbcor.moi_pivot_kg_m2;
+      bbcor["recoil_factor"] = f.bbcor.recoil_factor;
+      bbcor["apparent_cor"] = f.bbcor.apparent_cor;
+      bbcor["bbcor"] = f.bbcor.bbcor;
+      bbcor["besr"] = f.bbcor.besr;
+    }
+    out["free_bat"]["bbcor_style"] = std::move(bbcor);
+  }
+  if (r.hertz) {
+    const auto& h = *r.hertz;
+    const auto& p = h.problem;
+    out["hertz"] = {{"contact_time_s", h.contact_time_s},
+                    {"max_compression_m", h.max_compression_m},
+                    {"peak_force_n", h.peak_force_n},
+                    {"ball_impulse_n_s", h.ball_impulse_n_s},
+                    {"hands_impulse_n_s", h.hands_impulse_n_s},
+                    {"separation_speed_mps", h.separation_speed_mps},
+                    {"apparent_cor", h.apparent_cor},
+                    {"steps", h.steps},
+                    {"error_estimate",
+                     {{"contact_time_s", h.error_estimate_contact_time_s},
+                      {"exit_speed_mps", h.error_estimate_exit_speed_mps},
+                      {"peak_force_n", h.error_estimate_peak_force_n}}},
+                    {"parameters",
+                     {{"law", core::ContactLawName(p.law)},
+                      {"approach_speed_mps", p.approach_speed_mps},
+                      {"ball_mass_kg", p.ball_mass_kg},
+                      {"ball_stiffness_n_m_p", p.ball_stiffness},
+                      {"ball_exponent", p.ball_exponent},
+                      {"surface_stiffness_n_m1_5", p.surface_stiffness},
+                      {"cor", p.cor},
+                      {"hands_stiffness_n_m", p.hands_stiffness_n_m},
+                      {"hands_damping_n_s_m", p.hands_damping_n_s_m},
+                      {"c11_per_kg", p.c11_per_kg},
+                      {"c12_per_kg", p.c12_per_kg},
+                      {"c22_per_kg", p.c22_per_kg}}},
+                    {"summary", SummaryToJson(h.summary)}};
+    if (p.law == core::ContactLaw::kPaperConstants) {
+      out["hertz"]["parameters"]["paper_constants"] = {
+          {"k1", p.paper.k1}, {"k2", p.paper.k2}, {"k3", p.paper.k3}};
+    }
+  }
+  Json timings = Json::array();
+  for (const auto& t : r.timings) {
+    timings.push_back({{"model", t.model}, {"time_s", t.time_s}, {"calls", t.calls}});
+  }
+  out["timings"] = std::move(timings);
+  return out;
+}
+
+}  // namespace sweetspot::api

@@ -1,0 +1,48 @@
+// The scene as JSON (ball, swing, COR, outputs, options) for /v1/sweet-spot,
+// /v1/collision and /v1/compare, and the renderers of their results.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+
+#include "api/bat_json.hpp"
+#include "api/json_reader.hpp"
+#include "core/scene.hpp"
+
+namespace sweetspot::api {
+
+/// Reads the scene fields shared by every scene endpoint from `reader` (the
+/// request body): "ball", "swing", "cor", "inertia_model". Fields not given
+/// keep the defaults of the contract (Table 3 kinematics, a regulation ball,
+/// COR from the bat's material, pivot at the knob).
+bool ReadSceneCommon(ObjectReader& reader, core::Scene* scene);
+
+/// Reads "outputs" (an array of output names; default ["max_exit_speed"]).
+bool ReadOutputs(ObjectReader& reader, core::Scene* scene);
+
+/// Reads "options" of /v1/sweet-spot into `options`.
+bool ReadSceneOptions(ObjectReader& reader, const ApiLimits& limits, core::SceneOptions* options);
+
+/// Reads a "hertz" options object at `path`.
+bool ReadHertzOptions(const nlohmann::json& value, const std::string& path,
+                      core::HertzOptions* options, ApiError* error);
+
+/// The error response for a core result that was refused or failed: 501 for
+/// a missing model, 400 for invalid input, 500 for a failure.
+Response CoreFailure(const core::Summary& summary, const std::string& missing_model,
+                     const std::string& field);
+
+/// The summary block {termination, message, backend, raw_status, iterations,
+/// evaluations, error_estimate, solve_time_s, models_used, warnings}.
+nlohmann::json SummaryToJson(const core::Summary& summary);
+
+/// The outputs of a scene result, by output name, plus models_used,
+/// error_estimate, timings, cor and properties.
+nlohmann::json SceneResultToJson(const core::SceneResult& result);
+
+/// One collision result: exit speed, model and what the model knows.
+nlohmann::json CollisionResultToJson(const core::CollisionResult& result);
+
+}  // namespace sweetspot::api

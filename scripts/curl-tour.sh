@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# A curl tour of every endpoint against a running server (default
+# http://127.0.0.1:8080; first argument overrides). README.md pastes its output.
+set -uo pipefail
+base="${1:-http://127.0.0.1:8080}"
+run() {
+  echo "\$ $*"
+  "$@"
+  echo
+}
+post() {  # post PATH JSON
+  echo "\$ curl -s -X POST $base$1 -d '$2'"
+  curl -s -X POST "$base$1" -H 'Content-Type: application/json' -d "$2"
+  echo
+}
+run curl -s "$base/health"
+run curl -s "$base/v1/version"
+run curl -s "$base/v1/materials"
+run curl -s "$base/v1/presets"
+post /v1/bat/properties '{"bat": {"preset": "paper-wood"}, "inertia_model": "slender_rod"}'
+post /v1/bat/properties '{"bat": {"three_segment": {"length_m": 0.8636, "handle_radius_m": 0.0125, "barrel_radius_m": 0.033, "taper_start_m": 0.30, "taper_end_m": 0.55}, "material": "ash"}, "pivot_from_knob_m": 0.1524}'
+post /v1/bat/fit '{"bat": {"preset": "paper-wood"}, "targets": {"mass_kg": 0.95, "balance_point_m": 0.60}}'
+post /v1/bat/fit '{"bat": {"preset": "paper-wood"}, "targets": {"mass_kg": 0.885, "balance_point_m": 0.564}}'
+post /v1/sweet-spot '{"bat": {"preset": "paper-wood"}, "outputs": ["max_exit_speed", "center_of_percussion", "sweet_zone"]}'
+post /v1/sweet-spot '{"bat": {"preset": "paper-wood"}, "outputs": ["exit_speed_curve"], "options": {"curve_samples": 3}}'
+post /v1/sweet-spot '{"bat": {"preset": "paper-wood"}, "outputs": ["vibration_node"]}'
+post /v1/collision '{"bat": {"preset": "wood-34-ash"}, "impact_from_knob_m": 0.70, "model": "hertz"}'
+post /v1/collision '{"bat": {"preset": "bbcor-33-aluminium"}, "impact_from_knob_m": 0.70, "model": "free_bat"}'
+post /v1/compare '{"baseline": {"preset": "paper-wood"}, "variants": [{"name": "cork-320", "bat": {"preset": "paper-wood", "fill": {"material": {"density_kg_m3": 320, "youngs_modulus_pa": 2e7}, "diameter_m": 0.0254, "depth_m": 0.254}}}]}'
+post /v1/optimize '{}'
+job='{"path": "/v1/compare", "body": {"baseline": {"preset": "paper-wood"}, "variants": [{"name": "ash", "bat": {"preset": "paper-wood", "material": "ash"}}]}}'
+echo "\$ curl -s -X POST $base/v1/jobs -d '$job'"
+submitted=$(curl -s -X POST "$base/v1/jobs" -H 'Content-Type: application/json' -d "$job")
+echo "$submitted"
+echo
+id=$(echo "$submitted" | sed -n 's/.*"id":"\([0-9a-f]*\)".*/\1/p')
+sleep 0.2
+run curl -s "$base/v1/jobs/$id"
+run curl -s "$base/v1/jobs/$id/result"
+run curl -s -X DELETE "$base/v1/jobs/$id"
+run curl -s "$base/metrics"
+post /v1/sweet-spot '{"bat": {"preset": "paper-wood"}, "ball": {"mass_kg": -1}}'
+post /v1/sweet-spot '{"bat": {"preset": "paper-wood"}, "ball": {"mass": 0.145}}'

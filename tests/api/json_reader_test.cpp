@@ -1,0 +1,174 @@
+#include "api/json_reader.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace sweetspot::api {
+namespace {
+
+ApiError ParseError(const std::string& body, const ApiLimits& limits = {}) {
+  ApiError error;
+  const auto parsed = ParseBody(body, limits, &error);
+  EXPECT_FALSE(parsed.has_value()) << body.substr(0, 80);
+  return error;
+}
+
+TEST(ParseBodyTest, EmptyBodyIsAnEmptyObject) {
+  ApiError error;
+  const auto parsed = ParseBody("  \n", ApiLimits{}, &error);
+  ASSERT_TRUE(parsed.has_value());
+  EXPECT_EQ(*parsed, nlohmann::json::object());
+}
+
+TEST(ParseBodyTest, InvalidJsonNamesThePosition) {
+  const ApiError error = ParseError("{\"a\": }");
+  EXPECT_EQ(error.status, 400);
+  EXPECT_EQ(error.code, "InvalidJson");
+  EXPECT_EQ(error.message.rfind("body is not valid JSON at byte 7: ", 0), 0u) << error.message;
+}
+
+TEST(ParseBodyTest, NanAndInfinityTokensAreInvalidJson) {
+  EXPECT_EQ(ParseError("{\"x\": NaN}").code, "InvalidJson");
+  EXPECT_EQ(ParseError("{\"x\": Infinity}").code, "InvalidJson");
+  EXPECT_EQ(ParseError("{\"x\": -Infinity}").code, "InvalidJson");
+}
+
+TEST(ParseBodyTest, NumberOutOfDoubleRangeIsInvalidValue) {
+  const ApiError error = ParseError("{\"x\": 1e400}");
+  EXPECT_EQ(error.code, "InvalidValue");
+  EXPECT_EQ(error.message, "number 1e400 is out of range of a double");
+}
+
+TEST(ParseBodyTest, DeepNestingIsRefusedWithoutBuildingIt) {
+  // 200,000 levels would crash nlohmann-json when the value is destroyed
+  // (pitfalls.md); the limit stops the parse at depth 33.
+  const std::string bomb = std::string(200000, '[') + std::string(200000, ']');
+  const ApiError error = ParseError(bomb);
+  EXPECT_EQ(error.status, 413);
+  EXPECT_EQ(error.code, "TooBig");
+  EXPECT_EQ(error.message, "nesting exceeds the limit max_json_depth = 32");
+}
+
+TEST(ParseBodyTest, DepthAtTheLimitIsAccepted) {
+  ApiLimits limits;
+  limits.max_json_depth = 4;
+  ApiError error;
+  EXPECT_TRUE(ParseBody("[[[[1]]]]", limits, &error).has_value()) << error.message;
+  EXPECT_EQ(ParseError("[[[[[1]]]]]", limits).code, "TooBig");
+}
+
+TEST(ParseBodyTest, LongArraysAndStringsAreRefused) {
+  ApiLimits limits;
+  limits.max_array_length = 3;
+  limits.max_string_length = 5;
+  ApiError error;
+  EXPECT_TRUE(ParseBody("[1,2,3]", limits, &error).has_value());
+  EXPECT_EQ(ParseError("[1,2,3,4]", limits).message,
+            "an array exceeds the limit max_array_length = 3");
+  EXPECT_EQ(ParseError("\"abcdef\"", limits).message,
+            "a string of 6 bytes exceeds the limit max_string_length = 5");
+  EXPECT_EQ(ParseError("{\"abcdef\": 1}", limits).message,
+            "a key of 6 bytes exceeds the limit max_string_length = 5");
+}
+
+TEST(ObjectReaderTest, ReadsNumbersAndRefusesUnknownFields) {
+  const auto value = nlohmann::json::parse(R"({"mass_kg": 0.145, "masss_kg": 1})");
+  ApiError error;
+  ObjectReader reader(value, "ball", &error);
+  double mass = 0;
+  EXPECT_TRUE(reader.Number("mass_kg", Positive(), &mass));
+  EXPECT_EQ(mass, 0.145);
+  EXPECT_FALSE(reader.Finish());
+  EXPECT_EQ(error.code, "UnknownField");
+  EXPECT_EQ(error.field, "ball.masss_kg");
+  EXPECT_EQ(error.message, "ball.masss_kg is not a known field (known: mass_kg)");
+}
+
+TEST(ObjectReaderTest, MessagesNameFieldValueAndRule) {
+  const auto value =
+      nlohmann::json::parse(R"({"speed_mps": -3, "name": 7, "cor": "high", "n": 2.5})");
+  {
+    ApiError error;
+    ObjectReader reader(value, "ball", &error);
+    double speed = 0;
+    EXPECT_FALSE(reader.Number("speed_mps", NonNegative(200), &speed));
+    EXPECT_EQ(error.message, "ball.speed_mps = -3: must be a number in [0, 200]");
+    EXPECT_EQ(error.field, "ball.speed_mps");
+    EXPECT_EQ(error.code, "InvalidValue");
+  }
+  {
+    ApiError error;
+    ObjectReader reader(value, "", &error);
+    std::string name;
+    EXPECT_FALSE(reader.OptionalString("name", &name));
+    EXPECT_EQ(error.message, "name = 7: must be a string");
+  }
+  {
+    ApiError error;
+    ObjectReader reader(value, "", &error);
+    double cor = 0;
+    EXPECT_FALSE(reader.OptionalNumber("cor", Between(0, 1), &cor));
+    EXPECT_EQ(error.message, "cor = \"high\": must be a number");
+  }
+  {
+    ApiError error;
+    ObjectReader reader(value, "", &error);
+    long long n = 0;
+    EXPECT_FALSE(reader.OptionalInteger("n", 1, 10, &n));
+    EXPECT_EQ(error.message, "n = 2.5: must be an integer in [1, 10]");
+  }
+}
+
+TEST(ObjectReaderTest, MissingRequiredFieldIsMissingField) {
+  const auto value = nlohmann::json::object();
+  ApiError error;
+  ObjectReader reader(value, "bat.three_segment", &error);
+  double length = 0;
+  EXPECT_FALSE(reader.Number("length_m", Positive(), &length));
+  EXPECT_EQ(error.code, "MissingField");
+  EXPECT_EQ(error.message, "bat.three_segment.length_m is required");
+}
+
+TEST(ObjectReaderTest, NonObjectIsRefused) {
+  const auto value = nlohmann::json::array({1, 2});
+  ApiError error;
+  ObjectReader reader(value, "swing", &error);
+  EXPECT_FALSE(reader.ok());
+  EXPECT_EQ(error.message, "swing = [1,2]: must be an object");
+}
+
+TEST(ObjectReaderTest, FirstErrorWins) {
+  const auto value = nlohmann::json::parse(R"({"a": -1, "b": -1})");
+  ApiError error;
+  ObjectReader reader(value, "", &error);
+  double a = 0, b = 0;
+  reader.Number("a", Positive(), &a);
+  reader.Number("b", Positive(), &b);
+  EXPECT_EQ(error.field, "a");
+}
+
+TEST(NumberRuleTest, DescribesIntervals) {
+  EXPECT_EQ(Positive().Describe(), "must be a number > 0");
+  EXPECT_EQ(NonNegative(5).Describe(), "must be a number in [0, 5]");
+  EXPECT_EQ((NumberRule{-1, 0.5, true, true, false}).Describe(), "must be a number in (-1, 0.5)");
+  EXPECT_FALSE(Positive().Accepts(0.0));
+  EXPECT_FALSE(Positive().Accepts(std::nan("")));
+  EXPECT_TRUE(Between(0, 1).Accepts(1.0));
+}
+
+TEST(LimitsTest, DefaultsAreValidAndRulesAreNamed) {
+  std::string why;
+  EXPECT_TRUE(ApiLimits{}.IsValid(&why)) << why;
+  ApiLimits limits;
+  limits.max_json_depth = 1;
+  EXPECT_FALSE(limits.IsValid(&why));
+  EXPECT_EQ(why, "max_json_depth = 1: must be in [2, 512]");
+  limits = ApiLimits{};
+  limits.max_time_s = 0;
+  EXPECT_FALSE(limits.IsValid(&why));
+  EXPECT_EQ(why, "max_time_s = 0: must be > 0");
+}
+
+}  // namespace
+}  // namespace sweetspot::api

@@ -1,0 +1,66 @@
+// The served OpenAPI document and the router describe the same endpoints,
+// compared both ways.
+#include <gtest/gtest.h>
+
+#include <set>
+#include <utility>
+
+#include "api/router.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+std::string Lower(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
+TEST(OpenApiTest, DocumentIsOpenApi3) {
+  const Response r = Dispatch({"GET", "/openapi.json", ""}, Context{});
+  ASSERT_EQ(r.status, 200);
+  EXPECT_EQ(r.body["openapi"].get<std::string>().rfind("3.", 0), 0u);
+  EXPECT_TRUE(r.body["info"]["title"].is_string());
+  EXPECT_TRUE(r.body["paths"].is_object());
+}
+
+TEST(OpenApiTest, PathsMatchTheRouterBothWays) {
+  const Response r = Dispatch({"GET", "/openapi.json", ""}, Context{});
+  std::set<std::pair<std::string, std::string>> documented;
+  for (const auto& [path, operations] : r.body["paths"].items()) {
+    for (const auto& [method, operation] : operations.items()) {
+      documented.insert({Lower(method), path});
+      EXPECT_TRUE(operation.contains("responses")) << method << " " << path;
+    }
+  }
+  std::set<std::pair<std::string, std::string>> routed;
+  for (const Route& route : Routes()) routed.insert({Lower(route.method), route.path});
+  for (const auto& entry : routed) {
+    EXPECT_TRUE(documented.count(entry)) << "not in openapi.json: " << entry.first << " "
+                                          << entry.second;
+  }
+  for (const auto& entry : documented) {
+    EXPECT_TRUE(routed.count(entry)) << "not routed: " << entry.first << " " << entry.second;
+  }
+}
+
+TEST(OpenApiTest, EveryReferenceResolves) {
+  const Response r = Dispatch({"GET", "/openapi.json", ""}, Context{});
+  const nlohmann::json& schemas = r.body["components"]["schemas"];
+  std::function<void(const nlohmann::json&)> visit = [&](const nlohmann::json& node) {
+    if (node.is_object()) {
+      if (node.contains("$ref")) {
+        const std::string ref = node["$ref"];
+        const std::string prefix = "#/components/schemas/";
+        ASSERT_EQ(ref.rfind(prefix, 0), 0u) << ref;
+        EXPECT_TRUE(schemas.contains(ref.substr(prefix.size()))) << ref;
+      }
+      for (const auto& item : node.items()) visit(item.value());
+    } else if (node.is_array()) {
+      for (const auto& item : node) visit(item);
+    }
+  };
+  visit(r.body);
+}
+
+}  // namespace
+}  // namespace sweetspot::api
