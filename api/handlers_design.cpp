@@ -1,6 +1,5 @@
-// POST /v1/optimize and POST /v1/explore: their core (Ipopt design,
-// sampling) lands with the optimisation issue; until then they answer 501
-// with what is missing, never a made-up result.
+// POST /v1/optimize: its core (Ipopt design) lands with the optimisation
+// issue; until then it answers 501 with what is missing, never a made-up result.
 #include "api/handlers.hpp"
 
 namespace sweetspot::api {
@@ -8,12 +7,6 @@ namespace sweetspot::api {
 Response HandleOptimize(const Request&, const Context&) {
   return ErrorResponse(501, "NotImplemented",
                        "POST /v1/optimize needs the Ipopt design model, which is not "
-                       "available in this version");
-}
-
-Response HandleExplore(const Request&, const Context&) {
-  return ErrorResponse(501, "NotImplemented",
-                       "POST /v1/explore needs the design-sweep model, which is not "
                        "available in this version");
 }
 

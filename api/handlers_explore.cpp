@@ -1,0 +1,356 @@
+// POST /v1/explore: design sweeps for pipelines. Parameters are numeric fields
+// of the request's bat or scene, addressed by path; designs come from a grid,
+// a Latin hypercube or a Sobol sequence; each design is one row (failed
+// designs are rows with an error, never fatal to the sweep); shards split a
+// sweep deterministically (design i belongs to shard i mod count).
+#include <chrono>
+#include <algorithm>
+#include <cmath>
+
+#include "api/handlers.hpp"
+#include "api/json_path.hpp"
+#include "api/scene_json.hpp"
+#include "core/sampling.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// A swept parameter: its path as written, its steps from the template root.
+struct Parameter {
+  std::string path;
+  std::vector<PathStep> steps;
+};
+
+// What a row reports (besides parameters): "properties" and scene outputs.
+struct RowOutputs {
+  bool properties = false;
+  bool collision_efficiency = false;
+  std::vector<core::SceneOutput> scene;
+};
+
+// A row for one design evaluated from `design_json` (bat + scene fields).
+Json EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
+                    const core::SceneOptions& options, const ApiLimits& limits) {
+  ApiError error;
+  ObjectReader reader(design_json, "", &error);
+  core::Scene scene;
+  std::optional<BatSpec> spec;
+  if (const Json* bat = reader.Get("bat")) spec = ParseBat(*bat, "bat", limits, &error);
+  if (spec) {
+    scene.bat = spec->bat;
+    ReadSceneCommon(reader, &scene);
+  }
+  scene.outputs = outputs.scene;
+  std::string why;
+  if (error.code.empty() && !scene.IsValid(&why)) CoreRefusal(why, "", &error);
+  if (!error.code.empty()) {
+    return {{"feasible", false},
+            {"error", {{"code", error.code}, {"message", error.message}, {"field", error.field}}}};
+  }
+  Json row{{"feasible", true}};
+  core::SceneResult result;
+  if (!scene.outputs.empty()) {
+    result = core::EvaluateScene(scene, options);
+    if (!result.summary.IsSolutionUsable()) {
+      return {{"feasible", false},
+              {"error",
+               {{"code", result.missing_model.empty() ? "InvalidValue" : "NotImplemented"},
+                {"message", result.summary.message},
+                {"field", nullptr}}}};
+    }
+    Json rendered = SceneResultToJson(result);
+    for (const core::SceneOutput output : scene.outputs) {
+      const char* name = core::SceneOutputName(output);
+      if (rendered.contains(name)) row[name] = std::move(rendered[name]);
+    }
+  } else {
+    result.mass_properties = core::ComputeMassProperties(spec->bat, scene.inertia_model);
+    result.length_m = spec->bat.LengthM();
+  }
+  if (outputs.properties) {
+    row["properties"] = PropertiesToJson(result.mass_properties, result.length_m);
+  }
+  if (outputs.collision_efficiency && result.max_exit_speed) {
+    const core::CollisionResult hit = core::Collide(
+        scene, result.max_exit_speed->position_from_knob_m, core::CollisionModel::kRigidPivot);
+    if (hit.rigid_pivot) row["collision_efficiency"] = hit.rigid_pivot->collision_efficiency;
+  }
+  return row;
+}
+
+}  // namespace
+
+Response HandleExplore(const Request& request, const Context& context) {
+  const auto start = std::chrono::steady_clock::now();
+  Response failure;
+  const auto body = ParseObjectBody(request, context, &failure);
+  if (!body) return failure;
+  ApiError error;
+  ObjectReader reader(*body, "", &error);
+
+  // The design template: the bat and the scene fields, as written.
+  Json base = Json::object();
+  for (const char* key : {"bat", "ball", "swing", "cor", "inertia_model"}) {
+    if (const Json* value = reader.Get(key)) base[key] = *value;
+  }
+  if (!base.contains("bat")) {
+    reader.Missing("bat");
+    return ToResponse(error);
+  }
+  {  // The template itself must be a valid bat and scene.
+    core::Scene scene;
+    ObjectReader check(base, "", &error);
+    const auto spec = ParseBat(base["bat"], "bat", context.limits, &error);
+    if (!spec || !ReadSceneCommon(check, &scene)) return ToResponse(error);
+  }
+
+  core::SweepPlan plan;
+  std::string sampling = "grid";
+  reader.OptionalString("sampling", &sampling, {"grid", "lhs", "sobol"});
+  plan.method = *core::ParseSamplingMethod(sampling);
+  long long samples = 0, seed = 0;
+  reader.OptionalInteger("samples", 1, static_cast<long long>(context.limits.max_samples),
+                         &samples);
+  reader.OptionalInteger("seed", 0, 1LL << 53, &seed);
+  plan.samples = static_cast<std::uint64_t>(samples);
+  plan.seed = static_cast<std::uint64_t>(seed);
+  if (reader.ok() && plan.method != core::SamplingMethod::kGrid && samples == 0) {
+    reader.Missing("samples");
+  }
+
+  std::vector<Parameter> parameters;
+  const Json* params = reader.Get("parameters");
+  if (reader.ok() && params == nullptr) reader.Missing("parameters");
+  if (!reader.ok()) return ToResponse(error);
+  if (!params->is_array() || params->empty() || params->size() > 32) {
+    reader.Fail("parameters", "must be an array of 1 to 32 {\"path\", \"min\", \"max\"}");
+    return ToResponse(error);
+  }
+  for (std::size_t i = 0; i < params->size(); ++i) {
+    const std::string where = "parameters[" + std::to_string(i) + "]";
+    ObjectReader p((*params)[i], where, &error);
+    Parameter parameter;
+    core::SweepDimension dimension;
+    p.String("path", &parameter.path);
+    p.Number("min", Between(-1e12, 1e12), &dimension.min);
+    p.Number("max", Between(-1e12, 1e12), &dimension.max);
+    long long count = plan.method == core::SamplingMethod::kGrid ? 2 : 1;
+    p.OptionalInteger("count", 1, 1000000000, &count);  // the total is checked against max_samples
+    dimension.count = static_cast<int>(count);
+    if (!p.Finish()) return ToResponse(error);
+    if (dimension.max < dimension.min) {
+      p.Fail("max", "must be >= min = " + Show(Json(dimension.min)));
+      return ToResponse(error);
+    }
+    std::string path = parameter.path;
+    const std::string head = path.substr(0, path.find_first_of(".["));
+    if (head != "bat" && head != "ball" && head != "swing" && head != "cor") path = "bat." + path;
+    // A scene object the request left to its defaults can still be swept.
+    if ((head == "ball" || head == "swing") && !base.contains(head)) base[head] = Json::object();
+    std::string why;
+    auto steps = ParseJsonPath(path, &why);
+    Json probe = base;
+    if (!steps || !SetNumberAtPath(&probe, *steps, dimension.min, &why)) {
+      SetError(&error, "InvalidValue", where + ".path", &(*params)[i]["path"], why);
+      return ToResponse(error);
+    }
+    parameter.steps = std::move(*steps);
+    parameters.push_back(std::move(parameter));
+    plan.dimensions.push_back(dimension);
+  }
+
+  RowOutputs outputs;
+  outputs.properties = true;
+  outputs.scene = {core::SceneOutput::kMaxExitSpeed};
+  if (const Json* list = reader.Get("outputs")) {
+    if (!list->is_array() || list->empty()) {
+      reader.Fail("outputs", "must be a non-empty array of output names");
+      return ToResponse(error);
+    }
+    outputs = RowOutputs{};
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      const Json& item = (*list)[i];
+      const std::string name = item.is_string() ? item.get<std::string>() : "";
+      if (name == "properties") {
+        outputs.properties = true;
+      } else if (name == "collision_efficiency") {
+        outputs.collision_efficiency = true;
+      } else if (const auto output = core::ParseSceneOutput(name)) {
+        outputs.scene.push_back(*output);
+      } else {
+        reader.Fail("outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
+                                   " is not one of properties, max_exit_speed, "
+                                   "center_of_percussion, vibration_node, sweet_zone, "
+                                   "exit_speed_curve, collision_efficiency");
+        return ToResponse(error);
+      }
+    }
+    if (outputs.collision_efficiency &&
+        std::find(outputs.scene.begin(), outputs.scene.end(), core::SceneOutput::kMaxExitSpeed) ==
+            outputs.scene.end()) {
+      outputs.scene.push_back(core::SceneOutput::kMaxExitSpeed);
+    }
+  }
+  core::SceneOptions options;
+  if (!ReadSceneOptions(reader, context.limits, &options)) return ToResponse(error);
+
+  struct Objective {
+    std::string output;
+    std::string pointer;
+    core::Sense sense;
+  };
+  std::vector<Objective> objectives;
+  if (const Json* pareto = reader.Get("pareto")) {
+    ObjectReader p(*pareto, "pareto", &error);
+    const Json* list = p.Get("objectives");
+    if (p.ok() && (list == nullptr || !list->is_array() || list->size() < 2 || list->size() > 8)) {
+      p.Fail("objectives", "must be an array of 2 to 8 {\"output\", \"sense\"}");
+    }
+    if (!p.Finish()) return ToResponse(error);
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      ObjectReader o((*list)[i], "pareto.objectives[" + std::to_string(i) + "]", &error);
+      Objective objective;
+      std::string sense;
+      o.String("output", &objective.output);
+      o.String("sense", &sense, {"max", "min"});
+      if (!o.Finish()) return ToResponse(error);
+      objective.sense = sense == "max" ? core::Sense::kMaximize : core::Sense::kMinimize;
+      // "parameters.<path>" names a swept parameter (its path may hold dots);
+      // anything else is a dotted path into the row, e.g. "max_exit_speed.exit_speed_mps".
+      const bool is_parameter = objective.output.rfind("parameters.", 0) == 0;
+      std::vector<std::string> tokens;
+      if (is_parameter) {
+        tokens = {"parameters", objective.output.substr(11)};
+      } else {
+        std::string token;
+        for (const char c : objective.output) {
+          if (c == '.') {
+            tokens.push_back(token);
+            token.clear();
+          } else {
+            token.push_back(c);
+          }
+        }
+        tokens.push_back(token);
+      }
+      for (const auto& token : tokens) {
+        objective.pointer.push_back('/');
+        for (const char c : token) {  // RFC 6901 escapes
+          if (c == '~') {
+            objective.pointer.append("~0");
+          } else if (c == '/') {
+            objective.pointer.append("~1");
+          } else {
+            objective.pointer.push_back(c);
+          }
+        }
+      }
+      objectives.push_back(std::move(objective));
+    }
+  }
+  core::Shard shard;
+  if (const Json* s = reader.Get("shard")) {
+    ObjectReader sr(*s, "shard", &error);
+    long long index = 0, count = 1;
+    sr.OptionalInteger("index", 0, 1LL << 40, &index);
+    sr.OptionalInteger("count", 1, 1LL << 40, &count);
+    if (!sr.Finish()) return ToResponse(error);
+    shard = {static_cast<std::uint64_t>(index), static_cast<std::uint64_t>(count)};
+    std::string why;
+    if (!shard.IsValid(&why)) {
+      CoreRefusal(why, "", &error);
+      return ToResponse(error);
+    }
+  }
+  std::string format = "json";
+  reader.OptionalString("format", &format, {"json", "ndjson"});
+  if (!reader.Finish()) return ToResponse(error);
+  if (std::string why; !plan.IsValid(&why)) {
+    CoreRefusal(why, "", &error);
+    return ToResponse(error);
+  }
+  const std::uint64_t total = plan.DesignCount();
+  if (total > context.limits.max_samples) {
+    SetError(&error, "TooBig", "parameters", nullptr,
+             "describe " + std::to_string(total) + " designs, over the limit max_samples = " +
+                 std::to_string(context.limits.max_samples));
+    return ToResponse(error);
+  }
+
+  // Designs: grids are enumerated by index; LHS and Sobol are drawn in full
+  // (every shard draws the same sequence) and then filtered by shard.
+  std::vector<std::vector<double>> drawn;
+  if (plan.method != core::SamplingMethod::kGrid) drawn = core::GenerateDesigns(plan);
+  Json rows = Json::array();
+  std::vector<std::vector<double>> objective_values;
+  std::uint64_t evaluated = 0, failed = 0;
+  const std::uint64_t in_shard = total / shard.count + (shard.index < total % shard.count ? 1 : 0);
+  for (std::uint64_t i = shard.index; i < total; i += shard.count) {
+    if (core::IsCancelled(context.progress)) {
+      return ErrorResponse(409, "Cancelled", "the sweep was cancelled after " +
+                                                 std::to_string(evaluated) + " designs");
+    }
+    const std::vector<double> point =
+        plan.method == core::SamplingMethod::kGrid ? core::GridDesign(plan, i)
+                                                   : drawn[static_cast<std::size_t>(i)];
+    Json design = base;
+    Json values = Json::object();
+    for (std::size_t k = 0; k < parameters.size(); ++k) {
+      SetNumberAtPath(&design, parameters[k].steps, point[k], nullptr);
+      values[parameters[k].path] = point[k];
+    }
+    Json row = EvaluateDesign(design, outputs, options, context.limits);
+    row["index"] = i;
+    row["parameters"] = std::move(values);
+    if (!row["feasible"].get<bool>()) ++failed;
+    if (!objectives.empty()) {
+      std::vector<double> v;
+      for (const auto& objective : objectives) {
+        const Json::json_pointer pointer(objective.pointer);
+        v.push_back(row.contains(pointer) && row[pointer].is_number() ? row[pointer].get<double>()
+                                                                       : std::nan(""));
+      }
+      objective_values.push_back(std::move(v));
+    }
+    rows.push_back(std::move(row));
+    ++evaluated;
+    if (context.progress != nullptr && in_shard > 0) {
+      context.progress->Report(static_cast<double>(evaluated) / static_cast<double>(in_shard));
+    }
+  }
+  Json summary{{"designs_total", total},
+               {"designs_in_shard", evaluated},
+               {"failed", failed},
+               {"sampling", core::SamplingMethodName(plan.method)},
+               {"seed", plan.seed},
+               {"shard", {{"index", shard.index}, {"count", shard.count}}},
+               {"timing_s", SecondsSince(start)}};
+  if (!objectives.empty()) {
+    std::vector<core::Sense> senses;
+    for (const auto& o : objectives) senses.push_back(o.sense);
+    Json front = Json::array();
+    for (const std::size_t k : core::ParetoFront(objective_values, senses)) {
+      front.push_back(rows[k]["index"]);
+    }
+    summary["pareto_front"] = std::move(front);
+    summary["pareto_scope"] = "the rows of this response (this shard)";
+  }
+  summary["provenance"] = Provenance(*body, Json::object(), plan.seed);
+  if (format == "ndjson") {
+    std::string text;
+    for (const auto& row : rows) {
+      text += row.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
+    }
+    text += Json{{"summary", summary}}.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
+    return Response::Text(200, std::move(text), "application/x-ndjson");
+  }
+  return {200, {{"rows", std::move(rows)}, {"summary", std::move(summary)}}};
+}
+
+}  // namespace sweetspot::api

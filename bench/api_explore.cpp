@@ -1,0 +1,49 @@
+// Throughput of /v1/explore with the rigid model (issue 7's target: at least a
+// million designs per minute per core, i.e. >= 16,667 designs/s), and of one
+// /v1/sweet-spot request through the handler (no network).
+#include <benchmark/benchmark.h>
+
+#include <string>
+
+#include "api/router.hpp"
+
+namespace {
+
+using sweetspot::api::Context;
+using sweetspot::api::Dispatch;
+
+std::string Sweep(int designs, const char* outputs) {
+  return std::string(R"({"bat": {"preset": "paper-wood",
+      "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
+      "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": )") +
+         std::to_string(designs) + R"(}], "outputs": )" + outputs + "}";
+}
+
+void BM_ExploreRigid(benchmark::State& state, const char* outputs) {
+  const int designs = static_cast<int>(state.range(0));
+  const std::string body = Sweep(designs, outputs);
+  const Context context;
+  for (auto _ : state) {
+    auto response = Dispatch({"POST", "/v1/explore", body}, context);
+    if (response.status != 200) state.SkipWithError("explore failed");
+    benchmark::DoNotOptimize(response);
+  }
+  state.SetItemsProcessed(state.iterations() * designs);
+}
+BENCHMARK_CAPTURE(BM_ExploreRigid, max_exit_speed, R"(["max_exit_speed"])")->Arg(1000);
+BENCHMARK_CAPTURE(BM_ExploreRigid, max_and_properties, R"(["max_exit_speed", "properties"])")
+    ->Arg(1000);
+
+void BM_SweetSpotRequest(benchmark::State& state) {
+  const std::string body = R"({"bat": {"preset": "paper-wood"},
+      "outputs": ["max_exit_speed", "center_of_percussion", "sweet_zone"]})";
+  const Context context;
+  for (auto _ : state) {
+    auto response = Dispatch({"POST", "/v1/sweet-spot", body}, context);
+    benchmark::DoNotOptimize(response);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_SweetSpotRequest);
+
+}  // namespace

@@ -1,0 +1,209 @@
+// POST /v1/explore: sweeps, shards, seeds, failed designs, Pareto fronts, limits.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+
+#include "api/json_path.hpp"
+#include "api/router.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+Response Explore(const Json& body, const Context& context = {}) {
+  return Dispatch({"POST", "/v1/explore", body.dump()}, context);
+}
+
+Json CorkSweep() {
+  return Json::parse(R"({
+    "bat": {"preset": "paper-wood",
+            "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
+    "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 31}],
+    "outputs": ["max_exit_speed", "properties"]})");
+}
+
+TEST(ExploreTest, GridRowsMatchSingleRequests) {
+  const Response r = Explore(CorkSweep());
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  ASSERT_EQ(r.body["rows"].size(), 31u);
+  EXPECT_EQ(r.body["summary"]["designs_total"], 31);
+  const Json& row = r.body["rows"][10];
+  EXPECT_EQ(row["index"], 10);
+  EXPECT_NEAR(row["parameters"]["fill.depth_m"].get<double>(), 0.1, 1e-15);
+  // The same design through /v1/sweet-spot gives the same numbers (same code path).
+  Json single = Json::parse(R"({"bat": {"preset": "paper-wood",
+      "fill": {"material": "cork", "diameter_m": 0.0254}}})");
+  single["bat"]["fill"]["depth_m"] = row["parameters"]["fill.depth_m"];
+  const Response s = Dispatch({"POST", "/v1/sweet-spot", single.dump()}, Context{});
+  ASSERT_EQ(s.status, 200);
+  EXPECT_EQ(row["max_exit_speed"]["exit_speed_mps"], s.body["max_exit_speed"]["exit_speed_mps"]);
+  EXPECT_EQ(row["properties"]["mass_kg"], s.body["properties"]["mass_kg"]);
+  // Deeper cork: lighter bat (Table 4's direction).
+  EXPECT_LT(r.body["rows"][30]["properties"]["mass_kg"].get<double>(),
+            r.body["rows"][0]["properties"]["mass_kg"].get<double>());
+}
+
+TEST(ExploreTest, UnionOfShardsEqualsTheUnshardedSweepRowForRow) {
+  for (const char* sampling : {"grid", "lhs", "sobol"}) {
+    Json body = CorkSweep();
+    body["parameters"].push_back({{"path", "ball.speed_mps"}, {"min", 20}, {"max", 40}, {"count", 3}});
+    body["sampling"] = sampling;
+    if (std::string(sampling) != "grid") {
+      body["samples"] = 40;
+      body["seed"] = 11;
+    }
+    const Response whole = Explore(body);
+    ASSERT_EQ(whole.status, 200) << whole.body.dump();
+    std::map<int, Json> merged;
+    for (int index = 0; index < 3; ++index) {
+      body["shard"] = {{"index", index}, {"count", 3}};
+      const Response part = Explore(body);
+      ASSERT_EQ(part.status, 200);
+      for (const auto& row : part.body["rows"]) {
+        EXPECT_TRUE(merged.emplace(row["index"].get<int>(), row).second) << "duplicate row";
+      }
+    }
+    ASSERT_EQ(merged.size(), whole.body["rows"].size()) << sampling;
+    for (const auto& row : whole.body["rows"]) {
+      EXPECT_EQ(merged.at(row["index"].get<int>()), row) << sampling;
+    }
+  }
+}
+
+TEST(ExploreTest, SameSeedSameDesignsOtherSeedOthers) {
+  Json body = CorkSweep();
+  body["sampling"] = "lhs";
+  body["samples"] = 8;
+  body["seed"] = 5;
+  const Response a = Explore(body);
+  const Response b = Explore(body);
+  ASSERT_EQ(a.status, 200);
+  EXPECT_EQ(a.body["rows"], b.body["rows"]);
+  EXPECT_EQ(a.body["summary"]["provenance"]["seed"], 5);
+  body["seed"] = 6;
+  EXPECT_NE(Explore(body).body["rows"], a.body["rows"]);
+}
+
+TEST(ExploreTest, FailedDesignsAreRowsNotFailures) {
+  Json body = CorkSweep();
+  // Bores wider than the 0.07 m barrel are refused by the bat's rules.
+  body["parameters"] = {{{"path", "fill.diameter_m"}, {"min", 0.02}, {"max", 0.08}, {"count", 4}}};
+  const Response r = Explore(body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["summary"]["failed"], 1);
+  const Json& bad = r.body["rows"][3];
+  EXPECT_FALSE(bad["feasible"].get<bool>());
+  EXPECT_EQ(bad["error"]["field"], "bat.fill.diameter_m");
+  EXPECT_TRUE(r.body["rows"][0]["feasible"].get<bool>());
+}
+
+TEST(ExploreTest, ParetoFrontOverTwoObjectives) {
+  Json body = CorkSweep();
+  body["parameters"] = {{{"path", "fill.depth_m"}, {"min", 0.0}, {"max", 0.3}, {"count", 7}},
+                        {{"path", "ball.speed_mps"}, {"min", 20}, {"max", 30}, {"count", 3}}};
+  body["pareto"] = {{"objectives",
+                     {{{"output", "max_exit_speed.exit_speed_mps"}, {"sense", "max"}},
+                      {{"output", "properties.mass_kg"}, {"sense", "min"}}}}};
+  const Response r = Explore(body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  // Independent check: a row is on the front iff no row is at least as fast and as light,
+  // and strictly better in one.
+  std::set<int> expected;
+  const Json& rows = r.body["rows"];
+  for (const auto& a : rows) {
+    bool dominated = false;
+    for (const auto& b : rows) {
+      const double va = a["max_exit_speed"]["exit_speed_mps"], vb = b["max_exit_speed"]["exit_speed_mps"];
+      const double ma = a["properties"]["mass_kg"], mb = b["properties"]["mass_kg"];
+      dominated = dominated || (vb >= va && mb <= ma && (vb > va || mb < ma));
+    }
+    if (!dominated) expected.insert(a["index"].get<int>());
+  }
+  std::set<int> front;
+  for (const auto& i : r.body["summary"]["pareto_front"]) front.insert(i.get<int>());
+  EXPECT_EQ(front, expected);
+  EXPECT_FALSE(front.empty());
+}
+
+TEST(ExploreTest, NdjsonHasOneLinePerRowAndASummary) {
+  Json body = CorkSweep();
+  body["format"] = "ndjson";
+  const Response r = Explore(body);
+  ASSERT_EQ(r.status, 200);
+  EXPECT_EQ(r.content_type, "application/x-ndjson");
+  std::size_t lines = 0;
+  std::string last;
+  for (std::size_t pos = 0, next; (next = r.text.find('\n', pos)) != std::string::npos;
+       pos = next + 1) {
+    last = r.text.substr(pos, next - pos);
+    ASSERT_FALSE(Json::parse(last, nullptr, false).is_discarded());
+    ++lines;
+  }
+  EXPECT_EQ(lines, 32u);
+  EXPECT_TRUE(Json::parse(last).contains("summary"));
+}
+
+TEST(ExploreTest, LimitsAndBadPathsAreNamed) {
+  Context context;
+  context.limits.max_samples = 100;
+  Json body = CorkSweep();
+  body["parameters"][0]["count"] = 101;
+  Response r = Explore(body, context);
+  EXPECT_EQ(r.status, 413);
+  EXPECT_EQ(r.body["code"], "TooBig");
+  EXPECT_EQ(r.body["field"], "parameters");
+
+  body = CorkSweep();
+  body["parameters"][0]["path"] = "three_segment.taper_start_m";
+  r = Explore(body);
+  EXPECT_EQ(r.status, 400);
+  EXPECT_EQ(r.body["field"], "parameters[0].path");
+  EXPECT_EQ(r.body["message"],
+            "parameters[0].path = \"three_segment.taper_start_m\": the request has no field "
+            "bat.three_segment (give it in the request)");
+
+  body = CorkSweep();
+  body["sampling"] = "sobol";
+  r = Explore(body);
+  EXPECT_EQ(r.status, 400);
+  EXPECT_EQ(r.body["code"], "MissingField");
+  EXPECT_EQ(r.body["field"], "samples");
+
+  body = CorkSweep();
+  body["shard"] = {{"index", 2}, {"count", 2}};
+  r = Explore(body);
+  EXPECT_EQ(r.status, 400);
+  EXPECT_EQ(r.body["message"], "shard.index = 2: must be below shard.count = 2");
+}
+
+TEST(ExploreTest, CancelledSweepStops) {
+  core::Progress progress;
+  progress.Cancel();
+  Context context;
+  context.progress = &progress;
+  const Response r = Explore(CorkSweep(), context);
+  EXPECT_EQ(r.status, 409);
+  EXPECT_EQ(r.body["code"], "Cancelled");
+}
+
+TEST(JsonPathTest, ParsesSetsAndRefuses) {
+  std::string why;
+  const auto steps = ParseJsonPath("profile.knots[3].radius_m", &why);
+  ASSERT_TRUE(steps.has_value()) << why;
+  ASSERT_EQ(steps->size(), 4u);
+  EXPECT_EQ(std::get<std::size_t>((*steps)[2]), 3u);
+  Json doc = {{"profile", {{"knots", Json::array({{{"radius_m", 1}}, {{"radius_m", 2}},
+                                                  {{"radius_m", 3}}, {{"radius_m", 4}}})}}}};
+  EXPECT_TRUE(SetNumberAtPath(&doc, *steps, 0.5, &why)) << why;
+  EXPECT_EQ(doc["profile"]["knots"][3]["radius_m"], 0.5);
+  EXPECT_EQ(NumberAtPath(doc, *steps, &why), 0.5);
+  EXPECT_FALSE(ParseJsonPath("a..b", &why).has_value());
+  EXPECT_FALSE(ParseJsonPath("a[x]", &why).has_value());
+  EXPECT_FALSE(SetNumberAtPath(&doc, *ParseJsonPath("profile.knots[9].radius_m", &why), 1, &why));
+  EXPECT_EQ(why, "the request has no element profile.knots[9]");
+}
+
+}  // namespace
+}  // namespace sweetspot::api
