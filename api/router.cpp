@@ -57,8 +57,10 @@ const std::vector<Route>& Routes() {
        HandleCollision, true},
       {"POST", "/v1/compare", "A baseline bat against variants: properties, sweet spot, deltas.",
        HandleCompare, true},
-      {"POST", "/v1/optimize", "Ipopt bat design (not available yet: 501).", HandleOptimize,
-       true},
+      {"POST", "/v1/optimize",
+       "Ipopt design of a bat's profile and material under length, mass, balance-point, MOI, "
+       "diameter, taper and league-rule constraints.",
+       HandleOptimize, true},
       {"POST", "/v1/explore",
        "Design sweeps: grid, Latin hypercube or Sobol samples, shards, a Pareto front.",
        HandleExplore, true},

@@ -1,0 +1,357 @@
+// POST /v1/optimize: Ipopt design of a bat's profile and material under
+// length, mass, balance-point, MOI, diameter, taper and league-rule
+// constraints. The answer's bat is in the request's own form, so it can be
+// sent straight back to /v1/bat/properties.
+#include <chrono>
+#include <cmath>
+
+#include "api/bat_json.hpp"
+#include "api/handlers.hpp"
+#include "api/json_path.hpp"
+#include "api/scene_json.hpp"
+#include "core/optimize/design_problem.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Json Finite(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+// A constraint: a number (equality) or {"min", "max"} (either optional).
+bool ReadRange(ObjectReader& reader, const char* key, const NumberRule& rule,
+               std::optional<core::DesignRange>* out) {
+  const Json* value = reader.Get(key);
+  if (value == nullptr || !reader.ok()) return reader.ok();
+  if (value->is_number()) {
+    double v = 0;
+    if (!reader.OptionalNumber(key, rule, &v)) return false;
+    *out = core::DesignRange::Equal(v);
+    return true;
+  }
+  ObjectReader range(*value, reader.PathOf(key), reader.error());
+  core::DesignRange r;
+  r.min = range.MaybeNumber("min", rule);
+  r.max = range.MaybeNumber("max", rule);
+  if (!range.Finish()) return false;
+  if (!r.min && !r.max) return range.Fail("min", "give min, max or both", "MissingField");
+  if (r.min && r.max && *r.min > *r.max) {
+    return range.Fail("max", "must be >= min = " + Show(Json(*r.min)));
+  }
+  *out = r;
+  return true;
+}
+
+bool ReadConstraints(ObjectReader& top, core::DesignConstraints* c) {
+  const Json* value = top.Get("constraints");
+  if (value == nullptr || !top.ok()) return top.ok();
+  ObjectReader reader(*value, "constraints", top.error());
+  ReadRange(reader, "length_m", Positive(100.0), &c->length_m);
+  ReadRange(reader, "mass_kg", Positive(1e4), &c->mass_kg);
+  ReadRange(reader, "balance_point_m", Positive(100.0), &c->balance_point_m);
+  ReadRange(reader, "moi_six_inch_kg_m2", Positive(1e4), &c->moi_six_inch_kg_m2);
+  c->max_barrel_diameter_m = reader.MaybeNumber("max_barrel_diameter_m", Positive(10.0));
+  c->min_handle_diameter_m = reader.MaybeNumber("min_handle_diameter_m", Positive(10.0));
+  if (const Json* taper = reader.Get("taper")) {
+    if (taper->is_string() && taper->get<std::string>() == "non_decreasing") {
+      c->taper = core::TaperRule::kNonDecreasing;
+    } else if (taper->is_object()) {
+      ObjectReader t(*taper, "constraints.taper", top.error());
+      t.Number("max_slope", Positive(100.0), &c->max_taper_slope);
+      long long first = 0, last = -1;
+      t.OptionalInteger("first_knot", 0, 100000, &first);
+      t.OptionalInteger("last_knot", -1, 100000, &last);
+      if (!t.Finish()) return false;
+      c->taper = core::TaperRule::kMaxSlope;
+      c->taper_first_knot = static_cast<int>(first);
+      c->taper_last_knot = static_cast<int>(last);
+    } else {
+      return reader.Fail("taper", "must be \"non_decreasing\" or {\"max_slope\": dr/dx}");
+    }
+  }
+  if (const Json* rules = reader.Get("rules")) {
+    std::vector<Json> names;
+    if (rules->is_string()) {
+      names.push_back(*rules);
+    } else if (rules->is_array()) {
+      names.assign(rules->begin(), rules->end());
+    } else {
+      return reader.Fail("rules", "must be a rule-set name or an array of names");
+    }
+    for (const Json& name : names) {
+      const auto rule = name.is_string() ? core::ParseRuleSet(name.get<std::string>())
+                                         : std::nullopt;
+      if (!rule) return reader.Fail("rules", "must name rule sets among mlb-wood, bbcor, usssa");
+      c->rules.push_back(*rule);
+    }
+  }
+  return reader.Finish();
+}
+
+bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignOptions* o) {
+  const Json* value = top.Get("options");
+  if (value == nullptr || !top.ok()) return top.ok();
+  ObjectReader reader(*value, "options", top.error());
+  std::string backend = "ipopt", hessian = "limited_memory", check = "none";
+  reader.OptionalString("backend", &backend, {"ipopt", "nlopt_slsqp"});
+  reader.OptionalString("hessian", &hessian, {"limited_memory", "exact"});
+  reader.OptionalString("derivative_check", &check, {"none", "first_order", "second_order"});
+  o->backend = backend == "ipopt" ? core::DesignBackend::kIpopt : core::DesignBackend::kNloptSlsqp;
+  o->hessian = hessian == "exact" ? core::HessianMode::kExact : core::HessianMode::kLimitedMemory;
+  o->derivative_check = check == "first_order"    ? core::DerivativeCheck::kFirstOrder
+                        : check == "second_order" ? core::DerivativeCheck::kSecondOrder
+                                                  : core::DerivativeCheck::kNone;
+  long long iterations = o->max_iterations, starts = o->starts, seed = 1;
+  reader.OptionalInteger("max_iterations", 1, limits.max_iterations, &iterations);
+  reader.OptionalInteger("starts", 1, 64, &starts);
+  reader.OptionalInteger("seed", 0, 1LL << 53, &seed);
+  o->max_iterations = static_cast<int>(iterations);
+  o->starts = static_cast<int>(starts);
+  o->seed = static_cast<std::uint64_t>(seed);
+  reader.OptionalNumber("max_time_s", Positive(limits.max_time_s), &o->max_time_s);
+  reader.OptionalNumber("max_cpu_time_s", NonNegative(limits.max_time_s), &o->max_cpu_time_s);
+  reader.OptionalNumber("tolerance", NumberRule{0.0, 1.0, true, true, false}, &o->tolerance);
+  reader.OptionalNumber("constraint_tolerance", NumberRule{0.0, 1.0, true, true, false},
+                        &o->constraint_tolerance);
+  reader.OptionalBool("explain_infeasibility", &o->explain_infeasibility);
+  if (!reader.Finish()) return false;
+  if (std::string why; !o->IsValid(&why)) return CoreRefusal(why, "options", top.error());
+  return true;
+}
+
+// The answer's bat in the request's own form: each variable written back at
+// its path; where the request's form lacks the path's parent (a preset), the
+// shape or material block is written out whole.
+Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r) {
+  Json bat = request_bat;
+  for (const core::DesignValue& v : r.variables) {
+    std::string why;
+    const auto steps = ParseJsonPath(v.path, &why);
+    if (steps && SetNumberAtPath(&bat, *steps, v.value, &why)) continue;
+    if (v.path.rfind("three_segment.", 0) == 0 && r.three_segment) {
+      const auto& s = *r.three_segment;
+      bat["three_segment"] = {{"length_m", s.length_m},
+                              {"handle_radius_m", s.handle_radius_m},
+                              {"barrel_radius_m", s.barrel_radius_m},
+                              {"taper_start_m", s.taper_start_m},
+                              {"taper_end_m", s.taper_end_m}};
+    } else if (v.path.rfind("profile.", 0) == 0) {
+      bat["profile"] = BatToJson(r.bat)["profile"];
+    } else if (v.path.rfind("material.", 0) == 0) {
+      Json material = MaterialToJson(r.bat.material);
+      material.erase("source");
+      material.erase("density_range_kg_m3");
+      if (material["cor"].is_null()) material.erase("cor");
+      bat["material"] = std::move(material);
+    } else if (v.path.rfind("fill.", 0) == 0 || v.path == "wall_thickness_m") {
+      const Json built = BatToJson(r.bat);
+      if (built.contains("fill")) bat["fill"] = built["fill"];
+      if (built.contains("wall_thickness_m")) bat["wall_thickness_m"] = built["wall_thickness_m"];
+    }
+  }
+  return bat;
+}
+
+Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
+  Json variables = Json::object();
+  for (const auto& v : r.variables) variables[v.path] = v.value;
+  Json active = Json::array();
+  for (const auto& a : r.active_constraints) {
+    active.push_back({{"name", a.name},
+                      {"unit", a.unit},
+                      {"value", a.value},
+                      {"bound", a.bound},
+                      {"multiplier", a.multiplier}});
+  }
+  Json runs = Json::array();
+  for (const auto& s : r.spread.runs) {
+    runs.push_back({{"index", s.index},
+                    {"termination", core::TerminationName(s.termination)},
+                    {"raw_status", s.raw_status},
+                    {"iterations", s.iterations},
+                    {"objective", Finite(s.objective)},
+                    {"constraint_violation", Finite(s.constraint_violation)}});
+  }
+  Json summary = SummaryToJson(r.summary);
+  summary["constraint_violation"] = Finite(r.summary.constraint_violation);
+  summary["active_constraints"] = std::move(active);
+  summary["spread"] = {{"starts", r.spread.starts},
+                       {"converged", r.spread.converged},
+                       {"feasible", r.spread.feasible},
+                       {"best_start", r.spread.best_start},
+                       {"objective_min", Finite(r.spread.objective_min)},
+                       {"objective_max", Finite(r.spread.objective_max)},
+                       {"objective_median", Finite(r.spread.objective_median)},
+                       {"runs", std::move(runs)}};
+  if (r.derivative_check_errors >= 0) {
+    summary["derivative_check"] = {{"errors", r.derivative_check_errors},
+                                   {"report", r.derivative_check_report}};
+  }
+  Json conflicts = Json::array();
+  for (const auto& c : r.conflicts) {
+    conflicts.push_back({{"constraints", c.constraints},
+                         {"unit", c.unit},
+                         {"requested_min", Finite(c.requested_min)},
+                         {"requested_max", Finite(c.requested_max)},
+                         {"achievable_min", Finite(c.achievable_min)},
+                         {"achievable_max", Finite(c.achievable_max)},
+                         {"shortfall", Finite(c.shortfall)},
+                         {"message", c.message}});
+  }
+  Json out{{"bat", BatInRequestForm(request_bat, r)},
+           {"variables", std::move(variables)},
+           {"properties", PropertiesToJson(r.properties, r.bat.LengthM())},
+           {"objective_value", Finite(r.objective_value)},
+           {"objective_unit", r.objective_unit},
+           {"cor", r.cor},
+           {"sweet_spot",
+            {{"position_from_knob_m", Finite(r.sweet_spot_from_knob_m)},
+             {"exit_speed_mps", Finite(r.max_exit_speed_mps)},
+             {"angular_speed_rad_s", Finite(r.angular_speed_rad_s)}}},
+           {"summary", std::move(summary)}};
+  if (!conflicts.empty()) out["conflicts"] = std::move(conflicts);
+  return out;
+}
+
+}  // namespace
+
+Response HandleOptimize(const Request& request, const Context& context) {
+  const auto start = std::chrono::steady_clock::now();
+  Response failure;
+  const auto body = ParseObjectBody(request, context, &failure);
+  if (!body) return failure;
+  ApiError error;
+  ObjectReader reader(*body, "", &error);
+  const Json* bat_json = reader.Get("bat");
+  if (bat_json == nullptr) {
+    reader.Missing("bat");
+    return ToResponse(error);
+  }
+  const auto spec = ParseBat(*bat_json, "bat", context.limits, &error);
+  if (!spec) return ToResponse(error);
+  core::DesignProblem problem;
+  problem.bat = spec->bat;
+  problem.three_segment = spec->three_segment;
+  core::Scene scene;
+  if (!ReadSceneCommon(reader, &scene)) return ToResponse(error);
+  problem.ball = scene.ball;
+  problem.swing = scene.swing;
+  problem.cor = scene.cor;
+  problem.inertia_model = scene.inertia_model;
+
+  std::vector<core::Material> material_choices;
+  const Json* variables = reader.Get("variables");
+  if (reader.ok() && variables == nullptr) reader.Missing("variables");
+  if (!reader.ok()) return ToResponse(error);
+  if (!variables->is_array() || variables->empty() || variables->size() > 200) {
+    reader.Fail("variables", "must be an array of 1 to 200 {\"path\", \"min\", \"max\"}");
+    return ToResponse(error);
+  }
+  for (std::size_t i = 0; i < variables->size(); ++i) {
+    const std::string where = "variables[" + std::to_string(i) + "]";
+    ObjectReader v((*variables)[i], where, &error);
+    core::DesignVariable variable;
+    v.String("path", &variable.path);
+    if (v.ok() && variable.path == "material") {  // a discrete choice among materials
+      const Json* choices = v.Get("choices");
+      if (choices == nullptr || !choices->is_array() || choices->empty() || choices->size() > 16) {
+        v.Fail("choices", "must be an array of 1 to 16 material names");
+        return ToResponse(error);
+      }
+      for (std::size_t k = 0; k < choices->size(); ++k) {
+        auto m = ParseMaterial((*choices)[k], where + ".choices[" + std::to_string(k) + "]",
+                               false, &error);
+        if (!m) return ToResponse(error);
+        material_choices.push_back(*m);
+      }
+      if (!v.Finish()) return ToResponse(error);
+      continue;
+    }
+    v.Number("min", Between(-1e12, 1e12), &variable.min);
+    v.Number("max", Between(-1e12, 1e12), &variable.max);
+    if (!v.Finish()) return ToResponse(error);
+    if (!core::ParseDesignVariablePath(variable.path)) {
+      SetError(&error, "InvalidValue", where + ".path", &(*variables)[i]["path"],
+               "is not a design variable (profile.knots[i].radius_m, profile.knots[i].x_m, "
+               "three_segment.<field>, material.density_kg_m3, wall_thickness_m, "
+               "fill.diameter_m, fill.depth_m, fill.material.density_kg_m3, or material with "
+               "choices)");
+      return ToResponse(error);
+    }
+    problem.variables.push_back(variable);
+  }
+  if (!ReadConstraints(reader, &problem.constraints)) return ToResponse(error);
+  std::string objective = "max_exit_speed";
+  reader.OptionalString("objective", &objective,
+                        {"max_exit_speed", "max_exit_speed_swing_weight", "widest_sweet_zone",
+                         "min_moi", "min_sting"});
+  problem.objective = *core::ParseDesignObjective(objective);
+  reader.OptionalNumber("swing_weight_exponent", Between(0.0, 0.5), &problem.swing_weight_exponent);
+  reader.OptionalNumber("sweet_zone_tolerance_mps", Positive(100.0),
+                        &problem.sweet_zone_tolerance_mps);
+  core::DesignOptions options;
+  if (!ReadOptions(reader, context.limits, &options) || !reader.Finish()) return ToResponse(error);
+  if (problem.variables.empty()) {
+    reader.Fail("variables", "needs at least one continuous variable besides a material choice");
+    return ToResponse(error);
+  }
+  if (std::string why; !problem.IsValid(&why)) {
+    CoreRefusal(why, "", &error);
+    return ToResponse(error);
+  }
+
+  const Json options_json = body->contains("options") ? (*body)["options"] : Json::object();
+  Json out;
+  const core::DesignResult* chosen = nullptr;
+  core::MaterialChoiceResult choice;
+  core::DesignResult single;
+  if (!material_choices.empty()) {
+    choice = core::OptimizeOverMaterials(problem, material_choices, options, context.progress);
+    Json per_material = Json::array();
+    for (const auto& m : choice.per_material) {
+      per_material.push_back({{"material", m.material},
+                              {"termination", core::TerminationName(m.result.summary.termination)},
+                              {"message", m.result.summary.message},
+                              {"objective_value", Finite(m.result.objective_value)}});
+    }
+    if (choice.best >= 0) chosen = &choice.per_material[static_cast<std::size_t>(choice.best)].result;
+    out = chosen != nullptr ? ResultToJson(*chosen, *bat_json) : Json::object();
+    out["materials"] = std::move(per_material);
+    if (chosen == nullptr) {
+      return ErrorResponse(422, "Infeasible",
+                           "no material gives a usable design: " + choice.summary.message,
+                           "variables");
+    }
+  } else {
+    single = core::OptimizeDesign(problem, options, context.progress);
+    chosen = &single;
+    out = ResultToJson(single, *bat_json);
+  }
+  out["objective"] = objective;
+  out["provenance"] = Provenance(*body, options_json, options.seed);
+  out["timing_s"] = SecondsSince(start);
+  switch (chosen->summary.termination) {
+    case core::Termination::kInvalidInput: {
+      CoreRefusal(chosen->summary.message, "", &error);
+      return ToResponse(error);
+    }
+    case core::Termination::kInfeasible: {
+      std::string message = "no design meets the constraints";
+      if (!chosen->conflicts.empty()) message += ": " + chosen->conflicts.front().message;
+      return {422,
+              {{"code", "Infeasible"},
+               {"message", message},
+               {"field", "constraints"},
+               {"closest", std::move(out)}}};
+    }
+    default:
+      // converged, no_convergence and failure: the summary says which.
+      return {200, std::move(out)};
+  }
+}
+
+}  // namespace sweetspot::api

@@ -1,0 +1,133 @@
+// Design optimisation (core/optimize): a 16-knot profile design (target <= 100 ms per solve),
+// limited-memory vs exact Hessian, Ipopt vs NLopt SLSQP, and the model's evaluation costs.
+// Run: build/bench/sweetspot_bench_core --benchmark_filter=Optimize
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "core/material.hpp"
+#include "core/optimize/design_model.hpp"
+#include "core/optimize/design_problem.hpp"
+#include "core/presets.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+// A 16-knot solid ash bat, 0.86 m: handle 0.0125 m, a smooth taper to a 0.0325 m barrel.
+Bat SixteenKnotBat() {
+  Bat bat;
+  const int n = 16;
+  const double length = 0.86;
+  for (int i = 0; i < n; ++i) {
+    const double x = length * i / (n - 1);
+    const double s = x / length;
+    bat.knots.push_back({x, 0.0125 + 0.020 / (1.0 + std::exp(-14.0 * (s - 0.55)))});
+  }
+  bat.material = *FindMaterial("ash");
+  return bat;
+}
+
+// Max exit speed over the radii of knots 1..14 (the knob knot and the tip fixed), at the base
+// mass, with the balance point at most 0.60 m, a 2.61-in barrel limit, a 0.9-in handle
+// minimum and a non-decreasing taper.
+DesignProblem SixteenKnotProblem() {
+  DesignProblem p;
+  p.bat = SixteenKnotBat();
+  for (int i = 1; i <= 14; ++i) {
+    p.variables.push_back({"profile.knots[" + std::to_string(i) + "].radius_m", 0.0110, 0.0332});
+  }
+  p.constraints.mass_kg = DesignRange::Equal(ComputeMassProperties(p.bat).mass_kg);
+  p.constraints.balance_point_m = DesignRange::AtMost(0.60);
+  p.constraints.max_barrel_diameter_m = InchesToMetres(2.61);
+  p.constraints.min_handle_diameter_m = InchesToMetres(0.9);
+  p.constraints.taper = TaperRule::kNonDecreasing;
+  return p;
+}
+
+DesignProblem ThreeSegmentProblem() {
+  DesignProblem p;
+  p.three_segment = ThreeSegmentShape{0.8636, 0.0125, 0.033, 0.30, 0.55};
+  p.bat.material = *FindMaterial("ash");
+  p.variables = {{"three_segment.taper_start_m", 0.1, 0.5},
+                 {"three_segment.taper_end_m", 0.3, 0.8},
+                 {"three_segment.barrel_radius_m", 0.028, 0.0331}};
+  p.constraints.mass_kg = DesignRange::Equal(0.88);
+  p.constraints.balance_point_m = DesignRange::Between(0.56, 0.60);
+  p.constraints.rules = {RuleSet::kMlbWood};
+  return p;
+}
+
+void Report(benchmark::State& state, const DesignResult& r) {
+  state.counters["iterations"] = r.summary.iterations;
+  state.counters["evaluations"] = r.summary.evaluations;
+  state.counters["objective_mps"] = r.objective_value;
+  state.counters["converged"] = r.summary.termination == Termination::kConverged ? 1 : 0;
+}
+
+void BM_OptimizeSixteenKnots(benchmark::State& state) {
+  const DesignProblem p = SixteenKnotProblem();
+  DesignOptions o;
+  o.hessian = state.range(0) != 0 ? HessianMode::kExact : HessianMode::kLimitedMemory;
+  DesignResult r;
+  for (auto _ : state) {
+    r = OptimizeDesign(p, o);
+    benchmark::DoNotOptimize(r);
+  }
+  Report(state, r);
+  state.SetLabel(o.hessian == HessianMode::kExact ? "exact hessian" : "limited-memory");
+}
+BENCHMARK(BM_OptimizeSixteenKnots)->Arg(0)->Arg(1)->ArgName("exact")->Unit(benchmark::kMillisecond);
+
+void BM_OptimizeSixteenKnotsNlopt(benchmark::State& state) {
+  const DesignProblem p = SixteenKnotProblem();
+  DesignOptions o;
+  o.backend = DesignBackend::kNloptSlsqp;
+  DesignResult r;
+  for (auto _ : state) {
+    r = OptimizeDesign(p, o);
+    benchmark::DoNotOptimize(r);
+  }
+  Report(state, r);
+}
+BENCHMARK(BM_OptimizeSixteenKnotsNlopt)->Unit(benchmark::kMillisecond);
+
+void BM_OptimizeThreeSegment(benchmark::State& state) {
+  const DesignProblem p = ThreeSegmentProblem();
+  DesignOptions o;
+  o.hessian = state.range(0) != 0 ? HessianMode::kExact : HessianMode::kLimitedMemory;
+  DesignResult r;
+  for (auto _ : state) {
+    r = OptimizeDesign(p, o);
+    benchmark::DoNotOptimize(r);
+  }
+  Report(state, r);
+}
+BENCHMARK(BM_OptimizeThreeSegment)->Arg(0)->Arg(1)->ArgName("exact")->Unit(benchmark::kMillisecond);
+
+// The model alone: one evaluation with gradients, and one exact Hessian (16 knots, 14 variables).
+void BM_OptimizeModelEvaluate(benchmark::State& state) {
+  DesignModel model;
+  std::string why;
+  DesignModel::Build(SixteenKnotProblem(), DesignOptions{}, &model, &why);
+  const std::vector<double> x = model.BaseX();
+  DesignPoint point;
+  const bool hessian = state.range(0) != 0;
+  std::vector<double> weights(static_cast<std::size_t>(model.m()), 1.0);
+  Eigen::MatrixXd h;
+  for (auto _ : state) {
+    if (hessian) {
+      model.Hessian(x.data(), 1.0, weights.data(), &h);
+      benchmark::DoNotOptimize(h.data());
+    } else {
+      model.Evaluate(x.data(), true, &point);
+      benchmark::DoNotOptimize(point);
+    }
+  }
+  state.SetLabel(hessian ? "hessian" : "values+gradients");
+}
+BENCHMARK(BM_OptimizeModelEvaluate)->Arg(0)->Arg(1)->ArgName("hessian");
+
+}  // namespace
+}  // namespace sweetspot::core

@@ -1,0 +1,57 @@
+// Internal to core/optimize: one local solve of a ScaledDesignNlp by Ipopt or NLopt SLSQP.
+// The solvers' headers stay in ipopt_backend.cpp and nlopt_design.cpp.
+#pragma once
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "core/optimize/design_model.hpp"
+#include "core/optimize/design_problem.hpp"
+#include "core/progress.hpp"
+#include "core/summary.hpp"
+
+namespace sweetspot::core {
+
+/// How one local solve runs.
+struct LocalSolveSettings {
+  int max_iterations = 300;             ///< Iteration limit.
+  double tolerance = 1e-9;              ///< Ipopt tol / NLopt relative tolerances.
+  double constraint_tolerance = 1e-10;  ///< Ipopt constr_viol_tol (scaled constraints).
+  HessianMode hessian = HessianMode::kLimitedMemory;          ///< Ipopt's Hessian.
+  double max_cpu_time_s = 0.0;                                ///< Ipopt max_cpu_time; 0 = not set.
+  std::chrono::steady_clock::time_point deadline;             ///< Stop (no_convergence) after this.
+  Progress* progress = nullptr;                               ///< Polled for cancellation.
+  DerivativeCheck derivative_check = DerivativeCheck::kNone;  ///< Ipopt's checker.
+};
+
+/// The outcome of one local solve (scaled variables and multipliers).
+struct LocalSolveOutcome {
+  std::vector<double> s;         ///< Final point (scaled).
+  std::vector<double> lambda;    ///< Constraint multipliers of the scaled NLP (Ipopt sign).
+  std::vector<double> z_lower;   ///< Lower-bound multipliers (>= 0).
+  std::vector<double> z_upper;   ///< Upper-bound multipliers (>= 0).
+  bool has_multipliers = false;  ///< False for NLopt (estimated afterwards).
+  bool has_point = false;        ///< False when the solver returned no usable point.
+  Termination termination = Termination::kFailure;  ///< Mapped status.
+  int raw_status = 0;                               ///< The solver's own status.
+  std::string status_name;                          ///< Its name.
+  int iterations = 0;                               ///< Iterations (NLopt: objective evaluations).
+  int evaluations = 0;                              ///< Model evaluations.
+  bool cancelled = false;                           ///< Stopped by Progress::Cancel().
+  bool deadline_reached = false;                    ///< Stopped by the wall-clock budget.
+  std::string message;                              ///< Extra detail (exceptions, ...).
+  int derivative_check_errors = -1;     ///< Ipopt's checker: errors found (-1 = not run).
+  std::string derivative_check_report;  ///< Ipopt's checker: its output.
+};
+
+/// Solves from s0 with Ipopt (holds the process-wide Ipopt lock for the whole lifecycle of
+/// the application and the TNLP). Never throws.
+LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>& s0,
+                                 const LocalSolveSettings& settings);
+
+/// Solves from s0 with NLopt LD_SLSQP. Never throws.
+LocalSolveOutcome SolveWithNlopt(ScaledDesignNlp& nlp, const std::vector<double>& s0,
+                                 const LocalSolveSettings& settings);
+
+}  // namespace sweetspot::core

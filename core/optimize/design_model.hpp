@@ -1,0 +1,215 @@
+// Internal to core/optimize (public only so that tests can check it): the design problem as a
+// smooth nonlinear program. No solver headers here.
+//
+// Parameters: the knot list of the profile (a three-segment design is the 4 knots (0, r1),
+// (x1, r1), (x2, r2), (L, r2), coincident knots allowed: the integrals never divide by a
+// segment's length, so the map from (L, r1, r2, x1, x2) to the mass properties is smooth
+// everywhere, including x1 = 0, x2 = L and x1 = x2 where ThreeSegmentShape::Knots() merges
+// knots), then density, wall, fill diameter, depth and density (DesignParameterLayout order).
+// Each variable sets one or two of these parameters.
+//
+// Mass integrals: P = (M, S1, S2, L) with S1, S2 the first and second moments about a fixed
+// reference point c0 (the base design's balance point; S2 includes the cross-sections' own
+// moments for the rigid-body model). Every property is a closed form in P: C = c0 + S1 / M,
+// I(p) = S2 + 2 (c0 - p) S1 + (c0 - p)^2 M. Gradients come from forward-mode AD per segment
+// (6 local parameters) and per fill (5), Hessians from second-order forward-mode AD of the
+// same code (jet.hpp): H = (dP/dx)^T W (dP/dx) + sum_c w_c d2P_c/dx2.
+#pragma once
+
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/bat.hpp"
+#include "core/optimize/design_problem.hpp"
+
+namespace sweetspot::core {
+
+/// A smooth function of the design (internal).
+enum class DesignFunction {
+  kLinear,        ///< sum coefficient * parameter + constant.
+  kMass,          ///< M, kg.
+  kBalancePoint,  ///< C, m from the knob.
+  kMoiSixInch,    ///< I about 0.1524 m, kg·m².
+  kDrop,          ///< length_in - weight_oz (dimensionless).
+  kObjective,     ///< The problem's objective, in its unit.
+};
+
+/// A function of the design: what constraints and objectives are made of (internal).
+struct DesignFunctionSpec {
+  DesignFunction function = DesignFunction::kLinear;  ///< Which function.
+  std::vector<std::pair<int, double>> terms;          ///< kLinear: (parameter index, coefficient).
+  double constant = 0.0;                              ///< kLinear: constant term.
+};
+
+/// A constraint lower <= f(x) <= upper (internal).
+struct DesignConstraintSpec {
+  std::string name;      ///< Equality name / base name, e.g. "mass_kg".
+  std::string min_name;  ///< Name when the lower limit is active, e.g. "balance_point_m.min".
+  std::string max_name;  ///< Name when the upper limit is active.
+  std::string unit;      ///< "kg", "m", "kg_m2", "" (dimensionless).
+  DesignFunctionSpec f;  ///< The constrained function.
+  double lower = -std::numeric_limits<double>::infinity();  ///< Lower limit (unit).
+  double upper = std::numeric_limits<double>::infinity();   ///< Upper limit (unit).
+  double scale = 1.0;     ///< Typical magnitude (unit): the NLP sees f / scale.
+  bool property = false;  ///< A mass-property or length constraint (analysed for conflicts).
+};
+
+/// A design variable (internal).
+struct DesignVariableSpec {
+  std::string path;             ///< Its path.
+  DesignVariableRef ref;        ///< Parsed path.
+  double lower = 0.0;           ///< Bound, field unit.
+  double upper = 0.0;           ///< Bound, field unit.
+  double base = 0.0;            ///< The base design's value (not clamped).
+  std::vector<int> parameters;  ///< Parameter indices it sets.
+};
+
+/// Values (and gradients) of the objective and constraints at a point, in user units.
+struct DesignPoint {
+  double objective = 0.0;              ///< F, objective unit.
+  std::vector<double> constraints;     ///< g_k, unit of each.
+  Eigen::VectorXd objective_gradient;  ///< dF/dx (when requested).
+  Eigen::MatrixXd jacobian;            ///< dg/dx, m x n (when requested).
+  double mass_kg = 0.0;                ///< M.
+  double balance_point_m = 0.0;        ///< C.
+  double moi_six_inch_kg_m2 = 0.0;     ///< I6.
+  double length_m = 0.0;               ///< L.
+};
+
+/// The design problem as an NLP over the variables x (user units). Immutable after Build;
+/// const methods are thread-safe.
+class DesignModel {
+ public:
+  /// Builds the model; false (with "field = value: rule" in *why) for invalid input. A
+  /// constraint that no variable can change is checked here: if it fails, the model is still
+  /// built and fixed_violations() names it.
+  static bool Build(const DesignProblem& problem, const DesignOptions& options, DesignModel* out,
+                    std::string* why);
+
+  int n() const { return static_cast<int>(variables_.size()); }                    ///< Variables.
+  int m() const { return static_cast<int>(constraints_.size()); }                  ///< Constraints.
+  const std::vector<DesignVariableSpec>& variables() const { return variables_; }  ///< Variables.
+  const std::vector<DesignConstraintSpec>& constraints() const { return constraints_; }  ///< All.
+  /// Constraints that no variable changes and that fail at the base design (names + text).
+  const std::vector<std::string>& fixed_violations() const { return fixed_violations_; }
+  const DesignFunctionSpec& objective() const { return objective_; }  ///< The objective.
+  bool maximize() const { return maximize_; }                         ///< Objective sense.
+  double objective_scale() const { return objective_scale_; }         ///< Typical |F|.
+  std::string objective_unit() const { return objective_unit_; }      ///< Unit of F.
+  double cor() const { return cor_; }                                 ///< The COR used.
+  double reference_moi_six_inch_kg_m2() const { return i6_ref_; }     ///< I6_ref.
+  /// omega of the swing for a design with MOI `i6` about the 6-in point, rad/s.
+  double AngularSpeedFor(double i6_kg_m2) const;
+  /// The start: the base design clamped into the bounds.
+  std::vector<double> BaseX() const;
+
+  /// f(x) for a function (user units); NaN when not finite.
+  double Value(const DesignFunctionSpec& f, const double* x) const;
+  /// Objective and constraints at x; false when a value is not finite (or M <= 0).
+  bool Evaluate(const double* x, bool with_gradients, DesignPoint* out) const;
+  /// Hessian of objective_weight * F + sum_k constraint_weights[k] g_k at x (n x n, user
+  /// units); false when not finite.
+  bool Hessian(const double* x, double objective_weight, const double* constraint_weights,
+               Eigen::MatrixXd* out) const;
+
+  /// The bat at x (a three-segment design goes through ThreeSegmentShape::Knots()).
+  Bat BatAt(const double* x) const;
+  /// The three-segment shape at x (nullopt for a profile design).
+  std::optional<ThreeSegmentShape> ShapeAt(const double* x) const;
+
+  /// A copy that minimises or maximises `f` instead of the objective (same constraints).
+  DesignModel WithObjective(const DesignFunctionSpec& f, bool maximize, double scale,
+                            const std::string& unit) const;
+  /// A copy with only the constraints whose indices are in `keep` (in that order).
+  DesignModel WithConstraints(const std::vector<int>& keep) const;
+
+ private:
+  template <typename Scalar>
+  Scalar ObjectiveOf(const Scalar* p) const;
+  template <typename Scalar>
+  Scalar FunctionOf(DesignFunction f, const Scalar* p) const;
+  std::vector<double> ParametersAt(const double* x) const;
+
+  std::vector<DesignVariableSpec> variables_;
+  std::vector<DesignConstraintSpec> constraints_;
+  std::vector<std::string> fixed_violations_;
+  DesignFunctionSpec objective_;
+  bool maximize_ = true;
+  double objective_scale_ = 1.0;
+  std::string objective_unit_;
+  DesignObjective objective_kind_ = DesignObjective::kMaxExitSpeed;
+
+  Bat base_bat_;                                 // material, wall, fill, profile knots
+  std::optional<ThreeSegmentShape> base_shape_;  // three-segment designs
+  std::vector<double> base_parameters_;          // DesignParameterLayout order
+  std::vector<int> parameter_variable_;          // parameter -> variable index or -1
+  int num_knots_ = 0;
+  bool hollow_ = false;
+  bool has_fill_ = false;
+  bool rigid_ = true;
+  double c0_ = 0.0;  // reference point of S1, S2, m from the knob
+
+  // Scene.
+  double ball_mass_kg_ = 0.145;
+  double ball_speed_mps_ = 27.7;
+  double omega0_rad_s_ = 17.288;
+  double pivot_from_knob_m_ = 0.0;
+  double cor_ = 0.5;
+  double swing_weight_exponent_ = 0.27;
+  double zone_tolerance_mps_ = 1.0;
+  double i6_ref_ = 1.0;
+};
+
+/// The model as the solvers see it: variables scaled to s in [0, 1] (x = lower + (upper -
+/// lower) s), objective sense * F / objective_scale (always minimised), constraints g / scale.
+/// Caches the last point's values and gradients. One per solve (not thread-safe).
+class ScaledDesignNlp {
+ public:
+  explicit ScaledDesignNlp(const DesignModel& model);
+
+  int n() const { return model_.n(); }                 ///< Variables.
+  int m() const { return model_.m(); }                 ///< Constraints.
+  const DesignModel& model() const { return model_; }  ///< The model.
+  /// Scaled constraint bounds (+-inf for open sides).
+  void ConstraintBounds(std::vector<double>* lower, std::vector<double>* upper) const;
+  /// For each constraint, the variables its gradient may involve (the Jacobian's structure).
+  const std::vector<std::vector<int>>& structure() const { return structure_; }
+  /// x (user units) -> s.
+  std::vector<double> ToScaled(const std::vector<double>& x) const;
+  /// s -> x (user units).
+  std::vector<double> ToUser(const double* s) const;
+
+  /// Evaluates at s (cached); false when not finite.
+  bool Evaluate(const double* s, bool with_gradients);
+  double f() const { return f_; }                                ///< Scaled objective.
+  const std::vector<double>& g() const { return g_; }            ///< Scaled constraints.
+  const Eigen::VectorXd& grad_f() const { return grad_f_; }      ///< d f / d s.
+  const Eigen::MatrixXd& jacobian() const { return jacobian_; }  ///< d g / d s (m x n).
+  /// Hessian of sigma f + sum lambda_k g_k in s (n x n); false when not finite.
+  bool Hessian(const double* s, double sigma, const double* lambda, Eigen::MatrixXd* out) const;
+  int evaluations() const { return evaluations_; }  ///< Model evaluations so far.
+
+  /// Largest violation of the scaled constraints at the last evaluated point (>= 0).
+  double Violation() const;
+
+ private:
+  const DesignModel& model_;
+  std::vector<double> width_;
+  std::vector<std::vector<int>> structure_;
+  std::vector<double> last_s_;
+  bool have_values_ = false;
+  bool have_gradients_ = false;
+  double f_ = 0.0;
+  std::vector<double> g_;
+  Eigen::VectorXd grad_f_;
+  Eigen::MatrixXd jacobian_;
+  DesignPoint point_;
+  int evaluations_ = 0;
+};
+
+}  // namespace sweetspot::core

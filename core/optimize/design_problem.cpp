@@ -1,0 +1,141 @@
+// Names, parsing and validation of the design problem's public types.
+#include "core/optimize/design_problem.hpp"
+
+#include <charconv>
+#include <cmath>
+
+#include "core/geometry_format.hpp"
+#include "core/optimize/design_model.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+struct FixedPath {
+  DesignVariableKind kind;
+  const char* path;
+};
+
+constexpr FixedPath kFixedPaths[] = {
+    {DesignVariableKind::kLength, "three_segment.length_m"},
+    {DesignVariableKind::kHandleRadius, "three_segment.handle_radius_m"},
+    {DesignVariableKind::kBarrelRadius, "three_segment.barrel_radius_m"},
+    {DesignVariableKind::kTaperStart, "three_segment.taper_start_m"},
+    {DesignVariableKind::kTaperEnd, "three_segment.taper_end_m"},
+    {DesignVariableKind::kDensity, "material.density_kg_m3"},
+    {DesignVariableKind::kWallThickness, "wall_thickness_m"},
+    {DesignVariableKind::kFillDiameter, "fill.diameter_m"},
+    {DesignVariableKind::kFillDepth, "fill.depth_m"},
+    {DesignVariableKind::kFillDensity, "fill.material.density_kg_m3"},
+};
+
+struct ObjectiveName {
+  DesignObjective objective;
+  const char* name;
+};
+
+constexpr ObjectiveName kObjectiveNames[] = {
+    {DesignObjective::kMaxExitSpeed, "max_exit_speed"},
+    {DesignObjective::kMaxExitSpeedSwingWeight, "max_exit_speed_swing_weight"},
+    {DesignObjective::kWidestSweetZone, "widest_sweet_zone"},
+    {DesignObjective::kMinMoi, "min_moi"},
+    {DesignObjective::kMinSting, "min_sting"},
+};
+
+bool Refuse(std::string* why, std::string_view field, double value, std::string_view rule) {
+  if (why != nullptr) *why = RefusalMessage(field, value, rule);
+  return false;
+}
+
+}  // namespace
+
+std::optional<DesignVariableRef> ParseDesignVariablePath(std::string_view path) {
+  for (const FixedPath& f : kFixedPaths) {
+    if (path == f.path) return DesignVariableRef{f.kind, -1};
+  }
+  constexpr std::string_view kPrefix = "profile.knots[";
+  if (path.substr(0, kPrefix.size()) != kPrefix) return std::nullopt;
+  std::string_view rest = path.substr(kPrefix.size());
+  const std::size_t close = rest.find(']');
+  if (close == std::string_view::npos || close == 0 || close > 6) return std::nullopt;
+  const std::string_view digits = rest.substr(0, close);
+  for (char c : digits) {
+    if (c < '0' || c > '9') return std::nullopt;
+  }
+  if (digits.size() > 1 && digits[0] == '0') return std::nullopt;  // one spelling per index
+  int index = 0;
+  std::from_chars(digits.data(), digits.data() + digits.size(), index);
+  const std::string_view member = rest.substr(close + 1);
+  if (member == ".radius_m") return DesignVariableRef{DesignVariableKind::kKnotRadius, index};
+  if (member == ".x_m") return DesignVariableRef{DesignVariableKind::kKnotPosition, index};
+  return std::nullopt;
+}
+
+std::string DesignVariablePath(const DesignVariableRef& ref) {
+  if (ref.kind == DesignVariableKind::kKnotRadius) {
+    return "profile.knots[" + std::to_string(ref.knot) + "].radius_m";
+  }
+  if (ref.kind == DesignVariableKind::kKnotPosition) {
+    return "profile.knots[" + std::to_string(ref.knot) + "].x_m";
+  }
+  for (const FixedPath& f : kFixedPaths) {
+    if (f.kind == ref.kind) return f.path;
+  }
+  return "";
+}
+
+const char* DesignObjectiveName(DesignObjective objective) {
+  for (const auto& o : kObjectiveNames) {
+    if (o.objective == objective) return o.name;
+  }
+  return "unknown";
+}
+
+std::optional<DesignObjective> ParseDesignObjective(std::string_view name) {
+  for (const auto& o : kObjectiveNames) {
+    if (name == o.name) return o.objective;
+  }
+  return std::nullopt;
+}
+
+bool DesignProblem::IsValid(std::string* why) const {
+  DesignModel model;
+  return DesignModel::Build(*this, DesignOptions{}, &model, why);
+}
+
+bool DesignOptions::IsValid(std::string* why) const {
+  if (max_iterations < 1 || max_iterations > 100000) {
+    return Refuse(why, "max_iterations", max_iterations, "must be between 1 and 100000");
+  }
+  if (!std::isfinite(max_time_s) || !(max_time_s > 0.0)) {
+    return Refuse(why, "max_time_s", max_time_s, "must be finite and positive");
+  }
+  if (!std::isfinite(max_cpu_time_s) || max_cpu_time_s < 0.0) {
+    return Refuse(why, "max_cpu_time_s", max_cpu_time_s, "must be finite and >= 0 (0 = not set)");
+  }
+  if (!std::isfinite(tolerance) || !(tolerance > 0.0) || !(tolerance < 1.0)) {
+    return Refuse(why, "tolerance", tolerance, "must be in (0, 1)");
+  }
+  if (!std::isfinite(constraint_tolerance) || !(constraint_tolerance > 0.0) ||
+      !(constraint_tolerance < 1.0)) {
+    return Refuse(why, "constraint_tolerance", constraint_tolerance, "must be in (0, 1)");
+  }
+  if (starts < 1 || starts > 64) return Refuse(why, "starts", starts, "must be between 1 and 64");
+  if (!std::isfinite(min_knot_gap_m) || !(min_knot_gap_m > 0.0) || min_knot_gap_m > 0.1) {
+    return Refuse(why, "min_knot_gap_m", min_knot_gap_m, "must be in (0, 0.1]");
+  }
+  if (derivative_check == DerivativeCheck::kSecondOrder && hessian != HessianMode::kExact) {
+    if (why != nullptr) {
+      *why =
+          "derivative_check = second-order: needs hessian = exact (the limited-memory "
+          "approximation has no second derivatives to check)";
+    }
+    return false;
+  }
+  if (derivative_check != DerivativeCheck::kNone && backend != DesignBackend::kIpopt) {
+    if (why != nullptr) *why = "derivative_check: Ipopt's checker needs backend = ipopt";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace sweetspot::core

@@ -1,0 +1,325 @@
+// Bat design optimisation: what may change (variables with bounds), what must hold
+// (constraints, league rule sets), what to improve (objective) for a scene, and the answer
+// (the optimised bat, its properties, the objective, a Summary, the active constraints with
+// their multipliers, the conflicts of an infeasible request, the spread of a multi-start).
+// Solved with Ipopt (default) or NLopt SLSQP; the solvers' headers stay in core's .cpp files.
+// Value in, value out; never throws; thread-safe (Ipopt solves are serialised by one
+// process-wide lock: see docs/optimization.md). Everything SI; names carry units.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/bat.hpp"
+#include "core/mass_properties.hpp"
+#include "core/material.hpp"
+#include "core/optimize/rules.hpp"
+#include "core/progress.hpp"
+#include "core/scene.hpp"
+#include "core/summary.hpp"
+
+namespace sweetspot::core {
+
+/// What a design variable changes. The stable name of each is the request path of the field.
+enum class DesignVariableKind {
+  kKnotRadius,     ///< "profile.knots[i].radius_m": outer radius of knot i, m.
+  kKnotPosition,   ///< "profile.knots[i].x_m": knot i from the knob, m (i >= 1; the last is L).
+  kLength,         ///< "three_segment.length_m": L, m.
+  kHandleRadius,   ///< "three_segment.handle_radius_m": r1, m.
+  kBarrelRadius,   ///< "three_segment.barrel_radius_m": r2, m.
+  kTaperStart,     ///< "three_segment.taper_start_m": x1, m.
+  kTaperEnd,       ///< "three_segment.taper_end_m": x2, m.
+  kDensity,        ///< "material.density_kg_m3": the bat material's density, kg/m³.
+  kWallThickness,  ///< "wall_thickness_m": the shell's wall, m (the bat stays hollow).
+  kFillDiameter,   ///< "fill.diameter_m": m.
+  kFillDepth,      ///< "fill.depth_m": m.
+  kFillDensity,    ///< "fill.material.density_kg_m3": kg/m³ (0 = an empty bore).
+};
+
+/// A parsed variable path.
+struct DesignVariableRef {
+  DesignVariableKind kind = DesignVariableKind::kKnotRadius;  ///< Which field.
+  int knot = -1;  ///< Knot index for kKnotRadius / kKnotPosition; -1 otherwise.
+};
+
+/// The variable named by `path` ("profile.knots[3].radius_m", "fill.depth_m", ...), or nullopt.
+std::optional<DesignVariableRef> ParseDesignVariablePath(std::string_view path);
+/// The path of `ref` (inverse of ParseDesignVariablePath).
+std::string DesignVariablePath(const DesignVariableRef& ref);
+
+/// A field the optimiser may change, with its bounds in the field's unit.
+struct DesignVariable {
+  std::string path;  ///< The field (see DesignVariableKind), e.g. "three_segment.taper_start_m".
+  double min = 0.0;  ///< Lower bound, field unit (finite).
+  double max = 0.0;  ///< Upper bound, field unit (finite, > min).
+};
+
+/// A constraint's allowed values: equality when min == max; either side may be open.
+struct DesignRange {
+  std::optional<double> min;  ///< Lower limit (unit of the constrained quantity).
+  std::optional<double> max;  ///< Upper limit (unit of the constrained quantity).
+
+  /// [v, v].
+  static DesignRange Equal(double v) { return {v, v}; }
+  /// [lo, hi].
+  static DesignRange Between(double lo, double hi) { return {lo, hi}; }
+  /// (-inf, hi].
+  static DesignRange AtMost(double hi) { return {std::nullopt, hi}; }
+  /// [lo, inf).
+  static DesignRange AtLeast(double lo) { return {lo, std::nullopt}; }
+  /// True when both limits are set and equal.
+  bool IsEquality() const { return min.has_value() && max.has_value() && *min == *max; }
+};
+
+/// How the radius may vary along the taper.
+enum class TaperRule {
+  kNone,           ///< No rule.
+  kNonDecreasing,  ///< r(i+1) >= r(i) over the knot range (three-segment: r1 <= r2).
+  kMaxSlope,       ///< |r(i+1) - r(i)| <= max_taper_slope (x(i+1) - x(i)) over the knot range.
+};
+
+/// What must hold. Names of the constraints (for active constraints and conflicts) are given
+/// per field; a range reports "<name>.min" / "<name>.max" when one side is active.
+struct DesignConstraints {
+  std::optional<DesignRange> length_m;            ///< "length_m": L, m.
+  std::optional<DesignRange> mass_kg;             ///< "mass_kg": kg.
+  std::optional<DesignRange> balance_point_m;     ///< "balance_point_m": from the knob, m.
+  std::optional<DesignRange> moi_six_inch_kg_m2;  ///< "moi_six_inch_kg_m2": about 0.1524 m, kg·m².
+  /// "max_barrel_diameter_m.knots[i]": every knot's diameter at most this, m.
+  std::optional<double> max_barrel_diameter_m;
+  /// "min_handle_diameter_m.knots[i]": every knot's diameter at least this, m.
+  std::optional<double> min_handle_diameter_m;
+  TaperRule taper = TaperRule::kNone;  ///< "taper.knots[i]" / "max_slope.knots[i]" (i to i+1).
+  double max_taper_slope = 0.0;        ///< kMaxSlope: largest |dr/dx| (m per m, > 0).
+  int taper_first_knot = 0;            ///< Profile: the taper rule starts at this knot (>= 0).
+  int taper_last_knot = -1;            ///< Profile: ... and ends at this knot (-1 = the last).
+  std::vector<RuleSet> rules;          ///< League rule sets ("rules.<name>.<limit>").
+};
+
+/// What to improve.
+enum class DesignObjective {
+  /// "max_exit_speed": the rigid-pivot maximum exit speed over the bat, m/s (maximise).
+  kMaxExitSpeed,
+  /// "max_exit_speed_swing_weight": the same with omega = omega0 (I6 / I6_ref)^-n, m/s (maximise).
+  kMaxExitSpeedSwingWeight,
+  /// "widest_sweet_zone": length of the bat within sweet_zone_tolerance_mps of the max, m
+  /// (maximise).
+  kWidestSweetZone,
+  /// "min_moi": the MOI about the 6-in point, kg·m² (minimise).
+  kMinMoi,
+  /// "min_sting": refused (needs the flexible beam model, not available yet).
+  kMinSting,
+};
+
+/// Stable name (quoted above).
+const char* DesignObjectiveName(DesignObjective objective);
+/// The objective called `name`, or nullopt.
+std::optional<DesignObjective> ParseDesignObjective(std::string_view name);
+/// The refusal of "min_sting".
+inline constexpr char kMinStingRefusal[] =
+    "objective = min_sting: needs the flexible beam model, which is not available yet";
+
+/// A design problem: a base design, what may change, what must hold, what to improve.
+struct DesignProblem {
+  /// The base design: material, wall, fill and (without three_segment) the profile. It is the
+  /// first start (clamped into the variables' bounds) and supplies every fixed field.
+  Bat bat;
+  /// When set, the bat's profile is this three-segment shape (bat.knots is ignored) and the
+  /// "three_segment.*" variables apply; "profile.*" variables do not.
+  std::optional<ThreeSegmentShape> three_segment;
+  std::vector<DesignVariable> variables;                       ///< 1 to 200 distinct variables.
+  DesignConstraints constraints;                               ///< What must hold.
+  DesignObjective objective = DesignObjective::kMaxExitSpeed;  ///< What to improve.
+  /// kMaxExitSpeedSwingWeight: n in omega = omega0 (I6 / I6_ref)^-n, in [0, 0.5]; I6_ref is the
+  /// base design's MOI about the 6-in point, so the base design swings at omega0.
+  double swing_weight_exponent = 0.27;
+  /// kWidestSweetZone: the zone is where the exit speed is within this of the max, m/s (> 0).
+  double sweet_zone_tolerance_mps = 1.0;
+  Ball ball;                  ///< The pitched ball.
+  Swing swing;                ///< The swing (pivot and omega0); hands are not used.
+  std::optional<double> cor;  ///< COR in [0, 1]; unset = the bat material's default.
+  InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< How moments are computed.
+
+  /// True when the problem is well formed (variables parse and apply to this design, bounds
+  /// finite and ordered, constraints finite, the base bat valid, the rules' discrete limits
+  /// met); otherwise "field = value: rule" in *why.
+  bool IsValid(std::string* why) const;
+};
+
+/// How the Lagrangian's Hessian is obtained (Ipopt).
+enum class HessianMode {
+  kLimitedMemory,  ///< Ipopt's L-BFGS approximation (hessian_approximation = limited-memory).
+  /// Second derivatives by second-order forward-mode AD of the closed-form integrals and sweet
+  /// spot: exact up to rounding (no difference quotients).
+  kExact,
+};
+
+/// Which solver runs each local solve.
+enum class DesignBackend {
+  kIpopt,       ///< Ipopt 3.11 (interior point, MUMPS). The default.
+  kNloptSlsqp,  ///< NLopt LD_SLSQP (for cross-checks; multipliers estimated by least squares).
+};
+
+/// Ipopt's derivative checker, run at the first start.
+enum class DerivativeCheck {
+  kNone,         ///< Not run.
+  kFirstOrder,   ///< derivative_test = first-order (gradient and Jacobian).
+  kSecondOrder,  ///< derivative_test = second-order (also the Hessian; needs kExact).
+};
+
+/// How the optimisation runs. Defaults are valid.
+struct DesignOptions {
+  DesignBackend backend = DesignBackend::kIpopt;      ///< The local solver.
+  HessianMode hessian = HessianMode::kLimitedMemory;  ///< Ipopt's Hessian.
+  int max_iterations = 300;                           ///< Per local solve (1..100000).
+  /// Wall-clock budget of the whole call (all starts and the infeasibility analysis), s (> 0).
+  /// Checked in Ipopt's intermediate callback: a solve past it stops as no_convergence.
+  double max_time_s = 10.0;
+  /// Ipopt's max_cpu_time per local solve, s; 0 = not set. Ipopt 3.11 counts the CPU time of
+  /// every thread of the process, so under load it fires early: prefer max_time_s.
+  double max_cpu_time_s = 0.0;
+  double tolerance = 1e-9;  ///< Ipopt tol / NLopt ftol_rel (scaled problem, > 0, < 1).
+  /// Largest violation accepted for a converged point, relative to each constraint's scale
+  /// (Ipopt constr_viol_tol; > 0, < 1).
+  double constraint_tolerance = 1e-10;
+  int starts = 1;          ///< Local solves (1..64): the base design, then seeded random designs.
+  std::uint64_t seed = 1;  ///< Seed of the random starts (std::mt19937_64).
+  /// Smallest gap between neighbouring knots when knot positions are variables, m (> 0).
+  double min_knot_gap_m = 1e-4;
+  /// On an infeasible result, find which constraints conflict and by how much (a few small
+  /// solves).
+  bool explain_infeasibility = true;
+  DerivativeCheck derivative_check = DerivativeCheck::kNone;  ///< Ipopt's checker (first start).
+
+  /// True when every field is in range; otherwise "field = value: rule" in *why.
+  bool IsValid(std::string* why) const;
+};
+
+/// A variable's value in the answer.
+struct DesignValue {
+  std::string path;    ///< The variable's path.
+  double value = 0.0;  ///< Its value, field unit.
+};
+
+/// A constraint or variable bound that holds the design back.
+struct DesignActiveConstraint {
+  /// e.g. "mass_kg", "balance_point_m.max", "three_segment.barrel_radius_m.max",
+  /// "rules.bbcor.drop", "max_barrel_diameter_m.knots[5]".
+  std::string name;
+  std::string unit;    ///< Unit of value and bound ("kg", "m", "kg_m2", "kg_m3", "" = none).
+  double value = 0.0;  ///< The constrained quantity at the optimum.
+  double bound = 0.0;  ///< The limit it sits on.
+  /// Sensitivity of the optimal objective to the bound: objective unit per constraint unit
+  /// (first order, from the solver's multiplier). Positive: raising the bound raises the
+  /// objective value (better when maximising, worse when minimising).
+  double multiplier = 0.0;
+};
+
+/// A conflict found for an infeasible request.
+struct DesignConflict {
+  std::vector<std::string> constraints;  ///< The constraints involved, by name.
+  std::string unit;                      ///< Unit of the numbers below.
+  double requested_min = 0.0;            ///< What the first constraint asks (-inf if open).
+  double requested_max = 0.0;            ///< (+inf if open).
+  double achievable_min = 0.0;  ///< The least value reachable under the others (NaN if unknown).
+  double achievable_max = 0.0;  ///< The largest value reachable under the others (NaN if unknown).
+  double shortfall = 0.0;       ///< Distance between the two intervals (unit above; >= 0).
+  std::string message;          ///< One sentence, e.g. "mass_kg = 0.5 is below ...".
+};
+
+/// One local solve of a multi-start.
+struct DesignStart {
+  int index = 0;                                    ///< 0 = the base design.
+  Termination termination = Termination::kFailure;  ///< Its outcome.
+  int raw_status = 0;                               ///< Backend status.
+  int iterations = 0;                               ///< Iterations.
+  double objective = 0.0;                           ///< Objective at its end (NaN if none).
+  double constraint_violation = 0.0;                ///< Largest relative violation there.
+};
+
+/// The spread of the objective over the starts that ended feasible.
+struct DesignSpread {
+  int starts = 0;                 ///< Local solves run.
+  int converged = 0;              ///< Of which converged.
+  int feasible = 0;               ///< Of which ended feasible (converged or not).
+  int best_start = -1;            ///< Index of the start that gave the answer (-1 = none).
+  double objective_min = 0.0;     ///< Least objective over feasible ends (NaN if none).
+  double objective_max = 0.0;     ///< Largest (NaN if none).
+  double objective_median = 0.0;  ///< Median (NaN if none).
+  std::vector<DesignStart> runs;  ///< Every start, in order.
+};
+
+/// The answer of OptimizeDesign. The summary is always filled:
+/// - termination: converged (Ipopt converged and the design meets every constraint when
+///   re-checked through ComputeMassProperties), no_convergence (stopped by iterations, time,
+///   cancellation or round-off; best design kept), infeasible (no design meets the
+///   constraints: `conflicts` says why; the least-violating design is returned), failure,
+///   invalid_input (message names the field; the bat is the base design);
+/// - backend "ipopt" or "nlopt:LD_SLSQP"; raw_status = that solver's status of the chosen
+///   start (Ipopt ApplicationReturnStatus, NLopt result); iterations and evaluations summed
+///   over all solves; objective = objective_value; constraint_violation = the largest
+///   violation of a constraint or bound, each in its own unit, re-checked through the public
+///   mass properties; error_estimate = the relative first-order optimality (KKT) residual of
+///   the scaled problem at the answer; solve_time_s = wall time of the call.
+struct DesignResult {
+  Summary summary;                                 ///< How it went (see above).
+  Bat bat;                                         ///< The optimised bat.
+  std::optional<ThreeSegmentShape> three_segment;  ///< Its shape, for three-segment designs.
+  std::vector<DesignValue> variables;              ///< The variables' values, in request order.
+  MassProperties properties;                       ///< Its mass properties (problem.inertia_model).
+  double objective_value = 0.0;                    ///< The objective, in objective_unit.
+  std::string objective_unit;                      ///< "mps", "m" or "kg_m2".
+  double cor = 0.0;  ///< The COR used (NaN when none is known: min_moi without one).
+  /// Sweet spot of the answer (rigid pivot, closed form, at angular_speed_rad_s), m from the
+  /// knob; NaN when no COR is known (min_moi without one).
+  double sweet_spot_from_knob_m = 0.0;
+  double max_exit_speed_mps = 0.0;   ///< Max exit speed there, m/s (NaN as above).
+  double angular_speed_rad_s = 0.0;  ///< omega of the swing for the answer, rad/s.
+  std::vector<DesignActiveConstraint> active_constraints;  ///< What holds the design back.
+  std::vector<DesignConflict> conflicts;                   ///< For an infeasible request: why.
+  DesignSpread spread;                                     ///< Over the starts.
+  /// Errors reported by Ipopt's derivative checker (-1 = not run).
+  int derivative_check_errors = -1;
+  std::string derivative_check_report;  ///< The checker's output (empty if not run).
+};
+
+/// Optimises the design. Never throws. `progress` (may be null) receives the fraction of
+/// starts done and is polled for cancellation (a cancelled solve ends no_convergence with a
+/// message saying so).
+DesignResult OptimizeDesign(const DesignProblem& problem, const DesignOptions& options = {},
+                            Progress* progress = nullptr);
+
+/// One material's solve in OptimizeOverMaterials.
+struct MaterialDesignResult {
+  std::string material;  ///< The material's name.
+  DesignResult result;   ///< Its optimisation.
+};
+
+/// The answer of OptimizeOverMaterials.
+struct MaterialChoiceResult {
+  Summary summary;  ///< Termination of the best material's solve (or why none is usable).
+  int best = -1;    ///< Index into per_material of the best usable design (-1 = none).
+  std::vector<MaterialDesignResult> per_material;  ///< Every material, in the order given.
+};
+
+/// A discrete choice of material: solves `problem` once per material (the base bat's
+/// material replaced, the COR from the material unless problem.cor is set; rule sets apply
+/// per material, so e.g. mlb-wood refuses aluminium as invalid_input for that material) and
+/// picks the best usable design: converged ones first, then by objective. options.max_time_s
+/// bounds the whole call (one budget for all materials); `progress` covers all materials and is
+/// polled for cancellation inside each solve. Never throws.
+MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,
+                                           const std::vector<Material>& materials,
+                                           const DesignOptions& options = {},
+                                           Progress* progress = nullptr);
+
+/// The backend-neutral outcome of an Ipopt ApplicationReturnStatus (every value of 3.11:
+/// 0..6, -1..-4, -10..-13, -100..-102, -199); unknown codes map to kFailure.
+Termination TerminationFromIpoptStatus(int raw_status);
+/// Ipopt's name of a status ("Solve_Succeeded", ...; "Unknown" otherwise).
+const char* IpoptStatusName(int raw_status);
+
+}  // namespace sweetspot::core

@@ -1,0 +1,367 @@
+// The Ipopt backend: a TNLP per solve over ScaledDesignNlp, the status mapping, the lock.
+//
+// The lock: Ipopt 3.11.9 with the sequential MUMPS of Debian 12 is not thread-safe, and
+// guarding OptimizeTNLP alone is not enough (MUMPS aborted the process with exit status 0 in
+// that configuration; shared/docs/pitfalls.md). One process-wide mutex is therefore held from
+// creating the IpoptApplication to destroying it and the TNLP. It is the only mutable global
+// of core (a function-local static, constructed thread-safely on first use). Ipopt solves of
+// one process run one at a time: scale constrained solves with processes or replicas.
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <sstream>
+#include <string>
+
+#include <coin/IpIpoptApplication.hpp>
+#include <coin/IpJournalist.hpp>
+#include <coin/IpSolveStatistics.hpp>
+#include <coin/IpTNLP.hpp>
+
+#include "core/optimize/design_backends.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+std::mutex& IpoptMutex() {
+  static std::mutex mutex;  // the one allowed global: see the file comment
+  return mutex;
+}
+
+constexpr double kIpoptInfinity = 1e20;  // beyond nlp_lower/upper_bound_inf (1e19)
+
+using Ipopt::Index;
+using Ipopt::Number;
+
+class DesignTnlp : public Ipopt::TNLP {
+ public:
+  DesignTnlp(ScaledDesignNlp& nlp, const std::vector<double>& s0,
+             const LocalSolveSettings& settings, LocalSolveOutcome* out)
+      : nlp_(nlp), s0_(s0), settings_(settings), out_(out) {}
+
+  bool get_nlp_info(Index& n, Index& m, Index& nnz_jac_g, Index& nnz_h_lag,
+                    IndexStyleEnum& index_style) override {
+    n = nlp_.n();
+    m = nlp_.m();
+    nnz_jac_g = 0;
+    for (const auto& row : nlp_.structure()) nnz_jac_g += static_cast<Index>(row.size());
+    nnz_h_lag = n * (n + 1) / 2;
+    index_style = C_STYLE;
+    return true;
+  }
+
+  bool get_bounds_info(Index n, Number* x_l, Number* x_u, Index m, Number* g_l,
+                       Number* g_u) override {
+    for (Index j = 0; j < n; ++j) {
+      x_l[j] = 0.0;
+      x_u[j] = 1.0;
+    }
+    std::vector<double> lower, upper;
+    nlp_.ConstraintBounds(&lower, &upper);
+    for (Index k = 0; k < m; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      g_l[k] = std::isfinite(lower[kk]) ? lower[kk] : -kIpoptInfinity;
+      g_u[k] = std::isfinite(upper[kk]) ? upper[kk] : kIpoptInfinity;
+    }
+    return true;
+  }
+
+  bool get_starting_point(Index n, bool init_x, Number* x, bool init_z, Number* /*z_L*/,
+                          Number* /*z_U*/, Index /*m*/, bool init_lambda,
+                          Number* /*lambda*/) override {
+    if (init_z || init_lambda || !init_x) return false;
+    for (Index j = 0; j < n; ++j) x[j] = s0_[static_cast<std::size_t>(j)];
+    return true;
+  }
+
+  bool eval_f(Index /*n*/, const Number* x, bool /*new_x*/, Number& obj_value) override {
+    try {
+      if (!nlp_.Evaluate(x, false)) return false;
+      obj_value = nlp_.f();
+      return std::isfinite(obj_value);
+    } catch (...) {
+      return false;
+    }
+  }
+
+  bool eval_grad_f(Index n, const Number* x, bool /*new_x*/, Number* grad_f) override {
+    try {
+      if (!nlp_.Evaluate(x, true)) return false;
+      for (Index j = 0; j < n; ++j) {
+        grad_f[j] = nlp_.grad_f()(j);
+        if (!std::isfinite(grad_f[j])) return false;
+      }
+      return true;
+    } catch (...) {
+      return false;
+    }
+  }
+
+  bool eval_g(Index /*n*/, const Number* x, bool /*new_x*/, Index m, Number* g) override {
+    try {
+      if (!nlp_.Evaluate(x, false)) return false;
+      for (Index k = 0; k < m; ++k) {
+        g[k] = nlp_.g()[static_cast<std::size_t>(k)];
+        if (!std::isfinite(g[k])) return false;
+      }
+      return true;
+    } catch (...) {
+      return false;
+    }
+  }
+
+  bool eval_jac_g(Index /*n*/, const Number* x, bool /*new_x*/, Index /*m*/, Index /*nele_jac*/,
+                  Index* i_row, Index* j_col, Number* values) override {
+    try {
+      const auto& structure = nlp_.structure();
+      if (values == nullptr) {
+        Index e = 0;
+        for (std::size_t k = 0; k < structure.size(); ++k) {
+          for (int j : structure[k]) {
+            i_row[e] = static_cast<Index>(k);
+            j_col[e] = j;
+            ++e;
+          }
+        }
+        return true;
+      }
+      if (!nlp_.Evaluate(x, true)) return false;
+      Index e = 0;
+      for (std::size_t k = 0; k < structure.size(); ++k) {
+        for (int j : structure[k]) {
+          values[e] = nlp_.jacobian()(static_cast<Eigen::Index>(k), j);
+          if (!std::isfinite(values[e])) return false;
+          ++e;
+        }
+      }
+      return true;
+    } catch (...) {
+      return false;
+    }
+  }
+
+  bool eval_h(Index n, const Number* x, bool /*new_x*/, Number obj_factor, Index /*m*/,
+              const Number* lambda, bool /*new_lambda*/, Index /*nele_hess*/, Index* i_row,
+              Index* j_col, Number* values) override {
+    try {
+      if (values == nullptr) {
+        Index e = 0;
+        for (Index i = 0; i < n; ++i) {
+          for (Index j = 0; j <= i; ++j) {
+            i_row[e] = i;
+            j_col[e] = j;
+            ++e;
+          }
+        }
+        return true;
+      }
+      Eigen::MatrixXd h;
+      if (!nlp_.Hessian(x, obj_factor, lambda, &h)) return false;
+      Index e = 0;
+      for (Index i = 0; i < n; ++i) {
+        for (Index j = 0; j <= i; ++j) values[e++] = h(i, j);
+      }
+      return true;
+    } catch (...) {
+      return false;
+    }
+  }
+
+  void finalize_solution(Ipopt::SolverReturn /*status*/, Index n, const Number* x,
+                         const Number* z_L, const Number* z_U, Index m, const Number* /*g*/,
+                         const Number* lambda, Number /*obj_value*/,
+                         const Ipopt::IpoptData* /*ip_data*/,
+                         Ipopt::IpoptCalculatedQuantities* /*ip_cq*/) override {
+    if (x == nullptr) return;
+    out_->s.assign(x, x + n);
+    out_->has_point = true;
+    if (z_L != nullptr && z_U != nullptr && (m == 0 || lambda != nullptr)) {
+      out_->z_lower.assign(z_L, z_L + n);
+      out_->z_upper.assign(z_U, z_U + n);
+      out_->lambda.assign(lambda, lambda + m);
+      out_->has_multipliers = true;
+    }
+  }
+
+  bool intermediate_callback(Ipopt::AlgorithmMode /*mode*/, Index iter, Number /*obj_value*/,
+                             Number /*inf_pr*/, Number /*inf_du*/, Number /*mu*/, Number /*d_norm*/,
+                             Number /*regularization_size*/, Number /*alpha_du*/,
+                             Number /*alpha_pr*/, Index /*ls_trials*/,
+                             const Ipopt::IpoptData* /*ip_data*/,
+                             Ipopt::IpoptCalculatedQuantities* /*ip_cq*/) override {
+    out_->iterations = iter;
+    if (IsCancelled(settings_.progress)) {
+      out_->cancelled = true;
+      return false;
+    }
+    if (std::chrono::steady_clock::now() >= settings_.deadline) {
+      out_->deadline_reached = true;
+      return false;
+    }
+    return true;
+  }
+
+ private:
+  ScaledDesignNlp& nlp_;
+  std::vector<double> s0_;
+  const LocalSolveSettings& settings_;
+  LocalSolveOutcome* out_;
+};
+
+// Counts the errors in the derivative checker's output ("Derivative checker detected 3
+// error(s)." / "No errors detected by derivative checker."); -1 when neither line is there.
+int DerivativeCheckErrors(const std::string& report) {
+  if (report.find("No errors detected by derivative checker") != std::string::npos) return 0;
+  const std::string key = "Derivative checker detected ";
+  const std::size_t at = report.find(key);
+  if (at == std::string::npos) return -1;
+  return std::atoi(report.c_str() + at + key.size());
+}
+
+}  // namespace
+
+Termination TerminationFromIpoptStatus(int raw_status) {
+  switch (raw_status) {
+    case Ipopt::Solve_Succeeded:
+    case Ipopt::Solved_To_Acceptable_Level:
+      return Termination::kConverged;
+    case Ipopt::Infeasible_Problem_Detected:
+      return Termination::kInfeasible;
+    case Ipopt::Search_Direction_Becomes_Too_Small:
+    case Ipopt::User_Requested_Stop:
+    case Ipopt::Feasible_Point_Found:
+    case Ipopt::Maximum_Iterations_Exceeded:
+    case Ipopt::Maximum_CpuTime_Exceeded:
+      return Termination::kNoConvergence;
+    case Ipopt::Not_Enough_Degrees_Of_Freedom:
+    case Ipopt::Invalid_Problem_Definition:
+    case Ipopt::Invalid_Option:
+      return Termination::kInvalidInput;
+    case Ipopt::Diverging_Iterates:
+    case Ipopt::Restoration_Failed:
+    case Ipopt::Error_In_Step_Computation:
+    case Ipopt::Invalid_Number_Detected:
+    case Ipopt::Unrecoverable_Exception:
+    case Ipopt::NonIpopt_Exception_Thrown:
+    case Ipopt::Insufficient_Memory:
+    case Ipopt::Internal_Error:
+      return Termination::kFailure;
+  }
+  return Termination::kFailure;
+}
+
+const char* IpoptStatusName(int raw_status) {
+  switch (raw_status) {
+    case Ipopt::Solve_Succeeded:
+      return "Solve_Succeeded";
+    case Ipopt::Solved_To_Acceptable_Level:
+      return "Solved_To_Acceptable_Level";
+    case Ipopt::Infeasible_Problem_Detected:
+      return "Infeasible_Problem_Detected";
+    case Ipopt::Search_Direction_Becomes_Too_Small:
+      return "Search_Direction_Becomes_Too_Small";
+    case Ipopt::Diverging_Iterates:
+      return "Diverging_Iterates";
+    case Ipopt::User_Requested_Stop:
+      return "User_Requested_Stop";
+    case Ipopt::Feasible_Point_Found:
+      return "Feasible_Point_Found";
+    case Ipopt::Maximum_Iterations_Exceeded:
+      return "Maximum_Iterations_Exceeded";
+    case Ipopt::Restoration_Failed:
+      return "Restoration_Failed";
+    case Ipopt::Error_In_Step_Computation:
+      return "Error_In_Step_Computation";
+    case Ipopt::Maximum_CpuTime_Exceeded:
+      return "Maximum_CpuTime_Exceeded";
+    case Ipopt::Not_Enough_Degrees_Of_Freedom:
+      return "Not_Enough_Degrees_Of_Freedom";
+    case Ipopt::Invalid_Problem_Definition:
+      return "Invalid_Problem_Definition";
+    case Ipopt::Invalid_Option:
+      return "Invalid_Option";
+    case Ipopt::Invalid_Number_Detected:
+      return "Invalid_Number_Detected";
+    case Ipopt::Unrecoverable_Exception:
+      return "Unrecoverable_Exception";
+    case Ipopt::NonIpopt_Exception_Thrown:
+      return "NonIpopt_Exception_Thrown";
+    case Ipopt::Insufficient_Memory:
+      return "Insufficient_Memory";
+    case Ipopt::Internal_Error:
+      return "Internal_Error";
+  }
+  return "Unknown";
+}
+
+LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>& s0,
+                                 const LocalSolveSettings& settings) {
+  LocalSolveOutcome out;
+  const int evaluations_before = nlp.evaluations();
+  try {
+    std::ostringstream journal_text;
+    // Held until the application and the TNLP are gone (declared first, destroyed last).
+    std::lock_guard<std::mutex> lock(IpoptMutex());
+    Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+    Ipopt::SmartPtr<Ipopt::TNLP> tnlp = new DesignTnlp(nlp, s0, settings, &out);
+    Ipopt::SmartPtr<Ipopt::OptionsList> options = app->Options();
+    bool ok = true;
+    ok = ok && options->SetStringValue("sb", "yes");
+    ok = ok && options->SetIntegerValue("print_level", 0);
+    ok = ok && options->SetIntegerValue("max_iter", settings.max_iterations);
+    ok = ok && options->SetNumericValue("tol", settings.tolerance);
+    ok = ok && options->SetNumericValue("constr_viol_tol", settings.constraint_tolerance);
+    ok = ok && options->SetStringValue(
+                   "hessian_approximation",
+                   settings.hessian == HessianMode::kExact ? "exact" : "limited-memory");
+    ok = ok && options->SetStringValue("mu_strategy", "adaptive");
+    // No relaxation of the bounds: a design at a bound (a variable or a constraint) then meets
+    // it to round-off, not to 1e-8 of its scale (Ipopt's default relaxes both).
+    ok = ok && options->SetNumericValue("bound_relax_factor", 0.0);
+    if (settings.max_cpu_time_s > 0.0) {
+      ok = ok && options->SetNumericValue("max_cpu_time", settings.max_cpu_time_s);
+    }
+    if (settings.derivative_check != DerivativeCheck::kNone) {
+      ok = ok && options->SetStringValue("derivative_test",
+                                         settings.derivative_check == DerivativeCheck::kSecondOrder
+                                             ? "second-order"
+                                             : "first-order");
+      // The checker prints to the journals only: capture its lines in a string (the console
+      // journal stays at print_level 0).
+      Ipopt::SmartPtr<Ipopt::StreamJournal> journal =
+          new Ipopt::StreamJournal("sweetspot-derivative-check", Ipopt::J_WARNING);
+      journal->SetOutputStream(&journal_text);
+      journal->SetAllPrintLevels(Ipopt::J_NONE);
+      journal->SetPrintLevel(Ipopt::J_NLP, Ipopt::J_WARNING);
+      app->Jnlst()->AddJournal(Ipopt::GetRawPtr(journal));
+    }
+    if (!ok) {
+      out.raw_status = Ipopt::Invalid_Option;
+    } else {
+      std::istringstream no_options_file;  // never read ./ipopt.opt
+      Ipopt::ApplicationReturnStatus status = app->Initialize(no_options_file);
+      if (status == Ipopt::Solve_Succeeded) status = app->OptimizeTNLP(tnlp);
+      out.raw_status = static_cast<int>(status);
+      if (Ipopt::IsValid(app->Statistics())) {
+        out.iterations = app->Statistics()->IterationCount();
+      }
+    }
+    if (settings.derivative_check != DerivativeCheck::kNone) {
+      out.derivative_check_report = journal_text.str();
+      out.derivative_check_errors = DerivativeCheckErrors(out.derivative_check_report);
+    }
+  } catch (const std::exception& e) {
+    out.raw_status = Ipopt::NonIpopt_Exception_Thrown;
+    out.message = std::string("exception: ") + e.what();
+  } catch (...) {
+    out.raw_status = Ipopt::NonIpopt_Exception_Thrown;
+    out.message = "unknown exception";
+  }
+  out.termination = TerminationFromIpoptStatus(out.raw_status);
+  out.status_name = IpoptStatusName(out.raw_status);
+  out.evaluations = nlp.evaluations() - evaluations_before;
+  if (!out.has_point) out.s = s0;
+  return out;
+}
+
+}  // namespace sweetspot::core

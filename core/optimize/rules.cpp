@@ -1,0 +1,121 @@
+#include "core/optimize/rules.hpp"
+
+#include "core/geometry_format.hpp"
+#include "core/units.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+struct RuleName {
+  RuleSet rule;
+  const char* name;
+};
+
+constexpr RuleName kRuleNames[] = {
+    {RuleSet::kMlbWood, "mlb-wood"},
+    {RuleSet::kBbcor, "bbcor"},
+    {RuleSet::kUsssa, "usssa"},
+};
+
+constexpr const char* kWoods[] = {"ash", "hard-maple", "yellow-birch", "paper-wood"};
+
+bool Fail(std::string* why, const std::string& text) {
+  if (why != nullptr) *why = text;
+  return false;
+}
+
+}  // namespace
+
+const char* RuleSetName(RuleSet rule) {
+  for (const auto& r : kRuleNames) {
+    if (r.rule == rule) return r.name;
+  }
+  return "unknown";
+}
+
+std::optional<RuleSet> ParseRuleSet(std::string_view name) {
+  for (const auto& r : kRuleNames) {
+    if (name == r.name) return r.rule;
+  }
+  return std::nullopt;
+}
+
+const std::vector<RuleSet>& AllRuleSets() {
+  static const std::vector<RuleSet> kAll = {RuleSet::kMlbWood, RuleSet::kBbcor, RuleSet::kUsssa};
+  return kAll;
+}
+
+RuleSetLimits LimitsOf(RuleSet rule) {
+  RuleSetLimits out;
+  switch (rule) {
+    case RuleSet::kMlbWood:
+      out.max_diameter_m = InchesToMetres(2.61);
+      out.max_length_m = InchesToMetres(42.0);
+      out.solid_wood_only = true;
+      out.max_cup_depth_m = InchesToMetres(1.25);
+      out.min_cup_diameter_m = InchesToMetres(1.0);
+      out.max_cup_diameter_m = InchesToMetres(2.0);
+      out.source =
+          "MLB Official Baseball Rules 3.02(a): a smooth, round stick not more than 2.61 in in "
+          "diameter at the thickest part and not more than 42 in long, one piece of solid wood; "
+          "3.02(b) cupped bats: an indentation in the end up to 1 1/4 in deep (1 in in editions "
+          "before 2015, rule 1.10(b)), 1 in to 2 in in diameter, with no foreign substance.";
+      break;
+    case RuleSet::kBbcor:
+      out.max_diameter_m = InchesToMetres(2.625);
+      out.max_drop = 3.0;
+      out.max_bbcor = 0.50;
+      out.source =
+          "NCAA Baseball Rules 1-12 and NFHS Baseball Rules 1-3-2 (non-wood bats): barrel "
+          "diameter at most 2 5/8 in, length in inches minus weight in ounces at most 3, "
+          "certified BBCOR (batted-ball coefficient of restitution) at most 0.50. NFHS also "
+          "limits the length to 36 in (not applied here).";
+      break;
+    case RuleSet::kUsssa:
+      out.max_diameter_m = InchesToMetres(2.75);
+      out.source =
+          "USSSA Baseball bat rules: barrel diameter at most 2 3/4 in; the USSSA BPF 1.15 "
+          "performance mark is a lab certification, not modelled here.";
+      break;
+  }
+  return out;
+}
+
+bool IsWoodMaterial(const Material& material) {
+  for (const char* w : kWoods) {
+    if (material.name == w) return true;
+  }
+  return false;
+}
+
+bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, std::string* why) {
+  const RuleSetLimits limits = LimitsOf(rule);
+  const std::string prefix = std::string("rules.") + RuleSetName(rule) + ": ";
+  if (limits.solid_wood_only) {
+    if (!IsWoodMaterial(facts.material)) {
+      return Fail(why, prefix + "one piece of solid wood: material '" + facts.material.name +
+                           "' is not a wood of the catalogue (ash, hard-maple, yellow-birch, "
+                           "paper-wood)");
+    }
+    if (facts.wall_thickness_m > 0.0 || facts.wall_variable) {
+      return Fail(why, prefix + "one piece of solid wood: wall_thickness_m = " +
+                           FormatNumber(facts.wall_thickness_m) +
+                           (facts.wall_variable ? " (a design variable)" : "") +
+                           " makes a hollow shell");
+    }
+    if (facts.has_fill && (facts.fill_density_kg_m3 != 0.0 || facts.fill_density_variable)) {
+      return Fail(why, prefix + "one piece of solid wood: fill.material.density_kg_m3 = " +
+                           FormatNumber(facts.fill_density_kg_m3) +
+                           (facts.fill_density_variable ? " (a design variable)" : "") +
+                           " puts a foreign substance in the bat (only an empty cup is allowed)");
+    }
+  }
+  if (limits.max_bbcor.has_value() && facts.cor > *limits.max_bbcor) {
+    return Fail(why, prefix + "cor = " + FormatNumber(facts.cor) + " exceeds the BBCOR limit " +
+                         FormatNumber(*limits.max_bbcor) +
+                         " (for a rigid bat the BBCOR-style value equals the COR)");
+  }
+  return true;
+}
+
+}  // namespace sweetspot::core

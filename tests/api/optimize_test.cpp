@@ -1,0 +1,154 @@
+// POST /v1/optimize through the router: the contract's example, constraints
+// re-checked through /v1/bat/properties, infeasible and invalid requests,
+// material choice, reproducibility and concurrent solves.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
+
+#include "api/router.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+Response Post(const std::string& path, const Json& body) {
+  return Dispatch({"POST", path, body.dump()}, Context{});
+}
+
+Json ContractExample() {
+  return Json::parse(R"({
+    "bat": {"three_segment": {"length_m": 0.8636, "handle_radius_m": 0.0125,
+            "barrel_radius_m": 0.033, "taper_start_m": 0.30, "taper_end_m": 0.55},
+            "material": "ash"},
+    "variables": [{"path": "three_segment.taper_start_m", "min": 0.1, "max": 0.5},
+                  {"path": "three_segment.barrel_radius_m", "min": 0.028, "max": 0.0331}],
+    "constraints": {"mass_kg": 0.88, "balance_point_m": {"min": 0.56, "max": 0.60},
+                    "moi_six_inch_kg_m2": {"max": 0.20}, "rules": "mlb-wood"},
+    "objective": "max_exit_speed", "cor": 0.5,
+    "options": {"max_time_s": 10, "starts": 4, "seed": 1}})");
+}
+
+TEST(OptimizeEndpointTest, ContractExampleConvergesAndItsBatRoundTrips) {
+  const Response r = Post("/v1/optimize", ContractExample());
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["summary"]["termination"], "converged");
+  EXPECT_EQ(r.body["summary"]["backend"], "ipopt");
+  EXPECT_TRUE(r.body["summary"]["iterations"].get<int>() > 0);
+  EXPECT_TRUE(r.body["summary"]["solve_time_s"].is_number());
+  // The bat comes back in the request's form and re-checks through the mass
+  // properties: mass equality to 1e-8 kg, ranges to 1e-8 (Ipopt's constraint
+  // tolerance is 1e-10 relative).
+  ASSERT_TRUE(r.body["bat"].contains("three_segment"));
+  const Response p = Post("/v1/bat/properties", Json{{"bat", r.body["bat"]}});
+  ASSERT_EQ(p.status, 200) << p.body.dump();
+  EXPECT_NEAR(p.body["mass_kg"].get<double>(), 0.88, 1e-8);
+  EXPECT_GE(p.body["balance_point_m"].get<double>(), 0.56 - 1e-8);
+  EXPECT_LE(p.body["balance_point_m"].get<double>(), 0.60 + 1e-8);
+  EXPECT_LE(p.body["moi_six_inch_kg_m2"].get<double>(), 0.20 + 1e-8);
+  // MLB: diameter at most 2.61 in.
+  EXPECT_LE(r.body["bat"]["three_segment"]["barrel_radius_m"].get<double>(),
+            2.61 * 0.0254 / 2 + 1e-12);
+  // The objective is the closed-form max exit speed of that bat in that scene.
+  const Response s = Post("/v1/sweet-spot", Json{{"bat", r.body["bat"]}, {"cor", 0.5}});
+  ASSERT_EQ(s.status, 200);
+  EXPECT_NEAR(s.body["max_exit_speed"]["exit_speed_mps"].get<double>(),
+              r.body["objective_value"].get<double>(), 1e-9);
+  // What holds it back: named constraints with multipliers.
+  bool mass_active = false;
+  for (const auto& a : r.body["summary"]["active_constraints"]) {
+    mass_active = mass_active || a["name"] == "mass_kg";
+    EXPECT_TRUE(a["multiplier"].is_number());
+  }
+  EXPECT_TRUE(mass_active);
+  EXPECT_EQ(r.body["summary"]["spread"]["starts"], 4);
+}
+
+TEST(OptimizeEndpointTest, SameSeedSameAnswer) {
+  const Response a = Post("/v1/optimize", ContractExample());
+  const Response b = Post("/v1/optimize", ContractExample());
+  ASSERT_EQ(a.status, 200);
+  EXPECT_EQ(a.body["bat"], b.body["bat"]);
+  EXPECT_EQ(a.body["objective_value"], b.body["objective_value"]);
+  EXPECT_EQ(a.body["provenance"]["input_hash"], b.body["provenance"]["input_hash"]);
+}
+
+TEST(OptimizeEndpointTest, InfeasibleMassSaysWhichConstraintsConflict) {
+  Json body = ContractExample();
+  body["constraints"] = {{"mass_kg", 0.5}};
+  const Response r = Post("/v1/optimize", body);
+  ASSERT_EQ(r.status, 422) << r.body.dump();
+  EXPECT_EQ(r.body["code"], "Infeasible");
+  EXPECT_EQ(r.body["field"], "constraints");
+  ASSERT_TRUE(r.body["closest"].contains("conflicts")) << r.body.dump();
+  const auto& conflict = r.body["closest"]["conflicts"][0];
+  EXPECT_NE(conflict["message"].get<std::string>().find("mass_kg"), std::string::npos);
+  EXPECT_GT(conflict["shortfall"].get<double>(), 0.0);
+  EXPECT_EQ(r.body["closest"]["summary"]["termination"], "infeasible");
+}
+
+TEST(OptimizeEndpointTest, InvalidRequestsAreNamed) {
+  Json body = ContractExample();
+  body["variables"][0]["path"] = "three_segment.colour";
+  Response r = Post("/v1/optimize", body);
+  EXPECT_EQ(r.status, 400);
+  EXPECT_EQ(r.body["field"], "variables[0].path");
+
+  body = ContractExample();
+  body["objective"] = "min_sting";
+  r = Post("/v1/optimize", body);
+  EXPECT_EQ(r.status, 400) << r.body.dump();
+  EXPECT_NE(r.body["message"].get<std::string>().find("flexible"), std::string::npos);
+
+  body = ContractExample();
+  body["constraints"]["balance_point_m"] = {{"min", 0.6}, {"max", 0.5}};
+  r = Post("/v1/optimize", body);
+  EXPECT_EQ(r.status, 400);
+  EXPECT_EQ(r.body["field"], "constraints.balance_point_m.max");
+
+  body = ContractExample();
+  body["bat"]["wall_thickness_m"] = 0.003;  // a hollow bat is not one piece of solid wood
+  r = Post("/v1/optimize", body);
+  EXPECT_EQ(r.status, 400) << r.body.dump();
+  EXPECT_NE(r.body["message"].get<std::string>().find("mlb-wood"), std::string::npos);
+}
+
+TEST(OptimizeEndpointTest, MaterialChoiceSolvesEachAndPicksTheBest) {
+  Json body = ContractExample();
+  body["variables"].push_back({{"path", "material"}, {"choices", {"ash", "hard-maple", "yellow-birch"}}});
+  body["options"]["starts"] = 1;
+  const Response r = Post("/v1/optimize", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  ASSERT_EQ(r.body["materials"].size(), 3u);
+  double best = -1e9;
+  for (const auto& m : r.body["materials"]) {
+    if (m["termination"] == "converged") best = std::max(best, m["objective_value"].get<double>());
+  }
+  EXPECT_EQ(r.body["objective_value"].get<double>(), best);
+}
+
+TEST(OptimizeEndpointTest, ConcurrentOptimisationsAllAgree) {
+  // Ipopt 3.11 + MUMPS is not thread-safe: core serialises every solve under
+  // one lock. Eight threads solving at once must all get the single-thread answer.
+  Json body = ContractExample();
+  body["options"]["starts"] = 1;
+  const Response reference = Post("/v1/optimize", body);
+  ASSERT_EQ(reference.status, 200);
+  std::atomic<int> agree{0};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 8; ++t) {
+    threads.emplace_back([&] {
+      for (int i = 0; i < 3; ++i) {
+        const Response r = Post("/v1/optimize", body);
+        if (r.status == 200 && r.body["bat"] == reference.body["bat"]) ++agree;
+      }
+    });
+  }
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(agree.load(), 24);
+}
+
+}  // namespace
+}  // namespace sweetspot::api

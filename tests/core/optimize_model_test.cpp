@@ -1,0 +1,377 @@
+// The design model behind the optimiser: its mass integrals against the public mass
+// properties, its gradients and Hessians against finite differences and against
+// ComputeMassPropertiesWithGradient, Ipopt's own derivative checker, the status mapping,
+// variable paths and rule sets.
+#include "core/optimize/design_model.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/mass_properties.hpp"
+#include "core/material.hpp"
+#include "core/optimize/jet.hpp"
+#include "core/presets.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+// A hollow aluminium profile with a fill, every kind of profile variable.
+DesignProblem HollowFilledProfile(DesignObjective objective) {
+  DesignProblem p;
+  p.bat = FindPreset("bbcor-33-aluminium")->bat;
+  Fill fill;
+  fill.material = *FindMaterial("rubber");
+  fill.diameter_m = 0.03;
+  fill.depth_m = 0.2;
+  p.bat.fill = fill;
+  p.variables = {{"profile.knots[5].radius_m", 0.010, 0.013},
+                 {"profile.knots[10].radius_m", 0.030, 0.0334},
+                 {"profile.knots[10].x_m", 0.50, 0.54},
+                 {"profile.knots[12].x_m", 0.835, 0.845},
+                 {"material.density_kg_m3", 2500.0, 3000.0},
+                 {"wall_thickness_m", 0.0022, 0.0032},
+                 {"fill.diameter_m", 0.02, 0.04},
+                 {"fill.depth_m", 0.1, 0.3},
+                 {"fill.material.density_kg_m3", 500.0, 1500.0}};
+  p.constraints.mass_kg = DesignRange::Between(0.8, 0.9);
+  p.constraints.balance_point_m = DesignRange::AtMost(0.6);
+  p.constraints.moi_six_inch_kg_m2 = DesignRange::AtMost(0.25);
+  p.constraints.rules = {RuleSet::kBbcor};
+  p.objective = objective;
+  return p;
+}
+
+// A solid three-segment bat with a cork fill, every three-segment variable.
+DesignProblem FilledThreeSegment(DesignObjective objective) {
+  DesignProblem p;
+  p.three_segment = ThreeSegmentShape{0.86, 0.0125, 0.033, 0.30, 0.55};
+  p.bat.material = *FindMaterial("ash");
+  Fill fill;
+  fill.material = *FindMaterial("cork");
+  fill.diameter_m = 0.0254;
+  fill.depth_m = 0.254;
+  p.bat.fill = fill;
+  p.variables = {{"three_segment.length_m", 0.84, 0.88},
+                 {"three_segment.handle_radius_m", 0.011, 0.014},
+                 {"three_segment.barrel_radius_m", 0.030, 0.034},
+                 {"three_segment.taper_start_m", 0.2, 0.4},
+                 {"three_segment.taper_end_m", 0.45, 0.60},
+                 {"fill.depth_m", 0.1, 0.2}};
+  p.constraints.mass_kg = DesignRange::Equal(0.9);
+  p.constraints.taper = TaperRule::kMaxSlope;
+  p.constraints.max_taper_slope = 0.2;
+  p.swing.pivot_from_knob_m = 0.1;
+  p.objective = objective;
+  return p;
+}
+
+const DesignObjective kObjectives[] = {DesignObjective::kMaxExitSpeed,
+                                       DesignObjective::kMaxExitSpeedSwingWeight,
+                                       DesignObjective::kWidestSweetZone, DesignObjective::kMinMoi};
+
+DesignModel Build(const DesignProblem& p) {
+  DesignModel model;
+  std::string why;
+  EXPECT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why;
+  return model;
+}
+
+std::vector<double> RandomPoint(const DesignModel& model, std::mt19937_64& rng) {
+  std::vector<double> x;
+  for (const auto& v : model.variables()) {
+    const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;
+    x.push_back(v.lower + (0.05 + 0.9 * u) * (v.upper - v.lower));
+  }
+  return x;
+}
+
+TEST(OptimizeJet, SecondOrderDerivativesOfAKnownFunction) {
+  // f(x, y) = x^2 y / (1 + sqrt(y)) at (1.5, 4): f = 3, by hand:
+  // f_x = 2 x y / 3 = 4, f_y = x^2 (1 + sqrt(y) - y / (2 sqrt(y))) / 9 = 0.5,
+  // f_xx = 2 y / 3 = 8/3, f_xy = 2 x (1 + 1) / 9 = 2/3.
+  using J = jet::Jet<2, true>;
+  const J x = J::Variable(1.5, 0), y = J::Variable(4.0, 1);
+  const J f = x * x * y / (1.0 + jet::Sqrt(y));
+  EXPECT_DOUBLE_EQ(f.v, 3.0);
+  EXPECT_DOUBLE_EQ(f.g[0], 4.0);
+  EXPECT_DOUBLE_EQ(f.g[1], 0.5);
+  EXPECT_DOUBLE_EQ(f.h[0], 8.0 / 3.0);
+  EXPECT_DOUBLE_EQ(f.h[1], 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(f.h[2], f.h[1]);
+  const J p = jet::Pow(y, -0.5);  // d/dy = -y^-1.5 / 2, d2/dy2 = 0.75 y^-2.5
+  EXPECT_DOUBLE_EQ(p.g[1], -0.0625);
+  EXPECT_DOUBLE_EQ(p.h[3], 0.75 / 32.0);
+}
+
+TEST(OptimizeModel, PropertiesMatchThePublicMassProperties) {
+  for (const DesignProblem& p : {HollowFilledProfile(DesignObjective::kMinMoi),
+                                 FilledThreeSegment(DesignObjective::kMinMoi)}) {
+    const DesignModel model = Build(p);
+    std::mt19937_64 rng(3);
+    for (int trial = 0; trial < 20; ++trial) {
+      const std::vector<double> x = RandomPoint(model, rng);
+      DesignPoint point;
+      ASSERT_TRUE(model.Evaluate(x.data(), false, &point));
+      const Bat bat = model.BatAt(x.data());
+      ASSERT_TRUE(bat.IsValid(nullptr));
+      const MassProperties props = ComputeMassProperties(bat);
+      // Same integrals, other summation order and reference point: rounding only.
+      EXPECT_NEAR(point.mass_kg, props.mass_kg, 1e-13);
+      EXPECT_NEAR(point.balance_point_m, props.balance_point_m, 1e-13);
+      EXPECT_NEAR(point.moi_six_inch_kg_m2, props.MoiSixInchKgM2(), 1e-13);
+      EXPECT_NEAR(point.objective, props.MoiSixInchKgM2(), 1e-13);
+    }
+  }
+}
+
+// Three-segment designs through x1 = 0 and x1 = x2, where ThreeSegmentShape::Knots() merges
+// knots: the model keeps 4 knots (coincident allowed), so it is smooth there, and equals the
+// merged bat's properties (the step of width 1e-12 L changes them by < 1e-12 relative).
+TEST(OptimizeModel, ThreeSegmentDesignsAreSmoothWhereKnotsMerge) {
+  DesignProblem p = FilledThreeSegment(DesignObjective::kMinMoi);
+  p.bat.fill.reset();
+  p.variables = {{"three_segment.taper_start_m", 0.0, 0.5},
+                 {"three_segment.taper_end_m", 0.0, 0.7}};
+  p.constraints = DesignConstraints{};
+  const DesignModel model = Build(p);
+  for (const std::vector<double>& x : {std::vector<double>{0.0, 0.5}, {0.4, 0.4}, {0.0, 0.0}}) {
+    DesignPoint point;
+    ASSERT_TRUE(model.Evaluate(x.data(), true, &point));
+    const MassProperties props = ComputeMassProperties(model.BatAt(x.data()));
+    EXPECT_NEAR(point.mass_kg, props.mass_kg, 1e-12 * props.mass_kg);
+    EXPECT_NEAR(point.moi_six_inch_kg_m2, props.MoiSixInchKgM2(), 1e-12);
+    // One-sided differences into the feasible side agree with the gradient (exact on both
+    // sides of the merge: the integrals are polynomial in x1, x2).
+    for (int j = 0; j < 2; ++j) {
+      const double h = 1e-7;
+      std::vector<double> xp = x;
+      xp[static_cast<std::size_t>(j)] += h;
+      if (j == 0 && xp[0] > xp[1]) continue;
+      const double fd = (model.Value(model.objective(), xp.data()) - point.objective) / h;
+      // Forward difference: error ~ h |f''| / 2 ~ 1e-7 relative to |f'| ~ 0.1.
+      EXPECT_NEAR(point.objective_gradient[j], fd, 1e-6 + 1e-5 * std::abs(fd)) << j;
+    }
+  }
+}
+
+// The model's mass-property gradients against ComputeMassPropertiesWithGradient (independent
+// implementation of the same integrals' derivatives) for a profile design.
+TEST(OptimizeModel, GradientsMatchComputeMassPropertiesWithGradient) {
+  DesignProblem p = HollowFilledProfile(DesignObjective::kMinMoi);
+  p.constraints = DesignConstraints{};
+  p.constraints.mass_kg = DesignRange::AtLeast(0.1);
+  p.constraints.balance_point_m = DesignRange::AtLeast(0.1);
+  const DesignModel model = Build(p);
+  std::mt19937_64 rng(5);
+  const std::vector<double> x = RandomPoint(model, rng);
+  DesignPoint point;
+  ASSERT_TRUE(model.Evaluate(x.data(), true, &point));
+  const Bat bat = model.BatAt(x.data());
+  const MassPropertiesWithGradient ref = ComputeMassPropertiesWithGradient(bat);
+  const DesignParameterLayout& lay = ref.layout;
+  for (int j = 0; j < model.n(); ++j) {
+    const DesignVariableSpec& v = model.variables()[static_cast<std::size_t>(j)];
+    int idx = -1;
+    switch (v.ref.kind) {
+      case DesignVariableKind::kKnotRadius:
+        idx = lay.KnotRadius(v.ref.knot);
+        break;
+      case DesignVariableKind::kKnotPosition:
+        idx = lay.KnotPosition(v.ref.knot);
+        break;
+      case DesignVariableKind::kDensity:
+        idx = lay.Density();
+        break;
+      case DesignVariableKind::kWallThickness:
+        idx = lay.WallThickness();
+        break;
+      case DesignVariableKind::kFillDiameter:
+        idx = lay.FillDiameter();
+        break;
+      case DesignVariableKind::kFillDepth:
+        idx = lay.FillDepth();
+        break;
+      case DesignVariableKind::kFillDensity:
+        idx = lay.FillDensity();
+        break;
+      default:
+        break;
+    }
+    ASSERT_GE(idx, 0) << v.path;
+    const double dm = ref.mass_gradient[idx], dc = ref.balance_point_gradient[idx];
+    const double di6 = ref.MoiSixInchGradient()[idx];
+    // Rounding of two exact derivatives of the same integrals: 1e-10 relative to the scale.
+    EXPECT_NEAR(point.jacobian(0, j), dm, 1e-10 * (1.0 + std::abs(dm))) << v.path;
+    EXPECT_NEAR(point.jacobian(1, j), dc, 1e-10 * (1.0 + std::abs(dc))) << v.path;
+    EXPECT_NEAR(point.objective_gradient[j], di6, 1e-10 * (1.0 + std::abs(di6))) << v.path;
+  }
+}
+
+// Gradients of every objective and constraint, and the exact Hessian of a random Lagrangian,
+// against central differences of the model's own values and gradients.
+TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
+  std::mt19937_64 rng(11);
+  for (DesignObjective objective : kObjectives) {
+    for (const DesignProblem& p : {HollowFilledProfile(objective), FilledThreeSegment(objective)}) {
+      const DesignModel model = Build(p);
+      ASSERT_GT(model.m(), 3);
+      for (int trial = 0; trial < 3; ++trial) {
+        const std::vector<double> x = RandomPoint(model, rng);
+        DesignPoint point;
+        ASSERT_TRUE(model.Evaluate(x.data(), true, &point));
+        std::vector<double> weights(static_cast<std::size_t>(model.m()));
+        for (double& w : weights) w = static_cast<double>(rng() >> 11) * 0x1.0p-53 - 0.5;
+        Eigen::MatrixXd h;
+        ASSERT_TRUE(model.Hessian(x.data(), 0.7, weights.data(), &h));
+        EXPECT_LE((h - h.transpose()).norm(), 1e-12 * h.norm());
+        auto lagrangian_gradient = [&](const std::vector<double>& at) {
+          DesignPoint q;
+          EXPECT_TRUE(model.Evaluate(at.data(), true, &q));
+          Eigen::VectorXd g = 0.7 * q.objective_gradient;
+          for (int k = 0; k < model.m(); ++k)
+            g += weights[static_cast<std::size_t>(k)] * q.jacobian.row(k).transpose();
+          return g;
+        };
+        for (int j = 0; j < model.n(); ++j) {
+          const DesignVariableSpec& v = model.variables()[static_cast<std::size_t>(j)];
+          const double step = 1e-6 * (v.upper - v.lower);
+          std::vector<double> xp = x, xm = x;
+          xp[static_cast<std::size_t>(j)] += step;
+          xm[static_cast<std::size_t>(j)] -= step;
+          DesignPoint pp, pm;
+          ASSERT_TRUE(model.Evaluate(xp.data(), false, &pp));
+          ASSERT_TRUE(model.Evaluate(xm.data(), false, &pm));
+          // Central differences: truncation ~ step^2 |f'''| and rounding ~ eps |f| / step;
+          // both are below 1e-7 of the terms' scale here.
+          const double fd = (pp.objective - pm.objective) / (2.0 * step);
+          const double scale_f = std::abs(point.objective) / (v.upper - v.lower);
+          EXPECT_NEAR(point.objective_gradient[j], fd, 1e-6 * scale_f + 1e-7 * std::abs(fd))
+              << DesignObjectiveName(objective) << " d/d " << v.path;
+          for (int k = 0; k < model.m(); ++k) {
+            const double fdk = (pp.constraints[static_cast<std::size_t>(k)] -
+                                pm.constraints[static_cast<std::size_t>(k)]) /
+                               (2.0 * step);
+            const double scale_k =
+                model.constraints()[static_cast<std::size_t>(k)].scale / (v.upper - v.lower);
+            EXPECT_NEAR(point.jacobian(k, j), fdk, 1e-6 * scale_k + 1e-7 * std::abs(fdk))
+                << model.constraints()[static_cast<std::size_t>(k)].name << " d/d " << v.path;
+          }
+          const Eigen::VectorXd column =
+              (lagrangian_gradient(xp) - lagrangian_gradient(xm)) / (2.0 * step);
+          for (int i = 0; i < model.n(); ++i) {
+            const double scale =
+                (std::abs(h(i, j)) + std::abs(column[i]) + h.col(j).lpNorm<Eigen::Infinity>());
+            EXPECT_NEAR(h(i, j), column[i], 1e-5 * scale + 1e-12)
+                << DesignObjectiveName(objective) << " H(" << i << ", " << j << ")";
+          }
+        }
+      }
+    }
+  }
+}
+
+// Ipopt's own derivative checker (derivative_test = first-order and, with the exact Hessian,
+// second-order) at the start of each problem: no errors reported. The checker's output is
+// captured by a journal at J_WARNING on the J_NLP category (print_level 0 keeps the console
+// silent).
+TEST(OptimizeModel, IpoptDerivativeCheckerFindsNoErrors) {
+  for (DesignObjective objective : kObjectives) {
+    for (const DesignProblem& p : {HollowFilledProfile(objective), FilledThreeSegment(objective)}) {
+      for (DerivativeCheck check : {DerivativeCheck::kFirstOrder, DerivativeCheck::kSecondOrder}) {
+        DesignOptions o;
+        o.derivative_check = check;
+        o.hessian = check == DerivativeCheck::kSecondOrder ? HessianMode::kExact
+                                                           : HessianMode::kLimitedMemory;
+        o.max_iterations = 1;
+        o.explain_infeasibility = false;
+        const DesignResult r = OptimizeDesign(p, o);
+        EXPECT_EQ(r.derivative_check_errors, 0) << DesignObjectiveName(objective) << "\n"
+                                                << r.derivative_check_report;
+        EXPECT_NE(r.derivative_check_report.find(check == DerivativeCheck::kSecondOrder
+                                                     ? "Starting derivative checker for second"
+                                                     : "Starting derivative checker for first"),
+                  std::string::npos);
+      }
+    }
+  }
+}
+
+TEST(OptimizeStatus, EveryIpoptStatusMapsToATermination) {
+  const struct {
+    int status;
+    const char* name;
+    Termination termination;
+  } cases[] = {
+      {0, "Solve_Succeeded", Termination::kConverged},
+      {1, "Solved_To_Acceptable_Level", Termination::kConverged},
+      {2, "Infeasible_Problem_Detected", Termination::kInfeasible},
+      {3, "Search_Direction_Becomes_Too_Small", Termination::kNoConvergence},
+      {4, "Diverging_Iterates", Termination::kFailure},
+      {5, "User_Requested_Stop", Termination::kNoConvergence},
+      {6, "Feasible_Point_Found", Termination::kNoConvergence},
+      {-1, "Maximum_Iterations_Exceeded", Termination::kNoConvergence},
+      {-2, "Restoration_Failed", Termination::kFailure},
+      {-3, "Error_In_Step_Computation", Termination::kFailure},
+      {-4, "Maximum_CpuTime_Exceeded", Termination::kNoConvergence},
+      {-10, "Not_Enough_Degrees_Of_Freedom", Termination::kInvalidInput},
+      {-11, "Invalid_Problem_Definition", Termination::kInvalidInput},
+      {-12, "Invalid_Option", Termination::kInvalidInput},
+      {-13, "Invalid_Number_Detected", Termination::kFailure},
+      {-100, "Unrecoverable_Exception", Termination::kFailure},
+      {-101, "NonIpopt_Exception_Thrown", Termination::kFailure},
+      {-102, "Insufficient_Memory", Termination::kFailure},
+      {-199, "Internal_Error", Termination::kFailure},
+      {42, "Unknown", Termination::kFailure},
+  };
+  for (const auto& c : cases) {
+    EXPECT_EQ(TerminationFromIpoptStatus(c.status), c.termination) << c.status;
+    EXPECT_STREQ(IpoptStatusName(c.status), c.name);
+  }
+}
+
+// Max iterations reached maps to no_convergence with the point kept; Ipopt's raw status is kept.
+TEST(OptimizeStatus, IterationLimitIsNoConvergenceWithTheRawStatus) {
+  DesignOptions o;
+  o.max_iterations = 2;
+  const DesignResult r = OptimizeDesign(FilledThreeSegment(DesignObjective::kMaxExitSpeed), o);
+  EXPECT_EQ(r.summary.raw_status, -1);
+  EXPECT_EQ(r.summary.termination, Termination::kNoConvergence) << r.summary.FullReport();
+  EXPECT_NE(r.summary.message.find("Maximum_Iterations_Exceeded"), std::string::npos);
+}
+
+TEST(OptimizeNames, PathsObjectivesAndRuleSetsRoundTrip) {
+  for (const char* path :
+       {"profile.knots[0].radius_m", "profile.knots[12].x_m", "three_segment.length_m",
+        "three_segment.handle_radius_m", "three_segment.barrel_radius_m",
+        "three_segment.taper_start_m", "three_segment.taper_end_m", "material.density_kg_m3",
+        "wall_thickness_m", "fill.diameter_m", "fill.depth_m", "fill.material.density_kg_m3"}) {
+    const auto ref = ParseDesignVariablePath(path);
+    ASSERT_TRUE(ref.has_value()) << path;
+    EXPECT_EQ(DesignVariablePath(*ref), path);
+  }
+  for (const char* bad : {"profile.knots[01].radius_m", "profile.knots[].x_m", "profile.knots[1]",
+                          "profile.knots[1].r", "fill.material.density", "length_m"}) {
+    EXPECT_FALSE(ParseDesignVariablePath(bad).has_value()) << bad;
+  }
+  for (const char* name : {"max_exit_speed", "max_exit_speed_swing_weight", "widest_sweet_zone",
+                           "min_moi", "min_sting"}) {
+    EXPECT_STREQ(DesignObjectiveName(*ParseDesignObjective(name)), name);
+  }
+  for (RuleSet rule : AllRuleSets()) {
+    EXPECT_EQ(ParseRuleSet(RuleSetName(rule)), rule);
+    EXPECT_FALSE(LimitsOf(rule).source.empty());
+  }
+  EXPECT_NEAR(LimitsOf(RuleSet::kMlbWood).max_diameter_m, 0.066294, 1e-15);  // 2.61 in
+  EXPECT_NEAR(LimitsOf(RuleSet::kBbcor).max_diameter_m, 0.066675, 1e-15);    // 2 5/8 in
+  EXPECT_NEAR(LimitsOf(RuleSet::kUsssa).max_diameter_m, 0.06985, 1e-15);     // 2 3/4 in
+  EXPECT_NEAR(*LimitsOf(RuleSet::kMlbWood).max_length_m, 1.0668, 1e-15);     // 42 in
+  EXPECT_TRUE(IsWoodMaterial(*FindMaterial("hard-maple")));
+  EXPECT_FALSE(IsWoodMaterial(*FindMaterial("aluminium-7046")));
+}
+
+}  // namespace
+}  // namespace sweetspot::core
