@@ -68,13 +68,49 @@ bool ReadOutputs(ObjectReader& reader, core::Scene* scene) {
       return reader.Fail("outputs",
                          "outputs[" + std::to_string(i) + "] = " + Show(item) +
                              " is not one of max_exit_speed, center_of_percussion, "
-                             "vibration_node, sweet_zone, exit_speed_curve");
+                             "vibration_node, sweet_zone, exit_speed_curve, least_sting_zone");
     }
     if (std::find(scene->outputs.begin(), scene->outputs.end(), *parsed) == scene->outputs.end()) {
       scene->outputs.push_back(*parsed);
     }
   }
   return true;
+}
+
+bool ReadFlexibleOptions(const Json& value, const std::string& path, core::FlexibleOptions* options,
+                         ApiError* error) {
+  ObjectReader reader(value, path, error);
+  std::string theory = core::BeamTheoryName(options->theory);
+  reader.OptionalString("theory", &theory, {"timoshenko", "euler_bernoulli"});
+  options->theory = core::ParseBeamTheory(theory).value_or(core::BeamTheory::kTimoshenko);
+  reader.OptionalNumber("frequency_tolerance", Between(1e-9, 0.1), &options->frequency_tolerance);
+  long long max_elements = options->max_elements;
+  reader.OptionalInteger("max_elements", 2, 4096, &max_elements);
+  options->max_elements = static_cast<int>(max_elements);
+  core::FlexibleImpactOptions& impact = options->impact;
+  long long max_modes = impact.max_modes;
+  reader.OptionalInteger("max_modes", 1, 50, &max_modes);
+  impact.max_modes = static_cast<int>(max_modes);
+  reader.OptionalNumber("mode_frequency_tolerance", Between(1e-9, 0.1),
+                        &impact.frequency_tolerance);
+  reader.OptionalNumber("cutoff_factor", Between(1.0, 1000.0), &impact.cutoff_factor);
+  reader.OptionalBool("static_correction", &impact.static_correction);
+  reader.OptionalNumber("relative_tolerance", Between(1e-13, 1e-2), &impact.relative_tolerance);
+  long long max_steps = impact.max_steps;
+  reader.OptionalInteger("max_steps", 10, 10000000, &max_steps);
+  impact.max_steps = static_cast<int>(max_steps);
+  long long max_contacts = impact.max_contacts;
+  reader.OptionalInteger("max_contacts", 1, 1000, &max_contacts);
+  impact.max_contacts = static_cast<int>(max_contacts);
+  reader.OptionalBool("refine_check", &impact.refine_check);
+  reader.OptionalNumber("hands_grip_length_m", Between(0.0, 10.0), &impact.hands_grip_length_m);
+  reader.OptionalNumber("sting_window_s", Between(0.0, 1.0), &impact.sting_window_s);
+  long long sting_samples = options->sting_samples;
+  reader.OptionalInteger("sting_samples", 3, 1001, &sting_samples);
+  options->sting_samples = static_cast<int>(sting_samples);
+  reader.OptionalNumber("sting_zone_fraction", NumberRule{0.0, 1.0, true, false, false},
+                        &options->sting_zone_fraction);
+  return reader.Finish();
 }
 
 bool ReadHertzOptions(const Json& value, const std::string& path, core::HertzOptions* options,
@@ -186,6 +222,12 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
       return false;
     }
   }
+  if (const Json* flexible = reader.Get("flexible")) {
+    if (!ReadFlexibleOptions(*flexible, reader.PathOf("flexible"), &options->flexible,
+                             top.error())) {
+      return false;
+    }
+  }
   if (!reader.Finish()) return false;
   std::string why;
   if (!options->IsValid(&why)) return CoreRefusal(why, top.PathOf("options"), top.error());
@@ -261,6 +303,25 @@ Json SceneResultToJson(const core::SceneResult& r) {
     }
     out["exit_speed_curve"] = std::move(points);
     errors["exit_speed_curve"] = {{"exit_speed_mps", r.exit_speed_curve->error_estimate_mps}};
+  }
+  if (r.vibration_node) {
+    const auto& v = *r.vibration_node;
+    out["vibration_node"] = VibrationNodeToJson(v);
+    errors["vibration_node"] = {{"position_m", v.error_estimate_m},
+                                {"frequency_hz", v.error_estimate_hz},
+                                {"second_mode_frequency_hz", v.second_mode_error_estimate_hz}};
+  }
+  if (r.least_sting_zone) {
+    const auto& z = *r.least_sting_zone;
+    out["least_sting_zone"] = LeastStingZoneToJson(z);
+    double speed_err = 0.0, energy_err = 0.0;
+    for (const auto& p : z.curve) {
+      speed_err = std::max(speed_err, p.error_estimate_exit_speed_mps);
+      energy_err = std::max(energy_err, p.error_estimate_hands_energy_j);
+    }
+    errors["least_sting_zone"] = {{"ends_m", z.error_estimate_m},
+                                  {"exit_speed_mps", speed_err},
+                                  {"hands_energy_j", energy_err}};
   }
   out["error_estimate"] = std::move(errors);
   out["models_used"] = r.summary.models_used;
@@ -347,12 +408,106 @@ Json CollisionResultToJson(const core::CollisionResult& r) {
           {"k1", p.paper.k1}, {"k2", p.paper.k2}, {"k3", p.paper.k3}};
     }
   }
+  if (r.flexible) {
+    out["flexible"] = FlexibleImpactToJson(*r.flexible);
+    out["flexible"]["cache_hit"] = r.modes_cache_hit;
+  }
   Json timings = Json::array();
   for (const auto& t : r.timings) {
     timings.push_back({{"model", t.model}, {"time_s", t.time_s}, {"calls", t.calls}});
   }
   out["timings"] = std::move(timings);
   return out;
+}
+
+Json VibrationNodeToJson(const core::VibrationNodeResult& v) {
+  return {{"position_from_knob_m", v.position_from_knob_m},
+          {"frequency_hz", v.frequency_hz},
+          {"other_node_from_knob_m", v.other_node_from_knob_m},
+          {"second_mode",
+           {{"frequency_hz", v.second_mode_frequency_hz},
+            {"nodes_from_knob_m", v.second_mode_nodes_from_knob_m}}},
+          {"theory", v.theory},
+          {"method", "fem:" + v.theory},
+          {"elements", v.elements},
+          {"refinement_elements", v.refinement_elements},
+          {"relative_tolerance", v.relative_tolerance},
+          {"cache_hit", v.cache_hit},
+          {"termination", core::TerminationName(v.summary.termination)}};
+}
+
+Json LeastStingZoneToJson(const core::LeastStingZoneResult& z) {
+  Json curve = Json::array();
+  for (const auto& p : z.curve) {
+    curve.push_back({{"position_from_knob_m", p.position_from_knob_m},
+                     {"exit_speed_mps", p.exit_speed_mps},
+                     {"rigid_exit_speed_mps", p.rigid_exit_speed_mps},
+                     {"vibration_energy_j", p.vibration_energy_j},
+                     {"hands_vibration_energy_j", p.hands_vibration_energy_j},
+                     {"hands_peak_shear_force_n", p.hands_peak_shear_force_n},
+                     {"hands_peak_bending_moment_n_m", p.hands_peak_bending_moment_n_m},
+                     {"contact_time_s", p.contact_time_s}});
+  }
+  return {{"from_knob_m", z.from_knob_m},
+          {"to_knob_m", z.to_knob_m},
+          {"min_position_from_knob_m", z.min_position_from_knob_m},
+          {"min_hands_energy_j", z.min_hands_energy_j},
+          {"max_hands_energy_j", z.max_hands_energy_j},
+          {"threshold_j", z.threshold_j},
+          {"fraction", z.fraction},
+          {"exit_speed_at_min_mps", z.exit_speed_at_min_mps},
+          {"clipped_at_hands", z.clipped_at_hands},
+          {"clipped_at_tip", z.clipped_at_tip},
+          {"modes_used", z.modes_used},
+          {"elements", z.elements},
+          {"theory", z.theory},
+          {"metric",
+           "hands_vibration_energy_j: vibration energy left in the grip segment at the "
+           "hands after the impact"},
+          {"curve", std::move(curve)}};
+}
+
+Json FlexibleImpactToJson(const core::FlexibleImpactResult& f) {
+  Json modes = Json::array();
+  for (std::size_t i = 0; i < f.modal_energies_j.size(); ++i) {
+    modes.push_back({{"mode", i + 1},
+                     {"frequency_hz", f.mode_frequencies_hz[i]},
+                     {"energy_j", f.modal_energies_j[i]}});
+  }
+  return {{"exit_speed_mps", f.exit_speed_mps},
+          {"rigid_exit_speed_mps", f.rigid_exit_speed_mps},
+          {"vibration_energy_j", f.vibration_energy_j},
+          {"hands",
+           {{"vibration_energy_j", f.hands_vibration_energy_j},
+            {"peak_shear_force_n", f.hands_peak_shear_force_n},
+            {"peak_bending_moment_n_m", f.hands_peak_bending_moment_n_m}}},
+          {"contact_time_s", f.contact_time_s},
+          {"contact_time_estimate_s", f.contact_time_estimate_s},
+          {"contacts", f.contacts},
+          {"peak_force_n", f.peak_force_n},
+          {"max_compression_m", f.max_compression_m},
+          {"ball_impulse_n_s", f.ball_impulse_n_s},
+          {"energy",
+           {{"initial_j", f.initial_energy_j},
+            {"ball_j", f.ball_energy_j},
+            {"bat_rigid_body_j", f.rigid_body_energy_j},
+            {"vibration_j", f.vibration_energy_j},
+            {"contact_loss_j", f.contact_loss_j},
+            {"balance_error_j", f.energy_balance_error_j}}},
+          {"modes_used", f.modes_used},
+          {"modes", std::move(modes)},
+          {"cutoff_hz", f.cutoff_hz},
+          {"residual_compliance_m_n", f.residual_compliance_m_n},
+          {"elements", f.elements},
+          {"theory", core::BeamTheoryName(f.theory)},
+          {"steps", f.steps},
+          {"error_estimate",
+           {{"exit_speed_mps", f.error_estimate_exit_speed_mps},
+            {"integration_exit_speed_mps", f.integration_error_exit_speed_mps},
+            {"truncation_exit_speed_mps", f.truncation_error_exit_speed_mps},
+            {"vibration_energy_j", f.error_estimate_vibration_energy_j},
+            {"hands_vibration_energy_j", f.error_estimate_hands_energy_j}}},
+          {"summary", SummaryToJson(f.summary)}};
 }
 
 }  // namespace sweetspot::api

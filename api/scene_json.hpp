@@ -25,6 +25,11 @@ bool ReadOutputs(ObjectReader& reader, core::Scene* scene);
 /// Reads "options" of /v1/sweet-spot into `options`.
 bool ReadSceneOptions(ObjectReader& reader, const ApiLimits& limits, core::SceneOptions* options);
 
+/// Reads a "flexible" options object at `path` (the flexible beam: theory, tolerances, modes,
+/// the impact's integrator and the sting settings; see docs/models.md).
+bool ReadFlexibleOptions(const nlohmann::json& value, const std::string& path,
+                         core::FlexibleOptions* options, ApiError* error);
+
 /// Reads a "hertz" options object at `path`.
 bool ReadHertzOptions(const nlohmann::json& value, const std::string& path,
                       core::HertzOptions* options, ApiError* error);
@@ -44,5 +49,17 @@ nlohmann::json SceneResultToJson(const core::SceneResult& result);
 
 /// One collision result: exit speed, model and what the model knows.
 nlohmann::json CollisionResultToJson(const core::CollisionResult& result);
+
+/// The vibration_node block: {position_from_knob_m, frequency_hz, other_node_from_knob_m,
+/// second_mode: {frequency_hz, nodes_from_knob_m}, theory, elements, ...}.
+nlohmann::json VibrationNodeToJson(const core::VibrationNodeResult& node);
+
+/// The least_sting_zone block: the zone, the least-sting impact and the sweep's curve (flexible
+/// and rigid exit speeds side by side, vibration and hands' energy, peak loads at the hands).
+nlohmann::json LeastStingZoneToJson(const core::LeastStingZoneResult& zone);
+
+/// The "flexible" block of a collision: exit speed, vibration energy, the sting at the hands,
+/// contact time, peak force, the modes used, energies, error estimates and the solve summary.
+nlohmann::json FlexibleImpactToJson(const core::FlexibleImpactResult& impact);
 
 }  // namespace sweetspot::api

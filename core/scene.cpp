@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include <boost/math/tools/minima.hpp>
 #include <boost/math/tools/roots.hpp>
 
 namespace sweetspot::core {
@@ -189,12 +190,76 @@ HertzProblem MakeHertz(const Scene& scene, const Resolved& r, double impact_from
   return p;
 }
 
+FlexibleImpactInputs MakeFlexible(const Scene& scene, const Resolved& r, double impact_from_knob_m,
+                                  const HertzOptions& hertz) {
+  FlexibleImpactInputs in;
+  in.impact_from_knob_m = impact_from_knob_m;
+  in.hands_from_knob_m = scene.swing.hands_from_knob_m;
+  in.ball_mass_kg = scene.ball.mass_kg;
+  in.ball_speed_mps = scene.ball.speed_mps;
+  in.approach_speed_mps =
+      scene.ball.speed_mps +
+      scene.swing.angular_speed_rad_s * (impact_from_knob_m - scene.swing.pivot_from_knob_m);
+  in.ball_stiffness = scene.ball.stiffness;
+  in.ball_exponent = scene.ball.stiffness_exponent;
+  in.cor = r.cor;
+  in.surface_stiffness = 0.0;
+  if (hertz.bat_surface_compliance && scene.bat.has_value()) {
+    const double radius = scene.bat->RadiusAtM(impact_from_knob_m);
+    if (radius > 0.0) {
+      in.surface_stiffness =
+          BatSurfaceHertzStiffness(scene.bat->material.youngs_modulus_pa,
+                                   scene.bat->material.poissons_ratio, scene.ball.radius_m, radius);
+    }
+  }
+  return in;
+}
+
+// The flexible beam's modes within one request: each set computed once (or taken from the
+// caller's cross-request cache), timed under "flexible_beam".
+class FlexibleModes {
+ public:
+  FlexibleModes(const Scene& scene, const FlexibleOptions& options, TimingBook* book)
+      : scene_(scene), options_(options), book_(book) {}
+  const std::shared_ptr<const BatModes>& Impact() {
+    if (!impact_) impact_ = Get(options_.ImpactModes(), &impact_hit_);
+    return impact_;
+  }
+  const std::shared_ptr<const BatModes>& Vibration() {
+    if (!vibration_) vibration_ = Get(options_.VibrationModes(), &vibration_hit_);
+    return vibration_;
+  }
+  bool impact_hit() const { return impact_hit_; }
+  bool vibration_hit() const { return vibration_hit_; }
+
+ private:
+  std::shared_ptr<const BatModes> Get(const BeamModesOptions& o, bool* hit) {
+    const auto t0 = Clock::now();
+    auto modes = CachedBatModes(*scene_.bat, o, options_.modes_cache, hit);
+    book_->Add(kFlexibleBeamModel, Seconds(t0), 1);
+    return modes;
+  }
+  const Scene& scene_;
+  const FlexibleOptions& options_;
+  TimingBook* book_;
+  std::shared_ptr<const BatModes> impact_, vibration_;
+  bool impact_hit_ = false, vibration_hit_ = false;
+};
+
 // The exit speed along the bat under one model; closed-form models carry their profile.
 class ExitSpeedModel {
  public:
   ExitSpeedModel(CollisionModel model, const Scene& scene, const Resolved& r,
-                 const HertzOptions& hertz, TimingBook* book)
-      : model_(model), scene_(scene), r_(r), hertz_(hertz), book_(book) {
+                 const HertzOptions& hertz, TimingBook* book,
+                 const FlexibleOptions* flexible = nullptr,
+                 std::shared_ptr<const BatModes> modes = nullptr)
+      : model_(model),
+        scene_(scene),
+        r_(r),
+        hertz_(hertz),
+        book_(book),
+        flexible_(flexible),
+        modes_(std::move(modes)) {
     if (model == CollisionModel::kRigidPivot) {
       profile_ = RigidPivotProfile(MakeRigidPivot(scene, r));
     } else if (model == CollisionModel::kFreeBat) {
@@ -214,6 +279,19 @@ class ExitSpeedModel {
       *v = profile_->ExitSpeedMps(x);
       if (grad != nullptr) *grad = profile_->DerivativePerS(x);
       if (err != nullptr) *err = 8.0 * kEps * (profile_->ball_speed_mps + std::abs(*v));
+    } else if (model_ == CollisionModel::kFlexible) {
+      const FlexibleImpactResult fr = SolveFlexibleImpact(
+          *scene_.bat, *modes_, MakeFlexible(scene_, r_, s, hertz_), flexible_->impact);
+      for (auto& w : fr.summary.warnings) AddWarning(w);
+      if (!fr.summary.IsSolutionUsable()) {
+        ok = false;
+        if (why != nullptr) {
+          *why = "flexible at " + Num(s) + " m from the knob: " + fr.summary.message;
+        }
+      } else {
+        *v = fr.exit_speed_mps;
+        if (err != nullptr) *err = fr.error_estimate_exit_speed_mps;
+      }
     } else {
       std::vector<std::string> warnings;
       const HertzImpact hi =
@@ -246,6 +324,8 @@ class ExitSpeedModel {
   const Resolved& r_;
   HertzOptions hertz_;
   TimingBook* book_;
+  const FlexibleOptions* flexible_;
+  std::shared_ptr<const BatModes> modes_;
   std::optional<ExitSpeedProfile> profile_;
   std::vector<std::string> warnings_;
 };
@@ -358,6 +438,180 @@ bool NeedsExitModel(SceneOutput o) {
          o == SceneOutput::kExitSpeedCurve;
 }
 
+bool Wants(const std::vector<SceneOutput>& wanted, SceneOutput o) {
+  return std::find(wanted.begin(), wanted.end(), o) != wanted.end();
+}
+
+// vibration_node from the modes of the first two bending modes.
+bool VibrationNodeFrom(const BatModes& modes, bool cache_hit, VibrationNodeResult* out,
+                       std::string* error) {
+  if (!modes.summary.IsSolutionUsable()) {
+    *error = modes.summary.message;
+    return false;
+  }
+  if (modes.modes.size() < 2) {
+    *error = "the modes computation returned fewer than two modes";
+    return false;
+  }
+  const BeamMode& m1 = modes.modes[0];
+  const BeamMode& m2 = modes.modes[1];
+  if (m1.nodes_from_knob_m.empty()) {
+    *error = "the fundamental bending mode has no node on the bat";
+    return false;
+  }
+  out->position_from_knob_m = m1.nodes_from_knob_m.back();
+  out->other_node_from_knob_m = m1.nodes_from_knob_m.front();
+  out->frequency_hz = m1.frequency_hz;
+  out->error_estimate_hz = m1.error_estimate_hz;
+  out->error_estimate_m = m1.nodes_error_estimate_m;
+  out->second_mode_frequency_hz = m2.frequency_hz;
+  out->second_mode_nodes_from_knob_m = m2.nodes_from_knob_m;
+  out->second_mode_error_estimate_hz = m2.error_estimate_hz;
+  out->relative_tolerance = modes.tolerance;
+  out->elements = modes.Elements();
+  out->refinement_elements = modes.refinement_elements;
+  out->theory = BeamTheoryName(modes.theory);
+  out->cache_hit = cache_hit;
+  out->summary = modes.summary;
+  return true;
+}
+
+// least_sting_zone: flexible impacts from the hands to the tip (see LeastStingZoneResult).
+bool SweepSting(const Scene& scene, const Resolved& r, const SceneOptions& options,
+                const BatModes& modes, TimingBook* book, std::vector<std::string>* warnings,
+                LeastStingZoneResult* out, std::string* error) {
+  const FlexibleOptions& fo = options.flexible;
+  const double lo = scene.swing.hands_from_knob_m;
+  const double hi = r.length_m;
+  if (!(hi > lo)) {
+    *error = "swing.hands_from_knob_m = " + Num(lo) +
+             ": the sweep runs from the hands to the tip, so the hands must be before the tip";
+    return false;
+  }
+  FlexibleImpactOptions quick = fo.impact;
+  quick.refine_check = false;  // the refinement is reported on the samples
+  bool failed = false;
+  auto impact = [&](double s, bool refine) {
+    const auto t0 = Clock::now();
+    FlexibleImpactResult fr = SolveFlexibleImpact(
+        *scene.bat, modes, MakeFlexible(scene, r, s, options.hertz), refine ? fo.impact : quick);
+    book->Add(CollisionModelName(CollisionModel::kFlexible), Seconds(t0), 1);
+    for (const auto& w : fr.summary.warnings) {
+      if (std::find(warnings->begin(), warnings->end(), w) == warnings->end()) {
+        warnings->push_back(w);
+      }
+    }
+    if (!fr.summary.IsSolutionUsable() && !failed) {
+      failed = true;
+      *error = "flexible at " + Num(s) + " m from the knob: " + fr.summary.message;
+    }
+    return fr;
+  };
+  const int n = fo.sting_samples;
+  std::vector<double> xs, es;
+  double err_e = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double s = i + 1 == n ? hi : lo + (hi - lo) * i / (n - 1);
+    const FlexibleImpactResult fr = impact(s, true);
+    if (failed) return false;
+    StingPoint p;
+    p.position_from_knob_m = s;
+    p.exit_speed_mps = fr.exit_speed_mps;
+    p.rigid_exit_speed_mps = fr.rigid_exit_speed_mps;
+    p.vibration_energy_j = fr.vibration_energy_j;
+    p.hands_vibration_energy_j = fr.hands_vibration_energy_j;
+    p.hands_peak_shear_force_n = fr.hands_peak_shear_force_n;
+    p.hands_peak_bending_moment_n_m = fr.hands_peak_bending_moment_n_m;
+    p.contact_time_s = fr.contact_time_s;
+    p.error_estimate_exit_speed_mps = fr.error_estimate_exit_speed_mps;
+    p.error_estimate_hands_energy_j = fr.error_estimate_hands_energy_j;
+    out->curve.push_back(p);
+    out->modes_used = std::max(out->modes_used, fr.modes_used);
+    xs.push_back(s);
+    es.push_back(fr.hands_vibration_energy_j);
+    err_e = std::max(err_e, fr.error_estimate_hands_energy_j);
+  }
+  out->elements = modes.Elements();
+  out->theory = BeamTheoryName(modes.theory);
+  out->fraction = fo.sting_zone_fraction;
+  const std::size_t i_min =
+      static_cast<std::size_t>(std::min_element(es.begin(), es.end()) - es.begin());
+  out->max_hands_energy_j = *std::max_element(es.begin(), es.end());
+  // Refine the minimum between the neighbouring samples (Brent, ~1e-6 relative in s).
+  auto energy = [&](double s) { return impact(s, false).hands_vibration_energy_j; };
+  const double a = xs[i_min == 0 ? 0 : i_min - 1];
+  const double b = xs[std::min(i_min + 1, xs.size() - 1)];
+  double x_min = xs[i_min], e_min = es[i_min];
+  double err_x = 0.5 * (b - a);
+  if (b > a) {
+    boost::uintmax_t iters = 60;
+    const auto m = boost::math::tools::brent_find_minima(energy, a, b, 20, iters);
+    if (failed) return false;
+    if (m.second <= e_min) {
+      x_min = m.first;
+      e_min = m.second;
+    }
+    // Brent's bracket, widened by how far the energy's own error moves a flat minimum.
+    const double h = 0.5 * (b - a);
+    const double curv = (es[std::min(i_min + 1, es.size() - 1)] + es[i_min == 0 ? 0 : i_min - 1] -
+                         2.0 * es[i_min]) /
+                        (h * h);
+    err_x = std::ldexp(std::abs(x_min), -19) +
+            (curv > 0.0 ? std::sqrt(2.0 * err_e / curv) : 0.5 * (b - a));
+  }
+  out->min_position_from_knob_m = x_min;
+  out->min_hands_energy_j = e_min;
+  out->exit_speed_at_min_mps = impact(x_min, false).exit_speed_mps;
+  if (failed) return false;
+  out->threshold_j = e_min + fo.sting_zone_fraction * (out->max_hands_energy_j - e_min);
+  auto g = [&](double s) { return energy(s) - out->threshold_j; };
+  double err_edges = 0.0;
+  auto edge = [&](int dir, bool* clipped) -> double {
+    // The first sample beyond the threshold, walking away from the minimum.
+    long j = static_cast<long>(i_min);
+    while (true) {
+      const long next = j + dir;
+      if (next < 0 || next >= static_cast<long>(xs.size())) {
+        *clipped = true;
+        return dir < 0 ? lo : hi;
+      }
+      if (es[static_cast<std::size_t>(next)] > out->threshold_j) {
+        const double inside =
+            j == static_cast<long>(i_min) ? x_min : xs[static_cast<std::size_t>(j)];
+        const double outside = xs[static_cast<std::size_t>(next)];
+        const double ga = g(inside);
+        const double gb = es[static_cast<std::size_t>(next)] - out->threshold_j;
+        if (failed || !(ga <= 0.0)) return inside;
+        boost::uintmax_t iters = 60;
+        try {
+          const double x0 = std::min(inside, outside), x1 = std::max(inside, outside);
+          const auto rr = boost::math::tools::toms748_solve(
+              g, x0, x1, x0 == inside ? ga : gb, x0 == inside ? gb : ga,
+              boost::math::tools::eps_tolerance<double>(30), iters);
+          const double root = 0.5 * (rr.first + rr.second);
+          const double slope = std::abs(gb - ga) / std::abs(outside - inside);
+          err_edges =
+              std::max(err_edges, (rr.second - rr.first) + (slope > 0.0 ? err_e / slope : 0.0));
+          return root;
+        } catch (const std::exception& e) {
+          failed = true;
+          *error = std::string("least_sting_zone: root finding failed: ") + e.what();
+          return inside;
+        }
+      }
+      j = next;
+    }
+  };
+  bool clip_lo = false, clip_hi = false;
+  out->from_knob_m = edge(-1, &clip_lo);
+  out->to_knob_m = edge(+1, &clip_hi);
+  if (failed) return false;
+  out->clipped_at_hands = clip_lo;
+  out->clipped_at_tip = clip_hi;
+  out->error_estimate_m = std::max(err_x, err_edges);
+  return true;
+}
+
 }  // namespace
 
 // ----------------------------------------------------------------------------- validation
@@ -435,10 +689,49 @@ bool SceneOptions::IsValid(std::string* why) const {
       return Fail(why, "curve_positions_from_knob_m[" + std::to_string(i) +
                            "] = " + Num(curve_positions_from_knob_m[i]) + ": must be finite");
   }
-  return hertz.IsValid(why);
+  if (!hertz.IsValid(why)) return false;
+  return flexible.IsValid(why);
 }
 
-bool CollisionOptions::IsValid(std::string* why) const { return hertz.IsValid(why); }
+bool CollisionOptions::IsValid(std::string* why) const {
+  return hertz.IsValid(why) && flexible.IsValid(why);
+}
+
+bool FlexibleOptions::IsValid(std::string* why) const {
+  if (!(std::isfinite(frequency_tolerance) && frequency_tolerance >= 1e-9 &&
+        frequency_tolerance <= 0.1))
+    return Fail(why, "flexible.frequency_tolerance = " + Num(frequency_tolerance) +
+                         ": must be in [1e-9, 0.1]");
+  if (max_elements < 2 || max_elements > 4096)
+    return Fail(
+        why, "flexible.max_elements = " + std::to_string(max_elements) + ": must be in [2, 4096]");
+  if (sting_samples < 3 || sting_samples > 1001)
+    return Fail(why, "flexible.sting_samples = " + std::to_string(sting_samples) +
+                         ": must be in [3, 1001]");
+  if (!(std::isfinite(sting_zone_fraction) && sting_zone_fraction > 0.0 &&
+        sting_zone_fraction <= 1.0))
+    return Fail(
+        why, "flexible.sting_zone_fraction = " + Num(sting_zone_fraction) + ": must be in (0, 1]");
+  return impact.IsValid(why);
+}
+
+BeamModesOptions FlexibleOptions::VibrationModes() const {
+  BeamModesOptions o;
+  o.theory = theory;
+  o.num_modes = 2;
+  o.relative_tolerance = frequency_tolerance;
+  o.max_elements = max_elements;
+  return o;
+}
+
+BeamModesOptions FlexibleOptions::ImpactModes() const {
+  BeamModesOptions o;
+  o.theory = theory;
+  o.num_modes = impact.max_modes;
+  o.relative_tolerance = impact.frequency_tolerance;
+  o.max_elements = max_elements;
+  return o;
+}
 
 // ----------------------------------------------------------------------------- names
 
@@ -474,10 +767,14 @@ std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model
       return {"mass_properties"};
     case SceneOutput::kVibrationNode:
       return {kFlexibleBeamModel};
+    case SceneOutput::kLeastStingZone:
+      return {"mass_properties", kFlexibleBeamModel, "flexible"};
     case SceneOutput::kMaxExitSpeed:
     case SceneOutput::kSweetZone:
     case SceneOutput::kExitSpeedCurve:
-      if (exit_model == CollisionModel::kFlexible) return {kFlexibleBeamModel};
+      if (exit_model == CollisionModel::kFlexible) {
+        return {"mass_properties", kFlexibleBeamModel, "flexible"};
+      }
       return {"mass_properties", CollisionModelName(exit_model)};
   }
   return {};
@@ -509,18 +806,23 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
       if (std::find(wanted.begin(), wanted.end(), o) == wanted.end()) wanted.push_back(o);
     }
     const bool needs_exit = std::any_of(wanted.begin(), wanted.end(), NeedsExitModel);
-    // Refusals for models that do not exist yet come first: nothing else runs.
-    if (std::find(wanted.begin(), wanted.end(), SceneOutput::kVibrationNode) != wanted.end()) {
-      s.message = kVibrationNodeRefusal;
-      out.missing_model = kFlexibleBeamModel;
-      out.refused_field = "outputs";
-      return finish();
-    }
-    if (needs_exit && options.model == CollisionModel::kFlexible) {
-      s.message = "model = flexible: needs the flexible beam model, which is not available yet";
-      out.missing_model = kFlexibleBeamModel;
-      out.refused_field = "model";
-      return finish();
+    // The flexible beam needs the bat's geometry, not only its mass properties.
+    const bool flexible_exit = needs_exit && options.model == CollisionModel::kFlexible;
+    if (!scene.bat.has_value()) {
+      for (SceneOutput o : {SceneOutput::kVibrationNode, SceneOutput::kLeastStingZone}) {
+        if (Wants(wanted, o)) {
+          s.message = std::string("bat: ") + SceneOutputName(o) +
+                      " needs the bat's geometry (a bat, not only mass_properties)";
+          out.refused_field = "bat";
+          return finish();
+        }
+      }
+      if (flexible_exit) {
+        s.message =
+            "bat: model = flexible needs the bat's geometry (a bat, not only mass_properties)";
+        out.refused_field = "bat";
+        return finish();
+      }
     }
     Resolved r;
     if (!Resolve(scene, &book, &r, &s)) return finish();
@@ -554,9 +856,26 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
       if (!what.empty()) messages.push_back(what);
     };
 
+    FlexibleModes flexible_modes(scene, options.flexible, &book);
     std::optional<ExitSpeedModel> exit_model;
     if (needs_exit) {
-      exit_model.emplace(model, scene, r, options.hertz, &book);
+      if (model == CollisionModel::kFlexible) {
+        const auto& modes = flexible_modes.Impact();
+        if (!modes->summary.IsSolutionUsable()) {
+          s.termination = modes->summary.termination == Termination::kInvalidInput
+                              ? Termination::kInvalidInput
+                              : Termination::kFailure;
+          s.message = s.termination == Termination::kInvalidInput
+                          ? modes->summary.message + " (model = flexible)"
+                          : "model = flexible: the bat's modes: " + modes->summary.message;
+          if (s.termination == Termination::kInvalidInput) out.refused_field = "bat";
+          return finish();
+        }
+        for (const auto& w : modes->summary.warnings) s.warnings.push_back("flexible_beam: " + w);
+        exit_model.emplace(model, scene, r, options.hertz, &book, &options.flexible, modes);
+      } else {
+        exit_model.emplace(model, scene, r, options.hertz, &book);
+      }
       out.exit_speed_model = exit_model->name();
     }
     const bool closed = exit_model.has_value() && exit_model->profile().has_value() &&
@@ -621,6 +940,45 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
         out.center_of_percussion = cop;
       }
     }
+    if (Wants(wanted, SceneOutput::kVibrationNode)) {
+      const auto& modes = flexible_modes.Vibration();
+      VibrationNodeResult node;
+      std::string error;
+      if (VibrationNodeFrom(*modes, flexible_modes.vibration_hit(), &node, &error)) {
+        if (modes->summary.termination == Termination::kNoConvergence) {
+          note(Termination::kNoConvergence, "vibration_node: " + modes->summary.message);
+        }
+        out.vibration_node = std::move(node);
+      } else {
+        const bool invalid = modes->summary.termination == Termination::kInvalidInput;
+        // Invalid input keeps the core message first ("bat.length_m = ...: rule"): it names
+        // the field.
+        note(invalid ? Termination::kInvalidInput : Termination::kFailure,
+             invalid ? error + " (vibration_node)" : "vibration_node: " + error);
+        if (invalid) out.refused_field = "bat";
+      }
+    }
+    if (Wants(wanted, SceneOutput::kLeastStingZone)) {
+      const auto& modes = flexible_modes.Impact();
+      if (!modes->summary.IsSolutionUsable()) {
+        const bool invalid = modes->summary.termination == Termination::kInvalidInput;
+        note(invalid ? Termination::kInvalidInput : Termination::kFailure,
+             invalid ? modes->summary.message + " (least_sting_zone)"
+                     : "least_sting_zone: the bat's modes: " + modes->summary.message);
+        if (invalid) out.refused_field = "bat";
+      } else {
+        LeastStingZoneResult zone;
+        std::string error;
+        std::vector<std::string> warnings;
+        const bool ok = SweepSting(scene, r, options, *modes, &book, &warnings, &zone, &error);
+        for (const auto& w : warnings) s.warnings.push_back("least_sting_zone: " + w);
+        if (ok) {
+          out.least_sting_zone = std::move(zone);
+        } else {
+          note(Termination::kFailure, "least_sting_zone: " + error);
+        }
+      }
+    }
     if (std::find(wanted.begin(), wanted.end(), SceneOutput::kExitSpeedCurve) != wanted.end()) {
       ExitSpeedCurveResult curve;
       curve.model = exit_model->name();
@@ -659,6 +1017,10 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
     s.iterations = -1;
     double worst_err = 0.0;
     if (out.max_exit_speed) worst_err = std::max(worst_err, out.max_exit_speed->error_estimate_m);
+    if (out.vibration_node) worst_err = std::max(worst_err, out.vibration_node->error_estimate_m);
+    if (out.least_sting_zone) {
+      worst_err = std::max(worst_err, out.least_sting_zone->error_estimate_m);
+    }
     s.error_estimate = worst_err;
   } catch (const std::exception& e) {
     s.termination = Termination::kFailure;
@@ -693,10 +1055,10 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
       s.message = why;
       return finish();
     }
-    if (model == CollisionModel::kFlexible) {
+    if (model == CollisionModel::kFlexible && !scene.bat.has_value()) {
       out.model = model;
-      s.message = "model = flexible: needs the flexible beam model, which is not available yet";
-      out.missing_model = kFlexibleBeamModel;
+      s.message =
+          "bat: model = flexible needs the bat's geometry (a bat, not only mass_properties)";
       return finish();
     }
     Resolved r;
@@ -761,6 +1123,41 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
         out.exit_speed_mps = out.hertz->exit_speed_mps;
         out.error_estimate_mps = out.hertz->error_estimate_exit_speed_mps;
         break;
+      }
+      case CollisionModel::kFlexible: {
+        FlexibleModes flexible_modes(scene, options.flexible, &book);
+        const auto& modes = flexible_modes.Impact();
+        out.modes_cache_hit = flexible_modes.impact_hit();
+        if (!modes->summary.IsSolutionUsable()) {
+          s.termination = modes->summary.termination == Termination::kInvalidInput
+                              ? Termination::kInvalidInput
+                              : Termination::kFailure;
+          s.message = s.termination == Termination::kInvalidInput
+                          ? modes->summary.message + " (model = flexible)"
+                          : "model = flexible: the bat's modes: " + modes->summary.message;
+          return finish();
+        }
+        const auto tf = Clock::now();
+        const FlexibleImpactInputs in = MakeFlexible(scene, r, impact_from_knob_m, options.hertz);
+        out.approach_speed_mps = in.approach_speed_mps;
+        out.flexible = SolveFlexibleImpact(*scene.bat, *modes, in, options.flexible.impact);
+        const Summary& fs = out.flexible->summary;
+        s.termination = fs.termination;
+        if (fs.IsSolutionUsable() && modes->summary.termination == Termination::kNoConvergence) {
+          s.termination = Termination::kNoConvergence;
+        }
+        s.message = fs.message;
+        s.backend = fs.backend;
+        s.iterations = fs.iterations;
+        s.evaluations = fs.evaluations;
+        for (const auto& w : modes->summary.warnings) s.warnings.push_back("flexible_beam: " + w);
+        for (const auto& w : fs.warnings) s.warnings.push_back(w);
+        out.exit_speed_mps = out.flexible->exit_speed_mps;
+        out.error_estimate_mps = out.flexible->error_estimate_exit_speed_mps;
+        book.Add(CollisionModelName(model), Seconds(tf), 1);
+        s.objective = out.exit_speed_mps;
+        s.error_estimate = out.error_estimate_mps;
+        return finish();
       }
       default:
         s.termination = Termination::kFailure;

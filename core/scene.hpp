@@ -14,6 +14,10 @@
 #include "core/collision/free_bat.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
+#include "core/flexible/beam_model.hpp"
+#include "core/flexible/flexible_impact.hpp"
+#include "core/flexible/modes.hpp"
+#include "core/flexible/modes_cache.hpp"
 #include "core/mass_properties.hpp"
 #include "core/nlopt_search.hpp"
 #include "core/summary.hpp"
@@ -71,7 +75,7 @@ enum class CollisionModel {
   kRigidPivot,  ///< The paper's pivoted rigid bat (closed form).
   kFreeBat,     ///< The free rigid bat, collision efficiency (closed form).
   kHertz,       ///< The contact model (ODE).
-  kFlexible,    ///< The flexible beam (not available yet: a named refusal).
+  kFlexible,    ///< The flexible free-free beam, modal superposition + the contact law (ODE).
 };
 
 /// Stable name: "auto", "rigid_pivot", "free_bat", "hertz", "flexible".
@@ -80,7 +84,9 @@ const char* CollisionModelName(CollisionModel model);
 std::optional<CollisionModel> ParseCollisionModel(std::string_view name);
 
 /// The models an output needs with `exit_model` as the exit-speed model, in run order
-/// (e.g. {"mass_properties", "rigid_pivot"}; vibration_node: {"flexible_beam"}).
+/// (e.g. {"mass_properties", "rigid_pivot"}; vibration_node: {"flexible_beam"};
+/// least_sting_zone, or any exit output with model flexible: {"mass_properties",
+/// "flexible_beam", "flexible"}).
 std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model);
 
 /// How the sweet spot is found.
@@ -95,6 +101,28 @@ enum class ToleranceUnit {
   kPercent,          ///< Percent of the maximum exit speed.
 };
 
+/// Scene-level settings of the flexible beam (vibration_node, model = flexible, least_sting_zone).
+struct FlexibleOptions {
+  BeamTheory theory = BeamTheory::kTimoshenko;  ///< Beam theory of every flexible output.
+  /// vibration_node: relative tolerance of the first two frequencies, in [1e-9, 0.1].
+  double frequency_tolerance = 1e-4;
+  int max_elements = 512;        ///< Mesh bound of every modes computation, in [2, 4096].
+  FlexibleImpactOptions impact;  ///< Flexible impacts (model = flexible, least_sting_zone).
+  int sting_samples = 41;  ///< least_sting_zone: impacts from the hands to the tip, in [3, 1001].
+  /// least_sting_zone: the zone is E <= E_min + fraction (E_max - E_min), in (0, 1].
+  double sting_zone_fraction = 0.1;
+  /// Cross-request cache of modes, owned by the caller (the API's server context); null = none.
+  /// Within a request the modes are computed once whatever this is.
+  ModesCache* modes_cache = nullptr;
+
+  /// True when every field is in range; otherwise "flexible.field = value: rule" in *why.
+  bool IsValid(std::string* why) const;
+  /// The modes options of vibration_node (2 modes to frequency_tolerance).
+  BeamModesOptions VibrationModes() const;
+  /// The modes options of flexible impacts (impact.max_modes to impact.frequency_tolerance).
+  BeamModesOptions ImpactModes() const;
+};
+
 /// Options of EvaluateScene.
 struct SceneOptions {
   CollisionModel model =
@@ -107,6 +135,7 @@ struct SceneOptions {
   std::vector<double> curve_positions_from_knob_m;  ///< Explicit curve positions, m (overrides
                                                     ///< curve_samples; at most 10000).
   HertzOptions hertz;                               ///< Contact-model settings (model = kHertz).
+  FlexibleOptions flexible;  ///< Flexible-beam settings (vibration_node, flexible, sting).
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
@@ -134,6 +163,8 @@ struct SceneResult {
   std::optional<CenterOfPercussionResult> center_of_percussion;  ///< center_of_percussion.
   std::optional<SweetZoneResult> sweet_zone;                     ///< sweet_zone.
   std::optional<ExitSpeedCurveResult> exit_speed_curve;          ///< exit_speed_curve.
+  std::optional<VibrationNodeResult> vibration_node;             ///< vibration_node.
+  std::optional<LeastStingZoneResult> least_sting_zone;          ///< least_sting_zone.
   std::vector<ModelTiming> timings;  ///< Time per model, in first-use order.
 };
 
@@ -143,7 +174,9 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options);
 /// Options of Collide.
 struct CollisionOptions {
   bool want_contact_details = false;  ///< kAuto: contact time / peak force wanted (selects hertz).
-  HertzOptions hertz;                 ///< Contact-model settings.
+  HertzOptions hertz;                 ///< Contact-model settings (the flexible model uses its
+                                      ///< bat_surface_compliance too).
+  FlexibleOptions flexible;           ///< Flexible-beam settings (model = kFlexible).
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
@@ -164,7 +197,9 @@ struct CollisionResult {
   std::optional<RigidPivotImpact> rigid_pivot;         ///< Details when model = rigid_pivot.
   std::optional<FreeBatImpact> free_bat;               ///< Details when model = free_bat.
   std::optional<HertzImpact> hertz;                    ///< Details when model = hertz.
-  std::vector<ModelTiming> timings;                    ///< Time per model.
+  std::optional<FlexibleImpactResult> flexible;        ///< Details when model = flexible.
+  bool modes_cache_hit = false;      ///< model = flexible: the modes came from the cache.
+  std::vector<ModelTiming> timings;  ///< Time per model.
 };
 
 /// One impact at `impact_from_knob_m` with `model`. Never throws.

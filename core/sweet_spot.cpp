@@ -28,6 +28,7 @@ constexpr OutputName kOutputNames[] = {
     {SceneOutput::kVibrationNode, "vibration_node"},
     {SceneOutput::kSweetZone, "sweet_zone"},
     {SceneOutput::kExitSpeedCurve, "exit_speed_curve"},
+    {SceneOutput::kLeastStingZone, "least_sting_zone"},
 };
 
 }  // namespace

@@ -21,18 +21,19 @@ enum class SceneOutput {
   kVibrationNode,   ///< The node of the fundamental bending mode (needs the flexible beam model).
   kSweetZone,       ///< Positions whose exit speed is within a tolerance of the maximum.
   kExitSpeedCurve,  ///< Exit speed along the bat.
+  kLeastStingZone,  ///< Flexible impacts swept along the bat: where the hands get least vibration.
 };
 
 /// Stable name: "max_exit_speed", "center_of_percussion", "vibration_node", "sweet_zone",
-/// "exit_speed_curve".
+/// "exit_speed_curve", "least_sting_zone".
 const char* SceneOutputName(SceneOutput output);
 /// The output called `name`, or nullopt.
 std::optional<SceneOutput> ParseSceneOutput(std::string_view name);
 
-/// The refusal for vibration_node until the flexible beam model exists.
+/// The former refusal of vibration_node (kept for callers that quote it; no longer returned).
 inline constexpr char kVibrationNodeRefusal[] =
     "vibration_node needs the flexible beam model, which is not available yet";
-/// The name of the missing model in that refusal.
+/// The name of the flexible beam's modal model (in models_used and timings).
 inline constexpr char kFlexibleBeamModel[] = "flexible_beam";
 
 /// Where an optimum lies relative to the bat.
@@ -94,6 +95,61 @@ struct ExitSpeedCurveResult {
   std::vector<CurvePoint> points;   ///< In the order requested (samples: knob to tip).
   double error_estimate_mps = 0.0;  ///< Largest estimated error over the points, m/s.
   std::string model;                ///< The exit-speed model.
+};
+
+/// The vibration_node output: the nodes of the free-free bat's first two bending modes
+/// (core/flexible/modes.hpp). The sweet spot is the barrel-side node of the fundamental: an
+/// impact there excites it least, so the hands get the least vibration energy.
+struct VibrationNodeResult {
+  double position_from_knob_m = 0.0;      ///< Barrel-side node of mode 1, m from the knob.
+  double frequency_hz = 0.0;              ///< Mode 1's natural frequency, Hz.
+  double other_node_from_knob_m = 0.0;    ///< Handle-side node of mode 1, m from the knob.
+  double second_mode_frequency_hz = 0.0;  ///< Mode 2's natural frequency, Hz.
+  std::vector<double> second_mode_nodes_from_knob_m;  ///< Mode 2's nodes, m from the knob.
+  double error_estimate_m = 0.0;                      ///< Estimated error of the node positions, m.
+  double error_estimate_hz = 0.0;                     ///< Estimated error of frequency_hz, Hz.
+  double second_mode_error_estimate_hz = 0.0;  ///< Estimated error of mode 2's frequency, Hz.
+  double relative_tolerance = 0.0;             ///< The requested relative frequency tolerance.
+  int elements = 0;                            ///< Elements of the final mesh.
+  std::vector<int> refinement_elements;        ///< Elements of every mesh solved.
+  std::string theory;                          ///< "timoshenko" or "euler_bernoulli".
+  bool cache_hit = false;                      ///< The modes came from the cross-request cache.
+  Summary summary;                             ///< The modes computation's report.
+};
+
+/// One impact of the least_sting_zone sweep: the flexible and the rigid (free bat) models.
+struct StingPoint {
+  double position_from_knob_m = 0.0;      ///< Impact position, m from the knob.
+  double exit_speed_mps = 0.0;            ///< Flexible bat, m/s.
+  double rigid_exit_speed_mps = 0.0;      ///< Free rigid bat (same e and mass properties), m/s.
+  double vibration_energy_j = 0.0;        ///< Energy left in the bending modes, J.
+  double hands_vibration_energy_j = 0.0;  ///< Of which in the grip segment at the hands, J.
+  double hands_peak_shear_force_n = 0.0;  ///< Peak shear force at the hands' section, N.
+  double hands_peak_bending_moment_n_m = 0.0;  ///< Peak bending moment there, N m.
+  double contact_time_s = 0.0;                 ///< Contact time, s.
+  double error_estimate_exit_speed_mps = 0.0;  ///< m/s.
+  double error_estimate_hands_energy_j = 0.0;  ///< J.
+};
+
+/// The least_sting_zone output: flexible impacts swept from the hands to the tip; the zone is
+/// the connected interval around the least-sting impact where the hands' vibration energy
+/// E(s) <= E_min + fraction (E_max - E_min) (E_max: the largest over the sweep).
+struct LeastStingZoneResult {
+  double from_knob_m = 0.0;               ///< Start of the zone, m from the knob.
+  double to_knob_m = 0.0;                 ///< End of the zone, m from the knob.
+  double min_position_from_knob_m = 0.0;  ///< The least-sting impact, m from the knob.
+  double min_hands_energy_j = 0.0;        ///< E there, J.
+  double max_hands_energy_j = 0.0;        ///< Largest E over the sweep, J.
+  double threshold_j = 0.0;               ///< E_min + fraction (E_max - E_min), J.
+  double fraction = 0.0;                  ///< The fraction used.
+  double exit_speed_at_min_mps = 0.0;     ///< Flexible exit speed at the least-sting impact, m/s.
+  bool clipped_at_hands = false;          ///< The zone reaches the start of the sweep.
+  bool clipped_at_tip = false;            ///< The zone reaches the tip.
+  double error_estimate_m = 0.0;          ///< Estimated error of the ends and the minimum, m.
+  std::vector<StingPoint> curve;          ///< The sweep, knob to tip order.
+  int modes_used = 0;                     ///< Most bending modes used by an impact.
+  int elements = 0;                       ///< Elements of the beam mesh.
+  std::string theory;                     ///< The beam theory.
 };
 
 /// The closed-form sweet spot of `profile` over the bat [0, length_m] (candidates: the clamped

@@ -78,13 +78,16 @@ TEST(SweetSpotEndpointTest, SameInputSameHash) {
             Post("/v1/sweet-spot", reordered).body["provenance"]["input_hash"]);
 }
 
-TEST(SweetSpotEndpointTest, VibrationNodeIs501NamingTheMissingModel) {
+TEST(SweetSpotEndpointTest, VibrationNodeHasPositionAndFrequency) {
   const Response r =
       Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"}, "outputs": ["vibration_node"]})");
-  EXPECT_EQ(r.status, 501);
-  EXPECT_EQ(r.body["code"], "NotImplemented");
-  EXPECT_EQ(r.body["field"], "outputs");
-  EXPECT_NE(r.body["message"].get<std::string>().find("flexible beam"), std::string::npos);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  ASSERT_TRUE(r.body.contains("vibration_node")) << r.body.dump();
+  const double node = r.body["vibration_node"]["position_from_knob_m"];
+  EXPECT_GT(node, 0.5 * 0.855);  // the barrel-side node
+  EXPECT_LT(node, 0.855);
+  EXPECT_GT(r.body["vibration_node"]["frequency_hz"].get<double>(), 0.0);
+  EXPECT_EQ(r.body["models_used"], nlohmann::json::array({"mass_properties", "flexible_beam"}));
 }
 
 TEST(SweetSpotEndpointTest, RefusalsNameTheField) {
@@ -151,15 +154,16 @@ TEST(CollisionEndpointTest, AutoWithContactDetailsPicksHertz) {
   EXPECT_FALSE(r.body["model_reason"].get<std::string>().empty());
 }
 
-TEST(CollisionEndpointTest, ImpactOffTheBatAndFlexibleAreRefused) {
+TEST(CollisionEndpointTest, ImpactOffTheBatIsRefusedAndFlexibleRuns) {
   const Response off = Post("/v1/collision",
                             R"({"bat": {"preset": "paper-wood"}, "impact_from_knob_m": 0.9})");
   EXPECT_EQ(off.status, 400);
   EXPECT_EQ(off.body["message"], "impact_from_knob_m = 0.9: must be a number in [0, 0.855]");
   const Response flexible = Post("/v1/collision", R"({"bat": {"preset": "paper-wood"},
       "impact_from_knob_m": 0.7, "model": "flexible"})");
-  EXPECT_EQ(flexible.status, 501) << flexible.body.dump();
-  EXPECT_EQ(flexible.body["field"], "model");
+  ASSERT_EQ(flexible.status, 200) << flexible.body.dump();
+  EXPECT_EQ(flexible.body["model"], "flexible");
+  EXPECT_TRUE(flexible.body["flexible"]["hands"]["vibration_energy_j"].is_number());
 }
 
 TEST(CompareEndpointTest, CorkLowersTheMassAndSweetSpotSpeed) {

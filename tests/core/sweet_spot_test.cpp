@@ -54,16 +54,20 @@ TEST(CenterOfPercussion, RefusedWhenTheHandsAreNotBeforeTheBalancePoint) {
             "the balance point (0.59999999999999998 m) for a centre of percussion to exist");
 }
 
-TEST(VibrationNode, IsANamedRefusalAndRunsNothing) {
+TEST(VibrationNode, IsTheBarrelSideNodeOfTheFundamentalMode) {
   const SceneResult r =
       EvaluateScene(PaperWood({SceneOutput::kMaxExitSpeed, SceneOutput::kVibrationNode}), {});
-  EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
-  EXPECT_EQ(r.summary.message,
-            "vibration_node needs the flexible beam model, which is not available yet");
-  EXPECT_EQ(r.missing_model, "flexible_beam");
-  EXPECT_EQ(r.refused_field, "outputs");
-  EXPECT_TRUE(r.summary.models_used.empty());
-  EXPECT_FALSE(r.max_exit_speed.has_value());
+  ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.message;
+  ASSERT_TRUE(r.vibration_node.has_value());
+  const VibrationNodeResult& n = *r.vibration_node;
+  // A free-free beam's mode 1 has two nodes; the barrel-side one lies beyond
+  // the handle-side one, inside the bat (a uniform beam: 0.224 L and 0.776 L).
+  EXPECT_GT(n.position_from_knob_m, n.other_node_from_knob_m);
+  EXPECT_GT(n.position_from_knob_m, 0.5 * 0.855);
+  EXPECT_LT(n.position_from_knob_m, 0.855);
+  EXPECT_GT(n.frequency_hz, 0.0);
+  EXPECT_GT(n.second_mode_frequency_hz, n.frequency_hz);
+  EXPECT_TRUE(r.max_exit_speed.has_value());
 }
 
 TEST(SweetZone, EdgesAreWhereTheSpeedDropsByTheTolerance) {

@@ -1,0 +1,122 @@
+// POST /v1/bat/modes: parse -> validate -> core::CachedBatModes -> render.
+#include "api/handlers_modes.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "api/bat_json.hpp"
+#include "api/handlers.hpp"
+#include "api/scene_json.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// One mode: frequency, nodes and the shape sampled at `samples` evenly spaced positions,
+// scaled so that the largest |displacement| is 1 (tip positive).
+Json ModeToJson(const core::BatModes& modes, std::size_t k, int samples) {
+  const core::BeamMode& mode = modes.modes[k];
+  const double length = modes.length_m;
+  std::vector<double> xs, ws;
+  double peak = 0.0;
+  for (int i = 0; i < samples; ++i) {
+    const double x = i + 1 == samples ? length : length * i / (samples - 1);
+    const double w = modes.Displacement(mode.vector, x);
+    xs.push_back(x);
+    ws.push_back(w);
+    peak = std::max(peak, std::abs(w));
+  }
+  // The largest |w| over the mesh nodes too, so the scale does not depend on the sampling.
+  for (double x : modes.nodes_m)
+    peak = std::max(peak, std::abs(modes.Displacement(mode.vector, x)));
+  const double scale = peak > 0.0 ? peak : 1.0;
+  Json shape = Json::array();
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    shape.push_back({{"position_from_knob_m", xs[i]}, {"displacement", ws[i] / scale}});
+  }
+  return {{"mode", k + 1},
+          {"frequency_hz", mode.frequency_hz},
+          {"error_estimate_hz", mode.error_estimate_hz},
+          {"observed_order", mode.observed_order},
+          {"nodes_from_knob_m", mode.nodes_from_knob_m},
+          {"nodes_error_estimate_m", mode.nodes_error_estimate_m},
+          {"displacement_scale_per_sqrt_kg", scale},
+          {"shape", std::move(shape)}};
+}
+
+}  // namespace
+
+Response HandleBatModes(const Request& request, const Context& context) {
+  const auto start = std::chrono::steady_clock::now();
+  Response failure;
+  const auto body = ParseObjectBody(request, context, &failure);
+  if (!body) return failure;
+  ApiError error;
+  ObjectReader reader(*body, "", &error);
+  const Json* bat_json = reader.Get("bat");
+  if (bat_json == nullptr) {
+    reader.Missing("bat");
+    return ToResponse(error);
+  }
+  const auto spec = ParseBat(*bat_json, "bat", context.limits, &error);
+  if (!spec) return ToResponse(error);
+  core::BeamModesOptions options;
+  std::string theory = "timoshenko";
+  reader.OptionalString("theory", &theory, {"timoshenko", "euler_bernoulli"});
+  options.theory = core::ParseBeamTheory(theory).value_or(core::BeamTheory::kTimoshenko);
+  long long modes = 4;
+  reader.OptionalInteger("modes", 1, 20, &modes);
+  options.num_modes = static_cast<int>(modes);
+  reader.OptionalNumber("tolerance", Between(1e-9, 0.1), &options.relative_tolerance);
+  long long samples = 41;
+  reader.OptionalInteger("shape_samples", 2, 1001, &samples);
+  long long max_elements = options.max_elements;
+  reader.OptionalInteger("max_elements", 2, 4096, &max_elements);
+  options.max_elements = static_cast<int>(max_elements);
+  if (!reader.Finish()) return ToResponse(error);
+
+  bool cache_hit = false;
+  const auto result = core::CachedBatModes(spec->bat, options, ModesCacheOf(context), &cache_hit);
+  const core::Summary& s = result->summary;
+  if (!s.IsSolutionUsable()) return CoreFailure(s, "", "bat");
+
+  Json out = Json::object();
+  Json frequencies = Json::array(), errors = Json::array(), list = Json::array();
+  for (std::size_t k = 0; k < result->modes.size(); ++k) {
+    frequencies.push_back(result->modes[k].frequency_hz);
+    errors.push_back(result->modes[k].error_estimate_hz);
+    list.push_back(ModeToJson(*result, k, static_cast<int>(samples)));
+  }
+  out["theory"] = core::BeamTheoryName(result->theory);
+  out["boundary_conditions"] = "free-free";
+  out["frequencies_hz"] = std::move(frequencies);
+  out["modes"] = std::move(list);
+  const core::BeamMode& first = result->modes.front();
+  if (!first.nodes_from_knob_m.empty()) {
+    out["vibration_node"] = {{"position_from_knob_m", first.nodes_from_knob_m.back()},
+                             {"frequency_hz", first.frequency_hz},
+                             {"other_node_from_knob_m", first.nodes_from_knob_m.front()}};
+  }
+  out["elements"] = result->Elements();
+  out["refinement_elements"] = result->refinement_elements;
+  out["tolerance"] = result->tolerance;
+  out["error_estimate"] = {{"frequency_relative", result->max_relative_error},
+                           {"frequencies_hz", std::move(errors)}};
+  out["rigid_body"] = {{"mass_kg", result->mass_kg},
+                       {"balance_point_m", result->balance_point_m},
+                       {"moi_centroid_kg_m2", result->moi_centroid_kg_m2}};
+  out["models_used"] = {core::kFlexibleBeamModel};
+  out["cache_hit"] = cache_hit;
+  out["summary"] = SummaryToJson(s);
+  out["provenance"] = Provenance(*body, Json::object());
+  out["timing_s"] = SecondsSince(start);
+  return {200, std::move(out)};
+}
+
+}  // namespace sweetspot::api

@@ -1,0 +1,1001 @@
+// flexible_impact: implementation; the assumptions are stated at the top of flexible_impact.hpp.
+#include "core/flexible/flexible_impact.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <functional>
+#include <limits>
+#include <sstream>
+#include <utility>
+
+#include <Eigen/SparseCholesky>
+#include <boost/math/tools/roots.hpp>
+#include <boost/numeric/odeint.hpp>
+
+#include "core/units.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+namespace odeint = boost::numeric::odeint;
+using State = std::vector<double>;
+
+constexpr double kTwoPi = 2.0 * kPi;
+// Free flight after a separation is scanned with this many samples per period of the highest
+// mode (a touch shorter than 1/32 of that period can be missed; its impulse is negligible).
+constexpr int kSamplesPerPeriod = 32;
+// The longest free flight scanned for a further contact when the bat's rigid recoil does not
+// bound it, s.
+constexpr double kMaxFreeFlightS = 0.05;
+// A gap below this (scaled by the compression scale) counts as touching.
+constexpr double kTouch = 1e-12;
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
+bool Fail(std::string* why, const std::string& m) {
+  if (why != nullptr) *why = m;
+  return false;
+}
+
+// The ball's contact law (as in hertz_contact.cpp, ball_power_law): the ball's k d^p in series
+// with the bat surface's Hertz K d^1.5 on loading.
+struct ContactLaw {
+  double k = 0.0, p = 1.5, kk = 0.0, cor = 0.5;
+  double k_eff = 0.0;  // series stiffness when p = 3/2
+
+  void Init() {
+    if (kk > 0.0 && p == 1.5) {
+      const double kb = std::cbrt(1.0 / (k * k));
+      const double ks = std::cbrt(1.0 / (kk * kk));
+      k_eff = std::pow(kb + ks, -1.5);
+    }
+  }
+  // Force along the virgin loading curve at compression d (m), N.
+  double Loading(double d) const {
+    if (d <= 0.0) return 0.0;
+    if (kk <= 0.0) return k * std::pow(d, p);
+    if (p == 1.5) return k_eff * d * std::sqrt(d);
+    // Solve db + (k db^p / K)^{2/3} = d for the ball's share db (monotone; safeguarded Newton).
+    const double a = std::cbrt((k / kk) * (k / kk));
+    const double e = 2.0 * p / 3.0;
+    double lo = 0.0, hi = d, db = d / (1.0 + a * std::pow(d, e - 1.0));
+    for (int it = 0; it < 60; ++it) {
+      const double g = db + a * std::pow(db, e) - d;
+      if (g > 0.0) {
+        hi = db;
+      } else {
+        lo = db;
+      }
+      const double dg = 1.0 + a * e * std::pow(db, e - 1.0);
+      double next = db - g / dg;
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      if (std::abs(next - db) <= 1e-15 * d) {
+        db = next;
+        break;
+      }
+      db = next;
+    }
+    return k * std::pow(db, p);
+  }
+  // Compression on the virgin curve at force f (the inverse of Loading), m.
+  double LoadingCompression(double f) const {
+    if (f <= 0.0) return 0.0;
+    double d = BallCompression(f);
+    if (kk > 0.0) d += std::cbrt((f / kk) * (f / kk));
+    return d;
+  }
+  // The ball's own compression (f / k)^(1/p), m (cbrt for the default p = 3/2: no pow).
+  double BallCompression(double f) const {
+    if (p == 1.5) {
+      const double c = std::cbrt(f / k);
+      return c * c;
+    }
+    return std::pow(f / k, 1.0 / p);
+  }
+  // Work along the virgin curve up to force fm at compression dm, J.
+  double Work(double fm, double dm) const {
+    double comp = p / (p + 1.0) * std::pow(fm / k, 1.0 / p) * fm;
+    if (kk > 0.0) comp += 0.6 * std::cbrt((fm / kk) * (fm / kk)) * fm;
+    return fm * dm - comp;
+  }
+};
+
+enum class Phase { kLoading, kUnloading };
+
+// The modes in the superposition and what each contributes at the impact point and the hands.
+struct Model {
+  int n = 0;                      // modes, the 2 rigid ones first
+  std::vector<double> omega_hat;  // omega_k t_s (0 for the rigid modes)
+  std::vector<double> phi_hat;    // phi_k(s) sqrt(m)
+  std::vector<double> shear;      // S_k = int_0^h rho A phi_k dx, kg^0.5
+  std::vector<double> moment;     // T_k = int_0^h rho A phi_k (x - h) + rho I theta_k dx, kg^0.5 m
+  std::vector<double> grip;       // G_k = int_grip rho A phi_k^2 + rho I theta_k^2 dx
+  double residual_compliance = 0.0;  // sum over the modes left out of phi_k(s)^2 / omega_k^2, m/N
+  double force_sign_hands = 0.0;     // 1 when the ball strikes the knob-side segment [0, h)
+  double arm_hands_m = 0.0;          // s - h
+};
+
+// Scales and the contact state shared by the right-hand side and the driver.
+struct Rhs {
+  const Model* model = nullptr;
+  const ContactLaw* law = nullptr;
+  double delta_s = 1.0, v0 = 1.0, t_s = 1.0, m = 1.0;
+  Phase phase = Phase::kLoading;
+  double delta_max = 0.0;        // contact compression (ball + surface) where unloading began, m
+  double total_delta_max = 0.0;  // the same plus the residual spring's share, m
+  double force_max = 0.0, q = 1.5;
+  long* evaluations = nullptr;
+  mutable double last_force = 0.0;  // warm start of Force's Newton iteration (a cache only)
+
+  int Q(int k) const { return 2 + k; }
+  int QD(int k) const { return 2 + model->n + k; }
+  int P() const { return 2 + 2 * model->n; }
+  int W() const { return 3 + 2 * model->n; }
+  int Size() const { return 4 + 2 * model->n; }
+
+  // Scaled compression (ball surface to the bat's modal surface) and its rate.
+  double Delta(const State& y) const {
+    double w = 0.0;
+    for (int k = 0; k < model->n; ++k) {
+      w += model->phi_hat[static_cast<std::size_t>(k)] * y[static_cast<std::size_t>(Q(k))];
+    }
+    return y[0] - w;
+  }
+  double DeltaRate(const State& y) const {
+    double w = 0.0;
+    for (int k = 0; k < model->n; ++k) {
+      w += model->phi_hat[static_cast<std::size_t>(k)] * y[static_cast<std::size_t>(QD(k))];
+    }
+    return y[1] - w;
+  }
+  // Contact force (N) on the current branch at contact compression d (m), no residual spring.
+  double ContactForce(double d) const {
+    if (d <= 0.0) return 0.0;
+    if (phase == Phase::kLoading || d >= delta_max) return law->Loading(d);
+    return force_max * std::pow(d / delta_max, q);
+  }
+  // Compression (m) and its derivative d(compression)/df (m/N) at force f, one pow at most.
+  void CompressionAndCompliance(double f, double* d, double* c) const {
+    if (phase == Phase::kLoading || f >= force_max) {
+      const double ball = law->BallCompression(f);
+      double surface = 0.0;
+      if (law->kk > 0.0) surface = std::cbrt((f / law->kk) * (f / law->kk));
+      *d = ball + surface;
+      *c = ball / (law->p * f) + 2.0 / 3.0 * surface / f;
+      return;
+    }
+    *d = delta_max * std::pow(f / force_max, 1.0 / q);
+    *c = *d / (q * f);
+  }
+  // Force (N) at scaled total compression d: the contact in series with the residual spring
+  // c (the static compliance of the modes left out): compression(F) + c F = d, solved by a
+  // safeguarded Newton iteration (monotone in F, bracketed by 0 and the force without c).
+  double Force(double d_scaled) const {
+    const double d = d_scaled * delta_s;
+    if (d <= 0.0) return 0.0;
+    const double c = model->residual_compliance;
+    if (c <= 0.0) return ContactForce(d);
+    // Bracket: 0 < F <= d / c (and <= the force without c, computed only for a cold start).
+    double lo = 0.0, hi = d / c;
+    double f = last_force;  // warm start: the integrator calls with nearby states
+    if (!(f > 0.0 && f < hi)) {
+      hi = std::min(hi, ContactForce(d));
+      f = 0.5 * hi;
+    }
+    for (int it = 0; it < 60; ++it) {
+      double comp = 0.0, compliance = 0.0;
+      CompressionAndCompliance(f, &comp, &compliance);
+      const double g = comp + c * f - d;
+      if (std::abs(g) <= 4.0 * std::numeric_limits<double>::epsilon() * d) return last_force = f;
+      if (g > 0.0) {
+        hi = f;
+      } else {
+        lo = f;
+      }
+      double next = f - g / (compliance + c);
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      if (std::abs(next - f) <= 1e-14 * f) return last_force = next;
+      f = next;
+    }
+    return last_force = f;
+  }
+  void operator()(const State& y, State& dy, double /*t*/) const {
+    if (evaluations != nullptr) ++*evaluations;
+    const double f = Force(Delta(y));
+    const double fh = f * t_s / (m * v0);
+    dy[0] = y[1];
+    dy[1] = -fh;
+    const int n = model->n;
+    for (int k = 0; k < n; ++k) {
+      const std::size_t ks = static_cast<std::size_t>(k);
+      const double om = model->omega_hat[ks];
+      dy[static_cast<std::size_t>(Q(k))] = y[static_cast<std::size_t>(QD(k))];
+      dy[static_cast<std::size_t>(QD(k))] =
+          -om * om * y[static_cast<std::size_t>(Q(k))] + model->phi_hat[ks] * fh;
+    }
+    dy[static_cast<std::size_t>(P())] = fh;
+    dy[static_cast<std::size_t>(W())] = fh * DeltaRate(y);
+  }
+  // Shear force and bending moment at the hands (N, N m) for state y with contact force f.
+  void HandsLoads(const State& y, double f, double* shear, double* moment) const {
+    const double scale = delta_s * std::sqrt(m) / (t_s * t_s);  // scaled q'' -> physical
+    const double fh = f * t_s / (m * v0);
+    double v = 0.0, mo = 0.0;
+    for (int k = 0; k < model->n; ++k) {
+      const std::size_t ks = static_cast<std::size_t>(k);
+      const double om = model->omega_hat[ks];
+      const double acc =
+          scale * (-om * om * y[static_cast<std::size_t>(Q(k))] + model->phi_hat[ks] * fh);
+      v += model->shear[ks] * acc;
+      mo += model->moment[ks] * acc;
+    }
+    v -= model->force_sign_hands * f;
+    mo -= model->force_sign_hands * f * model->arm_hands_m;
+    *shear = v;
+    *moment = mo;
+  }
+};
+
+// Exact free motion over dtau (scaled): ballistic ball, rigid modes linear, flexible harmonic.
+void FreeAdvance(const Rhs& rhs, double dtau, State* y) {
+  State& s = *y;
+  s[0] += s[1] * dtau;
+  for (int k = 0; k < rhs.model->n; ++k) {
+    const std::size_t i = static_cast<std::size_t>(rhs.Q(k));
+    const std::size_t j = static_cast<std::size_t>(rhs.QD(k));
+    const double om = rhs.model->omega_hat[static_cast<std::size_t>(k)];
+    if (om == 0.0) {
+      s[i] += s[j] * dtau;
+    } else {
+      const double c = std::cos(om * dtau), sn = std::sin(om * dtau);
+      const double q = s[i], qd = s[j];
+      s[i] = q * c + qd / om * sn;
+      s[j] = -q * om * sn + qd * c;
+    }
+  }
+}
+
+struct RawRun {
+  bool ok = false;
+  std::string message;
+  std::vector<std::string> warnings;
+  State final_state;
+  double contact_time_s = 0.0;
+  int contacts = 0;
+  double peak_force_n = 0.0;
+  double max_compression_m = 0.0;
+  double loss_j = 0.0;
+  double released_j = 0.0;  // residual-spring energy released by an abrupt (plastic) end, J
+  double peak_shear_n = 0.0;
+  double peak_moment_n_m = 0.0;
+  int steps = 0;
+  long evaluations = 0;
+};
+
+// Samples the hands' loads along free motion from y over [0, window] (scaled) and updates the
+// peaks (rotation recurrences: no trigonometry per sample).
+void FreeHandsPeaks(const Rhs& rhs, const State& y, double window, double dtau, RawRun* run) {
+  const Model& md = *rhs.model;
+  const int n = md.n;
+  if (!(window > 0.0) || !(dtau > 0.0)) return;
+  // Clamp in double before the cast (no overflow for any ratio).
+  const long samples = static_cast<long>(std::min(std::ceil(window / dtau), 2e6));
+  std::vector<double> c(static_cast<std::size_t>(n), 1.0), s(static_cast<std::size_t>(n), 0.0),
+      cd(static_cast<std::size_t>(n)), sd(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    const double om = md.omega_hat[static_cast<std::size_t>(k)];
+    cd[static_cast<std::size_t>(k)] = std::cos(om * dtau);
+    sd[static_cast<std::size_t>(k)] = std::sin(om * dtau);
+  }
+  const double scale = rhs.delta_s * std::sqrt(rhs.m) / (rhs.t_s * rhs.t_s);
+  for (long i = 1; i <= samples; ++i) {
+    double v = 0.0, mo = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const std::size_t ks = static_cast<std::size_t>(k);
+      const double cn = c[ks] * cd[ks] - s[ks] * sd[ks];
+      const double sn = s[ks] * cd[ks] + c[ks] * sd[ks];
+      c[ks] = cn;
+      s[ks] = sn;
+      const double om = md.omega_hat[ks];
+      if (om == 0.0) continue;  // rigid modes do not accelerate in free motion
+      const double q0 = y[static_cast<std::size_t>(rhs.Q(k))];
+      const double qd0 = y[static_cast<std::size_t>(rhs.QD(k))];
+      const double q = q0 * cn + qd0 / om * sn;
+      const double acc = -scale * om * om * q;
+      v += md.shear[ks] * acc;
+      mo += md.moment[ks] * acc;
+    }
+    run->peak_shear_n = std::max(run->peak_shear_n, std::abs(v));
+    run->peak_moment_n_m = std::max(run->peak_moment_n_m, std::abs(mo));
+  }
+}
+
+// The first time (scaled, > 0) the free motion from y closes the gap again, or a negative value.
+double FindRecontact(const Rhs& rhs, const State& y, std::vector<std::string>* warnings) {
+  const Model& md = *rhs.model;
+  double v_rigid = y[1], amplitude = 0.0, om_max = 0.0;
+  for (int k = 0; k < md.n; ++k) {
+    const std::size_t ks = static_cast<std::size_t>(k);
+    const double om = md.omega_hat[ks];
+    const double q = y[static_cast<std::size_t>(rhs.Q(k))];
+    const double qd = y[static_cast<std::size_t>(rhs.QD(k))];
+    if (om == 0.0) {
+      v_rigid -= md.phi_hat[ks] * qd;
+    } else {
+      amplitude += std::abs(md.phi_hat[ks]) * std::hypot(q, qd / om);
+      om_max = std::max(om_max, om);
+    }
+  }
+  const double d0 = rhs.Delta(y);
+  // delta(tau) <= d0 + v_rigid tau + 2 A: no contact once that is negative.
+  double horizon = kMaxFreeFlightS / rhs.t_s;
+  if (v_rigid < 0.0) {
+    horizon = std::min(horizon, (std::max(d0, 0.0) + 2.0 * amplitude) / -v_rigid);
+  } else {
+    warnings->push_back(
+        "after a separation the ball does not move away from the bat's rigid-body recoil (a "
+        "soft, far-from-the-centre impact); a later contact was looked for during " +
+        Num(kMaxFreeFlightS) + " s only, beyond which the swing's rotation would matter");
+  }
+  if (!(horizon > 0.0)) return -1.0;
+  const double dtau = om_max > 0.0 ? kTwoPi / (kSamplesPerPeriod * om_max) : horizon;
+  const double wanted_samples = std::ceil(horizon / dtau);
+  const long samples = static_cast<long>(std::min(wanted_samples, 2e6));
+  if (wanted_samples > 2e6) {
+    warnings->push_back("the search for a further contact was cut at 2e6 samples");
+  }
+  auto gap = [&](double tau) {
+    State s = y;
+    FreeAdvance(rhs, tau, &s);
+    return rhs.Delta(s);
+  };
+  double t_prev = 0.0, g_prev = d0;
+  for (long i = 1; i <= std::min(samples, 2000000L); ++i) {
+    const double t = std::min(horizon, i * dtau);
+    const double g = gap(t);
+    if (g > kTouch) {
+      boost::uintmax_t iters = 100;
+      try {
+        const auto r =
+            boost::math::tools::toms748_solve(gap, t_prev, t, std::min(g_prev, 0.0), g,
+                                              boost::math::tools::eps_tolerance<double>(52), iters);
+        return r.second;
+      } catch (const std::exception&) {
+        return t;
+      }
+    }
+    t_prev = t;
+    g_prev = g;
+  }
+  return -1.0;
+}
+
+enum class Event { kNone, kMaxCompression, kEnd, kReload };
+
+RawRun Integrate(const Model& model, const ContactLaw& law, const FlexibleImpactInputs& in,
+                 double delta_s, double tol, const FlexibleImpactOptions& o,
+                 double sting_window_s) {
+  RawRun out;
+  Rhs rhs;
+  rhs.model = &model;
+  rhs.law = &law;
+  rhs.evaluations = &out.evaluations;
+  rhs.v0 = in.approach_speed_mps;
+  rhs.delta_s = delta_s;
+  rhs.t_s = delta_s / rhs.v0;
+  rhs.m = in.ball_mass_kg;
+  const std::size_t size = static_cast<std::size_t>(rhs.Size());
+  State y(size, 0.0);
+  y[1] = 1.0;
+  double tau = 0.0;
+  double peak_d = 0.0, peak_f = 0.0;
+  double om_max = 0.0;
+  for (double om : model.omega_hat) om_max = std::max(om_max, om);
+  auto sample_hands = [&](const State& s) {
+    double v = 0.0, mo = 0.0;
+    rhs.HandsLoads(s, rhs.Force(rhs.Delta(s)), &v, &mo);
+    out.peak_shear_n = std::max(out.peak_shear_n, std::abs(v));
+    out.peak_moment_n_m = std::max(out.peak_moment_n_m, std::abs(mo));
+  };
+  bool plastic = false;
+  try {
+    while (true) {
+      ++out.contacts;
+      rhs.phase = Phase::kLoading;
+      rhs.delta_max = 0.0;
+      rhs.total_delta_max = 0.0;
+      rhs.force_max = 0.0;
+      auto stepper = odeint::make_dense_output(tol, tol, 0.25, odeint::runge_kutta_dopri5<State>());
+      stepper.initialize(y, tau, 1e-2);
+      bool ended = false;
+      while (!ended) {
+        if (out.steps >= o.max_steps) {
+          out.message =
+              "the contact did not end within max_steps = " + std::to_string(o.max_steps) +
+              " integrator steps (t = " + Num(stepper.current_time() * rhs.t_s) +
+              " s): too stiff for the explicit integrator at this tolerance";
+          return out;
+        }
+        const State ya = stepper.current_state();
+        // Not a structured binding: clang 14 cannot capture one in the lambdas below.
+        const std::pair<double, double> step = stepper.do_step(std::ref(rhs));
+        const double ta = step.first;
+        const double tb = step.second;
+        ++out.steps;
+        const State& yb = stepper.current_state();
+        for (double v : yb) {
+          if (!std::isfinite(v)) {
+            out.message =
+                "the integrated state became non-finite at t = " + Num(tb * rhs.t_s) + " s";
+            return out;
+          }
+        }
+        State tmp(size);
+        for (int j = 1; j < 4; ++j) {
+          stepper.calc_state(ta + (tb - ta) * j / 4.0, tmp);
+          sample_hands(tmp);
+        }
+        sample_hands(yb);
+        const double dm_scaled = rhs.total_delta_max / rhs.delta_s;
+        auto g_max = [&](const State& s) { return rhs.DeltaRate(s); };
+        auto g_end = [&](const State& s) { return rhs.Delta(s); };
+        auto g_reload = [&](const State& s) { return dm_scaled - rhs.Delta(s); };
+        Event ev = Event::kNone;
+        double te = tb;
+        auto locate = [&](auto g, Event kind, bool at_start_if_already) {
+          const double ga = g(ya), gb = g(yb);
+          if (!(gb <= 0.0)) return;
+          double root = tb;
+          if (ga > 0.0) {
+            auto fn = [&](double tt) {
+              stepper.calc_state(tt, tmp);
+              return g(tmp);
+            };
+            if (gb < 0.0) {
+              boost::uintmax_t iters = 100;
+              const auto r = boost::math::tools::toms748_solve(
+                  fn, ta, tb, ga, gb, boost::math::tools::eps_tolerance<double>(52), iters);
+              root = 0.5 * (r.first + r.second);
+            }
+          } else if (at_start_if_already && gb < 0.0) {
+            root = ta;  // already past the event at the start of the step (a touching maximum)
+          } else {
+            return;
+          }
+          if (ev == Event::kNone || root < te) {
+            ev = kind;
+            te = root;
+          }
+        };
+        if (rhs.phase == Phase::kUnloading) {
+          locate(g_end, Event::kEnd, false);
+          locate(g_reload, Event::kReload, true);
+        } else {
+          locate(g_max, Event::kMaxCompression, false);
+          locate(g_end, Event::kEnd, false);
+        }
+        if (ev == Event::kNone) continue;
+        State ye(size);
+        stepper.calc_state(te, ye);
+        const double d_e = std::max(0.0, rhs.Delta(ye)) * rhs.delta_s;  // total compression
+        tau = te;
+        y = ye;
+        if (ev == Event::kEnd) {
+          ended = true;
+          break;
+        }
+        if (ev == Event::kMaxCompression) {
+          rhs.phase = Phase::kLoading;
+          const double f = rhs.Force(rhs.Delta(ye));
+          const double dc = law.LoadingCompression(f);  // the contact's share of d_e
+          peak_f = std::max(peak_f, f);
+          peak_d = std::max(peak_d, dc);
+          if (law.cor == 0.0) {
+            // Perfectly plastic: the stored energy is lost, the contact ends here; the static
+            // deflection of the modes left out (the residual spring) is released into them.
+            out.loss_j += law.Work(f, dc);
+            out.released_j += 0.5 * model.residual_compliance * f * f;
+            plastic = true;
+            out.warnings.push_back(
+                "cor = 0: perfectly plastic, the contact ends at maximum compression and later "
+                "contacts are not followed");
+            ended = true;
+            break;
+          }
+          rhs.phase = Phase::kUnloading;
+          rhs.delta_max = dc;
+          rhs.total_delta_max = d_e;
+          rhs.force_max = f;
+          rhs.q = f * dc / (law.cor * law.cor * law.Work(f, dc)) - 1.0;
+        } else if (ev == Event::kReload) {
+          rhs.phase = Phase::kLoading;
+        }
+        stepper.initialize(ye, te, std::max(1e-6, (tb - ta) * 0.5));
+      }
+      if (!plastic && rhs.force_max > 0.0) {
+        out.loss_j += (1.0 - law.cor * law.cor) * law.Work(rhs.force_max, rhs.delta_max);
+      }
+      out.contact_time_s = tau * rhs.t_s;
+      if (plastic) break;
+      if (out.contacts >= o.max_contacts) {
+        out.warnings.push_back("max_contacts = " + std::to_string(o.max_contacts) +
+                               " reached: further contacts are not followed");
+        break;
+      }
+      const double dt_r = FindRecontact(rhs, y, &out.warnings);
+      if (!(dt_r > 0.0)) break;
+      FreeAdvance(rhs, dt_r, &y);
+      tau += dt_r;
+    }
+  } catch (const std::exception& e) {
+    out.message = std::string("the integrator failed: ") + e.what();
+    return out;
+  }
+  // The hands' loads over the free ringing that follows.
+  if (om_max > 0.0) {
+    FreeHandsPeaks(rhs, y, sting_window_s / rhs.t_s, kTwoPi / (kSamplesPerPeriod * om_max), &out);
+  }
+  out.peak_force_n = peak_f;
+  out.max_compression_m = peak_d;
+  out.final_state = std::move(y);
+  out.ok = true;
+  return out;
+}
+
+// Calls f(x, weight) at 5-point Gauss points of every piece of [a, b] between mesh nodes and
+// section breakpoints (exact for the piecewise polynomials of the FE fields and sections).
+template <typename F>
+void IntegrateAlong(const BatModes& modes, double a, double b, F&& f) {
+  if (!(b > a)) return;
+  static constexpr double kX[5] = {-0.9061798459386639927976269, -0.5384693101056830910363144, 0.0,
+                                   0.5384693101056830910363144, 0.9061798459386639927976269};
+  static constexpr double kW[5] = {0.2369268850561890875142640, 0.4786286704993664680412915,
+                                   0.5688888888888888888888889, 0.4786286704993664680412915,
+                                   0.2369268850561890875142640};
+  std::vector<double> cuts = {a, b};
+  for (double x : modes.nodes_m) {
+    if (x > a && x < b) cuts.push_back(x);
+  }
+  for (double x : modes.breakpoints_m) {
+    if (x > a && x < b) cuts.push_back(x);
+  }
+  std::sort(cuts.begin(), cuts.end());
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+    const double half = 0.5 * (cuts[i + 1] - cuts[i]);
+    const double mid = 0.5 * (cuts[i + 1] + cuts[i]);
+    if (!(half > 0.0)) continue;
+    for (int g = 0; g < 5; ++g) f(mid + half * kX[g], half * kW[g]);
+  }
+}
+
+}  // namespace
+
+double InertiaReliefFlexibility(const Bat& bat, const BatModes& modes, double x_m) {
+  // The static solve's mesh: the modes' mesh with a node at x (the point load puts a kink in the
+  // shear deflection that only a node resolves): a node within a quarter element moves to x,
+  // otherwise x is inserted.
+  BeamMesh mesh;
+  mesh.nodes_m = modes.nodes_m;
+  mesh.breakpoints_m = modes.breakpoints_m;
+  std::vector<double>& nodes = mesh.nodes_m;
+  const double x = std::clamp(x_m, nodes.front(), nodes.back());
+  {
+    const auto it = std::upper_bound(nodes.begin(), nodes.end(), x);
+    const std::size_t e = std::min<std::size_t>(
+        it == nodes.begin() ? 0 : static_cast<std::size_t>(it - nodes.begin()) - 1,
+        nodes.size() - 2);
+    const double h = nodes[e + 1] - nodes[e];
+    const double dl = x - nodes[e], dr = nodes[e + 1] - x;
+    if (dl > 1e-9 * h && dr > 1e-9 * h) {
+      const std::size_t near = dl < dr ? e : e + 1;
+      if (std::min(dl, dr) < 0.25 * h && near != 0 && near != nodes.size() - 1) {
+        nodes[near] = x;
+      } else {
+        nodes.insert(nodes.begin() + static_cast<std::ptrdiff_t>(e) + 1, x);
+      }
+    }
+  }
+  BatModes on_mesh;  // the rigid-body modes on this mesh (same mass properties)
+  on_mesh.theory = modes.theory;
+  on_mesh.nodes_m = nodes;
+  on_mesh.mass_kg = modes.mass_kg;
+  on_mesh.balance_point_m = modes.balance_point_m;
+  on_mesh.moi_centroid_kg_m2 = modes.moi_centroid_kg_m2;
+  const BeamMatrices mats = AssembleBeam(bat, mesh, modes.theory, modes.rotary_inertia);
+  const int ne = mesh.Elements();
+  const Eigen::Index n = mats.stiffness.rows();
+  // The load: a unit force at x, as consistent nodal loads (the displacement shape functions).
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
+  {
+    const auto it = std::upper_bound(nodes.begin(), nodes.end(), x);
+    int e = it == nodes.begin() ? 0 : static_cast<int>(it - nodes.begin()) - 1;
+    e = std::min(e, ne - 1);
+    const double a = nodes[static_cast<std::size_t>(e)];
+    const double h = nodes[static_cast<std::size_t>(e) + 1] - a;
+    const ElementShape sh = EvaluateElementShape(h, std::clamp((x - a) / h, 0.0, 1.0));
+    int idx[kElementDofs];
+    ElementDofIndices(modes.theory, e, idx);
+    for (int i = 0; i < kElementDofs; ++i) {
+      if (idx[i] >= 0) f[idx[i]] += sh.w[i];
+    }
+  }
+  const Eigen::VectorXd t = on_mesh.TranslationMode();
+  const Eigen::VectorXd r = on_mesh.RotationMode();
+  // Inertia relief: the rigid body's inertia forces balance the load.
+  const Eigen::VectorXd f_bal = f - mats.mass * t * t.dot(f) - mats.mass * r * r.dot(f);
+  // Hold w_b at both ends (the balanced load has no reactions there), then remove the
+  // rigid-body part of the deflection.
+  const Eigen::Index first = 0;
+  int last_idx[kElementDofs];
+  ElementDofIndices(modes.theory, ne - 1, last_idx);
+  const Eigen::Index last = last_idx[4];
+  Eigen::SparseMatrix<double> k = mats.stiffness;
+  const double diag = k.coeff(first, first) > 0.0 ? k.coeff(first, first) : 1.0;
+  k.prune([&](Eigen::Index row, Eigen::Index col, double) {
+    return row != first && row != last && col != first && col != last;
+  });
+  k.coeffRef(first, first) = diag;
+  k.coeffRef(last, last) = diag;
+  Eigen::VectorXd rhs = f_bal;
+  rhs[first] = 0.0;
+  rhs[last] = 0.0;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>>
+      ldlt(k);
+  if (ldlt.info() != Eigen::Success) return std::numeric_limits<double>::quiet_NaN();
+  Eigen::VectorXd u = ldlt.solve(rhs);
+  u -= t * t.dot(mats.mass * u) + r * r.dot(mats.mass * u);
+  return f.dot(u);
+}
+
+double ElasticContactTimeS(double c11_per_kg, double stiffness, double exponent,
+                           double approach_speed_mps) {
+  const double p1 = exponent + 1.0;
+  const double d_max = std::pow(
+      p1 * approach_speed_mps * approach_speed_mps / (2.0 * c11_per_kg * stiffness), 1.0 / p1);
+  const double a = 1.0 / p1;
+  const double beta = std::tgamma(a) * std::sqrt(kPi) / std::tgamma(a + 0.5);
+  return 2.0 * d_max / approach_speed_mps * beta / p1;
+}
+
+bool FlexibleImpactOptions::IsValid(std::string* why) const {
+  if (max_modes < 1 || max_modes > 50)
+    return Fail(why, "flexible.max_modes = " + std::to_string(max_modes) + ": must be in [1, 50]");
+  if (!(std::isfinite(frequency_tolerance) && frequency_tolerance >= 1e-9 &&
+        frequency_tolerance <= 0.1))
+    return Fail(why, "flexible.frequency_tolerance = " + Num(frequency_tolerance) +
+                         ": must be in [1e-9, 0.1]");
+  if (!(std::isfinite(cutoff_factor) && cutoff_factor >= 1.0 && cutoff_factor <= 1000.0))
+    return Fail(why, "flexible.cutoff_factor = " + Num(cutoff_factor) + ": must be in [1, 1000]");
+  if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-13 &&
+        relative_tolerance <= 1e-2))
+    return Fail(why, "flexible.relative_tolerance = " + Num(relative_tolerance) +
+                         ": must be in [1e-13, 1e-2]");
+  if (max_steps < 10)
+    return Fail(why, "flexible.max_steps = " + std::to_string(max_steps) + ": must be >= 10");
+  if (max_contacts < 1 || max_contacts > 1000)
+    return Fail(
+        why, "flexible.max_contacts = " + std::to_string(max_contacts) + ": must be in [1, 1000]");
+  if (!(std::isfinite(hands_grip_length_m) && hands_grip_length_m >= 0.0 &&
+        hands_grip_length_m <= 10.0))
+    return Fail(
+        why, "flexible.hands_grip_length_m = " + Num(hands_grip_length_m) + ": must be in [0, 10]");
+  if (!(std::isfinite(sting_window_s) && sting_window_s >= 0.0 && sting_window_s <= 1.0))
+    return Fail(why, "flexible.sting_window_s = " + Num(sting_window_s) + ": must be in [0, 1]");
+  return true;
+}
+
+bool FlexibleImpactInputs::IsValid(std::string* why) const {
+  auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!std::isfinite(impact_from_knob_m))
+    return Fail(why, "impact_from_knob_m = " + Num(impact_from_knob_m) + ": must be finite");
+  if (!std::isfinite(hands_from_knob_m))
+    return Fail(why, "swing.hands_from_knob_m = " + Num(hands_from_knob_m) + ": must be finite");
+  if (!finite_pos(ball_mass_kg))
+    return Fail(why, "ball.mass_kg = " + Num(ball_mass_kg) + ": must be finite and > 0");
+  if (!(std::isfinite(ball_speed_mps) && ball_speed_mps >= 0.0))
+    return Fail(why, "ball.speed_mps = " + Num(ball_speed_mps) + ": must be finite and >= 0");
+  if (!finite_pos(approach_speed_mps))
+    return Fail(why,
+                "approach_speed_mps = " + Num(approach_speed_mps) +
+                    ": must be finite and > 0 (the ball and the bat must approach each other)");
+  if (!finite_pos(ball_stiffness))
+    return Fail(why, "ball.stiffness = " + Num(ball_stiffness) + ": must be finite and > 0");
+  if (!(std::isfinite(ball_exponent) && ball_exponent >= 1.0 && ball_exponent <= 3.0))
+    return Fail(why, "ball.stiffness_exponent = " + Num(ball_exponent) + ": must be in [1, 3]");
+  if (!(std::isfinite(surface_stiffness) && surface_stiffness >= 0.0))
+    return Fail(why, "surface_stiffness = " + Num(surface_stiffness) + ": must be finite and >= 0");
+  if (!(std::isfinite(cor) && cor >= 0.0 && cor <= 1.0))
+    return Fail(why, "cor = " + Num(cor) + ": must be in [0, 1]");
+  return true;
+}
+
+FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
+                                         const FlexibleImpactInputs& in,
+                                         const FlexibleImpactOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  FlexibleImpactResult out;
+  Summary& s = out.summary;
+  s.backend = "odeint:runge_kutta_dopri5";
+  s.models_used = {"flexible"};
+  s.termination = Termination::kInvalidInput;
+  auto finish = [&]() -> FlexibleImpactResult& {
+    s.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+  };
+  try {
+    std::string why;
+    if (!o.IsValid(&why) || !in.IsValid(&why)) {
+      s.message = why;
+      return finish();
+    }
+    if (!modes.summary.IsSolutionUsable() || modes.modes.empty() || modes.nodes_m.size() < 2) {
+      s.termination = Termination::kFailure;
+      s.message = "the bat's modes are not usable: " + modes.summary.message;
+      return finish();
+    }
+    const double length = modes.length_m;
+    if (!(in.impact_from_knob_m >= 0.0 && in.impact_from_knob_m <= length)) {
+      s.message = "impact_from_knob_m = " + Num(in.impact_from_knob_m) +
+                  ": must be within the bat [0, " + Num(length) + "]";
+      return finish();
+    }
+    if (!(in.hands_from_knob_m >= 0.0 && in.hands_from_knob_m <= length)) {
+      s.message = "swing.hands_from_knob_m = " + Num(in.hands_from_knob_m) +
+                  ": must be within the bat [0, " + Num(length) + "]";
+      return finish();
+    }
+    out.theory = modes.theory;
+    out.elements = modes.Elements();
+    const double m = in.ball_mass_kg;
+    const double u = in.ball_speed_mps;
+    const double v0 = in.approach_speed_mps;
+    const double e = in.cor;
+    const double big_m = modes.mass_kg;
+    const double i_cm = modes.moi_centroid_kg_m2;
+    const double b = in.impact_from_knob_m - modes.balance_point_m;
+    const double c11 = 1.0 / m + 1.0 / big_m + b * b / i_cm;
+    const double recoil = m * (1.0 / big_m + b * b / i_cm);
+    out.rigid_exit_speed_mps = -u + (1.0 + e) * v0 / (1.0 + recoil);
+    out.initial_energy_j = 0.5 * m * v0 * v0;
+
+    ContactLaw law;
+    law.k = in.ball_stiffness;
+    law.p = in.ball_exponent;
+    law.kk = in.surface_stiffness;
+    law.cor = e;
+    law.Init();
+    const double p1 = in.ball_exponent + 1.0;
+    const double delta_s = std::pow(p1 * v0 * v0 / (2.0 * c11 * in.ball_stiffness), 1.0 / p1);
+    out.contact_time_estimate_s = ElasticContactTimeS(c11, in.ball_stiffness, in.ball_exponent, v0);
+    out.cutoff_hz = o.cutoff_factor / out.contact_time_estimate_s;
+    if (!(std::isfinite(delta_s) && delta_s > 0.0 && std::isfinite(out.cutoff_hz))) {
+      s.termination = Termination::kFailure;
+      s.message = "contact scales are not finite (delta_s = " + Num(delta_s) + " m)";
+      return finish();
+    }
+    const double t_s = delta_s / v0;
+    const int available = static_cast<int>(modes.modes.size());
+    auto count_below = [&](double f_cut) {
+      int n = 0;
+      while (n < available && modes.modes[static_cast<std::size_t>(n)].frequency_hz <= f_cut) ++n;
+      return n;
+    };
+    const int n_used = count_below(out.cutoff_hz);
+    // Every computed mode below the cutoff: harmless with the static correction unless the
+    // computed modes stop well short of it.
+    if (n_used == available &&
+        (!o.static_correction || modes.modes.back().frequency_hz < 0.5 * out.cutoff_hz)) {
+      s.warnings.push_back(
+          "the mode cutoff (cutoff_factor / contact time) is above the highest "
+          "computed mode (" +
+          std::to_string(available) + " modes, up to " + Num(modes.modes.back().frequency_hz) +
+          " Hz): every computed mode is used, the static correction stands for "
+          "the rest; raise flexible.max_modes to include more");
+    }
+
+    // Every mode's coefficients (rigid ones first), computed once.
+    const double h = in.hands_from_knob_m;
+    std::vector<Eigen::VectorXd> vecs = {modes.TranslationMode(), modes.RotationMode()};
+    for (int k = 0; k < n_used; ++k)
+      vecs.push_back(modes.modes[static_cast<std::size_t>(k)].vector);
+    const int n_all = static_cast<int>(vecs.size());
+    Model full;
+    full.n = n_all;
+    full.omega_hat.assign(static_cast<std::size_t>(n_all), 0.0);
+    full.phi_hat.resize(static_cast<std::size_t>(n_all));
+    full.shear.assign(static_cast<std::size_t>(n_all), 0.0);
+    full.moment.assign(static_cast<std::size_t>(n_all), 0.0);
+    full.grip.assign(static_cast<std::size_t>(n_all), 0.0);
+    full.force_sign_hands = in.impact_from_knob_m < h ? 1.0 : 0.0;
+    full.arm_hands_m = in.impact_from_knob_m - h;
+    for (int k = 0; k < n_all; ++k) {
+      const std::size_t ks = static_cast<std::size_t>(k);
+      if (k >= 2) full.omega_hat[ks] = kTwoPi * modes.modes[ks - 2].frequency_hz * t_s;
+      full.phi_hat[ks] = modes.Displacement(vecs[ks], in.impact_from_knob_m) * std::sqrt(m);
+    }
+    // Residual flexibility of the modes left out: G(s) - sum over the modes used.
+    double flexibility = 0.0;
+    if (o.static_correction) {
+      flexibility = InertiaReliefFlexibility(bat, modes, in.impact_from_knob_m);
+      if (!std::isfinite(flexibility)) {
+        s.termination = Termination::kFailure;
+        s.message = "the static flexibility at the impact point could not be computed";
+        return finish();
+      }
+    }
+    auto residual_for = [&](int n_flex) {
+      if (!o.static_correction) return 0.0;
+      double used = 0.0;
+      for (int k = 0; k < n_flex; ++k) {
+        const double om = kTwoPi * modes.modes[static_cast<std::size_t>(k)].frequency_hz;
+        const double phi = full.phi_hat[static_cast<std::size_t>(k + 2)] / std::sqrt(m);
+        used += phi * phi / (om * om);
+      }
+      return std::max(0.0, flexibility - used);
+    };
+    full.residual_compliance = residual_for(n_used);
+    out.residual_compliance_m_n = full.residual_compliance;
+    const bool rotary = modes.rotary_inertia;
+    IntegrateAlong(modes, 0.0, h, [&](double x, double wgt) {
+      const BeamSection sec = SectionAt(bat, x);
+      for (int k = 0; k < n_all; ++k) {
+        const std::size_t ks = static_cast<std::size_t>(k);
+        const BeamField f = EvaluateField(modes.theory, modes.nodes_m, vecs[ks], x);
+        const double w = f.bending_m + f.shear_m;
+        full.shear[ks] += wgt * sec.mass_per_length_kg_m * w;
+        full.moment[ks] += wgt * (sec.mass_per_length_kg_m * w * (x - h) +
+                                  (rotary ? sec.rotary_inertia_kg_m * f.rotation : 0.0));
+      }
+    });
+    const double g_lo = std::max(0.0, h - 0.5 * o.hands_grip_length_m);
+    const double g_hi = std::min(length, h + 0.5 * o.hands_grip_length_m);
+    IntegrateAlong(modes, g_lo, g_hi, [&](double x, double wgt) {
+      const BeamSection sec = SectionAt(bat, x);
+      for (int k = 2; k < n_all; ++k) {
+        const std::size_t ks = static_cast<std::size_t>(k);
+        const BeamField f = EvaluateField(modes.theory, modes.nodes_m, vecs[ks], x);
+        const double w = f.bending_m + f.shear_m;
+        full.grip[ks] += wgt * (sec.mass_per_length_kg_m * w * w +
+                                (rotary ? sec.rotary_inertia_kg_m * f.rotation * f.rotation : 0.0));
+      }
+    });
+    double window = o.sting_window_s;
+    if (window == 0.0) window = 1.0 / modes.modes.front().frequency_hz;
+
+    // Energies and sting of one run.
+    struct Outcome {
+      double exit = 0.0, vib = 0.0, hands = 0.0;
+    };
+    const double e_scale = m * v0 * v0;  // scaled energy -> J
+    auto outcome_of = [&](const Model& md, const RawRun& r) {
+      Outcome oc;
+      const State& y = r.final_state;
+      const int n = md.n;
+      oc.exit = -u + y[static_cast<std::size_t>(2 + 2 * n)] * v0;
+      for (int k = 2; k < n; ++k) {
+        const double om = md.omega_hat[static_cast<std::size_t>(k)];
+        const double q = y[static_cast<std::size_t>(2 + k)];
+        const double qd = y[static_cast<std::size_t>(2 + n + k)];
+        const double ek = 0.5 * e_scale * (qd * qd + om * om * q * q);
+        oc.vib += ek;
+        oc.hands += ek * md.grip[static_cast<std::size_t>(k)];
+      }
+      return oc;
+    };
+    auto subset = [&](int n_flex) {
+      Model md = full;
+      const std::size_t n = static_cast<std::size_t>(2 + n_flex);
+      md.n = 2 + n_flex;
+      md.omega_hat.resize(n);
+      md.phi_hat.resize(n);
+      md.shear.resize(n);
+      md.moment.resize(n);
+      md.grip.resize(n);
+      md.residual_compliance = residual_for(n_flex);
+      return md;
+    };
+
+    RawRun a = Integrate(full, law, in, delta_s, o.relative_tolerance, o, window);
+    s.iterations = a.steps;
+    s.evaluations = static_cast<int>(a.evaluations);
+    out.steps = a.steps;
+    if (!a.ok) {
+      s.termination = Termination::kFailure;
+      s.message = a.message;
+      return finish();
+    }
+    const Outcome oa = outcome_of(full, a);
+    const State& y = a.final_state;
+    out.exit_speed_mps = oa.exit;
+    out.vibration_energy_j = oa.vib + a.released_j;
+    out.hands_vibration_energy_j = oa.hands;
+    out.ball_impulse_n_s = y[static_cast<std::size_t>(2 + 2 * n_all)] * m * v0;
+    out.contact_time_s = a.contact_time_s;
+    out.contacts = a.contacts;
+    out.peak_force_n = a.peak_force_n;
+    out.max_compression_m = a.max_compression_m;
+    out.hands_peak_shear_force_n = a.peak_shear_n;
+    out.hands_peak_bending_moment_n_m = a.peak_moment_n_m;
+    out.ball_energy_j = 0.5 * e_scale * y[1] * y[1];
+    for (int k = 0; k < 2; ++k) {
+      const double qd = y[static_cast<std::size_t>(2 + n_all + k)];
+      out.rigid_body_energy_j += 0.5 * e_scale * qd * qd;
+    }
+    for (int k = 2; k < n_all; ++k) {
+      const double om = full.omega_hat[static_cast<std::size_t>(k)];
+      const double q = y[static_cast<std::size_t>(2 + k)];
+      const double qd = y[static_cast<std::size_t>(2 + n_all + k)];
+      out.modal_energies_j.push_back(0.5 * e_scale * (qd * qd + om * om * q * q));
+      out.mode_frequencies_hz.push_back(modes.modes[static_cast<std::size_t>(k - 2)].frequency_hz);
+    }
+    out.modes_used = n_used;
+    out.contact_loss_j = a.loss_j;
+    out.contact_work_j = y[static_cast<std::size_t>(3 + 2 * n_all)] * e_scale;
+    out.energy_balance_error_j =
+        out.initial_energy_j -
+        (out.ball_energy_j + out.rigid_body_energy_j + out.vibration_energy_j + out.contact_loss_j);
+    s.warnings.insert(s.warnings.end(), a.warnings.begin(), a.warnings.end());
+
+    if (o.refine_check) {
+      RawRun fine = Integrate(full, law, in, delta_s, o.relative_tolerance / 16.0, o, window);
+      out.steps += fine.steps;
+      s.evaluations += static_cast<int>(fine.evaluations);
+      double de = 0.0, dv = 0.0, dh = 0.0;
+      if (fine.ok) {
+        const Outcome of = outcome_of(full, fine);
+        de = std::abs(of.exit - oa.exit);
+        dv = std::abs(of.vib - oa.vib);
+        dh = std::abs(of.hands - oa.hands);
+      } else {
+        s.warnings.push_back("the refinement run at tolerance / 16 failed: " + fine.message);
+        de = o.relative_tolerance * (u + std::abs(oa.exit));
+      }
+      out.integration_error_exit_speed_mps = de;
+      const int n_half = count_below(0.5 * out.cutoff_hz);
+      double te = 0.0, tv = 0.0, th = 0.0;
+      if (n_half < n_used) {
+        const Model half = subset(n_half);
+        RawRun hr = Integrate(half, law, in, delta_s, o.relative_tolerance, o, window);
+        out.steps += hr.steps;
+        s.evaluations += static_cast<int>(hr.evaluations);
+        if (hr.ok) {
+          const Outcome oh = outcome_of(half, hr);
+          te = std::abs(oh.exit - oa.exit);
+          tv = std::abs(oh.vib - oa.vib);
+          th = std::abs(oh.hands - oa.hands);
+        } else {
+          s.warnings.push_back("the truncation check with half the cutoff failed: " + hr.message);
+        }
+      }
+      out.truncation_error_exit_speed_mps = te;
+      out.error_estimate_exit_speed_mps = de + te;
+      out.error_estimate_vibration_energy_j = dv + tv;
+      out.error_estimate_hands_energy_j = dh + th;
+    } else {
+      out.error_estimate_exit_speed_mps = o.relative_tolerance * (u + std::abs(oa.exit));
+    }
+    s.iterations = out.steps;
+    s.termination = Termination::kConverged;
+    s.message = "contact ended after " + Num(out.contact_time_s) + " s (" +
+                std::to_string(out.contacts) + (out.contacts == 1 ? " contact" : " contacts") +
+                ", " + std::to_string(n_used) + " bending modes)";
+    s.objective = out.exit_speed_mps;
+    s.error_estimate = out.error_estimate_exit_speed_mps;
+  } catch (const std::exception& ex) {
+    s.termination = Termination::kFailure;
+    s.message = std::string("internal error: ") + ex.what();
+  } catch (...) {
+    s.termination = Termination::kFailure;
+    s.message = "internal error";
+  }
+  return finish();
+}
+
+}  // namespace sweetspot::core
