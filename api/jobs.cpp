@@ -18,6 +18,7 @@ namespace {
 constexpr int kMaxWorkers = 64;
 constexpr std::size_t kMaxQueuedLimit = 1000000;
 constexpr std::size_t kMaxKeptLimit = 1000000;
+constexpr int kMaxResumesLimit = 100;
 
 // An engine seeded from std::random_device with 256 bits, one per manager.
 std::mt19937_64 SeededEngine() {
@@ -50,15 +51,31 @@ Response NotFound(const std::string& id) {
   return ToResponse(ApiError{404, "NotFound", "no job with id " + QuoteId(id), ""});
 }
 
+// Serialises a JSON body for the store: never throws (invalid UTF-8 is replaced).
+std::string Serialize(const nlohmann::json& body) {
+  return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// The failure's message of an inner response: its "message", else its status.
+std::string FailureMessage(const Response& response) {
+  if (response.body.is_object()) {
+    const auto it = response.body.find("message");
+    if (it != response.body.end() && it->is_string()) return it->get<std::string>();
+  }
+  return "the request failed with HTTP status " + std::to_string(response.status);
+}
+
 }  // namespace
 
 struct JobManager::Job {
   std::string id;                             // 32 hex digits.
   std::string path;                           // The inner request's path.
-  Request inner;                              // Moved out by the worker that runs it.
+  Request inner;                              // Cleared once the job is finished.
   State state = State::kQueued;               // Current state.
   core::Progress progress;                    // Shared with the runner.
   bool cancel_requested = false;              // DELETE or Shutdown asked it to stop.
+  bool interrupted = false;                   // Shutdown (with a store) asked it to stop.
+  int resumes = 0;                            // Re-queued after the server died under it.
   Clock::time_point created;                  // Submit time.
   std::optional<Clock::time_point> started;   // When a worker took it.
   std::optional<Clock::time_point> finished;  // When it reached a final state.
@@ -89,14 +106,24 @@ bool JobConfig::IsValid(std::string* why) const {
     text << "keep_results_s = " << keep_results_s << ": must be finite and > 0";
     return fail(text.str());
   }
+  if (max_resumes < 0 || max_resumes > kMaxResumesLimit) {
+    return fail("max_resumes = " + std::to_string(max_resumes) + ": must be in [0, " +
+                std::to_string(kMaxResumesLimit) + "]");
+  }
   return true;
 }
 
-JobManager::JobManager(JobConfig config, JobRunner runner)
-    : config_(config), runner_(std::move(runner)), start_(Clock::now()), random_(SeededEngine()) {
+JobManager::JobManager(JobConfig config, JobRunner runner, JobPersistence persistence)
+    : config_(config),
+      runner_(std::move(runner)),
+      persistence_(std::move(persistence)),
+      start_(Clock::now()),
+      wall_start_(std::chrono::system_clock::now()),
+      random_(SeededEngine()) {
   std::string why;
   if (!config_.IsValid(&why)) throw std::invalid_argument("invalid JobConfig: " + why);
   if (!runner_) throw std::invalid_argument("invalid JobManager: the runner is empty");
+  if (persistence_.store != nullptr) LoadFromStore();
   try {
     workers_.reserve(static_cast<std::size_t>(config_.workers));
     for (int i = 0; i < config_.workers; ++i) workers_.emplace_back([this] { WorkerLoop(); });
@@ -151,6 +178,12 @@ Response JobManager::Submit(const Request& inner) {
     }
     job->id = NewIdLocked();
     job->created = now;
+    // Saved before it is visible: a 202 means the job survives a restart. The
+    // store's own message goes to the log, never to the client.
+    if (!SaveLocked(*job)) {
+      return ToResponse(ApiError{
+          503, "Unavailable", "the job could not be saved in the jobs database; retry later", ""});
+    }
     jobs_.emplace(job->id, job);
     queue_.push_back(job->id);
     body = ToJsonLocked(*job, now);
@@ -203,13 +236,17 @@ Response JobManager::Cancel(const std::string& id) {
       job->progress.Cancel();
       job->inner = Request{};  // Frees the body now.
       FinishLocked(*job, State::kCancelled, now);
+      SaveLocked(*job);
       nlohmann::json body = ToJsonLocked(*job, now);
       EvictLocked(now);  // max_kept may now be exceeded.
       return {200, std::move(body)};
     }
     case State::kRunning:
-      job->cancel_requested = true;
-      job->progress.Cancel();
+      if (!job->cancel_requested) {
+        job->cancel_requested = true;
+        job->progress.Cancel();
+        SaveLocked(*job);  // A crash now must not resume a job the client cancelled.
+      }
       return {202, ToJsonLocked(*job, now)};
     case State::kDone:
     case State::kFailed:
@@ -220,6 +257,7 @@ Response JobManager::Cancel(const std::string& id) {
   body["deleted"] = true;
   finished_.erase(std::find(finished_.begin(), finished_.end(), id));
   jobs_.erase(id);
+  ForgetLocked(id);
   return {200, std::move(body)};
 }
 
@@ -235,33 +273,54 @@ std::map<std::string, int> JobManager::CountsByState() const {
   return counts;
 }
 
-void JobManager::Shutdown() {
-  std::call_once(shutdown_once_, [this] {
+void JobManager::Shutdown() { Shutdown(0.0); }
+
+void JobManager::Shutdown(double grace_s) {
+  std::call_once(shutdown_once_, [this, grace_s] {
     {
-      std::lock_guard lock(mutex_);
-      stopping_ = true;
-      const Clock::time_point now = Clock::now();
-      for (const std::string& id : queue_) {
-        Job& job = *jobs_.at(id);
-        job.cancel_requested = true;
-        job.progress.Cancel();
-        job.inner = Request{};
-        FinishLocked(job, State::kCancelled, now);
-      }
-      queue_.clear();
-      for (const auto& [id, job] : jobs_) {
-        if (job->state == State::kRunning) {
-          job->cancel_requested = true;
-          job->progress.Cancel();
+      std::unique_lock lock(mutex_);
+      stopping_ = true;  // Submit answers 503; idle workers leave, busy ones after their job.
+      if (persistence_.store == nullptr) {
+        const Clock::time_point now = Clock::now();
+        for (const std::string& id : queue_) {
+          Job& job = *jobs_.at(id);
+          job.cancel_requested = true;
+          job.progress.Cancel();
+          job.inner = Request{};
+          FinishLocked(job, State::kCancelled, now);
         }
+        queue_.clear();
+      }  // With a store, queued jobs stay queued (and saved) for the next start.
+      work_cv_.notify_all();
+      if (grace_s > 0 && std::isfinite(grace_s)) {
+        const auto deadline =
+            Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                               std::chrono::duration<double>(std::min(grace_s, 1e6)));
+        idle_cv_.wait_until(lock, deadline, [this] { return busy_ == 0 || grace_ended_; });
       }
-      EvictLocked(now);
+      for (const auto& [id, job] : jobs_) {
+        if (job->state != State::kRunning || job->cancel_requested) continue;
+        if (persistence_.store != nullptr) {
+          job->interrupted = true;  // Back to the queue when its runner returns.
+        } else {
+          job->cancel_requested = true;
+        }
+        job->progress.Cancel();
+      }
+      EvictLocked(Clock::now());
     }
-    work_cv_.notify_all();
     for (std::thread& worker : workers_) {
       if (worker.joinable()) worker.join();
     }
   });
+}
+
+void JobManager::EndGrace() {
+  {
+    std::lock_guard lock(mutex_);
+    grace_ended_ = true;
+  }
+  idle_cv_.notify_all();
 }
 
 void JobManager::WorkerLoop() {
@@ -274,8 +333,9 @@ void JobManager::WorkerLoop() {
     job->state = State::kRunning;
     job->started = Clock::now();
     ++busy_;
-    Request inner = std::move(job->inner);
-    job->inner = Request{};
+    // Saved with the request, so a job the process dies under can be resumed.
+    SaveLocked(*job);
+    Request inner = job->inner;  // The runner's copy: job->inner is read under the lock.
     lock.unlock();
 
     Response response;
@@ -289,9 +349,18 @@ void JobManager::WorkerLoop() {
 
     lock.lock();
     --busy_;
+    idle_cv_.notify_all();
     const Clock::time_point now = Clock::now();
     if (job->cancel_requested) {
       FinishLocked(*job, State::kCancelled, now);  // A cancelled job's result is discarded.
+    } else if (job->interrupted) {
+      // Shutdown cut it short: its result (if any) is discarded, and it is
+      // queued again, saved for the next start, which runs it from the start.
+      job->state = State::kQueued;
+      job->started.reset();
+      queue_.push_front(job->id);
+      SaveLocked(*job);
+      continue;
     } else if (threw) {
       job->error = "internal error";
       job->result = ToResponse(ApiError{500, "InternalError", job->error, ""});
@@ -300,15 +369,12 @@ void JobManager::WorkerLoop() {
       job->result = std::move(response);
       FinishLocked(*job, State::kDone, now);
     } else {
-      const nlohmann::json& message = response.body.is_object() && response.body.contains("message")
-                                          ? response.body["message"]
-                                          : nlohmann::json();
-      job->error = message.is_string()
-                       ? message.get<std::string>()
-                       : "the request failed with HTTP status " + std::to_string(response.status);
+      job->error = FailureMessage(response);
       job->result = std::move(response);
       FinishLocked(*job, State::kFailed, now);
     }
+    job->inner = Request{};  // Frees the body; a finished job is never run again.
+    SaveLocked(*job);
     EvictLocked(now);
   }
 }
@@ -329,6 +395,7 @@ void JobManager::EvictLocked(Clock::time_point now) const {
                          config_.keep_results_s;
     if (!too_many && !too_old) break;
     jobs_.erase(it);
+    ForgetLocked(finished_.front());
     finished_.pop_front();
   }
 }
@@ -371,6 +438,7 @@ nlohmann::json JobManager::ToJsonLocked(const Job& job, Clock::time_point now) c
                      : nlohmann::json()},
       {"error", job.state == State::kFailed ? nlohmann::json(job.error) : nlohmann::json()},
       {"cancel_requested", job.cancel_requested},
+      {"resumes", job.resumes},
   };
   if (finished) {
     const double age_s = std::chrono::duration<double>(now - *job.finished).count();
@@ -379,6 +447,166 @@ nlohmann::json JobManager::ToJsonLocked(const Job& job, Clock::time_point now) c
     json["expires_in_s"] = nullptr;
   }
   return json;
+}
+
+double JobManager::ToUnixSeconds(Clock::time_point time) const {
+  const std::chrono::duration<double> since_epoch = wall_start_.time_since_epoch();
+  return since_epoch.count() + std::chrono::duration<double>(time - start_).count();
+}
+
+JobManager::Clock::time_point JobManager::FromUnixSeconds(double unix_s) const {
+  const std::chrono::duration<double> since_epoch = wall_start_.time_since_epoch();
+  return start_ + std::chrono::duration_cast<Clock::duration>(
+                      std::chrono::duration<double>(unix_s - since_epoch.count()));
+}
+
+JobRecord JobManager::RecordLocked(const Job& job) const {
+  JobRecord record;
+  record.id = job.id;
+  record.state = StateName(job.state);
+  record.method = job.inner.method;
+  record.path = job.path;
+  record.body = job.inner.body;  // Empty once finished (the body is freed then).
+  switch (job.state) {
+    case State::kQueued:
+      record.progress = 0.0;
+      break;
+    case State::kDone:
+      record.progress = 1.0;
+      break;
+    case State::kRunning:
+    case State::kFailed:
+    case State::kCancelled:
+      record.progress = job.progress.Fraction();
+      break;
+  }
+  record.cancel_requested = job.cancel_requested;
+  record.resumes = job.resumes;
+  record.created_at = job.created_at;
+  record.created_unix_s = ToUnixSeconds(job.created);
+  if (job.started) record.started_unix_s = ToUnixSeconds(*job.started);
+  if (job.finished) record.finished_unix_s = ToUnixSeconds(*job.finished);
+  if (job.state == State::kDone || job.state == State::kFailed) {
+    record.status = job.result.status;
+    if (job.result.content_type.empty()) {
+      record.response_json = Serialize(job.result.body);
+    } else {
+      record.response_text = job.result.text;
+      record.content_type = job.result.content_type;
+    }
+    record.error = job.error;
+  }
+  return record;
+}
+
+bool JobManager::SaveLocked(const Job& job) const {
+  if (persistence_.store == nullptr) return true;
+  std::string error;
+  if (persistence_.store->Save(RecordLocked(job), &error)) return true;
+  if (persistence_.on_store_error) {
+    persistence_.on_store_error("cannot save job " + job.id + " (" + StateName(job.state) +
+                                "): " + error);
+  }
+  return false;
+}
+
+void JobManager::ForgetLocked(const std::string& id) const {
+  if (persistence_.store == nullptr) return;
+  std::string error;
+  if (!persistence_.store->Delete(id, &error) && persistence_.on_store_error) {
+    persistence_.on_store_error("cannot delete job " + id + ": " + error);
+  }
+}
+
+void JobManager::LoadFromStore() {
+  std::vector<JobRecord> records;
+  std::string error;
+  if (!persistence_.store->LoadAll(&records, &error)) {
+    throw std::runtime_error("cannot load the jobs: " + error);
+  }
+  std::lock_guard lock(mutex_);
+  const Clock::time_point now = Clock::now();
+  std::vector<std::shared_ptr<Job>> finished;
+  for (JobRecord& record : records) {
+    bool changed = false;  // Its stored state must be rewritten.
+    auto job = std::make_shared<Job>();
+    job->id = record.id;
+    job->path = record.path;
+    job->inner = Request{record.method, record.path, std::move(record.body)};
+    job->cancel_requested = record.cancel_requested;
+    job->resumes = record.resumes;
+    job->created = FromUnixSeconds(record.created_unix_s);
+    job->created_at = record.created_at;
+    if (record.started_unix_s) job->started = FromUnixSeconds(*record.started_unix_s);
+    if (record.finished_unix_s) job->finished = FromUnixSeconds(*record.finished_unix_s);
+    if (record.state == "done" || record.state == "failed") {
+      job->state = record.state == "done" ? State::kDone : State::kFailed;
+      job->progress.Report(record.progress);
+      job->error = record.error;
+      if (!record.content_type.empty()) {
+        job->result = Response::Text(record.status, std::move(record.response_text),
+                                     std::move(record.content_type));
+      } else {
+        nlohmann::json body = nlohmann::json::parse(record.response_json, nullptr, false);
+        if (body.is_discarded()) {  // Only a damaged database gets here.
+          job->state = State::kFailed;
+          job->error = "the stored result of this job could not be read";
+          body = ToResponse(ApiError{500, "InternalError", job->error, ""}).body;
+          record.status = 500;
+        }
+        job->result = Response(record.status, std::move(body));
+      }
+    } else if (record.state == "cancelled") {
+      job->state = State::kCancelled;
+      job->progress.Report(record.progress);
+      job->progress.Cancel();
+    } else if (record.state == "queued") {
+      job->state = State::kQueued;  // Never started: queued again as it was.
+    } else if (record.state == "running") {
+      // The process died while this job ran (a clean stop saves it as queued).
+      job->finished.reset();
+      if (job->cancel_requested) {
+        job->state = State::kCancelled;
+        job->progress.Report(record.progress);
+        job->progress.Cancel();
+        job->finished = now;
+      } else if (job->resumes < config_.max_resumes) {
+        ++job->resumes;
+        job->started.reset();
+        job->state = State::kQueued;  // Run again from the start: the request is deterministic.
+      } else {
+        job->state = State::kFailed;
+        job->progress.Report(record.progress);
+        job->finished = now;
+        job->error =
+            "interrupted by a server restart: the job was running when the server "
+            "died, and it had already been resumed " +
+            std::to_string(job->resumes) +
+            " times (limit max_resumes = " + std::to_string(config_.max_resumes) + ")";
+        job->result = ToResponse(ApiError{503, "Interrupted", job->error, ""});
+      }
+      changed = true;
+    } else {
+      if (persistence_.on_store_error) {
+        persistence_.on_store_error("job " + record.id + " has an unknown state " +
+                                    QuoteId(record.state) + ": skipped");
+      }
+      continue;
+    }
+    if (job->state == State::kQueued) {
+      queue_.push_back(job->id);  // Records come oldest first: the queue keeps its order.
+    } else {
+      job->inner = Request{};
+      if (!job->finished) job->finished = now;
+      finished.push_back(job);
+    }
+    jobs_[job->id] = job;
+    if (changed) SaveLocked(*job);
+  }
+  std::stable_sort(finished.begin(), finished.end(),
+                   [](const auto& a, const auto& b) { return *a->finished < *b->finished; });
+  for (const auto& job : finished) finished_.push_back(job->id);
+  EvictLocked(now);  // Drops (and deletes) what is too old or beyond max_kept.
 }
 
 std::string JobManager::NewIdLocked() {

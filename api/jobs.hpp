@@ -13,13 +13,28 @@
 //    "path":        the inner request's path,
 //    "created_s", "started_s", "finished_s":
 //                   seconds since the manager started (steady clock, so differences
-//                   are durations); null until the event happened,
+//                   are durations; negative for events before a restart, converted
+//                   through the wall clock); null until the event happened,
 //    "created_at":  wall-clock submit time, ISO-8601 UTC ("2024-05-01T12:00:00.123Z"),
 //    "status":      the inner HTTP status once done or failed, else null,
 //    "error":       the failure's message once failed, else null,
-//    "cancel_requested": true once DELETE (or Shutdown) asked the job to stop,
+//    "cancel_requested": true once DELETE (or Shutdown, without a store) asked the
+//                   job to stop,
+//    "resumes":     times the job was re-queued because the server died while it ran,
 //    "expires_in_s": seconds until a finished job's result is dropped (at most;
 //                   count eviction may drop it sooner), null while unfinished}
+//
+// Persistence (optional, JobPersistence::store): every state change is saved before it is visible
+// (submit, start, finish, cancel, delete, eviction), so jobs and results survive a restart. At
+// construction the manager loads the store: finished jobs come back with their results
+// (keep_results_s and max_kept still apply); queued jobs are queued again; a job that was running
+// when the process died (crash, SIGKILL) is re-queued and run from the start (safe: a jobbable
+// request has no side effects and is a deterministic function of its body, seeds included; only a
+// solve cut by a wall-time budget may end elsewhere, as it could on any run) up to max_resumes
+// times, after which it is marked failed with "interrupted by a server restart: ..." (status 503,
+// code Interrupted) so that a request that kills the server cannot crash it forever. Shutdown with
+// a store keeps queued jobs queued and puts interrupted running ones back in the queue (state
+// "queued", saved) for the next start; without a store they are cancelled.
 #pragma once
 
 #include <chrono>
@@ -36,6 +51,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "api/job_store.hpp"
 #include "api/response.hpp"
 #include "api/router.hpp"
 #include "core/progress.hpp"
@@ -48,6 +64,7 @@ struct JobConfig {
   std::size_t max_queued = 64;     ///< Queued (not yet running) jobs; beyond: 429, [1, 1e6].
   std::size_t max_kept = 1000;     ///< Finished jobs kept, oldest finished dropped first, [1, 1e6].
   double keep_results_s = 3600.0;  ///< How long a finished job is kept after it finished, s (> 0).
+  int max_resumes = 2;  ///< Times a job the server died under is re-queued at start-up, [0, 100].
 
   /// True when every field is in range; otherwise "field = value: rule" in *why (if non-null).
   bool IsValid(std::string* why) const;
@@ -60,15 +77,26 @@ struct JobConfig {
 /// other status failed; an exception makes it failed with "internal error".
 using JobRunner = std::function<Response(const Request& inner, core::Progress* progress)>;
 
+/// Where a JobManager keeps its jobs across restarts. Default: nowhere (memory only).
+struct JobPersistence {
+  /// The store; not owned, must outlive the manager. Null: jobs live in memory only.
+  JobStore* store = nullptr;
+  /// Told every store failure after construction ("cannot save job ...: why"); may be
+  /// empty. Called with the manager's lock held: it must not call the manager.
+  std::function<void(const std::string& message)> on_store_error;
+};
+
 /// Queues, runs, reports and cancels jobs. Thread-safe; owns its worker
 /// threads; no globals. Finished jobs are dropped lazily (checked on every
 /// call) once older than keep_results_s or beyond max_kept; a dropped id 404s.
 class JobManager {
  public:
-  /// Starts config.workers threads. Throws std::invalid_argument when
-  /// !config.IsValid() (the message is IsValid's) or `runner` is empty.
-  JobManager(JobConfig config, JobRunner runner);
-  /// Shutdown(): cancels queued and running jobs and joins the workers.
+  /// Loads the jobs kept in persistence.store (if any; see the file comment),
+  /// then starts config.workers threads. Throws std::invalid_argument when
+  /// !config.IsValid() (the message is IsValid's) or `runner` is empty, and
+  /// std::runtime_error "cannot load the jobs: why" when the store cannot be read.
+  JobManager(JobConfig config, JobRunner runner, JobPersistence persistence = {});
+  /// Shutdown() with no grace period.
   ~JobManager();
   JobManager(const JobManager&) = delete;
   JobManager& operator=(const JobManager&) = delete;
@@ -96,10 +124,21 @@ class JobManager {
   /// failed and cancelled (for the Prometheus gauge).
   std::map<std::string, int> CountsByState() const;
 
-  /// Stops accepting jobs, cancels queued and running ones and joins the
-  /// workers (promptly if the runners poll Cancelled()). Idempotent; jobs stay
-  /// readable afterwards.
+  /// Shutdown(0): stops at once.
   void Shutdown();
+
+  /// Stops accepting jobs (503 ShuttingDown) and starting queued ones; waits up
+  /// to `grace_s` seconds (or until EndGrace()) for the running jobs to finish,
+  /// then asks the rest to stop (Progress::Cancel()) and joins the workers
+  /// (promptly if the runners poll Cancelled()). With a store, queued and
+  /// interrupted jobs are kept as "queued" for the next start; without one they
+  /// are cancelled. Idempotent (later calls wait for the first); jobs stay
+  /// readable afterwards.
+  void Shutdown(double grace_s);
+
+  /// Ends a running Shutdown's grace period now (e.g. on a second SIGTERM).
+  /// Harmless before or after Shutdown.
+  void EndGrace();
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -108,25 +147,35 @@ class JobManager {
 
   static const char* StateName(State state);
   void WorkerLoop();
+  void LoadFromStore();  // Before the workers start.
+  double ToUnixSeconds(Clock::time_point time) const;
+  Clock::time_point FromUnixSeconds(double unix_s) const;
   // The following require mutex_ to be held.
   void FinishLocked(Job& job, State state, Clock::time_point now);
   void EvictLocked(Clock::time_point now) const;
+  JobRecord RecordLocked(const Job& job) const;
+  bool SaveLocked(const Job& job) const;  // False (and reported) when the store failed.
+  void ForgetLocked(const std::string& id) const;
   std::shared_ptr<Job> FindLocked(const std::string& id) const;
   nlohmann::json ToJsonLocked(const Job& job, Clock::time_point now) const;
   std::string NewIdLocked();
 
   const JobConfig config_;
   const JobRunner runner_;
+  const JobPersistence persistence_;
   const Clock::time_point start_;
+  const std::chrono::system_clock::time_point wall_start_;  // The wall clock at start_.
 
   mutable std::mutex mutex_;
   std::condition_variable work_cv_;  // Signalled when queue_ grows or stopping_ is set.
+  std::condition_variable idle_cv_;  // Signalled when a worker finishes a job or grace ends.
   // Jobs by id. Mutable: const readers drop expired finished jobs (lazy eviction).
   mutable std::unordered_map<std::string, std::shared_ptr<Job>> jobs_;
   std::deque<std::string> queue_;             // Queued ids, oldest first.
   mutable std::deque<std::string> finished_;  // Finished ids, oldest finished first.
   int busy_ = 0;                              // Workers running a job.
   bool stopping_ = false;                     // Set by Shutdown().
+  bool grace_ended_ = false;                  // Set by EndGrace().
   std::mt19937_64 random_;                    // Id source, seeded from std::random_device.
 
   std::once_flag shutdown_once_;

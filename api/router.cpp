@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "api/handlers.hpp"
+#include "api/handlers_modes.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -47,6 +48,9 @@ const std::vector<Route>& Routes() {
       {"POST", "/v1/bat/properties",
        "Exact mass properties: mass, balance point, moments of inertia, volume.",
        HandleBatProperties, true},
+      {"POST", "/v1/bat/modes",
+       "The free-free bending modes: frequencies, mode shapes, nodes, with error estimates.",
+       HandleBatModes, true},
       {"POST", "/v1/bat/fit",
        "Solve unknown dimensions from a target mass and balance point (422 with the closest bat).",
        HandleBatFit, true},

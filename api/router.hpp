@@ -11,6 +11,10 @@
 #include "api/response.hpp"
 #include "core/progress.hpp"
 
+namespace sweetspot::core {
+class ModesCache;
+}  // namespace sweetspot::core
+
 namespace sweetspot::api {
 
 class JobManager;
@@ -29,6 +33,7 @@ struct Context {
   JobManager* jobs = nullptr;                ///< The job manager (server only).
   std::function<std::string()> metrics_text; ///< Prometheus text (server only).
   core::Progress* progress = nullptr;        ///< Cancel flag and progress (inside a job).
+  core::ModesCache* modes_cache = nullptr;   ///< Bending modes kept across requests (server only).
 };
 
 /// One endpoint: method, path pattern and handler. A pattern segment "{id}"

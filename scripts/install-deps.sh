@@ -9,13 +9,13 @@
 set -euo pipefail
 
 if [ "${1:-}" = "--runtime" ]; then
-  packages=(ca-certificates curl libnlopt-cxx0 coinor-libipopt1v5 libcpp-httplib0.11)
+  packages=(ca-certificates curl libnlopt-cxx0 coinor-libipopt1v5 libcpp-httplib0.11 libsqlite3-0)
 else
   packages=(
     cmake g++ make pkg-config ca-certificates curl
     libeigen3-dev libnlopt-cxx-dev coinor-libipopt-dev
     libcpp-httplib-dev nlohmann-json3-dev
-    libgtest-dev libgmock-dev libbenchmark-dev libboost-dev
+    libgtest-dev libgmock-dev libbenchmark-dev libboost-dev libsqlite3-dev
   )
 fi
 

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 
 namespace sweetspot::server {
@@ -83,8 +84,45 @@ const std::vector<Option>& Options() {
       {"--threads", "SWEETSPOT_THREADS", "request worker threads (default 8)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          long long n = 0;
-         if (!ParseLong(v, 1, 256, &n, rule)) return false;
+         if (!ParseLong(v, 1, 1024, &n, rule)) return false;
          c->threads = static_cast<int>(n);
+         return true;
+       }},
+      {"--max-connections", "SWEETSPOT_MAX_CONNECTIONS",
+       "connections served or waiting; beyond: 503 TooBusy (default 256)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1, 100000, &n, rule)) return false;
+         c->max_connections = static_cast<int>(n);
+         return true;
+       }},
+      {"--auth-token-file", "SWEETSPOT_AUTH_TOKEN_FILE",
+       "file holding a bearer token required on every path but /health (default: none; "
+       "SWEETSPOT_AUTH_TOKEN may hold the token itself)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         std::ifstream in(v);
+         std::string token;
+         if (!in || !std::getline(in, token)) {
+           *rule = "must name a readable file whose first line is the token";
+           return false;
+         }
+         while (!token.empty() && (token.back() == '\r' || token.back() == ' ')) token.pop_back();
+         if (token.size() < 16) {
+           *rule = "the token must have at least 16 characters";
+           return false;
+         }
+         c->auth_token = token;
+         return true;
+       }},
+      {"--cors-origin", "SWEETSPOT_CORS_ORIGIN",
+       "allow cross-origin requests from this Origin (or *); default: no CORS", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         if (v.empty()) {
+           *rule = "must be an origin such as https://example.org, or *";
+           return false;
+         }
+         c->cors_origin = v;
          return true;
        }},
       {"--max-body-bytes", "SWEETSPOT_MAX_BODY_BYTES",
@@ -187,6 +225,43 @@ const std::vector<Option>& Options() {
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return ParseSeconds(v, &c->jobs.keep_results_s, rule);
        }},
+      {"--job-max-resumes", "SWEETSPOT_JOB_MAX_RESUMES",
+       "times a job the server died under (crash, SIGKILL) is run again at start-up before it "
+       "is marked failed (default 2)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 0, 100, &n, rule)) return false;
+         c->jobs.max_resumes = static_cast<int>(n);
+         return true;
+       }},
+      {"--jobs-db", "SWEETSPOT_JOBS_DB",
+       "SQLite file keeping jobs and their results across restarts (default "
+       "sweetspot-jobs.db in the working directory; none = memory only)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         if (v.empty()) {
+           *rule = "must be a file path, or none for no persistence";
+           return false;
+         }
+         c->jobs_db = v;
+         return true;
+       }},
+      {"--shutdown-grace-s", "SWEETSPOT_SHUTDOWN_GRACE_S",
+       "on SIGTERM, how long running jobs may finish before they are interrupted and kept "
+       "for the next start, s (default 8; 0 = interrupt at once)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         char* end = nullptr;
+         const double value = std::strtod(v.c_str(), &end);
+         if (v.empty() || end == nullptr || *end != '\0' || !std::isfinite(value) || value < 0 ||
+             value > 3600) {
+           *rule = "must be a number of seconds in [0, 3600]";
+           return false;
+         }
+         c->shutdown_grace_s = value;
+         return true;
+       }},
       {"--access-log", "SWEETSPOT_ACCESS_LOG",
        "one JSON line per request on stderr, 1 or 0 (default 1)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
@@ -205,8 +280,14 @@ bool ServerConfig::IsValid(std::string* why) const {
   };
   if (host.empty()) return fail("host = \"\": must not be empty");
   if (port < 0 || port > 65535) return fail("port = " + std::to_string(port) + ": must be in [0, 65535]");
-  if (threads < 1 || threads > 256) {
-    return fail("threads = " + std::to_string(threads) + ": must be in [1, 256]");
+  if (threads < 1 || threads > 1024) {
+    return fail("threads = " + std::to_string(threads) + ": must be in [1, 1024]");
+  }
+  if (max_connections < 1) {
+    return fail("max_connections = " + std::to_string(max_connections) + ": must be at least 1");
+  }
+  if (!auth_token.empty() && auth_token.size() < 16) {
+    return fail("auth_token: must have at least 16 characters");
   }
   if (max_body_bytes < 1) return fail("max_body_bytes = 0: must be at least 1");
   for (const auto& [name, value] : {std::pair{"read_timeout_s", read_timeout_s},
@@ -220,6 +301,15 @@ bool ServerConfig::IsValid(std::string* why) const {
   }
   if (std::string limits_why; !limits.IsValid(&limits_why)) return fail("limits." + limits_why);
   if (std::string jobs_why; !jobs.IsValid(&jobs_why)) return fail("jobs." + jobs_why);
+  if (jobs_db.empty()) {
+    return fail("jobs_db = \"\": must be a file path, or \"" + std::string(kNoJobsDb) +
+                "\" for no persistence");
+  }
+  if (!std::isfinite(shutdown_grace_s) || shutdown_grace_s < 0 || shutdown_grace_s > 3600) {
+    std::ostringstream text;
+    text << "shutdown_grace_s = " << shutdown_grace_s << ": must be in [0, 3600]";
+    return fail(text.str());
+  }
   if (keep_alive_max_requests < 1) {
     return fail("keep_alive_max_requests = " + std::to_string(keep_alive_max_requests) +
                 ": must be at least 1");
@@ -232,6 +322,7 @@ ParsedCommandLine ParseCommandLine(
     const std::function<std::optional<std::string>(const std::string&)>& getenv) {
   ParsedCommandLine out;
   std::string rule;
+  if (auto token = getenv("SWEETSPOT_AUTH_TOKEN")) out.config.auth_token = *token;
   for (const Option& option : Options()) {
     if (auto value = getenv(option.env)) {
       if (!option.set(&out.config, *value, &rule)) {

@@ -17,7 +17,10 @@ namespace sweetspot::server {
 struct ServerConfig {
   std::string host = "127.0.0.1";        ///< Address to bind (--host, SWEETSPOT_HOST). Loopback by default.
   int port = 8080;                       ///< TCP port, 0 = ephemeral (--port, SWEETSPOT_PORT).
-  int threads = 8;                       ///< Worker threads for requests (--threads, SWEETSPOT_THREADS), 1..256.
+  int threads = 8;                       ///< Worker threads for requests (--threads, SWEETSPOT_THREADS), 1..1024. An open keep-alive connection holds one.
+  int max_connections = 256;             ///< Connections served or waiting; beyond: 503 TooBusy (--max-connections, SWEETSPOT_MAX_CONNECTIONS).
+  std::string auth_token;                ///< If set, every path but /health needs "Authorization: Bearer <token>" (SWEETSPOT_AUTH_TOKEN, --auth-token-file).
+  std::string cors_origin;               ///< CORS: the allowed Origin, or "*"; empty = no CORS headers (--cors-origin, SWEETSPOT_CORS_ORIGIN).
   std::size_t max_body_bytes = 1 << 20;  ///< Largest request body, bytes (--max-body-bytes, SWEETSPOT_MAX_BODY_BYTES).
   double read_timeout_s = 10.0;          ///< Socket read timeout, s (--read-timeout-s, SWEETSPOT_READ_TIMEOUT_S).
   double write_timeout_s = 10.0;         ///< Socket write timeout, s (--write-timeout-s, SWEETSPOT_WRITE_TIMEOUT_S).
@@ -25,11 +28,16 @@ struct ServerConfig {
   int keep_alive_max_requests = 10000;   ///< Requests per keep-alive connection (--keep-alive-max-requests, SWEETSPOT_KEEP_ALIVE_MAX_REQUESTS).
   bool access_log = true;                ///< One JSON line per request on stderr (--no-access-log, SWEETSPOT_ACCESS_LOG=0).
   api::ApiLimits limits;                 ///< Request limits (--max-json-depth, --max-knots, ...; see Usage()).
-  api::JobConfig jobs;                   ///< Job pool (--job-workers, --job-queue, --job-keep-s, --jobs-kept).
+  api::JobConfig jobs;                   ///< Job pool (--job-workers, --job-queue, --job-keep-s, --jobs-kept, --job-max-resumes).
+  std::string jobs_db = "sweetspot-jobs.db";  ///< SQLite file keeping jobs across restarts, relative to the working directory; "none" = memory only (--jobs-db, SWEETSPOT_JOBS_DB).
+  double shutdown_grace_s = 8.0;         ///< On SIGTERM/SIGINT, how long running jobs may still finish before they are interrupted, s, [0, 3600] (--shutdown-grace-s, SWEETSPOT_SHUTDOWN_GRACE_S).
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
 };
+
+/// The ServerConfig::jobs_db value that turns job persistence off.
+inline constexpr const char* kNoJobsDb = "none";
 
 /// What parsing the command line produced.
 struct ParsedCommandLine {

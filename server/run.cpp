@@ -45,10 +45,11 @@ int RunServerMain(const std::vector<std::string>& args) {
     return 1;
   }
   std::atomic<bool> run_returned{false};
+  std::atomic<bool> finished{false};  // Set before main wakes the signal thread to leave.
   std::thread signal_thread([&] {
     int signal_number = 0;
     sigwait(&stop_signals, &signal_number);
-    if (run_returned.load()) return;
+    if (finished.load()) return;
     std::cerr << "sweetspot-server: received " << (signal_number == SIGTERM ? "SIGTERM" : "SIGINT")
               << ", stopping\n";
     // Stop() is a no-op before the listen loop starts: repeat until it returns.
@@ -56,14 +57,26 @@ int RunServerMain(const std::vector<std::string>& args) {
       server.Stop();
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
+    // A second signal ends the running jobs' grace period at once.
+    sigwait(&stop_signals, &signal_number);
+    if (finished.load()) return;
+    std::cerr << "sweetspot-server: received a second signal, interrupting the running jobs\n";
+    server.EndShutdownGrace();
   });
 
+  std::cerr << "sweetspot-server: jobs "
+            << (parsed.config.jobs_db == kNoJobsDb
+                    ? std::string("are kept in memory only (--jobs-db none)")
+                    : "are kept in \"" + parsed.config.jobs_db + "\"")
+            << "\n";
   std::cerr << "sweetspot-server " << sweetspot::core::SweetspotVersion() << " listening on "
             << parsed.config.host << ":" << server.port() << " with " << parsed.config.threads
             << " threads" << std::endl;
-  const bool ok = server.Run();
+  const bool ok = server.Run();  // Returns once in-flight requests are answered.
   run_returned.store(true);
-  // Wake the signal thread if the loop ended for another reason.
+  server.Shutdown();  // Running jobs: the grace period, then interrupted and kept.
+  finished.store(true);
+  // Wake the signal thread (whichever sigwait it is in) so that it leaves.
   pthread_kill(signal_thread.native_handle(), SIGTERM);
   signal_thread.join();
   std::cerr << "sweetspot-server: stopped" << std::endl;

@@ -1,5 +1,8 @@
 #include "server/server.hpp"
 
+// Before httplib.h: it pulls in <resolv.h>, whose `_res` macro breaks Eigen.
+#include "core/flexible/modes_cache.hpp"
+
 #include <httplib.h>
 
 #include <chrono>
@@ -9,7 +12,9 @@
 
 #include "api/jobs.hpp"
 #include "api/router.hpp"
+#include "server/connection_pool.hpp"
 #include "server/metrics.hpp"
+#include "server/sqlite_job_store.hpp"
 
 namespace sweetspot::server {
 namespace {
@@ -50,13 +55,40 @@ const char* CodeForStatus(int status) {
 
 time_t WholeSeconds(double s) { return static_cast<time_t>(s < 1.0 ? 1.0 : s); }
 
+// "Bearer <token>" against the configured token, in time independent of
+// where the first difference is (no timing oracle for the token).
+bool TokenMatches(const std::string& header, const std::string& token) {
+  const std::string prefix = "Bearer ";
+  if (header.size() != prefix.size() + token.size() || header.compare(0, prefix.size(), prefix)) {
+    return false;
+  }
+  unsigned char diff = 0;
+  for (std::size_t i = 0; i < token.size(); ++i) {
+    diff |= static_cast<unsigned char>(header[prefix.size() + i] ^ token[i]);
+  }
+  return diff == 0;
+}
+
+}  // namespace
+
+namespace {
+// httplib 0.11.4 listens with a hard-coded backlog of 5: 64 clients connecting
+// at once overflow it and wait for SYN retransmits (~1 s). listen() again on a
+// listening socket raises the backlog (Linux).
+class HttpServer : public httplib::Server {
+ public:
+  bool RaiseBacklog(int backlog) { return ::listen(svr_sock_, backlog) == 0; }
+};
 }  // namespace
 
 struct Server::Impl {
-  httplib::Server http;
+  HttpServer http;
   api::Context context;
   Metrics metrics;
+  core::ModesCache modes_cache;  // bending modes kept across requests (bounded LRU)
+  std::unique_ptr<SqliteJobStore> job_store;  // Null with --jobs-db none; outlives `jobs`.
   std::unique_ptr<api::JobManager> jobs;
+  std::string startup_error;  // Why the jobs database cannot be used; Bind() reports it.
   std::mutex log_mutex;
 };
 
@@ -69,8 +101,11 @@ thread_local bool request_was_routed = false;
 
 Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::make_unique<Impl>()) {
   httplib::Server& http = impl_->http;
-  const int threads = config_.threads;
-  http.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<size_t>(threads)); };
+  const auto threads = static_cast<std::size_t>(config_.threads);
+  const auto max_connections = static_cast<std::size_t>(config_.max_connections);
+  http.new_task_queue = [threads, max_connections] {
+    return new ConnectionPool(threads, max_connections);
+  };
   // httplib's default also sets SO_REUSEPORT, which lets a second server bind
   // the same port silently and split the traffic: keep SO_REUSEADDR only.
   http.set_socket_options([](socket_t sock) {
@@ -84,8 +119,46 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
   http.set_keep_alive_timeout(WholeSeconds(config_.keep_alive_timeout_s));
   http.set_keep_alive_max_count(static_cast<size_t>(config_.keep_alive_max_requests));
 
-  // A chunked body bypasses the payload limit in 0.11.4 (pitfalls.md): refuse it.
-  http.set_pre_routing_handler([](const httplib::Request& req, httplib::Response& res) {
+  // Before the body is read: connections over the limit, CORS preflights,
+  // authentication and chunked bodies.
+  http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    if (ConnectionPool::CurrentConnectionRejected()) {
+      WriteApiResponse(api::ErrorResponse(503, "TooBusy",
+                                          "the server has " +
+                                              std::to_string(config_.max_connections) +
+                                              " connections open (limit max_connections); "
+                                              "retry later"),
+                       res);
+      res.set_header("Connection", "close");
+      res.set_header("Retry-After", "1");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (!config_.cors_origin.empty()) {
+      const std::string origin = req.get_header_value("Origin");
+      if (config_.cors_origin == "*" || origin == config_.cors_origin) {
+        res.set_header("Access-Control-Allow-Origin", config_.cors_origin == "*" ? "*" : origin);
+        res.set_header("Vary", "Origin");
+        if (req.method == "OPTIONS" && req.has_header("Access-Control-Request-Method")) {
+          res.status = 204;
+          res.set_header("Access-Control-Allow-Methods", "GET, POST, DELETE, OPTIONS");
+          res.set_header("Access-Control-Allow-Headers", "Content-Type, Authorization");
+          res.set_header("Access-Control-Max-Age", "600");
+          return httplib::Server::HandlerResponse::Handled;
+        }
+      }
+    }
+    if (!config_.auth_token.empty() && req.path != "/health" &&
+        !TokenMatches(req.get_header_value("Authorization"), config_.auth_token)) {
+      WriteApiResponse(api::ErrorResponse(401, "Unauthorized",
+                                          "header Authorization: must be \"Bearer <token>\" "
+                                          "with the server's token (everything but /health "
+                                          "needs it)",
+                                          "Authorization"),
+                       res);
+      res.set_header("WWW-Authenticate", "Bearer");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    // A chunked body bypasses the payload limit in 0.11.4 (pitfalls.md): refuse it.
     if (req.has_header("Transfer-Encoding")) {
       WriteApiResponse(api::ErrorResponse(411, "InvalidValue",
                                           "header Transfer-Encoding = \"" +
@@ -100,13 +173,36 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
   });
 
   impl_->context.limits = config_.limits;
-  // Jobs run the same router with the job's cancel flag and progress.
-  impl_->jobs = std::make_unique<api::JobManager>(
-      config_.jobs, [impl = impl_.get()](const api::Request& inner, core::Progress* progress) {
-        api::Context context = impl->context;
-        context.progress = progress;
-        return api::Dispatch(inner, context);
-      });
+  impl_->context.modes_cache = &impl_->modes_cache;
+  // Jobs run the same router with the job's cancel flag and progress, on a
+  // copy of the context taken now: loaded jobs may start before this
+  // constructor returns, and jobbable requests need neither jobs nor metrics.
+  const api::JobRunner runner = [context = impl_->context](const api::Request& inner,
+                                                           core::Progress* progress) {
+    api::Context job_context = context;
+    job_context.progress = progress;
+    return api::Dispatch(inner, job_context);
+  };
+  if (config_.jobs_db != kNoJobsDb) {
+    std::string error;
+    impl_->job_store = SqliteJobStore::Open(config_.jobs_db, &error);
+    if (!impl_->job_store) impl_->startup_error = error;
+  }
+  if (impl_->job_store) {
+    api::JobPersistence persistence;
+    persistence.store = impl_->job_store.get();
+    persistence.on_store_error = [impl = impl_.get()](const std::string& message) {
+      std::lock_guard<std::mutex> lock(impl->log_mutex);
+      std::cerr << "sweetspot-server: jobs database: " << message << std::endl;
+    };
+    try {
+      impl_->jobs = std::make_unique<api::JobManager>(config_.jobs, runner, persistence);
+    } catch (const std::runtime_error& load_error) {
+      impl_->startup_error = "jobs database \"" + config_.jobs_db + "\": " + load_error.what();
+    }
+  }
+  // Memory only: with --jobs-db none, or (never serving: Bind fails) when the database failed.
+  if (!impl_->jobs) impl_->jobs = std::make_unique<api::JobManager>(config_.jobs, runner);
   impl_->context.jobs = impl_->jobs.get();
   impl_->context.metrics_text = [impl = impl_.get()] {
     return impl->metrics.Render(impl->jobs->CountsByState());
@@ -147,6 +243,10 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
     std::string message = "HTTP status " + std::to_string(res.status);
     if (res.status == 413) message = "request body exceeds the configured max_body_bytes";
+    if (res.status == 400) {
+      message = "the request could not be read: malformed, or its body did not arrive within "
+                "the read timeout";
+    }
     WriteApiResponse(api::ErrorResponse(res.status, CodeForStatus(res.status), message), res);
     return httplib::Server::HandlerResponse::Handled;
   }));
@@ -174,10 +274,33 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
 
 Server::~Server() {
   Stop();
-  impl_->jobs->Shutdown();
+  impl_->jobs->Shutdown();  // No grace (a no-op after Shutdown()).
 }
 
+void Server::Shutdown() {
+  Stop();
+  const int running = impl_->jobs->CountsByState().at("running");
+  if (running > 0) {
+    std::lock_guard<std::mutex> lock(impl_->log_mutex);
+    std::cerr << "sweetspot-server: waiting up to " << config_.shutdown_grace_s << " s for "
+              << running << " running job(s) to finish" << std::endl;
+  }
+  impl_->jobs->Shutdown(config_.shutdown_grace_s);
+  const int queued = impl_->jobs->CountsByState().at("queued");
+  if (queued > 0 && impl_->job_store) {
+    std::lock_guard<std::mutex> lock(impl_->log_mutex);
+    std::cerr << "sweetspot-server: " << queued << " unfinished job(s) kept in \""
+              << config_.jobs_db << "\" for the next start" << std::endl;
+  }
+}
+
+void Server::EndShutdownGrace() { impl_->jobs->EndGrace(); }
+
 bool Server::Bind(std::string* error) {
+  if (!impl_->startup_error.empty()) {
+    if (error != nullptr) *error = impl_->startup_error;
+    return false;
+  }
   const int bound = config_.port == 0 ? impl_->http.bind_to_any_port(config_.host)
                                       : (impl_->http.bind_to_port(config_.host, config_.port)
                                              ? config_.port
@@ -190,6 +313,7 @@ bool Server::Bind(std::string* error) {
     return false;
   }
   port_ = bound;
+  impl_->http.RaiseBacklog(SOMAXCONN);
   return true;
 }
 

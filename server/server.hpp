@@ -13,13 +13,15 @@ namespace sweetspot::server {
 /// of api::Routes(). Thread-safe: Stop() may be called from any thread.
 class Server {
  public:
-  /// Prepares a server; nothing is bound until Bind().
+  /// Prepares a server; nothing is bound until Bind(). Opens the jobs
+  /// database and loads its jobs (unfinished ones start running at once).
   explicit Server(ServerConfig config);
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
 
-  /// Binds the listening socket. On failure returns false and says why.
+  /// Binds the listening socket. On failure returns false and says why; also
+  /// when the jobs database (config.jobs_db) could not be opened or loaded.
   bool Bind(std::string* error);
   /// The bound port (useful with port 0); -1 before Bind().
   int port() const { return port_; }
@@ -27,6 +29,13 @@ class Server {
   bool Run();
   /// Stops accepting and makes Run() return (in-flight requests finish).
   void Stop();
+  /// After Run() returned: Stop(), then stops the jobs: no new ones, running
+  /// ones get config.shutdown_grace_s seconds to finish, the rest are
+  /// interrupted and (with a jobs database) kept queued for the next start.
+  /// Logs to stderr what it waits for and what it keeps. Idempotent.
+  void Shutdown();
+  /// Ends Shutdown()'s grace period now (from another thread, e.g. on a second signal).
+  void EndShutdownGrace();
 
  private:
   struct Impl;

@@ -39,7 +39,7 @@ TEST(ConfigTest, BadValuesNameFlagValueAndRule) {
   EXPECT_EQ(Parse({"--port", "70000"}).error,
             "option --port = \"70000\": must be an integer in [0, 65535]");
   EXPECT_EQ(Parse({"--threads", "0"}).error,
-            "option --threads = \"0\": must be an integer in [1, 256]");
+            "option --threads = \"0\": must be an integer in [1, 1024]");
   EXPECT_EQ(Parse({"--read-timeout-s", "nan"}).error,
             "option --read-timeout-s = \"nan\": must be a number of seconds in (0, 3600]");
   EXPECT_EQ(Parse({}, {{"SWEETSPOT_PORT", "80x"}}).error,
@@ -53,7 +53,7 @@ TEST(ConfigTest, IsValidRefusesOutOfRange) {
   config.threads = 0;
   std::string why;
   EXPECT_FALSE(config.IsValid(&why));
-  EXPECT_EQ(why, "threads = 0: must be in [1, 256]");
+  EXPECT_EQ(why, "threads = 0: must be in [1, 1024]");
   config = ServerConfig{};
   config.read_timeout_s = -1;
   EXPECT_FALSE(config.IsValid(&why));

@@ -26,12 +26,17 @@ class ServerProcess {
     if (reader_.joinable()) reader_.join();
   }
 
-  /// Starts the server with `args` (port 0 and host 127.0.0.1 are added) and
-  /// waits up to 20 s for its "listening on" line. Returns false on failure.
+  /// Starts the server with `args` (port 0 and host 127.0.0.1 are added, and
+  /// --jobs-db none unless `args` name a jobs database: a shared default file
+  /// would couple tests) and waits up to 20 s for its "listening on" line.
+  /// Returns false on failure.
   bool Start(std::vector<std::string> args = {}) {
     int fds[2];
     if (pipe(fds) != 0) return false;
     const std::string binary = std::string(SWEETSPOT_BINARY_DIR) + "/server/sweetspot-server";
+    bool names_jobs_db = false;
+    for (const std::string& arg : args) names_jobs_db |= arg.rfind("--jobs-db", 0) == 0;
+    if (!names_jobs_db) args.insert(args.begin(), {"--jobs-db", "none"});
     args.insert(args.begin(), {binary, "--host", "127.0.0.1", "--port", "0"});
     pid_ = fork();
     if (pid_ == 0) {
@@ -96,6 +101,8 @@ class ServerProcess {
   }
 
   int port() const { return port_; }
+  /// The server's process id (-1 when not running).
+  pid_t pid() const { return pid_; }
   std::string log() {
     std::lock_guard<std::mutex> lock(mutex_);
     return log_;

@@ -35,7 +35,7 @@ TEST(ServerProcessTest, SigintAlsoStopsCleanly) {
 TEST(ServerProcessTest, BadFlagExitsWithStatus2AndNamesIt) {
   testing::ServerProcess server;
   EXPECT_FALSE(server.Start({"--threads", "0"}));
-  EXPECT_NE(server.log().find("option --threads = \"0\": must be an integer in [1, 256]"),
+  EXPECT_NE(server.log().find("option --threads = \"0\": must be an integer in [1, 1024]"),
             std::string::npos)
       << server.log();
 }

@@ -19,6 +19,7 @@ class ServerTest : public ::testing::Test {
     config.threads = 4;
     config.max_body_bytes = 1024;
     config.access_log = false;
+    config.jobs_db = kNoJobsDb;  // Jobs in memory: a shared default file would couple tests.
     server_ = std::make_unique<Server>(config);
     std::string error;
     ASSERT_TRUE(server_->Bind(&error)) << error;
@@ -93,6 +94,7 @@ TEST(ServerBindTest, PortInUseIsReported) {
   ServerConfig config;
   config.port = 0;
   config.access_log = false;
+  config.jobs_db = kNoJobsDb;  // Jobs in memory: a shared default file would couple tests.
   Server first(config);
   std::string error;
   ASSERT_TRUE(first.Bind(&error));
@@ -189,6 +191,7 @@ TEST(ServerLimitsTest, HostileBodiesGet4xxAndTheServerKeepsServing) {
   config.port = 0;
   config.threads = 4;
   config.access_log = false;
+  config.jobs_db = kNoJobsDb;  // Jobs in memory: a shared default file would couple tests.
   config.max_body_bytes = 512 * 1024;
   Server server(config);
   std::string error;
@@ -230,6 +233,7 @@ TEST(ServerLimitsTest, ConcurrentSweetSpotRequestsAllAgree) {
   config.port = 0;
   config.threads = 8;
   config.access_log = false;
+  config.jobs_db = kNoJobsDb;  // Jobs in memory: a shared default file would couple tests.
   Server server(config);
   std::string error;
   ASSERT_TRUE(server.Bind(&error)) << error;

@@ -1,0 +1,53 @@
+// Where a JobManager keeps its jobs so that they survive a restart: a small
+// storage interface the api layer calls and the server implements (with SQLite,
+// server/sqlite_job_store.hpp). HTTP- and database-agnostic: a record is plain
+// values, the store only saves, deletes and loads them.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace sweetspot::api {
+
+/// One job as stored: everything needed to show it, give its result, or run it
+/// again after a restart. Times are wall-clock seconds since the Unix epoch.
+struct JobRecord {
+  std::string id;         ///< 32 lowercase hex digits.
+  std::string state;      ///< "queued", "running", "done", "failed" or "cancelled".
+  std::string method;     ///< The inner request's method ("POST").
+  std::string path;       ///< The inner request's path ("/v1/explore").
+  std::string body;       ///< The inner request's body; kept only while the job is unfinished.
+  double progress = 0.0;  ///< Last saved progress, in [0, 1].
+  bool cancel_requested = false;  ///< DELETE asked the job to stop.
+  int resumes = 0;                ///< Times the job was re-queued after the server died under it.
+  std::string created_at;         ///< Submit time, ISO-8601 UTC ("2024-05-01T12:00:00.123Z").
+  double created_unix_s = 0.0;    ///< Submit time, s since the Unix epoch.
+  std::optional<double> started_unix_s;   ///< When a worker took it, s since the epoch.
+  std::optional<double> finished_unix_s;  ///< When it reached done/failed/cancelled, s.
+  int status = 0;             ///< The inner response's HTTP status; 0 until done or failed.
+  std::string response_json;  ///< The inner response's JSON body, serialised; "" if none.
+  std::string response_text;  ///< A non-JSON inner response body (with content_type).
+  std::string content_type;   ///< The non-JSON body's type; "" for a JSON body.
+  std::string error;          ///< The failure's message (failed), else "".
+};
+
+/// Saves, deletes and loads job records. Implementations are thread-safe.
+/// Every call reports failure by returning false with a message in *error
+/// (if non-null); none throws.
+class JobStore {
+ public:
+  virtual ~JobStore() = default;
+
+  /// Inserts `record`, or replaces the record with the same id. Durable once
+  /// it returns true (survives the process being killed).
+  virtual bool Save(const JobRecord& record, std::string* error) = 0;
+
+  /// Removes the record with this id (no error if there is none).
+  virtual bool Delete(const std::string& id, std::string* error) = 0;
+
+  /// Every stored record, oldest created first (replaces *records).
+  virtual bool LoadAll(std::vector<JobRecord>* records, std::string* error) = 0;
+};
+
+}  // namespace sweetspot::api

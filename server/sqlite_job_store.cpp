@@ -1,0 +1,293 @@
+#include "server/sqlite_job_store.hpp"
+
+#include <sqlite3.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <optional>
+#include <sstream>
+#include <utility>
+
+namespace sweetspot::server {
+namespace {
+
+constexpr double kMaxBusyTimeoutS = 60.0;
+
+// The columns, in the order of the statements' parameters and results.
+constexpr const char* kColumns =
+    "id, state, method, path, body, progress, cancel_requested, resumes, created_at, "
+    "created_unix_s, started_unix_s, finished_unix_s, status, response_json, response_text, "
+    "content_type, error";
+
+constexpr const char* kCreateTable =
+    "CREATE TABLE IF NOT EXISTS jobs ("
+    " id TEXT PRIMARY KEY NOT NULL,"
+    " state TEXT NOT NULL CHECK (state IN ('queued', 'running', 'done', 'failed', 'cancelled')),"
+    " method TEXT NOT NULL,"
+    " path TEXT NOT NULL,"
+    " body TEXT NOT NULL,"
+    " progress REAL NOT NULL,"
+    " cancel_requested INTEGER NOT NULL,"
+    " resumes INTEGER NOT NULL,"
+    " created_at TEXT NOT NULL,"
+    " created_unix_s REAL NOT NULL,"
+    " started_unix_s REAL,"
+    " finished_unix_s REAL,"
+    " status INTEGER NOT NULL,"
+    " response_json TEXT NOT NULL,"
+    " response_text TEXT NOT NULL,"
+    " content_type TEXT NOT NULL,"
+    " error TEXT NOT NULL)";
+
+// The text of column `index` (bytes as stored; NULL gives "").
+std::string ColumnText(sqlite3_stmt* statement, int index) {
+  const auto* text = sqlite3_column_text(statement, index);
+  const int bytes = sqlite3_column_bytes(statement, index);
+  if (text == nullptr || bytes <= 0) return {};
+  return std::string(reinterpret_cast<const char*>(text), static_cast<std::size_t>(bytes));
+}
+
+// Resets a statement after use (its bindings too) so it holds no lock or data.
+// sqlite3_reset repeats the last step's error, which the caller already
+// reported, so its result is not a new failure.
+void Rewind(sqlite3_stmt* statement) {
+  sqlite3_reset(statement);
+  sqlite3_clear_bindings(statement);
+}
+
+}  // namespace
+
+bool SqliteJobStoreOptions::IsValid(std::string* why) const {
+  if (!std::isfinite(busy_timeout_s) || busy_timeout_s < 0 || busy_timeout_s > kMaxBusyTimeoutS) {
+    if (why != nullptr) {
+      std::ostringstream text;
+      text << "busy_timeout_s = " << busy_timeout_s << ": must be in [0, " << kMaxBusyTimeoutS
+           << "]";
+      *why = text.str();
+    }
+    return false;
+  }
+  return true;
+}
+
+SqliteJobStore::SqliteJobStore(std::string path) : path_(std::move(path)) {}
+
+std::unique_ptr<SqliteJobStore> SqliteJobStore::Open(const std::string& path, std::string* error,
+                                                     const SqliteJobStoreOptions& options) {
+  std::string why;
+  if (!options.IsValid(&why)) {
+    if (error != nullptr) *error = "invalid SqliteJobStoreOptions: " + why;
+    return nullptr;
+  }
+  std::unique_ptr<SqliteJobStore> store(new SqliteJobStore(path));
+  if (!store->Initialize(options, &why)) {
+    if (error != nullptr) *error = "jobs database \"" + path + "\": " + why;
+    return nullptr;  // The destructor closes whatever was opened.
+  }
+  return store;
+}
+
+std::string SqliteJobStore::Failure(const std::string& what, int code) const {
+  std::string message = what + ": ";
+  message += db_ != nullptr ? sqlite3_errmsg(db_) : sqlite3_errstr(code);
+  message += " (code " + std::to_string(code) + ")";
+  if ((code & 0xff) == SQLITE_BUSY || (code & 0xff) == SQLITE_LOCKED) {
+    message += "; another process (or connection) holds the database: each server needs its own";
+  }
+  return message;
+}
+
+bool SqliteJobStore::Initialize(const SqliteJobStoreOptions& options, std::string* error) {
+  std::lock_guard lock(mutex_);
+  int code =
+      sqlite3_open_v2(path_.c_str(), &db_,
+                      SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr);
+  if (code != SQLITE_OK) {
+    *error = Failure("cannot open or create it", code);
+    return false;
+  }
+  if ((code = sqlite3_extended_result_codes(db_, 1)) != SQLITE_OK) {
+    *error = Failure("sqlite3_extended_result_codes", code);
+    return false;
+  }
+  const int busy_ms = static_cast<int>(std::lround(options.busy_timeout_s * 1000.0));
+  if ((code = sqlite3_busy_timeout(db_, busy_ms)) != SQLITE_OK) {
+    *error = Failure("sqlite3_busy_timeout", code);
+    return false;
+  }
+  auto exec = [this, error](const char* sql) {
+    const int rc = sqlite3_exec(db_, sql, nullptr, nullptr, nullptr);
+    if (rc != SQLITE_OK) *error = Failure(sql, rc);
+    return rc == SQLITE_OK;
+  };
+  // Runs one statement that returns one value into *value; false after setting *error.
+  auto query_text = [this, error](const char* sql, std::string* value) {
+    sqlite3_stmt* statement = nullptr;
+    int rc = sqlite3_prepare_v2(db_, sql, -1, &statement, nullptr);
+    if (rc == SQLITE_OK) {
+      rc = sqlite3_step(statement);
+      if (rc == SQLITE_ROW) {
+        *value = ColumnText(statement, 0);
+        rc = SQLITE_OK;
+      }
+    }
+    if (rc != SQLITE_OK) *error = Failure(sql, rc);
+    sqlite3_finalize(statement);  // Its result repeats the step's error, reported above.
+    return rc == SQLITE_OK;
+  };
+  // Exclusive before WAL: the lock is taken by the first write below and kept
+  // until close, and WAL then needs no shared-memory file.
+  std::string mode;
+  if (!query_text("PRAGMA locking_mode = EXCLUSIVE", &mode)) return false;
+  if (!query_text("PRAGMA journal_mode = WAL", &mode)) return false;
+  if (mode != "wal" && mode != "memory") {  // "memory" for ":memory:".
+    *error = "PRAGMA journal_mode = WAL: the journal mode is \"" + mode + "\", not \"wal\"";
+    return false;
+  }
+  if (!exec("PRAGMA synchronous = NORMAL")) return false;
+
+  // Takes the write lock now, so a second server is refused here and not later.
+  if (!exec("BEGIN IMMEDIATE")) return false;
+  std::string version_text;
+  bool ok = query_text("PRAGMA user_version", &version_text);
+  const int version = ok ? std::atoi(version_text.c_str()) : 0;
+  if (ok && version > kSchemaVersion) {
+    *error = "its schema version is " + std::to_string(version) + ", newer than this server's " +
+             std::to_string(kSchemaVersion) + ": use a newer server or another database";
+    ok = false;
+  }
+  if (ok && version < kSchemaVersion) {
+    ok = exec(kCreateTable) &&
+         exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
+  }
+  if (!ok) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);  // *error has the first failure.
+    return false;
+  }
+  if (!exec("COMMIT")) return false;
+
+  const std::string save_sql = std::string("INSERT OR REPLACE INTO jobs (") + kColumns +
+                               ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, "
+                               "?13, ?14, ?15, ?16, ?17)";
+  const std::string load_sql =
+      std::string("SELECT ") + kColumns + " FROM jobs ORDER BY created_unix_s, id";
+  const char* delete_sql = "DELETE FROM jobs WHERE id = ?1";
+  for (auto [sql, statement] :
+       {std::pair{save_sql.c_str(), &save_}, std::pair{load_sql.c_str(), &load_},
+        std::pair{delete_sql, &delete_}}) {
+    if ((code = sqlite3_prepare_v2(db_, sql, -1, statement, nullptr)) != SQLITE_OK) {
+      *error = Failure(std::string("prepare ") + sql, code);
+      return false;
+    }
+  }
+  return true;
+}
+
+SqliteJobStore::~SqliteJobStore() {
+  std::lock_guard lock(mutex_);
+  // sqlite3_finalize returns the statement's last error, already reported.
+  for (sqlite3_stmt* statement : {save_, delete_, load_}) sqlite3_finalize(statement);
+  // With every statement finalized, close cannot be SQLITE_BUSY; there is no
+  // one left to report another failure to, and the OS releases the lock anyway.
+  sqlite3_close(db_);
+}
+
+bool SqliteJobStore::Save(const api::JobRecord& record, std::string* error) {
+  std::lock_guard lock(mutex_);
+  int code = SQLITE_OK;
+  int index = 0;
+  auto text = [&](const std::string& value) {
+    if (code == SQLITE_OK) {
+      code = sqlite3_bind_text64(save_, ++index, value.data(), value.size(), SQLITE_STATIC,
+                                 SQLITE_UTF8);
+    }
+  };
+  auto real = [&](const std::optional<double>& value) {
+    if (code == SQLITE_OK) {
+      ++index;
+      code = value ? sqlite3_bind_double(save_, index, *value) : sqlite3_bind_null(save_, index);
+    }
+  };
+  auto integer = [&](long long value) {
+    if (code == SQLITE_OK) code = sqlite3_bind_int64(save_, ++index, value);
+  };
+  text(record.id);
+  text(record.state);
+  text(record.method);
+  text(record.path);
+  text(record.body);
+  real(record.progress);
+  integer(record.cancel_requested ? 1 : 0);
+  integer(record.resumes);
+  text(record.created_at);
+  real(record.created_unix_s);
+  real(record.started_unix_s);
+  real(record.finished_unix_s);
+  integer(record.status);
+  text(record.response_json);
+  text(record.response_text);
+  text(record.content_type);
+  text(record.error);
+  if (code != SQLITE_OK) {
+    if (error != nullptr) *error = Failure("bind parameter " + std::to_string(index), code);
+    Rewind(save_);
+    return false;
+  }
+  code = sqlite3_step(save_);
+  const bool ok = code == SQLITE_DONE;
+  if (!ok && error != nullptr) *error = Failure("save job " + record.id, code);
+  Rewind(save_);
+  return ok;
+}
+
+bool SqliteJobStore::Delete(const std::string& id, std::string* error) {
+  std::lock_guard lock(mutex_);
+  int code = sqlite3_bind_text64(delete_, 1, id.data(), id.size(), SQLITE_STATIC, SQLITE_UTF8);
+  if (code == SQLITE_OK) {
+    code = sqlite3_step(delete_);
+    if (code == SQLITE_DONE) code = SQLITE_OK;
+  }
+  if (code != SQLITE_OK && error != nullptr) *error = Failure("delete job " + id, code);
+  Rewind(delete_);
+  return code == SQLITE_OK;
+}
+
+bool SqliteJobStore::LoadAll(std::vector<api::JobRecord>* records, std::string* error) {
+  std::lock_guard lock(mutex_);
+  records->clear();
+  int code = SQLITE_OK;
+  while ((code = sqlite3_step(load_)) == SQLITE_ROW) {
+    auto optional_real = [this](int column) -> std::optional<double> {
+      if (sqlite3_column_type(load_, column) == SQLITE_NULL) return std::nullopt;
+      return sqlite3_column_double(load_, column);
+    };
+    api::JobRecord record;
+    record.id = ColumnText(load_, 0);
+    record.state = ColumnText(load_, 1);
+    record.method = ColumnText(load_, 2);
+    record.path = ColumnText(load_, 3);
+    record.body = ColumnText(load_, 4);
+    record.progress = sqlite3_column_double(load_, 5);
+    record.cancel_requested = sqlite3_column_int64(load_, 6) != 0;
+    record.resumes = static_cast<int>(sqlite3_column_int64(load_, 7));
+    record.created_at = ColumnText(load_, 8);
+    record.created_unix_s = sqlite3_column_double(load_, 9);
+    record.started_unix_s = optional_real(10);
+    record.finished_unix_s = optional_real(11);
+    record.status = static_cast<int>(sqlite3_column_int64(load_, 12));
+    record.response_json = ColumnText(load_, 13);
+    record.response_text = ColumnText(load_, 14);
+    record.content_type = ColumnText(load_, 15);
+    record.error = ColumnText(load_, 16);
+    records->push_back(std::move(record));
+  }
+  const bool ok = code == SQLITE_DONE;
+  if (!ok) {
+    records->clear();
+    if (error != nullptr) *error = Failure("load jobs", code);
+  }
+  Rewind(load_);
+  return ok;
+}
+
+}  // namespace sweetspot::server

@@ -1,0 +1,78 @@
+// api::JobStore in an embedded SQLite database: the service's jobs and their
+// results survive a restart (and a crash: every Save is committed before it
+// returns). Lives in the server layer because it is I/O against a system
+// library, like httplib; the api layer only sees the JobStore interface.
+//
+// The database: one table `jobs` (one row per job, the columns of
+// api::JobRecord), schema version in PRAGMA user_version (kSchemaVersion; a
+// newer version is refused, never rewritten). WAL journal with
+// synchronous=NORMAL: a commit survives the process being killed (SIGKILL, a
+// crash), though the last commits may be lost on a power failure. Exclusive
+// locking mode: one server per database file; a second one is refused at Open
+// ("is locked") instead of running the first one's jobs too.
+#pragma once
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "api/job_store.hpp"
+
+struct sqlite3;
+struct sqlite3_stmt;
+
+namespace sweetspot::server {
+
+/// Options of SqliteJobStore::Open, with their defaults.
+struct SqliteJobStoreOptions {
+  /// How long a statement waits for a lock another connection holds, s, in [0, 60].
+  /// Only a second process on the same file waits (and is then refused).
+  double busy_timeout_s = 2.0;
+
+  /// True when every field is in range; otherwise "field = value: rule" in *why (if non-null).
+  bool IsValid(std::string* why) const;
+};
+
+/// A JobStore in one SQLite database file. Thread-safe: one connection,
+/// serialized by a mutex, with prepared statements.
+class SqliteJobStore final : public api::JobStore {
+ public:
+  /// The schema this code writes (PRAGMA user_version).
+  static constexpr int kSchemaVersion = 1;
+
+  /// Opens or creates the database at `path` (":memory:" for a private
+  /// in-memory one), sets WAL and exclusive locking, creates or checks the
+  /// schema. Null with the reason in *error (if non-null) when the file cannot
+  /// be opened or created, is not a database, has a newer schema, or is locked
+  /// by another process; or when `options` are invalid.
+  static std::unique_ptr<SqliteJobStore> Open(const std::string& path, std::string* error,
+                                              const SqliteJobStoreOptions& options = {});
+
+  /// Finalizes the statements and closes the connection (releases the lock).
+  ~SqliteJobStore() override;
+  SqliteJobStore(const SqliteJobStore&) = delete;
+  SqliteJobStore& operator=(const SqliteJobStore&) = delete;
+
+  /// INSERT OR REPLACE of the record; committed when it returns true.
+  bool Save(const api::JobRecord& record, std::string* error) override;
+  /// DELETE by id; true also when there was no such row.
+  bool Delete(const std::string& id, std::string* error) override;
+  /// Every row, ordered by created_unix_s then id.
+  bool LoadAll(std::vector<api::JobRecord>* records, std::string* error) override;
+
+ private:
+  explicit SqliteJobStore(std::string path);
+  bool Initialize(const SqliteJobStoreOptions& options, std::string* error);
+  // "what: SQLite's message (code N)" for the last failure on the connection.
+  std::string Failure(const std::string& what, int code) const;
+
+  const std::string path_;
+  std::mutex mutex_;                // Serializes every use of the connection and statements.
+  sqlite3* db_ = nullptr;           // The connection.
+  sqlite3_stmt* save_ = nullptr;    // INSERT OR REPLACE INTO jobs ...
+  sqlite3_stmt* delete_ = nullptr;  // DELETE FROM jobs WHERE id = ?1
+  sqlite3_stmt* load_ = nullptr;    // SELECT ... FROM jobs ORDER BY ...
+};
+
+}  // namespace sweetspot::server

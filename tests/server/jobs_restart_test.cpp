@@ -1,0 +1,329 @@
+// Jobs survive the process: the real sweetspot-server with --jobs-db in a
+// temporary directory, killed with SIGKILL in the middle of a job or stopped
+// with SIGTERM while jobs run, then started again on the same database.
+// Also: an HTTP request in flight when SIGTERM arrives is still answered.
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <stdlib.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <thread>
+
+#include "tests/server/server_process.hpp"
+
+namespace sweetspot {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+// How long a test waits for something that must happen (a job to reach a
+// state, a request to be in flight). Only reached when the code is broken: the
+// slowest step, the sweep below under ASan on a loaded 2-core machine, takes a
+// few seconds; a passing Release run needs about one.
+constexpr auto kMustHappen = std::chrono::seconds(120);
+
+// A slow request with a small answer: 400 designs, each a Hertz-contact exit
+// speed maximised by NLopt (~1.5 ms each in Release, so ~0.6 s; several times
+// that under sanitizers), checking its cancel flag between designs. Its
+// numbers are deterministic, so running it again gives the same rows.
+const char* const kSlowSweep = R"({
+  "bat": {"preset": "paper-wood",
+          "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
+  "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 20},
+                 {"path": "fill.diameter_m", "min": 0.01, "max": 0.03, "count": 20}],
+  "outputs": ["max_exit_speed"],
+  "options": {"model": "hertz"}})";
+constexpr std::size_t kSlowSweepRows = 400;
+
+// A quick job's inner request.
+const char* const kQuick = R"({"bat": {"preset": "paper-wood"}})";
+
+// A fresh directory under the test temp dir, removed with its files at the end.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::path(::testing::TempDir()) / "sweetspot-jobs-XXXXXX").string();
+    if (mkdtemp(pattern.data()) != nullptr) path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    if (!path_.empty()) fs::remove_all(path_, ignored);
+  }
+  std::string File(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+// A client with time-outs far above the slowest answer here (the sweep).
+httplib::Client ClientOf(testing::ServerProcess& server) {
+  httplib::Client client("127.0.0.1", server.port());
+  client.set_read_timeout(std::chrono::seconds(120));
+  client.set_write_timeout(std::chrono::seconds(120));
+  return client;
+}
+
+struct Answer {
+  int status = 0;  // 0: no answer (connection failed).
+  Json body;
+};
+
+Answer Parse(const httplib::Result& result) {
+  if (!result) return {};
+  return {result->status, Json::parse(result->body, nullptr, false)};
+}
+
+Answer Get(testing::ServerProcess& server, const std::string& path) {
+  return Parse(ClientOf(server).Get(path.c_str()));
+}
+
+Answer PostJson(testing::ServerProcess& server, const std::string& path, const std::string& body) {
+  return Parse(ClientOf(server).Post(path.c_str(), body, "application/json"));
+}
+
+// Submits `inner` (JSON text) to `path` as a job; returns its id ("" on failure).
+std::string SubmitJob(testing::ServerProcess& server, const std::string& path,
+                      const std::string& inner) {
+  const Answer answer =
+      PostJson(server, "/v1/jobs", R"({"path": ")" + path + R"(", "body": )" + inner + "}");
+  EXPECT_EQ(answer.status, 202) << answer.body.dump();
+  return answer.body.value("id", "");
+}
+
+// Polls GET /v1/jobs/{id} until its state is `state` (at most kMustHappen).
+Json WaitForState(testing::ServerProcess& server, const std::string& id, const std::string& state) {
+  const auto deadline = Clock::now() + kMustHappen;
+  Answer answer = Get(server, "/v1/jobs/" + id);
+  while (answer.status == 200 && answer.body["state"] != state && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    answer = Get(server, "/v1/jobs/" + id);
+  }
+  EXPECT_EQ(answer.status, 200) << answer.body.dump();
+  EXPECT_EQ(answer.body["state"], state) << answer.body.dump();
+  return answer.body;
+}
+
+// Removes the keys that measure time ("timing_s", "solve_time_s") at any depth.
+Json WithoutTimings(Json json) {
+  if (json.is_object()) {
+    json.erase("timing_s");
+    json.erase("solve_time_s");
+    for (auto& [key, value] : json.items()) value = WithoutTimings(value);
+  } else if (json.is_array()) {
+    for (Json& value : json) value = WithoutTimings(value);
+  }
+  return json;
+}
+
+std::vector<std::string> ServerArgs(const std::string& db, std::vector<std::string> more = {}) {
+  std::vector<std::string> args{"--jobs-db", db, "--no-access-log"};
+  args.insert(args.end(), more.begin(), more.end());
+  return args;
+}
+
+TEST(JobsRestartTest, SigkillMidJobThenRestartResumesItWithTheSameResult) {
+  TempDir dir;
+  const std::string db = dir.File("jobs.db");
+  std::string id;
+  std::string created_at;
+  {
+    testing::ServerProcess first;
+    ASSERT_TRUE(first.Start(ServerArgs(db, {"--job-workers", "1"}))) << first.log();
+    id = SubmitJob(first, "/v1/explore", kSlowSweep);
+    ASSERT_FALSE(id.empty());
+    const Json running = WaitForState(first, id, "running");
+    created_at = running["created_at"];
+    EXPECT_LT(running["progress"].get<double>(), 1.0);
+    EXPECT_EQ(first.Stop(SIGKILL), -1);  // Killed: no clean-up of any kind ran.
+  }
+  testing::ServerProcess second;
+  ASSERT_TRUE(second.Start(ServerArgs(db))) << second.log();
+  EXPECT_NE(second.log().find("jobs are kept in \"" + db + "\""), std::string::npos)
+      << second.log();
+  const Answer resumed = Get(second, "/v1/jobs/" + id);
+  ASSERT_EQ(resumed.status, 200);
+  EXPECT_TRUE(resumed.body["state"] == "queued" || resumed.body["state"] == "running")
+      << resumed.body.dump();
+  EXPECT_EQ(resumed.body["resumes"], 1);
+  EXPECT_EQ(resumed.body["created_at"], created_at);
+  EXPECT_LT(resumed.body["created_s"].get<double>(), 0.0);  // Before this process started.
+
+  const Json done = WaitForState(second, id, "done");
+  EXPECT_EQ(done["status"], 200);
+  EXPECT_EQ(done["resumes"], 1);
+  EXPECT_GE(done["started_s"].get<double>(), 0.0);  // Run again, from the start, by this process.
+  const Answer result = Get(second, "/v1/jobs/" + id + "/result");
+  ASSERT_EQ(result.status, 200);
+  ASSERT_EQ(result.body["rows"].size(), kSlowSweepRows);
+  // The resumed run's rows are those of the same request sent directly.
+  const Answer direct = PostJson(second, "/v1/explore", kSlowSweep);
+  ASSERT_EQ(direct.status, 200);
+  EXPECT_EQ(WithoutTimings(result.body["rows"]), WithoutTimings(direct.body["rows"]));
+  EXPECT_EQ(second.Stop(SIGTERM), 0);
+}
+
+TEST(JobsRestartTest, SigkillMidJobBeyondMaxResumesMarksItFailedWithTheReason) {
+  TempDir dir;
+  const std::string db = dir.File("jobs.db");
+  std::string id;
+  {
+    testing::ServerProcess first;
+    ASSERT_TRUE(first.Start(ServerArgs(db, {"--job-max-resumes", "0"}))) << first.log();
+    id = SubmitJob(first, "/v1/explore", kSlowSweep);
+    ASSERT_FALSE(id.empty());
+    WaitForState(first, id, "running");
+    EXPECT_EQ(first.Stop(SIGKILL), -1);
+  }
+  testing::ServerProcess second;
+  ASSERT_TRUE(second.Start(ServerArgs(db, {"--job-max-resumes", "0"}))) << second.log();
+  const std::string reason =
+      "interrupted by a server restart: the job was running when the server died, and it had "
+      "already been resumed 0 times (limit max_resumes = 0)";
+  const Answer status = Get(second, "/v1/jobs/" + id);
+  ASSERT_EQ(status.status, 200);
+  EXPECT_EQ(status.body["state"], "failed");
+  EXPECT_EQ(status.body["error"], reason);
+  EXPECT_EQ(status.body["status"], 503);
+  const Answer result = Get(second, "/v1/jobs/" + id + "/result");
+  EXPECT_EQ(result.status, 503);
+  EXPECT_EQ(result.body, (Json{{"code", "Interrupted"}, {"message", reason}, {"field", nullptr}}));
+  EXPECT_EQ(second.Stop(SIGTERM), 0);
+}
+
+TEST(JobsRestartTest, FinishedJobAndItsResultSurviveACleanRestartAndSoDoesADelete) {
+  TempDir dir;
+  const std::string db = dir.File("jobs.db");
+  std::string id;
+  Json done_before;
+  Answer result_before;
+  {
+    testing::ServerProcess first;
+    ASSERT_TRUE(first.Start(ServerArgs(db))) << first.log();
+    id = SubmitJob(first, "/v1/sweet-spot", kQuick);
+    ASSERT_FALSE(id.empty());
+    done_before = WaitForState(first, id, "done");
+    result_before = Get(first, "/v1/jobs/" + id + "/result");
+    ASSERT_EQ(result_before.status, 200);
+    EXPECT_EQ(first.Stop(SIGTERM), 0);
+  }
+  {
+    testing::ServerProcess second;
+    ASSERT_TRUE(second.Start(ServerArgs(db))) << second.log();
+    const Answer status = Get(second, "/v1/jobs/" + id);
+    ASSERT_EQ(status.status, 200);
+    for (const char* key : {"id", "state", "path", "created_at", "status", "error", "progress",
+                            "cancel_requested", "resumes"}) {
+      EXPECT_EQ(status.body[key], done_before[key]) << key;
+    }
+    // The stored answer, byte for byte (its timing_s included): not a re-run.
+    const Answer result = Get(second, "/v1/jobs/" + id + "/result");
+    EXPECT_EQ(result.status, 200);
+    EXPECT_EQ(result.body, result_before.body);
+    const Answer deleted = Parse(ClientOf(second).Delete(("/v1/jobs/" + id).c_str()));
+    EXPECT_EQ(deleted.status, 200);
+    EXPECT_EQ(deleted.body["deleted"], true);
+    EXPECT_EQ(second.Stop(SIGTERM), 0);
+  }
+  testing::ServerProcess third;
+  ASSERT_TRUE(third.Start(ServerArgs(db))) << third.log();
+  EXPECT_EQ(Get(third, "/v1/jobs/" + id).status, 404);
+  EXPECT_EQ(third.Stop(SIGTERM), 0);
+}
+
+TEST(JobsRestartTest, SigtermLetsARunningJobFinishWithinTheGrace) {
+  TempDir dir;
+  const std::string db = dir.File("jobs.db");
+  std::string id;
+  {
+    testing::ServerProcess first;
+    // A grace far longer than the sweep, so it always finishes (the default is 8 s).
+    ASSERT_TRUE(first.Start(ServerArgs(db, {"--shutdown-grace-s", "100"}))) << first.log();
+    id = SubmitJob(first, "/v1/explore", kSlowSweep);
+    ASSERT_FALSE(id.empty());
+    WaitForState(first, id, "running");
+    EXPECT_EQ(first.Stop(SIGTERM), 0);
+    const std::string log = first.log();
+    EXPECT_NE(log.find("waiting up to 100 s for 1 running job(s) to finish"), std::string::npos)
+        << log;
+    EXPECT_EQ(log.find("unfinished job(s) kept"), std::string::npos) << log;  // None left.
+  }
+  testing::ServerProcess second;
+  ASSERT_TRUE(second.Start(ServerArgs(db))) << second.log();
+  const Answer status = Get(second, "/v1/jobs/" + id);
+  ASSERT_EQ(status.status, 200);
+  EXPECT_EQ(status.body["state"], "done");  // At once: it finished before the first exited.
+  EXPECT_EQ(status.body["resumes"], 0);
+  const Answer result = Get(second, "/v1/jobs/" + id + "/result");
+  EXPECT_EQ(result.status, 200);
+  EXPECT_EQ(result.body["rows"].size(), kSlowSweepRows);
+  EXPECT_EQ(second.Stop(SIGTERM), 0);
+}
+
+TEST(JobsRestartTest, SigtermBeyondTheGraceKeepsRunningAndQueuedJobsForTheNextStart) {
+  TempDir dir;
+  const std::string db = dir.File("jobs.db");
+  std::string running, queued;
+  {
+    testing::ServerProcess first;
+    ASSERT_TRUE(first.Start(ServerArgs(db, {"--shutdown-grace-s", "0", "--job-workers", "1"})))
+        << first.log();
+    running = SubmitJob(first, "/v1/explore", kSlowSweep);
+    ASSERT_FALSE(running.empty());
+    WaitForState(first, running, "running");
+    queued = SubmitJob(first, "/v1/sweet-spot", kQuick);
+    ASSERT_FALSE(queued.empty());
+    EXPECT_EQ(first.Stop(SIGTERM), 0);
+    const std::string log = first.log();
+    EXPECT_NE(log.find("2 unfinished job(s) kept in \"" + db + "\" for the next start"),
+              std::string::npos)
+        << log;
+  }
+  testing::ServerProcess second;
+  ASSERT_TRUE(second.Start(ServerArgs(db))) << second.log();
+  for (const std::string& id : {running, queued}) {
+    const Json done = WaitForState(second, id, "done");
+    EXPECT_EQ(done["resumes"], 0) << id;  // A clean stop is not a crash.
+    EXPECT_EQ(Get(second, "/v1/jobs/" + id + "/result").status, 200) << id;
+  }
+  EXPECT_EQ(Get(second, "/v1/jobs/" + running + "/result").body["rows"].size(), kSlowSweepRows);
+  EXPECT_EQ(second.Stop(SIGTERM), 0);
+}
+
+// The in-flight gauge of /metrics ("sweetspot_requests_in_flight N"), -1 if absent.
+int InFlight(testing::ServerProcess& server) {
+  const auto result = ClientOf(server).Get("/metrics");
+  if (!result) return -1;
+  const std::string name = "\nsweetspot_requests_in_flight ";
+  const auto at = result->body.find(name);
+  if (at == std::string::npos) return -1;
+  return std::atoi(result->body.c_str() + at + name.size());
+}
+
+TEST(JobsRestartTest, RequestInFlightWhenSigtermArrivesIsAnswered) {
+  testing::ServerProcess server;
+  ASSERT_TRUE(server.Start({"--no-access-log"})) << server.log();
+  Answer answer;
+  std::thread client([&] { answer = PostJson(server, "/v1/explore", kSlowSweep); });
+  // The /metrics request counts itself: 2 means the sweep is being computed.
+  const auto deadline = Clock::now() + kMustHappen;
+  int in_flight = InFlight(server);
+  while (in_flight < 2 && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    in_flight = InFlight(server);
+  }
+  EXPECT_GE(in_flight, 2);
+  EXPECT_EQ(server.Stop(SIGTERM), 0);
+  client.join();
+  EXPECT_EQ(answer.status, 200);
+  EXPECT_EQ(answer.body["rows"].size(), kSlowSweepRows);
+  EXPECT_NE(server.log().find("received SIGTERM"), std::string::npos) << server.log();
+}
+
+}  // namespace
+}  // namespace sweetspot

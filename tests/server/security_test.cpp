@@ -1,0 +1,149 @@
+// Bearer token, CORS and the connection limit, over real HTTP on 127.0.0.1.
+#include <httplib.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <thread>
+
+#include "server/server.hpp"
+
+namespace sweetspot::server {
+namespace {
+
+class RunningServer {
+ public:
+  explicit RunningServer(ServerConfig config) : server_(Prepare(std::move(config))) {
+    std::string error;
+    bound_ = server_.Bind(&error);
+    if (bound_) thread_ = std::thread([this] { server_.Run(); });
+  }
+  ~RunningServer() {
+    server_.Stop();
+    if (thread_.joinable()) thread_.join();
+  }
+  bool bound() const { return bound_; }
+  httplib::Client Client() const { return httplib::Client("127.0.0.1", server_.port()); }
+
+ private:
+  static ServerConfig Prepare(ServerConfig config) {
+    config.port = 0;
+    config.access_log = false;
+    config.jobs_db = kNoJobsDb;  // Jobs in memory: a shared default file would couple tests.
+    return config;
+  }
+  Server server_;
+  bool bound_ = false;
+  std::thread thread_;
+};
+
+TEST(SecurityTest, BearerTokenGuardsEverythingButHealth) {
+  ServerConfig config;
+  config.auth_token = "0123456789abcdef-secret";
+  RunningServer server(config);
+  ASSERT_TRUE(server.bound());
+  auto client = server.Client();
+  const auto health = client.Get("/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+  const auto anonymous = client.Get("/v1/materials");
+  ASSERT_TRUE(anonymous);
+  EXPECT_EQ(anonymous->status, 401);
+  EXPECT_EQ(nlohmann::json::parse(anonymous->body)["code"], "Unauthorized");
+  EXPECT_EQ(anonymous->get_header_value("WWW-Authenticate"), "Bearer");
+  const auto wrong = client.Get("/v1/materials", {{"Authorization", "Bearer 0123456789abcdef-secreT"}});
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(wrong->status, 401);
+  // A POST without the token is refused before its body is read.
+  const auto post = client.Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"}})",
+                                "application/json");
+  ASSERT_TRUE(post);
+  EXPECT_EQ(post->status, 401);
+  client.set_bearer_token_auth("0123456789abcdef-secret");
+  const auto allowed = client.Get("/v1/materials");
+  ASSERT_TRUE(allowed);
+  EXPECT_EQ(allowed->status, 200);
+}
+
+TEST(SecurityTest, NoCorsHeadersUnlessConfigured) {
+  RunningServer plain{ServerConfig{}};
+  ASSERT_TRUE(plain.bound());
+  auto client = plain.Client();
+  const auto res = client.Get("/health", {{"Origin", "https://example.org"}});
+  ASSERT_TRUE(res);
+  EXPECT_FALSE(res->has_header("Access-Control-Allow-Origin"));
+  const auto preflight = client.Options("/v1/sweet-spot", {{"Origin", "https://example.org"},
+                                                            {"Access-Control-Request-Method", "POST"}});
+  ASSERT_TRUE(preflight);
+  EXPECT_EQ(preflight->status, 405);  // OPTIONS is not an endpoint
+
+  ServerConfig config;
+  config.cors_origin = "https://example.org";
+  RunningServer cors(config);
+  ASSERT_TRUE(cors.bound());
+  auto cors_client = cors.Client();
+  const auto allowed = cors_client.Get("/health", {{"Origin", "https://example.org"}});
+  ASSERT_TRUE(allowed);
+  EXPECT_EQ(allowed->get_header_value("Access-Control-Allow-Origin"), "https://example.org");
+  const auto other = cors_client.Get("/health", {{"Origin", "https://evil.example"}});
+  ASSERT_TRUE(other);
+  EXPECT_FALSE(other->has_header("Access-Control-Allow-Origin"));
+  const auto pre = cors_client.Options(
+      "/v1/sweet-spot",
+      {{"Origin", "https://example.org"}, {"Access-Control-Request-Method", "POST"}});
+  ASSERT_TRUE(pre);
+  EXPECT_EQ(pre->status, 204);
+  EXPECT_EQ(pre->get_header_value("Access-Control-Allow-Methods"), "GET, POST, DELETE, OPTIONS");
+}
+
+TEST(SecurityTest, ConnectionsOverTheLimitGet503AndAdmittedOnesAreServed) {
+  ServerConfig config;
+  config.threads = 2;
+  config.max_connections = 2;
+  config.keep_alive_timeout_s = 5;
+  RunningServer server(config);
+  ASSERT_TRUE(server.bound());
+  // Two keep-alive connections stay open and hold both admitted slots.
+  auto first = server.Client();
+  auto second = server.Client();
+  first.set_keep_alive(true);
+  second.set_keep_alive(true);
+  ASSERT_EQ(first.Get("/health")->status, 200);
+  ASSERT_EQ(second.Get("/health")->status, 200);
+  auto third = server.Client();
+  const auto refused = third.Get("/health");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 503);
+  EXPECT_EQ(nlohmann::json::parse(refused->body)["code"], "TooBusy");
+  // The admitted connections are still served.
+  EXPECT_EQ(first.Get("/v1/version")->status, 200);
+  EXPECT_EQ(second.Get("/v1/version")->status, 200);
+  // Once one closes, a new connection is admitted (bounded wait: 200 x 10 ms).
+  first.stop();
+  int status = 0;
+  for (int i = 0; i < 200 && status != 200; ++i) {
+    auto next = server.Client();
+    const auto res = next.Get("/health");
+    status = res ? res->status : 0;
+    if (status != 200) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_EQ(status, 200);
+}
+
+TEST(SecurityTest, ErrorsCarryNoInternals) {
+  RunningServer server{ServerConfig{}};
+  ASSERT_TRUE(server.bound());
+  auto client = server.Client();
+  for (const char* body : {"{", "[[[[", "{\"bat\": 1}", "\x01\x02"}) {
+    const auto res = client.Post("/v1/sweet-spot", body, "application/json");
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 400);
+    // No source paths, no exception class names.
+    EXPECT_EQ(res->body.find("/work/"), std::string::npos) << res->body;
+    EXPECT_EQ(res->body.find(".cpp"), std::string::npos) << res->body;
+    EXPECT_EQ(res->body.find("json.exception"), std::string::npos) << res->body;
+    EXPECT_EQ(res->body.find("what()"), std::string::npos) << res->body;
+  }
+}
+
+}  // namespace
+}  // namespace sweetspot::server

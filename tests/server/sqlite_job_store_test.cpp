@@ -1,0 +1,280 @@
+// The SQLite JobStore on temporary files: every field round-trips through a
+// close and reopen, replace/delete/order, one server per file, schema
+// versions, unusable files, and a JobManager restarted on the same database.
+#include "server/sqlite_job_store.hpp"
+
+#include <gtest/gtest.h>
+#include <sqlite3.h>
+#include <stdlib.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "api/jobs.hpp"
+
+namespace sweetspot::server {
+namespace {
+
+namespace fs = std::filesystem;
+using api::JobRecord;
+
+// A fresh directory under the test temp dir, removed with its files at the end.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::path(::testing::TempDir()) / "sweetspot-store-XXXXXX").string();
+    if (mkdtemp(pattern.data()) != nullptr) path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    if (!path_.empty()) fs::remove_all(path_, ignored);
+  }
+  const fs::path& path() const { return path_; }
+  std::string File(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+JobRecord FullRecord(const std::string& id, double created_unix_s) {
+  JobRecord record;
+  record.id = id;
+  record.state = "done";
+  record.method = "POST";
+  record.path = "/v1/explore";
+  record.body = std::string("{\"k\": \"\xc3\xa9t\xc3\xa9\"}") + std::string(1, '\0') + "tail";
+  record.progress = 0.75;
+  record.cancel_requested = true;
+  record.resumes = 2;
+  record.created_at = "2024-05-01T12:00:00.123Z";
+  record.created_unix_s = created_unix_s;
+  record.started_unix_s = created_unix_s + 0.5;
+  record.finished_unix_s = created_unix_s + 1.25;
+  record.status = 422;
+  record.response_json = R"({"code":"Infeasible","message":"no bat"})";
+  record.response_text = "a,b\n1,2\n";
+  record.content_type = "text/csv";
+  record.error = "no bat";
+  return record;
+}
+
+void ExpectSameRecord(const JobRecord& a, const JobRecord& b) {
+  EXPECT_EQ(a.id, b.id);
+  EXPECT_EQ(a.state, b.state);
+  EXPECT_EQ(a.method, b.method);
+  EXPECT_EQ(a.path, b.path);
+  EXPECT_EQ(a.body, b.body);
+  EXPECT_EQ(a.progress, b.progress);
+  EXPECT_EQ(a.cancel_requested, b.cancel_requested);
+  EXPECT_EQ(a.resumes, b.resumes);
+  EXPECT_EQ(a.created_at, b.created_at);
+  EXPECT_EQ(a.created_unix_s, b.created_unix_s);
+  EXPECT_EQ(a.started_unix_s, b.started_unix_s);
+  EXPECT_EQ(a.finished_unix_s, b.finished_unix_s);
+  EXPECT_EQ(a.status, b.status);
+  EXPECT_EQ(a.response_json, b.response_json);
+  EXPECT_EQ(a.response_text, b.response_text);
+  EXPECT_EQ(a.content_type, b.content_type);
+  EXPECT_EQ(a.error, b.error);
+}
+
+std::unique_ptr<SqliteJobStore> OpenOrFail(const std::string& path) {
+  std::string error;
+  auto store = SqliteJobStore::Open(path, &error);
+  EXPECT_NE(store, nullptr) << error;
+  EXPECT_EQ(error, "");
+  return store;
+}
+
+std::vector<JobRecord> LoadAll(SqliteJobStore& store) {
+  std::vector<JobRecord> records;
+  std::string error;
+  EXPECT_TRUE(store.LoadAll(&records, &error)) << error;
+  return records;
+}
+
+TEST(SqliteJobStoreOptionsTest, DefaultsAreValidAndTheRangeIsChecked) {
+  SqliteJobStoreOptions options;
+  std::string why = "untouched";
+  EXPECT_TRUE(options.IsValid(&why));
+  EXPECT_EQ(why, "untouched");
+  EXPECT_EQ(options.busy_timeout_s, 2.0);
+  options.busy_timeout_s = -1;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_EQ(why, "busy_timeout_s = -1: must be in [0, 60]");
+  options.busy_timeout_s = 61;
+  EXPECT_FALSE(options.IsValid(nullptr));
+  std::string error;
+  EXPECT_EQ(SqliteJobStore::Open(":memory:", &error, options), nullptr);
+  EXPECT_EQ(error, "invalid SqliteJobStoreOptions: busy_timeout_s = 61: must be in [0, 60]");
+}
+
+TEST(SqliteJobStoreTest, EveryFieldSurvivesCloseAndReopen) {
+  TempDir dir;
+  ASSERT_FALSE(dir.path().empty());
+  const std::string path = dir.File("jobs.db");
+  const JobRecord full = FullRecord(std::string(32, 'a'), 1714564800.123456);
+  JobRecord sparse;  // Optional times absent, empty strings, a large body.
+  sparse.id = std::string(32, 'b');
+  sparse.state = "queued";
+  sparse.method = "POST";
+  sparse.path = "/v1/compare";
+  sparse.body = std::string(1 << 20, 'x');
+  sparse.created_at = "2024-05-01T12:00:01.000Z";
+  sparse.created_unix_s = 1714564801.0;
+  {
+    auto store = OpenOrFail(path);
+    ASSERT_NE(store, nullptr);
+    std::string error;
+    EXPECT_TRUE(store->Save(full, &error)) << error;
+    EXPECT_TRUE(store->Save(sparse, &error)) << error;
+    EXPECT_TRUE(fs::exists(path + "-wal"));  // WAL journal while open.
+  }
+  auto reopened = OpenOrFail(path);
+  ASSERT_NE(reopened, nullptr);
+  const std::vector<JobRecord> records = LoadAll(*reopened);
+  ASSERT_EQ(records.size(), 2u);
+  ExpectSameRecord(records[0], full);
+  ExpectSameRecord(records[1], sparse);
+  EXPECT_FALSE(records[1].started_unix_s.has_value());
+  EXPECT_FALSE(records[1].finished_unix_s.has_value());
+}
+
+TEST(SqliteJobStoreTest, SaveReplacesDeleteRemovesLoadOrdersByCreation) {
+  auto store = OpenOrFail(":memory:");
+  ASSERT_NE(store, nullptr);
+  std::string error;
+  JobRecord late = FullRecord(std::string(32, '1'), 300.0);
+  JobRecord early = FullRecord(std::string(32, '2'), 100.0);
+  JobRecord middle = FullRecord(std::string(32, '3'), 200.0);
+  for (const JobRecord& record : {late, early, middle}) {
+    ASSERT_TRUE(store->Save(record, &error)) << error;
+  }
+  std::vector<JobRecord> records = LoadAll(*store);
+  ASSERT_EQ(records.size(), 3u);
+  EXPECT_EQ(records[0].id, early.id);
+  EXPECT_EQ(records[1].id, middle.id);
+  EXPECT_EQ(records[2].id, late.id);
+
+  middle.state = "failed";
+  middle.error = "changed";
+  ASSERT_TRUE(store->Save(middle, &error)) << error;
+  ASSERT_TRUE(store->Delete(late.id, &error)) << error;
+  ASSERT_TRUE(store->Delete("no such id", &error)) << error;
+  records = LoadAll(*store);
+  ASSERT_EQ(records.size(), 2u);
+  ExpectSameRecord(records[0], early);
+  ExpectSameRecord(records[1], middle);
+}
+
+TEST(SqliteJobStoreTest, ASecondOpenOfTheSameFileIsRefusedUntilTheFirstCloses) {
+  TempDir dir;
+  const std::string path = dir.File("jobs.db");
+  auto first = OpenOrFail(path);
+  ASSERT_NE(first, nullptr);
+  SqliteJobStoreOptions quick;
+  quick.busy_timeout_s = 0.05;
+  std::string error;
+  EXPECT_EQ(SqliteJobStore::Open(path, &error, quick), nullptr);
+  EXPECT_EQ(error.rfind("jobs database \"" + path + "\": ", 0), 0u) << error;
+  EXPECT_NE(error.find("database is locked"), std::string::npos) << error;
+  EXPECT_NE(error.find("each server needs its own"), std::string::npos) << error;
+  first.reset();
+  EXPECT_NE(OpenOrFail(path), nullptr);
+}
+
+TEST(SqliteJobStoreTest, ANewerSchemaIsRefusedAndLeftAlone) {
+  TempDir dir;
+  const std::string path = dir.File("jobs.db");
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "PRAGMA user_version = 2", nullptr, nullptr, nullptr), SQLITE_OK);
+  ASSERT_EQ(sqlite3_close(db), SQLITE_OK);
+  std::string error;
+  EXPECT_EQ(SqliteJobStore::Open(path, &error), nullptr);
+  EXPECT_EQ(error, "jobs database \"" + path +
+                       "\": its schema version is 2, newer than this server's 1: use a newer "
+                       "server or another database");
+  // Still version 2 and without a jobs table: nothing was rewritten.
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* statement = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db,
+                               "SELECT (SELECT user_version FROM pragma_user_version), "
+                               "(SELECT count(*) FROM sqlite_master WHERE name = 'jobs')",
+                               -1, &statement, nullptr),
+            SQLITE_OK);
+  ASSERT_EQ(sqlite3_step(statement), SQLITE_ROW);
+  EXPECT_EQ(sqlite3_column_int(statement, 0), 2);
+  EXPECT_EQ(sqlite3_column_int(statement, 1), 0);
+  sqlite3_finalize(statement);
+  sqlite3_close(db);
+}
+
+TEST(SqliteJobStoreTest, TheSchemaVersionIsWritten) {
+  TempDir dir;
+  const std::string path = dir.File("jobs.db");
+  OpenOrFail(path).reset();
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  sqlite3_stmt* statement = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(db, "PRAGMA user_version", -1, &statement, nullptr), SQLITE_OK);
+  ASSERT_EQ(sqlite3_step(statement), SQLITE_ROW);
+  EXPECT_EQ(sqlite3_column_int(statement, 0), SqliteJobStore::kSchemaVersion);
+  sqlite3_finalize(statement);
+  sqlite3_close(db);
+}
+
+TEST(SqliteJobStoreTest, UnusableFilesAreRefusedWithTheReason) {
+  TempDir dir;
+  const std::string garbage = dir.File("garbage.db");
+  std::ofstream(garbage) << std::string(4096, 'g');
+  std::string error;
+  EXPECT_EQ(SqliteJobStore::Open(garbage, &error), nullptr);
+  EXPECT_EQ(error.rfind("jobs database \"" + garbage + "\": ", 0), 0u) << error;
+  EXPECT_NE(error.find("file is not a database"), std::string::npos) << error;
+
+  const std::string missing_dir = dir.File("no/such/dir/jobs.db");
+  EXPECT_EQ(SqliteJobStore::Open(missing_dir, &error), nullptr);
+  EXPECT_EQ(error, "jobs database \"" + missing_dir +
+                       "\": cannot open or create it: unable to open database file (code 14)");
+}
+
+TEST(SqliteJobStoreTest, AJobManagerRestartedOnTheSameFileGetsItsJobsBack) {
+  TempDir dir;
+  const std::string path = dir.File("jobs.db");
+  const auto echo = [](const api::Request& inner, core::Progress*) {
+    return api::Response{200, nlohmann::json{{"body", inner.body}}};
+  };
+  std::string id;
+  {
+    auto store = OpenOrFail(path);
+    ASSERT_NE(store, nullptr);
+    api::JobPersistence persistence;
+    persistence.store = store.get();
+    api::JobManager jobs(api::JobConfig{}, echo, persistence);
+    const api::Response submitted = jobs.Submit({"POST", "/v1/compare", "payload"});
+    ASSERT_EQ(submitted.status, 202);
+    id = submitted.body["id"];
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (jobs.Status(id).body["state"] != "done" && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    ASSERT_EQ(jobs.Status(id).body["state"], "done");
+  }
+  auto store = OpenOrFail(path);
+  ASSERT_NE(store, nullptr);
+  api::JobPersistence persistence;
+  persistence.store = store.get();
+  api::JobManager jobs(api::JobConfig{}, echo, persistence);
+  EXPECT_EQ(jobs.Status(id).body["state"], "done");
+  const api::Response result = jobs.Result(id);
+  EXPECT_EQ(result.status, 200);
+  EXPECT_EQ(result.body, (nlohmann::json{{"body", "payload"}}));
+}
+
+}  // namespace
+}  // namespace sweetspot::server
