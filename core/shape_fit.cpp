@@ -507,6 +507,10 @@ std::string DescribeUnknowns(const ShapeFitProblem& problem) {
   return out;
 }
 
+// Smallest target or scale of the fit's metric, kg or m: residuals divided by
+// less than this can overflow to inf.
+constexpr double kMinMetricScale = 1e-6;
+
 bool Refuse(std::string* why, std::string_view field, double value, std::string_view rule) {
   if (why != nullptr) *why = RefusalMessage(field, value, rule);
   return false;
@@ -534,6 +538,14 @@ bool ShapeFitOptions::IsValid(std::string* why) const {
   if (!std::isfinite(balance_point_scale_m) || balance_point_scale_m < 0.0) {
     return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
                   "must be finite and non-negative (0 = the target)");
+  }
+  // Smaller scales overflow the scaled residuals to inf (found by fuzzing).
+  if (mass_scale_kg > 0.0 && mass_scale_kg < kMinMetricScale) {
+    return Refuse(why, "mass_scale_kg", mass_scale_kg, "must be 0 (the target) or at least 1e-06");
+  }
+  if (balance_point_scale_m > 0.0 && balance_point_scale_m < kMinMetricScale) {
+    return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
+                  "must be 0 (the target) or at least 1e-06");
   }
   if (!std::isfinite(tolerance) || !(tolerance > 0.0)) {
     return Refuse(why, "tolerance", tolerance, "must be finite and positive");
@@ -564,6 +576,14 @@ bool ShapeFitProblem::IsValid(std::string* why) const {
       !(std::isfinite(*targets.balance_point_m) && *targets.balance_point_m > 0.0)) {
     return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
                   "must be finite and positive");
+  }
+  // A target is the metric's default scale: a smaller one overflows it (found by fuzzing).
+  if (targets.mass_kg.has_value() && *targets.mass_kg < kMinMetricScale) {
+    return Refuse(why, "targets.mass_kg", *targets.mass_kg, "must be at least 1e-06");
+  }
+  if (targets.balance_point_m.has_value() && *targets.balance_point_m < kMinMetricScale) {
+    return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
+                  "must be at least 1e-06");
   }
   if (unknowns.empty() || unknowns.size() > static_cast<std::size_t>(kNumParams)) {
     return Refuse(why, "unknowns.size()", static_cast<double>(unknowns.size()),

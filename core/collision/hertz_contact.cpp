@@ -185,7 +185,10 @@ RawRun Integrate(const HertzProblem& p, double tol, int max_steps) {
         return out;
       }
       const State ya = stepper.current_state();
-      const auto [ta, tb] = stepper.do_step(std::ref(rhs));
+      // Not a structured binding: clang 14 cannot capture one in the lambdas below.
+      const std::pair<double, double> step = stepper.do_step(std::ref(rhs));
+      const double ta = step.first;
+      const double tb = step.second;
       ++out.steps;
       const State& yb = stepper.current_state();
       for (double v : yb) {

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang in build-fuzz/ (-DSWEETSPOT_FUZZ=ON:
+# coverage + AddressSanitizer + UndefinedBehaviorSanitizer) and runs each one
+# for a few seconds on its seeds (fuzz/corpus/<target>/) plus what earlier runs
+# found (build-fuzz/corpus/<target>/, kept between runs). About a minute in all.
+#
+# A crash, a sanitizer report, a timeout or a broken contract fails the script;
+# the input is in build-fuzz/artifacts/<target>/. Fix the bug and keep the
+# input as fuzz/regressions/<target>/<what-it-does> (tests/api/
+# fuzz_regressions_test.cpp replays it in the normal build). fuzz/README.md
+# has the details.
+#
+#   SWEETSPOT_FUZZ_SECONDS=N   seconds per target (default 6: ~60 s for the 8 targets)
+#   SWEETSPOT_FUZZ_TARGETS="parse_body dispatch"   run only these targets
+#   SWEETSPOT_FUZZ_STRICT=1    a handler's deliberate 500 fails too (default: listed)
+#   SWEETSPOT_JOBS=N           build parallelism (default: nproc)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${SWEETSPOT_FUZZ_SECONDS:-6}"
+targets="${SWEETSPOT_FUZZ_TARGETS:-parse_body parse_bat dispatch bat_fit sweet_spot collision compare explore}"
+jobs="${SWEETSPOT_JOBS:-$(nproc)}"
+build=build-fuzz
+
+if ! command -v clang++ >/dev/null ||
+   ! clang++ -print-file-name=libclang_rt.fuzzer-x86_64.a | grep -q /; then
+  echo "fuzz.sh: needs clang++ with libFuzzer (Debian 12: clang clang-14 libclang-rt-14-dev)" >&2
+  exit 1
+fi
+
+echo "== libFuzzer build (clang, ASan + UBSan) in $build/" >&2
+CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DSWEETSPOT_FUZZ=ON -DBUILD_TESTING=OFF -DSWEETSPOT_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" -j"$jobs" --target fuzz_targets
+
+failed=()
+start=$SECONDS
+for t in $targets; do
+  mkdir -p "$build/corpus/$t" "$build/artifacts/$t" "$build/notes/$t" "$build/logs"
+  log="$build/logs/$t.log"
+  status=0
+  SWEETSPOT_FUZZ_NOTES_DIR="$build/notes/$t" \
+  ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1" \
+  UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
+    "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
+    -max_len=4096 -dict=fuzz/sweetspot.dict -print_final_stats=1 \
+    -artifact_prefix="$build/artifacts/$t/" "$build/corpus/$t" "fuzz/corpus/$t" \
+    >"$log" 2>&1 || status=$?
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n1)
+  cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+ corp: [0-9]+' "$log" | tail -n1 || true)
+  notes=$(grep -c '^fuzz note:' "$log" || true)
+  printf 'fuzz %-11s %8s runs  %s  notes: %s  %s\n' "$t" "${runs:-?}" "${cov:-?}" "$notes" \
+    "$([ "$status" -eq 0 ] && echo ok || echo FAILED)" >&2
+  grep '^fuzz note:' "$log" | cut -c1-300 >&2 || true
+  if [ "$status" -ne 0 ]; then
+    failed+=("$t")
+    grep -E '^fuzz problem:|ERROR: |SUMMARY: |runtime error|what\(\)|Test unit written to' "$log" \
+      | head -n 20 >&2 || true
+    echo "fuzz.sh: $t failed; full log: $log; input in $build/artifacts/$t/" >&2
+  fi
+done
+echo "fuzz.sh: $(( SECONDS - start )) s of fuzzing" >&2
+if [ ${#failed[@]} -ne 0 ]; then
+  echo "fuzz.sh: FAILED: ${failed[*]}" >&2
+  exit 1
+fi

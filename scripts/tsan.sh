@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Runs the concurrency tests under ThreadSanitizer: a GCC build with
+# -fsanitize=thread in build-tsan/ (api_tests, server_tests and the executables
+# the server tests start), then the tests that use threads or a live server.
+# Any race or lock-order report, from the test process or from a server it
+# started, fails the script; the reports are in build-tsan/tsan-logs/.
+#
+#   SWEETSPOT_TSAN_FILTER='Job*'   gtest filter (default below)
+#   SWEETSPOT_JOBS=N               build parallelism (default: nproc)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs="${SWEETSPOT_JOBS:-$(nproc)}"
+filter="${SWEETSPOT_TSAN_FILTER:-Job*:*Concurrent*:ServerTest.*:ServerLimits*}"
+build=build-tsan
+
+echo "== ThreadSanitizer build in $build/" >&2
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" \
+  -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
+  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" -DSWEETSPOT_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" -j"$jobs" --target api_tests server_tests
+
+logs="$build/tsan-logs"
+rm -rf "$logs"
+mkdir -p "$logs"
+# log_path: one file per process (the tests and every server they start).
+export TSAN_OPTIONS="log_path=$PWD/$logs/tsan:second_deadlock_stack=1:history_size=4"
+status=0
+for suite in api_tests server_tests; do
+  echo "== $suite --gtest_filter=$filter (TSan)" >&2
+  "$build/tests/$suite" --gtest_filter="$filter" --gtest_brief=1 || status=1
+done
+if compgen -G "$logs/tsan.*" >/dev/null; then
+  echo "tsan.sh: ThreadSanitizer reports:" >&2
+  for f in "$logs"/tsan.*; do
+    echo "--- $f" >&2
+    grep -E '^(WARNING|SUMMARY): ThreadSanitizer' "$f" >&2 || head -n 20 "$f" >&2
+  done
+  status=1
+fi
+[ "$status" -eq 0 ] && echo "tsan.sh: clean" >&2
+exit "$status"
