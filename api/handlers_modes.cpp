@@ -8,6 +8,7 @@
 #include "api/bat_json.hpp"
 #include "api/handlers.hpp"
 #include "api/scene_json.hpp"
+#include "core/flexible/modes_cache.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -82,7 +83,7 @@ Response HandleBatModes(const Request& request, const Context& context) {
   if (!reader.Finish()) return ToResponse(error);
 
   bool cache_hit = false;
-  const auto result = core::CachedBatModes(spec->bat, options, ModesCacheOf(context), &cache_hit);
+  const auto result = core::CachedBatModes(spec->bat, options, context.modes_cache, &cache_hit);
   const core::Summary& s = result->summary;
   if (!s.IsSolutionUsable()) return CoreFailure(s, "", "bat");
 

@@ -3,7 +3,6 @@
 #pragma once
 
 #include "api/router.hpp"
-#include "core/flexible/modes_cache.hpp"
 
 namespace sweetspot::api {
 
@@ -14,18 +13,7 @@ namespace sweetspot::api {
 /// nodes_from_knob_m, shape [{position_from_knob_m, displacement}], ...}], vibration_node,
 /// elements, error_estimate, theory, rigid_body, summary, timing_s. 400 for an invalid request
 /// or a bat that is no beam (named field); 200 with summary.termination = "no_convergence"
-/// when max_elements stops the refinement first.
+/// when max_elements stops the refinement first. Uses context.modes_cache when set.
 Response HandleBatModes(const Request& request, const Context& context);
-
-/// The cross-request modes cache of `context` if its type has a `modes_cache` member (the
-/// server's api::Context, once it holds one), else null: handlers compile against either.
-template <typename ContextType>
-core::ModesCache* ModesCacheOf(const ContextType& context) {
-  if constexpr (requires { context.modes_cache; }) {
-    return context.modes_cache;
-  } else {
-    return nullptr;
-  }
-}
 
 }  // namespace sweetspot::api

@@ -52,6 +52,7 @@ Response HandleSweetSpot(const Request& request, const Context& context) {
       !CheckScene(scene, &error)) {
     return ToResponse(error);
   }
+  options.flexible.modes_cache = context.modes_cache;
   const core::SceneResult result = core::EvaluateScene(scene, options);
   if (!result.summary.IsSolutionUsable()) {
     return CoreFailure(result.summary, result.missing_model,
@@ -89,6 +90,10 @@ Response HandleCollision(const Request& request, const Context& context) {
   if (const Json* hertz = reader.Get("hertz")) {
     ReadHertzOptions(*hertz, reader.PathOf("hertz"), &options.hertz, &error);
   }
+  if (const Json* flexible = reader.Get("flexible")) {
+    ReadFlexibleOptions(*flexible, reader.PathOf("flexible"), &options.flexible, &error);
+  }
+  options.flexible.modes_cache = context.modes_cache;
   if (!reader.Finish() || !CheckScene(scene, &error)) return ToResponse(error);
   const core::CollisionResult result =
       core::Collide(scene, impact, *core::ParseCollisionModel(model_name), options);
@@ -142,6 +147,7 @@ Response HandleCompare(const Request& request, const Context& context) {
     bats.emplace_back(name, std::move(*spec));
   }
   if (!reader.Finish()) return ToResponse(error);
+  options.flexible.modes_cache = context.modes_cache;
 
   Json rows = Json::array();
   Json base_row;

@@ -109,17 +109,24 @@ TEST(BatModesHandlerTest, TooSmallAMeshBoundIsNoConvergenceNotAnError) {
   EXPECT_GT(r.body["error_estimate"]["frequency_relative"].get<double>(), 1e-9);
 }
 
-// A context type with a cache, as api::Context will have: ModesCacheOf finds it.
-struct ContextWithCache {
-  core::ModesCache* modes_cache = nullptr;
-};
-
-TEST(BatModesHandlerTest, ModesCacheOfFindsTheMemberWhenThereIsOne) {
+TEST(BatModesHandlerTest, TheContextsCacheServesTheSecondRequest) {
   core::ModesCache cache(4);
-  ContextWithCache with{&cache};
-  EXPECT_EQ(ModesCacheOf(with), &cache);
-  struct NoCache {};
-  EXPECT_EQ(ModesCacheOf(NoCache{}), nullptr);
+  Context context;
+  context.modes_cache = &cache;
+  const std::string body = R"({"bat": {"preset": "paper-wood"}, "modes": 2})";
+  const Response first = Modes(body, context);
+  const Response second = Modes(body, context);
+  ASSERT_EQ(first.status, 200);
+  EXPECT_FALSE(first.body["cache_hit"].get<bool>());
+  EXPECT_TRUE(second.body["cache_hit"].get<bool>());
+  EXPECT_EQ(first.body["frequencies_hz"], second.body["frequencies_hz"]);
+  EXPECT_EQ(cache.Stats().hits, 1);
+}
+
+TEST(BatModesHandlerTest, TheRouteDispatchesToTheHandler) {
+  const Response r = Post("/v1/bat/modes", R"({"bat": {"preset": "paper-wood"}, "modes": 1})");
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["frequencies_hz"].size(), 1u);
 }
 
 TEST(FlexibleSweetSpotEndpointTest, VibrationNodeHasThePositionAndTheFrequency) {
