@@ -244,7 +244,9 @@ Response CoreFailure(const core::Summary& summary, const std::string& missing_mo
     return ErrorResponse(400, "InvalidValue", summary.message,
                          core_field.empty() ? field : core_field);
   }
-  return ErrorResponse(500, "InternalError", "the model failed: " + summary.message);
+  // The model ran and could not finish with these inputs and settings (e.g. a
+  // step or evaluation budget): the client's to change, so 422, not a 500.
+  return ErrorResponse(422, "ModelFailed", "the model failed: " + summary.message, field);
 }
 
 Json SummaryToJson(const core::Summary& s) {
