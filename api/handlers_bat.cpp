@@ -1,4 +1,5 @@
 // POST /v1/bat/properties and POST /v1/bat/fit.
+#include <algorithm>
 #include <chrono>
 
 #include "api/bat_json.hpp"
@@ -178,6 +179,9 @@ Response HandleBatFit(const Request& request, const Context& context) {
                         {core::FitVariable::kTaperEnd, 0.0, shape->length_m}};
   }
   core::ShapeFitOptions options;
+  // Defaults never exceed the configured limits.
+  options.max_time_s = std::min(options.max_time_s, context.limits.max_time_s);
+  options.max_evaluations = std::min(options.max_evaluations, context.limits.max_iterations);
   if (const nlohmann::json* o = reader.Get("options")) {
     ObjectReader opt(*o, "options", &error);
     opt.OptionalNumber("mass_scale_kg", NonNegative(1e4), &options.mass_scale_kg);

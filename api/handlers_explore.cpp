@@ -35,6 +35,31 @@ struct RowOutputs {
 };
 
 // A row for one design evaluated from `design_json` (bat + scene fields).
+// The value at a dotted path of `row` (object keys, or decimal array indices
+// such as "exit_speed_curve.3"), or nullptr when there is none. Never throws:
+// a pareto objective comes from the request, so its indices may be anything.
+const Json* FindAt(const Json& row, const std::vector<std::string>& tokens) {
+  const Json* node = &row;
+  for (const std::string& token : tokens) {
+    if (node->is_object()) {
+      const auto it = node->find(token);
+      if (it == node->end()) return nullptr;
+      node = &*it;
+    } else if (node->is_array()) {
+      if (token.empty() || token.size() > 9 ||
+          !std::all_of(token.begin(), token.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+        return nullptr;
+      }
+      const std::size_t index = std::stoul(token);  // at most 9 digits: cannot overflow
+      if (index >= node->size()) return nullptr;
+      node = &(*node)[index];
+    } else {
+      return nullptr;
+    }
+  }
+  return node;
+}
+
 Json EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
                     const core::SceneOptions& options, const ApiLimits& limits) {
   ApiError error;
@@ -202,7 +227,7 @@ Response HandleExplore(const Request& request, const Context& context) {
 
   struct Objective {
     std::string output;
-    std::string pointer;
+    std::vector<std::string> tokens;  // the dotted path, split
     core::Sense sense;
   };
   std::vector<Objective> objectives;
@@ -239,18 +264,7 @@ Response HandleExplore(const Request& request, const Context& context) {
         }
         tokens.push_back(token);
       }
-      for (const auto& token : tokens) {
-        objective.pointer.push_back('/');
-        for (const char c : token) {  // RFC 6901 escapes
-          if (c == '~') {
-            objective.pointer.append("~0");
-          } else if (c == '/') {
-            objective.pointer.append("~1");
-          } else {
-            objective.pointer.push_back(c);
-          }
-        }
-      }
+      objective.tokens = std::move(tokens);
       objectives.push_back(std::move(objective));
     }
   }
@@ -312,9 +326,8 @@ Response HandleExplore(const Request& request, const Context& context) {
     if (!objectives.empty()) {
       std::vector<double> v;
       for (const auto& objective : objectives) {
-        const Json::json_pointer pointer(objective.pointer);
-        v.push_back(row.contains(pointer) && row[pointer].is_number() ? row[pointer].get<double>()
-                                                                       : std::nan(""));
+        const Json* value = FindAt(row, objective.tokens);
+        v.push_back(value != nullptr && value->is_number() ? value->get<double>() : std::nan(""));
       }
       objective_values.push_back(std::move(v));
     }

@@ -2,6 +2,7 @@
 // length, mass, balance-point, MOI, diameter, taper and league-rule
 // constraints. The answer's bat is in the request's own form, so it can be
 // sent straight back to /v1/bat/properties.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -93,6 +94,9 @@ bool ReadConstraints(ObjectReader& top, core::DesignConstraints* c) {
 }
 
 bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignOptions* o) {
+  // Defaults never exceed the configured limits.
+  o->max_iterations = std::min(o->max_iterations, limits.max_iterations);
+  o->max_time_s = std::min(o->max_time_s, limits.max_time_s);
   const Json* value = top.Get("options");
   if (value == nullptr || !top.ok()) return top.ok();
   ObjectReader reader(*value, "options", top.error());
@@ -105,7 +109,8 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignOptions
   o->derivative_check = check == "first_order"    ? core::DerivativeCheck::kFirstOrder
                         : check == "second_order" ? core::DerivativeCheck::kSecondOrder
                                                   : core::DerivativeCheck::kNone;
-  long long iterations = o->max_iterations, starts = o->starts, seed = 1;
+  long long iterations = o->max_iterations;
+  long long starts = o->starts, seed = 1;
   reader.OptionalInteger("max_iterations", 1, limits.max_iterations, &iterations);
   reader.OptionalInteger("starts", 1, 64, &starts);
   reader.OptionalInteger("seed", 0, 1LL << 53, &seed);

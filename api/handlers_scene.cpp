@@ -86,12 +86,15 @@ Response HandleCollision(const Request& request, const Context& context) {
   reader.OptionalString("model", &model_name,
                         {"auto", "rigid_pivot", "free_bat", "hertz", "flexible"});
   core::CollisionOptions options;
+  ClampToLimits(context.limits, &options.hertz);
+  ClampToLimits(context.limits, &options.flexible);
   reader.OptionalBool("contact_details", &options.want_contact_details);
   if (const Json* hertz = reader.Get("hertz")) {
-    ReadHertzOptions(*hertz, reader.PathOf("hertz"), &options.hertz, &error);
+    ReadHertzOptions(*hertz, reader.PathOf("hertz"), context.limits, &options.hertz, &error);
   }
   if (const Json* flexible = reader.Get("flexible")) {
-    ReadFlexibleOptions(*flexible, reader.PathOf("flexible"), &options.flexible, &error);
+    ReadFlexibleOptions(*flexible, reader.PathOf("flexible"), context.limits, &options.flexible,
+                        &error);
   }
   options.flexible.modes_cache = context.modes_cache;
   if (!reader.Finish() || !CheckScene(scene, &error)) return ToResponse(error);

@@ -24,6 +24,10 @@ bool ApiLimits::IsValid(std::string* why) const {
   if (max_iterations < 1) {
     return fail("max_iterations = " + std::to_string(max_iterations) + ": must be at least 1");
   }
+  if (max_integration_steps < 10) {
+    return fail("max_integration_steps = " + std::to_string(max_integration_steps) +
+                ": must be at least 10");
+  }
   if (!std::isfinite(max_time_s) || max_time_s <= 0) {
     std::ostringstream text;
     text << "max_time_s = " << max_time_s << ": must be > 0";

@@ -18,6 +18,7 @@ struct ApiLimits {
   std::size_t max_samples = 100000;        ///< Designs in one /v1/explore request.
   int max_iterations = 10000;              ///< Solver iterations a request may ask for.
   double max_time_s = 60.0;                ///< Solver wall time a request may ask for, s.
+  long long max_integration_steps = 10000000;  ///< ODE steps of one impact (hertz, flexible).
 
   /// True when every limit is positive and sane; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;

@@ -11,8 +11,8 @@ using Json = nlohmann::json;
 
 bool ReadBall(const Json& value, const std::string& path, core::Ball* ball, ApiError* error) {
   ObjectReader reader(value, path, error);
-  reader.OptionalNumber("mass_kg", Positive(1e3), &ball->mass_kg);
-  reader.OptionalNumber("radius_m", Positive(10.0), &ball->radius_m);
+  reader.OptionalNumber("mass_kg", Between(core::kMinBallMassKg, 1e3), &ball->mass_kg);
+  reader.OptionalNumber("radius_m", Between(core::kMinBallRadiusM, 10.0), &ball->radius_m);
   reader.OptionalNumber("speed_mps", NonNegative(1e3), &ball->speed_mps);
   reader.OptionalNumber("stiffness_n_m_p", Positive(1e15), &ball->stiffness);
   reader.OptionalNumber("stiffness_exponent", Between(1.0, 3.0), &ball->stiffness_exponent);
@@ -77,7 +77,25 @@ bool ReadOutputs(ObjectReader& reader, core::Scene* scene) {
   return true;
 }
 
-bool ReadFlexibleOptions(const Json& value, const std::string& path, core::FlexibleOptions* options,
+void ClampToLimits(const ApiLimits& limits, core::HertzOptions* options) {
+  options->solver.max_steps = static_cast<int>(
+      std::min<long long>(options->solver.max_steps, limits.max_integration_steps));
+}
+
+void ClampToLimits(const ApiLimits& limits, core::FlexibleOptions* options) {
+  options->impact.max_steps = static_cast<int>(
+      std::min<long long>(options->impact.max_steps, limits.max_integration_steps));
+}
+
+void ClampToLimits(const ApiLimits& limits, core::SceneOptions* options) {
+  options->nlopt.max_time_s = std::min(options->nlopt.max_time_s, limits.max_time_s);
+  options->nlopt.max_evaluations = std::min(options->nlopt.max_evaluations, limits.max_iterations);
+  ClampToLimits(limits, &options->hertz);
+  ClampToLimits(limits, &options->flexible);
+}
+
+bool ReadFlexibleOptions(const Json& value, const std::string& path, const ApiLimits& limits,
+                         core::FlexibleOptions* options,
                          ApiError* error) {
   ObjectReader reader(value, path, error);
   std::string theory = core::BeamTheoryName(options->theory);
@@ -96,8 +114,9 @@ bool ReadFlexibleOptions(const Json& value, const std::string& path, core::Flexi
   reader.OptionalNumber("cutoff_factor", Between(1.0, 1000.0), &impact.cutoff_factor);
   reader.OptionalBool("static_correction", &impact.static_correction);
   reader.OptionalNumber("relative_tolerance", Between(1e-13, 1e-2), &impact.relative_tolerance);
+  ClampToLimits(limits, options);
   long long max_steps = impact.max_steps;
-  reader.OptionalInteger("max_steps", 10, 10000000, &max_steps);
+  reader.OptionalInteger("max_steps", 10, limits.max_integration_steps, &max_steps);
   impact.max_steps = static_cast<int>(max_steps);
   long long max_contacts = impact.max_contacts;
   reader.OptionalInteger("max_contacts", 1, 1000, &max_contacts);
@@ -113,8 +132,9 @@ bool ReadFlexibleOptions(const Json& value, const std::string& path, core::Flexi
   return reader.Finish();
 }
 
-bool ReadHertzOptions(const Json& value, const std::string& path, core::HertzOptions* options,
-                      ApiError* error) {
+bool ReadHertzOptions(const Json& value, const std::string& path, const ApiLimits& limits,
+                      core::HertzOptions* options, ApiError* error) {
+  ClampToLimits(limits, options);
   ObjectReader reader(value, path, error);
   std::string law = core::ContactLawName(options->law);
   reader.OptionalString("law", &law, {"ball_power_law", "paper_constants"});
@@ -133,13 +153,14 @@ bool ReadHertzOptions(const Json& value, const std::string& path, core::HertzOpt
   reader.OptionalNumber("relative_tolerance", Between(1e-13, 1e-2),
                         &options->solver.relative_tolerance);
   long long max_steps = options->solver.max_steps;
-  reader.OptionalInteger("max_steps", 10, 10000000, &max_steps);
+  reader.OptionalInteger("max_steps", 10, limits.max_integration_steps, &max_steps);
   options->solver.max_steps = static_cast<int>(max_steps);
   reader.OptionalBool("refine_check", &options->solver.refine_check);
   return reader.Finish();
 }
 
 bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOptions* options) {
+  ClampToLimits(limits, options);
   const Json* value = top.Get("options");
   if (value == nullptr || !top.ok()) return top.ok();
   ObjectReader reader(*value, top.PathOf("options"), top.error());
@@ -218,12 +239,12 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
     }
   }
   if (const Json* hertz = reader.Get("hertz")) {
-    if (!ReadHertzOptions(*hertz, reader.PathOf("hertz"), &options->hertz, top.error())) {
+    if (!ReadHertzOptions(*hertz, reader.PathOf("hertz"), limits, &options->hertz, top.error())) {
       return false;
     }
   }
   if (const Json* flexible = reader.Get("flexible")) {
-    if (!ReadFlexibleOptions(*flexible, reader.PathOf("flexible"), &options->flexible,
+    if (!ReadFlexibleOptions(*flexible, reader.PathOf("flexible"), limits, &options->flexible,
                              top.error())) {
       return false;
     }

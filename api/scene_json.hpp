@@ -28,11 +28,20 @@ bool ReadSceneOptions(ObjectReader& reader, const ApiLimits& limits, core::Scene
 /// Reads a "flexible" options object at `path` (the flexible beam: theory, tolerances, modes,
 /// the impact's integrator and the sting settings; see docs/models.md).
 bool ReadFlexibleOptions(const nlohmann::json& value, const std::string& path,
-                         core::FlexibleOptions* options, ApiError* error);
+                         const ApiLimits& limits, core::FlexibleOptions* options,
+                         ApiError* error);
 
 /// Reads a "hertz" options object at `path`.
 bool ReadHertzOptions(const nlohmann::json& value, const std::string& path,
-                      core::HertzOptions* options, ApiError* error);
+                      const ApiLimits& limits, core::HertzOptions* options, ApiError* error);
+
+/// Lowers the defaults of `options` (solver time, evaluations, integration steps)
+/// to the configured limits, so a default never exceeds what a request may ask for.
+void ClampToLimits(const ApiLimits& limits, core::SceneOptions* options);
+/// The same for the contact model's integrator.
+void ClampToLimits(const ApiLimits& limits, core::HertzOptions* options);
+/// The same for the flexible impact's integrator.
+void ClampToLimits(const ApiLimits& limits, core::FlexibleOptions* options);
 
 /// The error response for a core result that was refused or failed: 501 for
 /// a missing model, 400 for invalid input, 500 for a failure.

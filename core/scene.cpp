@@ -617,10 +617,12 @@ bool SweepSting(const Scene& scene, const Resolved& r, const SceneOptions& optio
 // ----------------------------------------------------------------------------- validation
 
 bool Ball::IsValid(std::string* why) const {
-  if (!(std::isfinite(mass_kg) && mass_kg > 0.0))
-    return Fail(why, "ball.mass_kg = " + Num(mass_kg) + ": must be finite and > 0");
-  if (!(std::isfinite(radius_m) && radius_m > 0.0))
-    return Fail(why, "ball.radius_m = " + Num(radius_m) + ": must be finite and > 0");
+  // Floors of 1 mg and 1 µm: smaller values are not balls, and a subnormal
+  // mass made 1/m infinite in the free-bat and Hertz models (found by fuzzing).
+  if (!(std::isfinite(mass_kg) && mass_kg >= kMinBallMassKg))
+    return Fail(why, "ball.mass_kg = " + Num(mass_kg) + ": must be finite and >= 1e-06");
+  if (!(std::isfinite(radius_m) && radius_m >= kMinBallRadiusM))
+    return Fail(why, "ball.radius_m = " + Num(radius_m) + ": must be finite and >= 1e-06");
   if (!(std::isfinite(speed_mps) && speed_mps >= 0.0))
     return Fail(why, "ball.speed_mps = " + Num(speed_mps) + ": must be >= 0");
   if (!(std::isfinite(stiffness) && stiffness > 0.0))

@@ -29,11 +29,15 @@ namespace sweetspot::core {
 inline constexpr double kDefaultBallStiffness = 4.0e7;
 /// Default ball stiffness exponent p (dimensionless).
 inline constexpr double kDefaultBallStiffnessExponent = 1.5;
+/// Smallest ball mass a scene accepts, kg (1 mg).
+inline constexpr double kMinBallMassKg = 1e-6;
+/// Smallest ball radius a scene accepts, m (1 µm).
+inline constexpr double kMinBallRadiusM = 1e-6;
 
 /// The ball. Defaults: a regulation baseball and the paper's Table 3 speed.
 struct Ball {
-  double mass_kg = 0.145;                    ///< Mass, kg (> 0).
-  double radius_m = 0.0366;                  ///< Radius, m (> 0).
+  double mass_kg = 0.145;                    ///< Mass, kg (>= kMinBallMassKg).
+  double radius_m = 0.0366;                  ///< Radius, m (>= kMinBallRadiusM).
   double speed_mps = 27.7;                   ///< Incoming speed towards the bat, m/s (>= 0).
   double stiffness = kDefaultBallStiffness;  ///< Contact models: k in F = k delta^p, N/m^p (> 0).
   double stiffness_exponent = kDefaultBallStiffnessExponent;  ///< Contact models: p, in [1, 3].

@@ -16,7 +16,18 @@ else
     libeigen3-dev libnlopt-cxx-dev coinor-libipopt-dev
     libcpp-httplib-dev nlohmann-json3-dev
     libgtest-dev libgmock-dev libbenchmark-dev libboost-dev libsqlite3-dev
+    # fuzzing (scripts/fuzz.sh): clang with libFuzzer and its sanitizer runtimes
+    clang clang-14 libclang-rt-14-dev llvm-14
+    # HTTP benchmark at 1/8/64 connections (bench/http_bench.sh)
+    wrk
+    # browser tests of the design explorer (headless, driven by playwright-core)
+    chromium
   )
+  # The explorer's bundle is built with Node.js and npm. Use the machine's own
+  # if it has one (e.g. NodeSource's nodejs ships npm); otherwise Debian's.
+  if ! command -v npm >/dev/null 2>&1; then
+    packages+=(nodejs npm)
+  fi
 fi
 
 missing=()

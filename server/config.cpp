@@ -200,6 +200,11 @@ const std::vector<Option>& Options() {
          c->limits.max_iterations = static_cast<int>(n);
          return true;
        }},
+      {"--max-integration-steps", "SWEETSPOT_MAX_INTEGRATION_STEPS",
+       "ODE steps one impact may take (hertz, flexible; default 10000000)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseLong(v, 10, 1000000000, &c->limits.max_integration_steps, rule);
+       }},
       {"--max-time-s", "SWEETSPOT_MAX_TIME_S", "solver wall time a request may ask for, s (default 60)",
        true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
@@ -260,6 +265,18 @@ const std::vector<Option>& Options() {
            return false;
          }
          c->shutdown_grace_s = value;
+         return true;
+       }},
+      {"--web-root", "SWEETSPOT_WEB_ROOT",
+       "folder of the design explorer's static files, served at / without a token (default: "
+       "the folder web next to the executable; a missing folder answers 404 at /)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         if (v.empty()) {
+           *rule = "must be a folder path";
+           return false;
+         }
+         c->web_root = v;
          return true;
        }},
       {"--access-log", "SWEETSPOT_ACCESS_LOG",

@@ -100,7 +100,7 @@ TEST(SweetSpotEndpointTest, RefusalsNameTheField) {
       {R"({"bat": {"preset": "paper-wood"}, "outputs": ["best"]})", "outputs",
        "outputs = [\"best\"]: outputs[0] = \"best\" is not one of"},
       {R"({"bat": {"preset": "paper-wood"}, "ball": {"mass_kg": 0}})", "ball.mass_kg",
-       "ball.mass_kg = 0: must be a number in (0, 1000]"},
+       "ball.mass_kg = 0: must be a number in [1e-06, 1000]"},
       {R"({"bat": {"preset": "paper-wood"}, "ball": {"speed": 3}})", "ball.speed",
        "ball.speed is not a known field"},
       {R"({"bat": {"preset": "paper-wood"}, "cor": 1.5})", "cor",

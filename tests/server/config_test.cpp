@@ -35,6 +35,17 @@ TEST(ConfigTest, EnvironmentThenFlagsOverride) {
   EXPECT_EQ(parsed.config.threads, 3);
 }
 
+TEST(ConfigTest, SolverLimitsFromFlagsAndEnvironment) {
+  const auto parsed = Parse({"--max-integration-steps", "5000", "--max-time-s", "2.5"},
+                            {{"SWEETSPOT_MAX_ITERATIONS", "40"}});
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_EQ(parsed.config.limits.max_integration_steps, 5000);
+  EXPECT_EQ(parsed.config.limits.max_time_s, 2.5);
+  EXPECT_EQ(parsed.config.limits.max_iterations, 40);
+  EXPECT_EQ(Parse({"--max-integration-steps", "9"}).error,
+            "option --max-integration-steps = \"9\": must be an integer in [10, 1000000000]");
+}
+
 TEST(ConfigTest, BadValuesNameFlagValueAndRule) {
   EXPECT_EQ(Parse({"--port", "70000"}).error,
             "option --port = \"70000\": must be an integer in [0, 65535]");
