@@ -6,6 +6,8 @@
 #include <chrono>
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <memory>
 
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
@@ -107,6 +109,108 @@ Json EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
     if (hit.rigid_pivot) row["collision_efficiency"] = hit.rigid_pivot->collision_efficiency;
   }
   return row;
+}
+
+// A Pareto objective: an output path of a row and its sense.
+struct Objective {
+  std::string output;
+  std::vector<std::string> tokens;  // the dotted path, split
+  core::Sense sense;
+};
+
+// A validated sweep: everything needed to evaluate its designs, owned, so a
+// streamed answer can run it after the handler has returned.
+struct Sweep {
+  Json base;                            // the design template (bat + scene fields)
+  std::vector<Parameter> parameters;    // the swept fields
+  core::SweepPlan plan;                 // sampling, dimensions, seed
+  std::vector<std::vector<double>> drawn;  // LHS / Sobol points (grids are enumerated)
+  RowOutputs outputs;
+  core::SceneOptions options;
+  ApiLimits limits;
+  std::vector<Objective> objectives;  // Pareto objectives (may be empty)
+  core::Shard shard;
+  std::uint64_t total = 0;  // designs in the whole sweep
+  Json provenance;
+  std::chrono::steady_clock::time_point start;
+};
+
+// How a sweep ended.
+struct SweepOutcome {
+  bool cancelled = false;  // Progress::Cancel() (message says after how many designs)
+  bool stopped = false;    // the row sink refused a row (a streaming client went away)
+  std::string message;
+  Json summary;  // set when neither
+};
+
+// Evaluates the shard's designs in index order, handing each row to `emit`
+// (false from it stops the sweep), and returns the summary.
+SweepOutcome RunSweep(const Sweep& sweep, core::Progress* progress,
+                      const std::function<bool(Json)>& emit) {
+  SweepOutcome outcome;
+  std::vector<std::vector<double>> objective_values;
+  std::vector<std::uint64_t> indices;
+  std::uint64_t evaluated = 0, failed = 0;
+  const core::Shard& shard = sweep.shard;
+  const std::uint64_t total = sweep.total;
+  const std::uint64_t in_shard = total / shard.count + (shard.index < total % shard.count ? 1 : 0);
+  for (std::uint64_t i = shard.index; i < total; i += shard.count) {
+    if (core::IsCancelled(progress)) {
+      outcome.cancelled = true;
+      outcome.message = "the sweep was cancelled after " + std::to_string(evaluated) + " designs";
+      return outcome;
+    }
+    const std::vector<double> point = sweep.plan.method == core::SamplingMethod::kGrid
+                                          ? core::GridDesign(sweep.plan, i)
+                                          : sweep.drawn[static_cast<std::size_t>(i)];
+    Json design = sweep.base;
+    Json values = Json::object();
+    for (std::size_t k = 0; k < sweep.parameters.size(); ++k) {
+      SetNumberAtPath(&design, sweep.parameters[k].steps, point[k], nullptr);
+      values[sweep.parameters[k].path] = point[k];
+    }
+    Json row = EvaluateDesign(design, sweep.outputs, sweep.options, sweep.limits);
+    row["index"] = i;
+    row["parameters"] = std::move(values);
+    if (!row["feasible"].get<bool>()) ++failed;
+    if (!sweep.objectives.empty()) {
+      std::vector<double> v;
+      for (const auto& objective : sweep.objectives) {
+        const Json* value = FindAt(row, objective.tokens);
+        v.push_back(value != nullptr && value->is_number() ? value->get<double>() : std::nan(""));
+      }
+      objective_values.push_back(std::move(v));
+      indices.push_back(i);
+    }
+    if (!emit(std::move(row))) {
+      outcome.stopped = true;
+      return outcome;
+    }
+    ++evaluated;
+    if (progress != nullptr && in_shard > 0) {
+      progress->Report(static_cast<double>(evaluated) / static_cast<double>(in_shard));
+    }
+  }
+  Json summary{{"designs_total", total},
+               {"designs_in_shard", evaluated},
+               {"failed", failed},
+               {"sampling", core::SamplingMethodName(sweep.plan.method)},
+               {"seed", sweep.plan.seed},
+               {"shard", {{"index", shard.index}, {"count", shard.count}}},
+               {"timing_s", SecondsSince(sweep.start)}};
+  if (!sweep.objectives.empty()) {
+    std::vector<core::Sense> senses;
+    for (const auto& o : sweep.objectives) senses.push_back(o.sense);
+    Json front = Json::array();
+    for (const std::size_t k : core::ParetoFront(objective_values, senses)) {
+      front.push_back(indices[k]);
+    }
+    summary["pareto_front"] = std::move(front);
+    summary["pareto_scope"] = "the rows of this response (this shard)";
+  }
+  summary["provenance"] = sweep.provenance;
+  outcome.summary = std::move(summary);
+  return outcome;
 }
 
 }  // namespace
@@ -225,11 +329,6 @@ Response HandleExplore(const Request& request, const Context& context) {
   core::SceneOptions options;
   if (!ReadSceneOptions(reader, context.limits, &options)) return ToResponse(error);
 
-  struct Objective {
-    std::string output;
-    std::vector<std::string> tokens;  // the dotted path, split
-    core::Sense sense;
-  };
   std::vector<Objective> objectives;
   if (const Json* pareto = reader.Get("pareto")) {
     ObjectReader p(*pareto, "pareto", &error);
@@ -297,73 +396,53 @@ Response HandleExplore(const Request& request, const Context& context) {
     return ToResponse(error);
   }
 
+  auto sweep = std::make_shared<Sweep>();
+  sweep->base = std::move(base);
+  sweep->parameters = std::move(parameters);
+  sweep->plan = std::move(plan);
+  sweep->outputs = std::move(outputs);
+  sweep->options = std::move(options);
+  sweep->limits = context.limits;
+  sweep->objectives = std::move(objectives);
+  sweep->shard = shard;
+  sweep->total = total;
+  sweep->provenance = Provenance(*body, Json::object(), sweep->plan.seed);
+  sweep->start = start;
   // Designs: grids are enumerated by index; LHS and Sobol are drawn in full
   // (every shard draws the same sequence) and then filtered by shard.
-  std::vector<std::vector<double>> drawn;
-  if (plan.method != core::SamplingMethod::kGrid) drawn = core::GenerateDesigns(plan);
-  Json rows = Json::array();
-  std::vector<std::vector<double>> objective_values;
-  std::uint64_t evaluated = 0, failed = 0;
-  const std::uint64_t in_shard = total / shard.count + (shard.index < total % shard.count ? 1 : 0);
-  for (std::uint64_t i = shard.index; i < total; i += shard.count) {
-    if (core::IsCancelled(context.progress)) {
-      return ErrorResponse(409, "Cancelled", "the sweep was cancelled after " +
-                                                 std::to_string(evaluated) + " designs");
-    }
-    const std::vector<double> point =
-        plan.method == core::SamplingMethod::kGrid ? core::GridDesign(plan, i)
-                                                   : drawn[static_cast<std::size_t>(i)];
-    Json design = base;
-    Json values = Json::object();
-    for (std::size_t k = 0; k < parameters.size(); ++k) {
-      SetNumberAtPath(&design, parameters[k].steps, point[k], nullptr);
-      values[parameters[k].path] = point[k];
-    }
-    Json row = EvaluateDesign(design, outputs, options, context.limits);
-    row["index"] = i;
-    row["parameters"] = std::move(values);
-    if (!row["feasible"].get<bool>()) ++failed;
-    if (!objectives.empty()) {
-      std::vector<double> v;
-      for (const auto& objective : objectives) {
-        const Json* value = FindAt(row, objective.tokens);
-        v.push_back(value != nullptr && value->is_number() ? value->get<double>() : std::nan(""));
-      }
-      objective_values.push_back(std::move(v));
-    }
-    rows.push_back(std::move(row));
-    ++evaluated;
-    if (context.progress != nullptr && in_shard > 0) {
-      context.progress->Report(static_cast<double>(evaluated) / static_cast<double>(in_shard));
-    }
+  if (sweep->plan.method != core::SamplingMethod::kGrid) {
+    sweep->drawn = core::GenerateDesigns(sweep->plan);
   }
-  Json summary{{"designs_total", total},
-               {"designs_in_shard", evaluated},
-               {"failed", failed},
-               {"sampling", core::SamplingMethodName(plan.method)},
-               {"seed", plan.seed},
-               {"shard", {{"index", shard.index}, {"count", shard.count}}},
-               {"timing_s", SecondsSince(start)}};
-  if (!objectives.empty()) {
-    std::vector<core::Sense> senses;
-    for (const auto& o : objectives) senses.push_back(o.sense);
-    Json front = Json::array();
-    for (const std::size_t k : core::ParetoFront(objective_values, senses)) {
-      front.push_back(rows[k]["index"]);
-    }
-    summary["pareto_front"] = std::move(front);
-    summary["pareto_scope"] = "the rows of this response (this shard)";
-  }
-  summary["provenance"] = Provenance(*body, Json::object(), plan.seed);
+
   if (format == "ndjson") {
-    std::string text;
-    for (const auto& row : rows) {
-      text += row.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
-    }
-    text += Json{{"summary", summary}}.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
-    return Response::Text(200, std::move(text), "application/x-ndjson");
+    // Streamed: a line per design as soon as it is evaluated, then the summary
+    // line. The sweep runs while the server writes (after this returns), so it
+    // owns copies of everything; a client that goes away stops it.
+    Response streamed = Response::Text(200, std::string(), "application/x-ndjson");
+    core::Progress* progress = context.progress;
+    streamed.stream = [sweep, progress](const ChunkSink& sink) {
+      const auto line = [&sink](const Json& value) {
+        return sink(value.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n");
+      };
+      const SweepOutcome outcome =
+          RunSweep(*sweep, progress, [&line](Json row) { return line(row); });
+      if (outcome.stopped) return false;
+      if (outcome.cancelled) {
+        return line({{"error", {{"code", "Cancelled"},
+                                {"message", outcome.message},
+                                {"field", nullptr}}}});
+      }
+      return line({{"summary", outcome.summary}});
+    };
+    return streamed;
   }
-  return {200, {{"rows", std::move(rows)}, {"summary", std::move(summary)}}};
+  Json rows = Json::array();
+  const SweepOutcome outcome = RunSweep(*sweep, context.progress, [&rows](Json row) {
+    rows.push_back(std::move(row));
+    return true;
+  });
+  if (outcome.cancelled) return ErrorResponse(409, "Cancelled", outcome.message);
+  return {200, {{"rows", std::move(rows)}, {"summary", outcome.summary}}};
 }
 
 }  // namespace sweetspot::api

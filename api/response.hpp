@@ -5,10 +5,16 @@
 
 #include <nlohmann/json.hpp>
 
+#include <functional>
 #include <string>
+#include <string_view>
 #include <utility>
 
 namespace sweetspot::api {
+
+/// Receives one chunk of a streamed body; false when the receiver is gone
+/// (e.g. the client disconnected) and the producer should stop.
+using ChunkSink = std::function<bool(std::string_view)>;
 
 /// A handler's answer: HTTP status code and body.
 struct Response {
@@ -28,6 +34,12 @@ struct Response {
   nlohmann::json body;       ///< JSON body (never contains NaN or Infinity).
   std::string text;          ///< A non-JSON body, used when content_type is set.
   std::string content_type;  ///< Empty = application/json with `body`.
+  /// When set, the body (of `content_type`) is produced by calling this with a
+  /// sink, chunk by chunk, after the status has been sent; it returns false
+  /// when it stopped early. It must not throw and owns everything it uses.
+  /// Only Dispatch(..., allow_stream = true) returns one; every other caller
+  /// gets the chunks collected into `text`.
+  std::function<bool(const ChunkSink&)> stream;
 };
 
 /// GET /health: {"status": "ok"}.

@@ -91,7 +91,8 @@ std::string PathParameter(std::string_view pattern, std::string_view path) {
   return parameter;
 }
 
-Response Dispatch(const Request& request, const Context& context, std::string* route_pattern) {
+Response Dispatch(const Request& request, const Context& context, std::string* route_pattern,
+                  bool allow_stream) {
   bool path_known = false;
   std::string allowed;
   for (const Route& route : Routes()) {
@@ -101,7 +102,17 @@ Response Dispatch(const Request& request, const Context& context, std::string* r
     if (route.method != request.method) continue;
     if (route_pattern != nullptr) *route_pattern = route.path;
     try {
-      return route.handler(request, context);
+      Response response = route.handler(request, context);
+      if (response.stream && !allow_stream) {
+        std::string text;
+        response.stream([&text](std::string_view chunk) {
+          text.append(chunk);
+          return true;
+        });
+        response.text = std::move(text);
+        response.stream = nullptr;
+      }
+      return response;
     } catch (...) {
       // The one place an unexpected exception becomes a 500, without details.
       return ErrorResponse(500, "InternalError", "internal error");

@@ -58,9 +58,11 @@ std::string PathParameter(std::string_view pattern, std::string_view path);
 /// Routes `request`: 404 NotFound for an unknown path, 405 MethodNotAllowed
 /// for a known path with another method. `route_pattern`, if non-null, gets
 /// the matched pattern (or "unmatched") for metrics and logs. Never throws:
-/// an escaping exception becomes a 500 InternalError without details.
+/// an escaping exception becomes a 500 InternalError without details. With
+/// `allow_stream`, a handler may answer with Response::stream (the server
+/// writes it chunked); otherwise streamed bodies are collected into `text`.
 Response Dispatch(const Request& request, const Context& context,
-                  std::string* route_pattern = nullptr);
+                  std::string* route_pattern = nullptr, bool allow_stream = false);
 
 /// The error envelope {"code", "message", "field"} with `status`.
 Response ErrorResponse(int status, std::string_view code, std::string message,

@@ -23,7 +23,8 @@ logs="$build/tsan-logs"
 rm -rf "$logs"
 mkdir -p "$logs"
 # log_path: one file per process (the tests and every server they start).
-export TSAN_OPTIONS="log_path=$PWD/$logs/tsan:second_deadlock_stack=1:history_size=4"
+# Suppressions: scripts/tsan.supp says what is suppressed and why.
+export TSAN_OPTIONS="log_path=$PWD/$logs/tsan:second_deadlock_stack=1:history_size=4:suppressions=$PWD/scripts/tsan.supp"
 status=0
 for suite in api_tests server_tests; do
   echo "== $suite --gtest_filter=$filter (TSan)" >&2

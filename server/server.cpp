@@ -24,7 +24,47 @@ std::string Serialize(const nlohmann::json& body) {
   return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
+// A streamed body is sent with chunked transfer encoding, in chunks of about
+// 16 KiB or whatever was produced in 0.1 s, whichever comes first.
+void WriteStreamedResponse(const api::Response& response, httplib::Response& res) {
+  res.status = response.status;
+  auto producer = response.stream;
+  res.set_chunked_content_provider(
+      response.content_type, [producer](std::size_t /*offset*/, httplib::DataSink& sink) {
+        constexpr std::size_t kChunkBytes = 16 * 1024;
+        constexpr auto kChunkTime = std::chrono::milliseconds(100);
+        std::string buffer;
+        auto last_flush = std::chrono::steady_clock::now();
+        bool writable = true;
+        const auto flush = [&] {
+          if (!buffer.empty() && writable) writable = sink.write(buffer.data(), buffer.size());
+          buffer.clear();
+          last_flush = std::chrono::steady_clock::now();
+          return writable;
+        };
+        try {
+          producer([&](std::string_view chunk) {
+            buffer.append(chunk);
+            if (buffer.size() >= kChunkBytes ||
+                std::chrono::steady_clock::now() - last_flush >= kChunkTime) {
+              return flush();
+            }
+            return true;
+          });
+        } catch (...) {
+          return false;  // closes the connection: the client sees a truncated stream
+        }
+        if (!flush()) return false;
+        sink.done();
+        return true;
+      });
+}
+
 void WriteApiResponse(const api::Response& response, httplib::Response& res) {
+  if (response.stream) {
+    WriteStreamedResponse(response, res);
+    return;
+  }
   res.status = response.status;
   if (!response.content_type.empty()) {
     res.set_content(response.text, response.content_type.c_str());
@@ -213,7 +253,8 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     impl_->metrics.Begin();
     std::string route;
     const api::Response response =
-        api::Dispatch({req.method, req.path, req.body}, impl_->context, &route);
+        api::Dispatch({req.method, req.path, req.body}, impl_->context, &route,
+                      /*allow_stream=*/true);
     WriteApiResponse(response, res);
     const double duration_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
