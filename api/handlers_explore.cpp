@@ -316,7 +316,7 @@ Response HandleExplore(const Request& request, const Context& context) {
         reader.Fail("outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
                                    " is not one of properties, max_exit_speed, "
                                    "center_of_percussion, vibration_node, sweet_zone, "
-                                   "exit_speed_curve, collision_efficiency");
+                                   "exit_speed_curve, least_sting_zone, collision_efficiency");
         return ToResponse(error);
       }
     }

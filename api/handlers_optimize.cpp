@@ -1,7 +1,8 @@
 // POST /v1/optimize: Ipopt design of a bat's profile and material under
 // length, mass, balance-point, MOI, diameter, taper and league-rule
-// constraints. The answer's bat is in the request's own form, so it can be
-// sent straight back to /v1/bat/properties.
+// constraints (min_sting: NLopt COBYLA over the flexible beam's sting). The
+// answer's bat is in the request's own form, so it can be sent straight back
+// to /v1/bat/properties.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -93,18 +94,28 @@ bool ReadConstraints(ObjectReader& top, core::DesignConstraints* c) {
   return reader.Finish();
 }
 
-bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignOptions* o) {
+// "options": the solver's settings, and "flexible" (min_sting: the flexible
+// beam's settings, as for /v1/sweet-spot). Without "backend", min_sting runs
+// nlopt_cobyla (the only solver it can use) and the other objectives ipopt.
+bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjective objective,
+                 core::DesignOptions* o, core::FlexibleOptions* flexible) {
   // Defaults never exceed the configured limits.
   o->max_iterations = std::min(o->max_iterations, limits.max_iterations);
   o->max_time_s = std::min(o->max_time_s, limits.max_time_s);
+  ClampToLimits(limits, flexible);
+  const bool sting = objective == core::DesignObjective::kMinSting;
+  if (sting) o->backend = core::DesignBackend::kNloptCobyla;
   const Json* value = top.Get("options");
   if (value == nullptr || !top.ok()) return top.ok();
   ObjectReader reader(*value, "options", top.error());
-  std::string backend = "ipopt", hessian = "limited_memory", check = "none";
-  reader.OptionalString("backend", &backend, {"ipopt", "nlopt_slsqp"});
+  std::string backend = sting ? "nlopt_cobyla" : "ipopt", hessian = "limited_memory",
+              check = "none";
+  reader.OptionalString("backend", &backend, {"ipopt", "nlopt_slsqp", "nlopt_cobyla"});
   reader.OptionalString("hessian", &hessian, {"limited_memory", "exact"});
   reader.OptionalString("derivative_check", &check, {"none", "first_order", "second_order"});
-  o->backend = backend == "ipopt" ? core::DesignBackend::kIpopt : core::DesignBackend::kNloptSlsqp;
+  o->backend = backend == "ipopt"         ? core::DesignBackend::kIpopt
+               : backend == "nlopt_slsqp" ? core::DesignBackend::kNloptSlsqp
+                                          : core::DesignBackend::kNloptCobyla;
   o->hessian = hessian == "exact" ? core::HessianMode::kExact : core::HessianMode::kLimitedMemory;
   o->derivative_check = check == "first_order"    ? core::DerivativeCheck::kFirstOrder
                         : check == "second_order" ? core::DerivativeCheck::kSecondOrder
@@ -123,6 +134,11 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignOptions
   reader.OptionalNumber("constraint_tolerance", NumberRule{0.0, 1.0, true, true, false},
                         &o->constraint_tolerance);
   reader.OptionalBool("explain_infeasibility", &o->explain_infeasibility);
+  if (const Json* f = reader.Get("flexible")) {
+    if (!ReadFlexibleOptions(*f, reader.PathOf("flexible"), limits, flexible, top.error())) {
+      return false;
+    }
+  }
   if (!reader.Finish()) return false;
   if (std::string why; !o->IsValid(&why)) return CoreRefusal(why, "options", top.error());
   return true;
@@ -170,7 +186,7 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
                       {"unit", a.unit},
                       {"value", a.value},
                       {"bound", a.bound},
-                      {"multiplier", a.multiplier}});
+                      {"multiplier", Finite(a.multiplier)}});  // null for min_sting
   }
   Json runs = Json::array();
   for (const auto& s : r.spread.runs) {
@@ -183,6 +199,7 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
   }
   Json summary = SummaryToJson(r.summary);
   summary["constraint_violation"] = Finite(r.summary.constraint_violation);
+  summary["error_estimate"] = Finite(r.summary.error_estimate);  // null for min_sting
   summary["active_constraints"] = std::move(active);
   summary["spread"] = {{"starts", r.spread.starts},
                        {"converged", r.spread.converged},
@@ -219,6 +236,12 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
              {"angular_speed_rad_s", Finite(r.angular_speed_rad_s)}}},
            {"summary", std::move(summary)}};
   if (!conflicts.empty()) out["conflicts"] = std::move(conflicts);
+  if (r.sting) {
+    out["sting"] = {{"position_from_knob_m", r.sting->impact_from_knob_m},
+                    {"hands_vibration_energy_j", r.sting->hands_vibration_energy_j},
+                    {"error_estimate_j", r.sting->error_estimate_j},
+                    {"flexible", FlexibleImpactToJson(r.sting->impact)}};
+  }
   return out;
 }
 
@@ -299,7 +322,10 @@ Response HandleOptimize(const Request& request, const Context& context) {
   reader.OptionalNumber("sweet_zone_tolerance_mps", Positive(100.0),
                         &problem.sweet_zone_tolerance_mps);
   core::DesignOptions options;
-  if (!ReadOptions(reader, context.limits, &options) || !reader.Finish()) return ToResponse(error);
+  if (!ReadOptions(reader, context.limits, problem.objective, &options, &problem.flexible) ||
+      !reader.Finish()) {
+    return ToResponse(error);
+  }
   if (problem.variables.empty()) {
     reader.Fail("variables", "needs at least one continuous variable besides a material choice");
     return ToResponse(error);

@@ -40,6 +40,7 @@ inline api::ApiLimits FuzzLimits() {
   limits.max_samples = 8;
   limits.max_iterations = 200;
   limits.max_time_s = 0.05;
+  limits.max_integration_steps = 200000;
   return limits;
 }
 

@@ -29,7 +29,7 @@ fi
 
 echo "== libFuzzer build (clang, ASan + UBSan) in $build/" >&2
 CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DSWEETSPOT_FUZZ=ON -DBUILD_TESTING=OFF -DSWEETSPOT_BUILD_BENCH=OFF >/dev/null
+  -DSWEETSPOT_FUZZ=ON -DBUILD_TESTING=OFF -DSWEETSPOT_BUILD_BENCH=OFF -DSWEETSPOT_BUILD_WEB=OFF >/dev/null
 cmake --build "$build" -j"$jobs" --target fuzz_targets
 
 failed=()

@@ -16,7 +16,7 @@ ctest --test-dir build --output-on-failure -j"$jobs"
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer build and tests" >&2
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" \
-  -DSWEETSPOT_SANITIZE=ON -DSWEETSPOT_BUILD_BENCH=OFF
+  -DSWEETSPOT_SANITIZE=ON -DSWEETSPOT_BUILD_BENCH=OFF -DSWEETSPOT_BUILD_WEB=OFF
 cmake --build build-asan -j"$jobs"
 # The load test runs 30 s in the Release pass; 5 s is enough to exercise it here.
 SWEETSPOT_LOAD_SECONDS=5 \

@@ -16,7 +16,8 @@ build=build-tsan
 echo "== ThreadSanitizer build in $build/" >&2
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" \
   -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
-  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" -DSWEETSPOT_BUILD_BENCH=OFF >/dev/null
+  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" -DSWEETSPOT_BUILD_BENCH=OFF \
+  -DSWEETSPOT_BUILD_WEB=OFF >/dev/null
 cmake --build "$build" -j"$jobs" --target api_tests server_tests
 
 logs="$build/tsan-logs"

@@ -267,6 +267,18 @@ const std::vector<Option>& Options() {
          c->shutdown_grace_s = value;
          return true;
        }},
+      {"--web-root", "SWEETSPOT_WEB_ROOT",
+       "folder of the design explorer's static files, served at / without a token (default: "
+       "the folder web next to the executable; a missing folder answers 404 at /)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         if (v.empty()) {
+           *rule = "must be a folder path";
+           return false;
+         }
+         c->web_root = v;
+         return true;
+       }},
       {"--access-log", "SWEETSPOT_ACCESS_LOG",
        "one JSON line per request on stderr, 1 or 0 (default 1)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {

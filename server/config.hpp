@@ -31,6 +31,7 @@ struct ServerConfig {
   api::JobConfig jobs;                   ///< Job pool (--job-workers, --job-queue, --job-keep-s, --jobs-kept, --job-max-resumes).
   std::string jobs_db = "sweetspot-jobs.db";  ///< SQLite file keeping jobs across restarts, relative to the working directory; "none" = memory only (--jobs-db, SWEETSPOT_JOBS_DB).
   double shutdown_grace_s = 8.0;         ///< On SIGTERM/SIGINT, how long running jobs may still finish before they are interrupted, s, [0, 3600] (--shutdown-grace-s, SWEETSPOT_SHUTDOWN_GRACE_S).
+  std::string web_root;                  ///< Folder of the design explorer's static files served at /; empty = "web" next to the executable (--web-root, SWEETSPOT_WEB_ROOT).
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;

@@ -15,6 +15,7 @@
 #include "server/connection_pool.hpp"
 #include "server/metrics.hpp"
 #include "server/sqlite_job_store.hpp"
+#include "server/static_files.hpp"
 
 namespace sweetspot::server {
 namespace {
@@ -109,6 +110,57 @@ bool TokenMatches(const std::string& header, const std::string& token) {
   return diff == 0;
 }
 
+// The route label of static files in metrics and the access log (one label
+// for every file keeps the label set bounded).
+constexpr const char* kStaticRoute = "static";
+
+// True for requests the design explorer's static files answer: GET or HEAD
+// of "/" (also when the explorer is not installed: then a 404 envelope), or
+// of an existing file under the web root at a path no API route matches.
+// The API's paths always win; /v1/ is the API's alone.
+bool IsStaticRequest(const httplib::Request& req, const StaticFiles& files) {
+  if (req.method != "GET" && req.method != "HEAD") return false;
+  if (req.path == "/") return true;
+  if (req.path.rfind("/v1/", 0) == 0 || !api::MatchRoutes(req.path).empty()) return false;
+  return files.Find(req.path).has_value();
+}
+
+// Answers a static request: the file with its Content-Type, Cache-Control
+// and ETag (304 when If-None-Match has it), or a 404 envelope.
+void WriteStaticResponse(const httplib::Request& req, const StaticFiles& files,
+                         httplib::Response& res) {
+  const std::optional<std::string> found = files.Find(req.path);
+  const std::optional<StaticFile> file = found ? files.Read(*found) : std::nullopt;
+  if (!file) {
+    std::string message = "no file at path " + req.path;
+    if (req.path == "/") {
+      message = "the design explorer is not installed: no index.html in the web root \"" +
+                files.root() +
+                "\" (build with -DSWEETSPOT_BUILD_WEB=ON, or set --web-root); the API under /v1/ "
+                "is unaffected";
+    }
+    WriteApiResponse(api::ErrorResponse(404, "NotFound", message), res);
+    return;
+  }
+  res.set_header("Cache-Control", file->cache_control);
+  res.set_header("ETag", file->etag);
+  res.set_header("X-Content-Type-Options", "nosniff");
+  if (file->content_type.rfind("text/html", 0) == 0) {
+    // The page loads its own bundle and calls its own origin's API only.
+    res.set_header("Content-Security-Policy",
+                   "default-src 'self'; style-src 'self' 'unsafe-inline'; img-src 'self' data:; "
+                   "object-src 'none'; base-uri 'none'; form-action 'none'; "
+                   "frame-ancestors 'none'");
+    res.set_header("Referrer-Policy", "no-referrer");
+  }
+  if (req.get_header_value("If-None-Match") == file->etag) {
+    res.status = 304;
+    return;
+  }
+  res.status = 200;
+  res.set_content(file->body, file->content_type.c_str());
+}
+
 }  // namespace
 
 namespace {
@@ -128,6 +180,7 @@ struct Server::Impl {
   core::ModesCache modes_cache;  // bending modes kept across requests (bounded LRU)
   std::unique_ptr<SqliteJobStore> job_store;  // Null with --jobs-db none; outlives `jobs`.
   std::unique_ptr<api::JobManager> jobs;
+  std::unique_ptr<StaticFiles> static_files;  // The explorer's files (web root); never null.
   std::string startup_error;  // Why the jobs database cannot be used; Bind() reports it.
   std::mutex log_mutex;
 };
@@ -187,12 +240,14 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
         }
       }
     }
+    // Static files carry no data: the page itself asks for the token.
     if (!config_.auth_token.empty() && req.path != "/health" &&
+        !IsStaticRequest(req, *impl_->static_files) &&
         !TokenMatches(req.get_header_value("Authorization"), config_.auth_token)) {
       WriteApiResponse(api::ErrorResponse(401, "Unauthorized",
                                           "header Authorization: must be \"Bearer <token>\" "
                                           "with the server's token (everything but /health "
-                                          "needs it)",
+                                          "and the explorer's static files needs it)",
                                           "Authorization"),
                        res);
       res.set_header("WWW-Authenticate", "Bearer");
@@ -212,6 +267,8 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     return httplib::Server::HandlerResponse::Unhandled;
   });
 
+  impl_->static_files =
+      std::make_unique<StaticFiles>(config_.web_root.empty() ? DefaultWebRoot() : config_.web_root);
   impl_->context.limits = config_.limits;
   impl_->context.modes_cache = &impl_->modes_cache;
   // Jobs run the same router with the job's cancel flag and progress, on a
@@ -252,17 +309,21 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     const auto start = std::chrono::steady_clock::now();
     impl_->metrics.Begin();
     std::string route;
-    const api::Response response =
-        api::Dispatch({req.method, req.path, req.body}, impl_->context, &route,
-                      /*allow_stream=*/true);
-    WriteApiResponse(response, res);
+    if (IsStaticRequest(req, *impl_->static_files)) {
+      route = kStaticRoute;
+      WriteStaticResponse(req, *impl_->static_files, res);
+    } else {
+      WriteApiResponse(api::Dispatch({req.method, req.path, req.body}, impl_->context, &route,
+                                     /*allow_stream=*/true),
+                       res);
+    }
     const double duration_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    impl_->metrics.End(route, req.method, response.status, duration_s);
+    impl_->metrics.End(route, req.method, res.status, duration_s);
     request_was_routed = true;
     if (config_.access_log) {
-      const nlohmann::json line{{"method", req.method},   {"path", req.path},
-                                {"route", route},         {"status", response.status},
+      const nlohmann::json line{{"method", req.method},     {"path", req.path},
+                                {"route", route},           {"status", res.status},
                                 {"duration_s", duration_s}, {"bytes_in", req.body.size()}};
       std::lock_guard<std::mutex> lock(impl_->log_mutex);
       std::cerr << Serialize(line) << "\n";
@@ -355,6 +416,17 @@ bool Server::Bind(std::string* error) {
   }
   port_ = bound;
   impl_->http.RaiseBacklog(SOMAXCONN);
+  {
+    std::lock_guard<std::mutex> lock(impl_->log_mutex);
+    const StaticFiles& files = *impl_->static_files;
+    if (files.Installed()) {
+      std::cerr << "sweetspot-server: design explorer at / from \"" << files.root() << "\""
+                << std::endl;
+    } else {
+      std::cerr << "sweetspot-server: design explorer not installed (no index.html in \""
+                << files.root() << "\"); / answers 404, the API is unaffected" << std::endl;
+    }
+  }
   return true;
 }
 

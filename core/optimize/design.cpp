@@ -83,13 +83,15 @@ std::vector<double> RandomStart(const DesignModel& model, std::mt19937_64& rng, 
   return x;
 }
 
-// The public re-evaluation of a design (ComputeMassProperties + the closed-form sweet spot).
+// The public re-evaluation of a design (ComputeMassProperties + the closed-form sweet spot;
+// min_sting: + Collide(kFlexible) there, with the error checks).
 struct PublicEvaluation {
   MassProperties properties;
   double objective = kNaN;
   double sweet_spot_m = kNaN;
   double max_exit_speed_mps = kNaN;
   double omega_rad_s = kNaN;
+  std::optional<StingEvaluation> sting;  // min_sting
 };
 
 PublicEvaluation EvaluatePublic(const DesignProblem& problem, const DesignModel& model,
@@ -130,6 +132,8 @@ PublicEvaluation EvaluatePublic(const DesignProblem& problem, const DesignModel&
       out.objective = p.MoiSixInchKgM2();
       break;
     case DesignObjective::kMinSting:
+      out.sting = model.StingOf(bat, true);
+      out.objective = out.sting->sting_j;
       break;
   }
   return out;
@@ -180,7 +184,9 @@ Run Finish(const DesignModel& model, LocalSolveOutcome outcome) {
   }
   const std::vector<double> s2 = nlp.ToScaled(run.x);
   if (nlp.Evaluate(s2.data(), false)) {
-    run.objective = model.Value(model.objective(), run.x.data());
+    // The sting is not recomputed (an impact per call): the NLP's value at the same point.
+    run.objective =
+        model.derivative_free() ? nlp.objective() : model.Value(model.objective(), run.x.data());
     run.violation = nlp.Violation();
     run.feasible = run.violation <= kFeasibleRelative;
   }
@@ -221,10 +227,42 @@ int ChooseRun(const DesignModel& model, const std::vector<Run>& runs) {
   return best;
 }
 
-LocalSolveOutcome Solve(const DesignOptions& options, ScaledDesignNlp& nlp,
-                        const std::vector<double>& s0, const LocalSolveSettings& settings) {
-  return options.backend == DesignBackend::kIpopt ? SolveWithIpopt(nlp, s0, settings)
-                                                  : SolveWithNlopt(nlp, s0, settings);
+LocalSolveOutcome Solve(DesignBackend backend, ScaledDesignNlp& nlp, const std::vector<double>& s0,
+                        const LocalSolveSettings& settings) {
+  switch (backend) {
+    case DesignBackend::kIpopt:
+      return SolveWithIpopt(nlp, s0, settings);
+    case DesignBackend::kNloptSlsqp:
+      return SolveWithNlopt(nlp, s0, settings);
+    case DesignBackend::kNloptCobyla:
+      return SolveWithCobyla(nlp, s0, settings);
+  }
+  return SolveWithIpopt(nlp, s0, settings);
+}
+
+// The backend of the design's local solves: min_sting has no derivative, so COBYLA whatever
+// was asked.
+DesignBackend MainBackend(const DesignProblem& problem, const DesignOptions& options) {
+  return problem.objective == DesignObjective::kMinSting ? DesignBackend::kNloptCobyla
+                                                         : options.backend;
+}
+
+// The backend of the infeasibility analysis, whose sub-problems are smooth (the objective is
+// a property, never the sting): the requested gradient solver, Ipopt when COBYLA was asked.
+DesignBackend SmoothBackend(const DesignOptions& options) {
+  return options.backend == DesignBackend::kNloptCobyla ? DesignBackend::kIpopt : options.backend;
+}
+
+const char* BackendName(DesignBackend backend) {
+  switch (backend) {
+    case DesignBackend::kIpopt:
+      return "ipopt";
+    case DesignBackend::kNloptSlsqp:
+      return "nlopt:LD_SLSQP";
+    case DesignBackend::kNloptCobyla:
+      return "nlopt:LN_COBYLA";
+  }
+  return "ipopt";
 }
 
 LocalSolveSettings SettingsFrom(const DesignOptions& options, Clock::time_point deadline,
@@ -237,6 +275,7 @@ LocalSolveSettings SettingsFrom(const DesignOptions& options, Clock::time_point 
   s.max_cpu_time_s = options.max_cpu_time_s;
   s.deadline = deadline;
   s.progress = progress;
+  s.feasibility_tolerance = kFeasibleRelative;
   return s;
 }
 
@@ -291,7 +330,8 @@ Reach ReachOf(const DesignModel& model, int k, const std::vector<int>& keep,
     const DesignModel m = restricted.WithObjective(c.f, side == 1, c.scale, c.unit);
     ScaledDesignNlp nlp(m);
     LocalSolveSettings settings = SettingsFrom(options, deadline, progress);
-    const LocalSolveOutcome o = Solve(options, nlp, nlp.ToScaled(m.BaseX()), settings);
+    const LocalSolveOutcome o =
+        Solve(SmoothBackend(options), nlp, nlp.ToScaled(m.BaseX()), settings);
     *evaluations += o.evaluations;
     *iterations += o.iterations;
     const Run run = Finish(m, o);
@@ -353,8 +393,8 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
     DesignFunctionSpec zero;  // kLinear, no terms: a constant objective
     const DesignModel m = model.WithConstraints(structural).WithObjective(zero, false, 1.0, "");
     ScaledDesignNlp nlp(m);
-    const LocalSolveOutcome o =
-        Solve(options, nlp, nlp.ToScaled(m.BaseX()), SettingsFrom(options, deadline, progress));
+    const LocalSolveOutcome o = Solve(SmoothBackend(options), nlp, nlp.ToScaled(m.BaseX()),
+                                      SettingsFrom(options, deadline, progress));
     *evaluations += o.evaluations;
     *iterations += o.iterations;
     const Run run = Finish(m, o);
@@ -512,6 +552,8 @@ const char* ObjectiveUnit(DesignObjective objective) {
       return "kg_m2";
     case DesignObjective::kWidestSweetZone:
       return "m";
+    case DesignObjective::kMinSting:
+      return "j";
     default:
       return "mps";
   }
@@ -528,9 +570,15 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
   };
   DesignResult result;
   Summary& summary = result.summary;
-  summary.backend = options.backend == DesignBackend::kNloptSlsqp ? "nlopt:LD_SLSQP" : "ipopt";
+  const DesignBackend backend = MainBackend(problem, options);
+  summary.backend = BackendName(backend);
   summary.models_used = {"mass_properties"};
   if (problem.objective != DesignObjective::kMinMoi) summary.models_used.push_back("rigid_pivot");
+  const bool sting = problem.objective == DesignObjective::kMinSting;
+  if (sting) {
+    summary.models_used.push_back(kFlexibleBeamModel);
+    summary.models_used.push_back("flexible");
+  }
   summary.iterations = 0;
   summary.evaluations = 0;
   result.objective_unit = ObjectiveUnit(problem.objective);
@@ -541,6 +589,11 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
   if (!options.IsValid(&why)) {
     invalid = true;
     why = "options." + why;
+  } else if (sting && options.derivative_check != DerivativeCheck::kNone) {
+    invalid = true;
+    why =
+        "options.derivative_check: objective = min_sting has no derivatives to check (it is "
+        "solved derivative-free by COBYLA)";
   } else if (!DesignModel::Build(problem, options, &model, &why)) {
     invalid = true;
   }
@@ -556,6 +609,13 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
   }
   const bool cor_known = problem.cor.has_value() || problem.bat.material.cor.has_value();
   result.cor = cor_known ? model.cor() : kNaN;
+  if (sting && options.backend != DesignBackend::kNloptCobyla) {
+    summary.warnings.push_back(
+        std::string("objective = min_sting: solved by NLopt LN_COBYLA, not ") +
+        BackendName(options.backend) +
+        ": the sting comes from an adaptive FE mesh and an adaptive ODE integration (piecewise "
+        "smooth, no derivative), so a derivative-free solver is used");
+  }
 
   try {
     const Clock::time_point deadline =
@@ -578,7 +638,7 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
         ScaledDesignNlp nlp(model);
         LocalSolveSettings settings = SettingsFrom(options, deadline, progress);
         if (i == 0) settings.derivative_check = options.derivative_check;
-        LocalSolveOutcome o = Solve(options, nlp, nlp.ToScaled(x), settings);
+        LocalSolveOutcome o = Solve(backend, nlp, nlp.ToScaled(x), settings);
         summary.iterations += o.iterations;
         summary.evaluations += o.evaluations;
         if (i == 0) {
@@ -695,12 +755,28 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
       summary.message = "time budget max_time_s = " + Num(options.max_time_s) + " s reached (" +
                         summary.message + "); the best design so far is kept";
     }
-    if (o.raw_status == 1 && options.backend == DesignBackend::kIpopt) {
+    if (o.raw_status == 1 && backend == DesignBackend::kIpopt) {
       summary.warnings.push_back("Ipopt converged to its acceptable (looser) tolerance");
     }
     if (!bat_valid) {
       summary.termination = Termination::kFailure;
       summary.message = "the optimised bat is invalid: " + bat_why;
+    }
+    if (pub.sting.has_value()) {
+      const StingEvaluation& st = *pub.sting;
+      for (const std::string& w : st.impact.summary.warnings)
+        summary.warnings.push_back("sting: " + w);
+      if (st.ok) {
+        DesignSting d;
+        d.impact_from_knob_m = st.sweet_spot_from_knob_m;
+        d.hands_vibration_energy_j = st.sting_j;
+        d.error_estimate_j = st.impact.error_estimate_hands_energy_j;
+        d.impact = st.impact;
+        result.sting = std::move(d);
+      } else if (summary.termination != Termination::kFailure) {
+        summary.termination = Termination::kFailure;
+        summary.message = "the sting of the optimised bat cannot be computed: " + st.message;
+      }
     }
     const bool feasible = worst_relative <= kFeasibleRelative;
     if (summary.termination == Termination::kConverged && !feasible) {
@@ -747,7 +823,15 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
       std::vector<double> s = nlp.ToScaled(x);
       LocalSolveOutcome mult = o;
       double kkt = kNaN;
-      if (o.has_multipliers && o.lambda.size() == static_cast<std::size_t>(model.m())) {
+      if (model.derivative_free()) {
+        // No gradient of the sting: neither multipliers nor a KKT residual.
+        mult.lambda.assign(static_cast<std::size_t>(model.m()), kNaN);
+        mult.z_lower.assign(static_cast<std::size_t>(model.n()), kNaN);
+        mult.z_upper.assign(static_cast<std::size_t>(model.n()), kNaN);
+        summary.warnings.push_back(
+            "objective = min_sting: the sting has no derivative, so the active constraints have "
+            "no multipliers (NaN) and error_estimate (the KKT residual) is not computed");
+      } else if (o.has_multipliers && o.lambda.size() == static_cast<std::size_t>(model.m())) {
         mult.s = s;
         kkt = KktResidual(nlp, mult);
       } else {
@@ -823,7 +907,7 @@ MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,
                   std::isfinite(options.max_time_s) && options.max_time_s > 0.0 ? options.max_time_s
                                                                                 : 0.0));
   MaterialChoiceResult out;
-  out.summary.backend = options.backend == DesignBackend::kNloptSlsqp ? "nlopt:LD_SLSQP" : "ipopt";
+  out.summary.backend = BackendName(MainBackend(problem, options));
   out.summary.iterations = 0;
   out.summary.evaluations = 0;
   out.summary.objective = kNaN;
@@ -833,7 +917,8 @@ MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,
     out.summary.solve_time_s = 0.0;
     return out;
   }
-  const bool maximize = problem.objective != DesignObjective::kMinMoi;
+  const bool maximize = problem.objective != DesignObjective::kMinMoi &&
+                        problem.objective != DesignObjective::kMinSting;
   for (std::size_t i = 0; i < materials.size(); ++i) {
     if (IsCancelled(progress)) {
       out.summary.warnings.push_back("cancelled after " + std::to_string(i) + " materials");

@@ -1,5 +1,5 @@
-// Internal to core/optimize: one local solve of a ScaledDesignNlp by Ipopt or NLopt SLSQP.
-// The solvers' headers stay in ipopt_backend.cpp and nlopt_design.cpp.
+// Internal to core/optimize: one local solve of a ScaledDesignNlp by Ipopt, NLopt SLSQP or
+// NLopt COBYLA. The solvers' headers stay in ipopt_backend.cpp and nlopt_design.cpp.
 #pragma once
 
 #include <chrono>
@@ -18,10 +18,13 @@ struct LocalSolveSettings {
   int max_iterations = 300;             ///< Iteration limit.
   double tolerance = 1e-9;              ///< Ipopt tol / NLopt relative tolerances.
   double constraint_tolerance = 1e-10;  ///< Ipopt constr_viol_tol (scaled constraints).
-  HessianMode hessian = HessianMode::kLimitedMemory;          ///< Ipopt's Hessian.
-  double max_cpu_time_s = 0.0;                                ///< Ipopt max_cpu_time; 0 = not set.
-  std::chrono::steady_clock::time_point deadline;             ///< Stop (no_convergence) after this.
-  Progress* progress = nullptr;                               ///< Polled for cancellation.
+  HessianMode hessian = HessianMode::kLimitedMemory;  ///< Ipopt's Hessian.
+  double max_cpu_time_s = 0.0;                        ///< Ipopt max_cpu_time; 0 = not set.
+  std::chrono::steady_clock::time_point deadline;     ///< Stop (no_convergence) after this.
+  Progress* progress = nullptr;                       ///< Polled for cancellation.
+  /// COBYLA: a point whose largest scaled violation is at most this counts as feasible when
+  /// the best evaluated point is chosen.
+  double feasibility_tolerance = 1e-10;
   DerivativeCheck derivative_check = DerivativeCheck::kNone;  ///< Ipopt's checker.
 };
 
@@ -53,5 +56,15 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
 /// Solves from s0 with NLopt LD_SLSQP. Never throws.
 LocalSolveOutcome SolveWithNlopt(ScaledDesignNlp& nlp, const std::vector<double>& s0,
                                  const LocalSolveSettings& settings);
+
+/// Solves from s0 with NLopt LN_COBYLA, derivative-free: only values are asked of `nlp` (the
+/// objective may have no derivative, as min_sting), bounds [0, 1] on s, every constraint as
+/// NLopt inequalities / equalities with tolerance settings.constraint_tolerance, ftol_rel and
+/// xtol_rel = max(settings.tolerance, kDerivativeFreeTolerance), maxeval = max_iterations.
+/// Returns the best point evaluated (least violation beyond settings.feasibility_tolerance, then
+/// least objective), so a stop by the deadline or cancellation keeps the best design so far.
+/// No multipliers. Never throws.
+LocalSolveOutcome SolveWithCobyla(ScaledDesignNlp& nlp, const std::vector<double>& s0,
+                                  const LocalSolveSettings& settings);
 
 }  // namespace sweetspot::core

@@ -5,11 +5,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <set>
 
+#include "core/collision/rigid_pivot.hpp"
 #include "core/geometry_format.hpp"
 #include "core/geometry_integrals.hpp"
 #include "core/optimize/jet.hpp"
+#include "core/scene.hpp"
+#include "core/sweet_spot.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -21,6 +25,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // material) into closed constraints the solver can sit on.
 constexpr double kStrictMargin = 1e-6;
 constexpr int kMaxVariables = 200;
+// min_sting: modes kept per solve (the start, the end and the points evaluated twice).
+constexpr std::size_t kStingModesCacheEntries = 16;
 
 // Integrals of one segment or of the fill, in the scalar type T.
 template <typename T>
@@ -386,6 +392,9 @@ std::vector<double> DesignModel::BaseX() const {
 }
 
 double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
+  if (f.function == DesignFunction::kObjective && objective_kind_ == DesignObjective::kMinSting) {
+    return StingOf(BatAt(x), false).sting_j;  // NaN when it cannot be computed
+  }
   const std::vector<double> t = ParametersAt(x);
   if (f.function == DesignFunction::kLinear) {
     double v = f.constant;
@@ -449,8 +458,12 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
     out->objective_gradient = Eigen::VectorXd::Zero(nv);
     out->jacobian = Eigen::MatrixXd::Zero(mc, nv);
   }
-  if (!evaluate(objective_, &out->objective,
-                with_gradients ? out->objective_gradient.data() : nullptr, 1)) {
+  if (derivative_free()) {
+    if (with_gradients) return false;  // the sting has no derivative
+    out->objective = StingOf(BatAt(x), false).sting_j;
+    if (!std::isfinite(out->objective)) return false;
+  } else if (!evaluate(objective_, &out->objective,
+                       with_gradients ? out->objective_gradient.data() : nullptr, 1)) {
     return false;
   }
   for (int k = 0; k < mc; ++k) {
@@ -469,6 +482,7 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
 
 bool DesignModel::Hessian(const double* x, double objective_weight,
                           const double* constraint_weights, Eigen::MatrixXd* out) const {
+  if (derivative_free() && objective_weight != 0.0) return false;
   const std::vector<double> t = ParametersAt(x);
   Integrals in;
   const design_detail::IntegralContext context{
@@ -540,6 +554,60 @@ Bat DesignModel::BatAt(const double* x) const {
   return bat;
 }
 
+StingEvaluation EvaluateSting(const Bat& bat, const StingScene& scene, bool refine_check,
+                              ModesCache* cache) {
+  StingEvaluation out;
+  try {
+    const MassProperties p = ComputeMassProperties(bat, scene.inertia_model);
+    RigidPivotInputs in;
+    in.bat_mass_kg = p.mass_kg;
+    in.balance_point_m = p.balance_point_m;
+    in.pivot_from_knob_m = scene.swing.pivot_from_knob_m;
+    in.moi_pivot_kg_m2 = p.MoiAboutKgM2(scene.swing.pivot_from_knob_m);
+    in.ball_mass_kg = scene.ball.mass_kg;
+    in.ball_speed_mps = scene.ball.speed_mps;
+    in.angular_speed_rad_s = scene.swing.angular_speed_rad_s;
+    in.cor = scene.cor;
+    const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(RigidPivotProfile(in), bat.LengthM());
+    out.sweet_spot_from_knob_m = max.position_from_knob_m;
+    Scene s;
+    s.bat = bat;
+    s.mass_properties = p;
+    s.inertia_model = scene.inertia_model;
+    s.ball = scene.ball;
+    s.swing = scene.swing;
+    s.cor = scene.cor;
+    CollisionOptions options;
+    options.flexible = scene.flexible;
+    options.flexible.modes_cache = cache;
+    options.flexible.impact.refine_check = refine_check && scene.flexible.impact.refine_check;
+    const CollisionResult r =
+        Collide(s, max.position_from_knob_m, CollisionModel::kFlexible, options);
+    out.termination = r.summary.termination;
+    out.message = r.summary.message;
+    if (!r.summary.IsSolutionUsable() || !r.flexible.has_value()) return out;
+    out.impact = *r.flexible;
+    for (const std::string& w : r.summary.warnings) {
+      if (std::find(out.impact.summary.warnings.begin(), out.impact.summary.warnings.end(), w) ==
+          out.impact.summary.warnings.end()) {
+        out.impact.summary.warnings.push_back(w);
+      }
+    }
+    out.sting_j = r.flexible->hands_vibration_energy_j;
+    out.ok = std::isfinite(out.sting_j);
+    if (!out.ok) out.message = "the hands' vibration energy is not finite";
+  } catch (const std::exception& e) {
+    out.ok = false;
+    out.message = std::string("internal error: ") + e.what();
+  }
+  if (!out.ok) out.sting_j = kNaN;
+  return out;
+}
+
+StingEvaluation DesignModel::StingOf(const Bat& bat, bool refine_check) const {
+  return EvaluateSting(bat, sting_scene_, refine_check, sting_modes_.get());
+}
+
 DesignModel DesignModel::WithObjective(const DesignFunctionSpec& f, bool maximize, double scale,
                                        const std::string& unit) const {
   DesignModel copy = *this;
@@ -609,7 +677,6 @@ bool DesignModel::Build(const DesignProblem& problem, const DesignOptions& optio
   std::string* inner_ptr = why != nullptr ? &inner : nullptr;
 
   // Scene and objective.
-  if (problem.objective == DesignObjective::kMinSting) return Fail(why, kMinStingRefusal);
   if (ParseDesignObjective(DesignObjectiveName(problem.objective)) != problem.objective) {
     return Fail(why, "objective: not a known objective");
   }
@@ -636,6 +703,9 @@ bool DesignModel::Build(const DesignProblem& problem, const DesignOptions& optio
   if (problem.inertia_model != InertiaModel::kRigidBody &&
       problem.inertia_model != InertiaModel::kSlenderRod) {
     return Fail(why, "inertia_model: not a known inertia model");
+  }
+  if (problem.objective == DesignObjective::kMinSting && !problem.flexible.IsValid(inner_ptr)) {
+    return Fail(why, inner);
   }
 
   // The base design.
@@ -842,6 +912,15 @@ bool DesignModel::Build(const DesignProblem& problem, const DesignOptions& optio
   model.swing_weight_exponent_ = problem.swing_weight_exponent;
   model.zone_tolerance_mps_ = problem.sweet_zone_tolerance_mps;
   model.objective_kind_ = problem.objective;
+  if (problem.objective == DesignObjective::kMinSting) {
+    model.sting_scene_.ball = problem.ball;
+    model.sting_scene_.swing = problem.swing;
+    model.sting_scene_.cor = model.cor_;
+    model.sting_scene_.inertia_model = problem.inertia_model;
+    model.sting_scene_.flexible = problem.flexible;
+    model.sting_scene_.flexible.modes_cache = nullptr;  // the model's own cache instead
+    model.sting_modes_ = std::make_shared<ModesCache>(kStingModesCacheEntries);
+  }
   const MassProperties base_properties = ComputeMassProperties(base, problem.inertia_model);
   model.c0_ = base_properties.balance_point_m;
   model.i6_ref_ = base_properties.MoiSixInchKgM2();
@@ -1176,12 +1255,27 @@ bool DesignModel::Build(const DesignProblem& problem, const DesignOptions& optio
 
   // Objective.
   model.objective_.function = DesignFunction::kObjective;
-  model.maximize_ = problem.objective != DesignObjective::kMinMoi;
+  model.maximize_ = problem.objective != DesignObjective::kMinMoi &&
+                    problem.objective != DesignObjective::kMinSting;
   model.objective_unit_ = problem.objective == DesignObjective::kMinMoi            ? "kg_m2"
                           : problem.objective == DesignObjective::kWidestSweetZone ? "m"
+                          : problem.objective == DesignObjective::kMinSting        ? "j"
                                                                                    : "mps";
   const std::vector<double> x0 = model.BaseX();
-  const double f0 = model.Value(model.objective_, x0.data());
+  double f0 = kNaN;
+  if (problem.objective == DesignObjective::kMinSting) {
+    // The flexible model refuses some bats (too stubby for a beam, ...): say so by name.
+    const StingEvaluation sting = model.StingOf(model.BatAt(x0.data()), false);
+    if (!sting.ok) {
+      return Fail(why,
+                  "objective = min_sting: the sting of the start (the base design clamped "
+                  "into the variables' bounds) cannot be computed: " +
+                      sting.message);
+    }
+    f0 = sting.sting_j;
+  } else {
+    f0 = model.Value(model.objective_, x0.data());
+  }
   if (!std::isfinite(f0)) {
     return Fail(why,
                 "variables: the objective is not finite at the start (the base design "

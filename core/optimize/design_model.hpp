@@ -17,6 +17,7 @@
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -25,6 +26,7 @@
 #include <Eigen/Core>
 
 #include "core/bat.hpp"
+#include "core/flexible/modes_cache.hpp"
 #include "core/optimize/design_problem.hpp"
 
 namespace sweetspot::core {
@@ -81,6 +83,34 @@ struct DesignPoint {
   double length_m = 0.0;               ///< L.
 };
 
+/// The scene of a sting evaluation (min_sting), taken from the DesignProblem.
+struct StingScene {
+  Ball ball;                                              ///< The ball.
+  Swing swing;                                            ///< Pivot, omega and the hands.
+  double cor = 0.5;                                       ///< The COR used.
+  InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< For the mass properties.
+  FlexibleOptions flexible;                               ///< The flexible beam's settings.
+};
+
+/// One sting evaluation (internal).
+struct StingEvaluation {
+  bool ok = false;      ///< False when the sting could not be computed.
+  std::string message;  ///< Why not (the flexible model's or the scene's message).
+  Termination termination = Termination::kFailure;  ///< The collision's termination.
+  double sweet_spot_from_knob_m = std::numeric_limits<double>::quiet_NaN();  ///< Impact, m.
+  double sting_j = std::numeric_limits<double>::quiet_NaN();  ///< Hands' vibration energy, J.
+  FlexibleImpactResult impact;                                ///< The impact (when computed).
+};
+
+/// The sting of `bat`: its mass properties (ComputeMassProperties), the rigid-pivot max-exit-
+/// speed point in closed form (RigidPivotProfile, ClosedFormMaxExitSpeed, at the scene's
+/// omega), then Collide(kFlexible) there; the sting is the impact's hands_vibration_energy_j
+/// (the measure of least_sting_zone). refine_check as in the scene's flexible options when
+/// true, off (one integration, 1/3 of the cost, same value) when false. `cache` (may be null)
+/// holds modes across calls. Never throws.
+StingEvaluation EvaluateSting(const Bat& bat, const StingScene& scene, bool refine_check,
+                              ModesCache* cache);
+
 /// The design problem as an NLP over the variables x (user units). Immutable after Build;
 /// const methods are thread-safe.
 class DesignModel {
@@ -110,10 +140,11 @@ class DesignModel {
 
   /// f(x) for a function (user units); NaN when not finite.
   double Value(const DesignFunctionSpec& f, const double* x) const;
-  /// Objective and constraints at x; false when a value is not finite (or M <= 0).
+  /// Objective and constraints at x; false when a value is not finite (or M <= 0). With
+  /// gradients, false for the sting objective (it has none): use values only.
   bool Evaluate(const double* x, bool with_gradients, DesignPoint* out) const;
   /// Hessian of objective_weight * F + sum_k constraint_weights[k] g_k at x (n x n, user
-  /// units); false when not finite.
+  /// units); false when not finite (and for the sting objective with a nonzero weight).
   bool Hessian(const double* x, double objective_weight, const double* constraint_weights,
                Eigen::MatrixXd* out) const;
 
@@ -121,6 +152,14 @@ class DesignModel {
   Bat BatAt(const double* x) const;
   /// The three-segment shape at x (nullopt for a profile design).
   std::optional<ThreeSegmentShape> ShapeAt(const double* x) const;
+
+  /// True when the objective is the sting (min_sting: values only, no derivatives).
+  bool derivative_free() const {
+    return objective_kind_ == DesignObjective::kMinSting &&
+           objective_.function == DesignFunction::kObjective;
+  }
+  /// The sting of `bat` in this problem's scene (EvaluateSting with the model's modes cache).
+  StingEvaluation StingOf(const Bat& bat, bool refine_check) const;
 
   /// A copy that minimises or maximises `f` instead of the objective (same constraints).
   DesignModel WithObjective(const DesignFunctionSpec& f, bool maximize, double scale,
@@ -163,6 +202,10 @@ class DesignModel {
   double swing_weight_exponent_ = 0.27;
   double zone_tolerance_mps_ = 1.0;
   double i6_ref_ = 1.0;
+  // min_sting: the scene of the flexible impact and a per-solve cache of modes (shared by the
+  // model's copies; thread-safe), so repeated points do not recompute them.
+  StingScene sting_scene_;
+  std::shared_ptr<ModesCache> sting_modes_;
 };
 
 /// The model as the solvers see it: variables scaled to s in [0, 1] (x = lower + (upper -
@@ -186,7 +229,9 @@ class ScaledDesignNlp {
 
   /// Evaluates at s (cached); false when not finite.
   bool Evaluate(const double* s, bool with_gradients);
-  double f() const { return f_; }                                ///< Scaled objective.
+  double f() const { return f_; }  ///< Scaled objective.
+  /// The objective at the last evaluated point, in its unit (unscaled, either sense).
+  double objective() const { return point_.objective; }
   const std::vector<double>& g() const { return g_; }            ///< Scaled constraints.
   const Eigen::VectorXd& grad_f() const { return grad_f_; }      ///< d f / d s.
   const Eigen::MatrixXd& jacobian() const { return jacobian_; }  ///< d g / d s (m x n).

@@ -2,7 +2,8 @@
 // (constraints, league rule sets), what to improve (objective) for a scene, and the answer
 // (the optimised bat, its properties, the objective, a Summary, the active constraints with
 // their multipliers, the conflicts of an infeasible request, the spread of a multi-start).
-// Solved with Ipopt (default) or NLopt SLSQP; the solvers' headers stay in core's .cpp files.
+// Solved with Ipopt (default), NLopt SLSQP or, for the derivative-free min_sting objective, NLopt
+// COBYLA; the solvers' headers stay in core's .cpp files.
 // Value in, value out; never throws; thread-safe (Ipopt solves are serialised by one
 // process-wide lock: see docs/optimization.md). Everything SI; names carry units.
 #pragma once
@@ -110,7 +111,9 @@ enum class DesignObjective {
   kWidestSweetZone,
   /// "min_moi": the MOI about the 6-in point, kg·m² (minimise).
   kMinMoi,
-  /// "min_sting": refused (needs the flexible beam model, not available yet).
+  /// "min_sting": the hands' vibration energy left by an impact at the design's rigid-pivot
+  /// max-exit-speed point (the flexible beam, as least_sting_zone measures sting), J
+  /// (minimise). No derivative exists (adaptive mesh and integration): solved by NLopt COBYLA.
   kMinSting,
 };
 
@@ -118,9 +121,6 @@ enum class DesignObjective {
 const char* DesignObjectiveName(DesignObjective objective);
 /// The objective called `name`, or nullopt.
 std::optional<DesignObjective> ParseDesignObjective(std::string_view name);
-/// The refusal of "min_sting".
-inline constexpr char kMinStingRefusal[] =
-    "objective = min_sting: needs the flexible beam model, which is not available yet";
 
 /// A design problem: a base design, what may change, what must hold, what to improve.
 struct DesignProblem {
@@ -138,10 +138,15 @@ struct DesignProblem {
   double swing_weight_exponent = 0.27;
   /// kWidestSweetZone: the zone is where the exit speed is within this of the max, m/s (> 0).
   double sweet_zone_tolerance_mps = 1.0;
-  Ball ball;                  ///< The pitched ball.
-  Swing swing;                ///< The swing (pivot and omega0); hands are not used.
+  Ball ball;  ///< The pitched ball.
+  /// The swing (pivot and omega0); the hands (hands_from_knob_m) only for min_sting.
+  Swing swing;
   std::optional<double> cor;  ///< COR in [0, 1]; unset = the bat material's default.
   InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< How moments are computed.
+  /// kMinSting: the flexible beam's settings (theory, modes, tolerances, grip length; defaults as
+  /// for /v1/sweet-spot). flexible.modes_cache is not used: every design has new modes, so each
+  /// solve keeps its own small cache (repeated points) instead of filling a shared one.
+  FlexibleOptions flexible;
 
   /// True when the problem is well formed (variables parse and apply to this design, bounds
   /// finite and ordered, constraints finite, the base bat valid, the rules' discrete limits
@@ -161,6 +166,9 @@ enum class HessianMode {
 enum class DesignBackend {
   kIpopt,       ///< Ipopt 3.11 (interior point, MUMPS). The default.
   kNloptSlsqp,  ///< NLopt LD_SLSQP (for cross-checks; multipliers estimated by least squares).
+  /// NLopt LN_COBYLA: derivative-free (linear models of the objective and constraints over a
+  /// simplex). Always used for min_sting, whatever is asked; no multipliers for min_sting.
+  kNloptCobyla,
 };
 
 /// Ipopt's derivative checker, run at the first start.
@@ -172,16 +180,19 @@ enum class DerivativeCheck {
 
 /// How the optimisation runs. Defaults are valid.
 struct DesignOptions {
-  DesignBackend backend = DesignBackend::kIpopt;      ///< The local solver.
+  DesignBackend backend = DesignBackend::kIpopt;      ///< The local solver (min_sting: COBYLA).
   HessianMode hessian = HessianMode::kLimitedMemory;  ///< Ipopt's Hessian.
-  int max_iterations = 300;                           ///< Per local solve (1..100000).
+  int max_iterations = 300;  ///< Per local solve (1..100000); COBYLA: evaluations per start.
   /// Wall-clock budget of the whole call (all starts and the infeasibility analysis), s (> 0).
-  /// Checked in Ipopt's intermediate callback: a solve past it stops as no_convergence.
+  /// Checked in Ipopt's intermediate callback and in every NLopt evaluation: a solve past it
+  /// stops as no_convergence.
   double max_time_s = 10.0;
   /// Ipopt's max_cpu_time per local solve, s; 0 = not set. Ipopt 3.11 counts the CPU time of
   /// every thread of the process, so under load it fires early: prefer max_time_s.
   double max_cpu_time_s = 0.0;
-  double tolerance = 1e-9;  ///< Ipopt tol / NLopt ftol_rel (scaled problem, > 0, < 1).
+  /// Ipopt tol / NLopt ftol_rel and xtol_rel (scaled problem, > 0, < 1). COBYLA uses
+  /// max(tolerance, kDerivativeFreeTolerance).
+  double tolerance = 1e-9;
   /// Largest violation accepted for a converged point, relative to each constraint's scale
   /// (Ipopt constr_viol_tol; > 0, < 1).
   double constraint_tolerance = 1e-10;
@@ -197,6 +208,11 @@ struct DesignOptions {
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
 };
+
+/// Smallest relative tolerance (ftol_rel and xtol_rel of the scaled problem) COBYLA is run
+/// with: each evaluation is a flexible impact (~5 ms), and the sting jumps by ~3e-5 relative
+/// where the FE mesh changes, so a tighter one only spends evaluations on the model's own error.
+inline constexpr double kDerivativeFreeTolerance = 1e-6;
 
 /// A variable's value in the answer.
 struct DesignValue {
@@ -214,7 +230,8 @@ struct DesignActiveConstraint {
   double bound = 0.0;  ///< The limit it sits on.
   /// Sensitivity of the optimal objective to the bound: objective unit per constraint unit
   /// (first order, from the solver's multiplier). Positive: raising the bound raises the
-  /// objective value (better when maximising, worse when minimising).
+  /// objective value (better when maximising, worse when minimising). NaN for min_sting (the
+  /// sting has no derivative, so no multiplier can be estimated).
   double multiplier = 0.0;
 };
 
@@ -252,18 +269,29 @@ struct DesignSpread {
   std::vector<DesignStart> runs;  ///< Every start, in order.
 };
 
+/// The sting of the answer (min_sting), recomputed through the public path: the rigid-pivot
+/// sweet spot in closed form, then Collide(kFlexible) there with problem.flexible.
+struct DesignSting {
+  double impact_from_knob_m = 0.0;        ///< The impact point (the rigid max-exit-speed point), m.
+  double hands_vibration_energy_j = 0.0;  ///< The sting: vibration energy in the grip, J.
+  /// Its estimated error (integration + mode truncation; 0 without refine_check), J.
+  double error_estimate_j = 0.0;
+  FlexibleImpactResult impact;  ///< Everything the flexible model knows about that impact.
+};
+
 /// The answer of OptimizeDesign. The summary is always filled:
 /// - termination: converged (Ipopt converged and the design meets every constraint when
 ///   re-checked through ComputeMassProperties), no_convergence (stopped by iterations, time,
 ///   cancellation or round-off; best design kept), infeasible (no design meets the
 ///   constraints: `conflicts` says why; the least-violating design is returned), failure,
 ///   invalid_input (message names the field; the bat is the base design);
-/// - backend "ipopt" or "nlopt:LD_SLSQP"; raw_status = that solver's status of the chosen
-///   start (Ipopt ApplicationReturnStatus, NLopt result); iterations and evaluations summed
-///   over all solves; objective = objective_value; constraint_violation = the largest
-///   violation of a constraint or bound, each in its own unit, re-checked through the public
-///   mass properties; error_estimate = the relative first-order optimality (KKT) residual of
-///   the scaled problem at the answer; solve_time_s = wall time of the call.
+/// - backend "ipopt", "nlopt:LD_SLSQP" or "nlopt:LN_COBYLA"; raw_status = that solver's status
+///   of the chosen start (Ipopt ApplicationReturnStatus, NLopt result); iterations and
+///   evaluations summed over all solves; objective = objective_value; constraint_violation =
+///   the largest violation of a constraint or bound, each in its own unit, re-checked through
+///   the public mass properties; error_estimate = the relative first-order optimality (KKT)
+///   residual of the scaled problem at the answer (NaN for min_sting: no derivative);
+///   solve_time_s = wall time of the call.
 struct DesignResult {
   Summary summary;                                 ///< How it went (see above).
   Bat bat;                                         ///< The optimised bat.
@@ -271,7 +299,7 @@ struct DesignResult {
   std::vector<DesignValue> variables;              ///< The variables' values, in request order.
   MassProperties properties;                       ///< Its mass properties (problem.inertia_model).
   double objective_value = 0.0;                    ///< The objective, in objective_unit.
-  std::string objective_unit;                      ///< "mps", "m" or "kg_m2".
+  std::string objective_unit;                      ///< "mps", "m", "kg_m2" or "j" (joules).
   double cor = 0.0;  ///< The COR used (NaN when none is known: min_moi without one).
   /// Sweet spot of the answer (rigid pivot, closed form, at angular_speed_rad_s), m from the
   /// knob; NaN when no COR is known (min_moi without one).
@@ -281,6 +309,7 @@ struct DesignResult {
   std::vector<DesignActiveConstraint> active_constraints;  ///< What holds the design back.
   std::vector<DesignConflict> conflicts;                   ///< For an infeasible request: why.
   DesignSpread spread;                                     ///< Over the starts.
+  std::optional<DesignSting> sting;  ///< min_sting: the answer's impact (else empty).
   /// Errors reported by Ipopt's derivative checker (-1 = not run).
   int derivative_check_errors = -1;
   std::string derivative_check_report;  ///< The checker's output (empty if not run).

@@ -72,5 +72,39 @@ TEST(OptimizeConcurrency, EightThreadsTimesTenSolvesAllMatchTheSerialAnswers) {
   EXPECT_EQ(mismatches.load(), 0);
 }
 
+// min_sting (COBYLA over the flexible beam, no lock) beside Ipopt solves: the flexible model and
+// each solve's modes cache are per call, so every thread gets the serial answer bit for bit.
+TEST(OptimizeConcurrency, StingSolvesBesideIpoptSolvesMatchTheSerialAnswer) {
+  DesignProblem sting;
+  sting.three_segment = ThreeSegmentShape{0.8636, 0.0125, 0.033, 0.30, 0.55};
+  sting.bat.material = *FindMaterial("ash");
+  sting.cor = 0.5;
+  sting.objective = DesignObjective::kMinSting;
+  sting.variables = {{"three_segment.taper_end_m", 0.45, 0.75}};
+  sting.constraints.mass_kg = DesignRange::Between(0.85, 1.25);
+  DesignOptions options;
+  options.hessian = HessianMode::kExact;
+  const DesignResult serial = OptimizeDesign(sting, options);
+  const DesignResult serial_ipopt = OptimizeDesign(Problem(0), options);
+  ASSERT_EQ(serial.summary.termination, Termination::kConverged) << serial.summary.FullReport();
+  std::atomic<int> mismatches{0};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&, t] {
+      const bool ipopt = t % 2 == 1;
+      const DesignResult r = OptimizeDesign(ipopt ? Problem(0) : sting, options);
+      const DesignResult& s = ipopt ? serial_ipopt : serial;
+      bool same = r.summary.termination == Termination::kConverged &&
+                  r.objective_value == s.objective_value;
+      for (std::size_t j = 0; j < r.variables.size(); ++j) {
+        same = same && r.variables[j].value == s.variables[j].value;
+      }
+      if (!same) ++mismatches;
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  EXPECT_EQ(mismatches.load(), 0);
+}
+
 }  // namespace
 }  // namespace sweetspot::core

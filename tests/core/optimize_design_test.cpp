@@ -440,8 +440,12 @@ TEST(OptimizeInvalid, IllPosedRequestsAreRefusedByName) {
       },
       "rules.bbcor: cor = 0.55 exceeds the BBCOR limit 0.5");
   with(
-      "sting", [](DesignProblem& p) { p.objective = DesignObjective::kMinSting; },
-      kMinStingRefusal);
+      "sting settings",
+      [](DesignProblem& p) {
+        p.objective = DesignObjective::kMinSting;
+        p.flexible.max_elements = 1;
+      },
+      "flexible.max_elements = 1: must be in [2, 4096]");
   with(
       "range", [](DesignProblem& p) { p.constraints.mass_kg = DesignRange::Between(1.0, 0.9); },
       "constraints.mass_kg.max = 0.9: must not be less than constraints.mass_kg.min = 1");

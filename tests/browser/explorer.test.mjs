@@ -1,0 +1,473 @@
+// The design explorer in a real browser: Debian's chromium (headless, driven
+// by playwright-core) against the real sweetspot-server on 127.0.0.1 with an
+// ephemeral port. Every value the page shows is checked against the API's own
+// answer to the same request. Screenshots go to --artifacts.
+//
+//   node tests/browser/explorer.test.mjs --server build/server/sweetspot-server \
+//     --web-root build/server/web --node-modules build/web/npm/node_modules \
+//     --artifacts build/browser-artifacts [--chromium /usr/bin/chromium]
+//
+// ctest runs it as Browser.Explorer (tests/CMakeLists.txt). Exit status 0 when
+// every scenario passed.
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import fs from 'node:fs';
+import { createRequire } from 'node:module';
+import path from 'node:path';
+import { parseArgs } from 'node:util';
+
+const { values: args } = parseArgs({
+  options: {
+    server: { type: 'string' },
+    'web-root': { type: 'string' },
+    'node-modules': { type: 'string' },
+    artifacts: { type: 'string' },
+    chromium: { type: 'string', default: '/usr/bin/chromium' },
+  },
+});
+for (const name of ['server', 'web-root', 'node-modules', 'artifacts']) {
+  if (!args[name]) {
+    console.error(`explorer.test.mjs: --${name} is required (see the comment at the top)`);
+    process.exit(2);
+  }
+}
+if (!fs.existsSync(args.chromium)) {
+  console.error(`explorer.test.mjs: no browser at ${args.chromium}: run scripts/install-deps.sh (Debian's chromium)`);
+  process.exit(1);
+}
+if (!fs.existsSync(path.join(args['web-root'], 'index.html'))) {
+  console.error(`explorer.test.mjs: no index.html in ${args['web-root']}: build the sweetspot_web target`);
+  process.exit(1);
+}
+const { chromium } = createRequire(path.join(path.resolve(args['node-modules']), 'x.cjs'))('playwright-core');
+const artifacts = path.resolve(args.artifacts);
+fs.rmSync(artifacts, { recursive: true, force: true });
+fs.mkdirSync(artifacts, { recursive: true });
+
+const TOKEN = 'browser-test-token-0123456789';
+
+// ---- the server ------------------------------------------------------------
+
+/** Starts sweetspot-server on 127.0.0.1:0; resolves to {url, stop()} once /health answers. */
+async function startServer(name, env = {}) {
+  const log = fs.createWriteStream(path.join(artifacts, `${name}.log`));
+  const child = spawn(
+    args.server,
+    ['--host', '127.0.0.1', '--port', '0', '--jobs-db', 'none', '--web-root', args['web-root'], '--job-workers', '2'],
+    { env: { ...process.env, ...env }, stdio: ['ignore', 'ignore', 'pipe'] },
+  );
+  let stderr = '';
+  const port = await new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error(`${name}: no "listening on" within 20 s:\n${stderr}`)), 20000);
+    child.stderr.on('data', (chunk) => {
+      log.write(chunk);
+      stderr += chunk;
+      const match = /listening on 127\.0\.0\.1:(\d+)/.exec(stderr);
+      if (match) {
+        clearTimeout(timer);
+        resolve(Number(match[1]));
+      }
+    });
+    child.on('exit', (code) => reject(new Error(`${name} exited with ${code}:\n${stderr}`)));
+  });
+  const url = `http://127.0.0.1:${port}`;
+  for (let i = 0; ; ++i) {
+    try {
+      if ((await fetch(`${url}/health`)).ok) break;
+    } catch (error) {
+      if (i > 100) throw error;
+    }
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  return {
+    url,
+    stop: () =>
+      new Promise((resolve) => {
+        child.removeAllListeners('exit');
+        child.on('exit', () => {
+          log.end();
+          resolve();
+        });
+        child.kill('SIGTERM');
+      }),
+  };
+}
+
+/** The API's answer to a POST, as the test's own client (never through the page). */
+async function apiPost(url, route, body, headers = {}) {
+  const res = await fetch(`${url}${route}`, {
+    method: 'POST',
+    headers: { 'Content-Type': 'application/json', ...headers },
+    body: JSON.stringify(body),
+  });
+  return { status: res.status, body: await res.json() };
+}
+
+// ---- the scenarios ---------------------------------------------------------
+
+const SWEET = ['max_exit_speed', 'center_of_percussion', 'vibration_node', 'sweet_zone', 'exit_speed_curve'];
+
+async function revision(page) {
+  return Number(await page.evaluate(() => document.body.dataset.revision || 0));
+}
+
+/** Waits until the page has finished a refresh newer than `after`. */
+async function waitForRefresh(page, after) {
+  await page.waitForFunction(
+    (r) => Number(document.body.dataset.revision || 0) > r && document.body.dataset.state === 'ready',
+    after,
+    { timeout: 20000 },
+  );
+}
+
+async function markerOf(page, key) {
+  const mark = page.locator(`#curve-chart .u-mark[data-marker="${key}"]`);
+  await mark.waitFor({ state: 'attached' });
+  return {
+    positionM: Number(await mark.getAttribute('data-position-m')),
+    xPx: Number(await mark.getAttribute('data-x-px')),
+  };
+}
+
+async function shot(page, name) {
+  await page.screenshot({ path: path.join(artifacts, `${name}.png`), fullPage: true });
+}
+
+const scenarios = [];
+const scenario = (name, fn) => scenarios.push({ name, fn });
+
+scenario('load the page: bat, properties, curve with markers, modes, variants', async ({ page, url }) => {
+  const response = await page.goto(url);
+  assert.equal(response.status(), 200);
+  assert.match(response.headers()['content-type'], /^text\/html/);
+  await page.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+  assert.equal(await page.title(), 'sweetspot — bat design explorer');
+  assert.equal(await page.locator('select[name="preset"]').inputValue(), 'paper-wood');
+
+  const bat = { preset: 'paper-wood' };
+  const properties = await apiPost(url, '/v1/bat/properties', { bat });
+  assert.equal(properties.status, 200);
+  assert.equal(
+    Number(await page.locator('#properties tr[data-key="mass_kg"] td[data-si]').getAttribute('data-si')),
+    properties.body.mass_kg,
+  );
+  assert.equal(
+    Number(await page.locator('#properties tr[data-key="mass_kg"] td[data-imperial]').getAttribute('data-imperial')),
+    properties.body.imperial.weight_oz,
+  );
+
+  const sweet = await apiPost(url, '/v1/sweet-spot', { bat, outputs: SWEET, options: { curve_samples: 121 } });
+  assert.equal(sweet.status, 200);
+  assert.equal((await markerOf(page, 'max_exit_speed')).positionM, sweet.body.max_exit_speed.position_from_knob_m);
+  assert.equal(
+    (await markerOf(page, 'center_of_percussion')).positionM,
+    sweet.body.center_of_percussion.position_from_knob_m,
+  );
+  assert.equal((await markerOf(page, 'vibration_node')).positionM, sweet.body.vibration_node.position_from_knob_m);
+  const zone = page.locator('#curve-chart .u-zone');
+  assert.equal(Number(await zone.getAttribute('data-from-m')), sweet.body.sweet_zone.from_knob_m);
+  assert.equal(Number(await zone.getAttribute('data-to-m')), sweet.body.sweet_zone.to_knob_m);
+  assert.equal(await page.locator('#curve-chart canvas').count(), 1);
+  // The drawing: one bat with the markers, to scale (viewBox width = length in mm).
+  assert.equal(await page.locator('#bat-drawing g.bat.main').count(), 1);
+  assert.equal(Number(await page.locator('#bat-drawing').getAttribute('data-length-m')), 0.855);
+  assert.equal(await page.locator('#bat-drawing g.mark').count(), 3);
+
+  const modes = await apiPost(url, '/v1/bat/modes', { bat, modes: 2, shape_samples: 81 });
+  assert.equal(
+    await page.locator('#modes-chart').getAttribute('data-frequencies-hz'),
+    modes.body.modes.map((m) => m.frequency_hz).join(','),
+  );
+  assert.equal(await page.locator('#modes-chart .u-legend .u-series').count(), 3); // x + 2 modes
+
+  // The variants: the paper's cork at 260 and 320 kg/m3, hollow aluminium, side by side.
+  await page.waitForSelector('#compare-table[data-variants]');
+  assert.equal(
+    await page.locator('#compare-table').getAttribute('data-variants'),
+    'baseline,cork-260,cork-320,aluminium',
+  );
+  assert.equal(await page.locator('#compare-table svg.mini .fill').count(), 2);
+  assert.equal(await page.locator('#compare-table svg.mini .hollow').count(), 1);
+  const cork = await apiPost(url, '/v1/compare', {
+    baseline: bat,
+    variants: [
+      {
+        name: 'cork-320',
+        bat: {
+          ...bat,
+          fill: {
+            material: { name: 'cork-320', density_kg_m3: 320, youngs_modulus_pa: 2e7 },
+            diameter_m: 0.0254,
+            depth_m: 0.254,
+          },
+        },
+      },
+    ],
+  });
+  const corkMass = await page.locator('#compare-table tbody tr:first-child td').nth(2).getAttribute('data-value');
+  assert.equal(Number(corkMass), cork.body.rows[1].properties.mass_kg);
+  await shot(page, '01-loaded');
+});
+
+scenario('change the bat: the curve and its markers move, to the API values', async ({ page, url }) => {
+  const before = await markerOf(page, 'max_exit_speed');
+  let rev = await revision(page);
+  await page.selectOption('select[name="preset"]', 'wood-34-ash');
+  await waitForRefresh(page, rev);
+  const ash = await apiPost(url, '/v1/sweet-spot', {
+    bat: { preset: 'wood-34-ash' },
+    outputs: SWEET,
+    options: { curve_samples: 121 },
+  });
+  const after = await markerOf(page, 'max_exit_speed');
+  assert.equal(after.positionM, ash.body.max_exit_speed.position_from_knob_m);
+  assert.notEqual(after.positionM, before.positionM);
+  assert.notEqual(after.xPx, before.xPx);
+  assert.equal(
+    Number(await page.locator('#curve-chart').getAttribute('data-max-exit-speed-mps')),
+    ash.body.max_exit_speed.exit_speed_mps,
+  );
+  await shot(page, '02-wood-34-ash');
+
+  // A hollow bat: the shell is drawn.
+  rev = await revision(page);
+  await page.selectOption('select[name="preset"]', 'bbcor-33-aluminium');
+  await waitForRefresh(page, rev);
+  assert.equal(await page.locator('#bat-drawing g.bat.metal path.hollow').count(), 1);
+
+  // Back to the paper's bat as three segments, then a thinner barrel.
+  rev = await revision(page);
+  await page.selectOption('select[name="preset"]', 'paper-wood');
+  await waitForRefresh(page, rev);
+  rev = await revision(page);
+  await page.selectOption('select[name="shape"]', 'three_segment');
+  await waitForRefresh(page, rev);
+  const paper = await markerOf(page, 'max_exit_speed');
+  rev = await revision(page);
+  await page.fill('input[name="barrel_radius_m"]', '0.03');
+  await page.press('input[name="barrel_radius_m"]', 'Tab');
+  await waitForRefresh(page, rev);
+  const bat = {
+    preset: 'paper-wood',
+    three_segment: {
+      length_m: 0.855,
+      handle_radius_m: 0.0125,
+      barrel_radius_m: 0.03,
+      taper_start_m: 0.3459,
+      taper_end_m: 0.6423,
+    },
+  };
+  const thin = await apiPost(url, '/v1/sweet-spot', { bat, outputs: SWEET, options: { curve_samples: 121 } });
+  const moved = await markerOf(page, 'max_exit_speed');
+  assert.equal(moved.positionM, thin.body.max_exit_speed.position_from_knob_m);
+  assert.notEqual(moved.positionM, paper.positionM);
+  assert.equal(
+    (await markerOf(page, 'center_of_percussion')).positionM,
+    thin.body.center_of_percussion.position_from_knob_m,
+  );
+  // A cork fill from the form is drawn in the bat.
+  rev = await revision(page);
+  await page.selectOption('select[name="fill_material"]', 'cork');
+  await waitForRefresh(page, rev);
+  assert.equal(await page.locator('#bat-drawing g.bat.main rect.fill').count(), 1);
+  await shot(page, '03-three-segment-cork');
+});
+
+scenario('a bad input shows the API message beside the field', async ({ page, url }) => {
+  const rev = await revision(page);
+  await page.fill('input[name="barrel_radius_m"]', '-0.01');
+  await page.press('input[name="barrel_radius_m"]', 'Tab');
+  await page.waitForSelector('body[data-state="error"]', { timeout: 20000 });
+  const bat = {
+    preset: 'paper-wood',
+    three_segment: {
+      length_m: 0.855,
+      handle_radius_m: 0.0125,
+      barrel_radius_m: -0.01,
+      taper_start_m: 0.3459,
+      taper_end_m: 0.6423,
+    },
+    fill: { material: 'cork', diameter_m: 0.0254, depth_m: 0.254 },
+  };
+  const refused = await apiPost(url, '/v1/bat/properties', { bat });
+  assert.equal(refused.status, 400);
+  assert.equal(refused.body.field, 'bat.three_segment.barrel_radius_m');
+  const slot = page.locator('[data-error-for="bat.three_segment.barrel_radius_m"]');
+  await slot.waitFor({ state: 'visible' });
+  assert.equal(await slot.textContent(), `${refused.body.message} (${refused.body.code})`);
+  assert.equal(await page.locator('input[name="barrel_radius_m"]').getAttribute('aria-invalid'), 'true');
+  // Beside the field: the message's box is just below the input.
+  const input = await page.locator('input[name="barrel_radius_m"]').boundingBox();
+  const box = await slot.boundingBox();
+  assert.ok(
+    Math.abs(box.y - (input.y + input.height)) < 30,
+    `message at y=${box.y}, input ends at ${input.y + input.height}`,
+  );
+  await shot(page, '04-bad-input');
+
+  // A fixed input clears the message.
+  await page.fill('input[name="barrel_radius_m"]', '0.035');
+  await page.press('input[name="barrel_radius_m"]', 'Tab');
+  await waitForRefresh(page, rev);
+  assert.equal(await slot.isVisible(), false);
+  assert.equal(await page.locator('input[name="barrel_radius_m"]').getAttribute('aria-invalid'), null);
+
+  // Text that is not a number goes to the API as text: the API says what is wrong.
+  const fixed = await revision(page);
+  await page.fill('input[name="ball_mass_kg"]', 'heavy');
+  await page.press('input[name="ball_mass_kg"]', 'Tab');
+  const mass = page.locator('[data-error-for="ball.mass_kg"]');
+  await mass.waitFor({ state: 'visible' });
+  const text = await apiPost(url, '/v1/sweet-spot', { bat: { preset: 'paper-wood' }, ball: { mass_kg: 'heavy' } });
+  assert.equal(text.status, 400);
+  assert.equal(await mass.textContent(), `${text.body.message} (${text.body.code})`);
+  await page.fill('input[name="ball_mass_kg"]', '');
+  await page.press('input[name="ball_mass_kg"]', 'Tab');
+  await waitForRefresh(page, fixed);
+  assert.equal(await mass.isVisible(), false);
+});
+
+scenario('run an optimisation: progress, then the optimised profile over the original', async ({ page, url }) => {
+  let rev = await revision(page);
+  await page.selectOption('select[name="fill_material"]', '');
+  await waitForRefresh(page, rev);
+  rev = await revision(page);
+  await page.selectOption('select[name="shape"]', 'preset');
+  await waitForRefresh(page, rev);
+  await page.click('#optimize-run');
+  await page.waitForSelector('#optimize-progress:not([hidden])', { timeout: 10000 });
+  await page.waitForSelector('#optimize-state[data-state="done"]', { timeout: 60000 });
+  const id = await page.locator('#optimize-state').getAttribute('data-job-id');
+  const result = await (await fetch(`${url}/v1/jobs/${id}/result`)).json();
+  assert.equal(result.summary.termination, 'converged');
+  assert.equal(await page.locator('#optimize-drawing g.bat.original').count(), 1);
+  assert.equal(await page.locator('#optimize-drawing g.bat.optimised').count(), 1);
+  const shown = await page.locator('#optimize-result tbody tr').nth(1).locator('td').first().getAttribute('data-value');
+  assert.equal(Number(shown), result.objective_value);
+  assert.equal(
+    Number(
+      await page
+        .locator('#optimize-progress')
+        .inputValue()
+        .catch(() => 1),
+    ) >= 0,
+    true,
+  );
+  await page.locator('#optimize-section').screenshot({ path: path.join(artifacts, '05-optimised.png') });
+});
+
+scenario('cancel a running optimisation', async ({ page, url }) => {
+  // Slow on purpose: the widest sweet zone, 64 starts, a 30 s budget.
+  await page.selectOption('select[name="objective"]', 'widest_sweet_zone');
+  await page.fill('input[name="starts"]', '64');
+  await page.fill('input[name="max_time_s"]', '30');
+  await page.click('#optimize-run');
+  await page.waitForSelector('#optimize-progress:not([hidden])', { timeout: 10000 });
+  await page.waitForSelector('#optimize-state[data-state="running"]', { timeout: 10000 });
+  await page.screenshot({ path: path.join(artifacts, '06-running.png'), fullPage: true });
+  const id = await page.locator('#optimize-state').getAttribute('data-job-id');
+  const clicked = Date.now();
+  await page.click('#optimize-cancel');
+  await page.waitForSelector('#optimize-state[data-state="cancelled"]', { timeout: 30000 });
+  const seconds = (Date.now() - clicked) / 1000;
+  const job = await (await fetch(`${url}/v1/jobs/${id}`)).json();
+  assert.equal(job.state, 'cancelled');
+  assert.equal(job.cancel_requested, true);
+  assert.ok(seconds < 15, `cancelled after ${seconds} s`);
+  const result = await fetch(`${url}/v1/jobs/${id}/result`);
+  assert.equal(result.status, 409);
+  assert.equal(await page.locator('#optimize-run').isEnabled(), true);
+  console.log(`    (cancelled ${seconds.toFixed(2)} s after the click)`);
+  await page.locator('#optimize-section').screenshot({ path: path.join(artifacts, '07-cancelled.png') });
+});
+
+scenario('an optimisation the API refuses shows the message beside the field', async ({ page }) => {
+  await page.selectOption('select[name="objective"]', 'max_exit_speed');
+  await page.fill('input[name="starts"]', '1000');
+  await page.click('#optimize-run');
+  const slot = page.locator('#optimize-form [data-error-for="options.starts"]');
+  await slot.waitFor({ state: 'visible', timeout: 30000 });
+  assert.match(await slot.textContent(), /^options\.starts = 1000: /);
+  await page.fill('input[name="starts"]', '4');
+});
+
+// ---- run -------------------------------------------------------------------
+
+const started = Date.now();
+const failures = [];
+const browser = await chromium.launch({
+  executablePath: args.chromium,
+  headless: true,
+  args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
+});
+const server = await startServer('server');
+let page;
+try {
+  const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+  page = await context.newPage();
+  const pageErrors = [];
+  page.on('pageerror', (error) => pageErrors.push(error.message));
+  page.on('console', (message) => {
+    // The browser logs every 4xx answer ("Failed to load resource"): those are the test's.
+    if (message.type() === 'error' && !/Failed to load resource/.test(message.text())) pageErrors.push(message.text());
+  });
+  for (const { name, fn } of scenarios) {
+    const t0 = Date.now();
+    try {
+      await fn({ page, url: server.url });
+      assert.deepEqual(pageErrors, [], 'errors in the page');
+      console.log(`ok    ${name} (${((Date.now() - t0) / 1000).toFixed(1)} s)`);
+    } catch (error) {
+      failures.push(name);
+      console.log(`FAIL  ${name} (${((Date.now() - t0) / 1000).toFixed(1)} s)\n${error.stack}`);
+      await shot(page, `FAIL-${failures.length}`).catch(() => {});
+      break; // Later scenarios start from this one's page.
+    }
+  }
+} finally {
+  await server.stop();
+}
+
+// The page with a token configured: static files load without it, the page asks for it.
+if (!failures.length) {
+  const guarded = await startServer('server-with-token', { SWEETSPOT_AUTH_TOKEN: TOKEN });
+  const t0 = Date.now();
+  const name = 'a server with a token: the page asks for it and then works';
+  try {
+    const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+    const tokenPage = await context.newPage();
+    const response = await tokenPage.goto(guarded.url);
+    assert.equal(response.status(), 200);
+    await tokenPage.waitForSelector('#token-form:not([hidden])', { timeout: 20000 });
+    await tokenPage.fill('#token', TOKEN);
+    await tokenPage.click('#token-form button[type="submit"]');
+    await tokenPage.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+    const sweet = await apiPost(
+      guarded.url,
+      '/v1/sweet-spot',
+      { bat: { preset: 'paper-wood' }, outputs: SWEET, options: { curve_samples: 121 } },
+      { Authorization: `Bearer ${TOKEN}` },
+    );
+    assert.equal(
+      (await markerOf(tokenPage, 'max_exit_speed')).positionM,
+      sweet.body.max_exit_speed.position_from_knob_m,
+    );
+    assert.equal(await tokenPage.evaluate(() => sessionStorage.getItem('sweetspot-token')), TOKEN);
+    await tokenPage.screenshot({ path: path.join(artifacts, '08-token.png') });
+    console.log(`ok    ${name} (${((Date.now() - t0) / 1000).toFixed(1)} s)`);
+  } catch (error) {
+    failures.push(name);
+    console.log(`FAIL  ${name}\n${error.stack}`);
+  } finally {
+    await guarded.stop();
+  }
+}
+await browser.close();
+
+const total = scenarios.length + 1;
+console.log(
+  `${failures.length ? `FAILED (${failures.join('; ')}; later scenarios not run)` : 'passed'}: ` +
+    `${total} scenarios, ${failures.length} failed, in ${((Date.now() - started) / 1000).toFixed(1)} s; ` +
+    `screenshots and server logs in ${artifacts}`,
+);
+process.exit(failures.length ? 1 : 0);
