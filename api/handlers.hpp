@@ -16,8 +16,13 @@ namespace sweetspot::api {
 Response HandleOpenApi(const Request& request, const Context& context);
 /// GET /metrics: Prometheus text from the server (501 where there is no server).
 Response HandleMetrics(const Request& request, const Context& context);
-/// GET /v1/version: versions of sweetspot and its libraries.
+/// GET /v1/version: versions of sweetspot and its libraries, and the speed-vs-error report's date.
 Response HandleVersion(const Request& request, const Context& context);
+/// GET /v1/speed-vs-error: the speed-versus-error report (docs/speed-vs-error.json, embedded):
+/// time per evaluation (s) against error for every model and numeric setting.
+Response HandleSpeedVsError(const Request& request, const Context& context);
+/// When the embedded speed-vs-error report was generated (UTC, ISO 8601), or null.
+nlohmann::json SpeedVsErrorGenerated();
 /// GET /v1/materials: the material catalogue with sources.
 Response HandleMaterials(const Request& request, const Context& context);
 /// GET /v1/presets: the preset bats with their properties and sources.

@@ -75,7 +75,13 @@ Json EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
   }
   scene.outputs = outputs.scene;
   std::string why;
-  if (error.code.empty() && !scene.IsValid(&why)) CoreRefusal(why, "", &error);
+  if (error.code.empty()) {
+    // A row of properties only names no scene output; the scene (bat, ball,
+    // swing, cor) must still be valid, so it is checked as if it named one.
+    core::Scene check = scene;
+    if (check.outputs.empty()) check.outputs = {core::SceneOutput::kMaxExitSpeed};
+    if (!check.IsValid(&why)) CoreRefusal(why, "", &error);
+  }
   if (!error.code.empty()) {
     return {{"feasible", false},
             {"error", {{"code", error.code}, {"message", error.message}, {"field", error.field}}}};
@@ -85,11 +91,12 @@ Json EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
   if (!scene.outputs.empty()) {
     result = core::EvaluateScene(scene, options);
     if (!result.summary.IsSolutionUsable()) {
-      return {{"feasible", false},
-              {"error",
-               {{"code", result.missing_model.empty() ? "InvalidValue" : "NotImplemented"},
-                {"message", result.summary.message},
-                {"field", nullptr}}}};
+      // The same code and field /v1/sweet-spot would answer for this design.
+      const Response failure =
+          CoreFailure(result.summary, result.missing_model,
+                      result.refused_field.empty() ? "outputs" : result.refused_field,
+                      /*options_object=*/true);
+      return {{"feasible", false}, {"error", failure.body}};
     }
     Json rendered = SceneResultToJson(result);
     for (const core::SceneOutput output : scene.outputs) {

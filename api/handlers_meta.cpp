@@ -33,7 +33,8 @@ Response HandleVersion(const Request&, const Context&) {
            {"nlohmann_json", std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." +
                                  std::to_string(NLOHMANN_JSON_VERSION_MINOR) + "." +
                                  std::to_string(NLOHMANN_JSON_VERSION_PATCH)},
-           {"compiler", __VERSION__}},
+           {"compiler", __VERSION__},
+           {"speed_vs_error_generated", SpeedVsErrorGenerated()}},
   };
 }
 

@@ -56,7 +56,8 @@ Response HandleSweetSpot(const Request& request, const Context& context) {
   const core::SceneResult result = core::EvaluateScene(scene, options);
   if (!result.summary.IsSolutionUsable()) {
     return CoreFailure(result.summary, result.missing_model,
-                       result.refused_field.empty() ? "outputs" : result.refused_field);
+                       result.refused_field.empty() ? "outputs" : result.refused_field,
+                       /*options_object=*/true);
   }
   Json out = SceneResultToJson(result);
   out["properties"] = PropertiesToJson(result.mass_properties, result.length_m);
@@ -168,7 +169,8 @@ Response HandleCompare(const Request& request, const Context& context) {
     const core::SceneResult result = core::EvaluateScene(bat_scene, options);
     if (!result.summary.IsSolutionUsable()) {
       return CoreFailure(result.summary, result.missing_model,
-                         result.refused_field.empty() ? field : result.refused_field);
+                         result.refused_field.empty() ? field : result.refused_field,
+                         /*options_object=*/true);
     }
     Json row = SceneResultToJson(result);
     row["name"] = bats[i].first;

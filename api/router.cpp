@@ -41,6 +41,10 @@ const std::vector<Route>& Routes() {
        HandleMetrics},
       {"GET", "/v1/version", "Versions of sweetspot and of the libraries it was built with.",
        HandleVersion},
+      {"GET", "/v1/speed-vs-error",
+       "Time per evaluation against error for every model and numeric setting "
+       "(docs/speed-vs-error.md); the service's defaults are marked is_auto.",
+       HandleSpeedVsError},
       {"GET", "/v1/materials", "The material catalogue with properties and sources.",
        HandleMaterials},
       {"GET", "/v1/presets", "The preset bats with their properties and sources.",

@@ -256,12 +256,17 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
 }
 
 Response CoreFailure(const core::Summary& summary, const std::string& missing_model,
-                     const std::string& field) {
+                     const std::string& field, bool options_object) {
   if (!missing_model.empty()) {
     return ErrorResponse(501, "NotImplemented", summary.message, field);
   }
   if (summary.termination == core::Termination::kInvalidInput) {
-    const std::string core_field = FieldOf(summary.message);
+    std::string core_field = FieldOf(summary.message);
+    const std::string head = core_field.substr(0, core_field.find_first_of(".["));
+    if (options_object && !core_field.empty() && head != "bat" && head != "ball" &&
+        head != "swing" && head != "cor" && head != "outputs" && head != "inertia_model") {
+      core_field = "options." + core_field;
+    }
     return ErrorResponse(400, "InvalidValue", summary.message,
                          core_field.empty() ? field : core_field);
   }

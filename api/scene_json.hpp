@@ -44,9 +44,13 @@ void ClampToLimits(const ApiLimits& limits, core::HertzOptions* options);
 void ClampToLimits(const ApiLimits& limits, core::FlexibleOptions* options);
 
 /// The error response for a core result that was refused or failed: 501 for
-/// a missing model, 400 for invalid input, 500 for a failure.
+/// a missing model, 400 for invalid input (field from the core message when it
+/// names one), 422 ModelFailed for a model that could not finish. With
+/// `options_object`, a field the core names that is not a scene field (bat,
+/// ball, swing, cor, outputs, inertia_model) is one of the request's
+/// "options" and is reported as "options.<field>".
 Response CoreFailure(const core::Summary& summary, const std::string& missing_model,
-                     const std::string& field);
+                     const std::string& field, bool options_object = false);
 
 /// The summary block {termination, message, backend, raw_status, iterations,
 /// evaluations, error_estimate, solve_time_s, models_used, warnings}.

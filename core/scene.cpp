@@ -237,6 +237,14 @@ class FlexibleModes {
     const auto t0 = Clock::now();
     auto modes = CachedBatModes(*scene_.bat, o, options_.modes_cache, hit);
     book_->Add(kFlexibleBeamModel, Seconds(t0), 1);
+    // Here the mesh bound is the scene's flexible.max_elements: name it so (a refusal's
+    // message starts with its field, which the API reports).
+    if (modes && modes->summary.termination == Termination::kInvalidInput &&
+        modes->summary.message.rfind("max_elements = ", 0) == 0) {
+      auto renamed = std::make_shared<BatModes>(*modes);
+      renamed->summary.message = "flexible." + renamed->summary.message;
+      modes = std::move(renamed);
+    }
     return modes;
   }
   const Scene& scene_;
@@ -933,7 +941,8 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
       std::string cop_why;
       auto cop = CenterOfPercussion(r.mp, scene.swing.hands_from_knob_m, r.length_m, &cop_why);
       if (!cop.has_value()) {
-        note(Termination::kInvalidInput, "center_of_percussion: " + cop_why);
+        // The core message first ("swing.hands_from_knob_m = ...: rule"): it names the field.
+        note(Termination::kInvalidInput, cop_why + " (center_of_percussion)");
       } else {
         if (cop->placement == Placement::kBeyondTip) {
           s.warnings.push_back("center_of_percussion: beyond the tip (" +

@@ -31,6 +31,14 @@ constexpr OutputName kOutputNames[] = {
     {SceneOutput::kLeastStingZone, "least_sting_zone"},
 };
 
+// A position x in a profile's coordinate (origin o from the knob) as metres from the knob, for
+// x in [lo, hi] = [-o, L - o]: the ends map to 0 and L exactly, the rest is clamped to [0, L].
+double FromProfile(double x, double o, double lo, double hi, double length_m) {
+  if (x <= lo) return 0.0;
+  if (x >= hi) return length_m;
+  return std::clamp(x + o, 0.0, length_m);
+}
+
 }  // namespace
 
 const char* SceneOutputName(SceneOutput output) {
@@ -78,7 +86,9 @@ MaxExitSpeedResult ClosedFormMaxExitSpeed(const ExitSpeedProfile& profile, doubl
       best_x = cand;
     }
   }
-  out.position_from_knob_m = best_x + profile.origin_from_knob_m;
+  // Back to the knob's coordinate; an end of the bat is that end exactly (o + (L - o) need not
+  // round to L: with the pivot 100 m away the tip came back as L + 4e-15, off the bat).
+  out.position_from_knob_m = FromProfile(best_x, profile.origin_from_knob_m, lo, hi, length_m);
   out.exit_speed_mps = best_f;
   out.unconstrained_position_from_knob_m = mx.x_m + profile.origin_from_knob_m;
   if (mx.flat) {
@@ -130,8 +140,8 @@ SweetZoneResult ClosedFormSweetZone(const ExitSpeedProfile& profile, double leng
   out.clipped_at_tip = zone.hi_m > hi;
   const double zlo = std::clamp(zone.lo_m, lo, hi);
   const double zhi = std::clamp(zone.hi_m, lo, hi);
-  out.from_knob_m = zlo + o;
-  out.to_knob_m = zhi + o;
+  out.from_knob_m = FromProfile(zlo, o, lo, hi, length_m);
+  out.to_knob_m = FromProfile(zhi, o, lo, hi, length_m);
   // Each end moves by (rounding of f) / |f'| there; at a double root (tolerance -> 0) by
   // sqrt(2 rounding / |f''|) instead.
   const ProfileMaximum mx = profile.Maximum();

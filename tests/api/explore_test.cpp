@@ -99,6 +99,41 @@ TEST(ExploreTest, FailedDesignsAreRowsNotFailures) {
   EXPECT_TRUE(r.body["rows"][0]["feasible"].get<bool>());
 }
 
+TEST(ExploreTest, PropertiesOnlyRowsAreFeasible) {
+  // Found by the hard-case suite: a sweep asking only for properties marked
+  // every design infeasible ("outputs: empty").
+  const Json body = Json::parse(R"({"bat": {"preset": "paper-wood"},
+      "parameters": [{"path": "ball.speed_mps", "min": 10, "max": 20, "count": 2}],
+      "outputs": ["properties"]})");
+  const Response r = Explore(body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["summary"]["failed"], 0);
+  for (const Json& row : r.body["rows"]) {
+    EXPECT_TRUE(row["feasible"].get<bool>()) << row.dump();
+    EXPECT_NEAR(row["properties"]["mass_kg"].get<double>(), 1.0078, 1e-4);  // paper-wood
+    EXPECT_FALSE(row.contains("max_exit_speed"));
+  }
+}
+
+TEST(ExploreTest, AModelThatCannotFinishIsAModelFailedRow) {
+  // The same code /v1/sweet-spot answers (422 ModelFailed), not InvalidValue.
+  const Json body = Json::parse(R"({"bat": {"preset": "paper-wood"},
+      "parameters": [{"path": "cor", "min": 0.4, "max": 0.5, "count": 2}],
+      "outputs": ["max_exit_speed"],
+      "options": {"model": "hertz", "hertz": {"max_steps": 10}}})");
+  const Response r = Explore(body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["summary"]["failed"], 2);
+  const Json& row = r.body["rows"][0];
+  EXPECT_FALSE(row["feasible"].get<bool>());
+  EXPECT_EQ(row["error"]["code"], "ModelFailed") << row.dump();
+  Json single = Json::parse(R"({"bat": {"preset": "paper-wood"}, "cor": 0.4,
+      "outputs": ["max_exit_speed"], "options": {"model": "hertz", "hertz": {"max_steps": 10}}})");
+  const Response s = Dispatch({"POST", "/v1/sweet-spot", single.dump()}, Context{});
+  EXPECT_EQ(s.status, 422);
+  EXPECT_EQ(s.body["code"], row["error"]["code"]);
+}
+
 TEST(ExploreTest, ParetoFrontOverTwoObjectives) {
   Json body = CorkSweep();
   body["parameters"] = {{{"path", "fill.depth_m"}, {"min", 0.0}, {"max", 0.3}, {"count", 7}},

@@ -187,6 +187,20 @@ TEST(CompareEndpointTest, CorkLowersTheMassAndSweetSpotSpeed) {
   EXPECT_LT(r.body["rows"][1]["deltas"]["max_exit_speed_mps"].get<double>(), 0.0);
 }
 
+TEST(SweetSpotEndpointTest, CoreRefusalsOfOptionsNameTheRequestField) {
+  // Found by the hard-case suite: the field lacked its "options." prefix.
+  const Response r = Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"},
+      "outputs": ["exit_speed_curve"], "options": {"curve_positions_from_knob_m": [-1e-300]}})");
+  EXPECT_EQ(r.status, 400) << r.body.dump();
+  EXPECT_EQ(r.body["field"], "options.curve_positions_from_knob_m[0]") << r.body.dump();
+  // A scene field keeps its own name: hands beyond the balance point (0.6090 m)
+  // leave no centre of percussion.
+  const Response s = Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"},
+      "outputs": ["center_of_percussion"], "swing": {"hands_from_knob_m": 0.7}})");
+  EXPECT_EQ(s.status, 400) << s.body.dump();
+  EXPECT_EQ(s.body["field"], "swing.hands_from_knob_m") << s.body.dump();
+}
+
 TEST(CompareEndpointTest, TooManyVariantsIs413) {
   std::string variants;
   for (int i = 0; i < 65; ++i) {
