@@ -9,6 +9,8 @@
 #include <limits>
 #include <new>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <nlopt.hpp>
 
@@ -233,6 +235,62 @@ void ProjectOntoConstraints(const ScaledDesignNlp& nlp, const LocalSolveSettings
   }
 }
 
+// Adds every constraint of `nlp` to `opt` as NLopt constraints on the scaled problem:
+// equalities as one equality, ranges as one or two inequalities (g - upper <= 0,
+// lower - g <= 0). `constraints` keeps their callback data alive (reserved up front so the
+// pointers stay valid). Constraint is NloptConstraint or CobylaConstraint.
+template <typename Context, typename Constraint>
+void AddConstraints(nlopt::opt& opt, ScaledDesignNlp& nlp, Context* context, double tol,
+                    nlopt::func value, std::vector<Constraint>* constraints) {
+  std::vector<double> lower, upper;
+  nlp.ConstraintBounds(&lower, &upper);
+  constraints->reserve(2 * static_cast<std::size_t>(nlp.m()));
+  for (int k = 0; k < nlp.m(); ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    if (lower[kk] == upper[kk]) {
+      constraints->push_back({context, k, upper[kk], 1.0});
+      opt.add_equality_constraint(value, &constraints->back(), tol);
+      continue;
+    }
+    if (std::isfinite(upper[kk])) {
+      constraints->push_back({context, k, upper[kk], 1.0});
+      opt.add_inequality_constraint(value, &constraints->back(), tol);
+    }
+    if (std::isfinite(lower[kk])) {
+      constraints->push_back({context, k, lower[kk], -1.0});
+      opt.add_inequality_constraint(value, &constraints->back(), tol);
+    }
+  }
+}
+
+// Runs opt.optimize from s (left at the point NLopt returns) and maps every NLopt exception
+// to its result code, with the exception's text in *message where it has one.
+int RunOptimize(nlopt::opt& opt, std::vector<double>& s, std::string* message) {
+  double f = 0.0;
+  try {
+    return opt.optimize(s, f);
+  } catch (const nlopt::roundoff_limited&) {
+    return nlopt::ROUNDOFF_LIMITED;  // s holds the best point: keep it
+  } catch (const nlopt::forced_stop&) {
+    return nlopt::FORCED_STOP;
+  } catch (const std::invalid_argument& e) {
+    *message = e.what();
+    return nlopt::INVALID_ARGS;
+  } catch (const std::bad_alloc&) {
+    return nlopt::OUT_OF_MEMORY;
+  } catch (const std::runtime_error& e) {
+    *message = e.what();
+    return nlopt::FAILURE;
+  }
+}
+
+// NLopt's time budget: what is left until the deadline (at least 1 ms), s.
+double SecondsLeft(const LocalSolveSettings& settings) {
+  const double left_s =
+      std::chrono::duration<double>(settings.deadline - std::chrono::steady_clock::now()).count();
+  return std::max(left_s, 1e-3);
+}
+
 }  // namespace
 
 LocalSolveOutcome SolveWithCobyla(ScaledDesignNlp& nlp, const std::vector<double>& s0,
@@ -251,50 +309,15 @@ LocalSolveOutcome SolveWithCobyla(ScaledDesignNlp& nlp, const std::vector<double
     opt.set_lower_bounds(std::vector<double>(n, 0.0));
     opt.set_upper_bounds(std::vector<double>(n, 1.0));
     opt.set_min_objective(CobylaObjective, &context);
-    std::vector<double> lower, upper;
-    nlp.ConstraintBounds(&lower, &upper);
     std::vector<CobylaConstraint> constraints;
-    constraints.reserve(2 * static_cast<std::size_t>(nlp.m()));
-    const double tol = settings.constraint_tolerance;
-    for (int k = 0; k < nlp.m(); ++k) {
-      const auto kk = static_cast<std::size_t>(k);
-      if (lower[kk] == upper[kk]) {
-        constraints.push_back({&context, k, upper[kk], 1.0});
-        opt.add_equality_constraint(CobylaConstraintValue, &constraints.back(), tol);
-        continue;
-      }
-      if (std::isfinite(upper[kk])) {
-        constraints.push_back({&context, k, upper[kk], 1.0});
-        opt.add_inequality_constraint(CobylaConstraintValue, &constraints.back(), tol);
-      }
-      if (std::isfinite(lower[kk])) {
-        constraints.push_back({&context, k, lower[kk], -1.0});
-        opt.add_inequality_constraint(CobylaConstraintValue, &constraints.back(), tol);
-      }
-    }
+    AddConstraints(opt, nlp, &context, settings.constraint_tolerance, CobylaConstraintValue,
+                   &constraints);
     const double rel = std::max(settings.tolerance, kDerivativeFreeTolerance);
     opt.set_ftol_rel(rel);
     opt.set_xtol_rel(rel);
     opt.set_maxeval(settings.max_iterations);  // one evaluation per COBYLA iteration
-    const double left_s =
-        std::chrono::duration<double>(settings.deadline - std::chrono::steady_clock::now()).count();
-    opt.set_maxtime(std::max(left_s, 1e-3));
-    double f = 0.0;
-    try {
-      status = opt.optimize(s, f);
-    } catch (const nlopt::roundoff_limited&) {
-      status = nlopt::ROUNDOFF_LIMITED;
-    } catch (const nlopt::forced_stop&) {
-      status = nlopt::FORCED_STOP;
-    } catch (const std::invalid_argument& e) {
-      status = nlopt::INVALID_ARGS;
-      out.message = e.what();
-    } catch (const std::bad_alloc&) {
-      status = nlopt::OUT_OF_MEMORY;
-    } catch (const std::runtime_error& e) {
-      status = nlopt::FAILURE;
-      out.message = e.what();
-    }
+    opt.set_maxtime(SecondsLeft(settings));
+    status = RunOptimize(opt, s, &out.message);
     out.iterations = opt.get_numevals();
   } catch (const std::exception& e) {
     status = nlopt::FAILURE;
@@ -341,50 +364,14 @@ LocalSolveOutcome SolveWithNlopt(ScaledDesignNlp& nlp, const std::vector<double>
     opt.set_lower_bounds(std::vector<double>(n, 0.0));
     opt.set_upper_bounds(std::vector<double>(n, 1.0));
     opt.set_min_objective(Objective, &context);
-    std::vector<double> lower, upper;
-    nlp.ConstraintBounds(&lower, &upper);
     std::vector<NloptConstraint> constraints;
-    constraints.reserve(2 * static_cast<std::size_t>(nlp.m()));
-    const double tol = settings.constraint_tolerance;
-    for (int k = 0; k < nlp.m(); ++k) {
-      const auto kk = static_cast<std::size_t>(k);
-      if (lower[kk] == upper[kk]) {
-        constraints.push_back({&context, k, upper[kk], 1.0});
-        opt.add_equality_constraint(Constraint, &constraints.back(), tol);
-        continue;
-      }
-      if (std::isfinite(upper[kk])) {
-        constraints.push_back({&context, k, upper[kk], 1.0});
-        opt.add_inequality_constraint(Constraint, &constraints.back(), tol);
-      }
-      if (std::isfinite(lower[kk])) {
-        constraints.push_back({&context, k, lower[kk], -1.0});
-        opt.add_inequality_constraint(Constraint, &constraints.back(), tol);
-      }
-    }
+    AddConstraints(opt, nlp, &context, settings.constraint_tolerance, Constraint, &constraints);
     opt.set_ftol_rel(settings.tolerance);
     opt.set_xtol_rel(settings.tolerance);
     // SLSQP counts evaluations, not iterations: allow a few per iteration.
     opt.set_maxeval(20 * settings.max_iterations);
-    const double left_s =
-        std::chrono::duration<double>(settings.deadline - std::chrono::steady_clock::now()).count();
-    opt.set_maxtime(std::max(left_s, 1e-3));
-    double f = 0.0;
-    try {
-      status = opt.optimize(s, f);
-    } catch (const nlopt::roundoff_limited&) {
-      status = nlopt::ROUNDOFF_LIMITED;  // s holds the best point: keep it
-    } catch (const nlopt::forced_stop&) {
-      status = nlopt::FORCED_STOP;
-    } catch (const std::invalid_argument& e) {
-      status = nlopt::INVALID_ARGS;
-      out.message = e.what();
-    } catch (const std::bad_alloc&) {
-      status = nlopt::OUT_OF_MEMORY;
-    } catch (const std::runtime_error& e) {
-      status = nlopt::FAILURE;
-      out.message = e.what();
-    }
+    opt.set_maxtime(SecondsLeft(settings));
+    status = RunOptimize(opt, s, &out.message);
     out.iterations = opt.get_numevals();
   } catch (const std::exception& e) {
     status = nlopt::FAILURE;
