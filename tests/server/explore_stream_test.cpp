@@ -13,34 +13,19 @@
 #include <thread>
 #include <vector>
 
-#include "server/server.hpp"
+#include "tests/server/running_server.hpp"
 
 namespace sweetspot::server {
 namespace {
 
 using Json = nlohmann::json;
 
-class ExploreStreamTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    ServerConfig config;
-    config.port = 0;
-    config.threads = 4;
-    config.access_log = false;
-    config.jobs_db = kNoJobsDb;
-    server_ = std::make_unique<Server>(config);
-    std::string error;
-    ASSERT_TRUE(server_->Bind(&error)) << error;
-    thread_ = std::thread([this] { server_->Run(); });
-  }
-  void TearDown() override {
-    server_->Stop();
-    thread_.join();
-  }
-
-  std::unique_ptr<Server> server_;
-  std::thread thread_;
-};
+// Four handler threads: the streaming test and the health checks run side by side.
+ServerConfig StreamConfig() {
+  ServerConfig config;
+  config.threads = 4;
+  return config;
+}
 
 // A grid over the fill depth of the paper's bat with a cork fill.
 Json Sweep(int count, const char* format) {
@@ -52,8 +37,10 @@ Json Sweep(int count, const char* format) {
   return body;
 }
 
-TEST_F(ExploreStreamTest, RowsArriveChunkedAndEqualTheJsonAnswer) {
-  httplib::Client client("127.0.0.1", server_->port());
+TEST(ExploreStreamTest, RowsArriveChunkedAndEqualTheJsonAnswer) {
+  RunningServer server(StreamConfig());
+  ASSERT_TRUE(server.bound());
+  httplib::Client client("127.0.0.1", server.port());
   const int count = 2000;
   std::string streamed;
   std::vector<std::size_t> chunk_sizes;
@@ -109,9 +96,11 @@ TEST_F(ExploreStreamTest, RowsArriveChunkedAndEqualTheJsonAnswer) {
   }
 }
 
-TEST_F(ExploreStreamTest, ClientGoingAwayMidStreamStopsTheSweepAndTheServerKeepsServing) {
+TEST(ExploreStreamTest, ClientGoingAwayMidStreamStopsTheSweepAndTheServerKeepsServing) {
+  RunningServer server(StreamConfig());
+  ASSERT_TRUE(server.bound());
   {
-    httplib::Client client("127.0.0.1", server_->port());
+    httplib::Client client("127.0.0.1", server.port());
     std::size_t received = 0;
     httplib::Request request;
     request.method = "POST";
@@ -128,7 +117,7 @@ TEST_F(ExploreStreamTest, ClientGoingAwayMidStreamStopsTheSweepAndTheServerKeeps
     EXPECT_GE(received, 64u * 1024u);
   }
   // The worker that streamed is free again and the server answers at once.
-  httplib::Client client("127.0.0.1", server_->port());
+  httplib::Client client("127.0.0.1", server.port());
   client.set_read_timeout(std::chrono::seconds(5));
   for (int i = 0; i < 8; ++i) {
     const auto health = client.Get("/health");

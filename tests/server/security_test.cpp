@@ -5,36 +5,10 @@
 
 #include <thread>
 
-#include "server/server.hpp"
+#include "tests/server/running_server.hpp"
 
 namespace sweetspot::server {
 namespace {
-
-class RunningServer {
- public:
-  explicit RunningServer(ServerConfig config) : server_(Prepare(std::move(config))) {
-    std::string error;
-    bound_ = server_.Bind(&error);
-    if (bound_) thread_ = std::thread([this] { server_.Run(); });
-  }
-  ~RunningServer() {
-    server_.Stop();
-    if (thread_.joinable()) thread_.join();
-  }
-  bool bound() const { return bound_; }
-  httplib::Client Client() const { return httplib::Client("127.0.0.1", server_.port()); }
-
- private:
-  static ServerConfig Prepare(ServerConfig config) {
-    config.port = 0;
-    config.access_log = false;
-    config.jobs_db = kNoJobsDb;  // Jobs in memory: a shared default file would couple tests.
-    return config;
-  }
-  Server server_;
-  bool bound_ = false;
-  std::thread thread_;
-};
 
 TEST(SecurityTest, BearerTokenGuardsEverythingButHealth) {
   ServerConfig config;

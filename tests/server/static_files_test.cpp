@@ -14,6 +14,7 @@
 
 #include "server/config.hpp"
 #include "server/server.hpp"
+#include "tests/server/running_server.hpp"
 
 namespace sweetspot::server {
 namespace {
@@ -129,36 +130,9 @@ TEST(StaticFilesTest, WebRootFromFlagAndEnvironment) {
   EXPECT_NE(Usage("sweetspot-server").find("SWEETSPOT_WEB_ROOT"), std::string::npos);
 }
 
-// A Server with `config`, running on its own thread.
-class RunningServer {
- public:
-  explicit RunningServer(ServerConfig config) : server_(Prepare(std::move(config))) {
-    std::string error;
-    bound_ = server_.Bind(&error);
-    if (bound_) thread_ = std::thread([this] { server_.Run(); });
-  }
-  ~RunningServer() {
-    server_.Stop();
-    if (thread_.joinable()) thread_.join();
-  }
-  bool bound() const { return bound_; }
-  httplib::Client Client() const { return httplib::Client("127.0.0.1", server_.port()); }
-
- private:
-  static ServerConfig Prepare(ServerConfig config) {
-    config.port = 0;
-    config.threads = 2;
-    config.access_log = false;
-    config.jobs_db = kNoJobsDb;
-    return config;
-  }
-  Server server_;
-  bool bound_ = false;
-  std::thread thread_;
-};
-
 ServerConfig WithRoot(const fs::path& root) {
   ServerConfig config;
+  config.threads = 2;
   config.web_root = root.string();
   return config;
 }
