@@ -3,8 +3,8 @@
 // a Latin hypercube or a Sobol sequence; each design is one row (failed
 // designs are rows with an error, never fatal to the sweep); shards split a
 // sweep deterministically (design i belongs to shard i mod count).
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -128,9 +128,9 @@ struct Objective {
 // A validated sweep: everything needed to evaluate its designs, owned, so a
 // streamed answer can run it after the handler has returned.
 struct Sweep {
-  Json base;                            // the design template (bat + scene fields)
-  std::vector<Parameter> parameters;    // the swept fields
-  core::SweepPlan plan;                 // sampling, dimensions, seed
+  Json base;                               // the design template (bat + scene fields)
+  std::vector<Parameter> parameters;       // the swept fields
+  core::SweepPlan plan;                    // sampling, dimensions, seed
   std::vector<std::vector<double>> drawn;  // LHS / Sobol points (grids are enumerated)
   RowOutputs outputs;
   core::SceneOptions options;
@@ -435,9 +435,8 @@ Response HandleExplore(const Request& request, const Context& context) {
           RunSweep(*sweep, progress, [&line](Json row) { return line(row); });
       if (outcome.stopped) return false;
       if (outcome.cancelled) {
-        return line({{"error", {{"code", "Cancelled"},
-                                {"message", outcome.message},
-                                {"field", nullptr}}}});
+        return line(
+            {{"error", {{"code", "Cancelled"}, {"message", outcome.message}, {"field", nullptr}}}});
       }
       return line({{"summary", outcome.summary}});
     };

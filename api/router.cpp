@@ -20,8 +20,8 @@ bool PathMatches(std::string_view pattern, std::string_view path,
     path.remove_prefix(1);
     const std::string_view pattern_seg = pattern.substr(0, pattern.find('/'));
     const std::string_view path_seg = path.substr(0, path.find('/'));
-    const bool wildcard = pattern_seg.size() >= 2 && pattern_seg.front() == '{' &&
-                          pattern_seg.back() == '}';
+    const bool wildcard =
+        pattern_seg.size() >= 2 && pattern_seg.front() == '{' && pattern_seg.back() == '}';
     if (wildcard ? path_seg.empty() : pattern_seg != path_seg) return false;
     if (wildcard && parameter != nullptr) *parameter = std::string(path_seg);
     pattern.remove_prefix(pattern_seg.size());
@@ -47,8 +47,7 @@ const std::vector<Route>& Routes() {
        HandleSpeedVsError},
       {"GET", "/v1/materials", "The material catalogue with properties and sources.",
        HandleMaterials},
-      {"GET", "/v1/presets", "The preset bats with their properties and sources.",
-       HandlePresets},
+      {"GET", "/v1/presets", "The preset bats with their properties and sources.", HandlePresets},
       {"POST", "/v1/bat/properties",
        "Exact mass properties: mass, balance point, moments of inertia, volume.",
        HandleBatProperties, true},
@@ -61,8 +60,9 @@ const std::vector<Route>& Routes() {
       {"POST", "/v1/sweet-spot",
        "The sweet spot(s) of a scene: max exit speed, centre of percussion, sweet zone, curve.",
        HandleSweetSpot, true},
-      {"POST", "/v1/collision", "One impact with a chosen model (auto, rigid_pivot, free_bat, hertz).",
-       HandleCollision, true},
+      {"POST", "/v1/collision",
+       "One impact with a chosen model (auto, rigid_pivot, free_bat, hertz).", HandleCollision,
+       true},
       {"POST", "/v1/compare", "A baseline bat against variants: properties, sweet spot, deltas.",
        HandleCompare, true},
       {"POST", "/v1/optimize",
@@ -131,8 +131,7 @@ Response Dispatch(const Request& request, const Context& context, std::string* r
   return ErrorResponse(404, "NotFound", "no endpoint at path " + request.path);
 }
 
-Response ErrorResponse(int status, std::string_view code, std::string message,
-                       std::string field) {
+Response ErrorResponse(int status, std::string_view code, std::string message, std::string field) {
   nlohmann::json body{{"code", code}, {"message", std::move(message)}};
   body["field"] = field.empty() ? nlohmann::json(nullptr) : nlohmann::json(std::move(field));
   return {status, std::move(body)};

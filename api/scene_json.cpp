@@ -62,8 +62,8 @@ bool ReadOutputs(ObjectReader& reader, core::Scene* scene) {
   scene->outputs.clear();
   for (std::size_t i = 0; i < outputs->size(); ++i) {
     const Json& item = (*outputs)[i];
-    const auto parsed = item.is_string() ? core::ParseSceneOutput(item.get<std::string>())
-                                         : std::nullopt;
+    const auto parsed =
+        item.is_string() ? core::ParseSceneOutput(item.get<std::string>()) : std::nullopt;
     if (!parsed) {
       return reader.Fail("outputs",
                          "outputs[" + std::to_string(i) + "] = " + Show(item) +
@@ -95,8 +95,7 @@ void ClampToLimits(const ApiLimits& limits, core::SceneOptions* options) {
 }
 
 bool ReadFlexibleOptions(const Json& value, const std::string& path, const ApiLimits& limits,
-                         core::FlexibleOptions* options,
-                         ApiError* error) {
+                         core::FlexibleOptions* options, ApiError* error) {
   ObjectReader reader(value, path, error);
   std::string theory = core::BeamTheoryName(options->theory);
   reader.OptionalString("theory", &theory, {"timoshenko", "euler_bernoulli"});
@@ -213,7 +212,8 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
     reader.OptionalNumber("sweet_zone_tolerance_mps", NonNegative(1e3),
                           &options->sweet_zone_tolerance);
   }
-  const double max_samples = static_cast<double>(std::min<std::size_t>(limits.max_curve_samples, 10000));
+  const double max_samples =
+      static_cast<double>(std::min<std::size_t>(limits.max_curve_samples, 10000));
   long long samples = options->curve_samples;
   reader.OptionalInteger("curve_samples", 2, static_cast<long long>(max_samples), &samples);
   options->curve_samples = static_cast<int>(samples);
@@ -231,9 +231,9 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
     for (std::size_t i = 0; i < positions->size(); ++i) {
       const Json& p = (*positions)[i];
       if (!p.is_number()) {
-        return reader.Fail("curve_positions_from_knob_m",
-                           "curve_positions_from_knob_m[" + std::to_string(i) + "] = " + Show(p) +
-                               " must be a number");
+        return reader.Fail("curve_positions_from_knob_m", "curve_positions_from_knob_m[" +
+                                                              std::to_string(i) + "] = " + Show(p) +
+                                                              " must be a number");
       }
       options->curve_positions_from_knob_m.push_back(p.get<double>());
     }
@@ -293,13 +293,13 @@ Json SceneResultToJson(const core::SceneResult& r) {
   Json errors = Json::object();
   if (r.max_exit_speed) {
     const auto& m = *r.max_exit_speed;
-    out["max_exit_speed"] = {{"position_from_knob_m", m.position_from_knob_m},
-                             {"exit_speed_mps", m.exit_speed_mps},
-                             {"placement", PlacementJson(m.placement)},
-                             {"unconstrained_position_from_knob_m",
-                              m.unconstrained_position_from_knob_m},
-                             {"model", m.model},
-                             {"method", m.method}};
+    out["max_exit_speed"] = {
+        {"position_from_knob_m", m.position_from_knob_m},
+        {"exit_speed_mps", m.exit_speed_mps},
+        {"placement", PlacementJson(m.placement)},
+        {"unconstrained_position_from_knob_m", m.unconstrained_position_from_knob_m},
+        {"model", m.model},
+        {"method", m.method}};
     if (m.method != "closed_form") out["max_exit_speed"]["summary"] = SummaryToJson(m.summary);
     errors["max_exit_speed"] = {{"position_m", m.error_estimate_m},
                                 {"exit_speed_mps", m.error_estimate_mps}};

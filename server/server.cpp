@@ -177,7 +177,7 @@ struct Server::Impl {
   HttpServer http;
   api::Context context;
   Metrics metrics;
-  core::ModesCache modes_cache;  // bending modes kept across requests (bounded LRU)
+  core::ModesCache modes_cache;               // bending modes kept across requests (bounded LRU)
   std::unique_ptr<SqliteJobStore> job_store;  // Null with --jobs-db none; outlives `jobs`.
   std::unique_ptr<api::JobManager> jobs;
   std::unique_ptr<StaticFiles> static_files;  // The explorer's files (web root); never null.
@@ -216,12 +216,12 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
   // authentication and chunked bodies.
   http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     if (ConnectionPool::CurrentConnectionRejected()) {
-      WriteApiResponse(api::ErrorResponse(503, "TooBusy",
-                                          "the server has " +
-                                              std::to_string(config_.max_connections) +
-                                              " connections open (limit max_connections); "
-                                              "retry later"),
-                       res);
+      WriteApiResponse(
+          api::ErrorResponse(503, "TooBusy",
+                             "the server has " + std::to_string(config_.max_connections) +
+                                 " connections open (limit max_connections); "
+                                 "retry later"),
+          res);
       res.set_header("Connection", "close");
       res.set_header("Retry-After", "1");
       return httplib::Server::HandlerResponse::Handled;
@@ -340,18 +340,19 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
 
   // Statuses httplib produces itself (413, 400 on a malformed request line,
   // ...) get the JSON error envelope; bodies our handlers wrote are kept.
-  http.set_error_handler(httplib::Server::HandlerWithResponse([](const httplib::Request&,
-                                                                 httplib::Response& res) {
-    if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
-    std::string message = "HTTP status " + std::to_string(res.status);
-    if (res.status == 413) message = "request body exceeds the configured max_body_bytes";
-    if (res.status == 400) {
-      message = "the request could not be read: malformed, or its body did not arrive within "
-                "the read timeout";
-    }
-    WriteApiResponse(api::ErrorResponse(res.status, CodeForStatus(res.status), message), res);
-    return httplib::Server::HandlerResponse::Handled;
-  }));
+  http.set_error_handler(
+      httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
+        if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+        std::string message = "HTTP status " + std::to_string(res.status);
+        if (res.status == 413) message = "request body exceeds the configured max_body_bytes";
+        if (res.status == 400) {
+          message =
+              "the request could not be read: malformed, or its body did not arrive within "
+              "the read timeout";
+        }
+        WriteApiResponse(api::ErrorResponse(res.status, CodeForStatus(res.status), message), res);
+        return httplib::Server::HandlerResponse::Handled;
+      }));
   http.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
     if (request_was_routed) {
       request_was_routed = false;
@@ -403,10 +404,10 @@ bool Server::Bind(std::string* error) {
     if (error != nullptr) *error = impl_->startup_error;
     return false;
   }
-  const int bound = config_.port == 0 ? impl_->http.bind_to_any_port(config_.host)
-                                      : (impl_->http.bind_to_port(config_.host, config_.port)
-                                             ? config_.port
-                                             : -1);
+  const int bound =
+      config_.port == 0
+          ? impl_->http.bind_to_any_port(config_.host)
+          : (impl_->http.bind_to_port(config_.host, config_.port) ? config_.port : -1);
   if (bound < 0) {
     if (error != nullptr) {
       *error = "cannot bind " + config_.host + ":" + std::to_string(config_.port) +

@@ -3,8 +3,8 @@
 // row arrives long before the last), the last line is the summary, the
 // stream equals the collected JSON answer row for row, and a client that
 // goes away mid-stream stops the sweep without harming the server.
-#include <httplib.h>
 #include <gtest/gtest.h>
+#include <httplib.h>
 #include <nlohmann/json.hpp>
 
 #include <chrono>
@@ -86,7 +86,8 @@ TEST(ExploreStreamTest, RowsArriveChunkedAndEqualTheJsonAnswer) {
   ASSERT_TRUE(summary.is_object()) << "the last line must be the summary";
   EXPECT_EQ(summary["designs_in_shard"], count);
 
-  const auto collected = client.Post("/v1/explore", Sweep(count, "json").dump(), "application/json");
+  const auto collected =
+      client.Post("/v1/explore", Sweep(count, "json").dump(), "application/json");
   ASSERT_TRUE(collected);
   ASSERT_EQ(collected->status, 200);
   const Json body = Json::parse(collected->body);
@@ -107,8 +108,7 @@ TEST(ExploreStreamTest, ClientGoingAwayMidStreamStopsTheSweepAndTheServerKeepsSe
     request.path = "/v1/explore";
     request.body = Sweep(100000, "ndjson").dump();  // ~1 s of designs if it ran to the end
     request.set_header("Content-Type", "application/json");
-    request.content_receiver = [&](const char*, std::size_t length, std::uint64_t,
-                                   std::uint64_t) {
+    request.content_receiver = [&](const char*, std::size_t length, std::uint64_t, std::uint64_t) {
       received += length;
       return received < 64 * 1024;  // hang up after the first few chunks
     };
