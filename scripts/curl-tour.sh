@@ -15,6 +15,7 @@ post() {  # post PATH JSON
 }
 run curl -s "$base/health"
 run curl -s "$base/v1/version"
+run curl -s "$base/v1/speed-vs-error"
 run curl -s "$base/v1/materials"
 run curl -s "$base/v1/presets"
 post /v1/bat/properties '{"bat": {"preset": "paper-wood"}, "inertia_model": "slender_rod"}'
@@ -29,6 +30,9 @@ post /v1/collision '{"bat": {"preset": "bbcor-33-aluminium"}, "impact_from_knob_
 post /v1/compare '{"baseline": {"preset": "paper-wood"}, "variants": [{"name": "cork-320", "bat": {"preset": "paper-wood", "fill": {"material": {"density_kg_m3": 320, "youngs_modulus_pa": 2e7}, "diameter_m": 0.0254, "depth_m": 0.254}}}]}'
 post /v1/optimize '{"bat": {"three_segment": {"length_m": 0.8636, "handle_radius_m": 0.0125, "barrel_radius_m": 0.033, "taper_start_m": 0.30, "taper_end_m": 0.55}, "material": "ash"}, "variables": [{"path": "three_segment.taper_start_m", "min": 0.1, "max": 0.5}, {"path": "three_segment.barrel_radius_m", "min": 0.028, "max": 0.0331}], "constraints": {"mass_kg": 0.88, "balance_point_m": {"min": 0.56, "max": 0.60}, "moi_six_inch_kg_m2": {"max": 0.20}, "rules": "mlb-wood"}, "objective": "max_exit_speed", "cor": 0.5, "options": {"max_time_s": 10, "starts": 4, "seed": 1}}'
 post /v1/explore '{"bat": {"preset": "paper-wood", "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}}, "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 4}], "outputs": ["max_exit_speed"], "shard": {"index": 0, "count": 1}}'
+echo "\$ curl -sN -X POST $base/v1/explore -d '{… the same sweep …, \"format\": \"ndjson\"}'"
+curl -sN -X POST "$base/v1/explore" -H 'Content-Type: application/json' -d '{"bat": {"preset": "paper-wood", "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}}, "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 4}], "outputs": ["max_exit_speed"], "format": "ndjson"}'
+echo
 job='{"path": "/v1/compare", "body": {"baseline": {"preset": "paper-wood"}, "variants": [{"name": "ash", "bat": {"preset": "paper-wood", "material": "ash"}}]}}'
 echo "\$ curl -s -X POST $base/v1/jobs -d '$job'"
 submitted=$(curl -s -X POST "$base/v1/jobs" -H 'Content-Type: application/json' -d "$job")
