@@ -33,6 +33,20 @@ api::JobManager& Jobs() {
   return manager;
 }
 
+// Waits until job `id` is finished (at most 60 s: only reached if the job hangs). A job must
+// not outlive its test: the job manager is a static, and a worker still running at exit
+// would use statics (the material catalogue) that exit has already destroyed.
+void WaitUntilFinished(const std::string& id, const api::Context& context) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    const api::Response status = api::Dispatch({"GET", "/v1/jobs/" + id, ""}, context);
+    const std::string state = status.body.value("state", "");
+    if (state == "done" || state == "failed" || state == "cancelled") return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ADD_FAILURE() << "job " << id << " did not finish within 60 s";
+}
+
 // Runs `c` as a job: submit, wait until it is finished (at most 60 s: only reached if the job
 // hangs), fetch the result.
 api::Response RunAsJob(const ApiCase& c) {
@@ -43,13 +57,7 @@ api::Response RunAsJob(const ApiCase& c) {
   EXPECT_EQ(queued.status, 202) << queued.body.dump();
   if (queued.status != 202) return queued;
   const std::string id = queued.body["id"].get<std::string>();
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  while (std::chrono::steady_clock::now() < deadline) {
-    const api::Response status = api::Dispatch({"GET", "/v1/jobs/" + id, ""}, context);
-    const std::string state = status.body.value("state", "");
-    if (state == "done" || state == "failed" || state == "cancelled") break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
+  WaitUntilFinished(id, context);
   return api::Dispatch({"GET", "/v1/jobs/" + id + "/result", ""}, context);
 }
 
@@ -221,6 +229,9 @@ void CheckApiCase(const ApiCase& c) {
   api::Context context;
   if (c.path.rfind("/v1/jobs", 0) == 0) context.jobs = &Jobs();
   const api::Response direct = api::Dispatch({"POST", c.path, c.body}, context);
+  if (context.jobs != nullptr && direct.status == 202 && direct.body.contains("id")) {
+    WaitUntilFinished(direct.body["id"].get<std::string>(), context);
+  }
   CheckResponse(c, direct, "direct");
   if (c.as_job) CheckResponse(c, RunAsJob(c), "as a job");
 }
