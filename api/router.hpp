@@ -36,6 +36,20 @@ struct Context {
   core::ModesCache* modes_cache = nullptr;   ///< Bending modes kept across requests (server only).
 };
 
+/// What answering a request costs, for the server's choice of worker pool.
+enum class Workload {
+  kLight,    ///< Well under a millisecond: catalogue, closed-form scenes, jobs, health.
+  kCompute,  ///< Runs an ODE, finite elements or an optimiser: the bounded compute pool.
+};
+
+/// How a route's workload is known.
+enum class RouteWorkload {
+  kLight,    ///< Always Workload::kLight.
+  kCompute,  ///< Always Workload::kCompute (explore, optimize, fit, modes).
+  kScene,    ///< Workload::kCompute when the body's outputs or model need a model
+             ///< other than the closed forms (hertz, flexible); see ClassifyWorkload.
+};
+
 /// One endpoint: method, path pattern and handler. A pattern segment "{id}"
 /// matches any one path segment.
 struct Route {
@@ -44,6 +58,7 @@ struct Route {
   std::string summary;  ///< One line for --help and OpenAPI.
   std::function<Response(const Request&, const Context&)> handler;  ///< The handler.
   bool jobbable = false;  ///< True when POST /v1/jobs may run it.
+  RouteWorkload workload = RouteWorkload::kLight;  ///< What answering it costs.
 };
 
 /// Every route the service answers, in a stable order.
@@ -63,6 +78,14 @@ std::string PathParameter(std::string_view pattern, std::string_view path);
 /// writes it chunked); otherwise streamed bodies are collected into `text`.
 Response Dispatch(const Request& request, const Context& context,
                   std::string* route_pattern = nullptr, bool allow_stream = false);
+
+/// The workload of `request`: kCompute for routes that always run models
+/// (explore, optimize, fit, modes) and for scene routes (sweet-spot, collision,
+/// compare) whose outputs or model need the hertz or flexible models
+/// (core::ModelsFor); kLight otherwise, also for unknown paths and bodies that
+/// do not parse (they are refused at once). Cost: path matching, plus one JSON
+/// parse of the body for scene routes. Never throws.
+Workload ClassifyWorkload(const Request& request, const Context& context);
 
 /// The error envelope {"code", "message", "field"} with `status`.
 Response ErrorResponse(int status, std::string_view code, std::string message,

@@ -81,15 +81,30 @@ const std::vector<Option>& Options() {
          c->port = static_cast<int>(p);
          return true;
        }},
-      {"--threads", "SWEETSPOT_THREADS", "request worker threads (default 8)", true,
+      {"--threads", "SWEETSPOT_THREADS",
+       "worker threads for cheap requests; a connection holds one only while a request of "
+       "it is answered (default 8)",
+       true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          long long n = 0;
          if (!ParseLong(v, 1, 1024, &n, rule)) return false;
          c->threads = static_cast<int>(n);
          return true;
        }},
+      {"--compute-threads", "SWEETSPOT_COMPUTE_THREADS",
+       "worker threads for requests that run models (explore, optimize, fit, modes, hertz and "
+       "flexible scenes); 0 = one per core (default 0)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 0, 1024, &n, rule)) return false;
+         c->compute_threads = static_cast<int>(n);
+         return true;
+       }},
       {"--max-connections", "SWEETSPOT_MAX_CONNECTIONS",
-       "connections served or waiting; beyond: 503 TooBusy (default 256)", true,
+       "open connections (reading, answered or idle keep-alive); beyond: 503 TooBusy at once, "
+       "then closed (default 256)",
+       true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          long long n = 0;
          if (!ParseLong(v, 1, 100000, &n, rule)) return false;
@@ -133,7 +148,35 @@ const std::vector<Option>& Options() {
          c->max_body_bytes = static_cast<std::size_t>(n);
          return true;
        }},
-      {"--read-timeout-s", "SWEETSPOT_READ_TIMEOUT_S", "socket read timeout in s (default 10)",
+      {"--max-head-bytes", "SWEETSPOT_MAX_HEAD_BYTES",
+       "largest request head (request line and headers) in bytes; beyond: 431 (default 65536)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 256, 1LL << 24, &n, rule)) return false;
+         c->max_head_bytes = static_cast<std::size_t>(n);
+         return true;
+       }},
+      {"--header-timeout-s", "SWEETSPOT_HEADER_TIMEOUT_S",
+       "a request head must arrive whole within this many s of its first byte (of the "
+       "accept, for a new connection); else 408 and the connection is closed (default 10)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseSeconds(v, &c->header_timeout_s, rule);
+       }},
+      {"--body-min-rate-bytes-per-s", "SWEETSPOT_BODY_MIN_RATE_BYTES_PER_S",
+       "a body of N bytes must arrive within header-timeout-s + N / this many s; else 408 "
+       "and the connection is closed (default 32768)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1, 1LL << 34, &n, rule)) return false;
+         c->body_min_rate_bytes_per_s = static_cast<double>(n);
+         return true;
+       }},
+      {"--read-timeout-s", "SWEETSPOT_READ_TIMEOUT_S",
+       "longest silence inside a request (head or body) in s; else 408 and the connection is "
+       "closed (default 10)",
        true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return ParseSeconds(v, &c->read_timeout_s, rule);
@@ -300,6 +343,18 @@ bool ServerConfig::IsValid(std::string* why) const {
   if (threads < 1 || threads > 1024) {
     return fail("threads = " + std::to_string(threads) + ": must be in [1, 1024]");
   }
+  if (compute_threads < 0 || compute_threads > 1024) {
+    return fail("compute_threads = " + std::to_string(compute_threads) +
+                ": must be in [0, 1024] (0 = one per core)");
+  }
+  if (max_head_bytes < 256) {
+    return fail("max_head_bytes = " + std::to_string(max_head_bytes) + ": must be at least 256");
+  }
+  if (!std::isfinite(body_min_rate_bytes_per_s) || body_min_rate_bytes_per_s < 1) {
+    std::ostringstream text;
+    text << "body_min_rate_bytes_per_s = " << body_min_rate_bytes_per_s << ": must be at least 1";
+    return fail(text.str());
+  }
   if (max_connections < 1) {
     return fail("max_connections = " + std::to_string(max_connections) + ": must be at least 1");
   }
@@ -307,7 +362,8 @@ bool ServerConfig::IsValid(std::string* why) const {
     return fail("auth_token: must have at least 16 characters");
   }
   if (max_body_bytes < 1) return fail("max_body_bytes = 0: must be at least 1");
-  for (const auto& [name, value] : {std::pair{"read_timeout_s", read_timeout_s},
+  for (const auto& [name, value] : {std::pair{"header_timeout_s", header_timeout_s},
+                                    std::pair{"read_timeout_s", read_timeout_s},
                                     std::pair{"write_timeout_s", write_timeout_s},
                                     std::pair{"keep_alive_timeout_s", keep_alive_timeout_s}}) {
     if (!std::isfinite(value) || value <= 0 || value > 3600) {

@@ -17,12 +17,16 @@ namespace sweetspot::server {
 struct ServerConfig {
   std::string host = "127.0.0.1";        ///< Address to bind (--host, SWEETSPOT_HOST). Loopback by default.
   int port = 8080;                       ///< TCP port, 0 = ephemeral (--port, SWEETSPOT_PORT).
-  int threads = 8;                       ///< Worker threads for requests (--threads, SWEETSPOT_THREADS), 1..1024. An open keep-alive connection holds one.
-  int max_connections = 256;             ///< Connections served or waiting; beyond: 503 TooBusy (--max-connections, SWEETSPOT_MAX_CONNECTIONS).
+  int threads = 8;                       ///< Worker threads for cheap requests (--threads, SWEETSPOT_THREADS), 1..1024. A connection holds one only while a request of it is being answered.
+  int compute_threads = 0;               ///< Worker threads for requests that run models (explore, optimize, fit, modes, hertz and flexible scenes); 0 = one per core (--compute-threads, SWEETSPOT_COMPUTE_THREADS), 0..1024.
+  int max_connections = 256;             ///< Open connections (reading, answered, idle keep-alive); beyond: 503 TooBusy at once, then closed (--max-connections, SWEETSPOT_MAX_CONNECTIONS).
   std::string auth_token;                ///< If set, every path but /health needs "Authorization: Bearer <token>" (SWEETSPOT_AUTH_TOKEN, --auth-token-file).
   std::string cors_origin;               ///< CORS: the allowed Origin, or "*"; empty = no CORS headers (--cors-origin, SWEETSPOT_CORS_ORIGIN).
   std::size_t max_body_bytes = 1 << 20;  ///< Largest request body, bytes (--max-body-bytes, SWEETSPOT_MAX_BODY_BYTES).
-  double read_timeout_s = 10.0;          ///< Socket read timeout, s (--read-timeout-s, SWEETSPOT_READ_TIMEOUT_S).
+  std::size_t max_head_bytes = 65536;    ///< Largest request head (request line and headers), bytes; beyond: 431 (--max-head-bytes, SWEETSPOT_MAX_HEAD_BYTES).
+  double header_timeout_s = 10.0;        ///< A request head must arrive whole within this, s, from its first byte (from the accept for a new connection); else 408 and closed (--header-timeout-s, SWEETSPOT_HEADER_TIMEOUT_S).
+  double body_min_rate_bytes_per_s = 32768;  ///< A body of N bytes must arrive within header_timeout_s + N / this, s; else 408 and closed (--body-min-rate-bytes-per-s, SWEETSPOT_BODY_MIN_RATE_BYTES_PER_S).
+  double read_timeout_s = 10.0;          ///< Longest silence inside a request (head or body), s; else 408 and closed (--read-timeout-s, SWEETSPOT_READ_TIMEOUT_S).
   double write_timeout_s = 10.0;         ///< Socket write timeout, s (--write-timeout-s, SWEETSPOT_WRITE_TIMEOUT_S).
   double keep_alive_timeout_s = 5.0;     ///< Idle keep-alive timeout, s (--keep-alive-timeout-s, SWEETSPOT_KEEP_ALIVE_TIMEOUT_S).
   int keep_alive_max_requests = 10000;   ///< Requests per keep-alive connection (--keep-alive-max-requests, SWEETSPOT_KEEP_ALIVE_MAX_REQUESTS).

@@ -1,6 +1,7 @@
 // The server's main loop, shared by sweetspot-server and `sweetspot serve`.
 #include <pthread.h>
 #include <signal.h>
+#include <sys/resource.h>
 
 #include <atomic>
 #include <chrono>
@@ -38,6 +39,13 @@ int RunServerMain(const std::vector<std::string>& args) {
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   signal(SIGPIPE, SIG_IGN);  // a client that disconnects must not kill the server
 
+  // Every open connection is a descriptor: raise the soft limit to the hard
+  // one, so that max_connections (and the connections refused past it) fit.
+  if (rlimit files{}; getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur < files.rlim_max) {
+    files.rlim_cur = files.rlim_max;
+    setrlimit(RLIMIT_NOFILE, &files);
+  }
+
   Server server(parsed.config);
   std::string error;
   if (!server.Bind(&error)) {
@@ -71,7 +79,9 @@ int RunServerMain(const std::vector<std::string>& args) {
             << "\n";
   std::cerr << "sweetspot-server " << sweetspot::core::SweetspotVersion() << " listening on "
             << parsed.config.host << ":" << server.port() << " with " << parsed.config.threads
-            << " threads" << std::endl;
+            << " threads for requests and " << server.compute_threads()
+            << " for models, up to " << parsed.config.max_connections << " connections"
+            << std::endl;
   const bool ok = server.Run();  // Returns once in-flight requests are answered.
   run_returned.store(true);
   server.Shutdown();  // Running jobs: the grace period, then interrupted and kept.

@@ -5,15 +5,21 @@
 
 #include <httplib.h>
 
+#include <netdb.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <mutex>
+#include <thread>
 
 #include "api/jobs.hpp"
 #include "api/router.hpp"
-#include "server/connection_pool.hpp"
+#include "server/connection_loop.hpp"
 #include "server/metrics.hpp"
+#include "server/request_stream.hpp"
 #include "server/sqlite_job_store.hpp"
 #include "server/static_files.hpp"
 
@@ -29,6 +35,8 @@ std::string Serialize(const nlohmann::json& body) {
 // 16 KiB or whatever was produced in 0.1 s, whichever comes first.
 void WriteStreamedResponse(const api::Response& response, httplib::Response& res) {
   res.status = response.status;
+  // The chunks must reach the client as they are produced, not when the answer ends.
+  if (RequestStream* stream = RequestStream::Current()) stream->WriteThrough();
   auto producer = response.stream;
   res.set_chunked_content_provider(
       response.content_type, [producer](std::size_t /*offset*/, httplib::DataSink& sink) {
@@ -164,17 +172,68 @@ void WriteStaticResponse(const httplib::Request& req, const StaticFiles& files,
 }  // namespace
 
 namespace {
-// httplib 0.11.4 listens with a hard-coded backlog of 5: 64 clients connecting
-// at once overflow it and wait for SYN retransmits (~1 s). listen() again on a
-// listening socket raises the backlog (Linux).
+// httplib's request handling (parsing, routing, our handlers, writing the
+// answer) for one request the connection loop has read completely.
 class HttpServer : public httplib::Server {
  public:
-  bool RaiseBacklog(int backlog) { return ::listen(svr_sock_, backlog) == 0; }
+  // httplib stops a streamed answer between two chunks once its listening
+  // socket is gone (svr_sock_ invalid); the connection loop owns the socket,
+  // so tell httplib whether the server is serving.
+  void SetServing(int listen_fd) { svr_sock_ = listen_fd; }
+  void SetStopping() { svr_sock_ = INVALID_SOCKET; }
+
+  bool ServeOne(httplib::Stream& stream, bool close_connection, bool* connection_closed) {
+    bool closed = false;
+    const bool ok = process_request(stream, close_connection, closed, nullptr);
+    *connection_closed = closed;
+    return ok;
+  }
 };
+
+// A listening TCP socket on host:port (port 0: any free port), with
+// SO_REUSEADDR only (httplib's default also sets SO_REUSEPORT, which lets a
+// second server bind the same port silently and split the traffic), and the
+// kernel's largest backlog. Returns the socket or -1; *bound_port gets the port.
+int Listen(const std::string& host, int port, int* bound_port) {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  if (getaddrinfo(host.c_str(), std::to_string(port).c_str(), &hints, &found) != 0) return -1;
+  int fd = -1;
+  for (addrinfo* a = found; a != nullptr && fd < 0; a = a->ai_next) {
+    fd = ::socket(a->ai_family, a->ai_socktype | SOCK_NONBLOCK | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) continue;
+    const int yes = 1;
+    setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    if (::bind(fd, a->ai_addr, a->ai_addrlen) != 0 || ::listen(fd, SOMAXCONN) != 0) {
+      ::close(fd);
+      fd = -1;
+    }
+  }
+  freeaddrinfo(found);
+  if (fd < 0) return -1;
+  sockaddr_storage addr{};
+  socklen_t len = sizeof addr;
+  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  *bound_port = addr.ss_family == AF_INET6
+                    ? ntohs(reinterpret_cast<const sockaddr_in6*>(&addr)->sin6_port)
+                    : ntohs(reinterpret_cast<const sockaddr_in*>(&addr)->sin_port);
+  return fd;
+}
+
+// The compute pool's size: the configured count, or (0) the cores.
+int ComputeWorkers(int configured) {
+  if (configured > 0) return configured;
+  const unsigned cores = std::thread::hardware_concurrency();
+  return cores == 0 ? 1 : static_cast<int>(cores);
+}
 }  // namespace
 
 struct Server::Impl {
   HttpServer http;
+  std::atomic<bool> stop_requested{false};
   api::Context context;
   Metrics metrics;
   core::ModesCache modes_cache;               // bending modes kept across requests (bounded LRU)
@@ -183,6 +242,8 @@ struct Server::Impl {
   std::unique_ptr<StaticFiles> static_files;  // The explorer's files (web root); never null.
   std::string startup_error;  // Why the jobs database cannot be used; Bind() reports it.
   std::mutex log_mutex;
+  // Created by Bind(); owns the listening socket. Last: its workers use the members above.
+  std::unique_ptr<ConnectionLoop> loop;
 };
 
 namespace {
@@ -194,38 +255,14 @@ thread_local bool request_was_routed = false;
 
 Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::make_unique<Impl>()) {
   httplib::Server& http = impl_->http;
-  const auto threads = static_cast<std::size_t>(config_.threads);
-  const auto max_connections = static_cast<std::size_t>(config_.max_connections);
-  http.new_task_queue = [threads, max_connections] {
-    return new ConnectionPool(threads, max_connections);
-  };
-  // httplib's default also sets SO_REUSEPORT, which lets a second server bind
-  // the same port silently and split the traffic: keep SO_REUSEADDR only.
-  http.set_socket_options([](socket_t sock) {
-    int yes = 1;
-    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
-  });
-  http.set_tcp_nodelay(true);  // Nagle's delay costs ~100x keep-alive throughput (pitfalls.md)
+  // Limits the connection loop does not apply itself (it hands over heads and
+  // bodies only once they are complete, so httplib's read timeout never waits).
   http.set_payload_max_length(config_.max_body_bytes);
-  http.set_read_timeout(WholeSeconds(config_.read_timeout_s));
-  http.set_write_timeout(WholeSeconds(config_.write_timeout_s));
   http.set_keep_alive_timeout(WholeSeconds(config_.keep_alive_timeout_s));
   http.set_keep_alive_max_count(static_cast<size_t>(config_.keep_alive_max_requests));
 
-  // Before the body is read: connections over the limit, CORS preflights,
-  // authentication and chunked bodies.
+  // Before the body is read: CORS preflights, authentication and chunked bodies.
   http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    if (ConnectionPool::CurrentConnectionRejected()) {
-      WriteApiResponse(
-          api::ErrorResponse(503, "TooBusy",
-                             "the server has " + std::to_string(config_.max_connections) +
-                                 " connections open (limit max_connections); "
-                                 "retry later"),
-          res);
-      res.set_header("Connection", "close");
-      res.set_header("Retry-After", "1");
-      return httplib::Server::HandlerResponse::Handled;
-    }
     if (!config_.cors_origin.empty()) {
       const std::string origin = req.get_header_value("Origin");
       if (config_.cors_origin == "*" || origin == config_.cors_origin) {
@@ -302,7 +339,9 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
   if (!impl_->jobs) impl_->jobs = std::make_unique<api::JobManager>(config_.jobs, runner);
   impl_->context.jobs = impl_->jobs.get();
   impl_->context.metrics_text = [impl = impl_.get()] {
-    return impl->metrics.Render(impl->jobs->CountsByState());
+    std::string text = impl->metrics.Render(impl->jobs->CountsByState());
+    if (impl->loop) text += impl->loop->MetricsText();
+    return text;
   };
 
   auto handle = [this](const httplib::Request& req, httplib::Response& res) {
@@ -404,11 +443,9 @@ bool Server::Bind(std::string* error) {
     if (error != nullptr) *error = impl_->startup_error;
     return false;
   }
-  const int bound =
-      config_.port == 0
-          ? impl_->http.bind_to_any_port(config_.host)
-          : (impl_->http.bind_to_port(config_.host, config_.port) ? config_.port : -1);
-  if (bound < 0) {
+  int bound = -1;
+  const int listen_fd = Listen(config_.host, config_.port, &bound);
+  if (listen_fd < 0) {
     if (error != nullptr) {
       *error = "cannot bind " + config_.host + ":" + std::to_string(config_.port) +
                " (address in use, not local, or not permitted)";
@@ -416,7 +453,45 @@ bool Server::Bind(std::string* error) {
     return false;
   }
   port_ = bound;
-  impl_->http.RaiseBacklog(SOMAXCONN);
+  ConnectionLoopOptions options;
+  options.max_connections = config_.max_connections;
+  options.max_head_bytes = config_.max_head_bytes;
+  options.max_body_bytes = config_.max_body_bytes;
+  options.header_timeout_s = config_.header_timeout_s;
+  options.body_min_rate_bytes_per_s = config_.body_min_rate_bytes_per_s;
+  options.read_timeout_s = config_.read_timeout_s;
+  options.write_timeout_s = config_.write_timeout_s;
+  options.keep_alive_timeout_s = config_.keep_alive_timeout_s;
+  options.keep_alive_max_requests = config_.keep_alive_max_requests;
+  options.light_workers = config_.threads;
+  options.compute_workers = ComputeWorkers(config_.compute_threads);
+  ConnectionLoopHooks hooks;
+  hooks.serve = [impl = impl_.get()](RequestStream& stream, bool close_connection, bool* closed) {
+    return impl->http.ServeOne(stream, close_connection, closed);
+  };
+  hooks.classify = [impl = impl_.get()](std::string_view method, std::string_view path,
+                                        std::string_view body) {
+    const api::Request request{std::string(method), std::string(path), std::string(body)};
+    return api::ClassifyWorkload(request, impl->context) == api::Workload::kCompute
+               ? Pool::kCompute
+               : Pool::kLight;
+  };
+  hooks.error_body = [](int status, const char* code, const std::string& message) {
+    return Serialize(api::ErrorResponse(status, code, message).body) + "\n";
+  };
+  hooks.refused = [this](int status, const char* /*code*/, const std::string& method,
+                         const std::string& path) {
+    impl_->metrics.Begin();
+    impl_->metrics.End("unrouted", method, status, 0.0);
+    if (config_.access_log) {
+      const nlohmann::json line{{"method", method}, {"path", path},         {"route", "unrouted"},
+                                {"status", status}, {"duration_s", 0.0}, {"bytes_in", 0}};
+      std::lock_guard<std::mutex> lock(impl_->log_mutex);
+      std::cerr << Serialize(line) << "\n";
+    }
+  };
+  impl_->http.SetServing(listen_fd);
+  impl_->loop = std::make_unique<ConnectionLoop>(listen_fd, options, std::move(hooks));
   {
     std::lock_guard<std::mutex> lock(impl_->log_mutex);
     const StaticFiles& files = *impl_->static_files;
@@ -431,8 +506,18 @@ bool Server::Bind(std::string* error) {
   return true;
 }
 
-bool Server::Run() { return impl_->http.listen_after_bind(); }
+int Server::compute_threads() const { return ComputeWorkers(config_.compute_threads); }
 
-void Server::Stop() { impl_->http.stop(); }
+bool Server::Run() {
+  if (!impl_->loop) return false;
+  if (impl_->stop_requested.load()) impl_->loop->Stop();
+  return impl_->loop->Run();
+}
+
+void Server::Stop() {
+  impl_->stop_requested.store(true);
+  impl_->http.SetStopping();  // streamed answers end at their next chunk, as before
+  if (impl_->loop) impl_->loop->Stop();
+}
 
 }  // namespace sweetspot::server

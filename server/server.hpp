@@ -10,7 +10,11 @@
 namespace sweetspot::server {
 
 /// An HTTP server bound to config.host:config.port that answers every route
-/// of api::Routes(). Thread-safe: Stop() may be called from any thread.
+/// of api::Routes(). One thread (Run's) owns the connections and reads whole
+/// requests under deadlines; complete requests are answered by a pool of
+/// config.threads workers, or, when they run models, by a pool of
+/// config.compute_threads (server/connection_loop.hpp). Thread-safe: Stop()
+/// may be called from any thread.
 class Server {
  public:
   /// Prepares a server; nothing is bound until Bind(). Opens the jobs
@@ -25,6 +29,8 @@ class Server {
   bool Bind(std::string* error);
   /// The bound port (useful with port 0); -1 before Bind().
   int port() const { return port_; }
+  /// Worker threads for requests that run models (config.compute_threads, or the cores).
+  int compute_threads() const;
   /// Serves until Stop(); returns false if the listen loop failed.
   bool Run();
   /// Stops accepting and makes Run() return (in-flight requests finish).

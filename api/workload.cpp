@@ -1,0 +1,84 @@
+// ClassifyWorkload: which of the server's worker pools a request belongs in.
+#include <string>
+#include <vector>
+
+#include "api/handlers.hpp"
+#include "api/router.hpp"
+#include "core/scene.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+// True when a model of `models` is not a closed form (hertz integrates an ODE,
+// flexible_beam builds finite elements, flexible does both).
+bool NeedsIterativeModel(const std::vector<std::string>& models) {
+  for (const std::string& model : models) {
+    if (model != "mass_properties" && model != "rigid_pivot" && model != "free_bat") return true;
+  }
+  return false;
+}
+
+// The collision model named by `object[key]`, or `fallback` when it is absent
+// or not a known name (the handler refuses such a body at once).
+core::CollisionModel ModelAt(const Json& object, const char* key, core::CollisionModel fallback) {
+  const auto it = object.find(key);
+  if (it == object.end() || !it->is_string()) return fallback;
+  return core::ParseCollisionModel(it->get_ref<const std::string&>()).value_or(fallback);
+}
+
+// A scene body (sweet-spot, compare, collision) needs the compute pool when an
+// output it asks for needs an iterative model.
+Workload SceneWorkload(const Request& request, const Json& body) {
+  if (request.path == "/v1/collision") {
+    const core::CollisionModel model = ModelAt(body, "model", core::CollisionModel::kAuto);
+    return NeedsIterativeModel(core::ModelsFor(core::SceneOutput::kMaxExitSpeed, model))
+               ? Workload::kCompute
+               : Workload::kLight;
+  }
+  core::CollisionModel model = core::CollisionModel::kRigidPivot;
+  if (const auto options = body.find("options"); options != body.end() && options->is_object()) {
+    model = ModelAt(*options, "model", model);
+  }
+  std::vector<core::SceneOutput> outputs = {core::SceneOutput::kMaxExitSpeed};
+  if (const auto named = body.find("outputs"); named != body.end() && named->is_array()) {
+    outputs.clear();
+    for (const Json& name : *named) {
+      if (!name.is_string()) continue;
+      if (const auto output = core::ParseSceneOutput(name.get_ref<const std::string&>())) {
+        outputs.push_back(*output);
+      }
+    }
+  }
+  for (const core::SceneOutput output : outputs) {
+    if (NeedsIterativeModel(core::ModelsFor(output, model))) return Workload::kCompute;
+  }
+  return Workload::kLight;
+}
+
+}  // namespace
+
+Workload ClassifyWorkload(const Request& request, const Context& context) {
+  try {
+    for (const Route* route : MatchRoutes(request.path)) {
+      if (route->method != request.method) continue;
+      switch (route->workload) {
+        case RouteWorkload::kLight:
+          return Workload::kLight;
+        case RouteWorkload::kCompute:
+          return Workload::kCompute;
+        case RouteWorkload::kScene: {
+          Response refused;
+          const auto body = ParseObjectBody(request, context, &refused);
+          return body ? SceneWorkload(request, *body) : Workload::kLight;
+        }
+      }
+    }
+  } catch (...) {
+    // Out of memory while parsing: the handler will answer; the light pool is fine.
+  }
+  return Workload::kLight;
+}
+
+}  // namespace sweetspot::api

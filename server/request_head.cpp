@@ -1,0 +1,88 @@
+#include "server/request_head.hpp"
+
+#include <algorithm>
+#include <cctype>
+
+namespace sweetspot::server {
+namespace {
+
+bool EqualsIgnoreCase(std::string_view a, std::string_view b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) ==
+                  std::tolower(static_cast<unsigned char>(y));
+         });
+}
+
+std::string_view Trim(std::string_view text) {
+  while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
+  while (!text.empty() && (text.back() == ' ' || text.back() == '\t')) text.remove_suffix(1);
+  return text;
+}
+
+// A Content-Length value: 1 to 18 decimal digits (a larger body is over any limit anyway).
+bool ParseLength(std::string_view text, std::uint64_t* out) {
+  if (text.empty() || text.size() > 18) return false;
+  std::uint64_t value = 0;
+  for (const char c : text) {
+    if (c < '0' || c > '9') return false;
+    value = value * 10 + static_cast<std::uint64_t>(c - '0');
+  }
+  *out = value;
+  return true;
+}
+
+}  // namespace
+
+HeadScan ScanRequestHead(std::string_view bytes, std::size_t max_head_bytes, std::size_t* scanned,
+                         RequestHead* head) {
+  // Search from 3 bytes before where the last scan stopped: the blank line may straddle.
+  const std::size_t from = *scanned > 3 ? *scanned - 3 : 0;
+  const std::size_t end = bytes.find("\r\n\r\n", from);
+  if (end == std::string_view::npos) {
+    *scanned = bytes.size();
+    return bytes.size() > max_head_bytes ? HeadScan::kTooLarge : HeadScan::kIncomplete;
+  }
+  if (end + 4 > max_head_bytes) return HeadScan::kTooLarge;
+  *head = RequestHead{};
+  head->head_bytes = end + 4;
+  const std::string_view text = bytes.substr(0, end + 2);  // every line ends with CRLF
+  std::size_t line_begin = 0;
+  bool first = true;
+  bool has_length = false;
+  while (line_begin < text.size()) {
+    const std::size_t line_end = text.find("\r\n", line_begin);
+    const std::string_view line = text.substr(line_begin, line_end - line_begin);
+    if (first) {
+      first = false;
+      const std::size_t sp1 = line.find(' ');
+      const std::size_t sp2 = sp1 == std::string_view::npos ? sp1 : line.find(' ', sp1 + 1);
+      if (sp2 != std::string_view::npos) {
+        head->method = std::string(line.substr(0, sp1));
+        const std::string_view target = line.substr(sp1 + 1, sp2 - sp1 - 1);
+        head->path = std::string(target.substr(0, target.find('?')));
+      }
+    } else if (const std::size_t colon = line.find(':'); colon != std::string_view::npos) {
+      const std::string_view name = line.substr(0, colon);
+      const std::string_view value = Trim(line.substr(colon + 1));
+      if (EqualsIgnoreCase(name, "Content-Length")) {
+        std::uint64_t length = 0;
+        if (!ParseLength(value, &length) || (has_length && length != head->content_length)) {
+          head->bad_content_length = true;
+        } else {
+          head->content_length = length;
+          has_length = true;
+        }
+      } else if (EqualsIgnoreCase(name, "Transfer-Encoding")) {
+        head->has_transfer_encoding = true;
+      } else if (EqualsIgnoreCase(name, "Expect") && EqualsIgnoreCase(value, "100-continue")) {
+        head->expects_continue = true;
+        head->expect_line_begin = line_begin;
+        head->expect_line_end = line_end + 2;
+      }
+    }
+    line_begin = line_end + 2;
+  }
+  return HeadScan::kComplete;
+}
+
+}  // namespace sweetspot::server

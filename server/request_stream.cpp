@@ -1,0 +1,118 @@
+#include "server/request_stream.hpp"
+
+#include <poll.h>
+#include <sys/select.h>
+#include <sys/socket.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+
+namespace sweetspot::server {
+namespace {
+
+// Answers up to this size go out in one send (head and body together).
+constexpr std::size_t kBufferBytes = 64 * 1024;
+
+thread_local RequestStream* current_stream = nullptr;
+
+int MillisecondsLeft(std::chrono::steady_clock::time_point deadline) {
+  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+      deadline - std::chrono::steady_clock::now());
+  return static_cast<int>(std::max<long long>(0, left.count()));
+}
+
+}  // namespace
+
+RequestStream::RequestStream(int fd, std::string_view request, double write_timeout_s,
+                             const std::string& remote_ip, int remote_port,
+                             const std::string& local_ip, int local_port)
+    : fd_(fd),
+      request_(request),
+      write_timeout_(write_timeout_s),
+      remote_ip_(remote_ip),
+      remote_port_(remote_port),
+      local_ip_(local_ip),
+      local_port_(local_port),
+      previous_current_(current_stream) {
+  current_stream = this;
+}
+
+RequestStream::~RequestStream() { current_stream = previous_current_; }
+
+RequestStream* RequestStream::Current() { return current_stream; }
+
+bool RequestStream::is_readable() const { return read_at_ < request_.size(); }
+
+bool RequestStream::is_writable() const {
+  if (!healthy_) return false;
+  pollfd p{fd_, POLLOUT, 0};
+  const int ms = static_cast<int>(
+      std::chrono::duration_cast<std::chrono::milliseconds>(write_timeout_).count());
+  return ::poll(&p, 1, ms) == 1 && (p.revents & (POLLERR | POLLHUP | POLLNVAL)) == 0;
+}
+
+ssize_t RequestStream::read(char* ptr, size_t size) {
+  const std::size_t n = std::min(size, request_.size() - read_at_);
+  std::memcpy(ptr, request_.data() + read_at_, n);
+  read_at_ += n;
+  return static_cast<ssize_t>(n);  // 0 at the end of the request: httplib reads no further
+}
+
+ssize_t RequestStream::write(const char* ptr, size_t size) {
+  if (!healthy_) return -1;
+  if (write_through_) {
+    if (!Flush() || !Send(ptr, size)) return -1;
+    return static_cast<ssize_t>(size);
+  }
+  out_.append(ptr, size);
+  if (out_.size() >= kBufferBytes && !Flush()) return -1;
+  return static_cast<ssize_t>(size);
+}
+
+bool RequestStream::Flush() {
+  if (out_.empty()) return healthy_;
+  const bool sent = Send(out_.data(), out_.size());
+  out_.clear();
+  return sent;
+}
+
+void RequestStream::WriteThrough() { write_through_ = true; }
+
+bool RequestStream::Send(const char* data, std::size_t size) {
+  if (!healthy_) return false;
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            write_timeout_);
+  while (size > 0) {
+    const ssize_t n = ::send(fd_, data, size, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n > 0) {
+      data += n;
+      size -= static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+      pollfd p{fd_, POLLOUT, 0};
+      const int ms = MillisecondsLeft(deadline);
+      if (ms > 0 && ::poll(&p, 1, ms) == 1 && (p.revents & POLLOUT) != 0) continue;
+    }
+    healthy_ = false;  // peer gone, or slower than the write timeout
+    return false;
+  }
+  return true;
+}
+
+void RequestStream::get_remote_ip_and_port(std::string& ip, int& port) const {
+  ip = remote_ip_;
+  port = remote_port_;
+}
+
+void RequestStream::get_local_ip_and_port(std::string& ip, int& port) const {
+  ip = local_ip_;
+  port = local_port_;
+}
+
+socket_t RequestStream::socket() const { return fd_ < FD_SETSIZE ? fd_ : 0; }
+
+}  // namespace sweetspot::server
