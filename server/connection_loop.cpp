@@ -73,9 +73,7 @@ std::string FormatSeconds(double s) {
   return out.str();
 }
 
-}  // namespace
-
-// Why the loop closed or refused a connection (metrics label).
+// Why a connection was closed or refused (metrics label).
 enum class Reason {
   kOverLimit,
   kHeaderTimeout,
@@ -88,55 +86,90 @@ enum class Reason {
 };
 
 constexpr std::array<const char*, static_cast<int>(Reason::kCount)> kReasonNames = {
-    "over_limit", "header_timeout", "body_too_slow", "read_timeout",
-    "head_too_large", "bad_request", "keep_alive_idle"};
+    "over_limit",     "header_timeout", "body_too_slow",  "read_timeout",
+    "head_too_large", "bad_request",    "keep_alive_idle"};
 
 enum class State {
-  kReadingHead,  // loop: waiting for the rest of a head
-  kReadingBody,  // loop: waiting for the rest of a body
-  kIdle,         // loop: keep-alive, between requests
-  kLingering,    // loop: answered and half-closed, draining until the client closes
-  kWorking,      // a worker's: queued or being served
+  kReadingHead,  // armed: waiting for the rest of a head
+  kReadingBody,  // armed: waiting for the rest of a body
+  kIdle,         // armed: keep-alive, between requests
+  kLingering,    // armed: answered and half-closed, draining until the client closes
+  kWorking,      // a complete request is queued or being answered
 };
 
+// epoll tags of the two descriptors that are not connections; connections
+// are tagged with their id (from 2 on), never with a pointer, so that an
+// event taken for a connection another thread just closed finds nothing.
+constexpr std::uint64_t kListenTag = 0;
+constexpr std::uint64_t kWakeTag = 1;
+
+// One client connection. Whoever handles it holds `mutex`: the worker woken
+// for it, the worker answering its request, or the deadline keeper.
 struct Connection {
+  std::mutex mutex;
+  std::uint64_t id = 0;
   int fd = -1;
+  bool closed = false;            // fd closed: nothing more to do
   State state = State::kReadingHead;
-  std::string in;            // received bytes not yet consumed (the current request first)
-  std::size_t scanned = 0;   // how much of `in` the head scan has seen
-  RequestHead head;          // the current request's framing (once its head is complete)
+  std::string in;                 // received bytes not yet consumed (the current request first)
+  std::size_t scanned = 0;        // how much of `in` the head scan has seen
+  RequestHead head;               // the current request's framing (once its head is complete)
   std::size_t request_bytes = 0;  // head + body of the current request
   Clock::time_point started;      // the current head's first byte (the accept for a new one)
   Clock::time_point last_read;    // the last byte received
   Clock::time_point body_deadline;
   Clock::time_point idle_since;
   Clock::time_point linger_until;
-  bool continue_sent = false;     // "100 Continue" sent for the current request
-  bool close_after = false;       // close once the current request is answered
-  bool keep_open = false;         // the worker's verdict
-  bool peer_closed = false;       // the client shut its side: nothing more will arrive
-  int served = 0;                 // requests answered on this connection
+  bool continue_sent = false;  // "100 Continue" sent for the current request
+  bool close_after = false;    // close once the current request is answered
+  bool keep_open = false;      // the verdict on the request just answered
+  bool peer_closed = false;    // the client shut its side: nothing more will arrive
+  int served = 0;              // requests answered on this connection
   std::string remote_ip, local_ip;
   int remote_port = 0, local_port = 0;
 };
+using ConnectionPtr = std::shared_ptr<Connection>;
 
-// A FIFO of connections with complete requests and the threads that serve them.
-class WorkerPool {
+// Counts the workers of a pool that are answering a request, and their peak.
+class BusyCounter {
  public:
-  WorkerPool(const char* name, int threads, std::function<void(Connection*)> serve)
-      : name_(name), serve_(std::move(serve)) {
+  void Enter() {
+    const long long now = busy_.fetch_add(1, std::memory_order_relaxed) + 1;
+    long long peak = peak_.load(std::memory_order_relaxed);
+    while (now > peak && !peak_.compare_exchange_weak(peak, now, std::memory_order_relaxed)) {
+    }
+  }
+  void Leave() {
+    busy_.fetch_sub(1, std::memory_order_relaxed);
+    served_.fetch_add(1, std::memory_order_relaxed);
+  }
+  long long busy() const { return busy_.load(std::memory_order_relaxed); }
+  long long peak() const { return peak_.load(std::memory_order_relaxed); }
+  unsigned long long served() const { return served_.load(std::memory_order_relaxed); }
+
+ private:
+  std::atomic<long long> busy_{0};
+  std::atomic<long long> peak_{0};
+  std::atomic<unsigned long long> served_{0};
+};
+
+// The compute pool: a FIFO of connections with a complete request that runs
+// models, and the threads that answer them.
+class ComputePool {
+ public:
+  ComputePool(int threads, std::function<void(ConnectionPtr)> serve) : serve_(std::move(serve)) {
     for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { Work(); });
   }
-  ~WorkerPool() { Shutdown(); }
+  ~ComputePool() { Shutdown(); }
 
-  void Push(Connection* connection) {
+  void Push(ConnectionPtr connection) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      queue_.push_back(connection);
+      queue_.push_back(std::move(connection));
     }
     cv_.notify_one();
   }
-  // Serves what is queued, then joins the threads.
+  // Answers what is queued, then joins the threads.
   void Shutdown() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -146,12 +179,7 @@ class WorkerPool {
     cv_.notify_all();
     for (auto& thread : threads_) thread.join();
   }
-
-  const char* name() const { return name_; }
   int size() const { return static_cast<int>(threads_.size()); }
-  long long busy() const { return busy_.load(std::memory_order_relaxed); }
-  long long peak_busy() const { return peak_busy_.load(std::memory_order_relaxed); }
-  unsigned long long served() const { return served_.load(std::memory_order_relaxed); }
   std::size_t queued() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return queue_.size();
@@ -160,114 +188,114 @@ class WorkerPool {
  private:
   void Work() {
     for (;;) {
-      Connection* connection = nullptr;
+      ConnectionPtr connection;
       {
         std::unique_lock<std::mutex> lock(mutex_);
         cv_.wait(lock, [this] { return shutdown_ || !queue_.empty(); });
         if (queue_.empty()) return;
-        connection = queue_.front();
+        connection = std::move(queue_.front());
         queue_.pop_front();
       }
-      const long long now_busy = busy_.fetch_add(1, std::memory_order_relaxed) + 1;
-      long long peak = peak_busy_.load(std::memory_order_relaxed);
-      while (now_busy > peak &&
-             !peak_busy_.compare_exchange_weak(peak, now_busy, std::memory_order_relaxed)) {
-      }
-      serve_(connection);
-      served_.fetch_add(1, std::memory_order_relaxed);
-      busy_.fetch_sub(1, std::memory_order_relaxed);
+      serve_(std::move(connection));
     }
   }
 
-  const char* name_;
-  std::function<void(Connection*)> serve_;
+  std::function<void(ConnectionPtr)> serve_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
-  std::deque<Connection*> queue_;
+  std::deque<ConnectionPtr> queue_;
   std::vector<std::thread> threads_;
   bool shutdown_ = false;
-  std::atomic<long long> busy_{0};
-  std::atomic<long long> peak_busy_{0};
-  std::atomic<unsigned long long> served_{0};
 };
+
+}  // namespace
 
 struct ConnectionLoop::Impl {
   Impl(int listen, ConnectionLoopOptions o, ConnectionLoopHooks h)
       : listen_fd(listen), options(o), hooks(std::move(h)) {}
 
-  // ---- the loop thread's state
   int listen_fd;
   int epoll_fd = -1;
-  int wake_fd = -1;
-  ConnectionLoopOptions options;
-  ConnectionLoopHooks hooks;
-  std::unordered_map<Connection*, std::unique_ptr<Connection>> connections;
-  int admitted = 0;   // open connections that count against max_connections
-  int lingering = 0;  // half-closed connections being drained
-  int working = 0;    // connections queued or being served
-  bool accept_paused = false;
-  Clock::time_point accept_resume;
-  char listen_tag = 0;
-  char wake_tag = 0;
+  int wake_fd = -1;  // becomes readable (and stays so) when the workers must leave
+  const ConnectionLoopOptions options;
+  const ConnectionLoopHooks hooks;
 
-  // ---- shared with the workers and other threads
+  std::mutex map_mutex;
+  std::unordered_map<std::uint64_t, ConnectionPtr> connections;
+  std::uint64_t next_id = 2;
+
   std::atomic<bool> stopping{false};
-  std::mutex returned_mutex;
-  std::vector<Connection*> returned;
-  std::unique_ptr<WorkerPool> light;
-  std::unique_ptr<WorkerPool> compute;
+  std::atomic<int> admitted{0};   // open connections that count against max_connections
+  std::atomic<int> lingering{0};  // half-closed connections being drained
+  std::atomic<bool> accept_paused{false};
+  std::atomic<long long> accept_resume_ns{0};
+  std::vector<std::thread> light_threads;
+  std::unique_ptr<ComputePool> compute;
+  BusyCounter light_busy, compute_busy;
   std::array<std::atomic<unsigned long long>, static_cast<int>(Reason::kCount)> closed_by{};
-  std::atomic<int> open_gauge{0};
+  std::atomic<unsigned long long> accepted{0};
   std::atomic<int> idle_gauge{0};
   std::atomic<int> reading_gauge{0};
-  std::atomic<int> lingering_gauge{0};
-  std::atomic<unsigned long long> accepted{0};
 
-  // ------------------------------------------------------------ epoll helpers
-  void Arm(Connection* c) {
+  // ------------------------------------------------------------ registry
+  ConnectionPtr Find(std::uint64_t id) {
+    std::lock_guard<std::mutex> lock(map_mutex);
+    const auto it = connections.find(id);
+    return it == connections.end() ? nullptr : it->second;
+  }
+
+  std::vector<ConnectionPtr> Snapshot() {
+    std::lock_guard<std::mutex> lock(map_mutex);
+    std::vector<ConnectionPtr> all;
+    all.reserve(connections.size());
+    for (const auto& [id, c] : connections) all.push_back(c);
+    return all;
+  }
+
+  // ------------------------------------------------------------ epoll
+  // Waits for the next bytes of `c` (one event, then disarmed until re-armed).
+  void Arm(Connection& c) {
     epoll_event event{};
     event.events = EPOLLIN | EPOLLRDHUP | EPOLLONESHOT;
-    event.data.ptr = c;
-    epoll_ctl(epoll_fd, EPOLL_CTL_MOD, c->fd, &event);
+    event.data.u64 = c.id;
+    epoll_ctl(epoll_fd, EPOLL_CTL_MOD, c.fd, &event);
   }
 
-  void Wake() {
-    const std::uint64_t one = 1;
-    [[maybe_unused]] const ssize_t n = ::write(wake_fd, &one, sizeof one);
-  }
-
-  // ------------------------------------------------------------ closing
-  void Close(Connection* c) {
-    if (c->state == State::kLingering) {
-      --lingering;
+  // ------------------------------------------------------------ closing (c.mutex held)
+  void Close(Connection& c) {
+    if (c.closed) return;
+    c.closed = true;
+    if (c.state == State::kLingering) {
+      lingering.fetch_sub(1, std::memory_order_relaxed);
     } else {
-      --admitted;
+      admitted.fetch_sub(1, std::memory_order_relaxed);
     }
-    ::close(c->fd);  // also removes it from the epoll set
-    connections.erase(c);
+    ::close(c.fd);  // also takes it out of the epoll set
+    std::lock_guard<std::mutex> lock(map_mutex);
+    connections.erase(c.id);
   }
 
   // Half-closes `c` and drains it until the client closes or linger_s passes,
   // so that the client reads what was sent instead of a reset.
-  void Linger(Connection* c, Clock::time_point now) {
-    ::shutdown(c->fd, SHUT_WR);
-    if (c->state != State::kLingering) {
-      --admitted;
-      ++lingering;
+  void Linger(Connection& c, Clock::time_point now) {
+    ::shutdown(c.fd, SHUT_WR);
+    if (c.state != State::kLingering) {
+      admitted.fetch_sub(1, std::memory_order_relaxed);
+      lingering.fetch_add(1, std::memory_order_relaxed);
+      c.state = State::kLingering;
     }
-    c->state = State::kLingering;
-    c->in.clear();
-    c->in.shrink_to_fit();
-    c->linger_until = now + Seconds(options.linger_s);
-    if (lingering > std::max(64, options.max_connections)) {
+    c.in.clear();
+    c.in.shrink_to_fit();
+    c.linger_until = now + Seconds(options.linger_s);
+    if (lingering.load(std::memory_order_relaxed) > std::max(64, options.max_connections)) {
       Close(c);  // too many already: no draining for this one
       return;
     }
     Arm(c);
   }
 
-  // Answers `c` with an error envelope of the loop's own, then lingers.
-  void Refuse(Connection* c, int status, const char* code, Reason reason,
+  // Answers `c` with an error envelope of its own, then lingers.
+  void Refuse(Connection& c, int status, const char* code, Reason reason,
               const std::string& message, Clock::time_point now) {
     closed_by[static_cast<int>(reason)].fetch_add(1, std::memory_order_relaxed);
     const std::string body = hooks.error_body ? hooks.error_body(status, code, message) : "";
@@ -276,36 +304,37 @@ struct ConnectionLoop::Impl {
                            std::to_string(body.size()) + "\r\nConnection: close\r\n";
     if (status == 503) response += "Retry-After: 1\r\n";
     response += "\r\n" + body;
-    // Best effort: a fresh socket's buffer takes a few hundred bytes at once.
+    // Best effort: a socket's buffer takes a few hundred bytes at once.
     [[maybe_unused]] const ssize_t n =
-        ::send(c->fd, response.data(), response.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
-    if (hooks.refused) hooks.refused(status, code, c->head.method, c->head.path);
+        ::send(c.fd, response.data(), response.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (hooks.refused) hooks.refused(status, code, c.head.method, c.head.path);
     Linger(c, now);
   }
 
   // ------------------------------------------------------------ accepting
-  void Accept(Clock::time_point now) {
+  void Accept() {
     for (;;) {
       sockaddr_storage peer{};
       socklen_t peer_len = sizeof peer;
       const int fd = ::accept4(listen_fd, reinterpret_cast<sockaddr*>(&peer), &peer_len,
                                SOCK_NONBLOCK | SOCK_CLOEXEC);
+      const Clock::time_point now = Clock::now();
       if (fd < 0) {
         if (errno == EINTR || errno == ECONNABORTED) continue;
         if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
-          // Out of descriptors: stop accepting for a moment instead of spinning.
+          // Out of descriptors: stop accepting for 100 ms instead of spinning.
           epoll_event event{};
-          event.data.ptr = &listen_tag;
+          event.data.u64 = kListenTag;
           epoll_ctl(epoll_fd, EPOLL_CTL_MOD, listen_fd, &event);
-          accept_paused = true;
-          accept_resume = now + std::chrono::milliseconds(100);
+          accept_resume_ns.store((now + std::chrono::milliseconds(100)).time_since_epoch().count());
+          accept_paused.store(true);
         }
         return;
       }
       const int yes = 1;
       setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &yes, sizeof yes);  // pitfalls.md: Nagle
-      auto owned = std::make_unique<Connection>();
-      Connection* c = owned.get();
+      auto c = std::make_shared<Connection>();
+      std::lock_guard<std::mutex> hold(c->mutex);  // an event may come as soon as it is added
       c->fd = fd;
       c->started = c->last_read = now;
       AddressOf(peer, &c->remote_ip, &c->remote_port);
@@ -314,18 +343,22 @@ struct ConnectionLoop::Impl {
       if (getsockname(fd, reinterpret_cast<sockaddr*>(&local), &local_len) == 0) {
         AddressOf(local, &c->local_ip, &c->local_port);
       }
+      {
+        std::lock_guard<std::mutex> lock(map_mutex);
+        c->id = next_id++;
+        connections.emplace(c->id, c);
+      }
+      accepted.fetch_add(1, std::memory_order_relaxed);
+      const bool over = admitted.fetch_add(1, std::memory_order_relaxed) >= options.max_connections;
       epoll_event event{};
       event.events = EPOLLIN | EPOLLRDHUP | EPOLLONESHOT;
-      event.data.ptr = c;
+      event.data.u64 = c->id;
       if (epoll_ctl(epoll_fd, EPOLL_CTL_ADD, fd, &event) != 0) {
-        ::close(fd);
+        Close(*c);
         continue;
       }
-      connections.emplace(c, std::move(owned));
-      accepted.fetch_add(1, std::memory_order_relaxed);
-      ++admitted;
-      if (admitted > options.max_connections) {
-        Refuse(c, 503, "TooBusy", Reason::kOverLimit,
+      if (over) {
+        Refuse(*c, 503, "TooBusy", Reason::kOverLimit,
                "the server has " + std::to_string(options.max_connections) +
                    " connections open (limit max_connections); retry later",
                now);
@@ -333,18 +366,18 @@ struct ConnectionLoop::Impl {
     }
   }
 
-  // ------------------------------------------------------------ reading
-  // Reads what the socket has (up to what the current request still needs,
-  // plus one chunk). Returns false when the peer closed its side or failed.
-  bool Receive(Connection* c, Clock::time_point now) {
+  // ------------------------------------------------------------ reading (c.mutex held)
+  // Reads what the socket has (up to the largest request, plus one chunk).
+  // Returns false when the peer closed its side or failed.
+  bool Receive(Connection& c, Clock::time_point now) {
     const std::size_t cap = options.max_head_bytes + options.max_body_bytes + kReadChunk;
     for (;;) {
-      if (c->state != State::kLingering && c->in.size() >= cap) return true;
+      if (c.state != State::kLingering && c.in.size() >= cap) return true;
       char buffer[kReadChunk];
-      const ssize_t n = ::recv(c->fd, buffer, sizeof buffer, 0);
+      const ssize_t n = ::recv(c.fd, buffer, sizeof buffer, 0);
       if (n > 0) {
-        if (c->state != State::kLingering) c->in.append(buffer, static_cast<std::size_t>(n));
-        c->last_read = now;
+        if (c.state != State::kLingering) c.in.append(buffer, static_cast<std::size_t>(n));
+        c.last_read = now;
         if (static_cast<std::size_t>(n) < sizeof buffer) return true;
         continue;
       }
@@ -354,125 +387,94 @@ struct ConnectionLoop::Impl {
     }
   }
 
-  void OnEvent(Connection* c, std::uint32_t events, Clock::time_point now) {
-    const bool open = Receive(c, now);
-    if (c->state == State::kLingering) {
-      if (!open || (events & (EPOLLHUP | EPOLLERR)) != 0) {
-        Close(c);
-      } else {
-        Arm(c);
-      }
-      return;
-    }
-    if (!open) {
-      // The client closed its side: a request it completed first is still
-      // answered (then the connection closes); otherwise nobody is listening.
-      c->peer_closed = true;
-      if (c->in.empty()) {
-        Close(c);
-        return;
-      }
-    }
-    Advance(c, now);
-  }
+  enum class Step {
+    kWait,     // armed again, or closed, or lingering: nothing more to do now
+    kRequest,  // a complete request is framed (state kWorking): answer it
+  };
 
   // Waits for more of the current request, unless the client can send no more.
-  void AwaitMore(Connection* c) {
-    if (c->peer_closed) {
+  Step AwaitMore(Connection& c) {
+    if (c.peer_closed) {
       Close(c);
     } else {
       Arm(c);
     }
+    return Step::kWait;
   }
 
   // Moves `c` on with what it has received: frames the head, waits for the
-  // body, hands a complete request to the light pool.
-  void Advance(Connection* c, Clock::time_point now) {
-    if (c->state == State::kIdle) {
-      if (c->in.empty()) {
-        AwaitMore(c);
-        return;
-      }
-      c->state = State::kReadingHead;
-      c->started = now;
+  // body, and says when a complete request is there.
+  Step Advance(Connection& c, Clock::time_point now) {
+    if (c.state == State::kIdle) {
+      if (c.in.empty()) return AwaitMore(c);
+      c.state = State::kReadingHead;
+      c.started = now;
     }
-    if (c->state == State::kReadingHead) {
-      const HeadScan scan = ScanRequestHead(c->in, options.max_head_bytes, &c->scanned, &c->head);
-      if (scan == HeadScan::kIncomplete) {
-        AwaitMore(c);
-        return;
-      }
+    if (c.state == State::kReadingHead) {
+      const HeadScan scan = ScanRequestHead(c.in, options.max_head_bytes, &c.scanned, &c.head);
+      if (scan == HeadScan::kIncomplete) return AwaitMore(c);
       if (scan == HeadScan::kTooLarge) {
-        Refuse(c, 431, "TooBig",
-               Reason::kHeadTooLarge,
+        Refuse(c, 431, "TooBig", Reason::kHeadTooLarge,
                "the request head is over max_head_bytes = " +
                    std::to_string(options.max_head_bytes) + " bytes",
                now);
-        return;
+        return Step::kWait;
       }
-      RequestHead& head = c->head;
+      RequestHead& head = c.head;
       if (head.bad_content_length) {
         Refuse(c, 400, "InvalidValue", Reason::kBadRequest,
                "header Content-Length: must be one decimal number of bytes", now);
-        return;
+        return Step::kWait;
       }
       if (head.expects_continue) {
-        // The loop answers "100 Continue" itself; httplib must not send another.
+        // "100 Continue" is sent here when the body is awaited; httplib must not send another.
         const std::size_t n = head.expect_line_end - head.expect_line_begin;
-        c->in.erase(head.expect_line_begin, n);
+        c.in.erase(head.expect_line_begin, n);
         head.head_bytes -= n;
       }
-      c->continue_sent = false;
+      c.continue_sent = false;
       if (head.has_transfer_encoding || head.content_length > options.max_body_bytes) {
         // httplib answers these from the head alone (411, 413); the body is never read.
-        c->request_bytes = head.head_bytes;
-        c->close_after = true;
-        Dispatch(c);
-        return;
+        c.request_bytes = head.head_bytes;
+        c.close_after = true;
+        return Framed(c);
       }
-      c->state = State::kReadingBody;
-      c->body_deadline = now + Seconds(options.header_timeout_s) +
-                         Seconds(static_cast<double>(head.content_length) /
-                                 options.body_min_rate_bytes_per_s);
+      c.state = State::kReadingBody;
+      c.body_deadline = now + Seconds(options.header_timeout_s) +
+                        Seconds(static_cast<double>(head.content_length) /
+                                options.body_min_rate_bytes_per_s);
     }
     // kReadingBody
-    const std::size_t needed = c->head.head_bytes + c->head.content_length;
-    if (c->in.size() >= needed) {
-      c->request_bytes = needed;
-      Dispatch(c);
-      return;
+    const std::size_t needed = c.head.head_bytes + c.head.content_length;
+    if (c.in.size() >= needed) {
+      c.request_bytes = needed;
+      return Framed(c);
     }
-    if (c->head.expects_continue && !c->continue_sent) {
+    if (c.head.expects_continue && !c.continue_sent) {
       static constexpr char kContinue[] = "HTTP/1.1 100 Continue\r\n\r\n";
       [[maybe_unused]] const ssize_t n =
-          ::send(c->fd, kContinue, sizeof kContinue - 1, MSG_NOSIGNAL | MSG_DONTWAIT);
-      c->continue_sent = true;
+          ::send(c.fd, kContinue, sizeof kContinue - 1, MSG_NOSIGNAL | MSG_DONTWAIT);
+      c.continue_sent = true;
     }
-    AwaitMore(c);
+    return AwaitMore(c);
   }
 
-  void Dispatch(Connection* c) {
-    if (c->peer_closed) c->close_after = true;
-    c->state = State::kWorking;
-    ++working;
-    light->Push(c);
+  Step Framed(Connection& c) {
+    if (c.peer_closed) c.close_after = true;
+    c.state = State::kWorking;
+    return Step::kRequest;
   }
 
-  // ------------------------------------------------------------ workers
-  void Serve(Connection* c, Pool pool) {
-    const std::string_view request(c->in.data(), c->request_bytes);
-    if (pool == Pool::kLight && hooks.classify) {
-      const std::string_view body = request.substr(c->head.head_bytes);
-      if (hooks.classify(c->head.method, c->head.path, body) == Pool::kCompute) {
-        compute->Push(c);
-        return;
-      }
-    }
+  // ------------------------------------------------------------ answering (c.mutex held)
+  // Answers the framed request of `c` with httplib; sets c.keep_open.
+  void Answer(Connection& c, BusyCounter& busy) {
+    busy.Enter();
     bool keep_open = false;
     try {
-      RequestStream stream(c->fd, request, options.write_timeout_s, c->remote_ip, c->remote_port,
-                           c->local_ip, c->local_port);
-      const bool last = c->close_after || c->served + 1 >= options.keep_alive_max_requests ||
+      const std::string_view request(c.in.data(), c.request_bytes);
+      RequestStream stream(c.fd, request, options.write_timeout_s, c.remote_ip, c.remote_port,
+                           c.local_ip, c.local_port);
+      const bool last = c.close_after || c.served + 1 >= options.keep_alive_max_requests ||
                         stopping.load(std::memory_order_relaxed);
       bool closed = false;
       const bool ok = hooks.serve(stream, last, &closed);
@@ -481,223 +483,251 @@ struct ConnectionLoop::Impl {
     } catch (...) {
       keep_open = false;  // httplib catches the handlers' exceptions; this is out of memory
     }
-    ++c->served;
-    c->keep_open = keep_open;
-    {
-      std::lock_guard<std::mutex> lock(returned_mutex);
-      returned.push_back(c);
-    }
-    Wake();
+    busy.Leave();
+    ++c.served;
+    c.keep_open = keep_open;
   }
 
-  // Takes back the connections the workers are done with.
-  void TakeReturned(Clock::time_point now) {
-    std::vector<Connection*> done;
-    {
-      std::lock_guard<std::mutex> lock(returned_mutex);
-      done.swap(returned);
+  // After an answer: closes (lingering) or goes back to waiting. Returns true
+  // when `c` waits for its next request (Advance may find one already in).
+  bool AfterAnswer(Connection& c, Clock::time_point now) {
+    c.in.erase(0, c.request_bytes);
+    c.request_bytes = 0;
+    c.scanned = 0;
+    c.head = RequestHead{};
+    if (!c.keep_open || stopping.load(std::memory_order_relaxed)) {
+      Linger(c, now);
+      return false;
     }
-    for (Connection* c : done) {
-      --working;
-      c->in.erase(0, c->request_bytes);
-      c->request_bytes = 0;
-      c->scanned = 0;
-      c->head = RequestHead{};
-      if (!c->keep_open || stopping.load(std::memory_order_relaxed)) {
-        Linger(c, now);
+    c.state = State::kIdle;
+    c.idle_since = now;
+    return true;
+  }
+
+  // Handles `c` until it waits for bytes, is closed, or went to the compute
+  // pool: answers each complete request, one after another for a client that
+  // pipelines.
+  void Drive(const ConnectionPtr& c, std::unique_lock<std::mutex>& lock, Clock::time_point now,
+             Pool pool) {
+    while (Advance(*c, now) == Step::kRequest) {
+      if (pool == Pool::kLight && hooks.classify &&
+          hooks.classify(c->head.method, c->head.path,
+                         std::string_view(c->in).substr(c->head.head_bytes,
+                                                        c->request_bytes - c->head.head_bytes)) ==
+              Pool::kCompute) {
+        lock.unlock();
+        compute->Push(c);
+        return;
+      }
+      Answer(*c, pool == Pool::kLight ? light_busy : compute_busy);
+      now = Clock::now();
+      if (!AfterAnswer(*c, now)) return;
+    }
+  }
+
+  // ------------------------------------------------------------ the threads
+  void LightWorker() {
+    for (;;) {
+      epoll_event event{};
+      const int n = epoll_wait(epoll_fd, &event, 1, 1000);
+      if (n <= 0) continue;
+      if (event.data.u64 == kWakeTag) return;  // Run() is done: leave
+      if (event.data.u64 == kListenTag) {
+        if (!stopping.load()) Accept();
         continue;
       }
-      c->state = State::kIdle;
-      c->idle_since = now;
-      Advance(c, now);  // a pipelined request may be there already
+      const ConnectionPtr c = Find(event.data.u64);
+      if (!c) continue;  // closed since the event was queued
+      std::unique_lock<std::mutex> lock(c->mutex);
+      if (c->closed) continue;
+      const Clock::time_point now = Clock::now();
+      const bool open = Receive(*c, now);
+      if (c->state == State::kLingering) {
+        if (!open || (event.events & (EPOLLHUP | EPOLLERR)) != 0) {
+          Close(*c);
+        } else {
+          Arm(*c);
+        }
+        continue;
+      }
+      if (!open) {
+        // The client closed its side: a request it completed first is still
+        // answered (then the connection closes); otherwise nobody is listening.
+        c->peer_closed = true;
+        if (c->in.empty()) {
+          Close(*c);
+          continue;
+        }
+      }
+      Drive(c, lock, now, Pool::kLight);
     }
   }
 
-  // ------------------------------------------------------------ deadlines
+  void ComputeWorker(ConnectionPtr c) {
+    std::unique_lock<std::mutex> lock(c->mutex);
+    if (c->closed) return;
+    Answer(*c, compute_busy);
+    const Clock::time_point now = Clock::now();
+    if (AfterAnswer(*c, now)) Drive(c, lock, now, Pool::kCompute);
+  }
+
+  // ------------------------------------------------------------ deadlines (Run's thread)
   void Sweep(Clock::time_point now) {
     int idle = 0, reading = 0;
-    std::vector<Connection*> expired;
-    for (const auto& [c, owned] : connections) {
+    for (const ConnectionPtr& c : Snapshot()) {
+      std::unique_lock<std::mutex> lock(c->mutex, std::try_to_lock);
+      if (!lock.owns_lock() || c->closed) continue;  // a worker has it: not waiting
       switch (c->state) {
         case State::kIdle:
           ++idle;
-          if (now - c->idle_since >= Seconds(options.keep_alive_timeout_s)) expired.push_back(c);
+          if (now - c->idle_since >= Seconds(options.keep_alive_timeout_s)) {
+            closed_by[static_cast<int>(Reason::kIdle)].fetch_add(1, std::memory_order_relaxed);
+            Close(*c);
+          }
           break;
         case State::kReadingHead:
           ++reading;
           if (now - c->started >= Seconds(options.header_timeout_s) ||
               now - c->last_read >= Seconds(options.read_timeout_s)) {
-            expired.push_back(c);
+            ExpireHead(*c, now);
           }
           break;
         case State::kReadingBody:
           ++reading;
           if (now >= c->body_deadline || now - c->last_read >= Seconds(options.read_timeout_s)) {
-            expired.push_back(c);
+            ExpireBody(*c, now);
           }
           break;
         case State::kLingering:
-          if (now >= c->linger_until) expired.push_back(c);
+          if (now >= c->linger_until) Close(*c);
           break;
         case State::kWorking:
           break;
       }
     }
-    for (Connection* c : expired) Expire(c, now);
-    open_gauge.store(admitted, std::memory_order_relaxed);
     idle_gauge.store(idle, std::memory_order_relaxed);
     reading_gauge.store(reading, std::memory_order_relaxed);
-    lingering_gauge.store(lingering, std::memory_order_relaxed);
   }
 
-  void Expire(Connection* c, Clock::time_point now) {
-    switch (c->state) {
-      case State::kIdle:
-        closed_by[static_cast<int>(Reason::kIdle)].fetch_add(1, std::memory_order_relaxed);
-        Close(c);
-        return;
-      case State::kLingering:
-        Close(c);
-        return;
-      case State::kReadingHead:
-        if (c->in.empty() && c->served == 0 &&
-            now - c->last_read >= Seconds(options.read_timeout_s)) {
-          // A connection that never sent a byte: nothing to answer.
-          closed_by[static_cast<int>(Reason::kReadTimeout)].fetch_add(1,
-                                                                       std::memory_order_relaxed);
-          Close(c);
-          return;
-        }
-        if (now - c->last_read >= Seconds(options.read_timeout_s) &&
-            now - c->started < Seconds(options.header_timeout_s)) {
-          Refuse(c, 408, "Timeout", Reason::kReadTimeout,
-                 "no byte of the request head arrived for read_timeout_s = " +
-                     FormatSeconds(options.read_timeout_s) + " s (read timeout)",
-                 now);
-          return;
-        }
-        Refuse(c, 408, "Timeout", Reason::kHeaderTimeout,
-               "the request head did not arrive within header_timeout_s = " +
-                   FormatSeconds(options.header_timeout_s) + " s",
-               now);
-        return;
-      case State::kReadingBody:
-        if (now >= c->body_deadline) {
-          Refuse(c, 408, "Timeout", Reason::kBodyTooSlow,
-                 "the request body of " + std::to_string(c->head.content_length) +
-                     " bytes did not arrive within header_timeout_s + bytes / "
-                     "body_min_rate_bytes_per_s = " +
-                     FormatSeconds(options.header_timeout_s) + " s + " +
-                     std::to_string(c->head.content_length) + " / " +
-                     FormatSeconds(options.body_min_rate_bytes_per_s) + " s",
-                 now);
-          return;
-        }
-        Refuse(c, 408, "Timeout", Reason::kReadTimeout,
-               "no byte of the request body arrived for read_timeout_s = " +
-                   FormatSeconds(options.read_timeout_s) + " s (read timeout)",
-               now);
-        return;
-      case State::kWorking:
-        return;
+  void ExpireHead(Connection& c, Clock::time_point now) {
+    const bool silent = now - c.last_read >= Seconds(options.read_timeout_s);
+    if (c.in.empty() && c.served == 0 && silent) {
+      // A connection that never sent a byte: nothing to answer.
+      closed_by[static_cast<int>(Reason::kReadTimeout)].fetch_add(1, std::memory_order_relaxed);
+      Close(c);
+      return;
     }
+    if (silent && now - c.started < Seconds(options.header_timeout_s)) {
+      Refuse(c, 408, "Timeout", Reason::kReadTimeout,
+             "no byte of the request head arrived for read_timeout_s = " +
+                 FormatSeconds(options.read_timeout_s) + " s (read timeout)",
+             now);
+      return;
+    }
+    Refuse(c, 408, "Timeout", Reason::kHeaderTimeout,
+           "the request head did not arrive within header_timeout_s = " +
+               FormatSeconds(options.header_timeout_s) + " s",
+           now);
+  }
+
+  void ExpireBody(Connection& c, Clock::time_point now) {
+    if (now >= c.body_deadline) {
+      Refuse(c, 408, "Timeout", Reason::kBodyTooSlow,
+             "the request body of " + std::to_string(c.head.content_length) +
+                 " bytes did not arrive within header_timeout_s + bytes / "
+                 "body_min_rate_bytes_per_s = " +
+                 FormatSeconds(options.header_timeout_s) + " s + " +
+                 std::to_string(c.head.content_length) + " / " +
+                 FormatSeconds(options.body_min_rate_bytes_per_s) + " s",
+             now);
+      return;
+    }
+    Refuse(c, 408, "Timeout", Reason::kReadTimeout,
+           "no byte of the request body arrived for read_timeout_s = " +
+               FormatSeconds(options.read_timeout_s) + " s (read timeout)",
+           now);
+  }
+
+  // Stop: closes every connection that is not being answered (those close
+  // themselves after their answer). Returns how many connections remain.
+  std::size_t CloseWaiting() {
+    for (const ConnectionPtr& c : Snapshot()) {
+      std::unique_lock<std::mutex> lock(c->mutex, std::try_to_lock);
+      if (lock.owns_lock() && !c->closed && c->state != State::kWorking) Close(*c);
+    }
+    std::lock_guard<std::mutex> lock(map_mutex);
+    return connections.size();
   }
 };
 
 ConnectionLoop::ConnectionLoop(int listen_fd, ConnectionLoopOptions options,
                                ConnectionLoopHooks hooks)
     : impl_(std::make_unique<Impl>(listen_fd, options, std::move(hooks))) {
-  Impl* impl = impl_.get();
-  impl->light = std::make_unique<WorkerPool>("light", std::max(1, options.light_workers),
-                                             [impl](Connection* c) { impl->Serve(c, Pool::kLight); });
-  impl->compute = std::make_unique<WorkerPool>(
-      "compute", std::max(1, options.compute_workers),
-      [impl](Connection* c) { impl->Serve(c, Pool::kCompute); });
-  impl->wake_fd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  impl_->wake_fd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  impl_->epoll_fd = epoll_create1(EPOLL_CLOEXEC);
 }
 
 ConnectionLoop::~ConnectionLoop() {
   Stop();
-  impl_->light->Shutdown();
-  impl_->compute->Shutdown();
-  for (auto& [c, owned] : impl_->connections) ::close(c->fd);
-  if (impl_->listen_fd >= 0) ::close(impl_->listen_fd);
-  if (impl_->epoll_fd >= 0) ::close(impl_->epoll_fd);
-  if (impl_->wake_fd >= 0) ::close(impl_->wake_fd);
+  Impl& m = *impl_;
+  for (auto& thread : m.light_threads) {
+    if (thread.joinable()) thread.join();
+  }
+  if (m.compute) m.compute->Shutdown();
+  for (const ConnectionPtr& c : m.Snapshot()) {
+    if (!c->closed) ::close(c->fd);
+  }
+  if (m.listen_fd >= 0) ::close(m.listen_fd);
+  if (m.epoll_fd >= 0) ::close(m.epoll_fd);
+  if (m.wake_fd >= 0) ::close(m.wake_fd);
 }
 
-void ConnectionLoop::Stop() {
-  impl_->stopping.store(true);
-  if (impl_->wake_fd >= 0) impl_->Wake();
-}
+void ConnectionLoop::Stop() { impl_->stopping.store(true); }
 
 bool ConnectionLoop::Run() {
   Impl& m = *impl_;
-  if (m.epoll_fd < 0) m.epoll_fd = epoll_create1(EPOLL_CLOEXEC);
-  if (m.epoll_fd < 0 || m.wake_fd < 0 || m.listen_fd < 0) return false;
+  if (m.epoll_fd < 0 || m.wake_fd < 0 || m.listen_fd < 0 || !m.light_threads.empty()) return false;
   epoll_event event{};
+  // Level-triggered and never read: once written, it wakes every worker (to leave).
   event.events = EPOLLIN;
-  event.data.ptr = &m.wake_tag;
+  event.data.u64 = kWakeTag;
   if (epoll_ctl(m.epoll_fd, EPOLL_CTL_ADD, m.wake_fd, &event) != 0) return false;
-  event.data.ptr = &m.listen_tag;
+  // One worker woken per new connection (EPOLLEXCLUSIVE), not all of them.
+  event.events = EPOLLIN | EPOLLEXCLUSIVE;
+  event.data.u64 = kListenTag;
   if (epoll_ctl(m.epoll_fd, EPOLL_CTL_ADD, m.listen_fd, &event) != 0) return false;
 
-  std::array<epoll_event, 256> events{};
-  Clock::time_point last_sweep = Clock::now();
-  bool draining = false;  // stopping: no new requests; waiting for the workers
-  for (;;) {
-    const int timeout_ms = static_cast<int>(
-        std::chrono::duration_cast<std::chrono::milliseconds>(kSweepInterval).count());
-    const int n = epoll_wait(m.epoll_fd, events.data(), static_cast<int>(events.size()),
-                             timeout_ms);
+  m.compute = std::make_unique<ComputePool>(
+      std::max(1, m.options.compute_workers),
+      [&m](ConnectionPtr c) { m.ComputeWorker(std::move(c)); });
+  for (int i = 0; i < std::max(1, m.options.light_workers); ++i) {
+    m.light_threads.emplace_back([&m] { m.LightWorker(); });
+  }
+
+  // This thread keeps the deadlines until Stop().
+  while (!m.stopping.load()) {
+    std::this_thread::sleep_for(kSweepInterval);
     const Clock::time_point now = Clock::now();
-    for (int i = 0; i < n; ++i) {
-      void* tag = events[i].data.ptr;
-      if (tag == &m.listen_tag) {
-        if (!draining) m.Accept(now);
-      } else if (tag == &m.wake_tag) {
-        std::uint64_t count = 0;
-        [[maybe_unused]] const ssize_t r = ::read(m.wake_fd, &count, sizeof count);
-      } else if (m.connections.count(static_cast<Connection*>(tag)) != 0) {
-        m.OnEvent(static_cast<Connection*>(tag), events[i].events, now);
-      }
-    }
-    m.TakeReturned(now);
-    if (m.accept_paused && now >= m.accept_resume && !draining) {
-      event.events = EPOLLIN;
-      event.data.ptr = &m.listen_tag;
-      epoll_ctl(m.epoll_fd, EPOLL_CTL_MOD, m.listen_fd, &event);
-      m.accept_paused = false;
-    }
-    if (!draining && m.stopping.load()) {
-      // Stop: no new connections; close those that wait for a request; the
-      // requests already read are answered (with Connection: close).
-      draining = true;
+    m.Sweep(now);
+    if (m.accept_paused.load() && now.time_since_epoch().count() >= m.accept_resume_ns.load()) {
+      m.accept_paused.store(false);
+      event.events = EPOLLIN | EPOLLEXCLUSIVE;
+      event.data.u64 = kListenTag;
+      // EPOLLEXCLUSIVE cannot be modified: take the socket out and add it again.
       epoll_ctl(m.epoll_fd, EPOLL_CTL_DEL, m.listen_fd, nullptr);
-      ::close(m.listen_fd);
-      m.listen_fd = -1;
-      std::vector<Connection*> waiting;
-      for (const auto& [c, owned] : m.connections) {
-        if (c->state != State::kWorking) waiting.push_back(c);
-      }
-      for (Connection* c : waiting) m.Close(c);
-    }
-    if (draining) {
-      // Connections the workers return are lingering now: close them at once.
-      std::vector<Connection*> done;
-      for (const auto& [c, owned] : m.connections) {
-        if (c->state == State::kLingering) done.push_back(c);
-      }
-      for (Connection* c : done) m.Close(c);
-      if (m.working == 0) break;
-      continue;
-    }
-    if (now - last_sweep >= kSweepInterval) {
-      m.Sweep(now);
-      last_sweep = now;
+      epoll_ctl(m.epoll_fd, EPOLL_CTL_ADD, m.listen_fd, &event);
     }
   }
-  m.light->Shutdown();
+  // Stop: no new connections; those waiting for a request are closed; the
+  // requests being answered finish (with Connection: close) and close theirs.
+  epoll_ctl(m.epoll_fd, EPOLL_CTL_DEL, m.listen_fd, nullptr);
+  ::close(m.listen_fd);
+  m.listen_fd = -1;
+  while (m.CloseWaiting() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const std::uint64_t one = 1;
+  [[maybe_unused]] const ssize_t n = ::write(m.wake_fd, &one, sizeof one);
+  for (auto& thread : m.light_threads) thread.join();
+  m.light_threads.clear();
   m.compute->Shutdown();
   return true;
 }
@@ -708,10 +738,10 @@ std::string ConnectionLoop::MetricsText() const {
   out << "# HELP sweetspot_connections Open connections by state (admitted ones count against "
          "max_connections).\n"
       << "# TYPE sweetspot_connections gauge\n"
-      << "sweetspot_connections{state=\"admitted\"} " << m.open_gauge.load() << "\n"
+      << "sweetspot_connections{state=\"admitted\"} " << m.admitted.load() << "\n"
       << "sweetspot_connections{state=\"idle\"} " << m.idle_gauge.load() << "\n"
       << "sweetspot_connections{state=\"reading\"} " << m.reading_gauge.load() << "\n"
-      << "sweetspot_connections{state=\"lingering\"} " << m.lingering_gauge.load() << "\n"
+      << "sweetspot_connections{state=\"lingering\"} " << m.lingering.load() << "\n"
       << "# HELP sweetspot_connections_accepted_total Connections accepted.\n"
       << "# TYPE sweetspot_connections_accepted_total counter\n"
       << "sweetspot_connections_accepted_total " << m.accepted.load() << "\n"
@@ -722,35 +752,28 @@ std::string ConnectionLoop::MetricsText() const {
     out << "sweetspot_connections_closed_total{reason=\"" << kReasonNames[i] << "\"} "
         << m.closed_by[i].load() << "\n";
   }
-  out << "# HELP sweetspot_workers Worker threads per pool.\n# TYPE sweetspot_workers gauge\n";
-  for (const WorkerPool* pool : {m.light.get(), m.compute.get()}) {
-    out << "sweetspot_workers{pool=\"" << pool->name() << "\"} " << pool->size() << "\n";
-  }
-  out << "# HELP sweetspot_workers_busy Workers serving a request now, per pool.\n"
-      << "# TYPE sweetspot_workers_busy gauge\n";
-  for (const WorkerPool* pool : {m.light.get(), m.compute.get()}) {
-    out << "sweetspot_workers_busy{pool=\"" << pool->name() << "\"} " << pool->busy() << "\n";
-  }
-  out << "# HELP sweetspot_workers_busy_peak The most workers busy at once since the start, per "
-         "pool.\n"
-      << "# TYPE sweetspot_workers_busy_peak gauge\n";
-  for (const WorkerPool* pool : {m.light.get(), m.compute.get()}) {
-    out << "sweetspot_workers_busy_peak{pool=\"" << pool->name() << "\"} " << pool->peak_busy()
-        << "\n";
-  }
-  out << "# HELP sweetspot_requests_queued Complete requests waiting for a worker, per pool.\n"
-      << "# TYPE sweetspot_requests_queued gauge\n";
-  for (const WorkerPool* pool : {m.light.get(), m.compute.get()}) {
-    out << "sweetspot_requests_queued{pool=\"" << pool->name() << "\"} " << pool->queued()
-        << "\n";
-  }
-  out << "# HELP sweetspot_pool_requests_total Requests served, per pool (a request the light "
-         "pool passes on counts in both).\n"
-      << "# TYPE sweetspot_pool_requests_total counter\n";
-  for (const WorkerPool* pool : {m.light.get(), m.compute.get()}) {
-    out << "sweetspot_pool_requests_total{pool=\"" << pool->name() << "\"} " << pool->served()
-        << "\n";
-  }
+  const int light_size = std::max(1, m.options.light_workers);
+  const int compute_size = std::max(1, m.options.compute_workers);
+  out << "# HELP sweetspot_workers Worker threads per pool.\n# TYPE sweetspot_workers gauge\n"
+      << "sweetspot_workers{pool=\"light\"} " << light_size << "\n"
+      << "sweetspot_workers{pool=\"compute\"} " << compute_size << "\n"
+      << "# HELP sweetspot_workers_busy Workers answering a request now, per pool.\n"
+      << "# TYPE sweetspot_workers_busy gauge\n"
+      << "sweetspot_workers_busy{pool=\"light\"} " << m.light_busy.busy() << "\n"
+      << "sweetspot_workers_busy{pool=\"compute\"} " << m.compute_busy.busy() << "\n"
+      << "# HELP sweetspot_workers_busy_peak The most workers answering at once since the "
+         "start, per pool.\n"
+      << "# TYPE sweetspot_workers_busy_peak gauge\n"
+      << "sweetspot_workers_busy_peak{pool=\"light\"} " << m.light_busy.peak() << "\n"
+      << "sweetspot_workers_busy_peak{pool=\"compute\"} " << m.compute_busy.peak() << "\n"
+      << "# HELP sweetspot_requests_queued Complete requests waiting for a compute worker.\n"
+      << "# TYPE sweetspot_requests_queued gauge\n"
+      << "sweetspot_requests_queued{pool=\"compute\"} "
+      << (m.compute ? m.compute->queued() : 0) << "\n"
+      << "# HELP sweetspot_pool_requests_total Requests answered, per pool.\n"
+      << "# TYPE sweetspot_pool_requests_total counter\n"
+      << "sweetspot_pool_requests_total{pool=\"light\"} " << m.light_busy.served() << "\n"
+      << "sweetspot_pool_requests_total{pool=\"compute\"} " << m.compute_busy.served() << "\n";
   return out.str();
 }
 

@@ -1,21 +1,27 @@
-// The server's connection loop: one thread owns every connection with epoll,
-// reads each request's whole head and body under deadlines, and only then hands
-// the complete request to a worker; idle keep-alive connections and slow
-// clients hold no worker. Requests are served first come, first served across
-// connections (one request per turn), so many keep-alive clients share the
-// workers fairly. Two pools: `light_workers` threads for cheap requests and
-// `compute_workers` threads (sized to the cores) for requests that run models,
-// so a burst of solver work never delays /health or a closed-form answer.
+// The server's connection handling: every connection lives in one epoll set
+// that the light workers wait on together; a worker that is woken for a
+// connection reads what arrived without blocking, and only when a request's
+// whole head and body are in does it answer the request (or pass it to the
+// compute pool), then puts the connection back into the set. So a connection
+// holds a worker only while a complete request of it is being answered: idle
+// keep-alive connections and slow clients hold none, and many keep-alive
+// clients take turns one request at a time (each connection is re-armed after
+// each request, behind those already waiting). Two pools: `light_workers`
+// threads for cheap requests and `compute_workers` threads (sized to the
+// cores) for requests that run models, so that a burst of solver work never
+// delays /health or a closed-form answer. The thread that calls Run() keeps the
+// deadlines.
 //
-// What the loop answers itself, then closes the connection:
+// What is answered without a handler, then the connection is closed:
 //   503 TooBusy   a connection past max_connections, at once (Retry-After: 1);
 //   408 Timeout   a head not complete within header_timeout_s of its first byte
 //                 (of the accept, for a new connection), a body slower than
 //                 body_min_rate_bytes_per_s, or read_timeout_s without a byte;
 //   431 TooBig    a head over max_head_bytes;
 //   400           a Content-Length that is not one decimal number.
-// A closed connection is first drained for up to linger_s (so that the client
-// reads the answer instead of a reset), without counting against the limit.
+// A closed connection is first half-closed and drained for up to linger_s (so
+// that the client reads the answer instead of a reset), without counting
+// against the limit.
 #pragma once
 
 #include <atomic>
@@ -67,18 +73,19 @@ struct ConnectionLoopHooks {
       refused;
 };
 
-/// The loop. Run() on one thread; Stop() and MetricsText() from any thread.
+/// The connections. Run() on one thread; Stop() and MetricsText() from any thread.
 class ConnectionLoop {
  public:
-  /// Takes ownership of `listen_fd` (bound and listening). Starts the workers.
+  /// Takes ownership of `listen_fd` (bound and listening). Nothing runs before Run().
   ConnectionLoop(int listen_fd, ConnectionLoopOptions options, ConnectionLoopHooks hooks);
   ~ConnectionLoop();
   ConnectionLoop(const ConnectionLoop&) = delete;
   ConnectionLoop& operator=(const ConnectionLoop&) = delete;
 
-  /// Serves until Stop(); then closes the listening socket and idle
-  /// connections, answers the requests already read (with Connection: close)
-  /// and returns. Returns false if the loop could not start (epoll failed).
+  /// Starts the workers and serves until Stop(); then closes the listening
+  /// socket and the connections that wait for a request, lets the requests
+  /// being answered finish (with Connection: close) and returns. Returns false
+  /// if it could not start (epoll failed).
   bool Run();
   /// Makes Run() return (after the in-flight requests); idempotent, any thread.
   void Stop();
