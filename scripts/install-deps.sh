@@ -18,8 +18,8 @@ else
     libgtest-dev libgmock-dev libbenchmark-dev libboost-dev libsqlite3-dev
     # fuzzing (scripts/fuzz.sh): clang with libFuzzer and its sanitizer runtimes
     clang clang-14 libclang-rt-14-dev llvm-14
-    # HTTP benchmark at 1/8/64 connections (bench/http_bench.sh)
-    wrk
+    # HTTP benchmark (bench/http_bench.sh); nginx also for the test of docker/nginx.conf
+    wrk nginx
     # browser tests of the design explorer (headless, driven by playwright-core)
     chromium
   )

@@ -35,8 +35,10 @@ std::string Serialize(const nlohmann::json& body) {
 // 16 KiB or whatever was produced in 0.1 s, whichever comes first.
 void WriteStreamedResponse(const api::Response& response, httplib::Response& res) {
   res.status = response.status;
-  // The chunks must reach the client as they are produced, not when the answer ends.
+  // The chunks must reach the client as they are produced, not when the answer
+  // ends: here, and in a proxy in front (nginx buffers answers unless told not to).
   if (RequestStream* stream = RequestStream::Current()) stream->WriteThrough();
+  res.set_header("X-Accel-Buffering", "no");
   auto producer = response.stream;
   res.set_chunked_content_provider(
       response.content_type, [producer](std::size_t /*offset*/, httplib::DataSink& sink) {
