@@ -81,6 +81,13 @@ const std::vector<Route>& Routes() {
   return routes;
 }
 
+const Route* FindRoute(std::string_view method, std::string_view path) {
+  for (const Route& route : Routes()) {
+    if (route.method == method && PathMatches(route.path, path)) return &route;
+  }
+  return nullptr;
+}
+
 std::vector<const Route*> MatchRoutes(std::string_view path) {
   std::vector<const Route*> matches;
   for (const Route& route : Routes()) {

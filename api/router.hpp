@@ -64,6 +64,9 @@ struct Route {
 /// Every route the service answers, in a stable order.
 const std::vector<Route>& Routes();
 
+/// The route for `method` on `path`, or null (unknown path, or another method).
+const Route* FindRoute(std::string_view method, std::string_view path);
+
 /// The routes whose pattern matches `path` (any method), in table order.
 std::vector<const Route*> MatchRoutes(std::string_view path);
 
@@ -85,7 +88,9 @@ Response Dispatch(const Request& request, const Context& context,
 /// (core::ModelsFor); kLight otherwise, also for unknown paths and bodies that
 /// do not parse (they are refused at once). Cost: path matching, plus one JSON
 /// parse of the body for scene routes. Never throws.
-Workload ClassifyWorkload(const Request& request, const Context& context);
+/// Takes views so that a server can classify the bytes it received without copying them.
+Workload ClassifyWorkload(std::string_view method, std::string_view path, std::string_view body,
+                          const Context& context);
 
 /// The error envelope {"code", "message", "field"} with `status`.
 Response ErrorResponse(int status, std::string_view code, std::string message,

@@ -96,21 +96,22 @@ Workload SceneWorkload(const Request& request, const Json& body) {
 
 }  // namespace
 
-Workload ClassifyWorkload(const Request& request, const Context& context) {
+Workload ClassifyWorkload(std::string_view method, std::string_view path, std::string_view body,
+                          const Context& context) {
   try {
-    for (const Route* route : MatchRoutes(request.path)) {
-      if (route->method != request.method) continue;
-      switch (route->workload) {
-        case RouteWorkload::kLight:
-          return Workload::kLight;
-        case RouteWorkload::kCompute:
-          return Workload::kCompute;
-        case RouteWorkload::kScene: {
-          if (CannotNeedIterativeModel(request.body)) return Workload::kLight;
-          Response refused;
-          const auto body = ParseObjectBody(request, context, &refused);
-          return body ? SceneWorkload(request, *body) : Workload::kLight;
-        }
+    const Route* route = FindRoute(method, path);
+    if (route == nullptr) return Workload::kLight;
+    switch (route->workload) {
+      case RouteWorkload::kLight:
+        return Workload::kLight;
+      case RouteWorkload::kCompute:
+        return Workload::kCompute;
+      case RouteWorkload::kScene: {
+        if (CannotNeedIterativeModel(body)) return Workload::kLight;
+        const Request request{std::string(method), std::string(path), std::string(body)};
+        Response refused;
+        const auto parsed = ParseObjectBody(request, context, &refused);
+        return parsed ? SceneWorkload(request, *parsed) : Workload::kLight;
       }
     }
   } catch (...) {

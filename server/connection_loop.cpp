@@ -82,17 +82,19 @@ enum class Reason {
   kHeadTooLarge,
   kBadRequest,
   kIdle,
+  kWriteTimeout,
   kCount
 };
 
 constexpr std::array<const char*, static_cast<int>(Reason::kCount)> kReasonNames = {
     "over_limit",     "header_timeout", "body_too_slow",  "read_timeout",
-    "head_too_large", "bad_request",    "keep_alive_idle"};
+    "head_too_large", "bad_request",    "keep_alive_idle", "write_timeout"};
 
 enum class State {
   kReadingHead,  // armed: waiting for the rest of a head
   kReadingBody,  // armed: waiting for the rest of a body
   kIdle,         // armed: keep-alive, between requests
+  kWriting,      // armed for writing: the rest of an answer, sent as the client reads
   kLingering,    // armed: answered and half-closed, draining until the client closes
   kWorking,      // a complete request is queued or being answered
 };
@@ -120,6 +122,8 @@ struct Connection {
   Clock::time_point body_deadline;
   Clock::time_point idle_since;
   Clock::time_point linger_until;
+  std::string unsent;                 // the rest of an answer (kWriting)
+  Clock::time_point write_deadline;   // kWriting: the client must take more by then
   bool continue_sent = false;  // "100 Continue" sent for the current request
   bool close_after = false;    // close once the current request is answered
   bool keep_open = false;      // the verdict on the request just answered
@@ -256,7 +260,7 @@ struct ConnectionLoop::Impl {
   // Waits for the next bytes of `c` (one event, then disarmed until re-armed).
   void Arm(Connection& c) {
     epoll_event event{};
-    event.events = EPOLLIN | EPOLLRDHUP | EPOLLONESHOT;
+    event.events = (c.state == State::kWriting ? EPOLLOUT : EPOLLIN | EPOLLRDHUP) | EPOLLONESHOT;
     event.data.u64 = c.id;
     epoll_ctl(epoll_fd, EPOLL_CTL_MOD, c.fd, &event);
   }
@@ -478,8 +482,10 @@ struct ConnectionLoop::Impl {
                         stopping.load(std::memory_order_relaxed);
       bool closed = false;
       const bool ok = hooks.serve(stream, last, &closed);
-      const bool flushed = stream.Flush();
-      keep_open = ok && flushed && stream.healthy() && !last && !closed;
+      // What the socket does not take now is sent as the client reads (kWriting).
+      const bool sent = stream.SendWithoutWaiting(&c.unsent);
+      keep_open = ok && sent && !last && !closed;
+      if (!sent) c.unsent.clear();
     } catch (...) {
       keep_open = false;  // httplib catches the handlers' exceptions; this is out of memory
     }
@@ -491,10 +497,20 @@ struct ConnectionLoop::Impl {
   // After an answer: closes (lingering) or goes back to waiting. Returns true
   // when `c` waits for its next request (Advance may find one already in).
   bool AfterAnswer(Connection& c, Clock::time_point now) {
-    c.in.erase(0, c.request_bytes);
-    c.request_bytes = 0;
-    c.scanned = 0;
-    c.head = RequestHead{};
+    if (c.request_bytes > 0) {
+      c.in.erase(0, c.request_bytes);
+      c.request_bytes = 0;
+      c.scanned = 0;
+      c.head = RequestHead{};
+    }
+    if (!c.unsent.empty()) {
+      // The client reads slower than the answer: send the rest as it reads,
+      // holding no worker (Writable), within the write timeout.
+      c.state = State::kWriting;
+      c.write_deadline = now + Seconds(options.write_timeout_s);
+      Arm(c);
+      return false;
+    }
     if (!c.keep_open || stopping.load(std::memory_order_relaxed)) {
       Linger(c, now);
       return false;
@@ -502,6 +518,36 @@ struct ConnectionLoop::Impl {
     c.state = State::kIdle;
     c.idle_since = now;
     return true;
+  }
+
+  // The socket of a kWriting connection takes more: send what it takes; once
+  // the answer is out, go on as after any answer. Returns true when `c` waits
+  // for its next request.
+  bool Writable(Connection& c, Clock::time_point now) {
+    std::size_t at = 0;
+    for (;;) {
+      const ssize_t n = ::send(c.fd, c.unsent.data() + at, c.unsent.size() - at,
+                               MSG_NOSIGNAL | MSG_DONTWAIT);
+      if (n > 0) {
+        at += static_cast<std::size_t>(n);
+        if (at == c.unsent.size()) break;
+        continue;
+      }
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) break;
+      c.unsent.clear();
+      Close(c);  // the client is gone
+      return false;
+    }
+    c.unsent.erase(0, at);
+    if (!c.unsent.empty()) {
+      c.write_deadline = now + Seconds(options.write_timeout_s);  // it took some: more time
+      Arm(c);
+      return false;
+    }
+    c.unsent.shrink_to_fit();
+    c.state = State::kWorking;  // as after an answer
+    return AfterAnswer(c, now);
   }
 
   // Handles `c` until it waits for bytes, is closed, or went to the compute
@@ -541,6 +587,14 @@ struct ConnectionLoop::Impl {
       std::unique_lock<std::mutex> lock(c->mutex);
       if (c->closed) continue;
       const Clock::time_point now = Clock::now();
+      if (c->state == State::kWriting) {
+        if ((event.events & (EPOLLHUP | EPOLLERR)) != 0) {
+          Close(*c);
+        } else if (Writable(*c, now)) {
+          Drive(c, lock, now, Pool::kLight);
+        }
+        continue;
+      }
       const bool open = Receive(*c, now);
       if (c->state == State::kLingering) {
         if (!open || (event.events & (EPOLLHUP | EPOLLERR)) != 0) {
@@ -598,6 +652,13 @@ struct ConnectionLoop::Impl {
             ExpireBody(*c, now);
           }
           break;
+        case State::kWriting:
+          if (now >= c->write_deadline) {
+            closed_by[static_cast<int>(Reason::kWriteTimeout)].fetch_add(
+                1, std::memory_order_relaxed);
+            Close(*c);
+          }
+          break;
         case State::kLingering:
           if (now >= c->linger_until) Close(*c);
           break;
@@ -649,11 +710,14 @@ struct ConnectionLoop::Impl {
   }
 
   // Stop: closes every connection that is not being answered (those close
-  // themselves after their answer). Returns how many connections remain.
-  std::size_t CloseWaiting() {
+  // themselves after their answer; answers still being sent get their write
+  // timeout). Returns how many connections remain.
+  std::size_t CloseWaiting(Clock::time_point now) {
     for (const ConnectionPtr& c : Snapshot()) {
       std::unique_lock<std::mutex> lock(c->mutex, std::try_to_lock);
-      if (lock.owns_lock() && !c->closed && c->state != State::kWorking) Close(*c);
+      if (!lock.owns_lock() || c->closed || c->state == State::kWorking) continue;
+      if (c->state == State::kWriting && now < c->write_deadline) continue;
+      Close(*c);
     }
     std::lock_guard<std::mutex> lock(map_mutex);
     return connections.size();
@@ -723,7 +787,7 @@ bool ConnectionLoop::Run() {
   epoll_ctl(m.epoll_fd, EPOLL_CTL_DEL, m.listen_fd, nullptr);
   ::close(m.listen_fd);
   m.listen_fd = -1;
-  while (m.CloseWaiting() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  while (m.CloseWaiting(Clock::now()) > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   const std::uint64_t one = 1;
   [[maybe_unused]] const ssize_t n = ::write(m.wake_fd, &one, sizeof one);
   for (auto& thread : m.light_threads) thread.join();

@@ -11,9 +11,6 @@
 namespace sweetspot::server {
 namespace {
 
-// Answers up to this size go out in one send (head and body together).
-constexpr std::size_t kBufferBytes = 64 * 1024;
-
 thread_local RequestStream* current_stream = nullptr;
 
 int MillisecondsLeft(std::chrono::steady_clock::time_point deadline) {
@@ -65,8 +62,7 @@ ssize_t RequestStream::write(const char* ptr, size_t size) {
     if (!Flush() || !Send(ptr, size)) return -1;
     return static_cast<ssize_t>(size);
   }
-  out_.append(ptr, size);
-  if (out_.size() >= kBufferBytes && !Flush()) return -1;
+  out_.append(ptr, size);  // the whole answer: httplib holds its body in memory already
   return static_cast<ssize_t>(size);
 }
 
@@ -75,6 +71,29 @@ bool RequestStream::Flush() {
   const bool sent = Send(out_.data(), out_.size());
   out_.clear();
   return sent;
+}
+
+bool RequestStream::SendWithoutWaiting(std::string* unsent) {
+  std::size_t at = 0;
+  while (healthy_ && at < out_.size()) {
+    const ssize_t n = ::send(fd_, out_.data() + at, out_.size() - at, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n > 0) {
+      at += static_cast<std::size_t>(n);
+    } else if (n < 0 && errno == EINTR) {
+      continue;
+    } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+      break;
+    } else {
+      healthy_ = false;
+    }
+  }
+  if (healthy_ && at < out_.size()) {
+    unsent->assign(out_, at, std::string::npos);
+  } else {
+    unsent->clear();
+  }
+  out_.clear();
+  return healthy_;
 }
 
 void RequestStream::WriteThrough() { write_through_ = true; }

@@ -1,8 +1,9 @@
 // The cpp-httplib Stream a worker hands to httplib for one request: reads come
-// from the request bytes the connection loop already received (the whole head
-// and body, so a handler never waits on a slow client), writes go to the
-// connection's socket with a deadline. Answers are written in one piece when
-// they fit in 64 KiB; a streamed answer (NDJSON) is written as it is produced.
+// from the request bytes already received (the whole head and body, so a
+// handler never waits on a slow client). An answer is collected whole and the
+// worker sends what the socket takes at once (TakeAnswer); the rest is sent as
+// the client reads, without a worker. A streamed answer (NDJSON) goes out as it
+// is produced, each write waiting at most the write timeout.
 #pragma once
 
 #include <httplib.h>
@@ -37,8 +38,12 @@ class RequestStream : public httplib::Stream {
   /// own stream uses select(); this one uses poll(), so such descriptors report 0.
   socket_t socket() const override;
 
-  /// Sends what is buffered; false when the socket failed or the deadline passed.
+  /// Sends what is buffered, waiting up to the write timeout; false when the
+  /// socket failed or the deadline passed.
   bool Flush();
+  /// Sends what the socket takes now of the collected answer, without waiting,
+  /// and moves the rest to *unsent. False when the socket failed.
+  bool SendWithoutWaiting(std::string* unsent);
   /// From now on every write goes out at once (a streamed answer's chunks).
   void WriteThrough();
   /// False once a write failed: the connection must be closed.

@@ -473,8 +473,7 @@ bool Server::Bind(std::string* error) {
   };
   hooks.classify = [impl = impl_.get()](std::string_view method, std::string_view path,
                                         std::string_view body) {
-    const api::Request request{std::string(method), std::string(path), std::string(body)};
-    return api::ClassifyWorkload(request, impl->context) == api::Workload::kCompute
+    return api::ClassifyWorkload(method, path, body, impl->context) == api::Workload::kCompute
                ? Pool::kCompute
                : Pool::kLight;
   };

@@ -11,6 +11,7 @@
 // their latency bounds are about the server, not about a neighbouring test.
 #include <gtest/gtest.h>
 #include <httplib.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -404,6 +405,70 @@ TEST(ServingTest, IdleKeepAliveConnectionsHoldNoWorker) {
   EXPECT_LE(worst, 0.100);
   EXPECT_EQ(Metric(metrics, "sweetspot_workers{pool=\"light\"}"), 8);
   for (const int fd : idle) close(fd);
+  EXPECT_EQ(server.Stop(SIGTERM), 0);
+}
+
+// Slow readers: 16 clients (more than the 8 light workers) ask for a 157 KB
+// answer through a 4 KiB receive window and do not read. The rest of each
+// answer is sent as its client reads, without holding a worker: probes from
+// another client are answered within 100 ms meanwhile, and each slow reader,
+// once it reads, gets its whole answer intact.
+TEST(ServingTest, ClientsThatDoNotReadHoldNoWorker) {
+  ServerProcess server;
+  ASSERT_TRUE(StartWithDefaults(&server)) << server.log();
+  const int port = server.port();
+  std::vector<int> readers;
+  for (int i = 0; i < 16; ++i) {
+    const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    ASSERT_GE(fd, 0);
+    const int window = 4096;  // before connect: the advertised window stays small
+    setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &window, sizeof window);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<uint16_t>(port));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+    ASSERT_TRUE(SendAll(fd, "GET /v1/speed-vs-error HTTP/1.1\r\nHost: x\r\n\r\n"));
+    readers.push_back(fd);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the answers are stuck
+  std::vector<double> probes_s;
+  httplib::Client probe("127.0.0.1", port);
+  probe.set_keep_alive(true);
+  for (int i = 0; i < 20; ++i) {
+    const auto t = Clock::now();
+    const auto health = probe.Get("/health");
+    const auto sweet = probe.Post("/v1/sweet-spot", kSweetSpotBody, "application/json");
+    probes_s.push_back(SecondsSince(t));
+    ASSERT_TRUE(health && sweet);
+    EXPECT_EQ(health->status, 200);
+    EXPECT_EQ(sweet->status, 200);
+  }
+  const std::string metrics = MetricsOf(port);
+  // Now read: every answer arrives whole.
+  std::size_t complete = 0;
+  for (const int fd : readers) {
+    const ReadResult r = ReadFor(fd, 5.0, [](const std::string& s) {
+      const auto head_end = s.find("\r\n\r\n");
+      if (head_end == std::string::npos) return false;
+      const auto at = s.find("Content-Length: ");
+      return at != std::string::npos &&
+             s.size() - head_end - 4 >= std::stoul(s.substr(at + 16, s.find("\r\n", at) - at - 16));
+    });
+    const auto body_at = r.bytes.find("\r\n\r\n");
+    if (r.bytes.rfind("HTTP/1.1 200", 0) == 0 && body_at != std::string::npos &&
+        nlohmann::json::accept(r.bytes.substr(body_at + 4))) {
+      ++complete;
+    }
+    close(fd);
+  }
+  const double worst = *std::max_element(probes_s.begin(), probes_s.end());
+  std::cout << "16 clients not reading 157 KB answers: probes (/health + /v1/sweet-spot) within "
+            << worst * 1e3 << " ms; light workers busy at the time "
+            << Metric(metrics, "sweetspot_workers_busy{pool=\"light\"}") << "; answers complete "
+            << "once read: " << complete << " of 16" << std::endl;
+  EXPECT_LE(worst, 0.100);
+  EXPECT_EQ(complete, 16u);
   EXPECT_EQ(server.Stop(SIGTERM), 0);
 }
 

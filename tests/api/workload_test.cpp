@@ -1,0 +1,74 @@
+// ClassifyWorkload: which worker pool the server answers a request in.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "api/router.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+Workload Classify(const std::string& method, const std::string& path, const std::string& body) {
+  return ClassifyWorkload(method, path, body, Context{});
+}
+
+TEST(WorkloadTest, RoutesThatAlwaysRunModelsAreCompute) {
+  EXPECT_EQ(Classify("POST", "/v1/explore", "{}"), Workload::kCompute);
+  EXPECT_EQ(Classify("POST", "/v1/optimize", "{}"), Workload::kCompute);
+  EXPECT_EQ(Classify("POST", "/v1/bat/fit", "{}"), Workload::kCompute);
+  EXPECT_EQ(Classify("POST", "/v1/bat/modes", "{}"), Workload::kCompute);
+}
+
+TEST(WorkloadTest, CatalogueJobsHealthAndUnknownPathsAreLight) {
+  EXPECT_EQ(Classify("GET", "/health", ""), Workload::kLight);
+  EXPECT_EQ(Classify("GET", "/metrics", ""), Workload::kLight);
+  EXPECT_EQ(Classify("GET", "/v1/presets", ""), Workload::kLight);
+  EXPECT_EQ(Classify("POST", "/v1/bat/properties", "{}"), Workload::kLight);
+  // Jobs run on the job workers: submitting one is cheap.
+  EXPECT_EQ(Classify("POST", "/v1/jobs", R"({"path": "/v1/explore", "body": {}})"),
+            Workload::kLight);
+  EXPECT_EQ(Classify("GET", "/v1/jobs/abc", ""), Workload::kLight);
+  EXPECT_EQ(Classify("GET", "/v1/nowhere", ""), Workload::kLight);
+  // A known path with another method is refused at once.
+  EXPECT_EQ(Classify("GET", "/v1/explore", ""), Workload::kLight);
+}
+
+TEST(WorkloadTest, ScenesAreComputeExactlyWhenAnOutputOrModelIsIterative) {
+  const std::string bat = R"("bat": {"preset": "paper-wood"})";
+  // Closed forms: light.
+  EXPECT_EQ(Classify("POST", "/v1/sweet-spot", "{" + bat + "}"), Workload::kLight);
+  EXPECT_EQ(Classify("POST", "/v1/sweet-spot",
+                     "{" + bat + R"(, "outputs": ["max_exit_speed", "center_of_percussion",
+                     "sweet_zone", "exit_speed_curve"], "options": {"model": "free_bat"}})"),
+            Workload::kLight);
+  EXPECT_EQ(Classify("POST", "/v1/collision", "{" + bat + R"(, "model": "rigid_pivot"})"),
+            Workload::kLight);
+  // The flexible beam (vibration node, least sting) and the ODE models: compute.
+  EXPECT_EQ(Classify("POST", "/v1/sweet-spot", "{" + bat + R"(, "outputs": ["vibration_node"]})"),
+            Workload::kCompute);
+  EXPECT_EQ(
+      Classify("POST", "/v1/sweet-spot", "{" + bat + R"(, "outputs": ["least_sting_zone"]})"),
+      Workload::kCompute);
+  EXPECT_EQ(Classify("POST", "/v1/sweet-spot", "{" + bat + R"(, "options": {"model": "hertz"}})"),
+            Workload::kCompute);
+  EXPECT_EQ(Classify("POST", "/v1/compare",
+                     R"({"baseline": {"preset": "paper-wood"}, "variants": [],
+                         "options": {"model": "flexible"}})"),
+            Workload::kCompute);
+  EXPECT_EQ(Classify("POST", "/v1/collision", "{" + bat + R"(, "model": "flexible"})"),
+            Workload::kCompute);
+  // A name in another field does not count: the body is parsed.
+  EXPECT_EQ(Classify("POST", "/v1/sweet-spot",
+                     R"({"bat": {"preset": "paper-wood"}, "note_hertz": 1})"),
+            Workload::kLight);
+  // A name behind a JSON escape is still seen.
+  EXPECT_EQ(Classify("POST", "/v1/sweet-spot",
+                     "{" + bat + R"(, "outputs": ["vibration_nod\u0065"]})"),
+            Workload::kCompute);
+  // A body that does not parse is refused at once: light.
+  EXPECT_EQ(Classify("POST", "/v1/sweet-spot", R"({"outputs": ["vibration_node")"),
+            Workload::kLight);
+}
+
+}  // namespace
+}  // namespace sweetspot::api
