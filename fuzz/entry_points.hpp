@@ -263,13 +263,17 @@ inline Verdict RunParseBat(std::string_view input) {
   return {};
 }
 
-/// Sends {method, path, body} to the route that matches, calling its handler
+/// Classifies {method, path, body} as the server does, then sends it to the
+/// route that matches, calling its handler
 /// directly (so an unexpected exception escapes to the caller with its
 /// origin) or, for no route, api::Dispatch (404/405); checks the answer.
 /// Skips (clean verdict) bodies over the fuzzing budget (kMaxHertzSteps).
 inline Verdict RunRequest(const api::Request& request) {
   if (internal::OverStepBudget(request.body)) return {};
   const api::Context context = FuzzContext();
+  // The server classifies every request before a handler sees it: it must
+  // take any bytes (ClassifyWorkload never throws; a crash is reported).
+  (void)api::ClassifyWorkload(request.method, request.path, request.body, context);
   api::Response response;
   bool routed = false;
   for (const api::Route* route : api::MatchRoutes(request.path)) {

@@ -326,10 +326,9 @@ struct ConnectionLoop::Impl {
       if (fd < 0) {
         if (errno == EINTR || errno == ECONNABORTED) continue;
         if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
-          // Out of descriptors: stop accepting for 100 ms instead of spinning.
-          epoll_event event{};
-          event.data.u64 = kListenTag;
-          epoll_ctl(epoll_fd, EPOLL_CTL_MOD, listen_fd, &event);
+          // Out of descriptors: stop accepting for 100 ms instead of spinning
+          // (an EPOLLEXCLUSIVE registration cannot be modified, only removed).
+          epoll_ctl(epoll_fd, EPOLL_CTL_DEL, listen_fd, nullptr);
           accept_resume_ns.store((now + std::chrono::milliseconds(100)).time_since_epoch().count());
           accept_paused.store(true);
         }
@@ -785,14 +784,17 @@ bool ConnectionLoop::Run() {
   // Stop: no new connections; those waiting for a request are closed; the
   // requests being answered finish (with Connection: close) and close theirs.
   epoll_ctl(m.epoll_fd, EPOLL_CTL_DEL, m.listen_fd, nullptr);
-  ::close(m.listen_fd);
-  m.listen_fd = -1;
-  while (m.CloseWaiting(Clock::now()) > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  while (m.CloseWaiting(Clock::now()) > 0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
   const std::uint64_t one = 1;
   [[maybe_unused]] const ssize_t n = ::write(m.wake_fd, &one, sizeof one);
   for (auto& thread : m.light_threads) thread.join();
   m.light_threads.clear();
   m.compute->Shutdown();
+  // Closed only now that no worker can be accepting on it: later connections are refused.
+  ::close(m.listen_fd);
+  m.listen_fd = -1;
   return true;
 }
 
