@@ -35,9 +35,8 @@ const std::vector<std::string>& IterativeNames() {
     std::vector<std::string> out;
     using core::SceneOutput;
     for (const SceneOutput output :
-         {SceneOutput::kMaxExitSpeed, SceneOutput::kCenterOfPercussion,
-          SceneOutput::kVibrationNode, SceneOutput::kSweetZone, SceneOutput::kExitSpeedCurve,
-          SceneOutput::kLeastStingZone}) {
+         {SceneOutput::kMaxExitSpeed, SceneOutput::kCenterOfPercussion, SceneOutput::kVibrationNode,
+          SceneOutput::kSweetZone, SceneOutput::kExitSpeedCurve, SceneOutput::kLeastStingZone}) {
       if (NeedsIterativeModel(core::ModelsFor(output, core::CollisionModel::kRigidPivot))) {
         out.emplace_back(core::SceneOutputName(output));
       }

@@ -87,7 +87,7 @@ enum class Reason {
 };
 
 constexpr std::array<const char*, static_cast<int>(Reason::kCount)> kReasonNames = {
-    "over_limit",     "header_timeout", "body_too_slow",  "read_timeout",
+    "over_limit",     "header_timeout", "body_too_slow",   "read_timeout",
     "head_too_large", "bad_request",    "keep_alive_idle", "write_timeout"};
 
 enum class State {
@@ -111,7 +111,7 @@ struct Connection {
   std::mutex mutex;
   std::uint64_t id = 0;
   int fd = -1;
-  bool closed = false;            // fd closed: nothing more to do
+  bool closed = false;  // fd closed: nothing more to do
   State state = State::kReadingHead;
   std::string in;                 // received bytes not yet consumed (the current request first)
   std::size_t scanned = 0;        // how much of `in` the head scan has seen
@@ -122,13 +122,13 @@ struct Connection {
   Clock::time_point body_deadline;
   Clock::time_point idle_since;
   Clock::time_point linger_until;
-  std::string unsent;                 // the rest of an answer (kWriting)
-  Clock::time_point write_deadline;   // kWriting: the client must take more by then
-  bool continue_sent = false;  // "100 Continue" sent for the current request
-  bool close_after = false;    // close once the current request is answered
-  bool keep_open = false;      // the verdict on the request just answered
-  bool peer_closed = false;    // the client shut its side: nothing more will arrive
-  int served = 0;              // requests answered on this connection
+  std::string unsent;                // the rest of an answer (kWriting)
+  Clock::time_point write_deadline;  // kWriting: the client must take more by then
+  bool continue_sent = false;        // "100 Continue" sent for the current request
+  bool close_after = false;          // close once the current request is answered
+  bool keep_open = false;            // the verdict on the request just answered
+  bool peer_closed = false;          // the client shut its side: nothing more will arrive
+  int served = 0;                    // requests answered on this connection
   std::string remote_ip, local_ip;
   int remote_port = 0, local_port = 0;
 };
@@ -303,9 +303,10 @@ struct ConnectionLoop::Impl {
               const std::string& message, Clock::time_point now) {
     closed_by[static_cast<int>(reason)].fetch_add(1, std::memory_order_relaxed);
     const std::string body = hooks.error_body ? hooks.error_body(status, code, message) : "";
-    std::string response = "HTTP/1.1 " + std::to_string(status) + " " + StatusText(status) +
-                           "\r\nContent-Type: application/json\r\nContent-Length: " +
-                           std::to_string(body.size()) + "\r\nConnection: close\r\n";
+    std::string response =
+        "HTTP/1.1 " + std::to_string(status) + " " + StatusText(status) +
+        "\r\nContent-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) +
+        "\r\nConnection: close\r\n";
     if (status == 503) response += "Retry-After: 1\r\n";
     response += "\r\n" + body;
     // Best effort: a socket's buffer takes a few hundred bytes at once.
@@ -443,9 +444,9 @@ struct ConnectionLoop::Impl {
         return Framed(c);
       }
       c.state = State::kReadingBody;
-      c.body_deadline = now + Seconds(options.header_timeout_s) +
-                        Seconds(static_cast<double>(head.content_length) /
-                                options.body_min_rate_bytes_per_s);
+      c.body_deadline =
+          now + Seconds(options.header_timeout_s) +
+          Seconds(static_cast<double>(head.content_length) / options.body_min_rate_bytes_per_s);
     }
     // kReadingBody
     const std::size_t needed = c.head.head_bytes + c.head.content_length;
@@ -525,8 +526,8 @@ struct ConnectionLoop::Impl {
   bool Writable(Connection& c, Clock::time_point now) {
     std::size_t at = 0;
     for (;;) {
-      const ssize_t n = ::send(c.fd, c.unsent.data() + at, c.unsent.size() - at,
-                               MSG_NOSIGNAL | MSG_DONTWAIT);
+      const ssize_t n =
+          ::send(c.fd, c.unsent.data() + at, c.unsent.size() - at, MSG_NOSIGNAL | MSG_DONTWAIT);
       if (n > 0) {
         at += static_cast<std::size_t>(n);
         if (at == c.unsent.size()) break;
@@ -653,8 +654,8 @@ struct ConnectionLoop::Impl {
           break;
         case State::kWriting:
           if (now >= c->write_deadline) {
-            closed_by[static_cast<int>(Reason::kWriteTimeout)].fetch_add(
-                1, std::memory_order_relaxed);
+            closed_by[static_cast<int>(Reason::kWriteTimeout)].fetch_add(1,
+                                                                         std::memory_order_relaxed);
             Close(*c);
           }
           break;
@@ -760,9 +761,9 @@ bool ConnectionLoop::Run() {
   event.data.u64 = kListenTag;
   if (epoll_ctl(m.epoll_fd, EPOLL_CTL_ADD, m.listen_fd, &event) != 0) return false;
 
-  m.compute = std::make_unique<ComputePool>(
-      std::max(1, m.options.compute_workers),
-      [&m](ConnectionPtr c) { m.ComputeWorker(std::move(c)); });
+  m.compute =
+      std::make_unique<ComputePool>(std::max(1, m.options.compute_workers),
+                                    [&m](ConnectionPtr c) { m.ComputeWorker(std::move(c)); });
   for (int i = 0; i < std::max(1, m.options.light_workers); ++i) {
     m.light_threads.emplace_back([&m] { m.LightWorker(); });
   }
@@ -834,8 +835,8 @@ std::string ConnectionLoop::MetricsText() const {
       << "sweetspot_workers_busy_peak{pool=\"compute\"} " << m.compute_busy.peak() << "\n"
       << "# HELP sweetspot_requests_queued Complete requests waiting for a compute worker.\n"
       << "# TYPE sweetspot_requests_queued gauge\n"
-      << "sweetspot_requests_queued{pool=\"compute\"} "
-      << (m.compute ? m.compute->queued() : 0) << "\n"
+      << "sweetspot_requests_queued{pool=\"compute\"} " << (m.compute ? m.compute->queued() : 0)
+      << "\n"
       << "# HELP sweetspot_pool_requests_total Requests answered, per pool.\n"
       << "# TYPE sweetspot_pool_requests_total counter\n"
       << "sweetspot_pool_requests_total{pool=\"light\"} " << m.light_busy.served() << "\n"

@@ -37,18 +37,30 @@ namespace sweetspot::server {
 
 /// The loop's limits and pool sizes (ServerConfig supplies them).
 struct ConnectionLoopOptions {
-  int max_connections = 256;             ///< Open connections admitted; beyond: 503.
-  std::size_t max_head_bytes = 65536;    ///< Largest request head, bytes; beyond: 431.
-  std::size_t max_body_bytes = 1 << 20;  ///< Larger bodies are not read (httplib answers 413).
-  double header_timeout_s = 10.0;        ///< Whole request head, s, from its first byte.
-  double body_min_rate_bytes_per_s = 32768;  ///< A body of N bytes gets header_timeout_s + N / rate.
-  double read_timeout_s = 10.0;          ///< Longest silence inside a request, s.
-  double write_timeout_s = 10.0;         ///< Longest wait for the socket to take more of an answer, s.
-  double keep_alive_timeout_s = 5.0;     ///< Idle keep-alive connection closed after this, s.
-  int keep_alive_max_requests = 10000;   ///< Requests per connection; the last says Connection: close.
-  int light_workers = 8;                 ///< Threads for cheap requests.
-  int compute_workers = 2;               ///< Threads for requests that run models.
-  double linger_s = 1.0;                 ///< How long a closed connection is drained, s.
+  /// Open connections admitted; beyond: 503.
+  int max_connections = 256;
+  /// Largest request head, bytes; beyond: 431.
+  std::size_t max_head_bytes = 65536;
+  /// Larger bodies are not read (httplib answers 413).
+  std::size_t max_body_bytes = 1 << 20;
+  /// Whole request head, s, from its first byte.
+  double header_timeout_s = 10.0;
+  /// A body of N bytes gets header_timeout_s + N / this, s.
+  double body_min_rate_bytes_per_s = 32768;
+  /// Longest silence inside a request, s.
+  double read_timeout_s = 10.0;
+  /// Longest wait for the client to take more of an answer, s.
+  double write_timeout_s = 10.0;
+  /// An idle keep-alive connection is closed after this, s.
+  double keep_alive_timeout_s = 5.0;
+  /// Requests per connection; the last is answered with Connection: close.
+  int keep_alive_max_requests = 10000;
+  /// Threads for cheap requests (they also accept and read).
+  int light_workers = 8;
+  /// Threads for requests that run models.
+  int compute_workers = 2;
+  /// How long a closed connection is drained, s.
+  double linger_s = 1.0;
 };
 
 /// The worker pool a request is served in.
@@ -64,8 +76,7 @@ struct ConnectionLoopHooks {
   std::function<Pool(std::string_view method, std::string_view path, std::string_view body)>
       classify;
   /// The JSON error envelope (with its trailing newline) for an answer the loop gives itself.
-  std::function<std::string(int status, const char* code, const std::string& message)>
-      error_body;
+  std::function<std::string(int status, const char* code, const std::string& message)> error_body;
   /// Called after the loop answered a request itself: status, code, the
   /// request's method and path when known ("" otherwise). May be empty.
   std::function<void(int status, const char* code, const std::string& method,

@@ -100,9 +100,9 @@ void RequestStream::WriteThrough() { write_through_ = true; }
 
 bool RequestStream::Send(const char* data, std::size_t size) {
   if (!healthy_) return false;
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            write_timeout_);
+  const auto deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(write_timeout_);
   while (size > 0) {
     const ssize_t n = ::send(fd_, data, size, MSG_NOSIGNAL | MSG_DONTWAIT);
     if (n > 0) {

@@ -46,9 +46,8 @@ TEST(WorkloadTest, ScenesAreComputeExactlyWhenAnOutputOrModelIsIterative) {
   // The flexible beam (vibration node, least sting) and the ODE models: compute.
   EXPECT_EQ(Classify("POST", "/v1/sweet-spot", "{" + bat + R"(, "outputs": ["vibration_node"]})"),
             Workload::kCompute);
-  EXPECT_EQ(
-      Classify("POST", "/v1/sweet-spot", "{" + bat + R"(, "outputs": ["least_sting_zone"]})"),
-      Workload::kCompute);
+  EXPECT_EQ(Classify("POST", "/v1/sweet-spot", "{" + bat + R"(, "outputs": ["least_sting_zone"]})"),
+            Workload::kCompute);
   EXPECT_EQ(Classify("POST", "/v1/sweet-spot", "{" + bat + R"(, "options": {"model": "hertz"}})"),
             Workload::kCompute);
   EXPECT_EQ(Classify("POST", "/v1/compare",
@@ -58,13 +57,13 @@ TEST(WorkloadTest, ScenesAreComputeExactlyWhenAnOutputOrModelIsIterative) {
   EXPECT_EQ(Classify("POST", "/v1/collision", "{" + bat + R"(, "model": "flexible"})"),
             Workload::kCompute);
   // A name in another field does not count: the body is parsed.
-  EXPECT_EQ(Classify("POST", "/v1/sweet-spot",
-                     R"({"bat": {"preset": "paper-wood"}, "note_hertz": 1})"),
-            Workload::kLight);
+  EXPECT_EQ(
+      Classify("POST", "/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"}, "note_hertz": 1})"),
+      Workload::kLight);
   // A name behind a JSON escape is still seen.
-  EXPECT_EQ(Classify("POST", "/v1/sweet-spot",
-                     "{" + bat + R"(, "outputs": ["vibration_nod\u0065"]})"),
-            Workload::kCompute);
+  EXPECT_EQ(
+      Classify("POST", "/v1/sweet-spot", "{" + bat + R"(, "outputs": ["vibration_nod\u0065"]})"),
+      Workload::kCompute);
   // A body that does not parse is refused at once: light.
   EXPECT_EQ(Classify("POST", "/v1/sweet-spot", R"({"outputs": ["vibration_node")"),
             Workload::kLight);

@@ -81,9 +81,8 @@ class Nginx {
     conf = std::regex_replace(conf, listen_line, "listen 127.0.0.1:" + std::to_string(port_) + ";");
     const std::string paths = "http {\n  access_log " + dir_ + "/access.log;\n" +
                               "  client_body_temp_path " + dir_ + "/body;\n" +
-                              "  proxy_temp_path " + dir_ + "/proxy;\n" +
-                              "  fastcgi_temp_path " + dir_ + "/fastcgi;\n" +
-                              "  uwsgi_temp_path " + dir_ + "/uwsgi;\n" +
+                              "  proxy_temp_path " + dir_ + "/proxy;\n" + "  fastcgi_temp_path " +
+                              dir_ + "/fastcgi;\n" + "  uwsgi_temp_path " + dir_ + "/uwsgi;\n" +
                               "  scgi_temp_path " + dir_ + "/scgi;\n";
     conf = std::regex_replace(conf, std::regex(R"(http \{)"), paths);
     {
@@ -230,8 +229,8 @@ TEST_F(NginxTest, TwoMebibyteBodyIsRefusedWith413AndRequestsReachBothReplicas) {
   EXPECT_EQ(big->status, 413);
   // Round robin over the two replicas, each answering with its own metrics.
   for (int i = 0; i < 20; ++i) {
-    const auto res = client.Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"}})",
-                                 "application/json");
+    const auto res =
+        client.Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"}})", "application/json");
     ASSERT_TRUE(res);
     ASSERT_EQ(res->status, 200) << res->body;
   }

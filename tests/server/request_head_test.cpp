@@ -51,7 +51,8 @@ TEST(RequestHeadTest, OverTheLimitWithoutABlankLineIsTooLarge) {
 
 TEST(RequestHeadTest, BadOrConflictingContentLengthsAreFlagged) {
   for (const char* value : {"-1", "12a", "", "0x10", "1234567890123456789"}) {
-    const std::string bytes = std::string("POST / HTTP/1.1\r\nContent-Length: ") + value + "\r\n\r\n";
+    const std::string bytes =
+        std::string("POST / HTTP/1.1\r\nContent-Length: ") + value + "\r\n\r\n";
     std::size_t scanned = 0;
     RequestHead head;
     ASSERT_EQ(ScanRequestHead(bytes, 65536, &scanned, &head), HeadScan::kComplete);

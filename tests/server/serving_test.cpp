@@ -74,10 +74,10 @@ std::string MetricsOf(int port) {
 
 // What one keep-alive client saw.
 struct ClientRecord {
-  long answers = 0;          // 200 answers
-  long failures = 0;         // transport errors and non-200 answers
-  double first_s = -1;       // from the start to its first answer
-  double worst_s = 0;        // its slowest request
+  long answers = 0;     // 200 answers
+  long failures = 0;    // transport errors and non-200 answers
+  double first_s = -1;  // from the start to its first answer
+  double worst_s = 0;   // its slowest request
 };
 
 // `clients` keep-alive clients post the example scene in a loop for
@@ -322,14 +322,15 @@ TEST(ServingTest, TwoHundredTricklingClientsAreCutOffAtTheHeadDeadlineAndProbesP
 TEST(ServingTest, BodySlowerThanTheMinimumRateIsCutOffAndAFasterOneIsServed) {
   ServerProcess server;
   // 1 s for the head, then 1000 B/s: a 4000-byte body must be in within 5 s.
-  ASSERT_TRUE(StartWithDefaults(&server, {"--header-timeout-s", "1", "--body-min-rate-bytes-per-s",
-                                          "1000"}))
+  ASSERT_TRUE(StartWithDefaults(&server,
+                                {"--header-timeout-s", "1", "--body-min-rate-bytes-per-s", "1000"}))
       << server.log();
   const int port = server.port();
   std::string body = kSweetSpotBody;
   body += std::string(4000 - body.size(), ' ');  // JSON allows trailing spaces
-  const std::string head = "POST /v1/sweet-spot HTTP/1.1\r\nHost: x\r\nContent-Type: "
-                           "application/json\r\nContent-Length: 4000\r\n\r\n";
+  const std::string head =
+      "POST /v1/sweet-spot HTTP/1.1\r\nHost: x\r\nContent-Type: "
+      "application/json\r\nContent-Length: 4000\r\n\r\n";
   // Sends the body in 100-byte pieces every `pause_s`; returns the answer and
   // the seconds from the head to the server's answer or close.
   auto post_slowly = [&](double pause_s, std::string* answer) {
@@ -338,7 +339,8 @@ TEST(ServingTest, BodySlowerThanTheMinimumRateIsCutOffAndAFasterOneIsServed) {
     SendAll(fd, head);
     const auto start = Clock::now();
     for (std::size_t at = 0; at < body.size(); at += 100) {
-      const ReadResult early = ReadFor(fd, pause_s, [](const std::string& s) { return !s.empty(); });
+      const ReadResult early =
+          ReadFor(fd, pause_s, [](const std::string& s) { return !s.empty(); });
       if (!early.bytes.empty() || early.closed) {
         *answer = early.bytes + ReadFor(fd, 2.0, [](const std::string&) { return false; }).bytes;
         close(fd);
@@ -355,7 +357,7 @@ TEST(ServingTest, BodySlowerThanTheMinimumRateIsCutOffAndAFasterOneIsServed) {
   };
   std::string slow_answer, fast_answer;
   double slow_s = 0, fast_s = 0;
-  std::thread slow([&] { slow_s = post_slowly(0.5, &slow_answer); });  // 200 B/s: 20 s needed
+  std::thread slow([&] { slow_s = post_slowly(0.5, &slow_answer); });   // 200 B/s: 20 s needed
   std::thread fast([&] { fast_s = post_slowly(0.05, &fast_answer); });  // 2000 B/s: 2 s
   slow.join();
   fast.join();
@@ -382,7 +384,8 @@ TEST(ServingTest, IdleKeepAliveConnectionsHoldNoWorker) {
     const int fd = Connect(port);
     ASSERT_GE(fd, 0);
     ASSERT_TRUE(SendAll(fd, "GET /health HTTP/1.1\r\nHost: x\r\n\r\n"));
-    const ReadResult r = ReadFor(fd, 5.0, [](const std::string& s) { return s.find("}") != std::string::npos; });
+    const ReadResult r =
+        ReadFor(fd, 5.0, [](const std::string& s) { return s.find("}") != std::string::npos; });
     ASSERT_EQ(r.bytes.substr(0, 12), "HTTP/1.1 200");
     idle.push_back(fd);  // open, idle, keep-alive
   }
@@ -484,9 +487,10 @@ TEST(ServingTest, ConnectionsPastTheLimitGet503AtOnceAndAreClosedEvenIfTheClient
     const int fd = Connect(port);
     ASSERT_GE(fd, 0);
     ASSERT_TRUE(SendAll(fd, "GET /health HTTP/1.1\r\nHost: x\r\n\r\n"));
-    ASSERT_EQ(ReadFor(fd, 5.0, [](const std::string& s) { return s.find("}") != std::string::npos; })
-                  .bytes.substr(0, 12),
-              "HTTP/1.1 200");
+    ASSERT_EQ(
+        ReadFor(fd, 5.0, [](const std::string& s) { return s.find("}") != std::string::npos; })
+            .bytes.substr(0, 12),
+        "HTTP/1.1 200");
     admitted.push_back(fd);
   }
   // 20 stubborn clients over the limit, at once.
@@ -499,9 +503,8 @@ TEST(ServingTest, ConnectionsPastTheLimitGet503AtOnceAndAreClosedEvenIfTheClient
       if (fd < 0) return;
       const auto start = Clock::now();
       SendAll(fd, "GET /health HTTP/1.1\r\nHost: x\r\n\r\n");
-      const ReadResult first = ReadFor(fd, 5.0, [](const std::string& s) {
-        return s.find("}\n") != std::string::npos;
-      });
+      const ReadResult first =
+          ReadFor(fd, 5.0, [](const std::string& s) { return s.find("}\n") != std::string::npos; });
       answer_s[static_cast<std::size_t>(i)] = SecondsSince(start);
       answers[static_cast<std::size_t>(i)] = first.bytes;
       // Ignore "Connection: close": keep the connection and keep sending. The
@@ -524,7 +527,8 @@ TEST(ServingTest, ConnectionsPastTheLimitGet503AtOnceAndAreClosedEvenIfTheClient
   for (const int fd : admitted) {
     const auto t = Clock::now();
     ASSERT_TRUE(SendAll(fd, "GET /v1/version HTTP/1.1\r\nHost: x\r\n\r\n"));
-    const ReadResult r = ReadFor(fd, 5.0, [](const std::string& s) { return s.find("}\n") != std::string::npos; });
+    const ReadResult r =
+        ReadFor(fd, 5.0, [](const std::string& s) { return s.find("}\n") != std::string::npos; });
     EXPECT_EQ(r.bytes.substr(0, 12), "HTTP/1.1 200");
     EXPECT_LE(SecondsSince(t), 0.100);
   }
@@ -619,8 +623,8 @@ TEST(ServingTest, ModelWorkStaysInItsBoundedPoolAndCheapRequestsPassIt) {
   std::ostringstream report;
   report << "16 clients posting 5000-design sweeps for " << seconds << " s: " << heavy_ok.load()
          << " answered, " << heavy_failed.load() << " failed; compute workers " << compute_workers
-         << " (cores " << cores << "), most busy at once " << compute_peak << "; probes: "
-         << health_s.size() << " /health worst " << worst_health * 1e3 << " ms, "
+         << " (cores " << cores << "), most busy at once " << compute_peak
+         << "; probes: " << health_s.size() << " /health worst " << worst_health * 1e3 << " ms, "
          << sweet_s.size() << " closed-form /v1/sweet-spot worst " << worst_sweet * 1e3 << " ms";
   std::cout << "model work: " << report.str() << std::endl;
   EXPECT_EQ(compute_workers, cores) << report.str();
