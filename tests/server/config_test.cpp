@@ -71,12 +71,44 @@ TEST(ConfigTest, IsValidRefusesOutOfRange) {
   EXPECT_EQ(why, "read_timeout_s = -1: must be in (0, 3600]");
 }
 
+TEST(ConfigTest, ServingLimitsFromFlagsAndEnvironment) {
+  const ServerConfig defaults;
+  EXPECT_EQ(defaults.header_timeout_s, 10.0);
+  EXPECT_EQ(defaults.body_min_rate_bytes_per_s, 32768.0);
+  EXPECT_EQ(defaults.max_head_bytes, 65536u);
+  EXPECT_EQ(defaults.compute_threads, 0);  // one per core
+  const auto parsed = Parse(
+      {"--header-timeout-s", "2.5", "--body-min-rate-bytes-per-s=1000", "--compute-threads", "3"},
+      {{"SWEETSPOT_MAX_HEAD_BYTES", "4096"}});
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_EQ(parsed.config.header_timeout_s, 2.5);
+  EXPECT_EQ(parsed.config.body_min_rate_bytes_per_s, 1000.0);
+  EXPECT_EQ(parsed.config.compute_threads, 3);
+  EXPECT_EQ(parsed.config.max_head_bytes, 4096u);
+  EXPECT_EQ(Parse({"--header-timeout-s", "0"}).error,
+            "option --header-timeout-s = \"0\": must be a number of seconds in (0, 3600]");
+  EXPECT_EQ(Parse({"--body-min-rate-bytes-per-s", "0"}).error,
+            "option --body-min-rate-bytes-per-s = \"0\": must be an integer in [1, 17179869184]");
+  EXPECT_EQ(Parse({"--max-head-bytes", "100"}).error,
+            "option --max-head-bytes = \"100\": must be an integer in [256, 16777216]");
+  EXPECT_EQ(Parse({"--compute-threads", "-1"}).error,
+            "option --compute-threads = \"-1\": must be an integer in [0, 1024]");
+  ServerConfig config;
+  config.body_min_rate_bytes_per_s = 0.5;
+  std::string why;
+  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_EQ(why, "body_min_rate_bytes_per_s = 0.5: must be at least 1");
+}
+
 TEST(ConfigTest, HelpListsEveryOptionAndEnvironmentVariable) {
   EXPECT_TRUE(Parse({"--help"}).show_help);
   const std::string usage = Usage("sweetspot-server");
-  for (const char* name : {"--host", "SWEETSPOT_HOST", "--port", "SWEETSPOT_PORT", "--threads",
-                           "SWEETSPOT_THREADS", "--max-body-bytes", "--read-timeout-s",
-                           "--write-timeout-s", "--keep-alive-timeout-s", "--access-log"}) {
+  for (const char* name :
+       {"--host", "SWEETSPOT_HOST", "--port", "SWEETSPOT_PORT", "--threads", "SWEETSPOT_THREADS",
+        "--max-body-bytes", "--read-timeout-s", "--write-timeout-s", "--keep-alive-timeout-s",
+        "--access-log", "--header-timeout-s", "SWEETSPOT_HEADER_TIMEOUT_S",
+        "--body-min-rate-bytes-per-s", "--max-head-bytes", "--compute-threads",
+        "SWEETSPOT_COMPUTE_THREADS"}) {
     EXPECT_NE(usage.find(name), std::string::npos) << name;
   }
 }
