@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 
+#include "api/explore_shards.hpp"
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
 #include "api/scene_json.hpp"
@@ -37,31 +38,6 @@ struct RowOutputs {
 };
 
 // A row for one design evaluated from `design_json` (bat + scene fields).
-// The value at a dotted path of `row` (object keys, or decimal array indices
-// such as "exit_speed_curve.3"), or nullptr when there is none. Never throws:
-// a pareto objective comes from the request, so its indices may be anything.
-const Json* FindAt(const Json& row, const std::vector<std::string>& tokens) {
-  const Json* node = &row;
-  for (const std::string& token : tokens) {
-    if (node->is_object()) {
-      const auto it = node->find(token);
-      if (it == node->end()) return nullptr;
-      node = &*it;
-    } else if (node->is_array()) {
-      if (token.empty() || token.size() > 9 ||
-          !std::all_of(token.begin(), token.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-        return nullptr;
-      }
-      const std::size_t index = std::stoul(token);  // at most 9 digits: cannot overflow
-      if (index >= node->size()) return nullptr;
-      node = &(*node)[index];
-    } else {
-      return nullptr;
-    }
-  }
-  return node;
-}
-
 Json EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
                     const core::SceneOptions& options, const ApiLimits& limits) {
   ApiError error;
@@ -119,12 +95,6 @@ Json EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
 }
 
 // A Pareto objective: an output path of a row and its sense.
-struct Objective {
-  std::string output;
-  std::vector<std::string> tokens;  // the dotted path, split
-  core::Sense sense;
-};
-
 // A validated sweep: everything needed to evaluate its designs, owned, so a
 // streamed answer can run it after the handler has returned.
 struct Sweep {
@@ -135,7 +105,7 @@ struct Sweep {
   RowOutputs outputs;
   core::SceneOptions options;
   ApiLimits limits;
-  std::vector<Objective> objectives;  // Pareto objectives (may be empty)
+  std::vector<ParetoObjective> objectives;  // Pareto objectives (may be empty)
   core::Shard shard;
   std::uint64_t total = 0;  // designs in the whole sweep
   Json provenance;
@@ -213,6 +183,7 @@ SweepOutcome RunSweep(const Sweep& sweep, core::Progress* progress,
       front.push_back(indices[k]);
     }
     summary["pareto_front"] = std::move(front);
+    summary["pareto_objectives"] = ObjectivesToJson(sweep.objectives);  // for explore-merge
     summary["pareto_scope"] = "the rows of this response (this shard)";
   }
   summary["provenance"] = sweep.provenance;
@@ -336,7 +307,7 @@ Response HandleExplore(const Request& request, const Context& context) {
   core::SceneOptions options;
   if (!ReadSceneOptions(reader, context.limits, &options)) return ToResponse(error);
 
-  std::vector<Objective> objectives;
+  std::vector<ParetoObjective> objectives;
   if (const Json* pareto = reader.Get("pareto")) {
     ObjectReader p(*pareto, "pareto", &error);
     const Json* list = p.Get("objectives");
@@ -346,7 +317,7 @@ Response HandleExplore(const Request& request, const Context& context) {
     if (!p.Finish()) return ToResponse(error);
     for (std::size_t i = 0; i < list->size(); ++i) {
       ObjectReader o((*list)[i], "pareto.objectives[" + std::to_string(i) + "]", &error);
-      Objective objective;
+      ParetoObjective objective;
       std::string sense;
       o.String("output", &objective.output);
       o.String("sense", &sense, {"max", "min"});
@@ -354,23 +325,7 @@ Response HandleExplore(const Request& request, const Context& context) {
       objective.sense = sense == "max" ? core::Sense::kMaximize : core::Sense::kMinimize;
       // "parameters.<path>" names a swept parameter (its path may hold dots);
       // anything else is a dotted path into the row, e.g. "max_exit_speed.exit_speed_mps".
-      const bool is_parameter = objective.output.rfind("parameters.", 0) == 0;
-      std::vector<std::string> tokens;
-      if (is_parameter) {
-        tokens = {"parameters", objective.output.substr(11)};
-      } else {
-        std::string token;
-        for (const char c : objective.output) {
-          if (c == '.') {
-            tokens.push_back(token);
-            token.clear();
-          } else {
-            token.push_back(c);
-          }
-        }
-        tokens.push_back(token);
-      }
-      objective.tokens = std::move(tokens);
+      objective.tokens = ObjectiveTokens(objective.output);
       objectives.push_back(std::move(objective));
     }
   }
@@ -413,7 +368,12 @@ Response HandleExplore(const Request& request, const Context& context) {
   sweep->objectives = std::move(objectives);
   sweep->shard = shard;
   sweep->total = total;
-  sweep->provenance = Provenance(*body, Json::object(), sweep->plan.seed);
+  // The sweep's identity: the request without its shard and format, so that
+  // every shard of one sweep carries the same provenance (explore-merge checks it).
+  Json identity = *body;
+  identity.erase("shard");
+  identity.erase("format");
+  sweep->provenance = Provenance(identity, Json::object(), sweep->plan.seed);
   sweep->start = start;
   // Designs: grids are enumerated by index; LHS and Sobol are drawn in full
   // (every shard draws the same sequence) and then filtered by shard.

@@ -20,6 +20,8 @@ else
     clang clang-14 libclang-rt-14-dev llvm-14
     # HTTP benchmark (bench/http_bench.sh); nginx also for the test of docker/nginx.conf
     wrk nginx
+    # a single-node Slurm for the sharded-sweep test (scripts/slurm-smoke.sh)
+    slurm-wlm munge bc
     # browser tests of the design explorer (headless, driven by playwright-core)
     chromium
   )

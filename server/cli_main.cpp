@@ -1,6 +1,8 @@
 // sweetspot: the command-line tool. Runs the same handlers as the HTTP
 // service without a network: `sweetspot PATH [FILE|-]` prints the response
 // body to stdout and exits 0 for a 2xx answer, 2 for a 4xx answer, 1 otherwise.
+// `sweetspot explore --shard I/N FILE` runs shard I of N of a sweep (NDJSON);
+// `sweetspot explore-merge FILE...` merges the shards' outputs into the sweep's.
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -8,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "api/explore_shards.hpp"
+#include "api/json_reader.hpp"
 #include "api/router.hpp"
 #include "server/run.hpp"
 
@@ -16,6 +20,8 @@ namespace {
 std::string Usage() {
   std::ostringstream text;
   text << "Usage: sweetspot [-X METHOD] PATH [FILE|-]\n"
+       << "       sweetspot explore --shard I/N [FILE|-]\n"
+       << "       sweetspot explore-merge FILE...\n"
        << "       sweetspot serve [SERVER OPTIONS]   (as sweetspot-server; see its --help)\n"
        << "  PATH  an endpoint path without the leading /v1/ (e.g. bat/properties);\n"
        << "        health, openapi.json and metrics name the top-level paths\n"
@@ -23,6 +29,13 @@ std::string Usage() {
        << "        standard input. GET endpoints take no body.\n"
        << "  -X    the method when a path has several (default: POST if the path\n"
        << "        has one, else GET)\n"
+       << "  --shard I/N  explore only: run shard I (0-based) of N of the sweep, as\n"
+       << "        NDJSON (the request's shard and format are set); design i is in\n"
+       << "        shard i mod N\n"
+       << "  explore-merge  reads the NDJSON outputs of all N shards of one sweep and\n"
+       << "        prints the sweep's NDJSON: rows in index order, then the summary of\n"
+       << "        the whole sweep (Pareto front over all rows); refuses shards of\n"
+       << "        different sweeps, missing or repeated shards, unfinished shards\n"
        << "Prints the response body; exit status 0 for a 2xx answer, 2 for 4xx,\n"
        << "1 otherwise.\n\nPaths:\n";
   for (const auto& route : sweetspot::api::Routes()) {
@@ -35,6 +48,58 @@ std::string Usage() {
     text << "  " << route.method << " " << path << "\n      " << route.summary << "\n";
   }
   return text.str();
+}
+
+bool ReadFile(const std::string& file, std::string* text) {
+  if (file == "-") {
+    text->assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+    return true;
+  }
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return false;
+  text->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return true;
+}
+
+// sweetspot explore-merge FILE...: the merged NDJSON on stdout; 2 when the
+// shards do not make one complete sweep (the reason on stderr).
+int ExploreMerge(const std::vector<std::string>& files) {
+  if (files.empty()) {
+    std::cerr << "sweetspot explore-merge: give the NDJSON output of every shard of one sweep\n";
+    return 2;
+  }
+  std::vector<sweetspot::api::ShardOutput> shards;
+  for (const std::string& file : files) {
+    sweetspot::api::ShardOutput shard{file, {}};
+    if (!ReadFile(file, &shard.text)) {
+      std::cerr << "sweetspot explore-merge: cannot read " << file << "\n";
+      return 1;
+    }
+    shards.push_back(std::move(shard));
+  }
+  const sweetspot::api::MergedSweep merged = sweetspot::api::MergeExploreShards(shards);
+  if (!merged.ok) {
+    std::cerr << "sweetspot explore-merge: " << merged.error << "\n";
+    return 2;
+  }
+  std::cout << merged.ndjson;
+  return 0;
+}
+
+// "I/N" with 0 <= I < N.
+bool ParseShard(const std::string& text, unsigned long long* index, unsigned long long* count) {
+  const auto slash = text.find('/');
+  if (slash == std::string::npos || slash == 0 || slash + 1 == text.size()) return false;
+  try {
+    std::size_t used = 0;
+    *index = std::stoull(text.substr(0, slash), &used);
+    if (used != slash) return false;
+    *count = std::stoull(text.substr(slash + 1), &used);
+    if (used != text.size() - slash - 1) return false;
+  } catch (const std::exception&) {
+    return false;
+  }
+  return text[0] != '-' && *count >= 1 && *index < *count;
 }
 
 int ExitCode(int status) {
@@ -54,10 +119,22 @@ int main(int argc, char** argv) {
     std::cout << Usage();
     return 0;
   }
+  if (!args.empty() && args[0] == "explore-merge") {
+    return ExploreMerge(std::vector<std::string>(args.begin() + 1, args.end()));
+  }
   std::string method;
   if (args.size() >= 2 && args[0] == "-X") {
     method = args[1];
     args.erase(args.begin(), args.begin() + 2);
+  }
+  std::string shard;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--shard" && i + 1 < args.size()) {
+      shard = args[i + 1];
+      args.erase(args.begin() + static_cast<std::ptrdiff_t>(i),
+                 args.begin() + static_cast<std::ptrdiff_t>(i) + 2);
+      break;
+    }
   }
   if (args.empty() || args.size() > 2) {
     std::cerr << Usage();
@@ -81,21 +158,34 @@ int main(int argc, char** argv) {
     }
   }
 
+  const sweetspot::api::Context context;  // default limits; no jobs, no metrics
   std::string body;
   if (method == "POST" || method == "PUT" || method == "PATCH") {
     const std::string file = args.size() == 2 ? args[1] : "-";
-    if (file == "-") {
-      body.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
-    } else {
-      std::ifstream in(file, std::ios::binary);
-      if (!in) {
-        std::cerr << "sweetspot: cannot read " << file << "\n";
-        return 1;
-      }
-      body.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (!ReadFile(file, &body)) {
+      std::cerr << "sweetspot: cannot read " << file << "\n";
+      return 1;
     }
   }
-  const sweetspot::api::Context context;  // default limits; no jobs, no metrics
+  if (!shard.empty()) {
+    unsigned long long index = 0, count = 0;
+    if (full_path != "/v1/explore" || !ParseShard(shard, &index, &count)) {
+      std::cerr << "sweetspot: --shard \"" << shard
+                << "\": must be I/N with 0 <= I < N, and only for explore\n";
+      return 2;
+    }
+    // Parsed with the service's limits (depth first: a deep body must not crash the CLI).
+    sweetspot::api::ApiError error;
+    std::optional<nlohmann::json> request = sweetspot::api::ParseBody(body, context.limits, &error);
+    if (!request || !request->is_object()) {
+      std::cerr << "sweetspot: --shard needs the request as a JSON object"
+                << (error.message.empty() ? "" : ": " + error.message) << "\n";
+      return 2;
+    }
+    (*request)["shard"] = {{"index", index}, {"count", count}};
+    (*request)["format"] = "ndjson";
+    body = request->dump();
+  }
   const auto response = sweetspot::api::Dispatch({method, full_path, body}, context);
   if (!response.content_type.empty()) {
     std::cout << response.text;

@@ -1,11 +1,15 @@
 // The `sweetspot` CLI: same handlers, no network; exit 0 for 2xx, 2 for 4xx.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <sys/wait.h>
+#include <nlohmann/json.hpp>
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace sweetspot {
 namespace {
@@ -25,7 +29,8 @@ CliResult RunCli(const std::string& args, const std::string& stdin_text = "") {
   if (pipe == nullptr) return result;
   std::array<char, 4096> buffer{};
   size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.out.append(buffer.data(), n);
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    result.out.append(buffer.data(), n);
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
@@ -52,8 +57,55 @@ TEST(CliTest, HelpListsPathsAndExitsZero) {
   EXPECT_NE(result.out.find("GET health"), std::string::npos) << result.out;
 }
 
-TEST(CliTest, NoArgumentsIsAUsageError) {
-  EXPECT_EQ(RunCli("").exit_code, 2);
+TEST(CliTest, NoArgumentsIsAUsageError) { EXPECT_EQ(RunCli("").exit_code, 2); }
+
+// A sweep run as three shards by `sweetspot explore --shard I/3` and merged by
+// `sweetspot explore-merge` equals the unsharded sweep's NDJSON (but timing_s).
+TEST(CliTest, ShardsMergeIntoTheUnshardedSweep) {
+  char folder[] = "/tmp/sweetspot-cli-XXXXXX";
+  ASSERT_NE(mkdtemp(folder), nullptr);
+  const std::string dir = folder;
+  {
+    std::ofstream request(dir + "/sweep.json");
+    request << R"({"bat": {"preset": "paper-wood", "fill": {"material": "cork",
+      "diameter_m": 0.0254, "depth_m": 0.254}}, "outputs": ["max_exit_speed", "properties"],
+      "parameters": [{"path": "fill.depth_m", "min": 0, "max": 0.3, "count": 7}],
+      "format": "ndjson"})";
+  }
+  std::string shard_files;
+  for (int i = 0; i < 3; ++i) {
+    const std::string file = dir + "/shard-" + std::to_string(i) + ".ndjson";
+    const CliResult shard =
+        RunCli("explore --shard " + std::to_string(i) + "/3 " + dir + "/sweep.json");
+    ASSERT_EQ(shard.exit_code, 0) << shard.out;
+    std::ofstream(file) << shard.out;
+    shard_files += " " + file;
+  }
+  const CliResult merged = RunCli("explore-merge" + shard_files);
+  const CliResult whole = RunCli("explore " + dir + "/sweep.json");
+  ASSERT_EQ(merged.exit_code, 0) << merged.out;
+  ASSERT_EQ(whole.exit_code, 0) << whole.out;
+  auto without_timing = [](const std::string& text) {
+    std::vector<nlohmann::json> lines;
+    std::istringstream in(text);
+    std::string line;
+    while (std::getline(in, line)) {
+      nlohmann::json value = nlohmann::json::parse(line);
+      if (value.contains("summary")) value["summary"].erase("timing_s");
+      lines.push_back(std::move(value));
+    }
+    return lines;
+  };
+  EXPECT_EQ(without_timing(merged.out), without_timing(whole.out));
+  EXPECT_EQ(without_timing(whole.out).size(), 8u);  // 7 rows and the summary
+  // Two shards of three: refused, exit 2, nothing on stdout.
+  const CliResult incomplete =
+      RunCli("explore-merge " + dir + "/shard-0.ndjson " + dir + "/shard-2.ndjson");
+  EXPECT_EQ(incomplete.exit_code, 2);
+  EXPECT_EQ(incomplete.out, "");
+  EXPECT_EQ(RunCli("explore --shard 3/3 " + dir + "/sweep.json").exit_code, 2);
+  EXPECT_EQ(RunCli("presets --shard 0/2").exit_code, 2);
+  std::system(("rm -rf " + dir).c_str());
 }
 
 }  // namespace
