@@ -679,10 +679,7 @@ struct ConnectionLoop::Impl {
       return;
     }
     if (silent && now - c.started < Seconds(options.header_timeout_s)) {
-      Refuse(c, 408, "Timeout", Reason::kReadTimeout,
-             "no byte of the request head arrived for read_timeout_s = " +
-                 FormatSeconds(options.read_timeout_s) + " s (read timeout)",
-             now);
+      RefuseSilent(c, "head", now);
       return;
     }
     Refuse(c, 408, "Timeout", Reason::kHeaderTimeout,
@@ -703,8 +700,13 @@ struct ConnectionLoop::Impl {
              now);
       return;
     }
+    RefuseSilent(c, "body", now);
+  }
+
+  // 408 for a request that sent nothing for read_timeout_s, in its head or body (`part`).
+  void RefuseSilent(Connection& c, const char* part, Clock::time_point now) {
     Refuse(c, 408, "Timeout", Reason::kReadTimeout,
-           "no byte of the request body arrived for read_timeout_s = " +
+           std::string("no byte of the request ") + part + " arrived for read_timeout_s = " +
                FormatSeconds(options.read_timeout_s) + " s (read timeout)",
            now);
   }

@@ -1,8 +1,8 @@
 // Faults on the wire: a client that disconnects mid-request and a client too
 // slow to send its request. The server drops them and keeps serving others.
 #include <arpa/inet.h>
-#include <httplib.h>
 #include <gtest/gtest.h>
+#include <httplib.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -12,22 +12,12 @@
 #include <thread>
 
 #include "server/server.hpp"
+#include "tests/server/wire.hpp"
 
 namespace sweetspot::server {
 namespace {
 
-int Connect(int port) {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<uint16_t>(port));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
-    close(fd);
-    return -1;
-  }
-  return fd;
-}
+using sweetspot::testing::Connect;
 
 class FaultsTest : public ::testing::Test {
  protected:
@@ -84,8 +74,7 @@ TEST_F(FaultsTest, SlowClientIsTimedOutAndOthersAreServed) {
   char buffer[4096];
   std::string answer;
   ssize_t n;
-  while (answer.find("}\n") == std::string::npos &&
-         (n = recv(fd, buffer, sizeof buffer, 0)) > 0) {
+  while (answer.find("}\n") == std::string::npos && (n = recv(fd, buffer, sizeof buffer, 0)) > 0) {
     answer.append(buffer, static_cast<size_t>(n));
   }
   const double waited_s =
