@@ -131,21 +131,23 @@ measure() {
 
 rows=()
 declare -A service_rps static_rps service_p99 static_p99
+# Measures `c` connections of one server, prints the row and keeps it for the file.
+run_row() {
+  local label="$1" title="$2" c="$3" script="$4" target="$5"
+  read -r rps p50 p90 p99 errors bad <<<"$(measure "$c" "$script" "$target")"
+  printf '%-10s  %11d  %10.0f  %6.3f  %6.3f  %6.3f  %6d  %7d\n' \
+    "$label" "$c" "$rps" "$p50" "$p90" "$p99" "$errors" "$bad"
+  rows+=("| $title | $c | $(printf '%.0f' "$rps") | $p50 | $p90 | $p99 | $errors | $bad |")
+}
 echo "server      connections  requests/s  p50_ms  p90_ms  p99_ms  errors  non_200"
 for c in 1 8 64 256; do
-  read -r rps p50 p90 p99 errors bad <<<"$(measure "$c" "$work/post.lua" "$url")"
+  run_row sweetspot "sweetspot, POST /v1/sweet-spot" "$c" "$work/post.lua" "$url"
   service_rps[$c]="$rps"
   service_p99[$c]="$p99"
-  printf 'sweetspot   %11d  %10.0f  %6.3f  %6.3f  %6.3f  %6d  %7d\n' \
-    "$c" "$rps" "$p50" "$p90" "$p99" "$errors" "$bad"
-  rows+=("| sweetspot, POST /v1/sweet-spot | $c | $(printf '%.0f' "$rps") | $p50 | $p90 | $p99 | $errors | $bad |")
   if [ "$c" -ge 8 ]; then
-    read -r rps p50 p90 p99 errors bad <<<"$(measure "$c" "$work/get.lua" "$static_url")"
+    run_row nginx "nginx, GET of the same answer as a file" "$c" "$work/get.lua" "$static_url"
     static_rps[$c]="$rps"
     static_p99[$c]="$p99"
-    printf 'nginx       %11d  %10.0f  %6.3f  %6.3f  %6.3f  %6d  %7d\n' \
-      "$c" "$rps" "$p50" "$p90" "$p99" "$errors" "$bad"
-    rows+=("| nginx, GET of the same answer as a file | $c | $(printf '%.0f' "$rps") | $p50 | $p90 | $p99 | $errors | $bad |")
   fi
 done
 ratios=()

@@ -257,8 +257,9 @@ thread_local bool request_was_routed = false;
 
 Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::make_unique<Impl>()) {
   httplib::Server& http = impl_->http;
-  // Limits the connection loop does not apply itself (it hands over heads and
-  // bodies only once they are complete, so httplib's read timeout never waits).
+  // What httplib still applies itself: the body limit (413 from the head alone)
+  // and the values of the Keep-Alive answer header. Reading, timeouts and the
+  // connection limit belong to the connection loop (it hands over complete requests).
   http.set_payload_max_length(config_.max_body_bytes);
   http.set_keep_alive_timeout(WholeSeconds(config_.keep_alive_timeout_s));
   http.set_keep_alive_max_count(static_cast<size_t>(config_.keep_alive_max_requests));
