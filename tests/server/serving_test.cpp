@@ -41,6 +41,20 @@ const char* const kSweetSpotBody =
     R"("speed_mps": 27.7}, "swing": {"angular_speed_rad_s": 17.288, "pivot_from_knob_m": 0.0, )"
     R"("hands_from_knob_m": 0.1524}, "cor": 0.5, "outputs": ["max_exit_speed"]})";
 
+// A latency bound of the issue (100 ms, 1 s) as asserted here. The issue's
+// numbers are for the Release build a user runs, and are asserted unchanged
+// there. Under AddressSanitizer (or ThreadSanitizer) the same server answers
+// about 10 times fewer requests (the 64-client run: 2.0k/s against 20k/s,
+// measured), and a first answer took 147 ms once, so there the bound is 5 times
+// the issue's: still far below what a starved client waits (seconds), but not a
+// measure of the instrumentation.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr double kLatencyScale = 5.0;
+#else
+constexpr double kLatencyScale = 1.0;
+#endif
+constexpr double Bound(double issue_s) { return issue_s * kLatencyScale; }
+
 // `full_s`, or SWEETSPOT_LOAD_SECONDS when that is lower (never below `floor_s`).
 double Seconds(double full_s, double floor_s = 1.0) {
   const char* env = std::getenv("SWEETSPOT_LOAD_SECONDS");
@@ -182,7 +196,7 @@ TEST(ServingTest, SixtyFourKeepAliveClientsAreServedFairly) {
   const FairnessFigures f = RunFairness(64, &report);
   // The issue's numbers: every first answer within 100 ms, the least served
   // client at least a quarter of the mean.
-  EXPECT_LE(f.worst_first_s, 0.100) << report;
+  EXPECT_LE(f.worst_first_s, Bound(0.100)) << report;
   EXPECT_GE(static_cast<double>(f.least), f.mean / 4) << report;
 }
 
@@ -191,8 +205,8 @@ TEST(ServingTest, SixtyFourKeepAliveClientsAreServedFairly) {
 TEST(ServingTest, TwoHundredFiftySixKeepAliveClientsAreAllServedWithinASecond) {
   std::string report;
   const FairnessFigures f = RunFairness(256, &report);
-  EXPECT_LE(f.worst_wait_s, 1.0) << report;
-  EXPECT_LE(f.worst_first_s, 1.0) << report;
+  EXPECT_LE(f.worst_wait_s, Bound(1.0)) << report;
+  EXPECT_LE(f.worst_first_s, Bound(1.0)) << report;
 }
 
 // Issue 14, 2: 200 connections trickle one header line a second for 30 s. A
@@ -300,8 +314,8 @@ TEST(ServingTest, TwoHundredTricklingClientsAreCutOffAtTheHeadDeadlineAndProbesP
   RecordProperty("report", report.str());
 
   EXPECT_EQ(probe_failures, 0) << report.str();
-  EXPECT_LE(worst_health, 0.100) << report.str();
-  EXPECT_LE(worst_sweet, 0.100) << report.str();
+  EXPECT_LE(worst_health, Bound(0.100)) << report.str();
+  EXPECT_LE(worst_sweet, Bound(0.100)) << report.str();
   EXPECT_EQ(connect_failures, 0) << report.str();
   // Every trickler that started in the first 2 s was cut once at least.
   ASSERT_GE(cut_after_s.size(), static_cast<std::size_t>(kTricklers)) << report.str();
@@ -402,7 +416,7 @@ TEST(ServingTest, IdleKeepAliveConnectionsHoldNoWorker) {
   std::cout << "200 idle keep-alive connections: 16 new clients answered within " << worst * 1e3
             << " ms; idle connections the server counts: "
             << Metric(metrics, "sweetspot_connections{state=\"idle\"}") << std::endl;
-  EXPECT_LE(worst, 0.100);
+  EXPECT_LE(worst, Bound(0.100));
   EXPECT_EQ(Metric(metrics, "sweetspot_workers{pool=\"light\"}"), 8);
   for (const int fd : idle) close(fd);
   EXPECT_EQ(server.Stop(SIGTERM), 0);
@@ -467,7 +481,7 @@ TEST(ServingTest, ClientsThatDoNotReadHoldNoWorker) {
             << worst * 1e3 << " ms; light workers busy at the time "
             << Metric(metrics, "sweetspot_workers_busy{pool=\"light\"}") << "; answers complete "
             << "once read: " << complete << " of 16" << std::endl;
-  EXPECT_LE(worst, 0.100);
+  EXPECT_LE(worst, Bound(0.100));
   EXPECT_EQ(complete, 16u);
   EXPECT_EQ(server.Stop(SIGTERM), 0);
 }
@@ -527,7 +541,7 @@ TEST(ServingTest, ConnectionsPastTheLimitGet503AtOnceAndAreClosedEvenIfTheClient
     const ReadResult r =
         ReadFor(fd, 5.0, [](const std::string& s) { return s.find("}\n") != std::string::npos; });
     EXPECT_EQ(r.bytes.substr(0, 12), "HTTP/1.1 200");
-    EXPECT_LE(SecondsSince(t), 0.100);
+    EXPECT_LE(SecondsSince(t), Bound(0.100));
   }
   for (auto& t : stubborn) t.join();
   const double worst_answer = *std::max_element(answer_s.begin(), answer_s.end());
@@ -541,7 +555,7 @@ TEST(ServingTest, ConnectionsPastTheLimitGet503AtOnceAndAreClosedEvenIfTheClient
     EXPECT_NE(a.find("Retry-After: 1"), std::string::npos) << a;
     EXPECT_NE(a.find("\"TooBusy\""), std::string::npos) << a;
   }
-  EXPECT_LE(worst_answer, 0.100);
+  EXPECT_LE(worst_answer, Bound(0.100));
   // Closed after the 1 s drain (the reset shows at the send after it, 50 ms
   // apart), not after the 5 s keep-alive timeout nor ever.
   EXPECT_GE(worst_close, 0.9);
@@ -630,8 +644,8 @@ TEST(ServingTest, ModelWorkStaysInItsBoundedPoolAndCheapRequestsPassIt) {
   EXPECT_GT(heavy_ok.load(), 0) << report.str();
   EXPECT_EQ(heavy_failed.load(), 0) << report.str();
   EXPECT_EQ(probe_failures, 0) << report.str();
-  EXPECT_LE(worst_health, 0.100) << report.str();
-  EXPECT_LE(worst_sweet, 0.100) << report.str();
+  EXPECT_LE(worst_health, Bound(0.100)) << report.str();
+  EXPECT_LE(worst_sweet, Bound(0.100)) << report.str();
   EXPECT_EQ(server.Stop(SIGTERM), 0);
 }
 
