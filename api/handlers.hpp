@@ -45,6 +45,8 @@ Response HandleExplore(const Request& request, const Context& context);
 Response HandleJobSubmit(const Request& request, const Context& context);
 /// GET /v1/jobs/{id}: a job's state and progress.
 Response HandleJobStatus(const Request& request, const Context& context);
+/// GET /v1/jobs: {"jobs": [...]}, every job the server keeps, oldest submitted first.
+Response HandleJobList(const Request& request, const Context& context);
 /// GET /v1/jobs/{id}/result: a finished job's result.
 Response HandleJobResult(const Request& request, const Context& context);
 /// DELETE /v1/jobs/{id}: cancel (or forget) a job.

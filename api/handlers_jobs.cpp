@@ -1,7 +1,8 @@
-// POST /v1/jobs, GET /v1/jobs/{id}, GET /v1/jobs/{id}/result, DELETE /v1/jobs/{id}:
-// any long POST endpoint run as a job (api/jobs.hpp has the states and JSON).
+// POST /v1/jobs, GET /v1/jobs, GET /v1/jobs/{id}, GET /v1/jobs/{id}/result,
+// DELETE /v1/jobs/{id}: any long POST endpoint run as a job (api/job_service.hpp
+// has the states and JSON; the server implements the service).
 #include "api/handlers.hpp"
-#include "api/jobs.hpp"
+#include "api/job_service.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -43,6 +44,11 @@ Response HandleJobSubmit(const Request& request, const Context& context) {
     return ToResponse(error);
   }
   return context.jobs->Submit({target->method, target->path, inner_body->dump()});
+}
+
+Response HandleJobList(const Request&, const Context& context) {
+  if (context.jobs == nullptr) return NoJobs();
+  return context.jobs->List();
 }
 
 Response HandleJobStatus(const Request& request, const Context& context) {

@@ -17,7 +17,7 @@ class ModesCache;
 
 namespace sweetspot::api {
 
-class JobManager;
+class JobService;
 
 /// A request as the handlers see it.
 struct Request {
@@ -30,7 +30,7 @@ struct Request {
 /// running server has (jobs, metrics). Null members mean "not available here".
 struct Context {
   ApiLimits limits;                          ///< Request limits (configuration).
-  JobManager* jobs = nullptr;                ///< The job manager (server only).
+  JobService* jobs = nullptr;                ///< The jobs (server only; server/jobs/).
   std::function<std::string()> metrics_text; ///< Prometheus text (server only).
   core::Progress* progress = nullptr;        ///< Cancel flag and progress (inside a job).
   core::ModesCache* modes_cache = nullptr;   ///< Bending modes kept across requests (server only).

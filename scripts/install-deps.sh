@@ -9,13 +9,15 @@
 set -euo pipefail
 
 if [ "${1:-}" = "--runtime" ]; then
-  packages=(ca-certificates curl libnlopt-cxx0 coinor-libipopt1v5 libcpp-httplib0.11 libsqlite3-0)
+  packages=(ca-certificates curl libnlopt-cxx0 coinor-libipopt1v5 libcpp-httplib0.11 libsqlite3-0 libpq5)
 else
   packages=(
     cmake g++ make pkg-config ca-certificates curl
     libeigen3-dev libnlopt-cxx-dev coinor-libipopt-dev
     libcpp-httplib-dev nlohmann-json3-dev
     libgtest-dev libgmock-dev libbenchmark-dev libboost-dev libsqlite3-dev
+    # jobs shared by replicas (libpq), and a throw-away PostgreSQL server for its tests
+    libpq-dev postgresql
     # fuzzing (scripts/fuzz.sh): clang with libFuzzer and its sanitizer runtimes
     clang clang-14 libclang-rt-14-dev llvm-14
     # HTTP benchmark (bench/http_bench.sh); nginx also for the test of docker/nginx.conf

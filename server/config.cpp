@@ -274,8 +274,9 @@ const std::vector<Option>& Options() {
          return ParseSeconds(v, &c->jobs.keep_results_s, rule);
        }},
       {"--job-max-resumes", "SWEETSPOT_JOB_MAX_RESUMES",
-       "times a job the server died under (crash, SIGKILL) is run again at start-up before it "
-       "is marked failed (default 2)",
+       "times a job the server died under (crash, SIGKILL) is run again (at start-up, or with "
+       "PostgreSQL by another replica once its lease expires) before it is marked failed "
+       "(default 2)",
        true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          long long n = 0;
@@ -283,13 +284,38 @@ const std::vector<Option>& Options() {
          c->jobs.max_resumes = static_cast<int>(n);
          return true;
        }},
+      {"--job-lease-s", "SWEETSPOT_JOB_LEASE_S",
+       "PostgreSQL: how long a running job's claim lasts unrenewed before another replica "
+       "may run it, s (default 10)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         double s = 0;
+         if (!ParseSeconds(v, &s, rule)) return false;
+         if (s < 1 || s > 3600) {
+           *rule = "must be in [1, 3600] s";
+           return false;
+         }
+         c->jobs.lease_s = s;
+         return true;
+       }},
+      {"--job-max-result-bytes", "SWEETSPOT_JOB_MAX_RESULT_BYTES",
+       "PostgreSQL: the largest job result stored; a larger one fails the job with its size, "
+       "never truncated (default 268435456)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1024, 1000000000, &n, rule)) return false;
+         c->jobs.max_result_bytes = static_cast<std::size_t>(n);
+         return true;
+       }},
       {"--jobs-db", "SWEETSPOT_JOBS_DB",
-       "SQLite file keeping jobs and their results across restarts (default "
-       "sweetspot-jobs.db in the working directory; none = memory only)",
+       "where jobs and their results are kept: a SQLite file (default sweetspot-jobs.db in "
+       "the working directory), a postgresql://user@host:port/db URI shared by every replica "
+       "(one store and one queue), or none = memory only",
        true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          if (v.empty()) {
-           *rule = "must be a file path, or none for no persistence";
+           *rule = "must be a file path, a postgresql:// URI, or none for no persistence";
            return false;
          }
          c->jobs_db = v;
@@ -375,8 +401,8 @@ bool ServerConfig::IsValid(std::string* why) const {
   if (std::string limits_why; !limits.IsValid(&limits_why)) return fail("limits." + limits_why);
   if (std::string jobs_why; !jobs.IsValid(&jobs_why)) return fail("jobs." + jobs_why);
   if (jobs_db.empty()) {
-    return fail("jobs_db = \"\": must be a file path, or \"" + std::string(kNoJobsDb) +
-                "\" for no persistence");
+    return fail("jobs_db = \"\": must be a file path, a postgresql:// URI, or \"" +
+                std::string(kNoJobsDb) + "\" for no persistence");
   }
   if (!std::isfinite(shutdown_grace_s) || shutdown_grace_s < 0 || shutdown_grace_s > 3600) {
     std::ostringstream text;

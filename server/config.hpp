@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "api/jobs.hpp"
+#include "server/jobs/job_common.hpp"
 #include "api/limits.hpp"
 
 namespace sweetspot::server {
@@ -32,8 +32,8 @@ struct ServerConfig {
   int keep_alive_max_requests = 10000;   ///< Requests per keep-alive connection (--keep-alive-max-requests, SWEETSPOT_KEEP_ALIVE_MAX_REQUESTS).
   bool access_log = true;                ///< One JSON line per request on stderr (--no-access-log, SWEETSPOT_ACCESS_LOG=0).
   api::ApiLimits limits;                 ///< Request limits (--max-json-depth, --max-knots, ...; see Usage()).
-  api::JobConfig jobs;                   ///< Job pool (--job-workers, --job-queue, --job-keep-s, --jobs-kept, --job-max-resumes).
-  std::string jobs_db = "sweetspot-jobs.db";  ///< SQLite file keeping jobs across restarts, relative to the working directory; "none" = memory only (--jobs-db, SWEETSPOT_JOBS_DB).
+  JobConfig jobs;                   ///< Job pool (--job-workers, --job-queue, --job-keep-s, --jobs-kept, --job-max-resumes, --job-lease-s, --job-max-result-bytes).
+  std::string jobs_db = "sweetspot-jobs.db";  ///< Where jobs are kept: a SQLite file (relative to the working directory), a postgresql:// URI shared by replicas, or "none" = memory only (--jobs-db, SWEETSPOT_JOBS_DB).
   double shutdown_grace_s = 8.0;         ///< On SIGTERM/SIGINT, how long running jobs may still finish before they are interrupted, s, [0, 3600] (--shutdown-grace-s, SWEETSPOT_SHUTDOWN_GRACE_S).
   std::string web_root;                  ///< Folder of the design explorer's static files served at /; empty = "web" next to the executable (--web-root, SWEETSPOT_WEB_ROOT).
 

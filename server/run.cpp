@@ -11,8 +11,9 @@
 
 #include "core/version.hpp"
 #include "server/config.hpp"
-#include "server/server.hpp"
+#include "server/jobs/postgres_job_service.hpp"
 #include "server/run.hpp"
+#include "server/server.hpp"
 
 namespace sweetspot::server {
 
@@ -75,6 +76,9 @@ int RunServerMain(const std::vector<std::string>& args) {
   std::cerr << "sweetspot-server: jobs "
             << (parsed.config.jobs_db == kNoJobsDb
                     ? std::string("are kept in memory only (--jobs-db none)")
+                : IsPostgresUri(parsed.config.jobs_db)
+                    ? "are kept in PostgreSQL \"" + RedactedUri(parsed.config.jobs_db) +
+                          "\", one store and one queue for every replica"
                     : "are kept in \"" + parsed.config.jobs_db + "\"")
             << "\n";
   std::cerr << "sweetspot-server " << sweetspot::core::SweetspotVersion() << " listening on "

@@ -15,12 +15,13 @@
 #include <mutex>
 #include <thread>
 
-#include "api/jobs.hpp"
+#include "server/jobs/job_manager.hpp"
 #include "api/router.hpp"
 #include "server/connection_loop.hpp"
 #include "server/metrics.hpp"
 #include "server/request_stream.hpp"
-#include "server/sqlite_job_store.hpp"
+#include "server/jobs/postgres_job_service.hpp"
+#include "server/jobs/sqlite_job_store.hpp"
 #include "server/static_files.hpp"
 
 namespace sweetspot::server {
@@ -77,6 +78,8 @@ void WriteApiResponse(const api::Response& response, httplib::Response& res) {
     return;
   }
   res.status = response.status;
+  // Too busy, shutting down or the jobs database away: worth retrying soon.
+  if (response.status == 429 || response.status == 503) res.set_header("Retry-After", "1");
   if (!response.content_type.empty()) {
     res.set_content(response.text, response.content_type.c_str());
   } else {
@@ -239,8 +242,8 @@ struct Server::Impl {
   api::Context context;
   Metrics metrics;
   core::ModesCache modes_cache;               // bending modes kept across requests (bounded LRU)
-  std::unique_ptr<SqliteJobStore> job_store;  // Null with --jobs-db none; outlives `jobs`.
-  std::unique_ptr<api::JobManager> jobs;
+  std::unique_ptr<SqliteJobStore> job_store;  // A SQLite --jobs-db only; outlives `jobs`.
+  std::unique_ptr<ServerJobService> jobs;     // Never null after the constructor.
   std::unique_ptr<StaticFiles> static_files;  // The explorer's files (web root); never null.
   std::string startup_error;  // Why the jobs database cannot be used; Bind() reports it.
   std::mutex log_mutex;
@@ -314,32 +317,38 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
   // Jobs run the same router with the job's cancel flag and progress, on a
   // copy of the context taken now: loaded jobs may start before this
   // constructor returns, and jobbable requests need neither jobs nor metrics.
-  const api::JobRunner runner = [context = impl_->context](const api::Request& inner,
+  const JobRunner runner = [context = impl_->context](const api::Request& inner,
                                                            core::Progress* progress) {
     api::Context job_context = context;
     job_context.progress = progress;
     return api::Dispatch(inner, job_context);
   };
-  if (config_.jobs_db != kNoJobsDb) {
+  auto log_store_error = [impl = impl_.get()](const std::string& message) {
+    std::lock_guard<std::mutex> lock(impl->log_mutex);
+    std::cerr << "sweetspot-server: jobs database: " << message << std::endl;
+  };
+  if (IsPostgresUri(config_.jobs_db)) {
+    std::string error;
+    impl_->jobs =
+        PostgresJobService::Open(config_.jobs_db, config_.jobs, runner, log_store_error, &error);
+    if (!impl_->jobs) impl_->startup_error = error;
+  } else if (config_.jobs_db != kNoJobsDb) {
     std::string error;
     impl_->job_store = SqliteJobStore::Open(config_.jobs_db, &error);
     if (!impl_->job_store) impl_->startup_error = error;
   }
   if (impl_->job_store) {
-    api::JobPersistence persistence;
+    JobPersistence persistence;
     persistence.store = impl_->job_store.get();
-    persistence.on_store_error = [impl = impl_.get()](const std::string& message) {
-      std::lock_guard<std::mutex> lock(impl->log_mutex);
-      std::cerr << "sweetspot-server: jobs database: " << message << std::endl;
-    };
+    persistence.on_store_error = log_store_error;
     try {
-      impl_->jobs = std::make_unique<api::JobManager>(config_.jobs, runner, persistence);
+      impl_->jobs = std::make_unique<JobManager>(config_.jobs, runner, persistence);
     } catch (const std::runtime_error& load_error) {
       impl_->startup_error = "jobs database \"" + config_.jobs_db + "\": " + load_error.what();
     }
   }
   // Memory only: with --jobs-db none, or (never serving: Bind fails) when the database failed.
-  if (!impl_->jobs) impl_->jobs = std::make_unique<api::JobManager>(config_.jobs, runner);
+  if (!impl_->jobs) impl_->jobs = std::make_unique<JobManager>(config_.jobs, runner);
   impl_->context.jobs = impl_->jobs.get();
   impl_->context.metrics_text = [impl = impl_.get()] {
     std::string text = impl->metrics.Render(impl->jobs->CountsByState());
@@ -419,23 +428,30 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
 
 Server::~Server() {
   Stop();
-  impl_->jobs->Shutdown();  // No grace (a no-op after Shutdown()).
+  impl_->jobs->Shutdown(0.0);  // No grace (a no-op after Shutdown()).
 }
 
 void Server::Shutdown() {
   Stop();
-  const int running = impl_->jobs->CountsByState().at("running");
+  const auto counts = impl_->jobs->CountsByState();
+  const int running = counts.count("running") != 0 ? counts.at("running") : 0;
   if (running > 0) {
     std::lock_guard<std::mutex> lock(impl_->log_mutex);
     std::cerr << "sweetspot-server: waiting up to " << config_.shutdown_grace_s << " s for "
               << running << " running job(s) to finish" << std::endl;
   }
   impl_->jobs->Shutdown(config_.shutdown_grace_s);
-  const int queued = impl_->jobs->CountsByState().at("queued");
+  const auto after = impl_->jobs->CountsByState();
+  const int queued = after.count("queued") != 0 ? after.at("queued") : 0;
   if (queued > 0 && impl_->job_store) {
     std::lock_guard<std::mutex> lock(impl_->log_mutex);
     std::cerr << "sweetspot-server: " << queued << " unfinished job(s) kept in \""
               << config_.jobs_db << "\" for the next start" << std::endl;
+  } else if (queued > 0 && IsPostgresUri(config_.jobs_db)) {
+    std::lock_guard<std::mutex> lock(impl_->log_mutex);
+    std::cerr << "sweetspot-server: " << queued
+              << " queued job(s) left in the shared PostgreSQL queue for the other replicas"
+              << std::endl;
   }
 }
 

@@ -49,11 +49,26 @@ TEST(JobsConfigTest, FlagsAndEnvironment) {
   EXPECT_EQ(from_env.config.jobs_db, "none");
   EXPECT_EQ(from_env.config.shutdown_grace_s, 2.5);
   EXPECT_EQ(from_env.config.jobs.max_resumes, 100);
+  // A PostgreSQL URI is kept as given; the lease and the result limit are PostgreSQL's.
+  const auto postgres = Parse({"--jobs-db", "postgresql://sweetspot@db.example:5432/jobs",
+                               "--job-lease-s", "4"},
+                              {{"SWEETSPOT_JOB_MAX_RESULT_BYTES", "1048576"}});
+  ASSERT_EQ(postgres.error, "");
+  EXPECT_EQ(postgres.config.jobs_db, "postgresql://sweetspot@db.example:5432/jobs");
+  EXPECT_EQ(postgres.config.jobs.lease_s, 4.0);
+  EXPECT_EQ(postgres.config.jobs.max_result_bytes, 1048576u);
+  EXPECT_EQ(ServerConfig{}.jobs.lease_s, 10.0);
+  EXPECT_EQ(ServerConfig{}.jobs.max_result_bytes, 256u << 20);
 }
 
 TEST(JobsConfigTest, BadValuesNameFlagValueAndRule) {
   EXPECT_EQ(Parse({"--jobs-db", ""}).error,
-            "option --jobs-db = \"\": must be a file path, or none for no persistence");
+            "option --jobs-db = \"\": must be a file path, a postgresql:// URI, or none for no "
+            "persistence");
+  EXPECT_EQ(Parse({"--job-lease-s", "0.5"}).error,
+            "option --job-lease-s = \"0.5\": must be in [1, 3600] s");
+  EXPECT_EQ(Parse({"--job-max-result-bytes", "100"}).error,
+            "option --job-max-result-bytes = \"100\": must be an integer in [1024, 1000000000]");
   EXPECT_EQ(Parse({"--shutdown-grace-s", "-1"}).error,
             "option --shutdown-grace-s = \"-1\": must be a number of seconds in [0, 3600]");
   EXPECT_EQ(Parse({"--shutdown-grace-s", "nan"}).error,
@@ -70,7 +85,17 @@ TEST(JobsConfigTest, IsValidRefusesOutOfRange) {
   ServerConfig config;
   config.jobs_db = "";
   EXPECT_FALSE(config.IsValid(&why));
-  EXPECT_EQ(why, "jobs_db = \"\": must be a file path, or \"none\" for no persistence");
+  EXPECT_EQ(why,
+            "jobs_db = \"\": must be a file path, a postgresql:// URI, or \"none\" for no "
+            "persistence");
+  config = ServerConfig{};
+  config.jobs.lease_s = 0.0;
+  EXPECT_FALSE(config.jobs.IsValid(&why));
+  EXPECT_EQ(why, "lease_s = 0: must be in [1, 3600]");
+  config.jobs.lease_s = 10.0;
+  config.jobs.max_result_bytes = 10;
+  EXPECT_FALSE(config.jobs.IsValid(&why));
+  EXPECT_EQ(why, "max_result_bytes = 10: must be in [1024, 1000000000]");
   config = ServerConfig{};
   config.shutdown_grace_s = -0.5;
   EXPECT_FALSE(config.IsValid(&why));

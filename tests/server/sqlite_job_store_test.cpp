@@ -1,7 +1,7 @@
 // The SQLite JobStore on temporary files: every field round-trips through a
 // close and reopen, replace/delete/order, one server per file, schema
 // versions, unusable files, and a JobManager restarted on the same database.
-#include "server/sqlite_job_store.hpp"
+#include "server/jobs/sqlite_job_store.hpp"
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -14,13 +14,12 @@
 #include <thread>
 #include <vector>
 
-#include "api/jobs.hpp"
+#include "server/jobs/job_manager.hpp"
 
 namespace sweetspot::server {
 namespace {
 
 namespace fs = std::filesystem;
-using api::JobRecord;
 
 // A fresh directory under the test temp dir, removed with its files at the end.
 class TempDir {
@@ -253,9 +252,9 @@ TEST(SqliteJobStoreTest, AJobManagerRestartedOnTheSameFileGetsItsJobsBack) {
   {
     auto store = OpenOrFail(path);
     ASSERT_NE(store, nullptr);
-    api::JobPersistence persistence;
+    JobPersistence persistence;
     persistence.store = store.get();
-    api::JobManager jobs(api::JobConfig{}, echo, persistence);
+    JobManager jobs(JobConfig{}, echo, persistence);
     const api::Response submitted = jobs.Submit({"POST", "/v1/compare", "payload"});
     ASSERT_EQ(submitted.status, 202);
     id = submitted.body["id"];
@@ -267,9 +266,9 @@ TEST(SqliteJobStoreTest, AJobManagerRestartedOnTheSameFileGetsItsJobsBack) {
   }
   auto store = OpenOrFail(path);
   ASSERT_NE(store, nullptr);
-  api::JobPersistence persistence;
+  JobPersistence persistence;
   persistence.store = store.get();
-  api::JobManager jobs(api::JobConfig{}, echo, persistence);
+  JobManager jobs(JobConfig{}, echo, persistence);
   EXPECT_EQ(jobs.Status(id).body["state"], "done");
   const api::Response result = jobs.Result(id);
   EXPECT_EQ(result.status, 200);

@@ -1,4 +1,4 @@
-#include "server/sqlite_job_store.hpp"
+#include "server/jobs/sqlite_job_store.hpp"
 
 #include <sqlite3.h>
 
@@ -192,7 +192,7 @@ SqliteJobStore::~SqliteJobStore() {
   sqlite3_close(db_);
 }
 
-bool SqliteJobStore::Save(const api::JobRecord& record, std::string* error) {
+bool SqliteJobStore::Save(const JobRecord& record, std::string* error) {
   std::lock_guard lock(mutex_);
   int code = SQLITE_OK;
   int index = 0;
@@ -252,7 +252,7 @@ bool SqliteJobStore::Delete(const std::string& id, std::string* error) {
   return code == SQLITE_OK;
 }
 
-bool SqliteJobStore::LoadAll(std::vector<api::JobRecord>* records, std::string* error) {
+bool SqliteJobStore::LoadAll(std::vector<JobRecord>* records, std::string* error) {
   std::lock_guard lock(mutex_);
   records->clear();
   int code = SQLITE_OK;
@@ -261,7 +261,7 @@ bool SqliteJobStore::LoadAll(std::vector<api::JobRecord>* records, std::string* 
       if (sqlite3_column_type(load_, column) == SQLITE_NULL) return std::nullopt;
       return sqlite3_column_double(load_, column);
     };
-    api::JobRecord record;
+    JobRecord record;
     record.id = ColumnText(load_, 0);
     record.state = ColumnText(load_, 1);
     record.method = ColumnText(load_, 2);

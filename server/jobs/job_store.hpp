@@ -1,6 +1,6 @@
 // Where a JobManager keeps its jobs so that they survive a restart: a small
-// storage interface the api layer calls and the server implements (with SQLite,
-// server/sqlite_job_store.hpp). HTTP- and database-agnostic: a record is plain
+// storage interface JobManager calls and the SQLite store implements (
+// server/jobs/sqlite_job_store.hpp). Database-agnostic: a record is plain
 // values, the store only saves, deletes and loads them.
 #pragma once
 
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace sweetspot::api {
+namespace sweetspot::server {
 
 /// One job as stored: everything needed to show it, give its result, or run it
 /// again after a restart. Times are wall-clock seconds since the Unix epoch.
@@ -50,4 +50,4 @@ class JobStore {
   virtual bool LoadAll(std::vector<JobRecord>* records, std::string* error) = 0;
 };
 
-}  // namespace sweetspot::api
+}  // namespace sweetspot::server

@@ -1,4 +1,4 @@
-#include "api/jobs.hpp"
+#include "server/jobs/job_manager.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,8 +14,12 @@
 #include <thread>
 #include <vector>
 
-namespace sweetspot::api {
+namespace sweetspot::server {
 namespace {
+
+using api::Request;
+using api::Response;
+
 
 using std::chrono::milliseconds;
 using Clock = std::chrono::steady_clock;
@@ -648,4 +652,4 @@ TEST(JobManagerTest, EachManagerDrawsItsOwnIds) {
 }
 
 }  // namespace
-}  // namespace sweetspot::api
+}  // namespace sweetspot::server

@@ -1,4 +1,4 @@
-#include "api/jobs.hpp"
+#include "server/jobs/job_manager.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,60 +12,12 @@
 
 #include "api/json_reader.hpp"
 
-namespace sweetspot::api {
-namespace {
+namespace sweetspot::server {
 
-constexpr int kMaxWorkers = 64;
-constexpr std::size_t kMaxQueuedLimit = 1000000;
-constexpr std::size_t kMaxKeptLimit = 1000000;
-constexpr int kMaxResumesLimit = 100;
-
-// An engine seeded from std::random_device with 256 bits, one per manager.
-std::mt19937_64 SeededEngine() {
-  std::random_device device;
-  std::seed_seq seed{device(), device(), device(), device(),
-                     device(), device(), device(), device()};
-  return std::mt19937_64(seed);
-}
-
-// "2024-05-01T12:00:00.123Z".
-std::string IsoUtc(std::chrono::system_clock::time_point time) {
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(time.time_since_epoch());
-  const std::time_t seconds = static_cast<std::time_t>(ms.count() / 1000);
-  std::tm utc{};
-  gmtime_r(&seconds, &utc);
-  char date[32];
-  std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%S", &utc);
-  char text[48];
-  std::snprintf(text, sizeof(text), "%s.%03dZ", date, static_cast<int>(ms.count() % 1000));
-  return text;
-}
-
-// Seconds rounded to microseconds (keeps the JSON short).
-double RoundedSeconds(double seconds) { return std::round(seconds * 1e6) / 1e6; }
-
-// The quoted id for messages ("\"abc\"", cut when long, control characters escaped).
-std::string QuoteId(const std::string& id) { return Show(nlohmann::json(id)); }
-
-Response NotFound(const std::string& id) {
-  return ToResponse(ApiError{404, "NotFound", "no job with id " + QuoteId(id), ""});
-}
-
-// Serialises a JSON body for the store: never throws (invalid UTF-8 is replaced).
-std::string Serialize(const nlohmann::json& body) {
-  return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
-// The failure's message of an inner response: its "message", else its status.
-std::string FailureMessage(const Response& response) {
-  if (response.body.is_object()) {
-    const auto it = response.body.find("message");
-    if (it != response.body.end() && it->is_string()) return it->get<std::string>();
-  }
-  return "the request failed with HTTP status " + std::to_string(response.status);
-}
-
-}  // namespace
+using api::ApiError;
+using api::Request;
+using api::Response;
+using api::ToResponse;
 
 struct JobManager::Job {
   std::string id;                             // 32 hex digits.
@@ -83,35 +35,6 @@ struct JobManager::Job {
   Response result;                            // The inner response (done or failed).
   std::string error;                          // The failure's message (failed).
 };
-
-bool JobConfig::IsValid(std::string* why) const {
-  auto fail = [why](const std::string& text) {
-    if (why != nullptr) *why = text;
-    return false;
-  };
-  if (workers < 1 || workers > kMaxWorkers) {
-    return fail("workers = " + std::to_string(workers) + ": must be in [1, " +
-                std::to_string(kMaxWorkers) + "]");
-  }
-  if (max_queued < 1 || max_queued > kMaxQueuedLimit) {
-    return fail("max_queued = " + std::to_string(max_queued) + ": must be in [1, " +
-                std::to_string(kMaxQueuedLimit) + "]");
-  }
-  if (max_kept < 1 || max_kept > kMaxKeptLimit) {
-    return fail("max_kept = " + std::to_string(max_kept) + ": must be in [1, " +
-                std::to_string(kMaxKeptLimit) + "]");
-  }
-  if (!std::isfinite(keep_results_s) || keep_results_s <= 0) {
-    std::ostringstream text;
-    text << "keep_results_s = " << keep_results_s << ": must be finite and > 0";
-    return fail(text.str());
-  }
-  if (max_resumes < 0 || max_resumes > kMaxResumesLimit) {
-    return fail("max_resumes = " + std::to_string(max_resumes) + ": must be in [0, " +
-                std::to_string(kMaxResumesLimit) + "]");
-  }
-  return true;
-}
 
 JobManager::JobManager(JobConfig config, JobRunner runner, JobPersistence persistence)
     : config_(config),
@@ -197,30 +120,41 @@ Response JobManager::Status(const std::string& id) const {
   const Clock::time_point now = Clock::now();
   EvictLocked(now);
   const std::shared_ptr<Job> job = FindLocked(id);
-  if (!job) return NotFound(id);
+  if (!job) return JobNotFound(id);
   return {200, ToJsonLocked(*job, now)};
+}
+
+Response JobManager::List() const {
+  std::lock_guard lock(mutex_);
+  const Clock::time_point now = Clock::now();
+  EvictLocked(now);
+  std::vector<const Job*> all;
+  all.reserve(jobs_.size());
+  for (const auto& [id, job] : jobs_) all.push_back(job.get());
+  std::stable_sort(all.begin(), all.end(), [](const Job* a, const Job* b) {
+    return a->created != b->created ? a->created < b->created : a->id < b->id;
+  });
+  nlohmann::json list = nlohmann::json::array();
+  for (const Job* job : all) list.push_back(ToJsonLocked(*job, now));
+  return {200, nlohmann::json{{"jobs", std::move(list)}}};
 }
 
 Response JobManager::Result(const std::string& id) const {
   std::lock_guard lock(mutex_);
   EvictLocked(Clock::now());
   const std::shared_ptr<Job> job = FindLocked(id);
-  if (!job) return NotFound(id);
+  if (!job) return JobNotFound(id);
   switch (job->state) {
     case State::kDone:
     case State::kFailed:
       return job->result;
     case State::kCancelled:
-      return ToResponse(ApiError{409, "Cancelled",
-                                 "job " + QuoteId(id) + " was cancelled: it has no result", ""});
+      return JobWasCancelled(id);
     case State::kQueued:
     case State::kRunning:
       break;
   }
-  return ToResponse(ApiError{409, "NotReady",
-                             "job " + QuoteId(id) + " is " + StateName(job->state) +
-                                 ": its result is ready once its state is done or failed",
-                             ""});
+  return JobNotReady(id, StateName(job->state));
 }
 
 Response JobManager::Cancel(const std::string& id) {
@@ -228,7 +162,7 @@ Response JobManager::Cancel(const std::string& id) {
   const Clock::time_point now = Clock::now();
   EvictLocked(now);
   const std::shared_ptr<Job> job = FindLocked(id);
-  if (!job) return NotFound(id);
+  if (!job) return JobNotFound(id);
   switch (job->state) {
     case State::kQueued: {
       queue_.erase(std::find(queue_.begin(), queue_.end(), id));
@@ -407,46 +341,38 @@ std::shared_ptr<JobManager::Job> JobManager::FindLocked(const std::string& id) c
 
 nlohmann::json JobManager::ToJsonLocked(const Job& job, Clock::time_point now) const {
   auto since_start = [this](Clock::time_point time) {
-    return nlohmann::json(RoundedSeconds(std::chrono::duration<double>(time - start_).count()));
+    return std::chrono::duration<double>(time - start_).count();
   };
-  double progress = 0.0;
+  JobView view;
+  view.id = job.id;
+  view.state = StateName(job.state);
   switch (job.state) {
     case State::kQueued:
-      progress = 0.0;
+      view.progress = 0.0;
       break;
     case State::kDone:
-      progress = 1.0;
+      view.progress = 1.0;
       break;
     case State::kRunning:
     case State::kFailed:
     case State::kCancelled:
-      progress = job.progress.Fraction();
+      view.progress = job.progress.Fraction();
       break;
   }
-  const bool finished = job.finished.has_value();
-  nlohmann::json json{
-      {"id", job.id},
-      {"state", StateName(job.state)},
-      {"progress", progress},
-      {"path", job.path},
-      {"created_s", since_start(job.created)},
-      {"started_s", job.started ? since_start(*job.started) : nlohmann::json()},
-      {"finished_s", finished ? since_start(*job.finished) : nlohmann::json()},
-      {"created_at", job.created_at},
-      {"status", job.state == State::kDone || job.state == State::kFailed
-                     ? nlohmann::json(job.result.status)
-                     : nlohmann::json()},
-      {"error", job.state == State::kFailed ? nlohmann::json(job.error) : nlohmann::json()},
-      {"cancel_requested", job.cancel_requested},
-      {"resumes", job.resumes},
-  };
-  if (finished) {
-    const double age_s = std::chrono::duration<double>(now - *job.finished).count();
-    json["expires_in_s"] = RoundedSeconds(std::max(0.0, config_.keep_results_s - age_s));
-  } else {
-    json["expires_in_s"] = nullptr;
+  view.path = job.path;
+  view.created_s = since_start(job.created);
+  if (job.started) view.started_s = since_start(*job.started);
+  if (job.finished) {
+    view.finished_s = since_start(*job.finished);
+    view.expires_in_s =
+        config_.keep_results_s - std::chrono::duration<double>(now - *job.finished).count();
   }
-  return json;
+  view.created_at = job.created_at;
+  if (job.state == State::kDone || job.state == State::kFailed) view.status = job.result.status;
+  if (job.state == State::kFailed) view.error = job.error;
+  view.cancel_requested = job.cancel_requested;
+  view.resumes = job.resumes;
+  return JobJson(view);
 }
 
 double JobManager::ToUnixSeconds(Clock::time_point time) const {
@@ -489,7 +415,7 @@ JobRecord JobManager::RecordLocked(const Job& job) const {
   if (job.state == State::kDone || job.state == State::kFailed) {
     record.status = job.result.status;
     if (job.result.content_type.empty()) {
-      record.response_json = Serialize(job.result.body);
+      record.response_json = SerializeJobBody(job.result.body);
     } else {
       record.response_text = job.result.text;
       record.content_type = job.result.content_type;
@@ -578,18 +504,13 @@ void JobManager::LoadFromStore() {
         job->state = State::kFailed;
         job->progress.Report(record.progress);
         job->finished = now;
-        job->error =
-            "interrupted by a server restart: the job was running when the server "
-            "died, and it had already been resumed " +
-            std::to_string(job->resumes) +
-            " times (limit max_resumes = " + std::to_string(config_.max_resumes) + ")";
-        job->result = ToResponse(ApiError{503, "Interrupted", job->error, ""});
+        job->result = JobInterrupted(job->resumes, config_.max_resumes, &job->error);
       }
       changed = true;
     } else {
       if (persistence_.on_store_error) {
         persistence_.on_store_error("job " + record.id + " has an unknown state " +
-                                    QuoteId(record.state) + ": skipped");
+                                    QuoteJobId(record.state) + ": skipped");
       }
       continue;
     }
@@ -612,12 +533,9 @@ void JobManager::LoadFromStore() {
 std::string JobManager::NewIdLocked() {
   std::string id;
   do {
-    char text[33];
-    std::snprintf(text, sizeof(text), "%016llx%016llx", static_cast<unsigned long long>(random_()),
-                  static_cast<unsigned long long>(random_()));
-    id = text;
+    id = NewJobId(random_);
   } while (jobs_.count(id) != 0);
   return id;
 }
 
-}  // namespace sweetspot::api
+}  // namespace sweetspot::server

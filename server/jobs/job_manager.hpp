@@ -1,28 +1,8 @@
-// Jobs: long requests run in a bounded worker pool, polled and cancelled by id
-// (POST /v1/jobs, GET /v1/jobs/{id}, GET /v1/jobs/{id}/result,
-// DELETE /v1/jobs/{id}). HTTP-agnostic like the rest of the api layer: the
-// manager runs an inner Request through a JobRunner (in the service, the
-// router's Dispatch) and answers with Responses in the contract's envelope.
-//
-// States (the contract's five): queued -> running -> done | failed | cancelled;
-// queued -> cancelled. A job's JSON:
-//   {"id":          32 lowercase hex digits (128 random bits),
-//    "state":       "queued" | "running" | "done" | "failed" | "cancelled",
-//    "progress":    0..1 (0 while queued, the runner's reports while running,
-//                   1 when done, frozen at the last report when failed/cancelled),
-//    "path":        the inner request's path,
-//    "created_s", "started_s", "finished_s":
-//                   seconds since the manager started (steady clock, so differences
-//                   are durations; negative for events before a restart, converted
-//                   through the wall clock); null until the event happened,
-//    "created_at":  wall-clock submit time, ISO-8601 UTC ("2024-05-01T12:00:00.123Z"),
-//    "status":      the inner HTTP status once done or failed, else null,
-//    "error":       the failure's message once failed, else null,
-//    "cancel_requested": true once DELETE (or Shutdown, without a store) asked the
-//                   job to stop,
-//    "resumes":     times the job was re-queued because the server died while it ran,
-//    "expires_in_s": seconds until a finished job's result is dropped (at most;
-//                   count eviction may drop it sooner), null while unfinished}
+// JobManager: the jobs of one server process (api::JobService), run in a
+// bounded worker pool, optionally kept in a JobStore (SQLite) so that they
+// survive a restart. The job JSON and the handlers' contract are in
+// api/job_service.hpp; replicas that share jobs use PostgresJobService
+// (server/jobs/postgres_job_service.hpp) instead.
 //
 // Persistence (optional, JobPersistence::store): every state change is saved before it is visible
 // (submit, start, finish, cancel, delete, eviction), so jobs and results survive a restart. At
@@ -51,31 +31,17 @@
 #include <unordered_map>
 #include <vector>
 
-#include "api/job_store.hpp"
+#include "api/job_service.hpp"
 #include "api/response.hpp"
 #include "api/router.hpp"
 #include "core/progress.hpp"
+#include "server/jobs/job_common.hpp"
+#include "server/jobs/job_store.hpp"
 
-namespace sweetspot::api {
+namespace sweetspot::server {
 
-/// Limits of a JobManager, with their defaults.
-struct JobConfig {
-  int workers = 2;                 ///< Threads running jobs, in [1, 64].
-  std::size_t max_queued = 64;     ///< Queued (not yet running) jobs; beyond: 429, [1, 1e6].
-  std::size_t max_kept = 1000;     ///< Finished jobs kept, oldest finished dropped first, [1, 1e6].
-  double keep_results_s = 3600.0;  ///< How long a finished job is kept after it finished, s (> 0).
-  int max_resumes = 2;  ///< Times a job the server died under is re-queued at start-up, [0, 100].
-
-  /// True when every field is in range; otherwise "field = value: rule" in *why (if non-null).
-  bool IsValid(std::string* why) const;
-};
-
-/// Runs one inner request. Called on a worker thread, concurrently with other
-/// calls (must be thread-safe). Long work polls progress->Cancelled() and
-/// returns soon after it turns true (its result is then discarded), and may
-/// call progress->Report(fraction). A 2xx response makes the job done, any
-/// other status failed; an exception makes it failed with "internal error".
-using JobRunner = std::function<Response(const Request& inner, core::Progress* progress)>;
+/// Runs one inner request (see api/job_service.hpp).
+using JobRunner = api::JobRunner;
 
 /// Where a JobManager keeps its jobs across restarts. Default: nowhere (memory only).
 struct JobPersistence {
@@ -89,7 +55,7 @@ struct JobPersistence {
 /// Queues, runs, reports and cancels jobs. Thread-safe; owns its worker
 /// threads; no globals. Finished jobs are dropped lazily (checked on every
 /// call) once older than keep_results_s or beyond max_kept; a dropped id 404s.
-class JobManager {
+class JobManager final : public ServerJobService {
  public:
   /// Loads the jobs kept in persistence.store (if any; see the file comment),
   /// then starts config.workers threads. Throws std::invalid_argument when
@@ -103,26 +69,29 @@ class JobManager {
 
   /// Queues `inner`: 202 with the job's JSON (state "queued"); 429 "TooBusy"
   /// when max_queued jobs already wait; 503 "ShuttingDown" after Shutdown().
-  Response Submit(const Request& inner);
+  api::Response Submit(const api::Request& inner) override;
 
   /// 200 with the job's JSON; 404 "NotFound" for an unknown (or dropped) id.
-  Response Status(const std::string& id) const;
+  api::Response Status(const std::string& id) const override;
+
+  /// 200 with {"jobs": [...]}: every kept job, oldest submitted first.
+  api::Response List() const override;
 
   /// The job's result. done or failed: the inner response verbatim (status,
   /// body, text, content type); a runner that threw gives 500 "InternalError".
   /// queued or running: 409 "NotReady"; cancelled: 409 "Cancelled"; unknown: 404.
-  Response Result(const std::string& id) const;
+  api::Response Result(const std::string& id) const override;
 
   /// DELETE. queued: cancelled at once, 200 with the job (state "cancelled").
   /// running: asks the runner to stop (Progress::Cancel()), 202 with the job
   /// (state still "running", "cancel_requested": true); it turns "cancelled"
   /// when the runner returns. done/failed/cancelled: the job is deleted, 200
   /// with its last JSON plus "deleted": true (its id then 404s). Unknown: 404.
-  Response Cancel(const std::string& id);
+  api::Response Cancel(const std::string& id) override;
 
   /// Number of jobs in each state; always has the keys queued, running, done,
   /// failed and cancelled (for the Prometheus gauge).
-  std::map<std::string, int> CountsByState() const;
+  std::map<std::string, int> CountsByState() const override;
 
   /// Shutdown(0): stops at once.
   void Shutdown();
@@ -134,11 +103,11 @@ class JobManager {
   /// interrupted jobs are kept as "queued" for the next start; without one they
   /// are cancelled. Idempotent (later calls wait for the first); jobs stay
   /// readable afterwards.
-  void Shutdown(double grace_s);
+  void Shutdown(double grace_s) override;
 
   /// Ends a running Shutdown's grace period now (e.g. on a second SIGTERM).
   /// Harmless before or after Shutdown.
-  void EndGrace();
+  void EndGrace() override;
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -182,4 +151,4 @@ class JobManager {
   std::vector<std::thread> workers_;
 };
 
-}  // namespace sweetspot::api
+}  // namespace sweetspot::server

@@ -3,7 +3,7 @@
 // how Shutdown's grace period ends. The store here is an in-memory fake; the
 // SQLite store has its own tests (tests/server/sqlite_job_store_test.cpp) and
 // the real restart is tested with the server process (tests/server/jobs_restart_test.cpp).
-#include "api/job_store.hpp"
+#include "server/jobs/job_store.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,10 +19,14 @@
 #include <thread>
 #include <vector>
 
-#include "api/jobs.hpp"
+#include "server/jobs/job_manager.hpp"
 
-namespace sweetspot::api {
+namespace sweetspot::server {
 namespace {
+
+using api::Request;
+using api::Response;
+
 
 using std::chrono::milliseconds;
 using Clock = std::chrono::steady_clock;
@@ -771,4 +775,4 @@ TEST(JobStoreTest, WithoutAStoreShutdownStillCancelsWhatIsLeft) {
 }
 
 }  // namespace
-}  // namespace sweetspot::api
+}  // namespace sweetspot::server

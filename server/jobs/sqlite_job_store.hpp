@@ -1,10 +1,10 @@
-// api::JobStore in an embedded SQLite database: the service's jobs and their
+// JobStore in an embedded SQLite database: the service's jobs and their
 // results survive a restart (and a crash: every Save is committed before it
 // returns). Lives in the server layer because it is I/O against a system
-// library, like httplib; the api layer only sees the JobStore interface.
+// library, like httplib; JobManager only sees the JobStore interface.
 //
 // The database: one table `jobs` (one row per job, the columns of
-// api::JobRecord), schema version in PRAGMA user_version (kSchemaVersion; a
+// JobRecord), schema version in PRAGMA user_version (kSchemaVersion; a
 // newer version is refused, never rewritten). WAL journal with
 // synchronous=NORMAL: a commit survives the process being killed (SIGKILL, a
 // crash), though the last commits may be lost on a power failure. Exclusive
@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "api/job_store.hpp"
+#include "server/jobs/job_store.hpp"
 
 struct sqlite3;
 struct sqlite3_stmt;
@@ -36,7 +36,7 @@ struct SqliteJobStoreOptions {
 
 /// A JobStore in one SQLite database file. Thread-safe: one connection,
 /// serialized by a mutex, with prepared statements.
-class SqliteJobStore final : public api::JobStore {
+class SqliteJobStore final : public JobStore {
  public:
   /// The schema this code writes (PRAGMA user_version).
   static constexpr int kSchemaVersion = 1;
@@ -55,11 +55,11 @@ class SqliteJobStore final : public api::JobStore {
   SqliteJobStore& operator=(const SqliteJobStore&) = delete;
 
   /// INSERT OR REPLACE of the record; committed when it returns true.
-  bool Save(const api::JobRecord& record, std::string* error) override;
+  bool Save(const JobRecord& record, std::string* error) override;
   /// DELETE by id; true also when there was no such row.
   bool Delete(const std::string& id, std::string* error) override;
   /// Every row, ordered by created_unix_s then id.
-  bool LoadAll(std::vector<api::JobRecord>* records, std::string* error) override;
+  bool LoadAll(std::vector<JobRecord>* records, std::string* error) override;
 
  private:
   explicit SqliteJobStore(std::string path);

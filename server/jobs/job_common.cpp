@@ -1,0 +1,154 @@
+#include "server/jobs/job_common.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <sstream>
+
+#include "api/json_reader.hpp"
+
+namespace sweetspot::server {
+namespace {
+
+constexpr int kMaxWorkers = 64;
+constexpr std::size_t kMaxQueuedLimit = 1000000;
+constexpr std::size_t kMaxKeptLimit = 1000000;
+constexpr int kMaxResumesLimit = 100;
+constexpr double kMaxLeaseS = 3600.0;
+constexpr std::size_t kMinResultBytes = 1024;
+constexpr std::size_t kMaxResultBytes = 1000000000;  // A PostgreSQL text value holds up to 1 GB.
+
+// Seconds rounded to microseconds (keeps the JSON short).
+double RoundedSeconds(double seconds) { return std::round(seconds * 1e6) / 1e6; }
+
+nlohmann::json OptionalSeconds(const std::optional<double>& seconds) {
+  return seconds ? nlohmann::json(RoundedSeconds(*seconds)) : nlohmann::json();
+}
+
+}  // namespace
+
+bool JobConfig::IsValid(std::string* why) const {
+  auto fail = [why](const std::string& text) {
+    if (why != nullptr) *why = text;
+    return false;
+  };
+  if (workers < 1 || workers > kMaxWorkers) {
+    return fail("workers = " + std::to_string(workers) + ": must be in [1, " +
+                std::to_string(kMaxWorkers) + "]");
+  }
+  if (max_queued < 1 || max_queued > kMaxQueuedLimit) {
+    return fail("max_queued = " + std::to_string(max_queued) + ": must be in [1, " +
+                std::to_string(kMaxQueuedLimit) + "]");
+  }
+  if (max_kept < 1 || max_kept > kMaxKeptLimit) {
+    return fail("max_kept = " + std::to_string(max_kept) + ": must be in [1, " +
+                std::to_string(kMaxKeptLimit) + "]");
+  }
+  if (!std::isfinite(keep_results_s) || keep_results_s <= 0) {
+    std::ostringstream text;
+    text << "keep_results_s = " << keep_results_s << ": must be finite and > 0";
+    return fail(text.str());
+  }
+  if (max_resumes < 0 || max_resumes > kMaxResumesLimit) {
+    return fail("max_resumes = " + std::to_string(max_resumes) + ": must be in [0, " +
+                std::to_string(kMaxResumesLimit) + "]");
+  }
+  if (!std::isfinite(lease_s) || lease_s < 1 || lease_s > kMaxLeaseS) {
+    std::ostringstream text;
+    text << "lease_s = " << lease_s << ": must be in [1, " << kMaxLeaseS << "]";
+    return fail(text.str());
+  }
+  if (max_result_bytes < kMinResultBytes || max_result_bytes > kMaxResultBytes) {
+    return fail("max_result_bytes = " + std::to_string(max_result_bytes) + ": must be in [" +
+                std::to_string(kMinResultBytes) + ", " + std::to_string(kMaxResultBytes) + "]");
+  }
+  return true;
+}
+
+nlohmann::json JobJson(const JobView& job) {
+  return nlohmann::json{
+      {"id", job.id},
+      {"state", job.state},
+      {"progress", job.progress},
+      {"path", job.path},
+      {"created_s", RoundedSeconds(job.created_s)},
+      {"started_s", OptionalSeconds(job.started_s)},
+      {"finished_s", OptionalSeconds(job.finished_s)},
+      {"created_at", job.created_at},
+      {"status", job.status ? nlohmann::json(*job.status) : nlohmann::json()},
+      {"error", job.error ? nlohmann::json(*job.error) : nlohmann::json()},
+      {"cancel_requested", job.cancel_requested},
+      {"resumes", job.resumes},
+      {"expires_in_s", job.expires_in_s ? nlohmann::json(RoundedSeconds(std::max(0.0, *job.expires_in_s)))
+                                        : nlohmann::json()},
+  };
+}
+
+std::string QuoteJobId(const std::string& id) { return api::Show(nlohmann::json(id)); }
+
+api::Response JobNotFound(const std::string& id) {
+  return api::ToResponse(api::ApiError{404, "NotFound", "no job with id " + QuoteJobId(id), ""});
+}
+
+api::Response JobNotReady(const std::string& id, const std::string& state) {
+  return api::ToResponse(api::ApiError{409, "NotReady",
+                                       "job " + QuoteJobId(id) + " is " + state +
+                                           ": its result is ready once its state is done or failed",
+                                       ""});
+}
+
+api::Response JobWasCancelled(const std::string& id) {
+  return api::ToResponse(api::ApiError{
+      409, "Cancelled", "job " + QuoteJobId(id) + " was cancelled: it has no result", ""});
+}
+
+std::string InterruptedMessage(const std::string& resumes, int max_resumes) {
+  return "interrupted by a server restart: the job was running when the server "
+         "died, and it had already been resumed " +
+         resumes + " times (limit max_resumes = " + std::to_string(max_resumes) + ")";
+}
+
+api::Response JobInterrupted(int resumes, int max_resumes, std::string* message) {
+  *message = InterruptedMessage(std::to_string(resumes), max_resumes);
+  return api::ToResponse(api::ApiError{503, "Interrupted", *message, ""});
+}
+
+std::string IsoUtc(std::chrono::system_clock::time_point time) {
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(time.time_since_epoch());
+  const std::time_t seconds = static_cast<std::time_t>(ms.count() / 1000);
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  char date[32];
+  std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%S", &utc);
+  char text[48];
+  std::snprintf(text, sizeof(text), "%s.%03dZ", date, static_cast<int>(ms.count() % 1000));
+  return text;
+}
+
+std::string SerializeJobBody(const nlohmann::json& body) {
+  return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+std::string FailureMessage(const api::Response& response) {
+  if (response.body.is_object()) {
+    const auto it = response.body.find("message");
+    if (it != response.body.end() && it->is_string()) return it->get<std::string>();
+  }
+  return "the request failed with HTTP status " + std::to_string(response.status);
+}
+
+std::mt19937_64 SeededEngine() {
+  std::random_device device;
+  std::seed_seq seed{device(), device(), device(), device(),
+                     device(), device(), device(), device()};
+  return std::mt19937_64(seed);
+}
+
+std::string NewJobId(std::mt19937_64& random) {
+  char text[33];
+  std::snprintf(text, sizeof(text), "%016llx%016llx", static_cast<unsigned long long>(random()),
+                static_cast<unsigned long long>(random()));
+  return text;
+}
+
+}  // namespace sweetspot::server

@@ -1,0 +1,97 @@
+// What both job services share (JobManager in one process, PostgresJobService
+// across replicas): their limits (JobConfig), the job's JSON and the answers
+// for unknown, unfinished and cancelled jobs, ids, and the time formats.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstddef>
+#include <optional>
+#include <random>
+#include <string>
+
+#include "api/job_service.hpp"
+#include "api/response.hpp"
+
+namespace sweetspot::server {
+
+/// Limits of the job services, with their defaults.
+struct JobConfig {
+  int workers = 2;                 ///< Threads running jobs (per replica), in [1, 64].
+  std::size_t max_queued = 64;     ///< Queued (not yet running) jobs; beyond: 429, [1, 1e6].
+  std::size_t max_kept = 1000;     ///< Finished jobs kept, oldest finished dropped first, [1, 1e6].
+  double keep_results_s = 3600.0;  ///< How long a finished job is kept after it finished, s (> 0).
+  /// Times a job whose server died under it is run again, [0, 100]: at start-up
+  /// (one process), or once its lease expires (PostgreSQL).
+  int max_resumes = 2;
+  /// PostgreSQL: how long a running job's claim lasts without renewal, s, [1, 3600]. The
+  /// replica running it renews it every lease_s / 4 (at most every 0.5 s); a replica that
+  /// died leaves its jobs to the others after this long.
+  double lease_s = 10.0;
+  /// PostgreSQL: the largest result stored, bytes, [1024, 1e9] (a text column holds up to
+  /// 1 GB). A larger result makes the job failed (status 507, code TooBig) with its size in
+  /// the message: never truncated.
+  std::size_t max_result_bytes = 256u << 20;
+
+  /// True when every field is in range; otherwise "field = value: rule" in *why (if non-null).
+  bool IsValid(std::string* why) const;
+};
+
+/// A job service the server owns: the api's calls plus the server's stop.
+class ServerJobService : public api::JobService {
+ public:
+  /// Stops accepting jobs (503 ShuttingDown) and starting queued ones; waits up
+  /// to `grace_s` seconds (or until EndGrace()) for the running jobs to finish,
+  /// then asks the rest to stop and joins the workers. Idempotent.
+  virtual void Shutdown(double grace_s) = 0;
+  /// Ends a running Shutdown's grace period now (e.g. on a second SIGTERM).
+  virtual void EndGrace() = 0;
+};
+
+/// The fields of a job's JSON (api/job_service.hpp) as values.
+struct JobView {
+  std::string id;                        ///< 32 hex digits.
+  std::string state;                     ///< "queued", "running", "done", "failed", "cancelled".
+  double progress = 0.0;                 ///< 0..1.
+  std::string path;                      ///< The inner request's path.
+  double created_s = 0.0;                ///< Submit time, s since this process started.
+  std::optional<double> started_s;       ///< Start, s since this process started.
+  std::optional<double> finished_s;      ///< Finish, s since this process started.
+  std::string created_at;                ///< Submit time, ISO-8601 UTC.
+  std::optional<int> status;             ///< Inner status once done or failed.
+  std::optional<std::string> error;      ///< Failure message once failed.
+  bool cancel_requested = false;         ///< DELETE asked it to stop.
+  int resumes = 0;                       ///< Times it was run again after its server died.
+  std::optional<double> expires_in_s;    ///< Until a finished job is dropped, s.
+};
+
+/// The job's JSON (api/job_service.hpp); times rounded to microseconds.
+nlohmann::json JobJson(const JobView& job);
+
+/// 404 NotFound "no job with id ...".
+api::Response JobNotFound(const std::string& id);
+/// 409 NotReady for a queued or running job's result.
+api::Response JobNotReady(const std::string& id, const std::string& state);
+/// 409 Cancelled for a cancelled job's result.
+api::Response JobWasCancelled(const std::string& id);
+/// 503 Interrupted: the job's server died under it more than max_resumes times;
+/// its message in *message.
+api::Response JobInterrupted(int resumes, int max_resumes, std::string* message);
+/// The message of JobInterrupted with `resumes` spelled as given (e.g. "%s" for a template).
+std::string InterruptedMessage(const std::string& resumes, int max_resumes);
+
+/// The quoted id for messages ("\"abc\"", cut when long, control characters escaped).
+std::string QuoteJobId(const std::string& id);
+/// "2024-05-01T12:00:00.123Z".
+std::string IsoUtc(std::chrono::system_clock::time_point time);
+/// A JSON body serialised for a store; never throws (invalid UTF-8 is replaced).
+std::string SerializeJobBody(const nlohmann::json& body);
+/// The failure's message of an inner response: its "message", else its status.
+std::string FailureMessage(const api::Response& response);
+/// An engine seeded from std::random_device with 256 bits.
+std::mt19937_64 SeededEngine();
+/// A new id: 32 lowercase hex digits (128 random bits).
+std::string NewJobId(std::mt19937_64& random);
+
+}  // namespace sweetspot::server
