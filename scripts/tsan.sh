@@ -10,7 +10,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs="${SWEETSPOT_JOBS:-$(nproc)}"
-filter="${SWEETSPOT_TSAN_FILTER:-Job*:*Concurrent*:ServerTest.*:ServerLimits*:ExploreStream*:FaultsTest.*:ServingTest.ConnectionsPast*:ServingTest.IdleKeepAlive*}"
+filter="${SWEETSPOT_TSAN_FILTER:-Job*:*Concurrent*:ServerTest.*:ServerLimits*:ExploreStream*:FaultsTest.*:ServingTest.ConnectionsPast*:ServingTest.IdleKeepAlive*:PostgresJobsTest.*}"
 build=build-tsan
 
 echo "== ThreadSanitizer build in $build/" >&2

@@ -533,6 +533,10 @@ bool PostgresJobService::Impl::ClaimAndRun() {
     }
     --busy;
   }
+  if (!saved) {
+    Report("job " + job->id + " finished while the database was away: its result is kept "
+           "here until it can be committed");
+  }
   idle_cv.notify_all();
   return true;
 }
@@ -596,6 +600,7 @@ void PostgresJobService::Impl::HeartbeatLoop() {
       if (unsaved && !job->lost) {
         PgResult ignored(nullptr, &PQclear);
         if (!Query(unsaved->first, unsaved->second, &ignored)) break;
+        Report("job " + job->id + " committed");
       }
       if (unsaved || job->lost) {
         std::lock_guard erase_lock(mutex);

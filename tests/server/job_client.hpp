@@ -1,0 +1,107 @@
+// What the job tests share: a slow and a quick jobbable request, and a small
+// HTTP client for the real sweetspot-server (submit, poll, read results).
+#pragma once
+
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstddef>
+#include <string>
+#include <thread>
+
+#include "tests/server/server_process.hpp"
+
+namespace sweetspot::testing::jobs {
+
+using Json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+// How long a test waits for something that must happen (a job to reach a
+// state, a request to be in flight). Only reached when the code is broken: the
+// slowest step, the sweep below under ASan on a loaded 2-core machine, takes a
+// few seconds; a passing Release run needs about one.
+inline constexpr auto kMustHappen = std::chrono::seconds(120);
+
+// A slow request with a small answer: 400 designs, each a Hertz-contact exit
+// speed maximised by NLopt (~1.5 ms each in Release, so ~0.6 s; several times
+// that under sanitizers), checking its cancel flag between designs. Its
+// numbers are deterministic, so running it again gives the same rows.
+inline const char* const kSlowSweep = R"({
+  "bat": {"preset": "paper-wood",
+          "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
+  "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 20},
+                 {"path": "fill.diameter_m", "min": 0.01, "max": 0.03, "count": 20}],
+  "outputs": ["max_exit_speed"],
+  "options": {"model": "hertz"}})";
+inline constexpr std::size_t kSlowSweepRows = 400;
+
+// A quick job's inner request.
+inline const char* const kQuick = R"({"bat": {"preset": "paper-wood"}})";
+
+// A client with time-outs far above the slowest answer here (the sweep).
+inline httplib::Client ClientOf(ServerProcess& server) {
+  httplib::Client client("127.0.0.1", server.port());
+  client.set_read_timeout(std::chrono::seconds(120));
+  client.set_write_timeout(std::chrono::seconds(120));
+  return client;
+}
+
+struct Answer {
+  int status = 0;  // 0: no answer (connection failed).
+  Json body;
+};
+
+inline Answer Parse(const httplib::Result& result) {
+  if (!result) return {};
+  return {result->status, Json::parse(result->body, nullptr, false)};
+}
+
+inline Answer Get(ServerProcess& server, const std::string& path) {
+  return Parse(ClientOf(server).Get(path.c_str()));
+}
+
+inline Answer Delete(ServerProcess& server, const std::string& path) {
+  return Parse(ClientOf(server).Delete(path.c_str()));
+}
+
+inline Answer PostJson(ServerProcess& server, const std::string& path, const std::string& body) {
+  return Parse(ClientOf(server).Post(path.c_str(), body, "application/json"));
+}
+
+// Submits `inner` (JSON text) to `path` as a job; returns its id ("" on failure).
+inline std::string SubmitJob(ServerProcess& server, const std::string& path,
+                      const std::string& inner) {
+  const Answer answer =
+      PostJson(server, "/v1/jobs", R"({"path": ")" + path + R"(", "body": )" + inner + "}");
+  EXPECT_EQ(answer.status, 202) << answer.body.dump();
+  return answer.body.value("id", "");
+}
+
+// Polls GET /v1/jobs/{id} until its state is `state` (at most kMustHappen).
+inline Json WaitForState(ServerProcess& server, const std::string& id, const std::string& state) {
+  const auto deadline = Clock::now() + kMustHappen;
+  Answer answer = Get(server, "/v1/jobs/" + id);
+  while (answer.status == 200 && answer.body["state"] != state && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    answer = Get(server, "/v1/jobs/" + id);
+  }
+  EXPECT_EQ(answer.status, 200) << answer.body.dump();
+  EXPECT_EQ(answer.body["state"], state) << answer.body.dump();
+  return answer.body;
+}
+
+// Removes the keys that measure time ("timing_s", "solve_time_s") at any depth.
+inline Json WithoutTimings(Json json) {
+  if (json.is_object()) {
+    json.erase("timing_s");
+    json.erase("solve_time_s");
+    for (auto& [key, value] : json.items()) value = WithoutTimings(value);
+  } else if (json.is_array()) {
+    for (Json& value : json) value = WithoutTimings(value);
+  }
+  return json;
+}
+
+
+}  // namespace sweetspot::testing::jobs
