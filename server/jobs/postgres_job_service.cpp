@@ -509,13 +509,16 @@ bool PostgresJobService::Impl::ClaimAndRun() {
       text.clear();
       content_type.clear();
     }
+    // Any owner: a finished result stands even if the lease ran out meanwhile
+    // (the database was away) and another replica took the job again; that
+    // replica stops it at its next renewal.
     finish.emplace(
-        "UPDATE sweetspot_jobs SET state = CASE WHEN cancel_requested THEN 'cancelled' ELSE $3 "
-        "END, progress = CASE WHEN cancel_requested THEN $4::double precision ELSE $5 END, "
-        "status = $6, response_json = $7, response_text = $8, content_type = $9, error = $10, "
+        "UPDATE sweetspot_jobs SET state = CASE WHEN cancel_requested THEN 'cancelled' ELSE $2 "
+        "END, progress = CASE WHEN cancel_requested THEN $3::double precision ELSE $4 END, "
+        "status = $5, response_json = $6, response_text = $7, content_type = $8, error = $9, "
         "body = '', finished_unix_s = " SWEETSPOT_NOW
-        ", lease_owner = NULL, lease_expires_unix_s = NULL" + where,
-        std::vector<Param>{job->id, owner, state, Decimal(job->progress.Fraction()),
+        ", lease_owner = NULL, lease_expires_unix_s = NULL WHERE id = $1 AND state = 'running'",
+        std::vector<Param>{job->id, state, Decimal(job->progress.Fraction()),
                            state == "done" ? "1" : Decimal(job->progress.Fraction()),
                            std::to_string(response.status), std::move(json), std::move(text),
                            std::move(content_type), std::move(error)});

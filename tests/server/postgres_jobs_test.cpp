@@ -247,8 +247,10 @@ TEST_F(PostgresJobsTest, ANewerSchemaIsRefusedWithTheReason) {
 }
 
 TEST_F(PostgresJobsTest, DatabaseStoppedAndRestartedUnderLoadLosesNothing) {
-  auto a = Replica({"--job-workers", "2"});
-  auto b = Replica({"--job-workers", "2"});
+  // Leases of 60 s outlast the outage even under sanitizers (about 15 s there):
+  // a job whose lease ran out would be run again by the other replica.
+  auto a = Replica({"--job-workers", "2", "--job-lease-s", "60"});
+  auto b = Replica({"--job-workers", "2", "--job-lease-s", "60"});
   // A job that runs while the database goes away: it finishes, and its result
   // is committed once the database is back.
   const std::string long_id = SubmitJob(*a, "/v1/explore", kLongSweep);

@@ -32,7 +32,9 @@ class ServerProcess {
   /// Returns false on failure.
   bool Start(std::vector<std::string> args = {}) {
     int fds[2];
-    if (pipe(fds) != 0) return false;
+    // Close-on-exec: a server started at the same time from another thread must
+    // not inherit this pipe, or its reader would wait for that server's exit too.
+    if (pipe2(fds, O_CLOEXEC) != 0) return false;
     const std::string binary = std::string(SWEETSPOT_BINARY_DIR) + "/server/sweetspot-server";
     bool names_jobs_db = false;
     for (const std::string& arg : args) names_jobs_db |= arg.rfind("--jobs-db", 0) == 0;
