@@ -1,6 +1,7 @@
 #include "server/jobs/postgres_job_service.hpp"
 
 #include <libpq-fe.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <functional>
 #include <condition_variable>
+#include <cstdint>
 #include <cstdlib>
 #include <mutex>
 #include <optional>
@@ -209,16 +211,8 @@ class Connections {
     return ok;
   }
 
- private:
-  PGconn* Take(std::string* error) {
-    {
-      std::lock_guard lock(mutex_);
-      if (!idle_.empty()) {
-        PGconn* connection = idle_.back();
-        idle_.pop_back();
-        return connection;
-      }
-    }
+  // A new connection of its own (not pooled; PQfinish it), or null with *error.
+  PGconn* Connect(std::string* error) const {
     // The URI's own settings win over these defaults (later keywords override).
     const char* keys[] = {"connect_timeout", "keepalives_idle", "keepalives_interval",
                           "keepalives_count", "application_name", "dbname", nullptr};
@@ -232,6 +226,19 @@ class Connections {
     // "relation ... already exists, skipping" and the like are not worth a log line.
     PQsetNoticeProcessor(connection, IgnoreNotice, nullptr);
     return connection;
+  }
+
+ private:
+  PGconn* Take(std::string* error) {
+    {
+      std::lock_guard lock(mutex_);
+      if (!idle_.empty()) {
+        PGconn* connection = idle_.back();
+        idle_.pop_back();
+        return connection;
+      }
+    }
+    return Connect(error);
   }
 
   void Give(PGconn* connection) {
@@ -283,6 +290,8 @@ struct PostgresJobService::Impl {
         random(SeededEngine()) {}
 
   bool Migrate(std::string* error);
+  void Wake();
+  void ListenLoop();
   void WorkerLoop();
   bool ClaimAndRun();
   void HeartbeatLoop();
@@ -301,7 +310,10 @@ struct PostgresJobService::Impl {
   const double wall_start_unix_s;  // The wall clock when this replica started, s.
 
   mutable std::mutex mutex;
-  std::condition_variable work_cv;   // Submit here, or stopping.
+  std::condition_variable work_cv;   // `wakeups` moved, or stopping.
+  std::uint64_t wakeups = 0;         // Bumped by a submit here or a NOTIFY from a replica.
+  std::atomic<bool> listen_stop{false};  // Ends ListenLoop.
+  std::thread listener;
   std::condition_variable idle_cv;   // A runner returned, or the grace ended.
   std::condition_variable beat_cv;   // The heartbeat must stop.
   std::map<std::string, std::shared_ptr<Running>> running;  // Claimed here, not yet committed.
@@ -402,15 +414,74 @@ JobView PostgresJobService::Impl::ViewOf(const PGresult* result, int row) const 
   return view;
 }
 
+void PostgresJobService::Impl::Wake() {
+  {
+    std::lock_guard lock(mutex);
+    ++wakeups;
+  }
+  work_cv.notify_all();
+}
+
+void PostgresJobService::Impl::ListenLoop() {
+  // Another replica's submit wakes this replica's idle workers at once (LISTEN /
+  // NOTIFY); without it they would find the job at their next poll.
+  PGconn* connection = nullptr;
+  while (!listen_stop) {
+    if (connection == nullptr) {
+      std::string ignored;
+      connection = db.Connect(&ignored);
+      if (connection != nullptr) {
+        PgResult listening(PQexec(connection, "LISTEN sweetspot_jobs; LISTEN sweetspot_cancel"),
+                           &PQclear);
+        if (!listening || PQresultStatus(listening.get()) != PGRES_COMMAND_OK) {
+          PQfinish(connection);
+          connection = nullptr;
+        }
+      }
+      if (connection == nullptr) {  // Away: the workers poll meanwhile.
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        continue;
+      }
+      Wake();  // Jobs may have been queued while it was away.
+    }
+    pollfd ready{PQsocket(connection), POLLIN, 0};
+    if (poll(&ready, 1, 200) < 0 || !PQconsumeInput(connection)) {
+      PQfinish(connection);
+      connection = nullptr;
+      continue;
+    }
+    bool notified = false;
+    while (PGnotify* notice = PQnotifies(connection)) {
+      if (std::string(notice->relname) == "sweetspot_cancel") {
+        // A DELETE on some replica: stop the job now if it runs here (the next
+        // lease renewal would see the flag too, within 0.5 s).
+        std::lock_guard lock(mutex);
+        const auto it = running.find(notice->extra);
+        if (it != running.end()) {
+          it->second->cancel_requested = true;
+          it->second->progress.Cancel();
+        }
+      } else {
+        notified = true;
+      }
+      PQfreemem(notice);
+    }
+    if (notified) Wake();
+  }
+  PQfinish(connection);
+}
+
 void PostgresJobService::Impl::WorkerLoop() {
   while (true) {
+    std::uint64_t seen = 0;
     {
       std::lock_guard lock(mutex);
       if (stopping) return;
+      seen = wakeups;
     }
     if (ClaimAndRun()) continue;
     std::unique_lock lock(mutex);
-    work_cv.wait_for(lock, kPollInterval, [this] { return stopping; });
+    work_cv.wait_for(lock, kPollInterval, [&] { return stopping || wakeups != seen; });
   }
 }
 
@@ -527,6 +598,9 @@ bool PostgresJobService::Impl::ClaimAndRun() {
 
   PgResult done(nullptr, &PQclear);
   const bool saved = !finish || Query(finish->first, finish->second, &done);
+  if (saved && job->interrupted && !job->cancel_requested) {
+    Query("SELECT pg_notify('sweetspot_jobs', '')", {}, &done);  // Queued again: tell the others.
+  }
   {
     std::lock_guard lock(mutex);
     if (saved) {
@@ -639,6 +713,7 @@ std::unique_ptr<PostgresJobService> PostgresJobService::Open(
   Impl& self = *service->impl_;
   for (int i = 0; i < config.workers; ++i) self.workers.emplace_back([&self] { self.WorkerLoop(); });
   self.heartbeat = std::thread([&self] { self.HeartbeatLoop(); });
+  self.listener = std::thread([&self] { self.ListenLoop(); });
   return service;
 }
 
@@ -691,7 +766,9 @@ api::Response PostgresJobService::Submit(const api::Request& inner) {
     }
     inserted = std::move(found);
   }
-  self.work_cv.notify_one();
+  PgResult notified(nullptr, &PQclear);  // Wakes the other replicas' idle workers.
+  self.Query("SELECT pg_notify('sweetspot_jobs', '')", {}, &notified);
+  self.Wake();
   return {202, JobJson(self.ViewOf(inserted.get(), 0))};
 }
 
@@ -771,8 +848,10 @@ api::Response PostgresJobService::Cancel(const std::string& id) {
       return Unavailable();
     }
     if (PQntuples(changed.get()) == 1) {
+      PgResult notified(nullptr, &PQclear);  // The replica running it stops it at once.
+      self.Query("SELECT pg_notify('sweetspot_cancel', $1)", {id}, &notified);
       {
-        // Running here: stop it now (other replicas see the flag at their next renewal).
+        // Running here: stop it now.
         std::lock_guard lock(self.mutex);
         const auto it = self.running.find(id);
         if (it != self.running.end()) {
@@ -847,6 +926,8 @@ void PostgresJobService::Shutdown(double grace_s) {
     }
     self.beat_cv.notify_all();
     if (self.heartbeat.joinable()) self.heartbeat.join();
+    self.listen_stop = true;
+    if (self.listener.joinable()) self.listener.join();
     std::lock_guard lock(self.mutex);
     for (const auto& [id, job] : self.running) {
       if (job->unsaved) {

@@ -6,14 +6,17 @@
 //   `SELECT ... FOR UPDATE SKIP LOCKED` (so two replicas never take the same
 //   job and never wait on each other) and holds a lease on it
 //   (JobConfig::lease_s) that its replica renews every lease_s / 4, at most
-//   every 0.5 s, together with the job's progress.
+//   every 0.5 s, together with the job's progress. A submit wakes the idle
+//   workers of every replica (NOTIFY sweetspot_jobs, which each replica LISTENs
+//   to); besides, idle workers look for work every 0.2 s.
 // - A replica that dies (SIGKILL, lost machine) stops renewing: once the lease
 //   has expired, another replica claims the job again and runs it from the start
 //   (safe: a jobbable request is a deterministic function of its body), up to
 //   JobConfig::max_resumes times; after that the job is failed with status 503,
 //   code Interrupted.
-// - Cancel: DELETE sets cancel_requested in the database; the replica running
-//   the job sees it at its next renewal (within 0.5 s) and stops the runner.
+// - Cancel: DELETE sets cancel_requested in the database and notifies
+//   sweetspot_cancel; the replica running the job stops its runner on the
+//   notice, or at its next renewal (within 0.5 s) if the notice was lost.
 // - Schema: created and migrated by the server at start, inside a transaction
 //   holding a PostgreSQL advisory lock, so replicas starting at once apply each
 //   migration once; versions are rows of sweetspot_schema_migrations. A
