@@ -9,8 +9,8 @@
 #include <thread>
 #include <utility>
 
-#include "api/jobs.hpp"
 #include "api/router.hpp"
+#include "server/jobs/job_manager.hpp"
 
 namespace sweetspot::hard_cases {
 namespace {
@@ -23,8 +23,8 @@ bool TerminationMatches(const std::string& required, const std::string& actual) 
 }
 
 // The job manager of as_job rows: two workers running the router, as the server does.
-api::JobManager& Jobs() {
-  static api::JobManager manager(api::JobConfig{},
+server::JobManager& Jobs() {
+  static server::JobManager manager(server::JobConfig{},
                                  [](const api::Request& inner, core::Progress* progress) {
                                    api::Context context;
                                    context.progress = progress;
