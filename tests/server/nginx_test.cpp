@@ -5,9 +5,11 @@
 // Checked: a streamed explore arrives in chunks as the rows are computed (not
 // held in nginx's buffers), a client trickling its head is cut off at nginx's
 // 10 s head deadline, a 2 MiB body is refused with 413, and requests are
-// shared by both replicas.
+// shared by both replicas. And the issue's round robin of jobs: with both
+// replicas on one PostgreSQL, a job posted through nginx is found by every read.
 #include <gtest/gtest.h>
 #include <httplib.h>
+#include <nlohmann/json.hpp>
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -22,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "tests/server/postgres_cluster.hpp"
 #include "tests/server/server_process.hpp"
 #include "tests/server/wire.hpp"
 
@@ -243,6 +246,42 @@ TEST_F(NginxTest, TwoMebibyteBodyIsRefusedWith413AndRequestsReachBothReplicas) {
     const auto at = metrics->body.find(series);
     ASSERT_NE(at, std::string::npos) << "replica on port " << port << " got no request";
     EXPECT_GE(std::stoi(metrics->body.substr(at + series.size())), 5) << port;
+  }
+}
+
+TEST(NginxJobsTest, AJobPostedThroughTheProxyIsFoundOnEveryReadWithPostgres) {
+  // The issue's reproduction: two replicas behind nginx's round robin, a job
+  // posted through nginx, then GET /v1/jobs/{id} six times through nginx. With
+  // a SQLite file per replica the reads went 404 200 404 200 404 200.
+  PostgresCluster cluster;
+  ASSERT_TRUE(cluster.Start()) << cluster.why();
+  ServerProcess first, second;
+  ASSERT_TRUE(first.Start({"--no-access-log", "--jobs-db", cluster.Uri()})) << first.log();
+  ASSERT_TRUE(second.Start({"--no-access-log", "--jobs-db", cluster.Uri()})) << second.log();
+  Nginx nginx;
+  ASSERT_TRUE(nginx.Start({first.port(), second.port()})) << nginx.error();
+  httplib::Client client("127.0.0.1", nginx.port());
+  const auto posted = client.Post(
+      "/v1/jobs", R"({"path": "/v1/bat/properties", "body": {"bat": {"preset": "paper-wood"}}})",
+      "application/json");
+  ASSERT_TRUE(posted);
+  ASSERT_EQ(posted->status, 202) << posted->body;
+  const std::string id = nlohmann::json::parse(posted->body)["id"];
+  std::string statuses;
+  for (int i = 0; i < 6; ++i) {
+    const auto read = client.Get(("/v1/jobs/" + id).c_str());
+    statuses += (i > 0 ? " " : "") + (read ? std::to_string(read->status) : std::string("none"));
+  }
+  EXPECT_EQ(statuses, "200 200 200 200 200 200");
+  // The reads reached both replicas (round robin), each of which found the job.
+  for (const int port : {first.port(), second.port()}) {
+    httplib::Client direct("127.0.0.1", port);
+    const auto metrics = direct.Get("/metrics");
+    ASSERT_TRUE(metrics);
+    EXPECT_NE(metrics->body.find(
+                  "sweetspot_requests_total{route=\"/v1/jobs/{id}\",method=\"GET\",status=\"200\"} "),
+              std::string::npos)
+        << "replica on port " << port << " answered no read";
   }
 }
 
