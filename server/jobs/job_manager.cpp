@@ -339,6 +339,20 @@ std::shared_ptr<JobManager::Job> JobManager::FindLocked(const std::string& id) c
   return it == jobs_.end() ? nullptr : it->second;
 }
 
+double JobManager::ProgressOf(const Job& job) {
+  switch (job.state) {
+    case State::kQueued:
+      return 0.0;
+    case State::kDone:
+      return 1.0;
+    case State::kRunning:
+    case State::kFailed:
+    case State::kCancelled:
+      break;
+  }
+  return job.progress.Fraction();
+}
+
 nlohmann::json JobManager::ToJsonLocked(const Job& job, Clock::time_point now) const {
   auto since_start = [this](Clock::time_point time) {
     return std::chrono::duration<double>(time - start_).count();
@@ -346,19 +360,7 @@ nlohmann::json JobManager::ToJsonLocked(const Job& job, Clock::time_point now) c
   JobView view;
   view.id = job.id;
   view.state = StateName(job.state);
-  switch (job.state) {
-    case State::kQueued:
-      view.progress = 0.0;
-      break;
-    case State::kDone:
-      view.progress = 1.0;
-      break;
-    case State::kRunning:
-    case State::kFailed:
-    case State::kCancelled:
-      view.progress = job.progress.Fraction();
-      break;
-  }
+  view.progress = ProgressOf(job);
   view.path = job.path;
   view.created_s = since_start(job.created);
   if (job.started) view.started_s = since_start(*job.started);
@@ -393,19 +395,7 @@ JobRecord JobManager::RecordLocked(const Job& job) const {
   record.method = job.inner.method;
   record.path = job.path;
   record.body = job.inner.body;  // Empty once finished (the body is freed then).
-  switch (job.state) {
-    case State::kQueued:
-      record.progress = 0.0;
-      break;
-    case State::kDone:
-      record.progress = 1.0;
-      break;
-    case State::kRunning:
-    case State::kFailed:
-    case State::kCancelled:
-      record.progress = job.progress.Fraction();
-      break;
-  }
+  record.progress = ProgressOf(job);
   record.cancel_requested = job.cancel_requested;
   record.resumes = job.resumes;
   record.created_at = job.created_at;

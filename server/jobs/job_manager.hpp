@@ -115,6 +115,8 @@ class JobManager final : public ServerJobService {
   struct Job;
 
   static const char* StateName(State state);
+  // 0 while queued, 1 when done, else the runner's last report.
+  static double ProgressOf(const Job& job);
   void WorkerLoop();
   void LoadFromStore();  // Before the workers start.
   double ToUnixSeconds(Clock::time_point time) const;

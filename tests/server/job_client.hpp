@@ -36,6 +36,16 @@ inline const char* const kSlowSweep = R"({
   "options": {"model": "hertz"}})";
 inline constexpr std::size_t kSlowSweepRows = 400;
 
+// A longer sweep than kSlowSweep (1600 designs, ~2.5 s in Release): long
+// enough to be killed or cancelled while it runs, and to report progress.
+inline const char* const kLongSweep = R"({
+  "bat": {"preset": "paper-wood",
+          "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
+  "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 40},
+                 {"path": "fill.diameter_m", "min": 0.01, "max": 0.03, "count": 40}],
+  "outputs": ["max_exit_speed"],
+  "options": {"model": "hertz"}})";
+
 // A quick job's inner request.
 inline const char* const kQuick = R"({"bat": {"preset": "paper-wood"}})";
 

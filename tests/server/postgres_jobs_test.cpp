@@ -34,6 +34,7 @@ using testing::jobs::Clock;
 using testing::jobs::Delete;
 using testing::jobs::Get;
 using testing::jobs::Json;
+using testing::jobs::kLongSweep;
 using testing::jobs::kMustHappen;
 using testing::jobs::kQuick;
 using testing::jobs::kSlowSweep;
@@ -52,15 +53,6 @@ constexpr double kSlowdown = 5.0;
 constexpr double kSlowdown = 1.0;
 #endif
 
-// A longer sweep than kSlowSweep (1600 designs, ~2.5 s in Release): long
-// enough to be killed or cancelled while it runs, and to report progress.
-const char* const kLongSweep = R"({
-  "bat": {"preset": "paper-wood",
-          "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
-  "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 40},
-                 {"path": "fill.diameter_m", "min": 0.01, "max": 0.03, "count": 40}],
-  "outputs": ["max_exit_speed"],
-  "options": {"model": "hertz"}})";
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
