@@ -116,6 +116,29 @@ std::optional<double> OptionalNumber(const PGresult* result, int row, int column
   return Number(result, row, column);
 }
 
+// Runs `sql` with `params` (text; nullopt = NULL) on `connection`: true with its
+// result in *out (if non-null) when it succeeded, else false with libpq's message.
+// Without parameters `sql` may hold several statements (a migration); the result
+// is the last one's.
+bool Execute(PGconn* connection, const std::string& sql, const std::vector<Param>& params,
+             PgResult* out, std::string* error) {
+  std::vector<const char*> values;
+  values.reserve(params.size());
+  for (const Param& param : params) values.push_back(param ? param->c_str() : nullptr);
+  PgResult result(params.empty()
+                      ? PQexec(connection, sql.c_str())
+                      : PQexecParams(connection, sql.c_str(), static_cast<int>(values.size()),
+                                     nullptr, values.data(), nullptr, nullptr, 0),
+                  &PQclear);
+  const ExecStatusType status = result ? PQresultStatus(result.get()) : PGRES_FATAL_ERROR;
+  if (status != PGRES_COMMAND_OK && status != PGRES_TUPLES_OK) {
+    *error = Message(result ? PQresultErrorMessage(result.get()) : PQerrorMessage(connection));
+    return false;
+  }
+  if (out != nullptr) *out = std::move(result);
+  return true;
+}
+
 std::string Decimal(double value) {
   char text[64];
   std::snprintf(text, sizeof(text), "%.17g", value);
@@ -160,20 +183,10 @@ class Connections {
     for (int attempt = 0; attempt < 2; ++attempt) {
       PGconn* connection = Take(error);
       if (connection == nullptr) return false;
-      std::vector<const char*> values;
-      values.reserve(params.size());
-      for (const Param& param : params) values.push_back(param ? param->c_str() : nullptr);
-      PgResult result(PQexecParams(connection, sql.c_str(), static_cast<int>(values.size()),
-                                   nullptr, values.data(), nullptr, nullptr, 0),
-                      &PQclear);
-      const ExecStatusType status =
-          result ? PQresultStatus(result.get()) : PGRES_FATAL_ERROR;
-      if (status == PGRES_COMMAND_OK || status == PGRES_TUPLES_OK) {
+      if (Execute(connection, sql, params, out, error)) {
         Give(connection);
-        *out = std::move(result);
         return true;
       }
-      *error = Message(result ? PQresultErrorMessage(result.get()) : PQerrorMessage(connection));
       if (PQstatus(connection) == CONNECTION_OK) {  // An SQL error: not worth a retry.
         Give(connection);
         return false;
@@ -184,18 +197,12 @@ class Connections {
     return false;
   }
 
-  // Runs `statements` (several, no parameters) in one transaction holding the
-  // migration lock; `body` runs inside it on the same connection.
+  // Runs `body` on one connection inside a transaction (BEGIN ... COMMIT, or
+  // ROLLBACK when anything failed).
   bool Transaction(const std::function<bool(PGconn*, std::string*)>& body, std::string* error) {
     PGconn* connection = Take(error);
     if (connection == nullptr) return false;
-    auto exec = [&](const char* sql) {
-      PgResult result(PQexec(connection, sql), &PQclear);
-      const ExecStatusType status = result ? PQresultStatus(result.get()) : PGRES_FATAL_ERROR;
-      if (status == PGRES_COMMAND_OK || status == PGRES_TUPLES_OK) return true;
-      *error = Message(result ? PQresultErrorMessage(result.get()) : PQerrorMessage(connection));
-      return false;
-    };
+    auto exec = [&](const char* sql) { return Execute(connection, sql, {}, nullptr, error); };
     bool ok = exec("BEGIN") && body(connection, error) && exec("COMMIT");
     if (!ok) {
       std::string ignored = *error;
@@ -278,11 +285,10 @@ struct PostgresJobService::Impl {
 
   Impl(std::string uri_in, JobConfig config_in, api::JobRunner runner_in,
        std::function<void(const std::string&)> log_in)
-      : uri(std::move(uri_in)),
-        config(config_in),
+      : config(config_in),
         runner(std::move(runner_in)),
         log(std::move(log_in)),
-        db(uri),
+        db(std::move(uri_in)),
         owner(LeaseOwner()),
         wall_start_unix_s(std::chrono::duration<double>(
                               std::chrono::system_clock::now().time_since_epoch())
@@ -301,7 +307,6 @@ struct PostgresJobService::Impl {
   void Report(const std::string& message) const;
   JobView ViewOf(const PGresult* result, int row) const;
 
-  const std::string uri;
   const JobConfig config;
   const api::JobRunner runner;
   const std::function<void(const std::string&)> log;
@@ -347,16 +352,7 @@ bool PostgresJobService::Impl::Migrate(std::string* error) {
   return db.Transaction(
       [this](PGconn* connection, std::string* why) {
         auto exec = [&](const std::string& sql, PgResult* out = nullptr) {
-          PgResult result(PQexec(connection, sql.c_str()), &PQclear);
-          const ExecStatusType status =
-              result ? PQresultStatus(result.get()) : PGRES_FATAL_ERROR;
-          if (status != PGRES_COMMAND_OK && status != PGRES_TUPLES_OK) {
-            *why = Message(result ? PQresultErrorMessage(result.get())
-                                  : PQerrorMessage(connection));
-            return false;
-          }
-          if (out != nullptr) *out = std::move(result);
-          return true;
+          return Execute(connection, sql, {}, out, why);
         };
         PgResult current(nullptr, &PQclear);
         if (!exec("SELECT pg_advisory_xact_lock(" + std::to_string(kMigrationLockKey) + ")") ||
@@ -375,15 +371,10 @@ bool PostgresJobService::Impl::Migrate(std::string* error) {
         }
         for (int next = version + 1; next <= kSchemaVersion; ++next) {
           if (!exec(kMigrations[next - 1])) return false;
-          std::vector<const char*> values = {owner.c_str()};
-          const std::string insert = "INSERT INTO sweetspot_schema_migrations (version, applied_by) "
-                                     "VALUES (" + std::to_string(next) + ", $1)";
-          PgResult inserted(PQexecParams(connection, insert.c_str(), 1, nullptr, values.data(),
-                                         nullptr, nullptr, 0),
-                            &PQclear);
-          if (!inserted || PQresultStatus(inserted.get()) != PGRES_COMMAND_OK) {
-            *why = Message(inserted ? PQresultErrorMessage(inserted.get())
-                                    : PQerrorMessage(connection));
+          if (!Execute(connection,
+                       "INSERT INTO sweetspot_schema_migrations (version, applied_by) VALUES (" +
+                           std::to_string(next) + ", $1)",
+                       {owner}, nullptr, why)) {
             return false;
           }
           Report("applied schema migration " + std::to_string(next));
