@@ -30,7 +30,7 @@ struct JobConfig {
   /// died leaves its jobs to the others after this long.
   double lease_s = 10.0;
   /// PostgreSQL: the largest result stored, bytes, [1024, 1e9] (a text column holds up to
-  /// 1 GB). A larger result makes the job failed (status 507, code TooBig) with its size in
+  /// 1 GB). A larger result makes the job failed (status 413, code TooBig, as the contract pairs them) with its size in
   /// the message: never truncated.
   std::size_t max_result_bytes = 256u << 20;
 

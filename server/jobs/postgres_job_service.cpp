@@ -566,7 +566,7 @@ bool PostgresJobService::Impl::ClaimAndRun() {
               " bytes, more than the jobs database keeps (max_result_bytes = " +
               std::to_string(config.max_result_bytes) +
               "): ask for fewer rows or outputs, or raise --job-max-result-bytes";
-      response = api::ToResponse(api::ApiError{507, "TooBig", error, ""});
+      response = api::ToResponse(api::ApiError{413, "TooBig", error, ""});
       json = SerializeJobBody(response.body);
       text.clear();
       content_type.clear();

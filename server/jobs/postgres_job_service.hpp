@@ -26,7 +26,7 @@
 //   the next request; a job that finished while the database was away keeps
 //   its result in memory (and its lease renewed) until the commit succeeds.
 // - Results: stored whole (a text value holds up to 1 GB); one larger than
-//   JobConfig::max_result_bytes fails the job with status 507, code TooBig, and
+//   JobConfig::max_result_bytes fails the job with status 413, code TooBig, and
 //   its size in the message: never truncated.
 // - Shutdown: no new claims; running jobs get the grace period; those still
 //   running then are handed back to the queue (state queued, no resume

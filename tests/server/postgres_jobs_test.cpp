@@ -337,13 +337,13 @@ TEST_F(PostgresJobsTest, AResultOverTheLimitFailsTheJobWholeNeverTruncated) {
   // The 400-row sweep's answer is far over 4 KiB; the properties' is under it.
   const std::string big = SubmitJob(*replica, "/v1/explore", kSlowSweep);
   const Json failed = WaitForState(*replica, big, "failed");
-  EXPECT_EQ(failed["status"], 507);
+  EXPECT_EQ(failed["status"], 413);
   const std::string error = failed["error"];
   EXPECT_NE(error.find("more than the jobs database keeps (max_result_bytes = 4096)"),
             std::string::npos)
       << error;
   const Answer result = Get(*replica, "/v1/jobs/" + big + "/result");
-  EXPECT_EQ(result.status, 507);
+  EXPECT_EQ(result.status, 413);
   EXPECT_EQ(result.body["code"], "TooBig");
 
   const std::string small = SubmitJob(*replica, "/v1/bat/properties", kQuick);
