@@ -339,14 +339,19 @@ TEST(JobManagerTest, UnknownIdIs404EverywhereAndLongIdsAreCut) {
 // --- Cancellation ------------------------------------------------------------
 
 TEST(JobManagerTest, CancelRunningJobStopsItPromptly) {
-  Gate started;
+  // The runner returns once it has seen the cancel and the test has asked
+  // twice: without `asked`, a fast runner could finish between the two DELETEs
+  // (seen under ASan), and the second would delete the cancelled job.
+  Gate started, asked;
   std::atomic<bool> saw_cancel{false};
   JobManager jobs(JobConfig{}, [&](const Request& inner, core::Progress* progress) {
     started.Open();
     while (!progress->Cancelled()) std::this_thread::sleep_for(milliseconds(1));
     saw_cancel = true;
+    asked.WaitForOpen();
     return Echo(inner, progress);  // Discarded: the job was cancelled.
   });
+  OpenOnExit open_asked{asked};
   const std::string id = IdOf(jobs.Submit(Post("/v1/optimize")));
   ASSERT_TRUE(started.WaitForOpen());
 
@@ -356,6 +361,7 @@ TEST(JobManagerTest, CancelRunningJobStopsItPromptly) {
   EXPECT_EQ(cancelling.body["state"], "running");
   EXPECT_EQ(cancelling.body["cancel_requested"], true);
   EXPECT_EQ(jobs.Cancel(id).status, 202);  // Asking again changes nothing.
+  asked.Open();
 
   const Json cancelled = WaitForState(jobs, id, "cancelled");
   EXPECT_LT(Clock::now() - cancel_time, kPrompt);
