@@ -355,8 +355,10 @@ Json SceneResultToJson(const core::SceneResult& r) {
   out["models_used"] = r.summary.models_used;
   out["exit_speed_model"] = r.exit_speed_model.empty() ? Json(nullptr) : Json(r.exit_speed_model);
   if (!r.model_reason.empty()) out["model_reason"] = r.model_reason;
-  out["cor"] = r.cor;
-  out["cor_source"] = r.cor_source;
+  if (r.cor.has_value()) {  // absent when no requested output uses a COR
+    out["cor"] = *r.cor;
+    out["cor_source"] = r.cor_source;
+  }
   Json timings = Json::array();
   for (const auto& t : r.timings) {
     timings.push_back({{"model", t.model}, {"time_s", t.time_s}, {"calls", t.calls}});

@@ -61,19 +61,22 @@ class TimingBook {
 struct Resolved {
   MassProperties mp;
   double length_m = 0.0;
-  double cor = 0.0;
-  std::string cor_source;
+  std::optional<double> cor;  // unset when no wanted output needs a COR
+  std::string cor_source;     // "" when `cor` is unset
 };
 
-// Validates the scene, resolves the COR, computes (or takes) the mass properties once.
-bool Resolve(const Scene& scene, TimingBook* book, Resolved* r, Summary* s) {
+// Validates the scene, resolves the COR when `needs_cor`, computes (or takes) the mass
+// properties once.
+bool Resolve(const Scene& scene, bool needs_cor, TimingBook* book, Resolved* r, Summary* s) {
   std::string why;
   if (!scene.IsValid(&why)) {
     s->termination = Termination::kInvalidInput;
     s->message = why;
     return false;
   }
-  if (scene.cor.has_value()) {
+  if (!needs_cor) {
+    // Nothing wanted uses a COR: none is resolved, so none is required.
+  } else if (scene.cor.has_value()) {
     r->cor = *scene.cor;
     r->cor_source = "scene";
   } else if (scene.bat.has_value() && scene.bat->material.cor.has_value()) {
@@ -128,7 +131,7 @@ RigidPivotInputs MakeRigidPivot(const Scene& scene, const Resolved& r) {
   in.ball_mass_kg = scene.ball.mass_kg;
   in.ball_speed_mps = scene.ball.speed_mps;
   in.angular_speed_rad_s = scene.swing.angular_speed_rad_s;
-  in.cor = r.cor;
+  in.cor = *r.cor;
   return in;
 }
 
@@ -142,7 +145,7 @@ FreeBatInputs MakeFreeBat(const Scene& scene, const Resolved& r) {
   in.ball_mass_kg = scene.ball.mass_kg;
   in.ball_speed_mps = scene.ball.speed_mps;
   in.angular_speed_rad_s = scene.swing.angular_speed_rad_s;
-  in.cor = r.cor;
+  in.cor = *r.cor;
   return in;
 }
 
@@ -164,7 +167,7 @@ HertzProblem MakeHertz(const Scene& scene, const Resolved& r, double impact_from
   p.c22_per_kg = 1.0 / m_bat + bh * bh / i;
   p.ball_stiffness = scene.ball.stiffness;
   p.ball_exponent = scene.ball.stiffness_exponent;
-  p.cor = r.cor;
+  p.cor = *r.cor;
   p.hands_stiffness_n_m = options.hands_stiffness_n_m;
   p.hands_damping_n_s_m = options.hands_damping_n_s_m;
   p.paper = options.paper;
@@ -202,7 +205,7 @@ FlexibleImpactInputs MakeFlexible(const Scene& scene, const Resolved& r, double 
       scene.swing.angular_speed_rad_s * (impact_from_knob_m - scene.swing.pivot_from_knob_m);
   in.ball_stiffness = scene.ball.stiffness;
   in.ball_exponent = scene.ball.stiffness_exponent;
-  in.cor = r.cor;
+  in.cor = *r.cor;
   in.surface_stiffness = 0.0;
   if (hertz.bat_surface_compliance && scene.bat.has_value()) {
     const double radius = scene.bat->RadiusAtM(impact_from_knob_m);
@@ -445,6 +448,10 @@ bool NeedsExitModel(SceneOutput o) {
   return o == SceneOutput::kMaxExitSpeed || o == SceneOutput::kSweetZone ||
          o == SceneOutput::kExitSpeedCurve;
 }
+
+// Outputs that run an impact (every impact model uses the COR): the exit-speed outputs and
+// least_sting_zone's flexible impacts. center_of_percussion and vibration_node do not.
+bool NeedsCor(SceneOutput o) { return NeedsExitModel(o) || o == SceneOutput::kLeastStingZone; }
 
 bool Wants(const std::vector<SceneOutput>& wanted, SceneOutput o) {
   return std::find(wanted.begin(), wanted.end(), o) != wanted.end();
@@ -835,7 +842,8 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
       }
     }
     Resolved r;
-    if (!Resolve(scene, &book, &r, &s)) return finish();
+    const bool needs_cor = std::any_of(wanted.begin(), wanted.end(), NeedsCor);
+    if (!Resolve(scene, needs_cor, &book, &r, &s)) return finish();
     out.cor = r.cor;
     out.cor_source = r.cor_source;
     out.mass_properties = r.mp;
@@ -1073,8 +1081,8 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
       return finish();
     }
     Resolved r;
-    if (!Resolve(scene, &book, &r, &s)) return finish();
-    out.cor = r.cor;
+    if (!Resolve(scene, /*needs_cor=*/true, &book, &r, &s)) return finish();
+    out.cor = *r.cor;
     out.mass_properties = r.mp;
     if (!(std::isfinite(impact_from_knob_m) && impact_from_knob_m >= 0.0 &&
           impact_from_knob_m <= r.length_m)) {

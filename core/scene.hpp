@@ -157,8 +157,8 @@ struct SceneResult {
   Summary summary;                 ///< Overall: termination, message, models_used, total time.
   std::string missing_model;       ///< Set (e.g. "flexible_beam") when refused for a missing model.
   std::string refused_field;       ///< The request field the refusal is about (e.g. "outputs").
-  double cor = 0.0;                ///< The COR used.
-  std::string cor_source;          ///< "scene" or "material:<name>".
+  std::optional<double> cor;       ///< The COR used; unset when no wanted output needs one.
+  std::string cor_source;          ///< "scene" or "material:<name>"; "" when `cor` is unset.
   MassProperties mass_properties;  ///< The properties used.
   double length_m = 0.0;           ///< The bat length used, m.
   std::string exit_speed_model;    ///< The exit-speed model used ("" when none was needed).

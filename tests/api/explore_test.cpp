@@ -115,6 +115,36 @@ TEST(ExploreTest, PropertiesOnlyRowsAreFeasible) {
   }
 }
 
+TEST(ExploreTest, RowsWithoutAnImpactNeedNoCor) {
+  // A custom material has no default COR; these rows run no impact, so they need none.
+  Json body = Json::parse(R"({"bat": {"preset": "paper-wood",
+      "material": {"density_kg_m3": 649, "youngs_modulus_pa": 1.814e10}},
+      "parameters": [{"path": "material.density_kg_m3", "min": 600, "max": 700, "count": 2}],
+      "outputs": ["properties"]})");
+  for (const Json& outputs : {Json::array({"properties"}),
+                              Json::array({"properties", "center_of_percussion"})}) {
+    body["outputs"] = outputs;
+    const Response r = Explore(body);
+    ASSERT_EQ(r.status, 200) << r.body.dump();
+    EXPECT_EQ(r.body["summary"]["failed"], 0) << r.body.dump();
+    ASSERT_EQ(r.body["rows"].size(), 2u);
+    // The mass scales with the density (no fill, solid): 1.0078 kg at 649 kg/m3 (paper-wood),
+    // so 1.0078 * 600 / 649 and 1.0078 * 700 / 649, to the 1e-4 of the preset's rounding.
+    EXPECT_NEAR(r.body["rows"][0]["properties"]["mass_kg"].get<double>(), 1.0078 * 600 / 649,
+                1e-4);
+    EXPECT_NEAR(r.body["rows"][1]["properties"]["mass_kg"].get<double>(), 1.0078 * 700 / 649,
+                1e-4);
+    EXPECT_EQ(r.body["rows"][0].contains("center_of_percussion"), outputs.size() == 2);
+  }
+  // An exit-speed row still needs one: a failed row with the same refusal.
+  body["outputs"] = {"properties", "max_exit_speed"};
+  const Response r = Explore(body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["summary"]["failed"], 2);
+  EXPECT_EQ(r.body["rows"][0]["error"]["message"],
+            "cor: not given, and material 'custom' has no default COR");
+}
+
 TEST(ExploreTest, AModelThatCannotFinishIsAModelFailedRow) {
   // The same code /v1/sweet-spot answers (422 ModelFailed), not InvalidValue.
   const Json body = Json::parse(R"({"bat": {"preset": "paper-wood"},

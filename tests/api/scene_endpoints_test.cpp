@@ -90,6 +90,44 @@ TEST(SweetSpotEndpointTest, VibrationNodeHasPositionAndFrequency) {
   EXPECT_EQ(r.body["models_used"], nlohmann::json::array({"mass_properties", "flexible_beam"}));
 }
 
+TEST(SweetSpotEndpointTest, OutputsWithoutAnImpactNeedNoCor) {
+  // paper-wood's shape and material numbers as a custom material: it has no default COR.
+  const std::string custom_bat =
+      R"({"preset": "paper-wood", "material": {"density_kg_m3": 649, )"
+      R"("youngs_modulus_pa": 1.814e10, "poissons_ratio": 0.25}})";
+  const Response r = Post("/v1/sweet-spot", R"({"bat": )" + custom_bat +
+                                                R"(, "outputs": ["center_of_percussion", )"
+                                                R"("vibration_node"]})");
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  // No output used a COR: none is reported.
+  EXPECT_FALSE(r.body.contains("cor")) << r.body.dump();
+  EXPECT_FALSE(r.body.contains("cor_source")) << r.body.dump();
+  // The preset's own material (COR 0.5) gives the same positions to the bit: neither output
+  // depends on the COR and every other input is identical.
+  const Response wood = Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"},
+      "outputs": ["center_of_percussion", "vibration_node"]})");
+  ASSERT_EQ(wood.status, 200) << wood.body.dump();
+  EXPECT_EQ(r.body["center_of_percussion"]["position_from_knob_m"],
+            wood.body["center_of_percussion"]["position_from_knob_m"]);
+  EXPECT_EQ(r.body["vibration_node"]["position_from_knob_m"],
+            wood.body["vibration_node"]["position_from_knob_m"]);
+  EXPECT_EQ(r.body["vibration_node"]["frequency_hz"], wood.body["vibration_node"]["frequency_hz"]);
+  // The COP of this bat lies on the barrel, between the balance point and the tip (0.855 m).
+  const double cop = r.body["center_of_percussion"]["position_from_knob_m"];
+  EXPECT_GT(cop, r.body["properties"]["balance_point_m"].get<double>());
+  EXPECT_LT(cop, 0.855);
+  // Where a COR is used, it is reported with its source.
+  EXPECT_EQ(Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"}})").body["cor_source"],
+            "material:paper-wood");
+  // An exit-speed output still needs a COR: the same refusal as before.
+  const Response refused = Post("/v1/sweet-spot", R"({"bat": )" + custom_bat +
+                                                      R"(, "outputs": ["center_of_percussion", )"
+                                                      R"("max_exit_speed"]})");
+  EXPECT_EQ(refused.status, 400) << refused.body.dump();
+  EXPECT_EQ(refused.body["code"], "InvalidValue");
+  EXPECT_EQ(refused.body["message"], "cor: not given, and material 'custom' has no default COR");
+}
+
 TEST(SweetSpotEndpointTest, RefusalsNameTheField) {
   struct Case {
     const char* body;

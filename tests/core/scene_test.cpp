@@ -99,6 +99,43 @@ TEST(SceneCor, FromTheMaterialOrTheScene) {
   EXPECT_EQ(r.summary.message, "cor: not given, and material 'paper-wood' has no default COR");
 }
 
+TEST(SceneCor, OnlyOutputsThatRunAnImpactNeedOne) {
+  // paper-wood's bat with the same material numbers but no default COR (a custom material).
+  Scene custom = PaperWood({SceneOutput::kCenterOfPercussion, SceneOutput::kVibrationNode});
+  custom.bat->material.name = "custom";
+  custom.bat->material.cor.reset();
+  const SceneResult r = EvaluateScene(custom, {});
+  ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.message;
+  // No COR was needed, so none is reported (and none was invented).
+  EXPECT_FALSE(r.cor.has_value());
+  EXPECT_EQ(r.cor_source, "");
+  // The same outputs of the paper-wood bat (COR 0.5): neither depends on the COR, and the bat's
+  // geometry and material numbers are identical, so the same arithmetic gives the same bits.
+  const SceneResult wood =
+      EvaluateScene(PaperWood({SceneOutput::kCenterOfPercussion, SceneOutput::kVibrationNode}), {});
+  ASSERT_EQ(wood.summary.termination, Termination::kConverged) << wood.summary.message;
+  ASSERT_TRUE(r.center_of_percussion.has_value());
+  ASSERT_TRUE(r.vibration_node.has_value());
+  EXPECT_EQ(r.center_of_percussion->position_from_knob_m,
+            wood.center_of_percussion->position_from_knob_m);
+  EXPECT_EQ(r.vibration_node->position_from_knob_m, wood.vibration_node->position_from_knob_m);
+  EXPECT_EQ(r.vibration_node->frequency_hz, wood.vibration_node->frequency_hz);
+  EXPECT_EQ(r.mass_properties.mass_kg, wood.mass_properties.mass_kg);
+  // Outputs that run an impact still need one, with the same refusal as before.
+  for (SceneOutput o : {SceneOutput::kMaxExitSpeed, SceneOutput::kSweetZone,
+                        SceneOutput::kExitSpeedCurve, SceneOutput::kLeastStingZone}) {
+    custom.outputs = {SceneOutput::kCenterOfPercussion, o};
+    const SceneResult refused = EvaluateScene(custom, {});
+    EXPECT_EQ(refused.summary.termination, Termination::kInvalidInput) << SceneOutputName(o);
+    EXPECT_EQ(refused.summary.message, "cor: not given, and material 'custom' has no default COR")
+        << SceneOutputName(o);
+  }
+  // Collide always runs an impact.
+  const CollisionResult hit = Collide(custom, 0.7, CollisionModel::kRigidPivot);
+  EXPECT_EQ(hit.summary.termination, Termination::kInvalidInput);
+  EXPECT_EQ(hit.summary.message, "cor: not given, and material 'custom' has no default COR");
+}
+
 TEST(SceneModels, EachOutputRunsOnlyWhatItNeeds) {
   EXPECT_EQ(ModelsFor(SceneOutput::kCenterOfPercussion, CollisionModel::kHertz),
             std::vector<std::string>{"mass_properties"});
