@@ -94,6 +94,22 @@ Json EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
   return row;
 }
 
+// The error a swept field gives because the design's parser does not know it (a misspelt
+// last key, "profile.knots[3].radius"): every design would fail alike, so the sweep is
+// refused before its first design. `probe` is the valid template with only that field set;
+// returns false (with the parser's UnknownField error in *unknown) when the field is unknown.
+bool IsKnownField(const Json& probe, const ApiLimits& limits, ApiError* unknown) {
+  ApiError error;
+  ObjectReader reader(probe, "", &error);
+  core::Scene scene;
+  if (const Json* bat = reader.Get("bat"); bat != nullptr && ParseBat(*bat, "bat", limits, &error)) {
+    ReadSceneCommon(reader, &scene);
+  }
+  if (error.code != "UnknownField") return true;
+  *unknown = std::move(error);
+  return false;
+}
+
 // A Pareto objective: an output path of a row and its sense.
 // A validated sweep: everything needed to evaluate its designs, owned, so a
 // streamed answer can run it after the handler has returned.
@@ -265,6 +281,10 @@ Response HandleExplore(const Request& request, const Context& context) {
     Json probe = base;
     if (!steps || !SetNumberAtPath(&probe, *steps, dimension.min, &why)) {
       SetError(&error, "InvalidValue", where + ".path", &(*params)[i]["path"], why);
+      return ToResponse(error);
+    }
+    if (ApiError unknown; !IsKnownField(probe, context.limits, &unknown)) {
+      SetError(&error, "InvalidValue", where + ".path", &(*params)[i]["path"], unknown.message);
       return ToResponse(error);
     }
     parameter.steps = std::move(*steps);

@@ -243,6 +243,48 @@ TEST(ExploreTest, LimitsAndBadPathsAreNamed) {
   EXPECT_EQ(r.body["message"], "shard.index = 2: must be below shard.count = 2");
 }
 
+TEST(ExploreTest, AnUnknownLastKeyIsRefusedBeforeTheFirstDesign) {
+  // Every design would fail alike (it was a 200 with every row failed): a 400 naming the
+  // parameter, the path as written and the parser's rule.
+  struct Case {
+    Json bat;
+    const char* path;
+    const char* message;
+  };
+  const Json profile = Json::parse(R"({"profile": {"knots": [{"x_m": 0, "radius_m": 0.015},
+      {"x_m": 0.2, "radius_m": 0.013}, {"x_m": 0.5, "radius_m": 0.03},
+      {"x_m": 0.84, "radius_m": 0.033}]}})");
+  const Case cases[] = {
+      {profile, "profile.knots[3].radius",
+       "parameters[0].path = \"profile.knots[3].radius\": bat.profile.knots[3].radius is not a "
+       "known field (known: radius_m, x_m)"},
+      {CorkSweep()["bat"], "fill.depht_m",
+       "parameters[0].path = \"fill.depht_m\": bat.fill.depht_m is not a known field (known: "
+       "depth_m, diameter_m, material)"},
+      {CorkSweep()["bat"], "ball.speed",
+       "parameters[0].path = \"ball.speed\": ball.speed is not a known field (known: mass_kg, "
+       "radius_m, speed_mps, stiffness_exponent, stiffness_n_m_p)"},
+  };
+  for (const Case& c : cases) {
+    Json body = CorkSweep();
+    body["bat"] = c.bat;
+    body["parameters"] = {{{"path", c.path}, {"min", 0.03}, {"max", 0.04}, {"count", 2}}};
+    const Response r = Explore(body);
+    EXPECT_EQ(r.status, 400) << c.path << ": " << r.body.dump();
+    EXPECT_EQ(r.body["code"], "InvalidValue") << c.path;
+    EXPECT_EQ(r.body["field"], "parameters[0].path") << c.path;
+    EXPECT_EQ(r.body["message"], c.message) << c.path;
+  }
+  // The known field beside it is swept (both designs feasible).
+  Json body = CorkSweep();
+  body["bat"] = profile;
+  body["parameters"] = {
+      {{"path", "profile.knots[3].radius_m"}, {"min", 0.03}, {"max", 0.04}, {"count", 2}}};
+  const Response r = Explore(body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["summary"]["failed"], 0) << r.body.dump();
+}
+
 TEST(ExploreTest, CancelledSweepStops) {
   core::Progress progress;
   progress.Cancel();
