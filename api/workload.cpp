@@ -4,7 +4,7 @@
 
 #include "api/handlers.hpp"
 #include "api/router.hpp"
-#include "core/scene.hpp"
+#include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::api {
 namespace {

@@ -9,11 +9,12 @@
 #include <cmath>
 #include <string>
 
+#include "core/collision/collide.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/flexible/flexible_impact.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/presets.hpp"
-#include "core/scene.hpp"
+#include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {
 namespace {

@@ -38,12 +38,13 @@
 #include <sched.h>
 #include <time.h>
 
+#include "core/collision/collide.hpp"
 #include "core/mass_properties.hpp"
 #include "core/material.hpp"
 #include "core/nlopt_search.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "core/presets.hpp"
-#include "core/scene.hpp"
+#include "core/scene/evaluate_scene.hpp"
 #include "core/version.hpp"
 
 #ifndef SWEETSPOT_BUILD_TYPE
@@ -259,7 +260,7 @@ void MassPropertiesRows(const TimingOptions& timing, Report* report) {
        "piecewise-linear profile; there is no quadrature setting)",
        "inertia_model = rigid_body (exact: each section's own moment included)",
        "inertia_model = rigid_body: core::Scene::inertia_model = InertiaModel::kRigidBody "
-       "(core/scene.hpp), request default \"rigid_body\" (api/scene_json.cpp)"});
+       "(core/scene/scene.hpp), request default \"rigid_body\" (api/scene_json.cpp)"});
   const core::Bat bat = core::FindPreset(kPreset)->bat;
   const core::MassProperties ref = core::ComputeMassProperties(bat, core::InertiaModel::kRigidBody);
   const core::InertiaModel default_model = core::Scene{}.inertia_model;
@@ -387,7 +388,7 @@ void RigidAndFreeSweetSpotRows(const TimingOptions& timing, bool quick, Report* 
        "properties + the sweet spot), by the closed form or by the NLopt search over [0, L]",
        "the closed form (core::ClosedFormMaxExitSpeed): the rows' errors are against it",
        "method = closed_form: core::SceneOptions::method = SweetSpotMethod::kClosedForm "
-       "(core/scene.hpp), request default \"closed_form\" (api/scene_json.cpp); model = auto "
+       "(core/scene/scene.hpp), request default \"closed_form\" (api/scene_json.cpp); model = auto "
        "and the request default are rigid_pivot. With method = nlopt the default algorithm is "
        "LD_SLSQP and x_tolerance_m = " +
            Tol(default_search.x_tolerance_m) +
@@ -536,7 +537,7 @@ void FlexibleModesRows(core::BeamTheory theory, const TimingOptions& timing, boo
        "the same at frequency_tolerance 1e-9, max_elements 4096",
        "frequency_tolerance = " + Tol(defaults.frequency_tolerance) +
            ", max_elements = " + std::to_string(defaults.max_elements) +
-           ": core::FlexibleOptions (core/scene.hpp); the default theory is " +
+           ": core::FlexibleOptions (core/scene/scene.hpp); the default theory is " +
            core::BeamTheoryName(defaults.theory)});
   core::Scene scene = PaperScene();
   scene.outputs = {core::SceneOutput::kVibrationNode};

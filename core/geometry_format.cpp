@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <sstream>
 
 namespace sweetspot::core {
 
@@ -11,6 +12,13 @@ std::string FormatNumber(double value) {
   char buffer[64];
   const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
   return std::string(buffer, result.ptr);
+}
+
+std::string FormatNumber17(double value) {
+  std::ostringstream s;
+  s.precision(17);
+  s << value;
+  return s.str();
 }
 
 std::string RefusalMessage(std::string_view field, double value, std::string_view rule) {

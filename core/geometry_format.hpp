@@ -12,6 +12,10 @@ namespace sweetspot::core {
 /// "nan", "inf", "-inf").
 std::string FormatNumber(double value);
 
+/// `value` with 17 significant digits ("0.85499999999999998"), as the scene's and the sweet
+/// spots' messages write numbers.
+std::string FormatNumber17(double value);
+
 /// "field = value: rule", the message format of every IsValid in core.
 std::string RefusalMessage(std::string_view field, double value, std::string_view rule);
 

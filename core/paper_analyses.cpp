@@ -10,7 +10,8 @@
 #include "core/mass_properties.hpp"
 #include "core/material.hpp"
 #include "core/presets.hpp"
-#include "core/sweet_spot.hpp"
+#include "core/scene/resolved_scene.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -20,7 +21,8 @@ constexpr double kTable5Moi[] = {0.163, 0.173, 0.183, 0.193, 0.203, 0.213};
 constexpr double kTable5Position[] = {0.596, 0.617, 0.638, 0.660, 0.682, 0.702};
 constexpr double kTable5Speed[] = {31.517, 32.085, 32.645, 33.198, 33.744, 34.283};
 
-// The unconstrained rigid-pivot maximum (x from the pivot, speed) for J about the pivot.
+// The unconstrained rigid-pivot maximum (x from the pivot, speed) for J about the pivot. The
+// paper's Table 5 gives J itself (no bat), so these inputs are not built from mass properties.
 ProfileMaximum MaxFor(double moi_pivot, double cor, double omega, double u, double m) {
   RigidPivotInputs in;
   in.moi_pivot_kg_m2 = moi_pivot;
@@ -174,13 +176,14 @@ std::vector<PaperMaterialRow> PaperWoodVsAluminium() {
         MaxFor(mp.moi_knob_kg_m2, r.cor, k.angular_speed_rad_s, k.ball_speed_mps, k.ball_mass_kg);
     const double length = b->LengthM();
     r.position_from_knob_m = std::min(a.x_m, length);
-    RigidPivotInputs in;
-    in.moi_pivot_kg_m2 = mp.moi_knob_kg_m2;
-    in.cor = r.cor;
-    in.angular_speed_rad_s = k.angular_speed_rad_s;
-    in.ball_speed_mps = k.ball_speed_mps;
-    in.ball_mass_kg = k.ball_mass_kg;
-    r.exit_speed_mps = RigidPivotProfile(in).ExitSpeedMps(r.position_from_knob_m);
+    Ball ball;
+    ball.mass_kg = k.ball_mass_kg;
+    ball.speed_mps = k.ball_speed_mps;
+    Swing swing;  // the paper's pivot: the knob
+    swing.pivot_from_knob_m = 0.0;
+    swing.angular_speed_rad_s = k.angular_speed_rad_s;
+    r.exit_speed_mps = RigidPivotProfile(RigidPivotInputsFor(mp, ball, swing, r.cor))
+                           .ExitSpeedMps(r.position_from_knob_m);
     out.push_back(r);
   }
   return out;

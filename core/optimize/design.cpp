@@ -19,7 +19,8 @@
 #include "core/optimize/design_backends.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
-#include "core/sweet_spot.hpp"
+#include "core/scene/resolved_scene.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -103,16 +104,10 @@ PublicEvaluation EvaluatePublic(const DesignProblem& problem, const DesignModel&
   out.omega_rad_s = model.AngularSpeedFor(p.MoiSixInchKgM2());
   double zone_width = kNaN;
   if (cor_known) {
-    RigidPivotInputs in;
-    in.bat_mass_kg = p.mass_kg;
-    in.balance_point_m = p.balance_point_m;
-    in.moi_pivot_kg_m2 = p.MoiAboutKgM2(problem.swing.pivot_from_knob_m);
-    in.pivot_from_knob_m = problem.swing.pivot_from_knob_m;
-    in.ball_mass_kg = problem.ball.mass_kg;
-    in.ball_speed_mps = problem.ball.speed_mps;
-    in.angular_speed_rad_s = out.omega_rad_s;
-    in.cor = model.cor();
-    const ExitSpeedProfile profile = RigidPivotProfile(in);
+    Swing swing = problem.swing;
+    swing.angular_speed_rad_s = out.omega_rad_s;  // the design's own (from its swing weight)
+    const ExitSpeedProfile profile =
+        RigidPivotProfile(RigidPivotInputsFor(p, problem.ball, swing, model.cor()));
     const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(profile, length);
     out.sweet_spot_m = max.position_from_knob_m;
     out.max_exit_speed_mps = max.exit_speed_mps;

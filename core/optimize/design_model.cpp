@@ -8,12 +8,13 @@
 #include <exception>
 #include <set>
 
+#include "core/collision/collide.hpp"
 #include "core/collision/rigid_pivot.hpp"
 #include "core/geometry_format.hpp"
 #include "core/geometry_integrals.hpp"
 #include "core/optimize/jet.hpp"
-#include "core/scene.hpp"
-#include "core/sweet_spot.hpp"
+#include "core/scene/resolved_scene.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -559,16 +560,9 @@ StingEvaluation EvaluateSting(const Bat& bat, const StingScene& scene, bool refi
   StingEvaluation out;
   try {
     const MassProperties p = ComputeMassProperties(bat, scene.inertia_model);
-    RigidPivotInputs in;
-    in.bat_mass_kg = p.mass_kg;
-    in.balance_point_m = p.balance_point_m;
-    in.pivot_from_knob_m = scene.swing.pivot_from_knob_m;
-    in.moi_pivot_kg_m2 = p.MoiAboutKgM2(scene.swing.pivot_from_knob_m);
-    in.ball_mass_kg = scene.ball.mass_kg;
-    in.ball_speed_mps = scene.ball.speed_mps;
-    in.angular_speed_rad_s = scene.swing.angular_speed_rad_s;
-    in.cor = scene.cor;
-    const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(RigidPivotProfile(in), bat.LengthM());
+    const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(
+        RigidPivotProfile(RigidPivotInputsFor(p, scene.ball, scene.swing, scene.cor)),
+        bat.LengthM());
     out.sweet_spot_from_knob_m = max.position_from_knob_m;
     Scene s;
     s.bat = bat;

@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "core/bat.hpp"
+#include "core/collision/collide.hpp"
 #include "core/mass_properties.hpp"
 #include "core/material.hpp"
 #include "core/optimize/rules.hpp"
 #include "core/progress.hpp"
-#include "core/scene.hpp"
 #include "core/summary.hpp"
 
 namespace sweetspot::core {

@@ -7,7 +7,7 @@
 
 #include "core/collision/rigid_pivot.hpp"
 #include "core/nlopt_search.hpp"
-#include "core/sweet_spot.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {

@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/collision/collide.hpp"
 #include "core/presets.hpp"
-#include "core/scene.hpp"
 
 namespace sweetspot::core {
 namespace {

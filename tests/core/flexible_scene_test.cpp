@@ -7,9 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include "core/collision/collide.hpp"
 #include "core/flexible/modes_cache.hpp"
 #include "core/presets.hpp"
-#include "core/scene.hpp"
+#include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {
 namespace {

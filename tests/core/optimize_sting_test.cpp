@@ -10,10 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "core/collision/collide.hpp"
 #include "core/mass_properties.hpp"
 #include "core/material.hpp"
 #include "core/optimize/design_problem.hpp"
-#include "core/scene.hpp"
+#include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {
 namespace {

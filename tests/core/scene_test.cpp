@@ -1,6 +1,7 @@
 // Scenes: validation, "model only what is needed", NLopt backend mapping and algorithms,
 // auto model choice, refusals, determinism across threads.
-#include "core/scene.hpp"
+#include "core/collision/collide.hpp"
+#include "core/scene/evaluate_scene.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,13 +1,14 @@
 // The sweet spots, the sweet zone and the exit-speed curve.
-#include "core/sweet_spot.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
+#include "core/collision/collide.hpp"
 #include "core/collision/rigid_pivot.hpp"
 #include "core/presets.hpp"
-#include "core/scene.hpp"
+#include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {
 namespace {

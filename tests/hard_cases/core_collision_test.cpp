@@ -8,13 +8,14 @@
 #include <string>
 #include <vector>
 
+#include "core/collision/collide.hpp"
 #include "core/collision/free_bat.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
 #include "core/nlopt_search.hpp"
 #include "core/presets.hpp"
-#include "core/scene.hpp"
-#include "core/sweet_spot.hpp"
+#include "core/scene/evaluate_scene.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 #include "tests/hard_cases/hard_case.hpp"
 #include "tests/hard_cases/reference.hpp"
 

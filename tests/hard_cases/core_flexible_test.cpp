@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "core/bat.hpp"
+#include "core/collision/collide.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/material.hpp"
 #include "core/presets.hpp"
-#include "core/scene.hpp"
 #include "tests/hard_cases/hard_case.hpp"
 #include "tests/hard_cases/reference.hpp"
 

@@ -11,8 +11,8 @@
 #include "core/mass_properties.hpp"
 #include "core/material.hpp"
 #include "core/presets.hpp"
-#include "core/scene.hpp"
-#include "core/sweet_spot.hpp"
+#include "core/scene/evaluate_scene.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 #include "tests/hard_cases/hard_case.hpp"
 #include "tests/hard_cases/reference.hpp"
 

@@ -1,8 +1,8 @@
-// A scene (bat, ball, swing, COR, the outputs wanted) and the two entry points the API
-// wires to HTTP: EvaluateScene (the sweet spots) and Collide (one impact). Both are
-// value-in/value-out, never throw, and run only the models the request needs: each output
-// declares its models (ModelsFor), mass properties are computed once per request, and the
-// result lists models_used, an error estimate per output and the time spent per model.
+// A scene: what is hit (the bat, or only its mass properties), by what (the ball), how (the
+// swing), with which COR, and what is wanted (the outputs); and the settings of its
+// computations (the collision models, the flexible beam, EvaluateScene's options). Plain values
+// with IsValid(); the computations are in core/scene/evaluate_scene.hpp and
+// core/collision/collide.hpp.
 #pragma once
 
 #include <optional>
@@ -11,17 +11,14 @@
 #include <vector>
 
 #include "core/bat.hpp"
-#include "core/collision/free_bat.hpp"
 #include "core/collision/hertz_contact.hpp"
-#include "core/collision/rigid_pivot.hpp"
 #include "core/flexible/beam_model.hpp"
 #include "core/flexible/flexible_impact.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/flexible/modes_cache.hpp"
 #include "core/mass_properties.hpp"
 #include "core/nlopt_search.hpp"
-#include "core/summary.hpp"
-#include "core/sweet_spot.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {
 
@@ -87,12 +84,6 @@ const char* CollisionModelName(CollisionModel model);
 /// The model called `name`, or nullopt.
 std::optional<CollisionModel> ParseCollisionModel(std::string_view name);
 
-/// The models an output needs with `exit_model` as the exit-speed model, in run order
-/// (e.g. {"mass_properties", "rigid_pivot"}; vibration_node: {"flexible_beam"};
-/// least_sting_zone, or any exit output with model flexible: {"mass_properties",
-/// "flexible_beam", "flexible"}).
-std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model);
-
 /// How the sweet spot is found.
 enum class SweetSpotMethod {
   kClosedForm,  ///< Closed form where the model has one (rigid_pivot, free_bat), NLopt otherwise.
@@ -144,70 +135,5 @@ struct SceneOptions {
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
 };
-
-/// Time spent in one model during a request.
-struct ModelTiming {
-  std::string model;    ///< e.g. "mass_properties", "rigid_pivot", "hertz".
-  double time_s = 0.0;  ///< Wall time, s.
-  int calls = 0;        ///< Evaluations.
-};
-
-/// The answer of EvaluateScene. Outputs not requested (or not computed) are empty.
-struct SceneResult {
-  Summary summary;                 ///< Overall: termination, message, models_used, total time.
-  std::string missing_model;       ///< Set (e.g. "flexible_beam") when refused for a missing model.
-  std::string refused_field;       ///< The request field the refusal is about (e.g. "outputs").
-  std::optional<double> cor;       ///< The COR used; unset when no wanted output needs one.
-  std::string cor_source;          ///< "scene" or "material:<name>"; "" when `cor` is unset.
-  MassProperties mass_properties;  ///< The properties used.
-  double length_m = 0.0;           ///< The bat length used, m.
-  std::string exit_speed_model;    ///< The exit-speed model used ("" when none was needed).
-  std::string model_reason;        ///< Why that model (auto).
-  std::optional<MaxExitSpeedResult> max_exit_speed;              ///< max_exit_speed.
-  std::optional<CenterOfPercussionResult> center_of_percussion;  ///< center_of_percussion.
-  std::optional<SweetZoneResult> sweet_zone;                     ///< sweet_zone.
-  std::optional<ExitSpeedCurveResult> exit_speed_curve;          ///< exit_speed_curve.
-  std::optional<VibrationNodeResult> vibration_node;             ///< vibration_node.
-  std::optional<LeastStingZoneResult> least_sting_zone;          ///< least_sting_zone.
-  std::vector<ModelTiming> timings;  ///< Time per model, in first-use order.
-};
-
-/// Computes the requested outputs. Never throws.
-SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options);
-
-/// Options of Collide.
-struct CollisionOptions {
-  bool want_contact_details = false;  ///< kAuto: contact time / peak force wanted (selects hertz).
-  HertzOptions hertz;                 ///< Contact-model settings (the flexible model uses its
-                                      ///< bat_surface_compliance too).
-  FlexibleOptions flexible;           ///< Flexible-beam settings (model = kFlexible).
-
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-};
-
-/// The answer of Collide.
-struct CollisionResult {
-  Summary summary;            ///< termination, message, backend, models_used, time.
-  std::string missing_model;  ///< Set when refused for a missing model.
-  CollisionModel model = CollisionModel::kRigidPivot;  ///< The model that ran.
-  std::string model_reason;                            ///< Why (auto) or "requested".
-  double impact_from_knob_m = 0.0;                     ///< m from the knob.
-  double approach_speed_mps = 0.0;                     ///< u + bat speed at the impact point, m/s.
-  double exit_speed_mps = 0.0;                         ///< m/s, positive away from the bat.
-  double error_estimate_mps = 0.0;                     ///< Estimated error of the exit speed, m/s.
-  double cor = 0.0;                                    ///< The COR used.
-  MassProperties mass_properties;                      ///< The properties used.
-  std::optional<RigidPivotImpact> rigid_pivot;         ///< Details when model = rigid_pivot.
-  std::optional<FreeBatImpact> free_bat;               ///< Details when model = free_bat.
-  std::optional<HertzImpact> hertz;                    ///< Details when model = hertz.
-  std::optional<FlexibleImpactResult> flexible;        ///< Details when model = flexible.
-  bool modes_cache_hit = false;      ///< model = flexible: the modes came from the cache.
-  std::vector<ModelTiming> timings;  ///< Time per model.
-};
-
-/// One impact at `impact_from_knob_m` with `model`. Never throws.
-CollisionResult Collide(const Scene& scene, double impact_from_knob_m, CollisionModel model,
-                        const CollisionOptions& options = {});
 
 }  // namespace sweetspot::core

@@ -1,21 +1,15 @@
-#include "core/sweet_spot.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
+
+#include "core/geometry_format.hpp"
 
 namespace sweetspot::core {
 namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
 
 struct OutputName {
   SceneOutput output;
@@ -110,8 +104,8 @@ MaxExitSpeedResult ClosedFormMaxExitSpeed(const ExitSpeedProfile& profile, doubl
     out.error_estimate_m = 0.0;  // an end of the bat, exactly
     out.error_estimate_mps = 8.0 * kEps * (profile.ball_speed_mps + std::abs(best_f));
     out.summary.warnings.push_back(
-        std::string("the unconstrained maximiser (") + Num(out.unconstrained_position_from_knob_m) +
-        " m from the knob) is " +
+        std::string("the unconstrained maximiser (") +
+        FormatNumber17(out.unconstrained_position_from_knob_m) + " m from the knob) is " +
         (out.placement == Placement::kBeyondTip ? "beyond the tip" : "before the knob") +
         "; the end of the bat is reported");
   }
@@ -166,9 +160,10 @@ std::optional<CenterOfPercussionResult> CenterOfPercussion(const MassProperties&
   const double arm = mass_properties.balance_point_m - hands_from_knob_m;
   if (!(arm > 0.0)) {
     if (why != nullptr) {
-      *why = "swing.hands_from_knob_m = " + Num(hands_from_knob_m) +
+      *why = "swing.hands_from_knob_m = " + FormatNumber17(hands_from_knob_m) +
              ": must be closer to the knob than the balance point (" +
-             Num(mass_properties.balance_point_m) + " m) for a centre of percussion to exist";
+             FormatNumber17(mass_properties.balance_point_m) +
+             " m) for a centre of percussion to exist";
     }
     return std::nullopt;
   }

@@ -1,6 +1,8 @@
 // The sweet spots the paper names (maximum exit speed, centre of percussion, node of the
 // fundamental bending mode), the sweet zone and the exit-speed curve: result types and
-// the closed forms. The orchestration (which model, which method) is in core/scene.hpp.
+// the closed forms. The numeric definitions are in numeric.hpp, least_sting.hpp and
+// vibration_node.hpp beside this file; the orchestration (which model, which method) is
+// core/scene/evaluate_scene.hpp.
 #pragma once
 
 #include <optional>

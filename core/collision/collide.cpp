@@ -1,0 +1,164 @@
+#include "core/collision/collide.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+
+#include "core/geometry_format.hpp"
+#include "core/scene/resolved_scene.hpp"
+#include "core/scene/scene_models.hpp"
+
+namespace sweetspot::core {
+
+bool CollisionOptions::IsValid(std::string* why) const {
+  return hertz.IsValid(why) && flexible.IsValid(why);
+}
+
+CollisionResult Collide(const Scene& scene, double impact_from_knob_m, CollisionModel model,
+                        const CollisionOptions& options) {
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  const auto t0 = std::chrono::steady_clock::now();
+  CollisionResult out;
+  Summary& s = out.summary;
+  s.termination = Termination::kInvalidInput;
+  s.backend = "closed_form";
+  TimingBook book;
+  out.impact_from_knob_m = impact_from_knob_m;
+  auto finish = [&]() -> CollisionResult& {
+    out.timings = book.timings();
+    s.models_used = book.Models();
+    s.solve_time_s = SecondsSince(t0);
+    return out;
+  };
+  try {
+    std::string why;
+    if (!options.IsValid(&why)) {
+      s.message = why;
+      return finish();
+    }
+    if (model == CollisionModel::kFlexible && !scene.bat.has_value()) {
+      out.model = model;
+      s.message =
+          "bat: model = flexible needs the bat's geometry (a bat, not only mass_properties)";
+      return finish();
+    }
+    ResolvedScene r;
+    if (!ResolveScene(scene, /*needs_cor=*/true, &book, &r, &s)) return finish();
+    out.cor = *r.cor;
+    out.mass_properties = r.mass_properties;
+    if (!(std::isfinite(impact_from_knob_m) && impact_from_knob_m >= 0.0 &&
+          impact_from_knob_m <= r.length_m)) {
+      s.termination = Termination::kInvalidInput;
+      s.message = "impact_from_knob_m = " + FormatNumber17(impact_from_knob_m) +
+                  ": must be within the bat [0, " + FormatNumber17(r.length_m) + "]";
+      return finish();
+    }
+    if (model == CollisionModel::kAuto) {
+      if (options.want_contact_details) {
+        model = CollisionModel::kHertz;
+        out.model_reason =
+            "auto: hertz, the only model that knows contact time, peak force and compression";
+      } else {
+        model = CollisionModel::kRigidPivot;
+        out.model_reason =
+            "auto: rigid_pivot, the cheapest adequate model (closed form; the swing has a fixed "
+            "pivot; only the exit speed and impulses were asked for)";
+      }
+    } else {
+      out.model_reason = "requested";
+    }
+    out.model = model;
+    const auto tm = std::chrono::steady_clock::now();
+    switch (model) {
+      case CollisionModel::kRigidPivot: {
+        out.rigid_pivot = RigidPivotImpactAt(RigidPivotInputsFor(scene, r), impact_from_knob_m);
+        out.exit_speed_mps = out.rigid_pivot->exit_speed_mps;
+        out.approach_speed_mps = out.rigid_pivot->approach_speed_mps;
+        out.error_estimate_mps = 8.0 * kEps * (scene.ball.speed_mps + std::abs(out.exit_speed_mps));
+        s.termination = Termination::kConverged;
+        s.message = "closed form";
+        break;
+      }
+      case CollisionModel::kFreeBat: {
+        out.free_bat = FreeBatImpactAt(FreeBatInputsFor(scene, r), impact_from_knob_m);
+        out.exit_speed_mps = out.free_bat->exit_speed_mps;
+        out.approach_speed_mps = out.free_bat->approach_speed_mps;
+        out.error_estimate_mps = 8.0 * kEps * (scene.ball.speed_mps + std::abs(out.exit_speed_mps));
+        s.termination = Termination::kConverged;
+        s.message = "closed form";
+        break;
+      }
+      case CollisionModel::kHertz: {
+        std::vector<std::string> warnings;
+        const HertzProblem p =
+            HertzProblemFor(scene, r, impact_from_knob_m, options.hertz, &warnings);
+        out.approach_speed_mps = p.approach_speed_mps;
+        out.hertz = SolveHertzImpact(p, options.hertz.solver);
+        const Summary& hs = out.hertz->summary;
+        s.termination = hs.termination;
+        s.message = hs.message;
+        s.backend = hs.backend;
+        s.iterations = hs.iterations;
+        s.evaluations = hs.evaluations;
+        s.warnings = warnings;
+        for (const auto& w : hs.warnings) s.warnings.push_back(w);
+        out.exit_speed_mps = out.hertz->exit_speed_mps;
+        out.error_estimate_mps = out.hertz->error_estimate_exit_speed_mps;
+        break;
+      }
+      case CollisionModel::kFlexible: {
+        FlexibleModes flexible_modes(scene, options.flexible, &book);
+        const auto& modes = flexible_modes.Impact();
+        out.modes_cache_hit = flexible_modes.impact_hit();
+        if (!modes->summary.IsSolutionUsable()) {
+          s.termination = modes->summary.termination == Termination::kInvalidInput
+                              ? Termination::kInvalidInput
+                              : Termination::kFailure;
+          s.message = s.termination == Termination::kInvalidInput
+                          ? modes->summary.message + " (model = flexible)"
+                          : "model = flexible: the bat's modes: " + modes->summary.message;
+          return finish();
+        }
+        const auto tf = std::chrono::steady_clock::now();
+        const FlexibleImpactInputs in =
+            FlexibleImpactInputsFor(scene, r, impact_from_knob_m, options.hertz);
+        out.approach_speed_mps = in.approach_speed_mps;
+        out.flexible = SolveFlexibleImpact(*scene.bat, *modes, in, options.flexible.impact);
+        const Summary& fs = out.flexible->summary;
+        s.termination = fs.termination;
+        if (fs.IsSolutionUsable() && modes->summary.termination == Termination::kNoConvergence) {
+          s.termination = Termination::kNoConvergence;
+        }
+        s.message = fs.message;
+        s.backend = fs.backend;
+        s.iterations = fs.iterations;
+        s.evaluations = fs.evaluations;
+        for (const auto& w : modes->summary.warnings) s.warnings.push_back("flexible_beam: " + w);
+        for (const auto& w : fs.warnings) s.warnings.push_back(w);
+        out.exit_speed_mps = out.flexible->exit_speed_mps;
+        out.error_estimate_mps = out.flexible->error_estimate_exit_speed_mps;
+        book.Add(CollisionModelName(model), SecondsSince(tf), 1);
+        s.objective = out.exit_speed_mps;
+        s.error_estimate = out.error_estimate_mps;
+        return finish();
+      }
+      default:
+        s.termination = Termination::kFailure;
+        s.message = "internal error: unknown model";
+        break;
+    }
+    book.Add(CollisionModelName(model), SecondsSince(tm), 1);
+    s.objective = out.exit_speed_mps;
+    s.error_estimate = out.error_estimate_mps;
+  } catch (const std::exception& e) {
+    s.termination = Termination::kFailure;
+    s.message = std::string("internal error: ") + e.what();
+  } catch (...) {
+    s.termination = Termination::kFailure;
+    s.message = "internal error";
+  }
+  return finish();
+}
+
+}  // namespace sweetspot::core

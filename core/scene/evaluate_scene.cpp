@@ -1,0 +1,356 @@
+#include "core/scene/evaluate_scene.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+
+#include "core/geometry_format.hpp"
+#include "core/scene/resolved_scene.hpp"
+#include "core/scene/scene_models.hpp"
+#include "core/sweet_spot/least_sting.hpp"
+#include "core/sweet_spot/numeric.hpp"
+#include "core/sweet_spot/vibration_node.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+Termination Worse(Termination a, Termination b) {
+  auto rank = [](Termination t) {
+    switch (t) {
+      case Termination::kConverged:
+        return 0;
+      case Termination::kNoConvergence:
+        return 1;
+      case Termination::kInfeasible:
+        return 2;
+      case Termination::kFailure:
+        return 3;
+      case Termination::kInvalidInput:
+        return 4;
+    }
+    return 3;
+  };
+  return rank(a) >= rank(b) ? a : b;
+}
+
+bool NeedsExitModel(SceneOutput o) {
+  return o == SceneOutput::kMaxExitSpeed || o == SceneOutput::kSweetZone ||
+         o == SceneOutput::kExitSpeedCurve;
+}
+
+// Outputs that run an impact (every impact model uses the COR): the exit-speed outputs and
+// least_sting_zone's flexible impacts. center_of_percussion and vibration_node do not.
+bool NeedsCor(SceneOutput o) { return NeedsExitModel(o) || o == SceneOutput::kLeastStingZone; }
+
+bool Wants(const std::vector<SceneOutput>& wanted, SceneOutput o) {
+  return std::find(wanted.begin(), wanted.end(), o) != wanted.end();
+}
+
+// least_sting_zone: the sweep from the hands to the tip with this scene's flexible impacts.
+bool StingZone(const Scene& scene, const ResolvedScene& r, const SceneOptions& options,
+               const BatModes& modes, TimingBook* book, std::vector<std::string>* warnings,
+               LeastStingZoneResult* out, std::string* error) {
+  const FlexibleOptions& fo = options.flexible;
+  const double hands = scene.swing.hands_from_knob_m;
+  if (!(r.length_m > hands)) {
+    *error = "swing.hands_from_knob_m = " + FormatNumber17(hands) +
+             ": the sweep runs from the hands to the tip, so the hands must be before the tip";
+    return false;
+  }
+  FlexibleImpactOptions quick = fo.impact;
+  quick.refine_check = false;  // the refinement is reported on the samples
+  const StingImpact impact = [&](double s, bool refine) {
+    const auto t0 = std::chrono::steady_clock::now();
+    FlexibleImpactResult fr =
+        SolveFlexibleImpact(*scene.bat, modes, FlexibleImpactInputsFor(scene, r, s, options.hertz),
+                            refine ? fo.impact : quick);
+    book->Add(CollisionModelName(CollisionModel::kFlexible), SecondsSince(t0), 1);
+    return fr;
+  };
+  if (!LeastStingZone(impact, hands, r.length_m, fo.sting_samples, fo.sting_zone_fraction, warnings,
+                      out, error)) {
+    return false;
+  }
+  out->elements = modes.Elements();
+  out->theory = BeamTheoryName(modes.theory);
+  return true;
+}
+
+}  // namespace
+
+std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model) {
+  if (exit_model == CollisionModel::kAuto) exit_model = CollisionModel::kRigidPivot;
+  switch (output) {
+    case SceneOutput::kCenterOfPercussion:
+      return {"mass_properties"};
+    case SceneOutput::kVibrationNode:
+      return {kFlexibleBeamModel};
+    case SceneOutput::kLeastStingZone:
+      return {"mass_properties", kFlexibleBeamModel, "flexible"};
+    case SceneOutput::kMaxExitSpeed:
+    case SceneOutput::kSweetZone:
+    case SceneOutput::kExitSpeedCurve:
+      if (exit_model == CollisionModel::kFlexible) {
+        return {"mass_properties", kFlexibleBeamModel, "flexible"};
+      }
+      return {"mass_properties", CollisionModelName(exit_model)};
+  }
+  return {};
+}
+
+SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SceneResult out;
+  Summary& s = out.summary;
+  s.backend = "scene";
+  s.termination = Termination::kInvalidInput;
+  TimingBook book;
+  auto finish = [&]() -> SceneResult& {
+    out.timings = book.timings();
+    s.models_used = book.Models();
+    s.solve_time_s = SecondsSince(t0);
+    return out;
+  };
+  try {
+    std::string why;
+    if (!options.IsValid(&why)) {
+      s.message = why;
+      return finish();
+    }
+    std::vector<SceneOutput> wanted;
+    for (SceneOutput o : scene.outputs) {
+      if (std::find(wanted.begin(), wanted.end(), o) == wanted.end()) wanted.push_back(o);
+    }
+    const bool needs_exit = std::any_of(wanted.begin(), wanted.end(), NeedsExitModel);
+    // The flexible beam needs the bat's geometry, not only its mass properties.
+    const bool flexible_exit = needs_exit && options.model == CollisionModel::kFlexible;
+    if (!scene.bat.has_value()) {
+      for (SceneOutput o : {SceneOutput::kVibrationNode, SceneOutput::kLeastStingZone}) {
+        if (Wants(wanted, o)) {
+          s.message = std::string("bat: ") + SceneOutputName(o) +
+                      " needs the bat's geometry (a bat, not only mass_properties)";
+          out.refused_field = "bat";
+          return finish();
+        }
+      }
+      if (flexible_exit) {
+        s.message =
+            "bat: model = flexible needs the bat's geometry (a bat, not only mass_properties)";
+        out.refused_field = "bat";
+        return finish();
+      }
+    }
+    ResolvedScene r;
+    const bool needs_cor = std::any_of(wanted.begin(), wanted.end(), NeedsCor);
+    if (!ResolveScene(scene, needs_cor, &book, &r, &s)) return finish();
+    out.cor = r.cor;
+    out.cor_source = r.cor_source;
+    out.mass_properties = r.mass_properties;
+    out.length_m = r.length_m;
+    for (size_t i = 0; i < options.curve_positions_from_knob_m.size(); ++i) {
+      const double x = options.curve_positions_from_knob_m[i];
+      if (!(x >= 0.0 && x <= r.length_m)) {
+        s.termination = Termination::kInvalidInput;
+        s.message = "curve_positions_from_knob_m[" + std::to_string(i) +
+                    "] = " + FormatNumber17(x) + ": must be within the bat [0, " +
+                    FormatNumber17(r.length_m) + "]";
+        return finish();
+      }
+    }
+    CollisionModel model = options.model;
+    if (model == CollisionModel::kAuto) {
+      model = CollisionModel::kRigidPivot;
+      out.model_reason =
+          "auto: rigid_pivot, the cheapest adequate model (closed form; the swing has a fixed "
+          "pivot and these outputs need only the exit speed)";
+    } else {
+      out.model_reason = "requested";
+    }
+    if (!needs_exit) out.model_reason.clear();
+    s.termination = Termination::kConverged;
+    std::vector<std::string> messages;
+    auto note = [&](Termination t, const std::string& what) {
+      s.termination = Worse(s.termination, t);
+      if (!what.empty()) messages.push_back(what);
+    };
+
+    FlexibleModes flexible_modes(scene, options.flexible, &book);
+    std::optional<ExitSpeedModel> exit_model;
+    if (needs_exit) {
+      if (model == CollisionModel::kFlexible) {
+        const auto& modes = flexible_modes.Impact();
+        if (!modes->summary.IsSolutionUsable()) {
+          s.termination = modes->summary.termination == Termination::kInvalidInput
+                              ? Termination::kInvalidInput
+                              : Termination::kFailure;
+          s.message = s.termination == Termination::kInvalidInput
+                          ? modes->summary.message + " (model = flexible)"
+                          : "model = flexible: the bat's modes: " + modes->summary.message;
+          if (s.termination == Termination::kInvalidInput) out.refused_field = "bat";
+          return finish();
+        }
+        for (const auto& w : modes->summary.warnings) s.warnings.push_back("flexible_beam: " + w);
+        exit_model.emplace(model, scene, r, options.hertz, &book, &options.flexible, modes);
+      } else {
+        exit_model.emplace(model, scene, r, options.hertz, &book);
+      }
+      out.exit_speed_model = exit_model->name();
+    }
+    const bool closed = exit_model.has_value() && exit_model->profile().has_value() &&
+                        options.method == SweetSpotMethod::kClosedForm;
+    const bool need_max =
+        std::find(wanted.begin(), wanted.end(), SceneOutput::kMaxExitSpeed) != wanted.end() ||
+        std::find(wanted.begin(), wanted.end(), SceneOutput::kSweetZone) != wanted.end();
+    if (need_max) {
+      MaxExitSpeedResult mx;
+      if (closed) {
+        const auto tm = std::chrono::steady_clock::now();
+        mx = ClosedFormMaxExitSpeed(*exit_model->profile(), r.length_m);
+        mx.model = exit_model->name();
+        mx.summary.solve_time_s = SecondsSince(tm);
+        mx.summary.models_used = {exit_model->name()};
+        book.Add(exit_model->name(), mx.summary.solve_time_s, 1);
+      } else {
+        mx = SearchMaxExitSpeed(&*exit_model, r.length_m, options.nlopt);
+        mx.summary.models_used = {exit_model->name()};
+      }
+      for (const auto& w : mx.summary.warnings) s.warnings.push_back("max_exit_speed: " + w);
+      note(mx.summary.termination,
+           mx.summary.IsSolutionUsable() ? std::string() : "max_exit_speed: " + mx.summary.message);
+      const bool usable = mx.summary.IsSolutionUsable();
+      if (std::find(wanted.begin(), wanted.end(), SceneOutput::kMaxExitSpeed) != wanted.end()) {
+        out.max_exit_speed = mx;
+      }
+      if (std::find(wanted.begin(), wanted.end(), SceneOutput::kSweetZone) != wanted.end()) {
+        if (!usable) {
+          note(Termination::kFailure, "sweet_zone: needs max_exit_speed, which failed");
+        } else {
+          const double tol =
+              options.sweet_zone_unit == ToleranceUnit::kPercent
+                  ? options.sweet_zone_tolerance / 100.0 * std::abs(mx.exit_speed_mps)
+                  : options.sweet_zone_tolerance;
+          if (closed) {
+            const auto tz = std::chrono::steady_clock::now();
+            out.sweet_zone = ClosedFormSweetZone(*exit_model->profile(), r.length_m, mx, tol);
+            book.Add(exit_model->name(), SecondsSince(tz), 1);
+          } else {
+            std::string error;
+            out.sweet_zone = RootFindSweetZone(&*exit_model, r.length_m, mx, tol, &error);
+            out.sweet_zone->error_estimate_m += mx.error_estimate_m;
+            if (!error.empty()) {
+              note(Termination::kFailure, "sweet_zone: " + error);
+              out.sweet_zone.reset();
+            }
+          }
+        }
+      }
+    }
+    if (std::find(wanted.begin(), wanted.end(), SceneOutput::kCenterOfPercussion) != wanted.end()) {
+      std::string cop_why;
+      auto cop = CenterOfPercussion(r.mass_properties, scene.swing.hands_from_knob_m, r.length_m,
+                                    &cop_why);
+      if (!cop.has_value()) {
+        // The core message first ("swing.hands_from_knob_m = ...: rule"): it names the field.
+        note(Termination::kInvalidInput, cop_why + " (center_of_percussion)");
+      } else {
+        if (cop->placement == Placement::kBeyondTip) {
+          s.warnings.push_back("center_of_percussion: beyond the tip (" +
+                               FormatNumber17(cop->position_from_knob_m) + " m from the knob)");
+        }
+        out.center_of_percussion = cop;
+      }
+    }
+    if (Wants(wanted, SceneOutput::kVibrationNode)) {
+      const auto& modes = flexible_modes.Vibration();
+      VibrationNodeResult node;
+      std::string error;
+      if (VibrationNodeFrom(*modes, flexible_modes.vibration_hit(), &node, &error)) {
+        if (modes->summary.termination == Termination::kNoConvergence) {
+          note(Termination::kNoConvergence, "vibration_node: " + modes->summary.message);
+        }
+        out.vibration_node = std::move(node);
+      } else {
+        const bool invalid = modes->summary.termination == Termination::kInvalidInput;
+        // Invalid input keeps the core message first ("bat.length_m = ...: rule"): it names
+        // the field.
+        note(invalid ? Termination::kInvalidInput : Termination::kFailure,
+             invalid ? error + " (vibration_node)" : "vibration_node: " + error);
+        if (invalid) out.refused_field = "bat";
+      }
+    }
+    if (Wants(wanted, SceneOutput::kLeastStingZone)) {
+      const auto& modes = flexible_modes.Impact();
+      if (!modes->summary.IsSolutionUsable()) {
+        const bool invalid = modes->summary.termination == Termination::kInvalidInput;
+        note(invalid ? Termination::kInvalidInput : Termination::kFailure,
+             invalid ? modes->summary.message + " (least_sting_zone)"
+                     : "least_sting_zone: the bat's modes: " + modes->summary.message);
+        if (invalid) out.refused_field = "bat";
+      } else {
+        LeastStingZoneResult zone;
+        std::string error;
+        std::vector<std::string> warnings;
+        const bool ok = StingZone(scene, r, options, *modes, &book, &warnings, &zone, &error);
+        for (const auto& w : warnings) s.warnings.push_back("least_sting_zone: " + w);
+        if (ok) {
+          out.least_sting_zone = std::move(zone);
+        } else {
+          note(Termination::kFailure, "least_sting_zone: " + error);
+        }
+      }
+    }
+    if (std::find(wanted.begin(), wanted.end(), SceneOutput::kExitSpeedCurve) != wanted.end()) {
+      ExitSpeedCurveResult curve;
+      curve.model = exit_model->name();
+      std::vector<double> xs = options.curve_positions_from_knob_m;
+      if (xs.empty()) {
+        const int n = options.curve_samples;
+        for (int i = 0; i < n; ++i)
+          xs.push_back(i + 1 == n ? r.length_m : r.length_m * i / (n - 1));
+      }
+      bool ok = true;
+      std::string error;
+      for (double x : xs) {
+        double v = 0.0, e = 0.0;
+        if (!exit_model->Eval(x, &v, nullptr, &e, &error)) {
+          ok = false;
+          break;
+        }
+        curve.points.push_back({x, v});
+        curve.error_estimate_mps = std::max(curve.error_estimate_mps, e);
+      }
+      if (ok) {
+        out.exit_speed_curve = std::move(curve);
+      } else {
+        note(Termination::kFailure, "exit_speed_curve: " + error);
+      }
+    }
+    if (exit_model.has_value()) {
+      for (const auto& w : exit_model->warnings()) s.warnings.push_back(w);
+    }
+    if (messages.empty()) {
+      s.message = "computed";
+      for (SceneOutput o : wanted) s.message += std::string(" ") + SceneOutputName(o);
+    } else {
+      for (size_t i = 0; i < messages.size(); ++i) s.message += (i ? "; " : "") + messages[i];
+    }
+    s.iterations = -1;
+    double worst_err = 0.0;
+    if (out.max_exit_speed) worst_err = std::max(worst_err, out.max_exit_speed->error_estimate_m);
+    if (out.vibration_node) worst_err = std::max(worst_err, out.vibration_node->error_estimate_m);
+    if (out.least_sting_zone) {
+      worst_err = std::max(worst_err, out.least_sting_zone->error_estimate_m);
+    }
+    s.error_estimate = worst_err;
+  } catch (const std::exception& e) {
+    s.termination = Termination::kFailure;
+    s.message = std::string("internal error: ") + e.what();
+  } catch (...) {
+    s.termination = Termination::kFailure;
+    s.message = "internal error";
+  }
+  return finish();
+}
+
+}  // namespace sweetspot::core

@@ -1,0 +1,48 @@
+// EvaluateScene: the sweet spots of a scene. Value-in/value-out, never throws, and runs only
+// the models the request needs: each output declares its models (ModelsFor), the scene is
+// resolved once per request (core/scene/resolved_scene.hpp), and the result lists
+// models_used, an error estimate per output and the time spent per model.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/mass_properties.hpp"
+#include "core/scene/scene.hpp"
+#include "core/scene/timing_book.hpp"
+#include "core/summary.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
+
+namespace sweetspot::core {
+
+/// The models an output needs with `exit_model` as the exit-speed model, in run order
+/// (e.g. {"mass_properties", "rigid_pivot"}; vibration_node: {"flexible_beam"};
+/// least_sting_zone, or any exit output with model flexible: {"mass_properties",
+/// "flexible_beam", "flexible"}).
+std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model);
+
+/// The answer of EvaluateScene. Outputs not requested (or not computed) are empty.
+struct SceneResult {
+  Summary summary;                 ///< Overall: termination, message, models_used, total time.
+  std::string missing_model;       ///< Set (e.g. "flexible_beam") when refused for a missing model.
+  std::string refused_field;       ///< The request field the refusal is about (e.g. "outputs").
+  std::optional<double> cor;       ///< The COR used; unset when no wanted output needs one.
+  std::string cor_source;          ///< "scene" or "material:<name>"; "" when `cor` is unset.
+  MassProperties mass_properties;  ///< The properties used.
+  double length_m = 0.0;           ///< The bat length used, m.
+  std::string exit_speed_model;    ///< The exit-speed model used ("" when none was needed).
+  std::string model_reason;        ///< Why that model (auto).
+  std::optional<MaxExitSpeedResult> max_exit_speed;              ///< max_exit_speed.
+  std::optional<CenterOfPercussionResult> center_of_percussion;  ///< center_of_percussion.
+  std::optional<SweetZoneResult> sweet_zone;                     ///< sweet_zone.
+  std::optional<ExitSpeedCurveResult> exit_speed_curve;          ///< exit_speed_curve.
+  std::optional<VibrationNodeResult> vibration_node;             ///< vibration_node.
+  std::optional<LeastStingZoneResult> least_sting_zone;          ///< least_sting_zone.
+  std::vector<ModelTiming> timings;  ///< Time per model, in first-use order.
+};
+
+/// Computes the requested outputs. Never throws.
+SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options);
+
+}  // namespace sweetspot::core

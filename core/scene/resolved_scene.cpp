@@ -1,0 +1,168 @@
+#include "core/scene/resolved_scene.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <exception>
+
+#include "core/geometry_format.hpp"
+
+namespace sweetspot::core {
+
+bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, ResolvedScene* r,
+                  Summary* s) {
+  std::string why;
+  if (!scene.IsValid(&why)) {
+    s->termination = Termination::kInvalidInput;
+    s->message = why;
+    return false;
+  }
+  if (!needs_cor) {
+    // Nothing wanted uses a COR: none is resolved, so none is required.
+  } else if (scene.cor.has_value()) {
+    r->cor = *scene.cor;
+    r->cor_source = "scene";
+  } else if (scene.bat.has_value() && scene.bat->material.cor.has_value()) {
+    r->cor = *scene.bat->material.cor;
+    r->cor_source = "material:" + scene.bat->material.name;
+  } else {
+    s->termination = Termination::kInvalidInput;
+    s->message =
+        scene.bat.has_value()
+            ? "cor: not given, and material '" + scene.bat->material.name + "' has no default COR"
+            : "cor: not given, and there is no bat material to take it from";
+    return false;
+  }
+  if (scene.mass_properties.has_value()) {
+    r->mass_properties = *scene.mass_properties;
+  } else {
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      r->mass_properties = ComputeMassProperties(*scene.bat, scene.inertia_model);
+    } catch (const std::exception& e) {
+      s->termination = Termination::kFailure;
+      s->message = std::string("mass properties failed: ") + e.what();
+      return false;
+    }
+    book->Add("mass_properties", SecondsSince(t0), 1);
+  }
+  const MassProperties& mp = r->mass_properties;
+  if (!(std::isfinite(mp.mass_kg) && mp.mass_kg > 0.0 && std::isfinite(mp.balance_point_m) &&
+        std::isfinite(mp.moi_centroid_kg_m2) && mp.moi_centroid_kg_m2 > 0.0)) {
+    s->termination = Termination::kFailure;
+    s->message = "mass properties are not usable (mass_kg = " + FormatNumber17(mp.mass_kg) +
+                 ", moi_centroid_kg_m2 = " + FormatNumber17(mp.moi_centroid_kg_m2) + ")";
+    return false;
+  }
+  r->length_m = scene.bat.has_value() ? scene.bat->LengthM() : scene.length_m;
+  const double h = scene.swing.hands_from_knob_m;
+  if (!(h >= 0.0 && h <= r->length_m)) {
+    s->termination = Termination::kInvalidInput;
+    s->message = "swing.hands_from_knob_m = " + FormatNumber17(h) +
+                 ": must be within the bat [0, " + FormatNumber17(r->length_m) + "]";
+    return false;
+  }
+  return true;
+}
+
+RigidPivotInputs RigidPivotInputsFor(const MassProperties& mass_properties, const Ball& ball,
+                                     const Swing& swing, double cor) {
+  RigidPivotInputs in;
+  in.bat_mass_kg = mass_properties.mass_kg;
+  in.balance_point_m = mass_properties.balance_point_m;
+  in.pivot_from_knob_m = swing.pivot_from_knob_m;
+  in.moi_pivot_kg_m2 = mass_properties.MoiAboutKgM2(swing.pivot_from_knob_m);
+  in.ball_mass_kg = ball.mass_kg;
+  in.ball_speed_mps = ball.speed_mps;
+  in.angular_speed_rad_s = swing.angular_speed_rad_s;
+  in.cor = cor;
+  return in;
+}
+
+RigidPivotInputs RigidPivotInputsFor(const Scene& scene, const ResolvedScene& r) {
+  return RigidPivotInputsFor(r.mass_properties, scene.ball, scene.swing, *r.cor);
+}
+
+FreeBatInputs FreeBatInputsFor(const Scene& scene, const ResolvedScene& r) {
+  FreeBatInputs in;
+  in.bat_mass_kg = r.mass_properties.mass_kg;
+  in.balance_point_m = r.mass_properties.balance_point_m;
+  in.moi_centroid_kg_m2 = r.mass_properties.moi_centroid_kg_m2;
+  in.pivot_from_knob_m = scene.swing.pivot_from_knob_m;
+  in.hands_from_knob_m = scene.swing.hands_from_knob_m;
+  in.ball_mass_kg = scene.ball.mass_kg;
+  in.ball_speed_mps = scene.ball.speed_mps;
+  in.angular_speed_rad_s = scene.swing.angular_speed_rad_s;
+  in.cor = *r.cor;
+  return in;
+}
+
+HertzProblem HertzProblemFor(const Scene& scene, const ResolvedScene& r, double impact_from_knob_m,
+                             const HertzOptions& options, std::vector<std::string>* warnings) {
+  HertzProblem p;
+  const double m_bat = r.mass_properties.mass_kg;
+  const double i = r.mass_properties.moi_centroid_kg_m2;
+  const double b = impact_from_knob_m - r.mass_properties.balance_point_m;
+  const double bh = scene.swing.hands_from_knob_m - r.mass_properties.balance_point_m;
+  p.law = options.law;
+  p.ball_mass_kg = scene.ball.mass_kg;
+  p.ball_speed_mps = scene.ball.speed_mps;
+  p.approach_speed_mps =
+      scene.ball.speed_mps +
+      scene.swing.angular_speed_rad_s * (impact_from_knob_m - scene.swing.pivot_from_knob_m);
+  p.c11_per_kg = 1.0 / scene.ball.mass_kg + 1.0 / m_bat + b * b / i;
+  p.c12_per_kg = 1.0 / m_bat + b * bh / i;
+  p.c22_per_kg = 1.0 / m_bat + bh * bh / i;
+  p.ball_stiffness = scene.ball.stiffness;
+  p.ball_exponent = scene.ball.stiffness_exponent;
+  p.cor = *r.cor;
+  p.hands_stiffness_n_m = options.hands_stiffness_n_m;
+  p.hands_damping_n_s_m = options.hands_damping_n_s_m;
+  p.paper = options.paper;
+  p.surface_stiffness = 0.0;
+  if (options.law == ContactLaw::kBallPowerLaw && options.bat_surface_compliance) {
+    if (!scene.bat.has_value()) {
+      if (warnings != nullptr)
+        warnings->push_back("no bat geometry in the scene: the bat surface is taken as rigid");
+    } else {
+      const double radius = scene.bat->RadiusAtM(impact_from_knob_m);
+      if (radius > 0.0) {
+        p.surface_stiffness = BatSurfaceHertzStiffness(scene.bat->material.youngs_modulus_pa,
+                                                       scene.bat->material.poissons_ratio,
+                                                       scene.ball.radius_m, radius);
+      }
+      if (scene.bat->wall_thickness_m > 0.0 && warnings != nullptr) {
+        warnings->push_back(
+            "hollow bat: the local contact is computed as for a solid surface (no trampoline "
+            "effect; that needs the flexible shell model)");
+      }
+    }
+  }
+  return p;
+}
+
+FlexibleImpactInputs FlexibleImpactInputsFor(const Scene& scene, const ResolvedScene& r,
+                                             double impact_from_knob_m, const HertzOptions& hertz) {
+  FlexibleImpactInputs in;
+  in.impact_from_knob_m = impact_from_knob_m;
+  in.hands_from_knob_m = scene.swing.hands_from_knob_m;
+  in.ball_mass_kg = scene.ball.mass_kg;
+  in.ball_speed_mps = scene.ball.speed_mps;
+  in.approach_speed_mps =
+      scene.ball.speed_mps +
+      scene.swing.angular_speed_rad_s * (impact_from_knob_m - scene.swing.pivot_from_knob_m);
+  in.ball_stiffness = scene.ball.stiffness;
+  in.ball_exponent = scene.ball.stiffness_exponent;
+  in.cor = *r.cor;
+  in.surface_stiffness = 0.0;
+  if (hertz.bat_surface_compliance && scene.bat.has_value()) {
+    const double radius = scene.bat->RadiusAtM(impact_from_knob_m);
+    if (radius > 0.0) {
+      in.surface_stiffness =
+          BatSurfaceHertzStiffness(scene.bat->material.youngs_modulus_pa,
+                                   scene.bat->material.poissons_ratio, scene.ball.radius_m, radius);
+    }
+  }
+  return in;
+}
+
+}  // namespace sweetspot::core

@@ -1,0 +1,55 @@
+// What every output of one request shares (the mass properties, the length, the COR): resolved
+// once per request and passed down; and the only adapters from a resolved scene to each
+// model's inputs.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/collision/free_bat.hpp"
+#include "core/collision/hertz_contact.hpp"
+#include "core/collision/rigid_pivot.hpp"
+#include "core/flexible/flexible_impact.hpp"
+#include "core/mass_properties.hpp"
+#include "core/scene/scene.hpp"
+#include "core/scene/timing_book.hpp"
+#include "core/summary.hpp"
+
+namespace sweetspot::core {
+
+/// A scene's shared quantities, computed once per request.
+struct ResolvedScene {
+  MassProperties mass_properties;  ///< The bat's (computed from `bat`, or the scene's own).
+  double length_m = 0.0;           ///< The bat length, m.
+  std::optional<double> cor;       ///< The COR; unset when nothing wanted needs one.
+  std::string cor_source;          ///< "scene" or "material:<name>"; "" when `cor` is unset.
+};
+
+/// Validates `scene`, resolves its COR when `needs_cor`, computes (or takes) its mass properties
+/// once (timed as "mass_properties" in *book when computed) and checks the hands are on the bat.
+/// False with the termination and message in *summary otherwise. Never throws.
+bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, ResolvedScene* resolved,
+                  Summary* summary);
+
+/// The rigid-pivot inputs of a bat with `mass_properties` hit by `ball` in `swing` with `cor`.
+RigidPivotInputs RigidPivotInputsFor(const MassProperties& mass_properties, const Ball& ball,
+                                     const Swing& swing, double cor);
+/// The rigid-pivot inputs of a resolved scene (its COR must be resolved).
+RigidPivotInputs RigidPivotInputsFor(const Scene& scene, const ResolvedScene& resolved);
+
+/// The free-bat inputs of a resolved scene (its COR must be resolved).
+FreeBatInputs FreeBatInputsFor(const Scene& scene, const ResolvedScene& resolved);
+
+/// The contact model's problem for an impact `impact_from_knob_m` m from the knob (the COR must
+/// be resolved); notes on the bat surface are appended to *warnings (may be null).
+HertzProblem HertzProblemFor(const Scene& scene, const ResolvedScene& resolved,
+                             double impact_from_knob_m, const HertzOptions& options,
+                             std::vector<std::string>* warnings);
+
+/// The flexible impact's inputs for an impact `impact_from_knob_m` m from the knob (the COR must
+/// be resolved); the bat surface's stiffness when hertz.bat_surface_compliance.
+FlexibleImpactInputs FlexibleImpactInputsFor(const Scene& scene, const ResolvedScene& resolved,
+                                             double impact_from_knob_m, const HertzOptions& hertz);
+
+}  // namespace sweetspot::core
