@@ -125,8 +125,8 @@ std::optional<core::Material> ParseMaterial(const Json& value, const std::string
   return material;
 }
 
-std::optional<BatSpec> ParseBat(const Json& value, const std::string& path,
-                                const ApiLimits& limits, ApiError* error) {
+std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& path,
+                                        const ApiLimits& limits, ApiError* error) {
   ObjectReader reader(value, path, error);
   if (!reader.ok()) return std::nullopt;
   BatSpec spec;
@@ -198,19 +198,31 @@ std::optional<BatSpec> ParseBat(const Json& value, const std::string& path,
     CoreRefusal(why, prefix, error);
     return std::nullopt;
   }
+  return spec;
+}
+
+bool CheckComputable(const core::MassProperties& p, const std::string& path, ApiError* error) {
   // A valid but absurdly small or light bat (e.g. radii of 1e-300 m) has a mass
   // or moment of inertia that underflows to 0, and a balance point of 0/0:
   // refuse it rather than answer NaN or fail in core (found by fuzzing:
   // fuzz/regressions/parse_bat/).
+  if (std::isfinite(p.mass_kg) && p.mass_kg > 0 && std::isfinite(p.balance_point_m) &&
+      std::isfinite(p.moi_knob_kg_m2) && std::isfinite(p.moi_centroid_kg_m2) &&
+      p.moi_centroid_kg_m2 > 0) {
+    return true;
+  }
+  return SetError(error, "InvalidValue", path, nullptr,
+                  "is too small or too light to compute with: its mass or moment of inertia is "
+                  "not a positive finite number (use SI units: metres, kg/m3)");
+}
+
+std::optional<BatSpec> ParseBat(const Json& value, const std::string& path, const ApiLimits& limits,
+                                ApiError* error) {
+  auto spec = ParseBatGeometry(value, path, limits, error);
+  if (!spec) return std::nullopt;
   for (const core::InertiaModel model :
        {core::InertiaModel::kRigidBody, core::InertiaModel::kSlenderRod}) {
-    const core::MassProperties p = core::ComputeMassProperties(spec.bat, model);
-    if (!(std::isfinite(p.mass_kg) && p.mass_kg > 0 && std::isfinite(p.balance_point_m) &&
-          std::isfinite(p.moi_knob_kg_m2) && std::isfinite(p.moi_centroid_kg_m2) &&
-          p.moi_centroid_kg_m2 > 0)) {
-      SetError(error, "InvalidValue", path, nullptr,
-               "is too small or too light to compute with: its mass or moment of inertia is "
-               "not a positive finite number (use SI units: metres, kg/m3)");
+    if (!CheckComputable(core::ComputeMassProperties(spec->bat, model), path, error)) {
       return std::nullopt;
     }
   }

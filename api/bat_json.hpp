@@ -27,9 +27,21 @@ struct BatSpec {
 
 /// Parses the bat object at `path` (e.g. "bat"). On error returns nullopt with
 /// *error naming the field (e.g. "bat.profile.knots[2].x_m = 0.1: must be
-/// greater than knots[1].x_m = 0.2").
+/// greater than knots[1].x_m = 0.2"); a bat too small or light to compute with
+/// (CheckComputable under either inertia model) is refused on `path`.
 std::optional<BatSpec> ParseBat(const nlohmann::json& value, const std::string& path,
                                 const ApiLimits& limits, ApiError* error);
+
+/// ParseBat without computing the mass properties: for requests whose core call
+/// computes them itself, once (the scene endpoints); they check that result with
+/// CheckComputable (SceneFailure does).
+std::optional<BatSpec> ParseBatGeometry(const nlohmann::json& value, const std::string& path,
+                                        const ApiLimits& limits, ApiError* error);
+
+/// False, with *error on `path` ("is too small or too light to compute with: ..."),
+/// when `properties` are not positive and finite (a bat whose integrals underflow).
+bool CheckComputable(const core::MassProperties& properties, const std::string& path,
+                     ApiError* error);
 
 /// Parses a material: a catalogue name or an object with at least
 /// density_kg_m3 and youngs_modulus_pa. `allow_empty` accepts "empty" (a fill).

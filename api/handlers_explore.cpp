@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 
+#include "api/explore_design.hpp"
 #include "api/explore_shards.hpp"
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
@@ -30,70 +31,6 @@ struct Parameter {
   std::vector<PathStep> steps;
 };
 
-// What a row reports (besides parameters): "properties" and scene outputs.
-struct RowOutputs {
-  bool properties = false;
-  bool collision_efficiency = false;
-  std::vector<core::SceneOutput> scene;
-};
-
-// A row for one design evaluated from `design_json` (bat + scene fields).
-Json EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
-                    const core::SceneOptions& options, const ApiLimits& limits) {
-  ApiError error;
-  ObjectReader reader(design_json, "", &error);
-  core::Scene scene;
-  std::optional<BatSpec> spec;
-  if (const Json* bat = reader.Get("bat")) spec = ParseBat(*bat, "bat", limits, &error);
-  if (spec) {
-    scene.bat = spec->bat;
-    ReadSceneCommon(reader, &scene);
-  }
-  scene.outputs = outputs.scene;
-  std::string why;
-  if (error.code.empty()) {
-    // A row of properties only names no scene output; the scene (bat, ball,
-    // swing, cor) must still be valid, so it is checked as if it named one.
-    core::Scene check = scene;
-    if (check.outputs.empty()) check.outputs = {core::SceneOutput::kMaxExitSpeed};
-    if (!check.IsValid(&why)) CoreRefusal(why, "", &error);
-  }
-  if (!error.code.empty()) {
-    return {{"feasible", false},
-            {"error", {{"code", error.code}, {"message", error.message}, {"field", error.field}}}};
-  }
-  Json row{{"feasible", true}};
-  core::SceneResult result;
-  if (!scene.outputs.empty()) {
-    result = core::EvaluateScene(scene, options);
-    if (!result.summary.IsSolutionUsable()) {
-      // The same code and field /v1/sweet-spot would answer for this design.
-      const Response failure =
-          CoreFailure(result.summary, result.missing_model,
-                      result.refused_field.empty() ? "outputs" : result.refused_field,
-                      /*options_object=*/true);
-      return {{"feasible", false}, {"error", failure.body}};
-    }
-    Json rendered = SceneResultToJson(result);
-    for (const core::SceneOutput output : scene.outputs) {
-      const char* name = core::SceneOutputName(output);
-      if (rendered.contains(name)) row[name] = std::move(rendered[name]);
-    }
-  } else {
-    result.mass_properties = core::ComputeMassProperties(spec->bat, scene.inertia_model);
-    result.length_m = spec->bat.LengthM();
-  }
-  if (outputs.properties) {
-    row["properties"] = PropertiesToJson(result.mass_properties, result.length_m);
-  }
-  if (outputs.collision_efficiency && result.max_exit_speed) {
-    const core::CollisionResult hit = core::Collide(
-        scene, result.max_exit_speed->position_from_knob_m, core::CollisionModel::kRigidPivot);
-    if (hit.rigid_pivot) row["collision_efficiency"] = hit.rigid_pivot->collision_efficiency;
-  }
-  return row;
-}
-
 // The error a swept field gives because the design's parser does not know it (a misspelt
 // last key, "profile.knots[3].radius"): every design would fail alike, so the sweep is
 // refused before its first design. `probe` is the valid template with only that field set;
@@ -102,7 +39,8 @@ bool IsKnownField(const Json& probe, const ApiLimits& limits, ApiError* unknown)
   ApiError error;
   ObjectReader reader(probe, "", &error);
   core::Scene scene;
-  if (const Json* bat = reader.Get("bat"); bat != nullptr && ParseBat(*bat, "bat", limits, &error)) {
+  const Json* bat = reader.Get("bat");
+  if (bat != nullptr && ParseBatGeometry(*bat, "bat", limits, &error)) {
     ReadSceneCommon(reader, &scene);
   }
   if (error.code != "UnknownField") return true;
@@ -162,7 +100,7 @@ SweepOutcome RunSweep(const Sweep& sweep, core::Progress* progress,
       SetNumberAtPath(&design, sweep.parameters[k].steps, point[k], nullptr);
       values[sweep.parameters[k].path] = point[k];
     }
-    Json row = EvaluateDesign(design, sweep.outputs, sweep.options, sweep.limits);
+    Json row = EvaluateDesign(design, sweep.outputs, sweep.options, sweep.limits).row;
     row["index"] = i;
     row["parameters"] = std::move(values);
     if (!row["feasible"].get<bool>()) ++failed;

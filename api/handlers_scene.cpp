@@ -14,7 +14,8 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Reads the required bat at `key` into `scene` (and returns its spec).
+// Reads the required bat at `key` into `scene` (and returns its spec). Its mass properties
+// are left to core, which computes them once per scene (SceneFailure checks them).
 std::optional<BatSpec> ReadBat(ObjectReader& reader, const char* key, const ApiLimits& limits,
                                core::Scene* scene) {
   const Json* value = reader.Get(key);
@@ -23,7 +24,7 @@ std::optional<BatSpec> ReadBat(ObjectReader& reader, const char* key, const ApiL
     reader.Missing(key);
     return std::nullopt;
   }
-  auto spec = ParseBat(*value, reader.PathOf(key), limits, reader.error());
+  auto spec = ParseBatGeometry(*value, reader.PathOf(key), limits, reader.error());
   if (spec && scene != nullptr) scene->bat = spec->bat;
   return spec;
 }
@@ -55,9 +56,9 @@ Response HandleSweetSpot(const Request& request, const Context& context) {
   options.flexible.modes_cache = context.modes_cache;
   const core::SceneResult result = core::EvaluateScene(scene, options);
   if (!result.summary.IsSolutionUsable()) {
-    return CoreFailure(result.summary, result.missing_model,
-                       result.refused_field.empty() ? "outputs" : result.refused_field,
-                       /*options_object=*/true);
+    return SceneFailure(result.summary, result.missing_model, result.mass_properties, "bat",
+                        result.refused_field.empty() ? "outputs" : result.refused_field,
+                        /*options_object=*/true);
   }
   Json out = SceneResultToJson(result);
   out["properties"] = PropertiesToJson(result.mass_properties, result.length_m);
@@ -102,7 +103,8 @@ Response HandleCollision(const Request& request, const Context& context) {
   const core::CollisionResult result =
       core::Collide(scene, impact, *core::ParseCollisionModel(model_name), options);
   if (!result.summary.IsSolutionUsable()) {
-    return CoreFailure(result.summary, result.missing_model, "model");
+    return SceneFailure(result.summary, result.missing_model, result.mass_properties, "bat",
+                        "model");
   }
   Json out = CollisionResultToJson(result);
   out["summary"] = SummaryToJson(result.summary);
@@ -168,9 +170,10 @@ Response HandleCompare(const Request& request, const Context& context) {
     }
     const core::SceneResult result = core::EvaluateScene(bat_scene, options);
     if (!result.summary.IsSolutionUsable()) {
-      return CoreFailure(result.summary, result.missing_model,
-                         result.refused_field.empty() ? field : result.refused_field,
-                         /*options_object=*/true);
+      return SceneFailure(result.summary, result.missing_model, result.mass_properties,
+                          i == 0 ? field : field + ".bat",
+                          result.refused_field.empty() ? field : result.refused_field,
+                          /*options_object=*/true);
     }
     Json row = SceneResultToJson(result);
     row["name"] = bats[i].first;

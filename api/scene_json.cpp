@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "api/bat_json.hpp"
 #include "api/router.hpp"
 
 namespace sweetspot::api {
@@ -273,6 +274,15 @@ Response CoreFailure(const core::Summary& summary, const std::string& missing_mo
   // The model ran and could not finish with these inputs and settings (e.g. a
   // step or evaluation budget): the client's to change, so 422, not a 500.
   return ErrorResponse(422, "ModelFailed", "the model failed: " + summary.message, field);
+}
+
+Response SceneFailure(const core::Summary& summary, const std::string& missing_model,
+                      const core::MassProperties& properties, const std::string& bat_path,
+                      const std::string& field, bool options_object) {
+  if (summary.termination == core::Termination::kFailure) {
+    if (ApiError error; !CheckComputable(properties, bat_path, &error)) return ToResponse(error);
+  }
+  return CoreFailure(summary, missing_model, field, options_object);
 }
 
 Json SummaryToJson(const core::Summary& s) {

@@ -53,6 +53,13 @@ void ClampToLimits(const ApiLimits& limits, core::FlexibleOptions* options);
 Response CoreFailure(const core::Summary& summary, const std::string& missing_model,
                      const std::string& field, bool options_object = false);
 
+/// CoreFailure for a scene whose bat was parsed with ParseBatGeometry: a failure
+/// on mass properties that are not usable (`properties`, as core computed them
+/// once) is the bat's, a 400 on `bat_path` as ParseBat answers.
+Response SceneFailure(const core::Summary& summary, const std::string& missing_model,
+                      const core::MassProperties& properties, const std::string& bat_path,
+                      const std::string& field, bool options_object = false);
+
 /// The summary block {termination, message, backend, raw_status, iterations,
 /// evaluations, error_estimate, solve_time_s, models_used, warnings}.
 nlohmann::json SummaryToJson(const core::Summary& summary);

@@ -44,9 +44,11 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
       return finish();
     }
     ResolvedScene r;
-    if (!ResolveScene(scene, /*needs_cor=*/true, &book, &r, &s)) return finish();
-    out.cor = *r.cor;
+    const bool resolved = ResolveScene(scene, /*needs_cor=*/true, &book, &r, &s);
+    // Also when refused: the caller can then tell properties that are not usable (the bat's).
     out.mass_properties = r.mass_properties;
+    if (!resolved) return finish();
+    out.cor = *r.cor;
     if (!(std::isfinite(impact_from_knob_m) && impact_from_knob_m >= 0.0 &&
           impact_from_knob_m <= r.length_m)) {
       s.termination = Termination::kInvalidInput;

@@ -40,7 +40,7 @@ struct CollisionResult {
   double exit_speed_mps = 0.0;                         ///< m/s, positive away from the bat.
   double error_estimate_mps = 0.0;                     ///< Estimated error of the exit speed, m/s.
   double cor = 0.0;                                    ///< The COR used.
-  MassProperties mass_properties;                      ///< The properties used.
+  MassProperties mass_properties;  ///< The properties used (when refused: as computed, or zero).
   std::optional<RigidPivotImpact> rigid_pivot;         ///< Details when model = rigid_pivot.
   std::optional<FreeBatImpact> free_bat;               ///< Details when model = free_bat.
   std::optional<HertzImpact> hertz;                    ///< Details when model = hertz.

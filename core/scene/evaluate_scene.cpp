@@ -143,10 +143,12 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
     }
     ResolvedScene r;
     const bool needs_cor = std::any_of(wanted.begin(), wanted.end(), NeedsCor);
-    if (!ResolveScene(scene, needs_cor, &book, &r, &s)) return finish();
+    const bool resolved = ResolveScene(scene, needs_cor, &book, &r, &s);
+    // Also when refused: the caller can then tell properties that are not usable (the bat's).
+    out.mass_properties = r.mass_properties;
+    if (!resolved) return finish();
     out.cor = r.cor;
     out.cor_source = r.cor_source;
-    out.mass_properties = r.mass_properties;
     out.length_m = r.length_m;
     for (size_t i = 0; i < options.curve_positions_from_knob_m.size(); ++i) {
       const double x = options.curve_positions_from_knob_m[i];

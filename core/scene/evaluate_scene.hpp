@@ -29,7 +29,7 @@ struct SceneResult {
   std::string refused_field;       ///< The request field the refusal is about (e.g. "outputs").
   std::optional<double> cor;       ///< The COR used; unset when no wanted output needs one.
   std::string cor_source;          ///< "scene" or "material:<name>"; "" when `cor` is unset.
-  MassProperties mass_properties;  ///< The properties used.
+  MassProperties mass_properties;  ///< The properties used (when refused: as computed, or zero).
   double length_m = 0.0;           ///< The bat length used, m.
   std::string exit_speed_model;    ///< The exit-speed model used ("" when none was needed).
   std::string model_reason;        ///< Why that model (auto).

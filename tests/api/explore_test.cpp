@@ -4,6 +4,7 @@
 #include <map>
 #include <set>
 
+#include "api/explore_design.hpp"
 #include "api/json_path.hpp"
 #include "api/router.hpp"
 
@@ -283,6 +284,42 @@ TEST(ExploreTest, AnUnknownLastKeyIsRefusedBeforeTheFirstDesign) {
   const Response r = Explore(body);
   ASSERT_EQ(r.status, 200) << r.body.dump();
   EXPECT_EQ(r.body["summary"]["failed"], 0) << r.body.dump();
+}
+
+TEST(ExploreTest, ARowComputesTheMassPropertiesOnce) {
+  // A row with collision_efficiency ran ParseBat's guard (twice), the scene and the collision:
+  // four computations. Now the scene's one is shared with the collision.
+  const Json design = Json::parse(R"({"bat": {"preset": "paper-wood"}, "cor": 0.45})");
+  RowOutputs outputs;
+  outputs.properties = true;
+  outputs.collision_efficiency = true;
+  outputs.scene = {core::SceneOutput::kMaxExitSpeed};
+  const DesignRow d = EvaluateDesign(design, outputs, core::SceneOptions{}, ApiLimits{});
+  ASSERT_TRUE(d.row["feasible"].get<bool>()) << d.row.dump();
+  int mass_properties_calls = 0, rigid_pivot_calls = 0;
+  for (const auto& t : d.timings) {
+    if (t.model == "mass_properties") mass_properties_calls += t.calls;
+    if (t.model == "rigid_pivot") rigid_pivot_calls += t.calls;
+  }
+  EXPECT_EQ(mass_properties_calls, 1);
+  EXPECT_EQ(rigid_pivot_calls, 2);  // the closed-form maximum, then the impact at it
+  // q at the sweet spot, as /v1/collision answers it there (same inputs, same arithmetic).
+  const Json collision{{"bat", {{"preset", "paper-wood"}}},
+                       {"cor", 0.45},
+                       {"model", "rigid_pivot"},
+                       {"impact_from_knob_m", d.row["max_exit_speed"]["position_from_knob_m"]}};
+  const Response hit = Dispatch({"POST", "/v1/collision", collision.dump()}, Context{});
+  ASSERT_EQ(hit.status, 200) << hit.body.dump();
+  EXPECT_EQ(d.row["collision_efficiency"], hit.body["rigid_pivot"]["collision_efficiency"]);
+  // A row of properties only: one computation too.
+  outputs = RowOutputs{};
+  outputs.properties = true;
+  const DesignRow p = EvaluateDesign(design, outputs, core::SceneOptions{}, ApiLimits{});
+  ASSERT_TRUE(p.row["feasible"].get<bool>()) << p.row.dump();
+  ASSERT_EQ(p.timings.size(), 1u);
+  EXPECT_EQ(p.timings[0].model, "mass_properties");
+  EXPECT_EQ(p.timings[0].calls, 1);
+  EXPECT_NEAR(p.row["properties"]["mass_kg"].get<double>(), 1.0078, 1e-4);  // paper-wood
 }
 
 TEST(ExploreTest, CancelledSweepStops) {

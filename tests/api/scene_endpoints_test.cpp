@@ -128,6 +128,37 @@ TEST(SweetSpotEndpointTest, OutputsWithoutAnImpactNeedNoCor) {
   EXPECT_EQ(refused.body["message"], "cor: not given, and material 'custom' has no default COR");
 }
 
+// The calls of `model` in a response's timings (0 when it did not run).
+int CallsOf(const nlohmann::json& body, const std::string& model) {
+  for (const auto& t : body["timings"]) {
+    if (t["model"] == model) return t["calls"].get<int>();
+  }
+  return 0;
+}
+
+TEST(SweetSpotEndpointTest, MassPropertiesAreComputedOncePerRequest) {
+  // The api no longer computes them as a guard (ParseBat did, under both inertia models):
+  // core's single computation is the only one, and it is what the timings count.
+  for (const char* body :
+       {R"({"bat": {"preset": "paper-wood"}})",
+        R"({"bat": {"preset": "paper-wood"}, "outputs": ["max_exit_speed", "sweet_zone",
+            "exit_speed_curve", "center_of_percussion"], "inertia_model": "slender_rod"})"}) {
+    const Response r = Post("/v1/sweet-spot", body);
+    ASSERT_EQ(r.status, 200) << r.body.dump();
+    EXPECT_EQ(CallsOf(r.body, "mass_properties"), 1) << body;
+  }
+  // A bat too small to compute with is still a 400 on the bat (fuzz/regressions/parse_bat/),
+  // found on that one computation's result.
+  const Response tiny = Post("/v1/sweet-spot", R"({"bat": {"profile": {"knots": [
+      {"x_m": 0, "radius_m": 1e-200}, {"x_m": 1e-200, "radius_m": 1e-200}]}, "material": "ash"}})");
+  EXPECT_EQ(tiny.status, 400) << tiny.body.dump();
+  EXPECT_EQ(tiny.body["code"], "InvalidValue");
+  EXPECT_EQ(tiny.body["field"], "bat");
+  EXPECT_EQ(tiny.body["message"],
+            "bat is too small or too light to compute with: its mass or moment of inertia is not "
+            "a positive finite number (use SI units: metres, kg/m3)");
+}
+
 TEST(SweetSpotEndpointTest, RefusalsNameTheField) {
   struct Case {
     const char* body;
