@@ -71,26 +71,24 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
       out.model_reason = "requested";
     }
     out.model = model;
+    // A closed-form impact: exact up to rounding.
+    const auto closed_form = [&](double exit_speed_mps, double approach_speed_mps) {
+      out.exit_speed_mps = exit_speed_mps;
+      out.approach_speed_mps = approach_speed_mps;
+      out.error_estimate_mps = 8.0 * kEps * (scene.ball.speed_mps + std::abs(exit_speed_mps));
+      s.termination = Termination::kConverged;
+      s.message = "closed form";
+    };
     const auto tm = std::chrono::steady_clock::now();
     switch (model) {
-      case CollisionModel::kRigidPivot: {
+      case CollisionModel::kRigidPivot:
         out.rigid_pivot = RigidPivotImpactAt(RigidPivotInputsFor(scene, r), impact_from_knob_m);
-        out.exit_speed_mps = out.rigid_pivot->exit_speed_mps;
-        out.approach_speed_mps = out.rigid_pivot->approach_speed_mps;
-        out.error_estimate_mps = 8.0 * kEps * (scene.ball.speed_mps + std::abs(out.exit_speed_mps));
-        s.termination = Termination::kConverged;
-        s.message = "closed form";
+        closed_form(out.rigid_pivot->exit_speed_mps, out.rigid_pivot->approach_speed_mps);
         break;
-      }
-      case CollisionModel::kFreeBat: {
+      case CollisionModel::kFreeBat:
         out.free_bat = FreeBatImpactAt(FreeBatInputsFor(scene, r), impact_from_knob_m);
-        out.exit_speed_mps = out.free_bat->exit_speed_mps;
-        out.approach_speed_mps = out.free_bat->approach_speed_mps;
-        out.error_estimate_mps = 8.0 * kEps * (scene.ball.speed_mps + std::abs(out.exit_speed_mps));
-        s.termination = Termination::kConverged;
-        s.message = "closed form";
+        closed_form(out.free_bat->exit_speed_mps, out.free_bat->approach_speed_mps);
         break;
-      }
       case CollisionModel::kHertz: {
         std::vector<std::string> warnings;
         const HertzProblem p =
@@ -113,15 +111,7 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
         FlexibleModes flexible_modes(scene, options.flexible, &book);
         const auto& modes = flexible_modes.Impact();
         out.modes_cache_hit = flexible_modes.impact_hit();
-        if (!modes->summary.IsSolutionUsable()) {
-          s.termination = modes->summary.termination == Termination::kInvalidInput
-                              ? Termination::kInvalidInput
-                              : Termination::kFailure;
-          s.message = s.termination == Termination::kInvalidInput
-                          ? modes->summary.message + " (model = flexible)"
-                          : "model = flexible: the bat's modes: " + modes->summary.message;
-          return finish();
-        }
+        if (FlexibleModesRefused(*modes, &s)) return finish();
         const auto tf = std::chrono::steady_clock::now();
         const FlexibleImpactInputs in =
             FlexibleImpactInputsFor(scene, r, impact_from_knob_m, options.hertz);

@@ -182,13 +182,7 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
     if (needs_exit) {
       if (model == CollisionModel::kFlexible) {
         const auto& modes = flexible_modes.Impact();
-        if (!modes->summary.IsSolutionUsable()) {
-          s.termination = modes->summary.termination == Termination::kInvalidInput
-                              ? Termination::kInvalidInput
-                              : Termination::kFailure;
-          s.message = s.termination == Termination::kInvalidInput
-                          ? modes->summary.message + " (model = flexible)"
-                          : "model = flexible: the bat's modes: " + modes->summary.message;
+        if (FlexibleModesRefused(*modes, &s)) {
           if (s.termination == Termination::kInvalidInput) out.refused_field = "bat";
           return finish();
         }

@@ -34,6 +34,15 @@ std::shared_ptr<const BatModes> FlexibleModes::Get(const BeamModesOptions& o, bo
   return modes;
 }
 
+bool FlexibleModesRefused(const BatModes& modes, Summary* summary) {
+  if (modes.summary.IsSolutionUsable()) return false;
+  const bool invalid = modes.summary.termination == Termination::kInvalidInput;
+  summary->termination = invalid ? Termination::kInvalidInput : Termination::kFailure;
+  summary->message = invalid ? modes.summary.message + " (model = flexible)"
+                             : "model = flexible: the bat's modes: " + modes.summary.message;
+  return true;
+}
+
 ExitSpeedModel::ExitSpeedModel(CollisionModel model, const Scene& scene,
                                const ResolvedScene& resolved, const HertzOptions& hertz,
                                TimingBook* book, const FlexibleOptions* flexible,

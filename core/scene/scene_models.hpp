@@ -41,6 +41,11 @@ class FlexibleModes {
   bool impact_hit_ = false, vibration_hit_ = false;
 };
 
+/// For model = flexible: when `modes` are not usable, sets *summary's termination (invalid
+/// input, or failure) and message (an invalid input's keeps the modes' message first: it names
+/// the field) and returns true.
+bool FlexibleModesRefused(const BatModes& modes, Summary* summary);
+
 /// The exit speed along the bat under one collision model (not kAuto); the closed-form models
 /// (rigid_pivot, free_bat) carry their profile. Each evaluation is timed under the model's name.
 class ExitSpeedModel : public ExitSpeedFunction {
