@@ -17,6 +17,8 @@
 #include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace bench_core_flexible {
 namespace {
 
 // See bench/core_collision.cpp: the const overload of DoNotOptimize is input-only.
@@ -226,4 +228,5 @@ BENCHMARK_CAPTURE(BM_SceneFlexible, least_sting_zone, SceneOutput::kLeastStingZo
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace
+}  // namespace bench_core_flexible
 }  // namespace sweetspot::core

@@ -1,6 +1,7 @@
-// One libFuzzer target of fuzz/entry_points.hpp, chosen at compile time by
-// SWEETSPOT_FUZZ_TARGET (a target name: "parse_body", "dispatch", ...), with a
-// JSON-aware mutator (fuzz/json_mutator.hpp) beside libFuzzer's own.
+// The libFuzzer driver of every target of fuzz/entry_points.hpp, with a
+// JSON-aware mutator (fuzz/json_mutator.hpp) beside libFuzzer's own. Compiled
+// once; each fuzz_<name> executable links it with a one-line source that defines
+// kSweetspotFuzzTarget (the target name: "parse_body", "dispatch", ...).
 // A problem aborts with its description, so libFuzzer keeps the input. A note
 // (a handler's deliberate 500) aborts too when SWEETSPOT_FUZZ_STRICT=1;
 // otherwise it is printed once per kind ("fuzz note: ...") and, when
@@ -18,20 +19,19 @@
 #include "fuzz/entry_points.hpp"
 #include "fuzz/json_mutator.hpp"
 
-#ifndef SWEETSPOT_FUZZ_TARGET
-#error "define SWEETSPOT_FUZZ_TARGET to a target name of sweetspot::fuzz::Targets()"
-#endif
+/// The name of the target this executable fuzzes (fuzz/target_name.cpp.in, one per executable).
+extern "C" const char kSweetspotFuzzTarget[];
 
 namespace {
 
 using sweetspot::fuzz::Verdict;
 
-// The entry point named SWEETSPOT_FUZZ_TARGET (aborts when there is none).
+// The entry point named kSweetspotFuzzTarget (aborts when there is none).
 Verdict (*Entry())(std::string_view) {
   for (const auto& target : sweetspot::fuzz::Targets()) {
-    if (std::string_view(target.name) == SWEETSPOT_FUZZ_TARGET) return target.run;
+    if (std::string_view(target.name) == kSweetspotFuzzTarget) return target.run;
   }
-  std::fprintf(stderr, "no fuzz target named %s\n", SWEETSPOT_FUZZ_TARGET);
+  std::fprintf(stderr, "no fuzz target named %s\n", kSweetspotFuzzTarget);
   std::abort();
 }
 
@@ -49,7 +49,7 @@ std::string KindOf(const std::string& note) {
 void Note(const std::string& note, std::string_view input) {
   static std::set<std::string> seen;
   if (seen.size() >= 64 || !seen.insert(KindOf(note)).second) return;
-  std::fprintf(stderr, "fuzz note: %s: %s\n", SWEETSPOT_FUZZ_TARGET, note.c_str());
+  std::fprintf(stderr, "fuzz note: %s: %s\n", kSweetspotFuzzTarget, note.c_str());
   if (const char* dir = std::getenv("SWEETSPOT_FUZZ_NOTES_DIR"); dir != nullptr && *dir != '\0') {
     const std::string path = std::string(dir) + "/note-" + std::to_string(seen.size());
     std::ofstream(path, std::ios::binary)
@@ -83,7 +83,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view input(reinterpret_cast<const char*>(data), size);
   const Verdict verdict = run(input);
   if (!verdict.problem.empty() || (strict && !verdict.note.empty())) {
-    std::fprintf(stderr, "fuzz problem: %s: %s\n", SWEETSPOT_FUZZ_TARGET,
+    std::fprintf(stderr, "fuzz problem: %s: %s\n", kSweetspotFuzzTarget,
                  verdict.problem.empty() ? verdict.note.c_str() : verdict.problem.c_str());
     std::abort();
   }

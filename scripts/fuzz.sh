@@ -16,6 +16,7 @@
 #   SWEETSPOT_JOBS=N           build parallelism (default: nproc)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/stages.sh
 seconds="${SWEETSPOT_FUZZ_SECONDS:-6}"
 targets="${SWEETSPOT_FUZZ_TARGETS:-parse_body parse_bat dispatch bat_fit sweet_spot collision compare explore}"
 jobs="${SWEETSPOT_JOBS:-$(nproc)}"
@@ -30,7 +31,7 @@ fi
 echo "== libFuzzer build (clang, ASan + UBSan) in $build/" >&2
 CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DSWEETSPOT_FUZZ=ON -DBUILD_TESTING=OFF -DSWEETSPOT_BUILD_BENCH=OFF -DSWEETSPOT_BUILD_WEB=OFF >/dev/null
-cmake --build "$build" -j"$jobs" --target fuzz_targets
+stage "fuzz: build" cmake --build "$build" -j"$jobs" --target fuzz_targets
 
 failed=()
 start=$SECONDS
@@ -58,7 +59,7 @@ for t in $targets; do
     echo "fuzz.sh: $t failed; full log: $log; input in $build/artifacts/$t/" >&2
   fi
 done
-echo "fuzz.sh: $(( SECONDS - start )) s of fuzzing" >&2
+echo "-- fuzz: run: $(( SECONDS - start )) s" >&2
 if [ ${#failed[@]} -ne 0 ]; then
   echo "fuzz.sh: FAILED: ${failed[*]}" >&2
   exit 1

@@ -9,6 +9,7 @@
 #   SWEETSPOT_JOBS=N               build parallelism (default: nproc)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/stages.sh
 jobs="${SWEETSPOT_JOBS:-$(nproc)}"
 filter="${SWEETSPOT_TSAN_FILTER:-Job*:*Concurrent*:ServerTest.*:ServerLimits*:ExploreStream*:FaultsTest.*:ServingTest.ConnectionsPast*:ServingTest.IdleKeepAlive*:PostgresJobsTest.*}"
 build=build-tsan
@@ -18,7 +19,7 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1"
   -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" -DSWEETSPOT_BUILD_BENCH=OFF \
   -DSWEETSPOT_BUILD_WEB=OFF >/dev/null
-cmake --build "$build" -j"$jobs" --target api_tests server_tests
+stage "tsan: build" cmake --build "$build" -j"$jobs" --target api_tests server_tests
 
 logs="$build/tsan-logs"
 rm -rf "$logs"
@@ -29,7 +30,7 @@ export TSAN_OPTIONS="log_path=$PWD/$logs/tsan:second_deadlock_stack=1:history_si
 status=0
 for suite in api_tests server_tests; do
   echo "== $suite --gtest_filter=$filter (TSan)" >&2
-  "$build/tests/$suite" --gtest_filter="$filter" --gtest_brief=1 || status=1
+  stage "tsan: $suite" "$build/tests/$suite" --gtest_filter="$filter" --gtest_brief=1 || status=1
 done
 if compgen -G "$logs/tsan.*" >/dev/null; then
   echo "tsan.sh: ThreadSanitizer reports:" >&2

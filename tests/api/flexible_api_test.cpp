@@ -11,6 +11,8 @@
 #include "core/flexible/modes_cache.hpp"
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace flexible_api_test {
 namespace {
 
 Response Post(const std::string& path, const std::string& body) {
@@ -212,4 +214,5 @@ TEST(FlexibleCollisionEndpointTest, ModelFlexibleReportsVibrationsStingAndErrors
 }
 
 }  // namespace
+}  // namespace flexible_api_test
 }  // namespace sweetspot::api

@@ -11,6 +11,8 @@
 #include "core/material.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace geometry_test {
 namespace {
 
 std::vector<std::pair<double, double>> Pairs(const std::vector<ProfileKnot>& knots) {
@@ -220,4 +222,5 @@ TEST(GeometryBat, RadiusLookups) {
 }
 
 }  // namespace
+}  // namespace geometry_test
 }  // namespace sweetspot::core

@@ -13,7 +13,7 @@
 namespace sweetspot::core {
 namespace {
 
-Scene PaperWood(std::vector<SceneOutput> outputs) {
+Scene PaperWoodScene(std::vector<SceneOutput> outputs) {
   Scene s;
   s.bat = FindPreset("paper-wood")->bat;
   s.outputs = std::move(outputs);
@@ -21,7 +21,7 @@ Scene PaperWood(std::vector<SceneOutput> outputs) {
 }
 
 TEST(CenterOfPercussion, IsWhereThePivotImpulseVanishesForAPivotAtTheHands) {
-  const SceneResult r = EvaluateScene(PaperWood({SceneOutput::kCenterOfPercussion}), {});
+  const SceneResult r = EvaluateScene(PaperWoodScene({SceneOutput::kCenterOfPercussion}), {});
   ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.message;
   ASSERT_TRUE(r.center_of_percussion.has_value());
   const MassProperties& mp = r.mass_properties;
@@ -57,7 +57,7 @@ TEST(CenterOfPercussion, RefusedWhenTheHandsAreNotBeforeTheBalancePoint) {
 
 TEST(VibrationNode, IsTheBarrelSideNodeOfTheFundamentalMode) {
   const SceneResult r =
-      EvaluateScene(PaperWood({SceneOutput::kMaxExitSpeed, SceneOutput::kVibrationNode}), {});
+      EvaluateScene(PaperWoodScene({SceneOutput::kMaxExitSpeed, SceneOutput::kVibrationNode}), {});
   ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.message;
   ASSERT_TRUE(r.vibration_node.has_value());
   const VibrationNodeResult& n = *r.vibration_node;
@@ -74,7 +74,7 @@ TEST(VibrationNode, IsTheBarrelSideNodeOfTheFundamentalMode) {
 TEST(SweetZone, EdgesAreWhereTheSpeedDropsByTheTolerance) {
   SceneOptions o;
   o.sweet_zone_tolerance = 0.2;  // the tip is 0.244 m/s below the maximum: not clipped
-  Scene s = PaperWood({SceneOutput::kSweetZone, SceneOutput::kMaxExitSpeed});
+  Scene s = PaperWoodScene({SceneOutput::kSweetZone, SceneOutput::kMaxExitSpeed});
   const SceneResult r = EvaluateScene(s, o);
   ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.message;
   ASSERT_TRUE(r.sweet_zone.has_value());
@@ -103,7 +103,7 @@ TEST(SweetZone, PercentZeroAndClipped) {
   SceneOptions o;
   o.sweet_zone_unit = ToleranceUnit::kPercent;
   o.sweet_zone_tolerance = 1.0;
-  Scene s = PaperWood({SceneOutput::kSweetZone, SceneOutput::kMaxExitSpeed});
+  Scene s = PaperWoodScene({SceneOutput::kSweetZone, SceneOutput::kMaxExitSpeed});
   SceneResult r = EvaluateScene(s, o);
   ASSERT_TRUE(r.sweet_zone.has_value());
   EXPECT_NEAR(r.sweet_zone->tolerance_mps, 0.01 * r.max_exit_speed->exit_speed_mps, 1e-15);
@@ -122,7 +122,7 @@ TEST(SweetZone, PercentZeroAndClipped) {
 
 TEST(SweetZone, AroundATipMaximum) {
   // Maximiser beyond the tip: the zone ends at the tip and starts where v2 = v2(tip) - tol.
-  Scene s = PaperWood({SceneOutput::kSweetZone, SceneOutput::kMaxExitSpeed});
+  Scene s = PaperWoodScene({SceneOutput::kSweetZone, SceneOutput::kMaxExitSpeed});
   s.swing.pivot_from_knob_m = -1.0;
   SceneOptions o;
   o.sweet_zone_tolerance = 0.2;
@@ -134,7 +134,7 @@ TEST(SweetZone, AroundATipMaximum) {
 }
 
 TEST(ExitSpeedCurve, SamplesAndExplicitPositions) {
-  Scene s = PaperWood({SceneOutput::kExitSpeedCurve});
+  Scene s = PaperWoodScene({SceneOutput::kExitSpeedCurve});
   SceneOptions o;
   o.curve_samples = 5;
   SceneResult r = EvaluateScene(s, o);

@@ -18,6 +18,8 @@
 #include "tests/hard_cases/reference.hpp"
 
 namespace sweetspot::hard_cases {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace core_flexible_test {
 namespace {
 
 using core::Bat;
@@ -302,4 +304,5 @@ INSTANTIATE_TEST_SUITE_P(Core, HardCaseFlexibleImpact, testing::ValuesIn(Flexibl
                          RowName<CoreCase>);
 
 }  // namespace
+}  // namespace core_flexible_test
 }  // namespace sweetspot::hard_cases

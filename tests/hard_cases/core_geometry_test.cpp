@@ -17,6 +17,8 @@
 #include "tests/hard_cases/reference.hpp"
 
 namespace sweetspot::hard_cases {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace core_geometry_test {
 namespace {
 
 using core::Bat;
@@ -426,4 +428,5 @@ INSTANTIATE_TEST_SUITE_P(Core, HardCaseCenterOfPercussion,
                          testing::ValuesIn(CenterOfPercussionCases()), RowName<CoreCase>);
 
 }  // namespace
+}  // namespace core_geometry_test
 }  // namespace sweetspot::hard_cases

@@ -15,6 +15,8 @@
 #include "tests/hard_cases/reference.hpp"
 
 namespace sweetspot::hard_cases {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace core_optimize_test {
 namespace {
 
 // ------------------------------------------------------------------------------ shape fit
@@ -249,4 +251,5 @@ TEST_P(HardCaseDesign, Holds) { CheckCoreCase(GetParam()); }
 INSTANTIATE_TEST_SUITE_P(Core, HardCaseDesign, testing::ValuesIn(DesignCases()), RowName<CoreCase>);
 
 }  // namespace
+}  // namespace core_optimize_test
 }  // namespace sweetspot::hard_cases

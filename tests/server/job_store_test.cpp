@@ -22,6 +22,8 @@
 #include "server/jobs/job_manager.hpp"
 
 namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace job_store_test {
 namespace {
 
 using api::Request;
@@ -775,4 +777,5 @@ TEST(JobStoreTest, WithoutAStoreShutdownStillCancelsWhatIsLeft) {
 }
 
 }  // namespace
+}  // namespace job_store_test
 }  // namespace sweetspot::server

@@ -13,6 +13,8 @@
 #include "tests/server/server_process.hpp"
 
 namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace jobs_config_test {
 namespace {
 
 ParsedCommandLine Parse(const std::vector<std::string>& args,
@@ -144,4 +146,5 @@ TEST(JobsConfigTest, AnUnusableJobsDatabaseStopsTheServerWithTheReason) {
 }
 
 }  // namespace
+}  // namespace jobs_config_test
 }  // namespace sweetspot::server

@@ -1,0 +1,63 @@
+# How the build stays fast on a 2-core machine (README "Build times" has the figures).
+#
+# - ccache, when installed, caches every compilation (scripts/install-deps.sh installs it).
+#   Precompiled headers need its pch_defines,time_macros sloppiness; CCACHE_BASEDIR makes
+#   two checkouts at the same depth share the cache.
+# - sweetspot_precompile(<target> <headers>...): the heavy third-party headers (Eigen,
+#   nlohmann-json, GoogleTest, Boost.Odeint) are parsed once per target instead of once per
+#   source file.
+# - sweetspot_unity(<target>): test and benchmark programs are unity builds (their sources
+#   compiled in batches, so the headers and the templates they share are compiled once per
+#   batch). A helper in a file's anonymous namespace must therefore not share a name with
+#   one of another file of the same program: the compiler says so at once ("redefinition
+#   of ..."). SWEETSPOT_UNITY_BATCH sets the batch size.
+# - sweetspot_test_flags(<target>): test programs compile at -O1 in optimised builds. The
+#   code under test keeps the build type's flags (-O3 in Release): only the test drivers
+#   are cheaper to compile. Benchmarks keep the build type's flags (they time header code).
+
+option(SWEETSPOT_CCACHE "Compile through ccache when it is installed" ON)
+option(SWEETSPOT_PCH "Precompile the heavy third-party headers" ON)
+option(SWEETSPOT_UNITY_TESTS "Compile test and benchmark programs as unity builds" ON)
+set(SWEETSPOT_UNITY_BATCH 8 CACHE STRING "Source files per unity batch of a test program")
+
+if(SWEETSPOT_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
+  find_program(SWEETSPOT_CCACHE_EXECUTABLE ccache)
+  if(SWEETSPOT_CCACHE_EXECUTABLE)
+    get_filename_component(sweetspot_checkouts ${PROJECT_SOURCE_DIR} DIRECTORY)
+    set(CMAKE_CXX_COMPILER_LAUNCHER
+        ${CMAKE_COMMAND} -E env CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
+        CCACHE_BASEDIR=${sweetspot_checkouts} ${SWEETSPOT_CCACHE_EXECUTABLE})
+    message(STATUS "Compiling through ${SWEETSPOT_CCACHE_EXECUTABLE}")
+  endif()
+endif()
+
+# sweetspot_precompile(<target> <header>...): precompiles the given headers for <target>
+# (angle-bracket names, e.g. <Eigen/Dense>). PRIVATE: dependants precompile their own.
+function(sweetspot_precompile target)
+  if(SWEETSPOT_PCH)
+    target_precompile_headers(${target} PRIVATE ${ARGN})
+  endif()
+endfunction()
+
+# sweetspot_unity(<target>): compiles a test or benchmark program in unity batches.
+function(sweetspot_unity target)
+  if(SWEETSPOT_UNITY_TESTS)
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON
+                                               UNITY_BUILD_BATCH_SIZE ${SWEETSPOT_UNITY_BATCH})
+  endif()
+endfunction()
+
+# sweetspot_test_flags(<target>): -O1 for a test program in optimised builds.
+function(sweetspot_test_flags target)
+  if(CMAKE_BUILD_TYPE MATCHES "^(Release|RelWithDebInfo)$")
+    # Appended after the build type's -O3/-O2, so it wins; the libraries keep theirs.
+    target_compile_options(${target} PRIVATE -O1)
+  endif()
+endfunction()
+
+# The headers each layer's sources share (and that cost the most to parse).
+set(SWEETSPOT_PCH_STD <algorithm> <chrono> <cmath> <functional> <limits> <map> <memory>
+                      <optional> <sstream> <string> <string_view> <utility> <vector>)
+set(SWEETSPOT_PCH_CORE ${SWEETSPOT_PCH_STD} <Eigen/Core> <Eigen/Dense>)
+set(SWEETSPOT_PCH_API ${SWEETSPOT_PCH_CORE} <nlohmann/json.hpp>)
+set(SWEETSPOT_PCH_TESTS ${SWEETSPOT_PCH_API} <gtest/gtest.h>)
