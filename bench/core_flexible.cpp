@@ -9,8 +9,8 @@
 #include <cmath>
 #include <string>
 
+#include "core/collision/flexible_impact.hpp"
 #include "core/collision/hertz_contact.hpp"
-#include "core/flexible/flexible_impact.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/presets.hpp"
 #include "core/scene.hpp"

@@ -11,11 +11,11 @@
 #include <vector>
 
 #include "core/bat.hpp"
+#include "core/collision/flexible_impact.hpp"
 #include "core/collision/free_bat.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
 #include "core/flexible/beam_model.hpp"
-#include "core/flexible/flexible_impact.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/flexible/modes_cache.hpp"
 #include "core/mass_properties.hpp"

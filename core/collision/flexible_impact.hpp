@@ -123,12 +123,6 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
                                          const FlexibleImpactInputs& inputs,
                                          const FlexibleImpactOptions& options);
 
-/// The static flexibility of the free-free beam at x under inertia relief, m/N: the sum over
-/// every flexible FE mode of phi_k(x)^2 / omega_k^2 (one sparse static solve with a
-/// self-equilibrated load and the rigid-body motion removed, on the modes' mesh with a node
-/// put at x: the point load's kink in the shear deflection needs one).
-double InertiaReliefFlexibility(const Bat& bat, const BatModes& modes, double x_m);
-
 /// The contact time of a ball of law k delta^p striking a rigid body of inverse effective mass
 /// c11 (1/kg, ball included) at v0 (elastic, closed form):
 /// 2 (delta_max / v0) B(1/(p+1), 1/2) / (p+1), delta_max = ((p+1) v0^2 / (2 c11 k))^(1/(p+1)).
