@@ -10,8 +10,8 @@
 #include <string>
 
 #include "core/collision/collide.hpp"
+#include "core/collision/flexible_impact.hpp"
 #include "core/collision/hertz_contact.hpp"
-#include "core/flexible/flexible_impact.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"

@@ -605,7 +605,7 @@ void FlexibleImpactRows(const TimingOptions& timing, bool quick, Report* report)
            Fixed(defaults.cutoff_factor, 0) + ", relative_tolerance " +
            Tol(defaults.relative_tolerance) +
            ", static_correction and refine_check on: core::FlexibleImpactOptions "
-           "(core/flexible/flexible_impact.hpp). The server keeps a modes cache, so a repeated "
+           "(core/collision/flexible_impact.hpp). The server keeps a modes cache, so a repeated "
            "request costs the \"modes cached\" row"});
   const core::Scene scene = PaperScene();
   core::CollisionOptions ref_o;

@@ -10,7 +10,7 @@
 #include "core/collision/free_bat.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
-#include "core/flexible/flexible_impact.hpp"
+#include "core/collision/flexible_impact.hpp"
 #include "core/mass_properties.hpp"
 #include "core/scene/scene.hpp"
 #include "core/scene/timing_book.hpp"

@@ -19,17 +19,20 @@
 //  - kPaperConstants: elastic, F1 proportional to delta^{3/2} with the paper's K1..K3 (about 20
 //    microseconds of contact: far stiffer than a real baseball). Forces in newtons are derived
 //    with the scene's effective masses (F1 = K1 delta^{3/2} / c11, F_h = 2 K2 delta2 / c22).
-//  - kBallPowerLaw (default): the ball's own nonlinear stiffness F = k delta_b^p in series with
-//    the bat surface's Hertz stiffness F = K delta_s^{3/2}, K = (4/3) E* sqrt(R*), loaded along
-//    that curve and unloaded along F = F_max (delta / delta_max)^q, with q chosen so that the
-//    unloading returns e^2 of the loading work: a two-body impact then has a COR of exactly e.
+//  - kBallPowerLaw (default): core/collision/contact_law.hpp, shared with the flexible impact:
+//    the ball's own nonlinear stiffness F = k delta_b^p in series with the bat surface's Hertz
+//    stiffness F = K delta_s^{3/2}, K = (4/3) E* sqrt(R*), loaded along that curve and unloaded
+//    along F = F_max (delta / delta_max)^q, with q chosen so that the unloading returns e^2 of
+//    the loading work: a two-body impact then has a COR of exactly e.
 //    Parameters and sources: docs/models.md.
-// Integration: Boost.Odeint Dormand-Prince 5(4) with dense output on a scaled state, event
-// location on the dense output (TOMS 748), a bounded number of steps; a failure is reported.
+// Integration: core/numerics/event_integrator.hpp (dense-output Dormand-Prince 5(4) from
+// Boost.Odeint, event location, a step bound) on a state scaled by the contact scale; the
+// events are the maximum compression, the separation and a reload; a failure is reported.
 #pragma once
 
 #include <string>
 
+#include "core/collision/contact_law.hpp"
 #include "core/summary.hpp"
 
 namespace sweetspot::core {
@@ -131,12 +134,5 @@ struct HertzImpact {
 /// Integrates one impact. Never throws; failures (step bound, non-finite state, invalid
 /// coefficients) are reported in the summary.
 HertzImpact SolveHertzImpact(const HertzProblem& problem, const HertzSolverOptions& options);
-
-/// The bat surface's Hertz stiffness K = (4/3) E* sqrt(R*), N/m^1.5, for a rigid ball of radius
-/// `ball_radius_m` on a bat of local radius `bat_radius_m`: E* = E / (1 - nu^2), and the
-/// sphere-on-cylinder ellipse is replaced by a circle of radius R* = sqrt(R' R''),
-/// 1/R' = 1/R_ball, 1/R'' = 1/R_ball + 1/R_bat.
-double BatSurfaceHertzStiffness(double youngs_modulus_pa, double poissons_ratio,
-                                double ball_radius_m, double bat_radius_m);
 
 }  // namespace sweetspot::core

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "core/bat.hpp"
+#include "core/collision/flexible_impact.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/flexible/beam_model.hpp"
-#include "core/flexible/flexible_impact.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/flexible/modes_cache.hpp"
 #include "core/mass_properties.hpp"

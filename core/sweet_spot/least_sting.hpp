@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "core/flexible/flexible_impact.hpp"
+#include "core/collision/flexible_impact.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {

@@ -1,6 +1,6 @@
 // The flexible collision: energy balance, the rigid limit, the residual flexibility, realistic
 // contact figures, sting, error estimates, and hard cases.
-#include "core/flexible/flexible_impact.hpp"
+#include "core/collision/flexible_impact.hpp"
 
 #include <cmath>
 #include <string>
@@ -12,6 +12,7 @@
 #include "core/collision/hertz_contact.hpp"
 #include "core/flexible/beam_model.hpp"
 #include "core/flexible/modes.hpp"
+#include "core/flexible/static_flexibility.hpp"
 #include "core/presets.hpp"
 #include "core/units.hpp"
 

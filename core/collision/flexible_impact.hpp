@@ -11,17 +11,17 @@
 //   core/flexible/modes.hpp with f_k <= cutoff_factor / t_c (t_c: the contact time of a rigid
 //   bat, estimated in closed form), all mass-normalised:
 //     m z'' = -F,   q_k'' + omega_k^2 q_k = phi_k(s) F,   delta = z - w(s, t),
-//   F = F(delta) the contact law of hertz_contact.hpp (ball_power_law) in series with the
+//   F = F(delta) the contact law of contact_law.hpp (hertz's ball_power_law) in series with the
 //   static compliance of the modes left out (residual flexibility, optional): the ball's
 //   k delta_b^p in series with the bat surface's Hertz contact on loading, unloading along
 //   F_max (delta / delta_max)^q with q set so the unloading returns e^2 of the loading work;
 //   a rise above delta_max reloads along the virgin curve. Undamped otherwise.
-// - Integration: Boost.Odeint Dormand-Prince 5(4) with dense output on a scaled state; events
-//   (maximum compression, reload, separation) located on the dense output with TOMS 748; the
-//   step count is bounded. After a separation the motion is free (exact: ballistic ball,
-//   harmonic modes); the gap is scanned (32 samples per period of the highest mode) for a
-//   further contact until the bat's rigid-body recoil has outrun the vibration amplitude;
-//   a new contact starts on the virgin curve.
+// - Integration: core/numerics/event_integrator.hpp (dense-output Dormand-Prince 5(4) from
+//   Boost.Odeint) on a scaled state; events (maximum compression, reload, separation) located
+//   on the dense output; the step count is bounded over all contacts. After a separation the motion
+//   is free (exact: ballistic ball, harmonic modes); the gap is scanned (32 samples per period of
+//   the highest mode) for a further contact until the bat's rigid-body recoil has outrun the
+//   vibration amplitude; a new contact starts on the virgin curve.
 // - Sting at the hands h: (1) hands_vibration_energy_j = sum_k E_k G_k, G_k the share of mode
 //   k's mass-normalised kinetic energy in the grip segment [h - l/2, h + l/2] (the vibration
 //   energy residing where the hands are; modes uncorrelated on average); (2) the peak shear
@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "core/bat.hpp"
+#include "core/collision/contact_law.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/summary.hpp"
 
@@ -122,17 +123,5 @@ struct FlexibleImpactResult {
 FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
                                          const FlexibleImpactInputs& inputs,
                                          const FlexibleImpactOptions& options);
-
-/// The static flexibility of the free-free beam at x under inertia relief, m/N: the sum over
-/// every flexible FE mode of phi_k(x)^2 / omega_k^2 (one sparse static solve with a
-/// self-equilibrated load and the rigid-body motion removed, on the modes' mesh with a node
-/// put at x: the point load's kink in the shear deflection needs one).
-double InertiaReliefFlexibility(const Bat& bat, const BatModes& modes, double x_m);
-
-/// The contact time of a ball of law k delta^p striking a rigid body of inverse effective mass
-/// c11 (1/kg, ball included) at v0 (elastic, closed form):
-/// 2 (delta_max / v0) B(1/(p+1), 1/2) / (p+1), delta_max = ((p+1) v0^2 / (2 c11 k))^(1/(p+1)).
-double ElasticContactTimeS(double c11_per_kg, double stiffness, double exponent,
-                           double approach_speed_mps);
 
 }  // namespace sweetspot::core

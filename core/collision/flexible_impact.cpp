@@ -1,25 +1,25 @@
 // flexible_impact: implementation; the assumptions are stated at the top of flexible_impact.hpp.
-#include "core/flexible/flexible_impact.hpp"
+#include "core/collision/flexible_impact.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
-#include <functional>
 #include <limits>
+#include <span>
 #include <sstream>
 #include <utility>
 
-#include <Eigen/SparseCholesky>
 #include <boost/math/tools/roots.hpp>
-#include <boost/numeric/odeint.hpp>
 
+#include "core/collision/contact_law.hpp"
+#include "core/flexible/static_flexibility.hpp"
+#include "core/numerics/event_integrator.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
 namespace {
 
-namespace odeint = boost::numeric::odeint;
 using State = std::vector<double>;
 
 constexpr double kTwoPi = 2.0 * kPi;
@@ -44,71 +44,6 @@ bool Fail(std::string* why, const std::string& m) {
   return false;
 }
 
-// The ball's contact law (as in hertz_contact.cpp, ball_power_law): the ball's k d^p in series
-// with the bat surface's Hertz K d^1.5 on loading.
-struct ContactLaw {
-  double k = 0.0, p = 1.5, kk = 0.0, cor = 0.5;
-  double k_eff = 0.0;  // series stiffness when p = 3/2
-
-  void Init() {
-    if (kk > 0.0 && p == 1.5) {
-      const double kb = std::cbrt(1.0 / (k * k));
-      const double ks = std::cbrt(1.0 / (kk * kk));
-      k_eff = std::pow(kb + ks, -1.5);
-    }
-  }
-  // Force along the virgin loading curve at compression d (m), N.
-  double Loading(double d) const {
-    if (d <= 0.0) return 0.0;
-    if (kk <= 0.0) return k * std::pow(d, p);
-    if (p == 1.5) return k_eff * d * std::sqrt(d);
-    // Solve db + (k db^p / K)^{2/3} = d for the ball's share db (monotone; safeguarded Newton).
-    const double a = std::cbrt((k / kk) * (k / kk));
-    const double e = 2.0 * p / 3.0;
-    double lo = 0.0, hi = d, db = d / (1.0 + a * std::pow(d, e - 1.0));
-    for (int it = 0; it < 60; ++it) {
-      const double g = db + a * std::pow(db, e) - d;
-      if (g > 0.0) {
-        hi = db;
-      } else {
-        lo = db;
-      }
-      const double dg = 1.0 + a * e * std::pow(db, e - 1.0);
-      double next = db - g / dg;
-      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-      if (std::abs(next - db) <= 1e-15 * d) {
-        db = next;
-        break;
-      }
-      db = next;
-    }
-    return k * std::pow(db, p);
-  }
-  // Compression on the virgin curve at force f (the inverse of Loading), m.
-  double LoadingCompression(double f) const {
-    if (f <= 0.0) return 0.0;
-    double d = BallCompression(f);
-    if (kk > 0.0) d += std::cbrt((f / kk) * (f / kk));
-    return d;
-  }
-  // The ball's own compression (f / k)^(1/p), m (cbrt for the default p = 3/2: no pow).
-  double BallCompression(double f) const {
-    if (p == 1.5) {
-      const double c = std::cbrt(f / k);
-      return c * c;
-    }
-    return std::pow(f / k, 1.0 / p);
-  }
-  // Work along the virgin curve up to force fm at compression dm, J.
-  double Work(double fm, double dm) const {
-    double comp = p / (p + 1.0) * std::pow(fm / k, 1.0 / p) * fm;
-    if (kk > 0.0) comp += 0.6 * std::cbrt((fm / kk) * (fm / kk)) * fm;
-    return fm * dm - comp;
-  }
-};
-
-enum class Phase { kLoading, kUnloading };
-
 // The modes in the superposition and what each contributes at the impact point and the hands.
 struct Model {
   int n = 0;                      // modes, the 2 rigid ones first
@@ -125,13 +60,10 @@ struct Model {
 // Scales and the contact state shared by the right-hand side and the driver.
 struct Rhs {
   const Model* model = nullptr;
-  const ContactLaw* law = nullptr;
+  const BallPowerLaw* law = nullptr;
   double delta_s = 1.0, v0 = 1.0, t_s = 1.0, m = 1.0;
-  Phase phase = Phase::kLoading;
-  double delta_max = 0.0;        // contact compression (ball + surface) where unloading began, m
-  double total_delta_max = 0.0;  // the same plus the residual spring's share, m
-  double force_max = 0.0, q = 1.5;
-  long* evaluations = nullptr;
+  ContactBranch branch;             // the contact's own compression (ball + surface), m
+  double total_delta_max = 0.0;     // branch.delta_max_m plus the residual spring's share, m
   mutable double last_force = 0.0;  // warm start of Force's Newton iteration (a cache only)
 
   int Q(int k) const { return 2 + k; }
@@ -155,59 +87,13 @@ struct Rhs {
     }
     return y[1] - w;
   }
-  // Contact force (N) on the current branch at contact compression d (m), no residual spring.
-  double ContactForce(double d) const {
-    if (d <= 0.0) return 0.0;
-    if (phase == Phase::kLoading || d >= delta_max) return law->Loading(d);
-    return force_max * std::pow(d / delta_max, q);
-  }
-  // Compression (m) and its derivative d(compression)/df (m/N) at force f, one pow at most.
-  void CompressionAndCompliance(double f, double* d, double* c) const {
-    if (phase == Phase::kLoading || f >= force_max) {
-      const double ball = law->BallCompression(f);
-      double surface = 0.0;
-      if (law->kk > 0.0) surface = std::cbrt((f / law->kk) * (f / law->kk));
-      *d = ball + surface;
-      *c = ball / (law->p * f) + 2.0 / 3.0 * surface / f;
-      return;
-    }
-    *d = delta_max * std::pow(f / force_max, 1.0 / q);
-    *c = *d / (q * f);
-  }
   // Force (N) at scaled total compression d: the contact in series with the residual spring
-  // c (the static compliance of the modes left out): compression(F) + c F = d, solved by a
-  // safeguarded Newton iteration (monotone in F, bracketed by 0 and the force without c).
+  // (the static compliance of the modes left out; contact_law.hpp's SeriesContactForce).
   double Force(double d_scaled) const {
-    const double d = d_scaled * delta_s;
-    if (d <= 0.0) return 0.0;
-    const double c = model->residual_compliance;
-    if (c <= 0.0) return ContactForce(d);
-    // Bracket: 0 < F <= d / c (and <= the force without c, computed only for a cold start).
-    double lo = 0.0, hi = d / c;
-    double f = last_force;  // warm start: the integrator calls with nearby states
-    if (!(f > 0.0 && f < hi)) {
-      hi = std::min(hi, ContactForce(d));
-      f = 0.5 * hi;
-    }
-    for (int it = 0; it < 60; ++it) {
-      double comp = 0.0, compliance = 0.0;
-      CompressionAndCompliance(f, &comp, &compliance);
-      const double g = comp + c * f - d;
-      if (std::abs(g) <= 4.0 * std::numeric_limits<double>::epsilon() * d) return last_force = f;
-      if (g > 0.0) {
-        hi = f;
-      } else {
-        lo = f;
-      }
-      double next = f - g / (compliance + c);
-      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-      if (std::abs(next - f) <= 1e-14 * f) return last_force = next;
-      f = next;
-    }
-    return last_force = f;
+    return SeriesContactForce(*law, branch, model->residual_compliance, d_scaled * delta_s,
+                              &last_force);
   }
   void operator()(const State& y, State& dy, double /*t*/) const {
-    if (evaluations != nullptr) ++*evaluations;
     const double f = Force(Delta(y));
     const double fh = f * t_s / (m * v0);
     dy[0] = y[1];
@@ -377,16 +263,89 @@ double FindRecontact(const Rhs& rhs, const State& y, std::vector<std::string>* w
   return -1.0;
 }
 
-enum class Event { kNone, kMaxCompression, kEnd, kReload };
+// The events of one contact (each crosses from > 0 to <= 0): the compression rate falls through
+// 0 (maximum compression), the compression falls through 0 (separation), the compression rises
+// back above its maximum (reload; it may already be above it when an unloading step begins).
+enum EventId : int { kMaxCompression, kEnd, kReload };
+constexpr EventSpec kLoadingEvents[] = {{kMaxCompression, false}, {kEnd, false}};
+constexpr EventSpec kUnloadingEvents[] = {{kEnd, false}, {kReload, true}};
 
-RawRun Integrate(const Model& model, const ContactLaw& law, const FlexibleImpactInputs& in,
+// One contact as the event integrator sees it: the right-hand side of Rhs, its events, the
+// hands' loads sampled on every step and the branch changes at the events.
+struct FlexibleSystem {
+  Rhs* rhs = nullptr;
+  double cor = 0.5;
+  RawRun* out = nullptr;
+  State sample;  // dense-output samples for the hands' loads
+  double peak_d = 0.0, peak_f = 0.0;
+  bool plastic = false;
+
+  void operator()(const State& y, State& dy, double t) const { (*rhs)(y, dy, t); }
+  std::span<const EventSpec> ActiveEvents() const {
+    if (rhs->branch.unloading) return kUnloadingEvents;
+    return kLoadingEvents;
+  }
+  double EventFunction(int id, const State& s) const {
+    switch (id) {
+      case kMaxCompression:
+        return rhs->DeltaRate(s);
+      case kEnd:
+        return rhs->Delta(s);
+      default:
+        return rhs->total_delta_max / rhs->delta_s - rhs->Delta(s);
+    }
+  }
+  void SampleHands(const State& s) {
+    double v = 0.0, mo = 0.0;
+    rhs->HandsLoads(s, rhs->Force(rhs->Delta(s)), &v, &mo);
+    out->peak_shear_n = std::max(out->peak_shear_n, std::abs(v));
+    out->peak_moment_n_m = std::max(out->peak_moment_n_m, std::abs(mo));
+  }
+  // The hands' loads at the quarter points and the end of each step.
+  void OnStep(const DenseStep<State>& step) {
+    for (int j = 1; j < 4; ++j) {
+      step.StateAt(step.t_start + (step.t_end - step.t_start) * j / 4.0, &sample);
+      SampleHands(sample);
+    }
+    SampleHands(*step.y_end);
+  }
+  EventAction OnEvent(int id, double /*t*/, const State& ye) {
+    if (id == kEnd) return EventAction::kStop;
+    if (id == kReload) {
+      rhs->branch.unloading = false;
+      return EventAction::kContinue;
+    }
+    // Maximum compression: d_e (total) = the contact's share dc + the residual spring's.
+    const double d_e = std::max(0.0, rhs->Delta(ye)) * rhs->delta_s;
+    rhs->branch.unloading = false;
+    const double f = rhs->Force(rhs->Delta(ye));
+    const double dc = rhs->law->LoadingCompression(f);
+    peak_f = std::max(peak_f, f);
+    peak_d = std::max(peak_d, dc);
+    if (cor == 0.0) {
+      // Perfectly plastic: the stored energy is lost, the contact ends here; the static
+      // deflection of the modes left out (the residual spring) is released into them.
+      out->loss_j += rhs->law->LoadingWork(f, dc);
+      out->released_j += 0.5 * rhs->model->residual_compliance * f * f;
+      plastic = true;
+      out->warnings.push_back(
+          "cor = 0: perfectly plastic, the contact ends at maximum compression and later "
+          "contacts are not followed");
+      return EventAction::kStop;
+    }
+    rhs->branch.StartUnloading(*rhs->law, dc, f, cor);
+    rhs->total_delta_max = d_e;
+    return EventAction::kContinue;
+  }
+};
+
+RawRun Integrate(const Model& model, const BallPowerLaw& law, const FlexibleImpactInputs& in,
                  double delta_s, double tol, const FlexibleImpactOptions& o,
                  double sting_window_s) {
   RawRun out;
   Rhs rhs;
   rhs.model = &model;
   rhs.law = &law;
-  rhs.evaluations = &out.evaluations;
   rhs.v0 = in.approach_speed_mps;
   rhs.delta_s = delta_s;
   rhs.t_s = delta_s / rhs.v0;
@@ -395,155 +354,53 @@ RawRun Integrate(const Model& model, const ContactLaw& law, const FlexibleImpact
   State y(size, 0.0);
   y[1] = 1.0;
   double tau = 0.0;
-  double peak_d = 0.0, peak_f = 0.0;
   double om_max = 0.0;
   for (double om : model.omega_hat) om_max = std::max(om_max, om);
-  auto sample_hands = [&](const State& s) {
-    double v = 0.0, mo = 0.0;
-    rhs.HandsLoads(s, rhs.Force(rhs.Delta(s)), &v, &mo);
-    out.peak_shear_n = std::max(out.peak_shear_n, std::abs(v));
-    out.peak_moment_n_m = std::max(out.peak_moment_n_m, std::abs(mo));
-  };
-  bool plastic = false;
-  try {
-    while (true) {
-      ++out.contacts;
-      rhs.phase = Phase::kLoading;
-      rhs.delta_max = 0.0;
-      rhs.total_delta_max = 0.0;
-      rhs.force_max = 0.0;
-      auto stepper = odeint::make_dense_output(tol, tol, 0.25, odeint::runge_kutta_dopri5<State>());
-      stepper.initialize(y, tau, 1e-2);
-      bool ended = false;
-      while (!ended) {
-        if (out.steps >= o.max_steps) {
-          out.message =
-              "the contact did not end within max_steps = " + std::to_string(o.max_steps) +
-              " integrator steps (t = " + Num(stepper.current_time() * rhs.t_s) +
-              " s): too stiff for the explicit integrator at this tolerance";
-          return out;
-        }
-        const State ya = stepper.current_state();
-        // Not a structured binding: clang 14 cannot capture one in the lambdas below.
-        const std::pair<double, double> step = stepper.do_step(std::ref(rhs));
-        const double ta = step.first;
-        const double tb = step.second;
-        ++out.steps;
-        const State& yb = stepper.current_state();
-        for (double v : yb) {
-          if (!std::isfinite(v)) {
-            out.message =
-                "the integrated state became non-finite at t = " + Num(tb * rhs.t_s) + " s";
-            return out;
-          }
-        }
-        State tmp(size);
-        for (int j = 1; j < 4; ++j) {
-          stepper.calc_state(ta + (tb - ta) * j / 4.0, tmp);
-          sample_hands(tmp);
-        }
-        sample_hands(yb);
-        const double dm_scaled = rhs.total_delta_max / rhs.delta_s;
-        auto g_max = [&](const State& s) { return rhs.DeltaRate(s); };
-        auto g_end = [&](const State& s) { return rhs.Delta(s); };
-        auto g_reload = [&](const State& s) { return dm_scaled - rhs.Delta(s); };
-        Event ev = Event::kNone;
-        double te = tb;
-        auto locate = [&](auto g, Event kind, bool at_start_if_already) {
-          const double ga = g(ya), gb = g(yb);
-          if (!(gb <= 0.0)) return;
-          double root = tb;
-          if (ga > 0.0) {
-            auto fn = [&](double tt) {
-              stepper.calc_state(tt, tmp);
-              return g(tmp);
-            };
-            if (gb < 0.0) {
-              boost::uintmax_t iters = 100;
-              const auto r = boost::math::tools::toms748_solve(
-                  fn, ta, tb, ga, gb, boost::math::tools::eps_tolerance<double>(52), iters);
-              root = 0.5 * (r.first + r.second);
-            }
-          } else if (at_start_if_already && gb < 0.0) {
-            root = ta;  // already past the event at the start of the step (a touching maximum)
-          } else {
-            return;
-          }
-          if (ev == Event::kNone || root < te) {
-            ev = kind;
-            te = root;
-          }
-        };
-        if (rhs.phase == Phase::kUnloading) {
-          locate(g_end, Event::kEnd, false);
-          locate(g_reload, Event::kReload, true);
-        } else {
-          locate(g_max, Event::kMaxCompression, false);
-          locate(g_end, Event::kEnd, false);
-        }
-        if (ev == Event::kNone) continue;
-        State ye(size);
-        stepper.calc_state(te, ye);
-        const double d_e = std::max(0.0, rhs.Delta(ye)) * rhs.delta_s;  // total compression
-        tau = te;
-        y = ye;
-        if (ev == Event::kEnd) {
-          ended = true;
-          break;
-        }
-        if (ev == Event::kMaxCompression) {
-          rhs.phase = Phase::kLoading;
-          const double f = rhs.Force(rhs.Delta(ye));
-          const double dc = law.LoadingCompression(f);  // the contact's share of d_e
-          peak_f = std::max(peak_f, f);
-          peak_d = std::max(peak_d, dc);
-          if (law.cor == 0.0) {
-            // Perfectly plastic: the stored energy is lost, the contact ends here; the static
-            // deflection of the modes left out (the residual spring) is released into them.
-            out.loss_j += law.Work(f, dc);
-            out.released_j += 0.5 * model.residual_compliance * f * f;
-            plastic = true;
-            out.warnings.push_back(
-                "cor = 0: perfectly plastic, the contact ends at maximum compression and later "
-                "contacts are not followed");
-            ended = true;
-            break;
-          }
-          rhs.phase = Phase::kUnloading;
-          rhs.delta_max = dc;
-          rhs.total_delta_max = d_e;
-          rhs.force_max = f;
-          rhs.q = f * dc / (law.cor * law.cor * law.Work(f, dc)) - 1.0;
-        } else if (ev == Event::kReload) {
-          rhs.phase = Phase::kLoading;
-        }
-        stepper.initialize(ye, te, std::max(1e-6, (tb - ta) * 0.5));
-      }
-      if (!plastic && rhs.force_max > 0.0) {
-        out.loss_j += (1.0 - law.cor * law.cor) * law.Work(rhs.force_max, rhs.delta_max);
-      }
-      out.contact_time_s = tau * rhs.t_s;
-      if (plastic) break;
-      if (out.contacts >= o.max_contacts) {
-        out.warnings.push_back("max_contacts = " + std::to_string(o.max_contacts) +
-                               " reached: further contacts are not followed");
-        break;
-      }
-      const double dt_r = FindRecontact(rhs, y, &out.warnings);
-      if (!(dt_r > 0.0)) break;
-      FreeAdvance(rhs, dt_r, &y);
-      tau += dt_r;
+  FlexibleSystem sys;
+  sys.rhs = &rhs;
+  sys.cor = in.cor;
+  sys.out = &out;
+  sys.sample.assign(size, 0.0);
+  EventIntegratorOptions io;
+  io.relative_tolerance = tol;
+  io.absolute_tolerance = tol;
+  io.max_steps = o.max_steps;
+  io.time_unit_s = rhs.t_s;
+  io.subject = "the contact";
+  EventIntegrator<State> integrator(io);
+  while (true) {
+    ++out.contacts;
+    rhs.branch = ContactBranch{};
+    rhs.total_delta_max = 0.0;
+    const bool stopped = integrator.Run(sys, &y, &tau);
+    out.steps = integrator.summary().steps;
+    out.evaluations = integrator.summary().evaluations;
+    if (!stopped) {
+      out.message = integrator.summary().message;
+      return out;
     }
-  } catch (const std::exception& e) {
-    out.message = std::string("the integrator failed: ") + e.what();
-    return out;
+    if (!sys.plastic && rhs.branch.force_max_n > 0.0) {
+      out.loss_j +=
+          (1.0 - in.cor * in.cor) * law.LoadingWork(rhs.branch.force_max_n, rhs.branch.delta_max_m);
+    }
+    out.contact_time_s = tau * rhs.t_s;
+    if (sys.plastic) break;
+    if (out.contacts >= o.max_contacts) {
+      out.warnings.push_back("max_contacts = " + std::to_string(o.max_contacts) +
+                             " reached: further contacts are not followed");
+      break;
+    }
+    const double dt_r = FindRecontact(rhs, y, &out.warnings);
+    if (!(dt_r > 0.0)) break;
+    FreeAdvance(rhs, dt_r, &y);
+    tau += dt_r;
   }
   // The hands' loads over the free ringing that follows.
   if (om_max > 0.0) {
     FreeHandsPeaks(rhs, y, sting_window_s / rhs.t_s, kTwoPi / (kSamplesPerPeriod * om_max), &out);
   }
-  out.peak_force_n = peak_f;
-  out.max_compression_m = peak_d;
+  out.peak_force_n = sys.peak_f;
+  out.max_compression_m = sys.peak_d;
   out.final_state = std::move(y);
   out.ok = true;
   return out;
@@ -576,93 +433,6 @@ void IntegrateAlong(const BatModes& modes, double a, double b, F&& f) {
 }
 
 }  // namespace
-
-double InertiaReliefFlexibility(const Bat& bat, const BatModes& modes, double x_m) {
-  // The static solve's mesh: the modes' mesh with a node at x (the point load puts a kink in the
-  // shear deflection that only a node resolves): a node within a quarter element moves to x,
-  // otherwise x is inserted.
-  BeamMesh mesh;
-  mesh.nodes_m = modes.nodes_m;
-  mesh.breakpoints_m = modes.breakpoints_m;
-  std::vector<double>& nodes = mesh.nodes_m;
-  const double x = std::clamp(x_m, nodes.front(), nodes.back());
-  {
-    const auto it = std::upper_bound(nodes.begin(), nodes.end(), x);
-    const std::size_t e = std::min<std::size_t>(
-        it == nodes.begin() ? 0 : static_cast<std::size_t>(it - nodes.begin()) - 1,
-        nodes.size() - 2);
-    const double h = nodes[e + 1] - nodes[e];
-    const double dl = x - nodes[e], dr = nodes[e + 1] - x;
-    if (dl > 1e-9 * h && dr > 1e-9 * h) {
-      const std::size_t near = dl < dr ? e : e + 1;
-      if (std::min(dl, dr) < 0.25 * h && near != 0 && near != nodes.size() - 1) {
-        nodes[near] = x;
-      } else {
-        nodes.insert(nodes.begin() + static_cast<std::ptrdiff_t>(e) + 1, x);
-      }
-    }
-  }
-  BatModes on_mesh;  // the rigid-body modes on this mesh (same mass properties)
-  on_mesh.theory = modes.theory;
-  on_mesh.nodes_m = nodes;
-  on_mesh.mass_kg = modes.mass_kg;
-  on_mesh.balance_point_m = modes.balance_point_m;
-  on_mesh.moi_centroid_kg_m2 = modes.moi_centroid_kg_m2;
-  const BeamMatrices mats = AssembleBeam(bat, mesh, modes.theory, modes.rotary_inertia);
-  const int ne = mesh.Elements();
-  const Eigen::Index n = mats.stiffness.rows();
-  // The load: a unit force at x, as consistent nodal loads (the displacement shape functions).
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(n);
-  {
-    const auto it = std::upper_bound(nodes.begin(), nodes.end(), x);
-    int e = it == nodes.begin() ? 0 : static_cast<int>(it - nodes.begin()) - 1;
-    e = std::min(e, ne - 1);
-    const double a = nodes[static_cast<std::size_t>(e)];
-    const double h = nodes[static_cast<std::size_t>(e) + 1] - a;
-    const ElementShape sh = EvaluateElementShape(h, std::clamp((x - a) / h, 0.0, 1.0));
-    int idx[kElementDofs];
-    ElementDofIndices(modes.theory, e, idx);
-    for (int i = 0; i < kElementDofs; ++i) {
-      if (idx[i] >= 0) f[idx[i]] += sh.w[i];
-    }
-  }
-  const Eigen::VectorXd t = on_mesh.TranslationMode();
-  const Eigen::VectorXd r = on_mesh.RotationMode();
-  // Inertia relief: the rigid body's inertia forces balance the load.
-  const Eigen::VectorXd f_bal = f - mats.mass * t * t.dot(f) - mats.mass * r * r.dot(f);
-  // Hold w_b at both ends (the balanced load has no reactions there), then remove the
-  // rigid-body part of the deflection.
-  const Eigen::Index first = 0;
-  int last_idx[kElementDofs];
-  ElementDofIndices(modes.theory, ne - 1, last_idx);
-  const Eigen::Index last = last_idx[4];
-  Eigen::SparseMatrix<double> k = mats.stiffness;
-  const double diag = k.coeff(first, first) > 0.0 ? k.coeff(first, first) : 1.0;
-  k.prune([&](Eigen::Index row, Eigen::Index col, double) {
-    return row != first && row != last && col != first && col != last;
-  });
-  k.coeffRef(first, first) = diag;
-  k.coeffRef(last, last) = diag;
-  Eigen::VectorXd rhs = f_bal;
-  rhs[first] = 0.0;
-  rhs[last] = 0.0;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>>
-      ldlt(k);
-  if (ldlt.info() != Eigen::Success) return std::numeric_limits<double>::quiet_NaN();
-  Eigen::VectorXd u = ldlt.solve(rhs);
-  u -= t * t.dot(mats.mass * u) + r * r.dot(mats.mass * u);
-  return f.dot(u);
-}
-
-double ElasticContactTimeS(double c11_per_kg, double stiffness, double exponent,
-                           double approach_speed_mps) {
-  const double p1 = exponent + 1.0;
-  const double d_max = std::pow(
-      p1 * approach_speed_mps * approach_speed_mps / (2.0 * c11_per_kg * stiffness), 1.0 / p1);
-  const double a = 1.0 / p1;
-  const double beta = std::tgamma(a) * std::sqrt(kPi) / std::tgamma(a + 0.5);
-  return 2.0 * d_max / approach_speed_mps * beta / p1;
-}
 
 bool FlexibleImpactOptions::IsValid(std::string* why) const {
   if (max_modes < 1 || max_modes > 50)
@@ -765,14 +535,8 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     out.rigid_exit_speed_mps = -u + (1.0 + e) * v0 / (1.0 + recoil);
     out.initial_energy_j = 0.5 * m * v0 * v0;
 
-    ContactLaw law;
-    law.k = in.ball_stiffness;
-    law.p = in.ball_exponent;
-    law.kk = in.surface_stiffness;
-    law.cor = e;
-    law.Init();
-    const double p1 = in.ball_exponent + 1.0;
-    const double delta_s = std::pow(p1 * v0 * v0 / (2.0 * c11 * in.ball_stiffness), 1.0 / p1);
+    const BallPowerLaw law(in.ball_stiffness, in.ball_exponent, in.surface_stiffness);
+    const double delta_s = ContactCompressionScaleM(c11, in.ball_stiffness, in.ball_exponent, v0);
     out.contact_time_estimate_s = ElasticContactTimeS(c11, in.ball_stiffness, in.ball_exponent, v0);
     out.cutoff_hz = o.cutoff_factor / out.contact_time_estimate_s;
     if (!(std::isfinite(delta_s) && delta_s > 0.0 && std::isfinite(out.cutoff_hz))) {
@@ -902,7 +666,10 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
       return md;
     };
 
-    RawRun a = Integrate(full, law, in, delta_s, o.relative_tolerance, o, window);
+    const RefinedRuns<RawRun> runs = SolveWithRefineCheck<RawRun>(
+        o.relative_tolerance, o.refine_check,
+        [&](double tol) { return Integrate(full, law, in, delta_s, tol, o, window); });
+    const RawRun& a = runs.coarse;
     s.iterations = a.steps;
     s.evaluations = static_cast<int>(a.evaluations);
     out.steps = a.steps;
@@ -943,8 +710,8 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
         (out.ball_energy_j + out.rigid_body_energy_j + out.vibration_energy_j + out.contact_loss_j);
     s.warnings.insert(s.warnings.end(), a.warnings.begin(), a.warnings.end());
 
-    if (o.refine_check) {
-      RawRun fine = Integrate(full, law, in, delta_s, o.relative_tolerance / 16.0, o, window);
+    if (runs.refined) {
+      const RawRun& fine = runs.fine;
       out.steps += fine.steps;
       s.evaluations += static_cast<int>(fine.evaluations);
       double de = 0.0, dv = 0.0, dh = 0.0;
@@ -954,7 +721,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
         dv = std::abs(of.vib - oa.vib);
         dh = std::abs(of.hands - oa.hands);
       } else {
-        s.warnings.push_back("the refinement run at tolerance / 16 failed: " + fine.message);
+        s.warnings.push_back(RefineFailedWarning(fine.message));
         de = o.relative_tolerance * (u + std::abs(oa.exit));
       }
       out.integration_error_exit_speed_mps = de;
