@@ -15,6 +15,8 @@
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace bench_core_collision {
 namespace {
 
 // benchmark 1.7.1's DoNotOptimize(T&) uses a "+m,r" constraint that GCC 12 may satisfy with a
@@ -158,4 +160,5 @@ void BM_CollideHertzWithRefinement(benchmark::State& state) {
 BENCHMARK(BM_CollideHertzWithRefinement)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
+}  // namespace bench_core_collision
 }  // namespace sweetspot::core

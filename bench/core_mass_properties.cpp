@@ -10,6 +10,8 @@
 #include "core/shape_fit.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace bench_core_mass_properties {
 namespace {
 
 // A smooth, bat-like profile with n knots (deterministic).
@@ -61,4 +63,5 @@ void BM_ShapeFitTable2(benchmark::State& state) {
 BENCHMARK(BM_ShapeFitTable2)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
+}  // namespace bench_core_mass_properties
 }  // namespace sweetspot::core

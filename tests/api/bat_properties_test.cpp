@@ -5,6 +5,8 @@
 #include "api/router.hpp"
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace bat_properties_test {
 namespace {
 
 Response Post(const std::string& path, const std::string& body) {
@@ -158,4 +160,5 @@ INSTANTIATE_TEST_SUITE_P(
     [](const ::testing::TestParamInfo<Refusal>& param_info) { return param_info.param.name; });
 
 }  // namespace
+}  // namespace bat_properties_test
 }  // namespace sweetspot::api

@@ -12,6 +12,8 @@
 #include "api/router.hpp"
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace explore_shards_test {
 namespace {
 
 using Json = nlohmann::json;
@@ -134,4 +136,5 @@ TEST(ExploreShardsTest, ShardsThatDoNotMakeOneCompleteSweepAreRefusedWithTheReas
 }
 
 }  // namespace
+}  // namespace explore_shards_test
 }  // namespace sweetspot::api

@@ -9,6 +9,8 @@
 #include "api/router.hpp"
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace explore_test {
 namespace {
 
 using Json = nlohmann::json;
@@ -350,4 +352,5 @@ TEST(JsonPathTest, ParsesSetsAndRefuses) {
 }
 
 }  // namespace
+}  // namespace explore_test
 }  // namespace sweetspot::api

@@ -18,6 +18,8 @@
 #include <vector>
 
 namespace sweetspot::fuzz {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace fuzz_regressions_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -117,4 +119,5 @@ TEST(FuzzRegressionsTest, EveryTargetHasSeeds) {
 }
 
 }  // namespace
+}  // namespace fuzz_regressions_test
 }  // namespace sweetspot::fuzz

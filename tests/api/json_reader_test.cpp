@@ -5,6 +5,8 @@
 #include <string>
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace json_reader_test {
 namespace {
 
 ApiError ParseError(const std::string& body, const ApiLimits& limits = {}) {
@@ -171,4 +173,5 @@ TEST(LimitsTest, DefaultsAreValidAndRulesAreNamed) {
 }
 
 }  // namespace
+}  // namespace json_reader_test
 }  // namespace sweetspot::api

@@ -8,6 +8,8 @@
 #include "api/router.hpp"
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace openapi_test {
 namespace {
 
 std::string Lower(std::string text) {
@@ -63,4 +65,5 @@ TEST(OpenApiTest, EveryReferenceResolves) {
 }
 
 }  // namespace
+}  // namespace openapi_test
 }  // namespace sweetspot::api

@@ -10,6 +10,8 @@
 #include "api/router.hpp"
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace optimize_test {
 namespace {
 
 using Json = nlohmann::json;
@@ -233,4 +235,5 @@ TEST(OptimizeEndpointTest, ConcurrentOptimisationsAllAgree) {
 }
 
 }  // namespace
+}  // namespace optimize_test
 }  // namespace sweetspot::api

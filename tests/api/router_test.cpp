@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace router_test {
 namespace {
 
 TEST(RouterTest, HealthAnswersOk) {
@@ -47,4 +49,5 @@ TEST(RouterTest, RoutesAreUniqueByMethodAndPath) {
 }
 
 }  // namespace
+}  // namespace router_test
 }  // namespace sweetspot::api

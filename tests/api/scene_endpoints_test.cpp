@@ -7,6 +7,8 @@
 #include "api/router.hpp"
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace scene_endpoints_test {
 namespace {
 
 Response Post(const std::string& path, const std::string& body) {
@@ -320,4 +322,5 @@ TEST(FitEndpointTest, GeneralProfileIsRefused) {
 }
 
 }  // namespace
+}  // namespace scene_endpoints_test
 }  // namespace sweetspot::api

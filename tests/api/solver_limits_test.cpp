@@ -8,6 +8,8 @@
 #include "api/router.hpp"
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace solver_limits_test {
 namespace {
 
 using Json = nlohmann::json;
@@ -96,4 +98,5 @@ TEST(SolverLimitsTest, DefaultSolverBudgetsFollowTheLimits) {
 }
 
 }  // namespace
+}  // namespace solver_limits_test
 }  // namespace sweetspot::api

@@ -12,6 +12,8 @@
 #include "api/router.hpp"
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace speed_vs_error_test {
 namespace {
 
 std::string ReadDoc(const std::string& name) {
@@ -105,4 +107,5 @@ TEST(SpeedVsErrorTest, VersionNamesTheReportsDate) {
 }
 
 }  // namespace
+}  // namespace speed_vs_error_test
 }  // namespace sweetspot::api

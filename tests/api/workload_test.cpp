@@ -6,6 +6,8 @@
 #include "api/router.hpp"
 
 namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace workload_test {
 namespace {
 
 Workload Classify(const std::string& method, const std::string& path, const std::string& body) {
@@ -70,4 +72,5 @@ TEST(WorkloadTest, ScenesAreComputeExactlyWhenAnOutputOrModelIsIterative) {
 }
 
 }  // namespace
+}  // namespace workload_test
 }  // namespace sweetspot::api

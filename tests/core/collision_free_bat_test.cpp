@@ -11,6 +11,8 @@
 #include "core/units.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace collision_free_bat_test {
 namespace {
 
 FreeBatInputs PaperBat() {
@@ -91,4 +93,5 @@ TEST(FreeBat, ClosedFormMaximumAgreesWithNlopt) {
 }
 
 }  // namespace
+}  // namespace collision_free_bat_test
 }  // namespace sweetspot::core

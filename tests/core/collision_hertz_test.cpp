@@ -9,6 +9,8 @@
 #include "core/presets.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace collision_hertz_test {
 namespace {
 
 // The paper's reading: K1..K3 given directly; masses only scale the forces.
@@ -168,4 +170,5 @@ TEST(HertzValidation, ExactMessages) {
 }
 
 }  // namespace
+}  // namespace collision_hertz_test
 }  // namespace sweetspot::core

@@ -10,6 +10,8 @@
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace collision_rigid_pivot_test {
 namespace {
 
 // The paper-wood bat by hand (paper-notes: M = 1.0078 kg, C = 0.6090 m, slender-rod
@@ -141,4 +143,5 @@ TEST(RigidPivot, ClosedFormAndNloptAgreeOnRandomScenes) {
 }
 
 }  // namespace
+}  // namespace collision_rigid_pivot_test
 }  // namespace sweetspot::core

@@ -10,6 +10,8 @@
 #include "core/units.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace contact_law_test {
 namespace {
 
 constexpr double kBall = 4.0e7;     // k, N/m^p (the default ball)
@@ -159,4 +161,5 @@ TEST(ContactLaw, ContactScalesOfALinearSpring) {
 }
 
 }  // namespace
+}  // namespace contact_law_test
 }  // namespace sweetspot::core

@@ -15,6 +15,8 @@
 #include "core/units.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace event_integrator_test {
 namespace {
 
 // y'' = -w^2 y, y(0) = 1, y'(0) = 0: y = cos(w t), first zero at pi / (2 w), where y' = -w.
@@ -260,4 +262,5 @@ TEST(EventIntegrator, TheRefineCheckRunsAtASixteenthOfTheTolerance) {
 }
 
 }  // namespace
+}  // namespace event_integrator_test
 }  // namespace sweetspot::core

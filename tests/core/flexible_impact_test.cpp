@@ -17,6 +17,8 @@
 #include "core/units.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace flexible_impact_test {
 namespace {
 
 // The modes an impact uses by default (12 modes to 1e-3), computed once per bat.
@@ -303,4 +305,5 @@ TEST(FlexibleImpactHardCases, AVerySoftBatStillBalancesItsEnergy) {
 }
 
 }  // namespace
+}  // namespace flexible_impact_test
 }  // namespace sweetspot::core

@@ -18,6 +18,8 @@
 #include "core/units.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace flexible_modes_test {
 namespace {
 
 // A uniform solid rod: radius r, length L, density rho, modulus E, Poisson's ratio nu.
@@ -452,4 +454,5 @@ TEST(FlexibleModesHardCases, AnInvalidBatIsRefusedWithItsField) {
 }
 
 }  // namespace
+}  // namespace flexible_modes_test
 }  // namespace sweetspot::core

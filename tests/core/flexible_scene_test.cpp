@@ -13,6 +13,8 @@
 #include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace flexible_scene_test {
 namespace {
 
 Scene PaperWood(std::vector<SceneOutput> outputs) {
@@ -308,4 +310,5 @@ TEST(FlexibleSceneHardCases, HollowAndFilledBatsGiveAVibrationNodeAndASting) {
 }
 
 }  // namespace
+}  // namespace flexible_scene_test
 }  // namespace sweetspot::core

@@ -14,6 +14,8 @@
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace hard_cases_collision_test {
 namespace {
 
 // A bat given by its mass properties only: M, C, I_cm, length.
@@ -275,4 +277,5 @@ TEST(HardCases, NonFiniteInputsAreRefusedWithTheirName) {
 }
 
 }  // namespace
+}  // namespace hard_cases_collision_test
 }  // namespace sweetspot::core

@@ -10,6 +10,8 @@
 #include "core/presets.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace mass_properties_gradient_test {
 namespace {
 
 struct NamedBat {
@@ -218,4 +220,5 @@ TEST(MassPropertiesGradient, ValuesIdenticalToComputeMassProperties) {
 }
 
 }  // namespace
+}  // namespace mass_properties_gradient_test
 }  // namespace sweetspot::core

@@ -14,6 +14,8 @@
 #include "core/units.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace mass_properties_test {
 namespace {
 
 Material Wood(double density_kg_m3) {
@@ -567,4 +569,5 @@ TEST(MassPropertiesHard, TinyRelativePerturbationsGiveTinyChanges) {
 }
 
 }  // namespace
+}  // namespace mass_properties_test
 }  // namespace sweetspot::core

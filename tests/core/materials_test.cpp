@@ -9,6 +9,8 @@
 #include "core/material.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace materials_test {
 namespace {
 
 TEST(MaterialsCatalogue, HasEveryEntryValidWithASource) {
@@ -121,4 +123,5 @@ TEST(MaterialValidity, CustomMaterialsAndRanges) {
 }
 
 }  // namespace
+}  // namespace materials_test
 }  // namespace sweetspot::core

@@ -12,6 +12,8 @@
 #include "core/optimize/design_problem.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace optimize_concurrency_test {
 namespace {
 
 DesignProblem Problem(int i) {
@@ -107,4 +109,5 @@ TEST(OptimizeConcurrency, StingSolvesBesideIpoptSolvesMatchTheSerialAnswer) {
 }
 
 }  // namespace
+}  // namespace optimize_concurrency_test
 }  // namespace sweetspot::core

@@ -15,6 +15,8 @@
 #include "core/units.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace optimize_design_test {
 namespace {
 
 constexpr double kL = 0.86;  // m
@@ -614,4 +616,5 @@ TEST(OptimizeMaterials, TheBestMaterialIsChosenAndEveryMaterialIsReported) {
 }
 
 }  // namespace
+}  // namespace optimize_design_test
 }  // namespace sweetspot::core

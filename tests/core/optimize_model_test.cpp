@@ -17,6 +17,8 @@
 #include "core/presets.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace optimize_model_test {
 namespace {
 
 // A hollow aluminium profile with a fill, every kind of profile variable.
@@ -374,4 +376,5 @@ TEST(OptimizeNames, PathsObjectivesAndRuleSetsRoundTrip) {
 }
 
 }  // namespace
+}  // namespace optimize_model_test
 }  // namespace sweetspot::core

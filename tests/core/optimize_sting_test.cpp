@@ -17,6 +17,8 @@
 #include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace optimize_sting_test {
 namespace {
 
 // The contract's three-segment ash bat (0.8636 m, handle 0.0125 m, barrel 0.033 m, taper
@@ -288,4 +290,5 @@ TEST(OptimizeSting, TheMaterialWithTheLeastStingIsChosen) {
 }
 
 }  // namespace
+}  // namespace optimize_sting_test
 }  // namespace sweetspot::core

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace paper_analyses_test {
 namespace {
 
 TEST(PaperTable5, ReproducesPrintedNumbersWithTheNotesConventions) {
@@ -91,4 +93,5 @@ TEST(PaperMaterials, HollowAluminiumIsLighterAndHasASmallerSweetSpotDistance) {
 }
 
 }  // namespace
+}  // namespace paper_analyses_test
 }  // namespace sweetspot::core

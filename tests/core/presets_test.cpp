@@ -10,6 +10,8 @@
 #include "core/units.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace presets_test {
 namespace {
 
 double MaxDiameterIn(const Bat& bat) {
@@ -106,4 +108,5 @@ TEST(Presets, Bbcor33Aluminium) {
 TEST(Presets, PresetsAreStable) { EXPECT_EQ(&BatPresets(), &BatPresets()); }
 
 }  // namespace
+}  // namespace presets_test
 }  // namespace sweetspot::core

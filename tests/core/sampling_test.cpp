@@ -7,6 +7,8 @@
 #include <set>
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace sampling_test {
 namespace {
 
 TEST(SamplingTest, GridIsTheRowMajorProductWithExactEnds) {
@@ -124,4 +126,5 @@ TEST(SamplingTest, InvalidPlansAreNamed) {
 }
 
 }  // namespace
+}  // namespace sampling_test
 }  // namespace sweetspot::core

@@ -13,6 +13,8 @@
 #include "core/presets.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace scene_test {
 namespace {
 
 Scene PaperWood(std::vector<SceneOutput> outputs = {SceneOutput::kMaxExitSpeed}) {
@@ -379,4 +381,5 @@ TEST(SceneThreads, ManySolvesOnManyThreadsGiveIdenticalResults) {
 }
 
 }  // namespace
+}  // namespace scene_test
 }  // namespace sweetspot::core

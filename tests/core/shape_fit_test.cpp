@@ -12,6 +12,8 @@
 #include "core/presets.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace shape_fit_test {
 namespace {
 
 constexpr double kL = 0.855;
@@ -322,4 +324,5 @@ TEST(ShapeFitThreads, ParallelFitsAgreeWithTheSerialOne) {
 }
 
 }  // namespace
+}  // namespace shape_fit_test
 }  // namespace sweetspot::core

@@ -5,6 +5,8 @@
 #include "core/version.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace summary_test {
 namespace {
 
 TEST(SummaryTest, TerminationNamesAreTheContractNames) {
@@ -57,4 +59,5 @@ TEST(VersionTest, DependencyVersionsAreTheDebian12Ones) {
 }
 
 }  // namespace
+}  // namespace summary_test
 }  // namespace sweetspot::core

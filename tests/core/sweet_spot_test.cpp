@@ -11,6 +11,8 @@
 #include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace sweet_spot_test {
 namespace {
 
 Scene PaperWoodScene(std::vector<SceneOutput> outputs) {
@@ -169,4 +171,5 @@ TEST(OutputNames, RoundTrip) {
 }
 
 }  // namespace
+}  // namespace sweet_spot_test
 }  // namespace sweetspot::core

@@ -10,6 +10,8 @@
 #include "tests/hard_cases/hard_case.hpp"
 
 namespace sweetspot::hard_cases {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace api_bat_test {
 namespace {
 
 constexpr long double kPi = 3.141592653589793238462643383279502884L;
@@ -269,4 +271,5 @@ INSTANTIATE_TEST_SUITE_P(Api, HardCaseBatModesEndpoint, testing::ValuesIn(ModesC
                          RowName<ApiCase>);
 
 }  // namespace
+}  // namespace api_bat_test
 }  // namespace sweetspot::hard_cases

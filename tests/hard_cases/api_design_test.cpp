@@ -9,6 +9,8 @@
 #include "tests/hard_cases/hard_case.hpp"
 
 namespace sweetspot::hard_cases {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace api_design_test {
 namespace {
 
 // The contract's example family (api.md): ash, 34 in, x1 in [0.1, 0.5], r2 in [0.028, 0.0331];
@@ -202,4 +204,5 @@ INSTANTIATE_TEST_SUITE_P(Api, HardCaseJobsEndpoint, testing::ValuesIn(JobCases()
                          RowName<ApiCase>);
 
 }  // namespace
+}  // namespace api_design_test
 }  // namespace sweetspot::hard_cases

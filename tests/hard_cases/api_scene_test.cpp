@@ -11,6 +11,8 @@
 #include "tests/hard_cases/hard_case.hpp"
 
 namespace sweetspot::hard_cases {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace api_scene_test {
 namespace {
 
 // A paper-wood request with more top-level fields (`rest`, with a leading comma).
@@ -353,4 +355,5 @@ INSTANTIATE_TEST_SUITE_P(Api, HardCaseCompareEndpoint, testing::ValuesIn(Compare
                          RowName<ApiCase>);
 
 }  // namespace
+}  // namespace api_scene_test
 }  // namespace sweetspot::hard_cases

@@ -20,6 +20,8 @@
 #include "tests/hard_cases/reference.hpp"
 
 namespace sweetspot::hard_cases {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace core_collision_test {
 namespace {
 
 // ------------------------------------------------------------------ rigid pivot, closed form
@@ -499,4 +501,5 @@ INSTANTIATE_TEST_SUITE_P(Core, HardCaseNloptFlat, testing::ValuesIn(FlatObjectiv
                          RowName<CoreCase>);
 
 }  // namespace
+}  // namespace core_collision_test
 }  // namespace sweetspot::hard_cases

@@ -5,6 +5,8 @@
 #include <map>
 
 namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace config_test {
 namespace {
 
 ParsedCommandLine Parse(const std::vector<std::string>& args,
@@ -114,4 +116,5 @@ TEST(ConfigTest, HelpListsEveryOptionAndEnvironmentVariable) {
 }
 
 }  // namespace
+}  // namespace config_test
 }  // namespace sweetspot::server

@@ -16,6 +16,8 @@
 #include "tests/server/running_server.hpp"
 
 namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace explore_stream_test {
 namespace {
 
 using Json = nlohmann::json;
@@ -127,4 +129,5 @@ TEST(ExploreStreamTest, ClientGoingAwayMidStreamStopsTheSweepAndTheServerKeepsSe
 }
 
 }  // namespace
+}  // namespace explore_stream_test
 }  // namespace sweetspot::server

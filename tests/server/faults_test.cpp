@@ -15,6 +15,8 @@
 #include "tests/server/wire.hpp"
 
 namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace faults_test {
 namespace {
 
 using sweetspot::testing::Connect;
@@ -103,4 +105,5 @@ TEST_F(FaultsTest, GarbageRequestLineGetsAnErrorAndTheServerLives) {
 }
 
 }  // namespace
+}  // namespace faults_test
 }  // namespace sweetspot::server

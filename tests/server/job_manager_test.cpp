@@ -15,6 +15,8 @@
 #include <vector>
 
 namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace job_manager_test {
 namespace {
 
 using api::Request;
@@ -658,4 +660,5 @@ TEST(JobManagerTest, EachManagerDrawsItsOwnIds) {
 }
 
 }  // namespace
+}  // namespace job_manager_test
 }  // namespace sweetspot::server

@@ -29,6 +29,8 @@
 #include "tests/server/wire.hpp"
 
 namespace sweetspot::testing {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace nginx_test {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -286,4 +288,5 @@ TEST(NginxJobsTest, AJobPostedThroughTheProxyIsFoundOnEveryReadWithPostgres) {
 }
 
 }  // namespace
+}  // namespace nginx_test
 }  // namespace sweetspot::testing

@@ -6,6 +6,8 @@
 #include <string>
 
 namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace request_head_test {
 namespace {
 
 TEST(RequestHeadTest, FramesAPostWithItsContentLength) {
@@ -92,4 +94,5 @@ TEST(RequestHeadTest, GarbageIsFramedAndLeftToHttplibToRefuse) {
 }
 
 }  // namespace
+}  // namespace request_head_test
 }  // namespace sweetspot::server

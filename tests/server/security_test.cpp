@@ -8,6 +8,8 @@
 #include "tests/server/running_server.hpp"
 
 namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace security_test {
 namespace {
 
 TEST(SecurityTest, BearerTokenGuardsEverythingButHealth) {
@@ -120,4 +122,5 @@ TEST(SecurityTest, ErrorsCarryNoInternals) {
 }
 
 }  // namespace
+}  // namespace security_test
 }  // namespace sweetspot::server

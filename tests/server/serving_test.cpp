@@ -31,6 +31,8 @@
 #include "tests/server/wire.hpp"
 
 namespace sweetspot::testing {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace serving_test {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -650,4 +652,5 @@ TEST(ServingTest, ModelWorkStaysInItsBoundedPoolAndCheapRequestsPassIt) {
 }
 
 }  // namespace
+}  // namespace serving_test
 }  // namespace sweetspot::testing

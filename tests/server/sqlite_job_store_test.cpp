@@ -17,6 +17,8 @@
 #include "server/jobs/job_manager.hpp"
 
 namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace sqlite_job_store_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -276,4 +278,5 @@ TEST(SqliteJobStoreTest, AJobManagerRestartedOnTheSameFileGetsItsJobsBack) {
 }
 
 }  // namespace
+}  // namespace sqlite_job_store_test
 }  // namespace sweetspot::server

@@ -17,6 +17,8 @@
 #include "tests/server/running_server.hpp"
 
 namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace static_files_test {
 namespace {
 
 namespace fs = std::filesystem;
@@ -281,4 +283,5 @@ TEST(StaticServingTest, MetricsCountStaticFilesUnderOneRoute) {
 }
 
 }  // namespace
+}  // namespace static_files_test
 }  // namespace sweetspot::server
