@@ -59,7 +59,7 @@ for t in $targets; do
     echo "fuzz.sh: $t failed; full log: $log; input in $build/artifacts/$t/" >&2
   fi
 done
-echo "-- fuzz: run: $(( SECONDS - start )) s" >&2
+echo "== fuzz: run: $(( SECONDS - start )) s" >&2
 if [ ${#failed[@]} -ne 0 ]; then
   echo "fuzz.sh: FAILED: ${failed[*]}" >&2
   exit 1

@@ -1,7 +1,7 @@
 # Sourced by the build and test scripts: names stages, times them, and sets the
 # build defaults they share.
 #
-#   stage "<name>" <command>...   runs the command; prints "-- <name>: N s" when it ends
+#   stage "<name>" <command>...   runs the command; prints "== <name>: N s" when it ends
 #                                 (also when it fails, then the script stops as before)
 #   stages_report                 prints every stage's wall time and the total
 
@@ -22,7 +22,7 @@ stage() {
   local took=$((SECONDS - start))
   sweetspot_stage_names+=("$name")
   sweetspot_stage_seconds+=("$took")
-  printf -- '-- %s: %d s%s\n' "$name" "$took" "$([ "$status" -eq 0 ] || echo " (FAILED, status $status)")" >&2
+  printf '== %s: %d s%s\n' "$name" "$took" "$([ "$status" -eq 0 ] || echo " (FAILED, status $status)")" >&2
   return "$status"
 }
 
