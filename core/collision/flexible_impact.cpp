@@ -10,9 +10,8 @@
 #include <sstream>
 #include <utility>
 
-#include <boost/math/tools/roots.hpp>
-
 #include "core/collision/contact_law.hpp"
+#include "core/collision/flexible_modal_system.hpp"
 #include "core/flexible/static_flexibility.hpp"
 #include "core/numerics/event_integrator.hpp"
 #include "core/units.hpp"
@@ -20,17 +19,16 @@
 namespace sweetspot::core {
 namespace {
 
-using State = std::vector<double>;
+using flexible_detail::FindRecontact;
+using flexible_detail::FreeAdvance;
+using flexible_detail::FreeHandsPeaks;
+using flexible_detail::kSamplesPerPeriod;
+using flexible_detail::Model;
+using flexible_detail::RawRun;
+using flexible_detail::Rhs;
+using flexible_detail::State;
 
 constexpr double kTwoPi = 2.0 * kPi;
-// Free flight after a separation is scanned with this many samples per period of the highest
-// mode (a touch shorter than 1/32 of that period can be missed; its impulse is negligible).
-constexpr int kSamplesPerPeriod = 32;
-// The longest free flight scanned for a further contact when the bat's rigid recoil does not
-// bound it, s.
-constexpr double kMaxFreeFlightS = 0.05;
-// A gap below this (scaled by the compression scale) counts as touching.
-constexpr double kTouch = 1e-12;
 
 std::string Num(double v) {
   std::ostringstream s;
@@ -42,225 +40,6 @@ std::string Num(double v) {
 bool Fail(std::string* why, const std::string& m) {
   if (why != nullptr) *why = m;
   return false;
-}
-
-// The modes in the superposition and what each contributes at the impact point and the hands.
-struct Model {
-  int n = 0;                      // modes, the 2 rigid ones first
-  std::vector<double> omega_hat;  // omega_k t_s (0 for the rigid modes)
-  std::vector<double> phi_hat;    // phi_k(s) sqrt(m)
-  std::vector<double> shear;      // S_k = int_0^h rho A phi_k dx, kg^0.5
-  std::vector<double> moment;     // T_k = int_0^h rho A phi_k (x - h) + rho I theta_k dx, kg^0.5 m
-  std::vector<double> grip;       // G_k = int_grip rho A phi_k^2 + rho I theta_k^2 dx
-  double residual_compliance = 0.0;  // sum over the modes left out of phi_k(s)^2 / omega_k^2, m/N
-  double force_sign_hands = 0.0;     // 1 when the ball strikes the knob-side segment [0, h)
-  double arm_hands_m = 0.0;          // s - h
-};
-
-// Scales and the contact state shared by the right-hand side and the driver.
-struct Rhs {
-  const Model* model = nullptr;
-  const BallPowerLaw* law = nullptr;
-  double delta_s = 1.0, v0 = 1.0, t_s = 1.0, m = 1.0;
-  ContactBranch branch;             // the contact's own compression (ball + surface), m
-  double total_delta_max = 0.0;     // branch.delta_max_m plus the residual spring's share, m
-  mutable double last_force = 0.0;  // warm start of Force's Newton iteration (a cache only)
-
-  int Q(int k) const { return 2 + k; }
-  int QD(int k) const { return 2 + model->n + k; }
-  int P() const { return 2 + 2 * model->n; }
-  int W() const { return 3 + 2 * model->n; }
-  int Size() const { return 4 + 2 * model->n; }
-
-  // Scaled compression (ball surface to the bat's modal surface) and its rate.
-  double Delta(const State& y) const {
-    double w = 0.0;
-    for (int k = 0; k < model->n; ++k) {
-      w += model->phi_hat[static_cast<std::size_t>(k)] * y[static_cast<std::size_t>(Q(k))];
-    }
-    return y[0] - w;
-  }
-  double DeltaRate(const State& y) const {
-    double w = 0.0;
-    for (int k = 0; k < model->n; ++k) {
-      w += model->phi_hat[static_cast<std::size_t>(k)] * y[static_cast<std::size_t>(QD(k))];
-    }
-    return y[1] - w;
-  }
-  // Force (N) at scaled total compression d: the contact in series with the residual spring
-  // (the static compliance of the modes left out; contact_law.hpp's SeriesContactForce).
-  double Force(double d_scaled) const {
-    return SeriesContactForce(*law, branch, model->residual_compliance, d_scaled * delta_s,
-                              &last_force);
-  }
-  void operator()(const State& y, State& dy, double /*t*/) const {
-    const double f = Force(Delta(y));
-    const double fh = f * t_s / (m * v0);
-    dy[0] = y[1];
-    dy[1] = -fh;
-    const int n = model->n;
-    for (int k = 0; k < n; ++k) {
-      const std::size_t ks = static_cast<std::size_t>(k);
-      const double om = model->omega_hat[ks];
-      dy[static_cast<std::size_t>(Q(k))] = y[static_cast<std::size_t>(QD(k))];
-      dy[static_cast<std::size_t>(QD(k))] =
-          -om * om * y[static_cast<std::size_t>(Q(k))] + model->phi_hat[ks] * fh;
-    }
-    dy[static_cast<std::size_t>(P())] = fh;
-    dy[static_cast<std::size_t>(W())] = fh * DeltaRate(y);
-  }
-  // Shear force and bending moment at the hands (N, N m) for state y with contact force f.
-  void HandsLoads(const State& y, double f, double* shear, double* moment) const {
-    const double scale = delta_s * std::sqrt(m) / (t_s * t_s);  // scaled q'' -> physical
-    const double fh = f * t_s / (m * v0);
-    double v = 0.0, mo = 0.0;
-    for (int k = 0; k < model->n; ++k) {
-      const std::size_t ks = static_cast<std::size_t>(k);
-      const double om = model->omega_hat[ks];
-      const double acc =
-          scale * (-om * om * y[static_cast<std::size_t>(Q(k))] + model->phi_hat[ks] * fh);
-      v += model->shear[ks] * acc;
-      mo += model->moment[ks] * acc;
-    }
-    v -= model->force_sign_hands * f;
-    mo -= model->force_sign_hands * f * model->arm_hands_m;
-    *shear = v;
-    *moment = mo;
-  }
-};
-
-// Exact free motion over dtau (scaled): ballistic ball, rigid modes linear, flexible harmonic.
-void FreeAdvance(const Rhs& rhs, double dtau, State* y) {
-  State& s = *y;
-  s[0] += s[1] * dtau;
-  for (int k = 0; k < rhs.model->n; ++k) {
-    const std::size_t i = static_cast<std::size_t>(rhs.Q(k));
-    const std::size_t j = static_cast<std::size_t>(rhs.QD(k));
-    const double om = rhs.model->omega_hat[static_cast<std::size_t>(k)];
-    if (om == 0.0) {
-      s[i] += s[j] * dtau;
-    } else {
-      const double c = std::cos(om * dtau), sn = std::sin(om * dtau);
-      const double q = s[i], qd = s[j];
-      s[i] = q * c + qd / om * sn;
-      s[j] = -q * om * sn + qd * c;
-    }
-  }
-}
-
-struct RawRun {
-  bool ok = false;
-  std::string message;
-  std::vector<std::string> warnings;
-  State final_state;
-  double contact_time_s = 0.0;
-  int contacts = 0;
-  double peak_force_n = 0.0;
-  double max_compression_m = 0.0;
-  double loss_j = 0.0;
-  double released_j = 0.0;  // residual-spring energy released by an abrupt (plastic) end, J
-  double peak_shear_n = 0.0;
-  double peak_moment_n_m = 0.0;
-  int steps = 0;
-  long evaluations = 0;
-};
-
-// Samples the hands' loads along free motion from y over [0, window] (scaled) and updates the
-// peaks (rotation recurrences: no trigonometry per sample).
-void FreeHandsPeaks(const Rhs& rhs, const State& y, double window, double dtau, RawRun* run) {
-  const Model& md = *rhs.model;
-  const int n = md.n;
-  if (!(window > 0.0) || !(dtau > 0.0)) return;
-  // Clamp in double before the cast (no overflow for any ratio).
-  const long samples = static_cast<long>(std::min(std::ceil(window / dtau), 2e6));
-  std::vector<double> c(static_cast<std::size_t>(n), 1.0), s(static_cast<std::size_t>(n), 0.0),
-      cd(static_cast<std::size_t>(n)), sd(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) {
-    const double om = md.omega_hat[static_cast<std::size_t>(k)];
-    cd[static_cast<std::size_t>(k)] = std::cos(om * dtau);
-    sd[static_cast<std::size_t>(k)] = std::sin(om * dtau);
-  }
-  const double scale = rhs.delta_s * std::sqrt(rhs.m) / (rhs.t_s * rhs.t_s);
-  for (long i = 1; i <= samples; ++i) {
-    double v = 0.0, mo = 0.0;
-    for (int k = 0; k < n; ++k) {
-      const std::size_t ks = static_cast<std::size_t>(k);
-      const double cn = c[ks] * cd[ks] - s[ks] * sd[ks];
-      const double sn = s[ks] * cd[ks] + c[ks] * sd[ks];
-      c[ks] = cn;
-      s[ks] = sn;
-      const double om = md.omega_hat[ks];
-      if (om == 0.0) continue;  // rigid modes do not accelerate in free motion
-      const double q0 = y[static_cast<std::size_t>(rhs.Q(k))];
-      const double qd0 = y[static_cast<std::size_t>(rhs.QD(k))];
-      const double q = q0 * cn + qd0 / om * sn;
-      const double acc = -scale * om * om * q;
-      v += md.shear[ks] * acc;
-      mo += md.moment[ks] * acc;
-    }
-    run->peak_shear_n = std::max(run->peak_shear_n, std::abs(v));
-    run->peak_moment_n_m = std::max(run->peak_moment_n_m, std::abs(mo));
-  }
-}
-
-// The first time (scaled, > 0) the free motion from y closes the gap again, or a negative value.
-double FindRecontact(const Rhs& rhs, const State& y, std::vector<std::string>* warnings) {
-  const Model& md = *rhs.model;
-  double v_rigid = y[1], amplitude = 0.0, om_max = 0.0;
-  for (int k = 0; k < md.n; ++k) {
-    const std::size_t ks = static_cast<std::size_t>(k);
-    const double om = md.omega_hat[ks];
-    const double q = y[static_cast<std::size_t>(rhs.Q(k))];
-    const double qd = y[static_cast<std::size_t>(rhs.QD(k))];
-    if (om == 0.0) {
-      v_rigid -= md.phi_hat[ks] * qd;
-    } else {
-      amplitude += std::abs(md.phi_hat[ks]) * std::hypot(q, qd / om);
-      om_max = std::max(om_max, om);
-    }
-  }
-  const double d0 = rhs.Delta(y);
-  // delta(tau) <= d0 + v_rigid tau + 2 A: no contact once that is negative.
-  double horizon = kMaxFreeFlightS / rhs.t_s;
-  if (v_rigid < 0.0) {
-    horizon = std::min(horizon, (std::max(d0, 0.0) + 2.0 * amplitude) / -v_rigid);
-  } else {
-    warnings->push_back(
-        "after a separation the ball does not move away from the bat's rigid-body recoil (a "
-        "soft, far-from-the-centre impact); a later contact was looked for during " +
-        Num(kMaxFreeFlightS) + " s only, beyond which the swing's rotation would matter");
-  }
-  if (!(horizon > 0.0)) return -1.0;
-  const double dtau = om_max > 0.0 ? kTwoPi / (kSamplesPerPeriod * om_max) : horizon;
-  const double wanted_samples = std::ceil(horizon / dtau);
-  const long samples = static_cast<long>(std::min(wanted_samples, 2e6));
-  if (wanted_samples > 2e6) {
-    warnings->push_back("the search for a further contact was cut at 2e6 samples");
-  }
-  auto gap = [&](double tau) {
-    State s = y;
-    FreeAdvance(rhs, tau, &s);
-    return rhs.Delta(s);
-  };
-  double t_prev = 0.0, g_prev = d0;
-  for (long i = 1; i <= std::min(samples, 2000000L); ++i) {
-    const double t = std::min(horizon, i * dtau);
-    const double g = gap(t);
-    if (g > kTouch) {
-      boost::uintmax_t iters = 100;
-      try {
-        const auto r =
-            boost::math::tools::toms748_solve(gap, t_prev, t, std::min(g_prev, 0.0), g,
-                                              boost::math::tools::eps_tolerance<double>(52), iters);
-        return r.second;
-      } catch (const std::exception&) {
-        return t;
-      }
-    }
-    t_prev = t;
-    g_prev = g;
-  }
-  return -1.0;
 }
 
 // The events of one contact (each crosses from > 0 to <= 0): the compression rate falls through
