@@ -1,13 +1,14 @@
 #include "core/nlopt_search.hpp"
 
-#include <nlopt.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <limits>
 #include <sstream>
+
+#include "core/optimize/nlopt_run.hpp"
+#include "core/optimize/termination.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -17,22 +18,21 @@ constexpr double kEps = std::numeric_limits<double>::epsilon();
 struct AlgorithmInfo {
   NloptAlgorithm id;
   const char* name;
-  nlopt::algorithm nlopt_id;
 };
 
 constexpr AlgorithmInfo kAlgorithms[] = {
-    {NloptAlgorithm::kLdSlsqp, "LD_SLSQP", nlopt::LD_SLSQP},
-    {NloptAlgorithm::kLdLbfgs, "LD_LBFGS", nlopt::LD_LBFGS},
-    {NloptAlgorithm::kLdTnewton, "LD_TNEWTON_PRECOND_RESTART", nlopt::LD_TNEWTON_PRECOND_RESTART},
-    {NloptAlgorithm::kLdMma, "LD_MMA", nlopt::LD_MMA},
-    {NloptAlgorithm::kLdCcsaq, "LD_CCSAQ", nlopt::LD_CCSAQ},
-    {NloptAlgorithm::kLnBobyqa, "LN_BOBYQA", nlopt::LN_BOBYQA},
-    {NloptAlgorithm::kLnCobyla, "LN_COBYLA", nlopt::LN_COBYLA},
-    {NloptAlgorithm::kLnSbplx, "LN_SBPLX", nlopt::LN_SBPLX},
-    {NloptAlgorithm::kLnNelderMead, "LN_NELDERMEAD", nlopt::LN_NELDERMEAD},
-    {NloptAlgorithm::kGnDirectL, "GN_DIRECT_L", nlopt::GN_DIRECT_L},
-    {NloptAlgorithm::kGnAgs, "GN_AGS", nlopt::GN_AGS},
-    {NloptAlgorithm::kGnCrs2Lm, "GN_CRS2_LM", nlopt::GN_CRS2_LM},
+    {NloptAlgorithm::kLdSlsqp, "LD_SLSQP"},
+    {NloptAlgorithm::kLdLbfgs, "LD_LBFGS"},
+    {NloptAlgorithm::kLdTnewton, "LD_TNEWTON_PRECOND_RESTART"},
+    {NloptAlgorithm::kLdMma, "LD_MMA"},
+    {NloptAlgorithm::kLdCcsaq, "LD_CCSAQ"},
+    {NloptAlgorithm::kLnBobyqa, "LN_BOBYQA"},
+    {NloptAlgorithm::kLnCobyla, "LN_COBYLA"},
+    {NloptAlgorithm::kLnSbplx, "LN_SBPLX"},
+    {NloptAlgorithm::kLnNelderMead, "LN_NELDERMEAD"},
+    {NloptAlgorithm::kGnDirectL, "GN_DIRECT_L"},
+    {NloptAlgorithm::kGnAgs, "GN_AGS"},
+    {NloptAlgorithm::kGnCrs2Lm, "GN_CRS2_LM"},
 };
 
 const AlgorithmInfo& Info(NloptAlgorithm a) {
@@ -57,7 +57,6 @@ double SecondsSince(std::chrono::steady_clock::time_point t0) {
 // exception escape: it records the problem and asks NLopt to stop.
 struct Tracker {
   const ScalarObjective* f = nullptr;
-  nlopt::opt* opt = nullptr;
   int evaluations = 0;
   bool failed = false;
   std::string error;
@@ -95,63 +94,34 @@ struct Tracker {
   }
 };
 
-double Callback(unsigned /*n*/, const double* x, double* grad, void* data) {
-  auto* t = static_cast<Tracker*>(data);
-  double v = 0.0;
-  double g = 0.0;
-  if (!t->Eval(x[0], &v, grad != nullptr ? &g : nullptr)) {
-    if (t->opt != nullptr) t->opt->force_stop();
-    if (grad != nullptr) grad[0] = 0.0;
-    return HUGE_VAL;
-  }
-  if (grad != nullptr) grad[0] = -g;
-  return -v;  // NLopt minimises
-}
-
-// One NLopt run from x0; returns the raw result code and updates x0 / fval (maximised f).
+// One NLopt run from x0 (the trampoline; f maximised as -f minimised); returns the raw result
+// code and updates x0 / fval (maximised f). An objective failure is recorded in the tracker.
 int RunStage(NloptAlgorithm alg, double lower, double upper, double x_tol, int max_eval,
              double max_time_s, double initial_step, unsigned seed, Tracker* tracker, double* x0,
              double* fval, std::string* error) {
-  try {
-    nlopt::opt opt(Info(alg).nlopt_id, 1);
-    tracker->opt = &opt;
-    opt.set_min_objective(Callback, tracker);
-    opt.set_lower_bounds(std::vector<double>{lower});
-    opt.set_upper_bounds(std::vector<double>{upper});
-    opt.set_xtol_abs(x_tol);
-    opt.set_maxeval(std::max(1, max_eval));
-    opt.set_maxtime(std::max(1e-6, max_time_s));
-    if (initial_step > 0.0) opt.set_initial_step(initial_step);
-    std::vector<double> x{std::clamp(*x0, lower, upper)};
-    double minf = HUGE_VAL;
-    int raw = 0;
-    if (NloptAlgorithmIsStochastic(alg)) nlopt::srand(seed);
-    try {
-      raw = static_cast<int>(opt.optimize(x, minf));
-    } catch (const nlopt::roundoff_limited&) {
-      raw = static_cast<int>(nlopt::ROUNDOFF_LIMITED);  // x holds the best point: keep it
-    } catch (const nlopt::forced_stop&) {
-      raw = static_cast<int>(nlopt::FORCED_STOP);
-    } catch (const std::invalid_argument& e) {
-      raw = static_cast<int>(nlopt::INVALID_ARGS);
-      *error = std::string("NLopt refused the problem: ") + e.what();
-    } catch (const std::bad_alloc&) {
-      raw = static_cast<int>(nlopt::OUT_OF_MEMORY);
-      *error = "NLopt ran out of memory";
-    } catch (const std::exception& e) {
-      raw = static_cast<int>(opt.last_optimize_result());
-      if (raw > 0) raw = static_cast<int>(nlopt::FAILURE);
-      *error = std::string("NLopt failed: ") + e.what();
-    }
-    tracker->opt = nullptr;
-    if (std::isfinite(x[0])) *x0 = x[0];
-    if (std::isfinite(minf) && minf != HUGE_VAL) *fval = -minf;
-    return raw;
-  } catch (const std::exception& e) {
-    tracker->opt = nullptr;
-    *error = std::string("NLopt failed: ") + e.what();
-    return static_cast<int>(nlopt::FAILURE);
-  }
+  NloptRunSettings settings;
+  settings.algorithm = alg;
+  settings.lower = {lower};
+  settings.upper = {upper};
+  settings.x_tolerance_abs = x_tol;
+  settings.max_evaluations = std::max(1, max_eval);
+  settings.max_time_s = std::max(1e-6, max_time_s);
+  settings.initial_step = initial_step;
+  if (NloptAlgorithmIsStochastic(alg)) settings.seed = seed;
+  const NloptFunction objective = [tracker](const double* x, double* grad) {
+    double v = 0.0;
+    double g = 0.0;
+    if (!tracker->Eval(x[0], &v, grad != nullptr ? &g : nullptr))
+      return std::numeric_limits<double>::quiet_NaN();
+    if (grad != nullptr) grad[0] = -g;
+    return -v;  // NLopt minimises
+  };
+  std::vector<double> x{std::clamp(*x0, lower, upper)};
+  const NloptRunOutcome run = RunNlopt(objective, {}, settings, &x);
+  if (!run.message.empty() && !run.callback_failed) *error = run.message;
+  if (std::isfinite(x[0])) *x0 = x[0];
+  if (std::isfinite(run.minimum) && run.minimum != HUGE_VAL) *fval = -run.minimum;
+  return run.raw_status;
 }
 
 }  // namespace
@@ -188,56 +158,6 @@ const std::vector<NloptAlgorithm>& OfferedNloptAlgorithms() {
 bool NloptAlgorithmNeedsGradient(NloptAlgorithm a) { return Info(a).name[1] == 'D'; }
 bool NloptAlgorithmIsGlobal(NloptAlgorithm a) { return Info(a).name[0] == 'G'; }
 bool NloptAlgorithmIsStochastic(NloptAlgorithm a) { return a == NloptAlgorithm::kGnCrs2Lm; }
-
-Termination TerminationFromNloptResult(int raw_status) {
-  switch (raw_status) {
-    case 1:  // SUCCESS
-    case 2:  // STOPVAL_REACHED
-    case 3:  // FTOL_REACHED
-    case 4:  // XTOL_REACHED
-      return Termination::kConverged;
-    case 5:   // MAXEVAL_REACHED
-    case 6:   // MAXTIME_REACHED
-    case -4:  // ROUNDOFF_LIMITED: the best point is kept
-      return Termination::kNoConvergence;
-    case -2:  // INVALID_ARGS
-      return Termination::kInvalidInput;
-    case -1:  // FAILURE
-    case -3:  // OUT_OF_MEMORY
-    case -5:  // FORCED_STOP (only ever forced by us after an objective failure)
-    default:
-      return Termination::kFailure;
-  }
-}
-
-const char* NloptResultName(int raw_status) {
-  switch (raw_status) {
-    case -1:
-      return "FAILURE";
-    case -2:
-      return "INVALID_ARGS";
-    case -3:
-      return "OUT_OF_MEMORY";
-    case -4:
-      return "ROUNDOFF_LIMITED";
-    case -5:
-      return "FORCED_STOP";
-    case 1:
-      return "SUCCESS";
-    case 2:
-      return "STOPVAL_REACHED";
-    case 3:
-      return "FTOL_REACHED";
-    case 4:
-      return "XTOL_REACHED";
-    case 5:
-      return "MAXEVAL_REACHED";
-    case 6:
-      return "MAXTIME_REACHED";
-    default:
-      return "UNKNOWN";
-  }
-}
 
 bool ScalarSearchOptions::IsValid(std::string* why) const {
   auto fail = [why](const std::string& m) {
@@ -347,7 +267,7 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
                    std::min(options.global_max_evaluations, options.max_evaluations),
                    options.max_time_s, 0.0, options.seed, &tracker, &x, &fx, &nlopt_error);
     // A global stage stopping on its budget is expected; the polish decides convergence.
-    if (options.polish && !tracker.failed && (raw > 0 || raw == -4)) {
+    if (options.polish && !tracker.failed && (raw > 0 || raw == kNloptRoundoffLimited)) {
       const NloptAlgorithm local =
           has_gradient ? NloptAlgorithm::kLdSlsqp : NloptAlgorithm::kLnBobyqa;
       tracker.record = true;
@@ -369,7 +289,7 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
   s.termination = TerminationFromNloptResult(raw);
   s.message = std::string("NLopt ") + NloptResultName(raw);
   if (!nlopt_error.empty()) s.message += ": " + nlopt_error;
-  if (raw == -4) {
+  if (raw == kNloptRoundoffLimited) {
     s.warnings.push_back("NLopt stopped on round-off (ROUNDOFF_LIMITED); the best point is kept");
   }
   if (!s.IsSolutionUsable()) {
