@@ -9,6 +9,7 @@
 #include <set>
 
 #include "core/collision/collide.hpp"
+#include "core/collision/exit_speed_algebra.hpp"
 #include "core/collision/rigid_pivot.hpp"
 #include "core/geometry_format.hpp"
 #include "core/geometry_integrals.hpp"
@@ -265,69 +266,25 @@ T DesignModel::ObjectiveOf(const T* p) const {
   }
   const double lo = -pivot;   // the knob, in coordinates from the pivot
   const T hi = p[3] - pivot;  // the tip
-  // The rigid-pivot closed form (paper-notes.md section 3), without cancellation.
-  const T s = jet::Sqrt(u * u + omega * omega * j * (1.0 / m));
-  const T xs = omega * j / (m * (u + s));
-  auto exit_speed_at = [&](const T& x) {
-    return (1.0 + e) * j * (u + omega * x) / (j + m * x * x) - u;
-  };
-  const bool beyond_tip = jet::Value(xs) > jet::Value(hi);
-  const bool before_knob = jet::Value(xs) < lo;
+  // The rigid-pivot closed forms (exit_speed_algebra.hpp, the code ExitSpeedProfile runs).
+  const exit_speed::Form<T> form = exit_speed::RigidPivotForm(j, m, u, omega, e);
+  const exit_speed::Maximum<T> mx = exit_speed::MaximumOf(form);
+  const bool beyond_tip = jet::Value(mx.x_m) > jet::Value(hi);
+  const bool before_knob = jet::Value(mx.x_m) < lo;
   if (objective_kind_ != DesignObjective::kWidestSweetZone) {
-    if (beyond_tip) return exit_speed_at(hi);
-    if (before_knob) return exit_speed_at(T(lo));
-    return 0.5 * ((1.0 + e) * s - (1.0 - e) * u);
+    if (beyond_tip) return exit_speed::ExitSpeedAt(form, hi);
+    if (before_knob) return exit_speed::ExitSpeedAt(form, T(lo));
+    return mx.peak_mps - u;
   }
-  // The sweet zone: where f(x) >= f(x_c) - tolerance, x_c the sweet spot on the bat. With
-  // cG = (1 + e)(u + S) / 2, f(x*) - f(x) = cG m (x - x*)^2 / (J + m x^2), so the zone is
-  // a x^2 - 2 b x + c <= 0 (as ExitSpeedProfile::ZoneAround, same algebra).
-  const T cg = 0.5 * (1.0 + e) * (u + s);
+  // The sweet zone (ClosedFormSweetZone's algebra): where f(x) >= f(x_c) - tolerance, x_c the
+  // sweet spot on the bat, i.e. within tolerance + (f(x*) - f(x_c)) of the maximum.
   T delta(zone_tolerance_mps_);
   if (beyond_tip || before_knob) {
-    const T xc = beyond_tip ? hi : T(lo);
-    const T d = xc - xs;
-    delta = delta + cg * m * d * d / (j + m * xc * xc);
+    delta = delta + exit_speed::DeficitAt(form, mx, beyond_tip ? hi : T(lo));
   }
-  const T a = m * (cg - delta);
-  const T b = cg * m * xs;
-  const T c = cg * m * xs * xs - delta * j;
-  const T disc = m * delta * (cg * (j + m * xs * xs) - delta * j);
-  T zlo = xs, zhi = xs;
-  bool lo_open = false, hi_open = false;
-  if (jet::Value(a) > 0.0) {
-    if (jet::Value(disc) > 0.0) {
-      const T q = b + jet::Sqrt(disc);
-      const T r1 = q / a;
-      const T r2 = c / q;
-      const bool order = jet::Value(r1) <= jet::Value(r2);
-      zlo = order ? r1 : r2;
-      zhi = order ? r2 : r1;
-    }
-  } else if (jet::Value(a) == 0.0) {
-    hi_open = true;
-    if (jet::Value(b) > 0.0) {
-      zlo = c / (2.0 * b);
-    } else {
-      lo_open = true;
-    }
-  } else if (!(jet::Value(disc) >= 0.0)) {
-    lo_open = hi_open = true;
-  } else {
-    const T q = b + jet::Sqrt(disc);
-    const T r1 = q / a;
-    const T r2 = c / q;
-    const T root_lo = jet::Value(r1) <= jet::Value(r2) ? r1 : r2;
-    const T root_hi = jet::Value(r1) <= jet::Value(r2) ? r2 : r1;
-    if (jet::Value(xs) >= jet::Value(root_hi)) {
-      zlo = root_hi;
-      hi_open = true;
-    } else {
-      zhi = root_lo;
-      lo_open = true;
-    }
-  }
-  const T top = (hi_open || jet::Value(zhi) > jet::Value(hi)) ? hi : zhi;
-  const T bottom = (lo_open || jet::Value(zlo) < lo) ? T(lo) : zlo;
+  const exit_speed::Zone<T> zone = exit_speed::ZoneAround(form, mx, delta);
+  const T top = (zone.hi_open || jet::Value(zone.hi_m) > jet::Value(hi)) ? hi : zone.hi_m;
+  const T bottom = (zone.lo_open || jet::Value(zone.lo_m) < lo) ? T(lo) : zone.lo_m;
   return top - bottom;
 }
 
