@@ -102,10 +102,10 @@ nlopt::result Optimize(const NloptFunction& objective,
   nlopt::opt opt(NloptId(settings.algorithm), static_cast<unsigned>(x->size()));
   RunState run{&settings, &opt, outcome,
                settings.deadline != std::chrono::steady_clock::time_point::max()};
-  std::vector<Callback> callbacks;
-  callbacks.reserve(constraints.size() + 1);  // stable addresses for NLopt's data pointers
-  callbacks.push_back({&run, &objective, true});
-  opt.set_min_objective(Trampoline, &callbacks.back());
+  Callback objective_callback{&run, &objective, true};
+  opt.set_min_objective(Trampoline, &objective_callback);
+  std::vector<Callback> callbacks;  // no allocation without constraints (the scalar search)
+  callbacks.reserve(constraints.size());  // stable addresses for NLopt's data pointers
   for (const NloptConstraintFunction& c : constraints) {
     callbacks.push_back({&run, &c.value, false});
     if (c.equality) {
