@@ -85,6 +85,18 @@ Reach ReachOf(const DesignModel& model, int k, const std::vector<int>& keep,
   return out;
 }
 
+// Adds constraint k to d->constraints, and "name (off by v unit)" to *names, when x violates
+// it beyond the feasibility tolerance.
+void NoteViolation(const DesignModel& model, int k, const std::vector<double>& x, DesignConflict* d,
+                   std::string* names) {
+  const DesignConstraintSpec& c = model.constraints()[static_cast<std::size_t>(k)];
+  const double viol = Violation(c, model.Value(c.f, x.data()));
+  if (!(viol > kFeasibleRelative * c.scale)) return;
+  d->constraints.push_back(c.name);
+  if (!names->empty()) *names += ", ";
+  *names += c.name + " (off by " + WithUnit(viol, c.unit) + ")";
+}
+
 }  // namespace
 
 // Why no design meets the constraints: single constraints that cannot be met within the
@@ -144,16 +156,7 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
     if (!run.feasible && o.termination == Termination::kInfeasible) {
       DesignConflict d;
       std::string names;
-      for (int k : structural) {
-        const DesignConstraintSpec& c = model.constraints()[static_cast<std::size_t>(k)];
-        const double v = model.Value(c.f, run.x.data());
-        const double viol = Violation(c, v);
-        if (viol > kFeasibleRelative * c.scale) {
-          d.constraints.push_back(c.name);
-          if (!names.empty()) names += ", ";
-          names += c.name + " (off by " + WithUnit(viol, c.unit) + ")";
-        }
-      }
+      for (int k : structural) NoteViolation(model, k, run.x, &d, &names);
       d.achievable_min = d.achievable_max = d.requested_min = d.requested_max = kNaN;
       d.shortfall = run.violation;
       d.message =
@@ -190,15 +193,7 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
   // least-violating design breaks.
   DesignConflict d;
   std::string names;
-  for (int k = 0; k < model.m(); ++k) {
-    const DesignConstraintSpec& c = model.constraints()[static_cast<std::size_t>(k)];
-    const double viol = Violation(c, model.Value(c.f, least_violating.x.data()));
-    if (viol > kFeasibleRelative * c.scale) {
-      d.constraints.push_back(c.name);
-      if (!names.empty()) names += ", ";
-      names += c.name + " (off by " + WithUnit(viol, c.unit) + ")";
-    }
-  }
+  for (int k = 0; k < model.m(); ++k) NoteViolation(model, k, least_violating.x, &d, &names);
   d.achievable_min = d.achievable_max = d.requested_min = d.requested_max = kNaN;
   d.shortfall = least_violating.violation;
   d.message = names.empty() ? "no conflict could be isolated"
