@@ -124,6 +124,207 @@ int RunStage(NloptAlgorithm alg, double lower, double upper, double x_tol, int m
   return run.raw_status;
 }
 
+// The state of one MaximizeScalar: the problem, the evaluations and the best point so far.
+struct ScalarSearch {
+  const ScalarSearchOptions* options = nullptr;
+  double lower = 0.0;
+  double upper = 0.0;
+  bool has_gradient = false;
+  std::chrono::steady_clock::time_point t0;
+  Tracker tracker;
+  double x = 0.0;   // the best point so far
+  double fx = 0.0;  // f there
+  int raw = 0;      // NLopt's last result code
+  std::string nlopt_error;
+  Summary* summary = nullptr;
+};
+
+// The search proper: coarse samples then the local method, or the global method then a
+// polish; updates x, fx, raw and the warnings.
+void RunStages(NloptAlgorithm alg, bool global, ScalarSearch& st) {
+  const ScalarSearchOptions& options = *st.options;
+  const double lower = st.lower, upper = st.upper, range = st.upper - st.lower;
+  const bool has_gradient = st.has_gradient;
+  Tracker& tracker = st.tracker;
+  double& x = st.x;
+  double& fx = st.fx;
+  int& raw = st.raw;
+  std::string& nlopt_error = st.nlopt_error;
+  Summary& s = *st.summary;
+  const auto t0 = st.t0;
+  if (!global) {
+    // Coarse samples pick the start, so a local method starts in the right basin.
+    const int n = options.start_samples;
+    double best = -HUGE_VAL;
+    for (int i = 0; i < n; ++i) {
+      const double xi = i + 1 == n ? upper : lower + range * i / (n - 1);
+      double fi = 0.0;
+      if (!tracker.Eval(xi, &fi, nullptr)) break;
+      if (fi > best) {
+        best = fi;
+        x = xi;
+      }
+    }
+    fx = best;
+    tracker.record = true;
+    if (!tracker.failed) {
+      const double remaining_time = options.max_time_s - SecondsSince(t0);
+      raw = RunStage(alg, lower, upper, options.x_tolerance_m,
+                     options.max_evaluations - tracker.evaluations, remaining_time,
+                     NloptAlgorithmNeedsGradient(alg) ? 0.0 : range / (n - 1), options.seed,
+                     &tracker, &x, &fx, &nlopt_error);
+    }
+  } else {
+    raw = RunStage(alg, lower, upper, std::max(options.x_tolerance_m, 1e-4 * range),
+                   std::min(options.global_max_evaluations, options.max_evaluations),
+                   options.max_time_s, 0.0, options.seed, &tracker, &x, &fx, &nlopt_error);
+    // A global stage stopping on its budget is expected; the polish decides convergence.
+    if (options.polish && !tracker.failed && (raw > 0 || raw == kNloptRoundoffLimited)) {
+      const NloptAlgorithm local =
+          has_gradient ? NloptAlgorithm::kLdSlsqp : NloptAlgorithm::kLnBobyqa;
+      tracker.record = true;
+      const double remaining_time = options.max_time_s - SecondsSince(t0);
+      raw = RunStage(local, lower, upper, options.x_tolerance_m,
+                     options.max_evaluations - tracker.evaluations, remaining_time,
+                     has_gradient ? 0.0 : 1e-3 * range, options.seed, &tracker, &x, &fx,
+                     &nlopt_error);
+      s.warnings.push_back(std::string("polished with ") + NloptAlgorithmName(local));
+    }
+  }
+}
+
+// A posteriori check (first-order conditions) and restarts of the local method from the
+// point with the smallest |f'| among the ties of the best f.
+void Polish(NloptAlgorithm alg, bool global, ScalarSearch& st) {
+  const ScalarSearchOptions& options = *st.options;
+  const double lower = st.lower, upper = st.upper, range = st.upper - st.lower;
+  const bool has_gradient = st.has_gradient;
+  Tracker& tracker = st.tracker;
+  double& x = st.x;
+  double& fx = st.fx;
+  int& raw = st.raw;
+  std::string& nlopt_error = st.nlopt_error;
+  Summary& s = *st.summary;
+  const auto t0 = st.t0;
+  // A posteriori check and error estimate (first-order conditions; curvature by differences).
+  // Near a smooth maximum f is flat to rounding over ~sqrt(eps |f| / |f''|) (about 1e-8 m
+  // here), so "the best f seen", which NLopt returns, cannot resolve the position further.
+  // With a derivative, pick among the points NLopt evaluated whose f ties the best (within
+  // rounding) the one with the smallest |f'|: the first-order condition resolves the
+  // maximiser to ~eps |x| instead of ~sqrt(eps).
+  auto select_by_first_order = [&]() {
+    if (!has_gradient || tracker.points.empty()) return;
+    double best_f = -HUGE_VAL;
+    for (const auto& p : tracker.points) best_f = std::max(best_f, p.f);
+    // Points within 1e-10 (relative) of the best f are all within ~sqrt(2e-10 |f| / |f''|) of
+    // the maximiser, where f is quadratic and |f'| grows with the distance: the smallest |f'|
+    // wins. (Rounding in f can exceed eps |f| when f is a difference of larger terms.)
+    const double tie = 1e-10 * std::max(1.0, std::abs(best_f));
+    double best_g = HUGE_VAL;
+    for (const auto& p : tracker.points) {
+      if (p.f >= best_f - tie && std::abs(p.g) < best_g && p.x > lower && p.x < upper) {
+        best_g = std::abs(p.g);
+        x = p.x;
+      }
+    }
+  };
+  select_by_first_order();
+  // If the selected point's Newton step still exceeds the tolerance, restart the local
+  // method there (a fresh quasi-Newton model takes a full step), at most three times.
+  const NloptAlgorithm final_alg =
+      global ? (has_gradient ? NloptAlgorithm::kLdSlsqp : NloptAlgorithm::kLnBobyqa) : alg;
+  for (int restart = 0; has_gradient && NloptAlgorithmNeedsGradient(final_alg) && restart < 3 &&
+                        !tracker.failed && raw > 0 && raw < 5;
+       ++restart) {
+    const double hr = 1e-6 * range;
+    if (x - lower <= hr || upper - x <= hr) break;
+    tracker.record = false;
+    double f0 = 0.0, g0 = 0.0, fa = 0.0, ga = 0.0, fb = 0.0, gb = 0.0;
+    if (!(tracker.Eval(x, &f0, &g0) && tracker.Eval(x + hr, &fa, &ga) &&
+          tracker.Eval(x - hr, &fb, &gb))) {
+      break;
+    }
+    const double curv = (ga - gb) / (2.0 * hr);
+    if (!(curv < 0.0) || std::abs(g0 / curv) <= 10.0 * options.x_tolerance_m) break;
+    const double remaining_time = options.max_time_s - SecondsSince(t0);
+    const int remaining_evals = options.max_evaluations - tracker.evaluations;
+    if (remaining_evals < 5 || remaining_time <= 0.0) break;
+    tracker.record = true;
+    raw = RunStage(final_alg, lower, upper, options.x_tolerance_m, remaining_evals, remaining_time,
+                   0.0, options.seed, &tracker, &x, &fx, &nlopt_error);
+    s.raw_status = raw;
+    s.termination = TerminationFromNloptResult(raw);
+    select_by_first_order();
+  }
+}
+
+// The answer: x on the interval, the bound flags, the first-order check and the error
+// estimates (curvature by differences); a failed evaluation is a failure in the summary.
+void Certify(ScalarSearch& st, ScalarSearchResult* result) {
+  const ScalarSearchOptions& options = *st.options;
+  const double lower = st.lower, upper = st.upper, range = st.upper - st.lower;
+  const bool has_gradient = st.has_gradient;
+  Tracker& tracker = st.tracker;
+  const double x = st.x;
+  double& fx = st.fx;
+  Summary& s = *st.summary;
+  ScalarSearchResult& out = *result;
+  out.x = std::clamp(x, lower, upper);
+  const double bound_tol = std::max(options.x_tolerance_m, 4.0 * kEps * std::abs(out.x));
+  out.at_lower_bound = out.x - lower <= bound_tol;
+  out.at_upper_bound = upper - out.x <= bound_tol;
+  double g = 0.0;
+  bool ok = tracker.Eval(out.x, &fx, has_gradient ? &g : nullptr);
+  out.value = fx;
+  const double h = 1e-4 * range;
+  const double xp = std::min(upper, out.x + h);
+  const double xm = std::max(lower, out.x - h);
+  double curvature = 0.0;
+  if (ok && has_gradient) {
+    double fp = 0.0, fm = 0.0, gp = 0.0, gm = 0.0;
+    ok = tracker.Eval(xp, &fp, &gp) && tracker.Eval(xm, &fm, &gm);
+    if (ok && xp > xm) curvature = (gp - gm) / (xp - xm);
+  } else if (ok) {
+    double fp = 0.0, fm = 0.0;
+    ok = tracker.Eval(xp, &fp, nullptr) && tracker.Eval(xm, &fm, nullptr);
+    if (ok && xp > out.x && out.x > xm) {
+      curvature = 2.0 * ((fp - fx) / (xp - out.x) - (fx - fm) / (out.x - xm)) / (xp - xm);
+    }
+  }
+  s.evaluations = tracker.evaluations;
+  if (!ok) {
+    s.termination = Termination::kFailure;
+    s.message = tracker.error;
+    return;
+  }
+  const double value_noise = 8.0 * kEps * std::abs(fx);
+  if (out.at_lower_bound || out.at_upper_bound) {
+    out.error_estimate_x = options.x_tolerance_m;
+    if (has_gradient && ((out.at_lower_bound && g > 0.0 && !out.at_upper_bound) ||
+                         (out.at_upper_bound && g < 0.0 && !out.at_lower_bound))) {
+      s.termination = Termination::kNoConvergence;
+      s.warnings.push_back("stopped at a bound where the derivative points inside (f' = " + Num(g) +
+                           ")");
+    }
+  } else if (has_gradient) {
+    const double newton = curvature < 0.0 ? std::abs(g / curvature) : range;
+    out.error_estimate_x = std::max(options.x_tolerance_m, newton);
+    if (newton > 1e-6 * range) {
+      s.termination = Termination::kNoConvergence;
+      s.warnings.push_back("first-order check failed: f' = " + Num(g) +
+                           " at the reported point (Newton step " + Num(newton) + ")");
+    }
+  } else {
+    // Without derivatives the position is resolvable only to sqrt(noise / |f''|).
+    const double resolvable = curvature < 0.0 ? std::sqrt(2.0 * value_noise / -curvature) : 0.0;
+    out.error_estimate_x = std::max(options.x_tolerance_m, resolvable);
+  }
+  out.error_estimate_value =
+      0.5 * std::abs(curvature) * out.error_estimate_x * out.error_estimate_x + value_noise;
+  s.objective = out.value;
+  s.error_estimate = out.error_estimate_x;
+}
+
 }  // namespace
 
 const char* NloptAlgorithmName(NloptAlgorithm a) { return Info(a).name; }
@@ -215,11 +416,19 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
                 "LN_ or GN_ algorithm";
     return finish();
   }
-  Tracker tracker;
+  ScalarSearch st;
+  st.options = &options;
+  st.lower = lower;
+  st.upper = upper;
+  st.has_gradient = has_gradient;
+  st.t0 = t0;
+  st.summary = &s;
+  Tracker& tracker = st.tracker;
   tracker.f = &f;
   const double range = upper - lower;
-  double x = 0.5 * (lower + upper);
-  double fx = 0.0;
+  double& x = st.x;
+  double& fx = st.fx;
+  x = 0.5 * (lower + upper);
   if (range == 0.0) {
     if (!tracker.Eval(lower, &fx, nullptr)) {
       s.termination = Termination::kFailure;
@@ -237,116 +446,26 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
     return finish();
   }
 
-  std::string nlopt_error;
-  int raw = 0;
   const bool global = NloptAlgorithmIsGlobal(alg);
-  if (!global) {
-    // Coarse samples pick the start, so a local method starts in the right basin.
-    const int n = options.start_samples;
-    double best = -HUGE_VAL;
-    for (int i = 0; i < n; ++i) {
-      const double xi = i + 1 == n ? upper : lower + range * i / (n - 1);
-      double fi = 0.0;
-      if (!tracker.Eval(xi, &fi, nullptr)) break;
-      if (fi > best) {
-        best = fi;
-        x = xi;
-      }
-    }
-    fx = best;
-    tracker.record = true;
-    if (!tracker.failed) {
-      const double remaining_time = options.max_time_s - SecondsSince(t0);
-      raw = RunStage(alg, lower, upper, options.x_tolerance_m,
-                     options.max_evaluations - tracker.evaluations, remaining_time,
-                     NloptAlgorithmNeedsGradient(alg) ? 0.0 : range / (n - 1), options.seed,
-                     &tracker, &x, &fx, &nlopt_error);
-    }
-  } else {
-    raw = RunStage(alg, lower, upper, std::max(options.x_tolerance_m, 1e-4 * range),
-                   std::min(options.global_max_evaluations, options.max_evaluations),
-                   options.max_time_s, 0.0, options.seed, &tracker, &x, &fx, &nlopt_error);
-    // A global stage stopping on its budget is expected; the polish decides convergence.
-    if (options.polish && !tracker.failed && (raw > 0 || raw == kNloptRoundoffLimited)) {
-      const NloptAlgorithm local =
-          has_gradient ? NloptAlgorithm::kLdSlsqp : NloptAlgorithm::kLnBobyqa;
-      tracker.record = true;
-      const double remaining_time = options.max_time_s - SecondsSince(t0);
-      raw = RunStage(local, lower, upper, options.x_tolerance_m,
-                     options.max_evaluations - tracker.evaluations, remaining_time,
-                     has_gradient ? 0.0 : 1e-3 * range, options.seed, &tracker, &x, &fx,
-                     &nlopt_error);
-      s.warnings.push_back(std::string("polished with ") + NloptAlgorithmName(local));
-    }
-  }
-  s.raw_status = raw;
+  RunStages(alg, global, st);
+  s.raw_status = st.raw;
   s.evaluations = tracker.evaluations;
   if (tracker.failed) {
     s.termination = Termination::kFailure;
     s.message = tracker.error;
     return finish();
   }
-  s.termination = TerminationFromNloptResult(raw);
-  s.message = std::string("NLopt ") + NloptResultName(raw);
-  if (!nlopt_error.empty()) s.message += ": " + nlopt_error;
-  if (raw == kNloptRoundoffLimited) {
+  s.termination = TerminationFromNloptResult(st.raw);
+  s.message = std::string("NLopt ") + NloptResultName(st.raw);
+  if (!st.nlopt_error.empty()) s.message += ": " + st.nlopt_error;
+  if (st.raw == kNloptRoundoffLimited) {
     s.warnings.push_back("NLopt stopped on round-off (ROUNDOFF_LIMITED); the best point is kept");
   }
   if (!s.IsSolutionUsable()) {
     s.evaluations = tracker.evaluations;
     return finish();
   }
-
-  // A posteriori check and error estimate (first-order conditions; curvature by differences).
-  // Near a smooth maximum f is flat to rounding over ~sqrt(eps |f| / |f''|) (about 1e-8 m
-  // here), so "the best f seen", which NLopt returns, cannot resolve the position further.
-  // With a derivative, pick among the points NLopt evaluated whose f ties the best (within
-  // rounding) the one with the smallest |f'|: the first-order condition resolves the
-  // maximiser to ~eps |x| instead of ~sqrt(eps).
-  auto select_by_first_order = [&]() {
-    if (!has_gradient || tracker.points.empty()) return;
-    double best_f = -HUGE_VAL;
-    for (const auto& p : tracker.points) best_f = std::max(best_f, p.f);
-    // Points within 1e-10 (relative) of the best f are all within ~sqrt(2e-10 |f| / |f''|) of
-    // the maximiser, where f is quadratic and |f'| grows with the distance: the smallest |f'|
-    // wins. (Rounding in f can exceed eps |f| when f is a difference of larger terms.)
-    const double tie = 1e-10 * std::max(1.0, std::abs(best_f));
-    double best_g = HUGE_VAL;
-    for (const auto& p : tracker.points) {
-      if (p.f >= best_f - tie && std::abs(p.g) < best_g && p.x > lower && p.x < upper) {
-        best_g = std::abs(p.g);
-        x = p.x;
-      }
-    }
-  };
-  select_by_first_order();
-  // If the selected point's Newton step still exceeds the tolerance, restart the local
-  // method there (a fresh quasi-Newton model takes a full step), at most three times.
-  const NloptAlgorithm final_alg =
-      global ? (has_gradient ? NloptAlgorithm::kLdSlsqp : NloptAlgorithm::kLnBobyqa) : alg;
-  for (int restart = 0; has_gradient && NloptAlgorithmNeedsGradient(final_alg) && restart < 3 &&
-                        !tracker.failed && raw > 0 && raw < 5;
-       ++restart) {
-    const double hr = 1e-6 * range;
-    if (x - lower <= hr || upper - x <= hr) break;
-    tracker.record = false;
-    double f0 = 0.0, g0 = 0.0, fa = 0.0, ga = 0.0, fb = 0.0, gb = 0.0;
-    if (!(tracker.Eval(x, &f0, &g0) && tracker.Eval(x + hr, &fa, &ga) &&
-          tracker.Eval(x - hr, &fb, &gb))) {
-      break;
-    }
-    const double curv = (ga - gb) / (2.0 * hr);
-    if (!(curv < 0.0) || std::abs(g0 / curv) <= 10.0 * options.x_tolerance_m) break;
-    const double remaining_time = options.max_time_s - SecondsSince(t0);
-    const int remaining_evals = options.max_evaluations - tracker.evaluations;
-    if (remaining_evals < 5 || remaining_time <= 0.0) break;
-    tracker.record = true;
-    raw = RunStage(final_alg, lower, upper, options.x_tolerance_m, remaining_evals, remaining_time,
-                   0.0, options.seed, &tracker, &x, &fx, &nlopt_error);
-    s.raw_status = raw;
-    s.termination = TerminationFromNloptResult(raw);
-    select_by_first_order();
-  }
+  Polish(alg, global, st);
   tracker.record = false;
   if (tracker.failed) {
     s.termination = Termination::kFailure;
@@ -354,60 +473,7 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
     s.evaluations = tracker.evaluations;
     return finish();
   }
-  out.x = std::clamp(x, lower, upper);
-  const double bound_tol = std::max(options.x_tolerance_m, 4.0 * kEps * std::abs(out.x));
-  out.at_lower_bound = out.x - lower <= bound_tol;
-  out.at_upper_bound = upper - out.x <= bound_tol;
-  double g = 0.0;
-  bool ok = tracker.Eval(out.x, &fx, has_gradient ? &g : nullptr);
-  out.value = fx;
-  const double h = 1e-4 * range;
-  const double xp = std::min(upper, out.x + h);
-  const double xm = std::max(lower, out.x - h);
-  double curvature = 0.0;
-  if (ok && has_gradient) {
-    double fp = 0.0, fm = 0.0, gp = 0.0, gm = 0.0;
-    ok = tracker.Eval(xp, &fp, &gp) && tracker.Eval(xm, &fm, &gm);
-    if (ok && xp > xm) curvature = (gp - gm) / (xp - xm);
-  } else if (ok) {
-    double fp = 0.0, fm = 0.0;
-    ok = tracker.Eval(xp, &fp, nullptr) && tracker.Eval(xm, &fm, nullptr);
-    if (ok && xp > out.x && out.x > xm) {
-      curvature = 2.0 * ((fp - fx) / (xp - out.x) - (fx - fm) / (out.x - xm)) / (xp - xm);
-    }
-  }
-  s.evaluations = tracker.evaluations;
-  if (!ok) {
-    s.termination = Termination::kFailure;
-    s.message = tracker.error;
-    return finish();
-  }
-  const double value_noise = 8.0 * kEps * std::abs(fx);
-  if (out.at_lower_bound || out.at_upper_bound) {
-    out.error_estimate_x = options.x_tolerance_m;
-    if (has_gradient && ((out.at_lower_bound && g > 0.0 && !out.at_upper_bound) ||
-                         (out.at_upper_bound && g < 0.0 && !out.at_lower_bound))) {
-      s.termination = Termination::kNoConvergence;
-      s.warnings.push_back("stopped at a bound where the derivative points inside (f' = " + Num(g) +
-                           ")");
-    }
-  } else if (has_gradient) {
-    const double newton = curvature < 0.0 ? std::abs(g / curvature) : range;
-    out.error_estimate_x = std::max(options.x_tolerance_m, newton);
-    if (newton > 1e-6 * range) {
-      s.termination = Termination::kNoConvergence;
-      s.warnings.push_back("first-order check failed: f' = " + Num(g) +
-                           " at the reported point (Newton step " + Num(newton) + ")");
-    }
-  } else {
-    // Without derivatives the position is resolvable only to sqrt(noise / |f''|).
-    const double resolvable = curvature < 0.0 ? std::sqrt(2.0 * value_noise / -curvature) : 0.0;
-    out.error_estimate_x = std::max(options.x_tolerance_m, resolvable);
-  }
-  out.error_estimate_value =
-      0.5 * std::abs(curvature) * out.error_estimate_x * out.error_estimate_x + value_noise;
-  s.objective = out.value;
-  s.error_estimate = out.error_estimate_x;
+  Certify(st, &out);
   return finish();
 }
 
