@@ -124,34 +124,44 @@ int RunStage(NloptAlgorithm alg, double lower, double upper, double x_tol, int m
   return run.raw_status;
 }
 
-// The state of one MaximizeScalar: the problem, the evaluations and the best point so far.
+// The state of one MaximizeScalar: the problem, the evaluations and the best point so far;
+// its stages are the member functions.
 struct ScalarSearch {
-  const ScalarSearchOptions* options = nullptr;
-  double lower = 0.0;
-  double upper = 0.0;
-  bool has_gradient = false;
-  std::chrono::steady_clock::time_point t0;
+  ScalarSearch(const ScalarSearchOptions& o, double lo, double hi, bool gradient,
+               std::chrono::steady_clock::time_point start, Summary* summary)
+      : options(o),
+        lower(lo),
+        upper(hi),
+        range(hi - lo),
+        has_gradient(gradient),
+        t0(start),
+        s(*summary) {}
+
+  // The search proper: coarse samples then the local method, or the global method then a
+  // polish; updates x, fx, raw and the warnings.
+  void RunStages(NloptAlgorithm alg, bool global);
+  // A posteriori check (first-order conditions) and restarts of the local method from the
+  // point with the smallest |f'| among the ties of the best f.
+  void Polish(NloptAlgorithm alg, bool global);
+  // The answer: x on the interval, the bound flags, the first-order check and the error
+  // estimates (curvature by differences); a failed evaluation is a failure in the summary.
+  void Certify(ScalarSearchResult* result);
+
+  const ScalarSearchOptions& options;
+  const double lower;
+  const double upper;
+  const double range;
+  const bool has_gradient;
+  const std::chrono::steady_clock::time_point t0;
+  Summary& s;
   Tracker tracker;
   double x = 0.0;   // the best point so far
   double fx = 0.0;  // f there
   int raw = 0;      // NLopt's last result code
   std::string nlopt_error;
-  Summary* summary = nullptr;
 };
 
-// The search proper: coarse samples then the local method, or the global method then a
-// polish; updates x, fx, raw and the warnings.
-void RunStages(NloptAlgorithm alg, bool global, ScalarSearch& st) {
-  const ScalarSearchOptions& options = *st.options;
-  const double lower = st.lower, upper = st.upper, range = st.upper - st.lower;
-  const bool has_gradient = st.has_gradient;
-  Tracker& tracker = st.tracker;
-  double& x = st.x;
-  double& fx = st.fx;
-  int& raw = st.raw;
-  std::string& nlopt_error = st.nlopt_error;
-  Summary& s = *st.summary;
-  const auto t0 = st.t0;
+void ScalarSearch::RunStages(NloptAlgorithm alg, bool global) {
   if (!global) {
     // Coarse samples pick the start, so a local method starts in the right basin.
     const int n = options.start_samples;
@@ -193,19 +203,7 @@ void RunStages(NloptAlgorithm alg, bool global, ScalarSearch& st) {
   }
 }
 
-// A posteriori check (first-order conditions) and restarts of the local method from the
-// point with the smallest |f'| among the ties of the best f.
-void Polish(NloptAlgorithm alg, bool global, ScalarSearch& st) {
-  const ScalarSearchOptions& options = *st.options;
-  const double lower = st.lower, upper = st.upper, range = st.upper - st.lower;
-  const bool has_gradient = st.has_gradient;
-  Tracker& tracker = st.tracker;
-  double& x = st.x;
-  double& fx = st.fx;
-  int& raw = st.raw;
-  std::string& nlopt_error = st.nlopt_error;
-  Summary& s = *st.summary;
-  const auto t0 = st.t0;
+void ScalarSearch::Polish(NloptAlgorithm alg, bool global) {
   // A posteriori check and error estimate (first-order conditions; curvature by differences).
   // Near a smooth maximum f is flat to rounding over ~sqrt(eps |f| / |f''|) (about 1e-8 m
   // here), so "the best f seen", which NLopt returns, cannot resolve the position further.
@@ -258,16 +256,7 @@ void Polish(NloptAlgorithm alg, bool global, ScalarSearch& st) {
   }
 }
 
-// The answer: x on the interval, the bound flags, the first-order check and the error
-// estimates (curvature by differences); a failed evaluation is a failure in the summary.
-void Certify(ScalarSearch& st, ScalarSearchResult* result) {
-  const ScalarSearchOptions& options = *st.options;
-  const double lower = st.lower, upper = st.upper, range = st.upper - st.lower;
-  const bool has_gradient = st.has_gradient;
-  Tracker& tracker = st.tracker;
-  const double x = st.x;
-  double& fx = st.fx;
-  Summary& s = *st.summary;
+void ScalarSearch::Certify(ScalarSearchResult* result) {
   ScalarSearchResult& out = *result;
   out.x = std::clamp(x, lower, upper);
   const double bound_tol = std::max(options.x_tolerance_m, 4.0 * kEps * std::abs(out.x));
@@ -416,13 +405,7 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
                 "LN_ or GN_ algorithm";
     return finish();
   }
-  ScalarSearch st;
-  st.options = &options;
-  st.lower = lower;
-  st.upper = upper;
-  st.has_gradient = has_gradient;
-  st.t0 = t0;
-  st.summary = &s;
+  ScalarSearch st(options, lower, upper, has_gradient, t0, &s);
   Tracker& tracker = st.tracker;
   tracker.f = &f;
   const double range = upper - lower;
@@ -447,7 +430,7 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
   }
 
   const bool global = NloptAlgorithmIsGlobal(alg);
-  RunStages(alg, global, st);
+  st.RunStages(alg, global);
   s.raw_status = st.raw;
   s.evaluations = tracker.evaluations;
   if (tracker.failed) {
@@ -465,7 +448,7 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
     s.evaluations = tracker.evaluations;
     return finish();
   }
-  Polish(alg, global, st);
+  st.Polish(alg, global);
   tracker.record = false;
   if (tracker.failed) {
     s.termination = Termination::kFailure;
@@ -473,7 +456,7 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
     s.evaluations = tracker.evaluations;
     return finish();
   }
-  Certify(st, &out);
+  st.Certify(&out);
   return finish();
 }
 
