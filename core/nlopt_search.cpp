@@ -1,13 +1,14 @@
 #include "core/nlopt_search.hpp"
 
-#include <nlopt.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <limits>
 #include <sstream>
+
+#include "core/optimize/nlopt_run.hpp"
+#include "core/optimize/termination.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -17,22 +18,21 @@ constexpr double kEps = std::numeric_limits<double>::epsilon();
 struct AlgorithmInfo {
   NloptAlgorithm id;
   const char* name;
-  nlopt::algorithm nlopt_id;
 };
 
 constexpr AlgorithmInfo kAlgorithms[] = {
-    {NloptAlgorithm::kLdSlsqp, "LD_SLSQP", nlopt::LD_SLSQP},
-    {NloptAlgorithm::kLdLbfgs, "LD_LBFGS", nlopt::LD_LBFGS},
-    {NloptAlgorithm::kLdTnewton, "LD_TNEWTON_PRECOND_RESTART", nlopt::LD_TNEWTON_PRECOND_RESTART},
-    {NloptAlgorithm::kLdMma, "LD_MMA", nlopt::LD_MMA},
-    {NloptAlgorithm::kLdCcsaq, "LD_CCSAQ", nlopt::LD_CCSAQ},
-    {NloptAlgorithm::kLnBobyqa, "LN_BOBYQA", nlopt::LN_BOBYQA},
-    {NloptAlgorithm::kLnCobyla, "LN_COBYLA", nlopt::LN_COBYLA},
-    {NloptAlgorithm::kLnSbplx, "LN_SBPLX", nlopt::LN_SBPLX},
-    {NloptAlgorithm::kLnNelderMead, "LN_NELDERMEAD", nlopt::LN_NELDERMEAD},
-    {NloptAlgorithm::kGnDirectL, "GN_DIRECT_L", nlopt::GN_DIRECT_L},
-    {NloptAlgorithm::kGnAgs, "GN_AGS", nlopt::GN_AGS},
-    {NloptAlgorithm::kGnCrs2Lm, "GN_CRS2_LM", nlopt::GN_CRS2_LM},
+    {NloptAlgorithm::kLdSlsqp, "LD_SLSQP"},
+    {NloptAlgorithm::kLdLbfgs, "LD_LBFGS"},
+    {NloptAlgorithm::kLdTnewton, "LD_TNEWTON_PRECOND_RESTART"},
+    {NloptAlgorithm::kLdMma, "LD_MMA"},
+    {NloptAlgorithm::kLdCcsaq, "LD_CCSAQ"},
+    {NloptAlgorithm::kLnBobyqa, "LN_BOBYQA"},
+    {NloptAlgorithm::kLnCobyla, "LN_COBYLA"},
+    {NloptAlgorithm::kLnSbplx, "LN_SBPLX"},
+    {NloptAlgorithm::kLnNelderMead, "LN_NELDERMEAD"},
+    {NloptAlgorithm::kGnDirectL, "GN_DIRECT_L"},
+    {NloptAlgorithm::kGnAgs, "GN_AGS"},
+    {NloptAlgorithm::kGnCrs2Lm, "GN_CRS2_LM"},
 };
 
 const AlgorithmInfo& Info(NloptAlgorithm a) {
@@ -57,7 +57,6 @@ double SecondsSince(std::chrono::steady_clock::time_point t0) {
 // exception escape: it records the problem and asks NLopt to stop.
 struct Tracker {
   const ScalarObjective* f = nullptr;
-  nlopt::opt* opt = nullptr;
   int evaluations = 0;
   bool failed = false;
   std::string error;
@@ -95,63 +94,224 @@ struct Tracker {
   }
 };
 
-double Callback(unsigned /*n*/, const double* x, double* grad, void* data) {
-  auto* t = static_cast<Tracker*>(data);
-  double v = 0.0;
-  double g = 0.0;
-  if (!t->Eval(x[0], &v, grad != nullptr ? &g : nullptr)) {
-    if (t->opt != nullptr) t->opt->force_stop();
-    if (grad != nullptr) grad[0] = 0.0;
-    return HUGE_VAL;
-  }
-  if (grad != nullptr) grad[0] = -g;
-  return -v;  // NLopt minimises
-}
-
-// One NLopt run from x0; returns the raw result code and updates x0 / fval (maximised f).
+// One NLopt run from x0 (the trampoline; f maximised as -f minimised); returns the raw result
+// code and updates x0 / fval (maximised f). An objective failure is recorded in the tracker.
 int RunStage(NloptAlgorithm alg, double lower, double upper, double x_tol, int max_eval,
              double max_time_s, double initial_step, unsigned seed, Tracker* tracker, double* x0,
              double* fval, std::string* error) {
-  try {
-    nlopt::opt opt(Info(alg).nlopt_id, 1);
-    tracker->opt = &opt;
-    opt.set_min_objective(Callback, tracker);
-    opt.set_lower_bounds(std::vector<double>{lower});
-    opt.set_upper_bounds(std::vector<double>{upper});
-    opt.set_xtol_abs(x_tol);
-    opt.set_maxeval(std::max(1, max_eval));
-    opt.set_maxtime(std::max(1e-6, max_time_s));
-    if (initial_step > 0.0) opt.set_initial_step(initial_step);
-    std::vector<double> x{std::clamp(*x0, lower, upper)};
-    double minf = HUGE_VAL;
-    int raw = 0;
-    if (NloptAlgorithmIsStochastic(alg)) nlopt::srand(seed);
-    try {
-      raw = static_cast<int>(opt.optimize(x, minf));
-    } catch (const nlopt::roundoff_limited&) {
-      raw = static_cast<int>(nlopt::ROUNDOFF_LIMITED);  // x holds the best point: keep it
-    } catch (const nlopt::forced_stop&) {
-      raw = static_cast<int>(nlopt::FORCED_STOP);
-    } catch (const std::invalid_argument& e) {
-      raw = static_cast<int>(nlopt::INVALID_ARGS);
-      *error = std::string("NLopt refused the problem: ") + e.what();
-    } catch (const std::bad_alloc&) {
-      raw = static_cast<int>(nlopt::OUT_OF_MEMORY);
-      *error = "NLopt ran out of memory";
-    } catch (const std::exception& e) {
-      raw = static_cast<int>(opt.last_optimize_result());
-      if (raw > 0) raw = static_cast<int>(nlopt::FAILURE);
-      *error = std::string("NLopt failed: ") + e.what();
+  NloptRunSettings settings;
+  settings.algorithm = alg;
+  settings.lower = {lower};
+  settings.upper = {upper};
+  settings.x_tolerance_abs = x_tol;
+  settings.max_evaluations = std::max(1, max_eval);
+  settings.max_time_s = std::max(1e-6, max_time_s);
+  settings.initial_step = initial_step;
+  if (NloptAlgorithmIsStochastic(alg)) settings.seed = seed;
+  const NloptFunction objective = [tracker](const double* x, double* grad) {
+    double v = 0.0;
+    double g = 0.0;
+    if (!tracker->Eval(x[0], &v, grad != nullptr ? &g : nullptr))
+      return std::numeric_limits<double>::quiet_NaN();
+    if (grad != nullptr) grad[0] = -g;
+    return -v;  // NLopt minimises
+  };
+  std::vector<double> x{std::clamp(*x0, lower, upper)};
+  const NloptRunOutcome run = RunNlopt(objective, {}, settings, &x);
+  if (!run.message.empty() && !run.callback_failed) *error = run.message;
+  if (std::isfinite(x[0])) *x0 = x[0];
+  if (std::isfinite(run.minimum) && run.minimum != HUGE_VAL) *fval = -run.minimum;
+  return run.raw_status;
+}
+
+// The state of one MaximizeScalar: the problem, the evaluations and the best point so far;
+// its stages are the member functions.
+struct ScalarSearch {
+  ScalarSearch(const ScalarSearchOptions& o, double lo, double hi, bool gradient,
+               std::chrono::steady_clock::time_point start, Summary* summary)
+      : options(o),
+        lower(lo),
+        upper(hi),
+        range(hi - lo),
+        has_gradient(gradient),
+        t0(start),
+        s(*summary) {}
+
+  // The search proper: coarse samples then the local method, or the global method then a
+  // polish; updates x, fx, raw and the warnings.
+  void RunStages(NloptAlgorithm alg, bool global);
+  // A posteriori check (first-order conditions) and restarts of the local method from the
+  // point with the smallest |f'| among the ties of the best f.
+  void Polish(NloptAlgorithm alg, bool global);
+  // The answer: x on the interval, the bound flags, the first-order check and the error
+  // estimates (curvature by differences); a failed evaluation is a failure in the summary.
+  void Certify(ScalarSearchResult* result);
+
+  const ScalarSearchOptions& options;
+  const double lower;
+  const double upper;
+  const double range;
+  const bool has_gradient;
+  const std::chrono::steady_clock::time_point t0;
+  Summary& s;
+  Tracker tracker;
+  double x = 0.0;   // the best point so far
+  double fx = 0.0;  // f there
+  int raw = 0;      // NLopt's last result code
+  std::string nlopt_error;
+};
+
+void ScalarSearch::RunStages(NloptAlgorithm alg, bool global) {
+  if (!global) {
+    // Coarse samples pick the start, so a local method starts in the right basin.
+    const int n = options.start_samples;
+    double best = -HUGE_VAL;
+    for (int i = 0; i < n; ++i) {
+      const double xi = i + 1 == n ? upper : lower + range * i / (n - 1);
+      double fi = 0.0;
+      if (!tracker.Eval(xi, &fi, nullptr)) break;
+      if (fi > best) {
+        best = fi;
+        x = xi;
+      }
     }
-    tracker->opt = nullptr;
-    if (std::isfinite(x[0])) *x0 = x[0];
-    if (std::isfinite(minf) && minf != HUGE_VAL) *fval = -minf;
-    return raw;
-  } catch (const std::exception& e) {
-    tracker->opt = nullptr;
-    *error = std::string("NLopt failed: ") + e.what();
-    return static_cast<int>(nlopt::FAILURE);
+    fx = best;
+    tracker.record = true;
+    if (!tracker.failed) {
+      const double remaining_time = options.max_time_s - SecondsSince(t0);
+      raw = RunStage(alg, lower, upper, options.x_tolerance_m,
+                     options.max_evaluations - tracker.evaluations, remaining_time,
+                     NloptAlgorithmNeedsGradient(alg) ? 0.0 : range / (n - 1), options.seed,
+                     &tracker, &x, &fx, &nlopt_error);
+    }
+  } else {
+    raw = RunStage(alg, lower, upper, std::max(options.x_tolerance_m, 1e-4 * range),
+                   std::min(options.global_max_evaluations, options.max_evaluations),
+                   options.max_time_s, 0.0, options.seed, &tracker, &x, &fx, &nlopt_error);
+    // A global stage stopping on its budget is expected; the polish decides convergence.
+    if (options.polish && !tracker.failed && (raw > 0 || raw == kNloptRoundoffLimited)) {
+      const NloptAlgorithm local =
+          has_gradient ? NloptAlgorithm::kLdSlsqp : NloptAlgorithm::kLnBobyqa;
+      tracker.record = true;
+      const double remaining_time = options.max_time_s - SecondsSince(t0);
+      raw = RunStage(local, lower, upper, options.x_tolerance_m,
+                     options.max_evaluations - tracker.evaluations, remaining_time,
+                     has_gradient ? 0.0 : 1e-3 * range, options.seed, &tracker, &x, &fx,
+                     &nlopt_error);
+      s.warnings.push_back(std::string("polished with ") + NloptAlgorithmName(local));
+    }
   }
+}
+
+void ScalarSearch::Polish(NloptAlgorithm alg, bool global) {
+  // A posteriori check and error estimate (first-order conditions; curvature by differences).
+  // Near a smooth maximum f is flat to rounding over ~sqrt(eps |f| / |f''|) (about 1e-8 m
+  // here), so "the best f seen", which NLopt returns, cannot resolve the position further.
+  // With a derivative, pick among the points NLopt evaluated whose f ties the best (within
+  // rounding) the one with the smallest |f'|: the first-order condition resolves the
+  // maximiser to ~eps |x| instead of ~sqrt(eps).
+  auto select_by_first_order = [&]() {
+    if (!has_gradient || tracker.points.empty()) return;
+    double best_f = -HUGE_VAL;
+    for (const auto& p : tracker.points) best_f = std::max(best_f, p.f);
+    // Points within 1e-10 (relative) of the best f are all within ~sqrt(2e-10 |f| / |f''|) of
+    // the maximiser, where f is quadratic and |f'| grows with the distance: the smallest |f'|
+    // wins. (Rounding in f can exceed eps |f| when f is a difference of larger terms.)
+    const double tie = 1e-10 * std::max(1.0, std::abs(best_f));
+    double best_g = HUGE_VAL;
+    for (const auto& p : tracker.points) {
+      if (p.f >= best_f - tie && std::abs(p.g) < best_g && p.x > lower && p.x < upper) {
+        best_g = std::abs(p.g);
+        x = p.x;
+      }
+    }
+  };
+  select_by_first_order();
+  // If the selected point's Newton step still exceeds the tolerance, restart the local
+  // method there (a fresh quasi-Newton model takes a full step), at most three times.
+  const NloptAlgorithm final_alg =
+      global ? (has_gradient ? NloptAlgorithm::kLdSlsqp : NloptAlgorithm::kLnBobyqa) : alg;
+  for (int restart = 0; has_gradient && NloptAlgorithmNeedsGradient(final_alg) && restart < 3 &&
+                        !tracker.failed && raw > 0 && raw < 5;
+       ++restart) {
+    const double hr = 1e-6 * range;
+    if (x - lower <= hr || upper - x <= hr) break;
+    tracker.record = false;
+    double f0 = 0.0, g0 = 0.0, fa = 0.0, ga = 0.0, fb = 0.0, gb = 0.0;
+    if (!(tracker.Eval(x, &f0, &g0) && tracker.Eval(x + hr, &fa, &ga) &&
+          tracker.Eval(x - hr, &fb, &gb))) {
+      break;
+    }
+    const double curv = (ga - gb) / (2.0 * hr);
+    if (!(curv < 0.0) || std::abs(g0 / curv) <= 10.0 * options.x_tolerance_m) break;
+    const double remaining_time = options.max_time_s - SecondsSince(t0);
+    const int remaining_evals = options.max_evaluations - tracker.evaluations;
+    if (remaining_evals < 5 || remaining_time <= 0.0) break;
+    tracker.record = true;
+    raw = RunStage(final_alg, lower, upper, options.x_tolerance_m, remaining_evals, remaining_time,
+                   0.0, options.seed, &tracker, &x, &fx, &nlopt_error);
+    s.raw_status = raw;
+    s.termination = TerminationFromNloptResult(raw);
+    select_by_first_order();
+  }
+}
+
+void ScalarSearch::Certify(ScalarSearchResult* result) {
+  ScalarSearchResult& out = *result;
+  out.x = std::clamp(x, lower, upper);
+  const double bound_tol = std::max(options.x_tolerance_m, 4.0 * kEps * std::abs(out.x));
+  out.at_lower_bound = out.x - lower <= bound_tol;
+  out.at_upper_bound = upper - out.x <= bound_tol;
+  double g = 0.0;
+  bool ok = tracker.Eval(out.x, &fx, has_gradient ? &g : nullptr);
+  out.value = fx;
+  const double h = 1e-4 * range;
+  const double xp = std::min(upper, out.x + h);
+  const double xm = std::max(lower, out.x - h);
+  double curvature = 0.0;
+  if (ok && has_gradient) {
+    double fp = 0.0, fm = 0.0, gp = 0.0, gm = 0.0;
+    ok = tracker.Eval(xp, &fp, &gp) && tracker.Eval(xm, &fm, &gm);
+    if (ok && xp > xm) curvature = (gp - gm) / (xp - xm);
+  } else if (ok) {
+    double fp = 0.0, fm = 0.0;
+    ok = tracker.Eval(xp, &fp, nullptr) && tracker.Eval(xm, &fm, nullptr);
+    if (ok && xp > out.x && out.x > xm) {
+      curvature = 2.0 * ((fp - fx) / (xp - out.x) - (fx - fm) / (out.x - xm)) / (xp - xm);
+    }
+  }
+  s.evaluations = tracker.evaluations;
+  if (!ok) {
+    s.termination = Termination::kFailure;
+    s.message = tracker.error;
+    return;
+  }
+  const double value_noise = 8.0 * kEps * std::abs(fx);
+  if (out.at_lower_bound || out.at_upper_bound) {
+    out.error_estimate_x = options.x_tolerance_m;
+    if (has_gradient && ((out.at_lower_bound && g > 0.0 && !out.at_upper_bound) ||
+                         (out.at_upper_bound && g < 0.0 && !out.at_lower_bound))) {
+      s.termination = Termination::kNoConvergence;
+      s.warnings.push_back("stopped at a bound where the derivative points inside (f' = " + Num(g) +
+                           ")");
+    }
+  } else if (has_gradient) {
+    const double newton = curvature < 0.0 ? std::abs(g / curvature) : range;
+    out.error_estimate_x = std::max(options.x_tolerance_m, newton);
+    if (newton > 1e-6 * range) {
+      s.termination = Termination::kNoConvergence;
+      s.warnings.push_back("first-order check failed: f' = " + Num(g) +
+                           " at the reported point (Newton step " + Num(newton) + ")");
+    }
+  } else {
+    // Without derivatives the position is resolvable only to sqrt(noise / |f''|).
+    const double resolvable = curvature < 0.0 ? std::sqrt(2.0 * value_noise / -curvature) : 0.0;
+    out.error_estimate_x = std::max(options.x_tolerance_m, resolvable);
+  }
+  out.error_estimate_value =
+      0.5 * std::abs(curvature) * out.error_estimate_x * out.error_estimate_x + value_noise;
+  s.objective = out.value;
+  s.error_estimate = out.error_estimate_x;
 }
 
 }  // namespace
@@ -188,56 +348,6 @@ const std::vector<NloptAlgorithm>& OfferedNloptAlgorithms() {
 bool NloptAlgorithmNeedsGradient(NloptAlgorithm a) { return Info(a).name[1] == 'D'; }
 bool NloptAlgorithmIsGlobal(NloptAlgorithm a) { return Info(a).name[0] == 'G'; }
 bool NloptAlgorithmIsStochastic(NloptAlgorithm a) { return a == NloptAlgorithm::kGnCrs2Lm; }
-
-Termination TerminationFromNloptResult(int raw_status) {
-  switch (raw_status) {
-    case 1:  // SUCCESS
-    case 2:  // STOPVAL_REACHED
-    case 3:  // FTOL_REACHED
-    case 4:  // XTOL_REACHED
-      return Termination::kConverged;
-    case 5:   // MAXEVAL_REACHED
-    case 6:   // MAXTIME_REACHED
-    case -4:  // ROUNDOFF_LIMITED: the best point is kept
-      return Termination::kNoConvergence;
-    case -2:  // INVALID_ARGS
-      return Termination::kInvalidInput;
-    case -1:  // FAILURE
-    case -3:  // OUT_OF_MEMORY
-    case -5:  // FORCED_STOP (only ever forced by us after an objective failure)
-    default:
-      return Termination::kFailure;
-  }
-}
-
-const char* NloptResultName(int raw_status) {
-  switch (raw_status) {
-    case -1:
-      return "FAILURE";
-    case -2:
-      return "INVALID_ARGS";
-    case -3:
-      return "OUT_OF_MEMORY";
-    case -4:
-      return "ROUNDOFF_LIMITED";
-    case -5:
-      return "FORCED_STOP";
-    case 1:
-      return "SUCCESS";
-    case 2:
-      return "STOPVAL_REACHED";
-    case 3:
-      return "FTOL_REACHED";
-    case 4:
-      return "XTOL_REACHED";
-    case 5:
-      return "MAXEVAL_REACHED";
-    case 6:
-      return "MAXTIME_REACHED";
-    default:
-      return "UNKNOWN";
-  }
-}
 
 bool ScalarSearchOptions::IsValid(std::string* why) const {
   auto fail = [why](const std::string& m) {
@@ -295,11 +405,13 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
                 "LN_ or GN_ algorithm";
     return finish();
   }
-  Tracker tracker;
+  ScalarSearch st(options, lower, upper, has_gradient, t0, &s);
+  Tracker& tracker = st.tracker;
   tracker.f = &f;
   const double range = upper - lower;
-  double x = 0.5 * (lower + upper);
-  double fx = 0.0;
+  double& x = st.x;
+  double& fx = st.fx;
+  x = 0.5 * (lower + upper);
   if (range == 0.0) {
     if (!tracker.Eval(lower, &fx, nullptr)) {
       s.termination = Termination::kFailure;
@@ -317,116 +429,26 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
     return finish();
   }
 
-  std::string nlopt_error;
-  int raw = 0;
   const bool global = NloptAlgorithmIsGlobal(alg);
-  if (!global) {
-    // Coarse samples pick the start, so a local method starts in the right basin.
-    const int n = options.start_samples;
-    double best = -HUGE_VAL;
-    for (int i = 0; i < n; ++i) {
-      const double xi = i + 1 == n ? upper : lower + range * i / (n - 1);
-      double fi = 0.0;
-      if (!tracker.Eval(xi, &fi, nullptr)) break;
-      if (fi > best) {
-        best = fi;
-        x = xi;
-      }
-    }
-    fx = best;
-    tracker.record = true;
-    if (!tracker.failed) {
-      const double remaining_time = options.max_time_s - SecondsSince(t0);
-      raw = RunStage(alg, lower, upper, options.x_tolerance_m,
-                     options.max_evaluations - tracker.evaluations, remaining_time,
-                     NloptAlgorithmNeedsGradient(alg) ? 0.0 : range / (n - 1), options.seed,
-                     &tracker, &x, &fx, &nlopt_error);
-    }
-  } else {
-    raw = RunStage(alg, lower, upper, std::max(options.x_tolerance_m, 1e-4 * range),
-                   std::min(options.global_max_evaluations, options.max_evaluations),
-                   options.max_time_s, 0.0, options.seed, &tracker, &x, &fx, &nlopt_error);
-    // A global stage stopping on its budget is expected; the polish decides convergence.
-    if (options.polish && !tracker.failed && (raw > 0 || raw == -4)) {
-      const NloptAlgorithm local =
-          has_gradient ? NloptAlgorithm::kLdSlsqp : NloptAlgorithm::kLnBobyqa;
-      tracker.record = true;
-      const double remaining_time = options.max_time_s - SecondsSince(t0);
-      raw = RunStage(local, lower, upper, options.x_tolerance_m,
-                     options.max_evaluations - tracker.evaluations, remaining_time,
-                     has_gradient ? 0.0 : 1e-3 * range, options.seed, &tracker, &x, &fx,
-                     &nlopt_error);
-      s.warnings.push_back(std::string("polished with ") + NloptAlgorithmName(local));
-    }
-  }
-  s.raw_status = raw;
+  st.RunStages(alg, global);
+  s.raw_status = st.raw;
   s.evaluations = tracker.evaluations;
   if (tracker.failed) {
     s.termination = Termination::kFailure;
     s.message = tracker.error;
     return finish();
   }
-  s.termination = TerminationFromNloptResult(raw);
-  s.message = std::string("NLopt ") + NloptResultName(raw);
-  if (!nlopt_error.empty()) s.message += ": " + nlopt_error;
-  if (raw == -4) {
+  s.termination = TerminationFromNloptResult(st.raw);
+  s.message = std::string("NLopt ") + NloptResultName(st.raw);
+  if (!st.nlopt_error.empty()) s.message += ": " + st.nlopt_error;
+  if (st.raw == kNloptRoundoffLimited) {
     s.warnings.push_back("NLopt stopped on round-off (ROUNDOFF_LIMITED); the best point is kept");
   }
   if (!s.IsSolutionUsable()) {
     s.evaluations = tracker.evaluations;
     return finish();
   }
-
-  // A posteriori check and error estimate (first-order conditions; curvature by differences).
-  // Near a smooth maximum f is flat to rounding over ~sqrt(eps |f| / |f''|) (about 1e-8 m
-  // here), so "the best f seen", which NLopt returns, cannot resolve the position further.
-  // With a derivative, pick among the points NLopt evaluated whose f ties the best (within
-  // rounding) the one with the smallest |f'|: the first-order condition resolves the
-  // maximiser to ~eps |x| instead of ~sqrt(eps).
-  auto select_by_first_order = [&]() {
-    if (!has_gradient || tracker.points.empty()) return;
-    double best_f = -HUGE_VAL;
-    for (const auto& p : tracker.points) best_f = std::max(best_f, p.f);
-    // Points within 1e-10 (relative) of the best f are all within ~sqrt(2e-10 |f| / |f''|) of
-    // the maximiser, where f is quadratic and |f'| grows with the distance: the smallest |f'|
-    // wins. (Rounding in f can exceed eps |f| when f is a difference of larger terms.)
-    const double tie = 1e-10 * std::max(1.0, std::abs(best_f));
-    double best_g = HUGE_VAL;
-    for (const auto& p : tracker.points) {
-      if (p.f >= best_f - tie && std::abs(p.g) < best_g && p.x > lower && p.x < upper) {
-        best_g = std::abs(p.g);
-        x = p.x;
-      }
-    }
-  };
-  select_by_first_order();
-  // If the selected point's Newton step still exceeds the tolerance, restart the local
-  // method there (a fresh quasi-Newton model takes a full step), at most three times.
-  const NloptAlgorithm final_alg =
-      global ? (has_gradient ? NloptAlgorithm::kLdSlsqp : NloptAlgorithm::kLnBobyqa) : alg;
-  for (int restart = 0; has_gradient && NloptAlgorithmNeedsGradient(final_alg) && restart < 3 &&
-                        !tracker.failed && raw > 0 && raw < 5;
-       ++restart) {
-    const double hr = 1e-6 * range;
-    if (x - lower <= hr || upper - x <= hr) break;
-    tracker.record = false;
-    double f0 = 0.0, g0 = 0.0, fa = 0.0, ga = 0.0, fb = 0.0, gb = 0.0;
-    if (!(tracker.Eval(x, &f0, &g0) && tracker.Eval(x + hr, &fa, &ga) &&
-          tracker.Eval(x - hr, &fb, &gb))) {
-      break;
-    }
-    const double curv = (ga - gb) / (2.0 * hr);
-    if (!(curv < 0.0) || std::abs(g0 / curv) <= 10.0 * options.x_tolerance_m) break;
-    const double remaining_time = options.max_time_s - SecondsSince(t0);
-    const int remaining_evals = options.max_evaluations - tracker.evaluations;
-    if (remaining_evals < 5 || remaining_time <= 0.0) break;
-    tracker.record = true;
-    raw = RunStage(final_alg, lower, upper, options.x_tolerance_m, remaining_evals, remaining_time,
-                   0.0, options.seed, &tracker, &x, &fx, &nlopt_error);
-    s.raw_status = raw;
-    s.termination = TerminationFromNloptResult(raw);
-    select_by_first_order();
-  }
+  st.Polish(alg, global);
   tracker.record = false;
   if (tracker.failed) {
     s.termination = Termination::kFailure;
@@ -434,60 +456,7 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
     s.evaluations = tracker.evaluations;
     return finish();
   }
-  out.x = std::clamp(x, lower, upper);
-  const double bound_tol = std::max(options.x_tolerance_m, 4.0 * kEps * std::abs(out.x));
-  out.at_lower_bound = out.x - lower <= bound_tol;
-  out.at_upper_bound = upper - out.x <= bound_tol;
-  double g = 0.0;
-  bool ok = tracker.Eval(out.x, &fx, has_gradient ? &g : nullptr);
-  out.value = fx;
-  const double h = 1e-4 * range;
-  const double xp = std::min(upper, out.x + h);
-  const double xm = std::max(lower, out.x - h);
-  double curvature = 0.0;
-  if (ok && has_gradient) {
-    double fp = 0.0, fm = 0.0, gp = 0.0, gm = 0.0;
-    ok = tracker.Eval(xp, &fp, &gp) && tracker.Eval(xm, &fm, &gm);
-    if (ok && xp > xm) curvature = (gp - gm) / (xp - xm);
-  } else if (ok) {
-    double fp = 0.0, fm = 0.0;
-    ok = tracker.Eval(xp, &fp, nullptr) && tracker.Eval(xm, &fm, nullptr);
-    if (ok && xp > out.x && out.x > xm) {
-      curvature = 2.0 * ((fp - fx) / (xp - out.x) - (fx - fm) / (out.x - xm)) / (xp - xm);
-    }
-  }
-  s.evaluations = tracker.evaluations;
-  if (!ok) {
-    s.termination = Termination::kFailure;
-    s.message = tracker.error;
-    return finish();
-  }
-  const double value_noise = 8.0 * kEps * std::abs(fx);
-  if (out.at_lower_bound || out.at_upper_bound) {
-    out.error_estimate_x = options.x_tolerance_m;
-    if (has_gradient && ((out.at_lower_bound && g > 0.0 && !out.at_upper_bound) ||
-                         (out.at_upper_bound && g < 0.0 && !out.at_lower_bound))) {
-      s.termination = Termination::kNoConvergence;
-      s.warnings.push_back("stopped at a bound where the derivative points inside (f' = " + Num(g) +
-                           ")");
-    }
-  } else if (has_gradient) {
-    const double newton = curvature < 0.0 ? std::abs(g / curvature) : range;
-    out.error_estimate_x = std::max(options.x_tolerance_m, newton);
-    if (newton > 1e-6 * range) {
-      s.termination = Termination::kNoConvergence;
-      s.warnings.push_back("first-order check failed: f' = " + Num(g) +
-                           " at the reported point (Newton step " + Num(newton) + ")");
-    }
-  } else {
-    // Without derivatives the position is resolvable only to sqrt(noise / |f''|).
-    const double resolvable = curvature < 0.0 ? std::sqrt(2.0 * value_noise / -curvature) : 0.0;
-    out.error_estimate_x = std::max(options.x_tolerance_m, resolvable);
-  }
-  out.error_estimate_value =
-      0.5 * std::abs(curvature) * out.error_estimate_x * out.error_estimate_x + value_noise;
-  s.objective = out.value;
-  s.error_estimate = out.error_estimate_x;
+  st.Certify(&out);
   return finish();
 }
 

@@ -49,12 +49,6 @@ bool NloptAlgorithmIsGlobal(NloptAlgorithm a);
 /// True when the algorithm draws random numbers (seeded with ScalarSearchOptions::seed).
 bool NloptAlgorithmIsStochastic(NloptAlgorithm a);
 
-/// The backend-neutral outcome of an NLopt result code (nlopt_result values, -5 ... 6);
-/// unknown codes map to kFailure.
-Termination TerminationFromNloptResult(int raw_status);
-/// NLopt's name of a result code ("SUCCESS", "ROUNDOFF_LIMITED", ...; "UNKNOWN" otherwise).
-const char* NloptResultName(int raw_status);
-
 /// Options of a 1-D maximisation.
 struct ScalarSearchOptions {
   /// The algorithm; unset = LD_SLSQP when the objective has a derivative, LN_BOBYQA otherwise.

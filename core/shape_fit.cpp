@@ -10,11 +10,12 @@
 #include <stdexcept>
 
 #include <Eigen/Dense>
-#include <nlopt.hpp>
 #include <unsupported/Eigen/AutoDiff>
 
 #include "core/geometry_format.hpp"
 #include "core/geometry_integrals.hpp"
+#include "core/optimize/nlopt_run.hpp"
+#include "core/optimize/termination.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -407,20 +408,6 @@ class FitContext {
   int evaluations_ = 0;
 };
 
-double ObjectiveCallback(unsigned /*n*/, const double* s, double* grad, void* data) {
-  return static_cast<FitContext*>(data)->Objective(s, grad);
-}
-
-struct ConstraintData {
-  const FitContext* context;
-  ConstraintKind kind;
-};
-
-double ConstraintCallback(unsigned /*n*/, const double* s, double* grad, void* data) {
-  const auto* d = static_cast<const ConstraintData*>(data);
-  return d->context->Constraint(d->kind, s, grad);
-}
-
 // Radical-inverse (Halton) point `index` in [0, 1)^n: a deterministic scan.
 double RadicalInverse(int index, int base) {
   double result = 0.0;
@@ -751,53 +738,46 @@ ShapeFitResult FitShape(const ShapeFitProblem& problem, const ShapeFitOptions& o
     bool improved = false;
     const std::vector<double> lower(static_cast<std::size_t>(n), 0.0);
     const std::vector<double> upper(static_cast<std::size_t>(n), 1.0);
-    std::vector<ConstraintData> constraint_data;
-    for (ConstraintKind kind : context.constraints()) constraint_data.push_back({&context, kind});
+    const NloptFunction objective = [&context](const double* x, double* grad) {
+      return context.Objective(x, grad);
+    };
+    std::vector<NloptConstraintFunction> constraints;
+    for (ConstraintKind kind : context.constraints()) {
+      constraints.push_back({[&context, kind](const double* x, double* grad) {
+                               return context.Constraint(kind, x, grad);
+                             },
+                             false, 0.0});
+    }
     for (std::size_t c = 0; c < candidates.size() && local_runs < options.local_starts; ++c) {
       const double time_left = options.max_time_s - elapsed_s();
       if (budget_left() <= 0 || time_left <= 0.0) break;
       ++local_runs;
-      nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(n));
-      opt.set_lower_bounds(lower);
-      opt.set_upper_bounds(upper);
-      opt.set_min_objective(ObjectiveCallback, &context);
-      for (ConstraintData& d : constraint_data) {
-        opt.add_inequality_constraint(ConstraintCallback, &d, 0.0);
-      }
-      opt.set_xtol_rel(1e-14);
-      opt.set_ftol_abs(1e-30);
-      opt.set_maxeval(budget_left());
-      opt.set_maxtime(time_left);
+      NloptRunSettings run;
+      run.algorithm = NloptAlgorithm::kLdSlsqp;
+      run.lower = lower;
+      run.upper = upper;
+      run.x_tolerance_rel = 1e-14;
+      run.f_tolerance_abs = 1e-30;
+      run.max_evaluations = budget_left();
+      run.max_time_s = time_left;
       std::vector<double> x = candidates[c].second;
-      double f = candidates[c].first;
-      nlopt::result status = nlopt::FAILURE;
-      try {
-        status = opt.optimize(x, f);
-      } catch (const nlopt::roundoff_limited&) {
-        status = nlopt::ROUNDOFF_LIMITED;  // x holds the best point: keep it
-      } catch (const nlopt::forced_stop&) {
-        status = nlopt::FORCED_STOP;
-      } catch (const std::invalid_argument&) {
-        status = nlopt::INVALID_ARGS;
-      } catch (const std::runtime_error&) {
-        status = nlopt::FAILURE;
-      }
+      const int status = RunNlopt(objective, constraints, run, &x).raw_status;
       for (double& xj : x) xj = std::clamp(xj, 0.0, 1.0);
-      if (status > 0 || status == nlopt::ROUNDOFF_LIMITED) {
+      if (status > 0 || status == kNloptRoundoffLimited) {  // x holds the best point: keep it
         const double phi = context.Objective(x.data(), nullptr);
         if (context.Feasible(x.data()) && phi < best_phi) {
           best_phi = phi;
           best = x;
-          raw_status = static_cast<int>(status);
+          raw_status = status;
           improved = true;
         }
       }
-      if (!improved) raw_status = static_cast<int>(status);
+      if (!improved) raw_status = status;
     }
     summary.raw_status = raw_status;
-    if (raw_status == nlopt::ROUNDOFF_LIMITED) {
+    if (raw_status == kNloptRoundoffLimited) {
       summary.warnings.push_back("NLopt SLSQP stopped round-off limited; its best point is kept");
-    } else if (raw_status == nlopt::MAXEVAL_REACHED || raw_status == nlopt::MAXTIME_REACHED) {
+    } else if (raw_status == kNloptMaxevalReached || raw_status == kNloptMaxtimeReached) {
       summary.warnings.push_back("NLopt SLSQP stopped at the evaluation or time budget");
     }
 

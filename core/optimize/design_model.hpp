@@ -31,6 +31,10 @@
 
 namespace sweetspot::core {
 
+namespace design_detail {
+struct ModelBuilder;  // DesignModel::Build's steps (design_model_build.cpp)
+}  // namespace design_detail
+
 /// A smooth function of the design (internal).
 enum class DesignFunction {
   kLinear,        ///< sum coefficient * parameter + constant.
@@ -168,6 +172,8 @@ class DesignModel {
   DesignModel WithConstraints(const std::vector<int>& keep) const;
 
  private:
+  friend struct design_detail::ModelBuilder;
+
   template <typename Scalar>
   Scalar ObjectiveOf(const Scalar* p) const;
   template <typename Scalar>

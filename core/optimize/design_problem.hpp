@@ -345,10 +345,4 @@ MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,
                                            const DesignOptions& options = {},
                                            Progress* progress = nullptr);
 
-/// The backend-neutral outcome of an Ipopt ApplicationReturnStatus (every value of 3.11:
-/// 0..6, -1..-4, -10..-13, -100..-102, -199); unknown codes map to kFailure.
-Termination TerminationFromIpoptStatus(int raw_status);
-/// Ipopt's name of a status ("Solve_Succeeded", ...; "Unknown" otherwise).
-const char* IpoptStatusName(int raw_status);
-
 }  // namespace sweetspot::core

@@ -19,6 +19,7 @@
 #include <coin/IpTNLP.hpp>
 
 #include "core/optimize/design_backends.hpp"
+#include "core/optimize/termination.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -219,80 +220,6 @@ int DerivativeCheckErrors(const std::string& report) {
 }
 
 }  // namespace
-
-Termination TerminationFromIpoptStatus(int raw_status) {
-  switch (raw_status) {
-    case Ipopt::Solve_Succeeded:
-    case Ipopt::Solved_To_Acceptable_Level:
-      return Termination::kConverged;
-    case Ipopt::Infeasible_Problem_Detected:
-      return Termination::kInfeasible;
-    case Ipopt::Search_Direction_Becomes_Too_Small:
-    case Ipopt::User_Requested_Stop:
-    case Ipopt::Feasible_Point_Found:
-    case Ipopt::Maximum_Iterations_Exceeded:
-    case Ipopt::Maximum_CpuTime_Exceeded:
-      return Termination::kNoConvergence;
-    case Ipopt::Not_Enough_Degrees_Of_Freedom:
-    case Ipopt::Invalid_Problem_Definition:
-    case Ipopt::Invalid_Option:
-      return Termination::kInvalidInput;
-    case Ipopt::Diverging_Iterates:
-    case Ipopt::Restoration_Failed:
-    case Ipopt::Error_In_Step_Computation:
-    case Ipopt::Invalid_Number_Detected:
-    case Ipopt::Unrecoverable_Exception:
-    case Ipopt::NonIpopt_Exception_Thrown:
-    case Ipopt::Insufficient_Memory:
-    case Ipopt::Internal_Error:
-      return Termination::kFailure;
-  }
-  return Termination::kFailure;
-}
-
-const char* IpoptStatusName(int raw_status) {
-  switch (raw_status) {
-    case Ipopt::Solve_Succeeded:
-      return "Solve_Succeeded";
-    case Ipopt::Solved_To_Acceptable_Level:
-      return "Solved_To_Acceptable_Level";
-    case Ipopt::Infeasible_Problem_Detected:
-      return "Infeasible_Problem_Detected";
-    case Ipopt::Search_Direction_Becomes_Too_Small:
-      return "Search_Direction_Becomes_Too_Small";
-    case Ipopt::Diverging_Iterates:
-      return "Diverging_Iterates";
-    case Ipopt::User_Requested_Stop:
-      return "User_Requested_Stop";
-    case Ipopt::Feasible_Point_Found:
-      return "Feasible_Point_Found";
-    case Ipopt::Maximum_Iterations_Exceeded:
-      return "Maximum_Iterations_Exceeded";
-    case Ipopt::Restoration_Failed:
-      return "Restoration_Failed";
-    case Ipopt::Error_In_Step_Computation:
-      return "Error_In_Step_Computation";
-    case Ipopt::Maximum_CpuTime_Exceeded:
-      return "Maximum_CpuTime_Exceeded";
-    case Ipopt::Not_Enough_Degrees_Of_Freedom:
-      return "Not_Enough_Degrees_Of_Freedom";
-    case Ipopt::Invalid_Problem_Definition:
-      return "Invalid_Problem_Definition";
-    case Ipopt::Invalid_Option:
-      return "Invalid_Option";
-    case Ipopt::Invalid_Number_Detected:
-      return "Invalid_Number_Detected";
-    case Ipopt::Unrecoverable_Exception:
-      return "Unrecoverable_Exception";
-    case Ipopt::NonIpopt_Exception_Thrown:
-      return "NonIpopt_Exception_Thrown";
-    case Ipopt::Insufficient_Memory:
-      return "Insufficient_Memory";
-    case Ipopt::Internal_Error:
-      return "Internal_Error";
-  }
-  return "Unknown";
-}
 
 LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>& s0,
                                  const LocalSolveSettings& settings) {

@@ -1,68 +1,44 @@
 // The NLopt backends over ScaledDesignNlp: LD_SLSQP (the same functions and gradients Ipopt
-// sees), for cross-checks, and LN_COBYLA (values only), for the derivative-free min_sting. One
-// nlopt::opt per solve; every NLopt exception is caught; the best point is kept on round-off
-// (NLopt 2.7.1 leaves it in x) and, for COBYLA, on any early stop (tracked in the callbacks).
+// sees), for cross-checks, and LN_COBYLA (values only), for the derivative-free min_sting. Each
+// solve is one run of the NLopt trampoline (nlopt_run.hpp: callbacks, deadline, cancellation,
+// exception ladder); the best point is kept on round-off (NLopt 2.7.1 leaves it in x) and, for
+// COBYLA, on any early stop (tracked in the objective).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <limits>
-#include <new>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
-#include <nlopt.hpp>
-
-#include "core/nlopt_search.hpp"
 #include "core/optimize/design_backends.hpp"
+#include "core/optimize/nlopt_run.hpp"
+#include "core/optimize/termination.hpp"
 
 namespace sweetspot::core {
 namespace {
 
-struct NloptContext {
-  ScaledDesignNlp* nlp = nullptr;
-  const LocalSolveSettings* settings = nullptr;
-  bool failed = false;     // an evaluation was not finite
-  bool cancelled = false;  // Progress::Cancel()
-  bool deadline = false;   // wall-clock budget
-};
-
-struct NloptConstraint {
-  NloptContext* context = nullptr;
-  int index = 0;       // constraint k
-  double bound = 0.0;  // scaled bound
-  double sign = 1.0;   // +1: g - upper <= 0; -1: lower - g <= 0
-};
-
-double Objective(unsigned n, const double* s, double* grad, void* data) {
-  auto* c = static_cast<NloptContext*>(data);
-  if (IsCancelled(c->settings->progress)) {
-    c->cancelled = true;
-    throw nlopt::forced_stop();
-  }
-  if (std::chrono::steady_clock::now() >= c->settings->deadline) {
-    c->deadline = true;
-    throw nlopt::forced_stop();
-  }
-  if (!c->nlp->Evaluate(s, grad != nullptr)) {
-    c->failed = true;
+// The SLSQP objective: f and its gradient on the scaled problem.
+double SlsqpObjective(ScaledDesignNlp& nlp, const double* s, double* grad) {
+  const auto n = static_cast<unsigned>(nlp.n());
+  if (!nlp.Evaluate(s, grad != nullptr)) {
     if (grad != nullptr) {
       for (unsigned j = 0; j < n; ++j) grad[j] = 0.0;
     }
     return std::numeric_limits<double>::max();  // SLSQP backs off from a huge value
   }
   if (grad != nullptr) {
-    for (unsigned j = 0; j < n; ++j) grad[j] = c->nlp->grad_f()(static_cast<Eigen::Index>(j));
+    for (unsigned j = 0; j < n; ++j) grad[j] = nlp.grad_f()(static_cast<Eigen::Index>(j));
   }
-  return c->nlp->f();
+  return nlp.f();
 }
 
-double Constraint(unsigned n, const double* s, double* grad, void* data) {
-  auto* k = static_cast<NloptConstraint*>(data);
-  ScaledDesignNlp& nlp = *k->context->nlp;
+// One side of constraint k: sign (g_k - bound) <= 0 (sign +1: upper, -1: lower), with its
+// gradient; a failed evaluation counts as violated.
+double SlsqpConstraint(ScaledDesignNlp& nlp, int k, double bound, double sign, const double* s,
+                       double* grad) {
+  const auto n = static_cast<unsigned>(nlp.n());
   if (!nlp.Evaluate(s, grad != nullptr)) {
-    k->context->failed = true;
     if (grad != nullptr) {
       for (unsigned j = 0; j < n; ++j) grad[j] = 0.0;
     }
@@ -70,10 +46,37 @@ double Constraint(unsigned n, const double* s, double* grad, void* data) {
   }
   if (grad != nullptr) {
     for (unsigned j = 0; j < n; ++j) {
-      grad[j] = k->sign * nlp.jacobian()(k->index, static_cast<Eigen::Index>(j));
+      grad[j] = sign * nlp.jacobian()(k, static_cast<Eigen::Index>(j));
     }
   }
-  return k->sign * (nlp.g()[static_cast<std::size_t>(k->index)] - k->bound);
+  return sign * (nlp.g()[static_cast<std::size_t>(k)] - bound);
+}
+
+// Every constraint of `nlp` as NLopt constraints on the scaled problem: equalities as one
+// equality, ranges as one or two inequalities (g - upper <= 0, lower - g <= 0). `side(k, bound,
+// sign)` gives the function of one side.
+template <typename Side>
+std::vector<NloptConstraintFunction> ConstraintsOf(const ScaledDesignNlp& nlp, double tol,
+                                                   const Side& side) {
+  std::vector<double> lower, upper;
+  nlp.ConstraintBounds(&lower, &upper);
+  std::vector<NloptConstraintFunction> out;
+  for (int k = 0; k < nlp.m(); ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    if (lower[kk] == upper[kk]) {
+      out.push_back({side(k, upper[kk], 1.0), true, tol});
+      continue;
+    }
+    if (std::isfinite(upper[kk])) out.push_back({side(k, upper[kk], 1.0), false, tol});
+    if (std::isfinite(lower[kk])) out.push_back({side(k, lower[kk], -1.0), false, tol});
+  }
+  return out;
+}
+
+// The box [0, 1]^n of the scaled variables.
+void SetUnitBox(int n, NloptRunSettings* settings) {
+  settings->lower.assign(static_cast<std::size_t>(n), 0.0);
+  settings->upper.assign(static_cast<std::size_t>(n), 1.0);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -87,22 +90,13 @@ constexpr double kCobylaBarrier = 1e6;
 struct CobylaContext {
   ScaledDesignNlp* nlp = nullptr;
   const LocalSolveSettings* settings = nullptr;
-  int failures = 0;        // evaluations where the objective had no value
-  bool cancelled = false;  // Progress::Cancel()
-  bool deadline = false;   // wall-clock budget
+  int failures = 0;  // evaluations where the objective had no value
   // The point where the objective last failed: its constraints come straight from the model.
   std::vector<double> failed_s;
   // The best point evaluated: least violation beyond the feasibility tolerance, then least f.
   std::vector<double> best_s;
   double best_excess = std::numeric_limits<double>::infinity();
   double best_f = std::numeric_limits<double>::infinity();
-};
-
-struct CobylaConstraint {
-  CobylaContext* context = nullptr;
-  int index = 0;       // constraint k
-  double bound = 0.0;  // scaled bound
-  double sign = 1.0;   // +1: g - upper <= 0; -1: lower - g <= 0
 };
 
 bool SamePoint(const std::vector<double>& a, const double* s) {
@@ -117,16 +111,8 @@ bool CobylaEvaluate(CobylaContext* c, const double* s) {
   return false;
 }
 
-double CobylaObjective(unsigned n, const double* s, double* /*grad*/, void* data) {
-  auto* c = static_cast<CobylaContext*>(data);
-  if (IsCancelled(c->settings->progress)) {
-    c->cancelled = true;
-    throw nlopt::forced_stop();
-  }
-  if (std::chrono::steady_clock::now() >= c->settings->deadline) {
-    c->deadline = true;
-    throw nlopt::forced_stop();
-  }
+double CobylaObjective(CobylaContext* c, const double* s) {
+  const auto n = static_cast<std::size_t>(c->nlp->n());
   if (!CobylaEvaluate(c, s)) {
     ++c->failures;
     return kCobylaBarrier;
@@ -141,12 +127,12 @@ double CobylaObjective(unsigned n, const double* s, double* /*grad*/, void* data
   return f;
 }
 
-double CobylaConstraintValue(unsigned /*n*/, const double* s, double* /*grad*/, void* data) {
-  auto* k = static_cast<CobylaConstraint*>(data);
-  ScaledDesignNlp& nlp = *k->context->nlp;
-  const auto kk = static_cast<std::size_t>(k->index);
+// One side of constraint k for COBYLA: sign (g_k - bound) <= 0.
+double CobylaConstraintValue(CobylaContext* c, int k, double bound, double sign, const double* s) {
+  ScaledDesignNlp& nlp = *c->nlp;
+  const auto kk = static_cast<std::size_t>(k);
   double g = 0.0;
-  if (CobylaEvaluate(k->context, s)) {
+  if (CobylaEvaluate(c, s)) {
     g = nlp.g()[kk];
   } else {
     // The objective failed here, the constraints (closed forms) need not have.
@@ -155,26 +141,11 @@ double CobylaConstraintValue(unsigned /*n*/, const double* s, double* /*grad*/, 
     g = nlp.model().Value(spec.f, x.data()) / spec.scale;
     if (!std::isfinite(g)) return 1.0;  // violated
   }
-  return k->sign * (g - k->bound);
+  return sign * (g - bound);
 }
 
 // ---------------------------------------------------------------------------------------------
 // Projection onto the constraints (after COBYLA).
-
-struct ProjectionContext {
-  std::vector<double> centre;  // the point projected
-};
-
-double ProjectionObjective(unsigned n, const double* s, double* grad, void* data) {
-  auto* c = static_cast<ProjectionContext*>(data);
-  double f = 0.0;
-  for (unsigned j = 0; j < n; ++j) {
-    const double d = s[j] - c->centre[j];
-    f += 0.5 * d * d;
-    if (grad != nullptr) grad[j] = d;
-  }
-  return f;
-}
 
 // COBYLA meets the constraints only as its trust radius shrinks, and may stop on the objective's
 // tolerance with a violation of ~1e-8 relative. The constraints are smooth closed forms with
@@ -190,43 +161,31 @@ void ProjectOntoConstraints(const ScaledDesignNlp& nlp, const LocalSolveSettings
     if (!constraints_only.Evaluate(s->data(), false)) return;
     const double before = constraints_only.Violation();
     if (!(before > settings.constraint_tolerance)) return;
-    NloptContext context{&constraints_only, &settings};
-    ProjectionContext projection{*s};
-    const auto n = static_cast<unsigned>(nlp.n());
-    nlopt::opt opt(nlopt::LD_SLSQP, n);
-    opt.set_lower_bounds(std::vector<double>(n, 0.0));
-    opt.set_upper_bounds(std::vector<double>(n, 1.0));
-    opt.set_min_objective(ProjectionObjective, &projection);
-    std::vector<double> lower, upper;
-    constraints_only.ConstraintBounds(&lower, &upper);
-    std::vector<NloptConstraint> constraints;
-    constraints.reserve(2 * static_cast<std::size_t>(nlp.m()));
-    const double tol = settings.constraint_tolerance;
-    for (int k = 0; k < nlp.m(); ++k) {
-      const auto kk = static_cast<std::size_t>(k);
-      if (lower[kk] == upper[kk]) {
-        constraints.push_back({&context, k, upper[kk], 1.0});
-        opt.add_equality_constraint(Constraint, &constraints.back(), tol);
-        continue;
+    const std::vector<double> centre = *s;
+    const NloptFunction distance = [&centre](const double* p, double* grad) {
+      double f = 0.0;
+      for (std::size_t j = 0; j < centre.size(); ++j) {
+        const double d = p[j] - centre[j];
+        f += 0.5 * d * d;
+        if (grad != nullptr) grad[j] = d;
       }
-      if (std::isfinite(upper[kk])) {
-        constraints.push_back({&context, k, upper[kk], 1.0});
-        opt.add_inequality_constraint(Constraint, &constraints.back(), tol);
-      }
-      if (std::isfinite(lower[kk])) {
-        constraints.push_back({&context, k, lower[kk], -1.0});
-        opt.add_inequality_constraint(Constraint, &constraints.back(), tol);
-      }
-    }
-    opt.set_xtol_rel(1e-14);
-    opt.set_maxeval(100);
+      return f;
+    };
+    const auto constraints = ConstraintsOf(
+        constraints_only, settings.constraint_tolerance, [&](int k, double bound, double sign) {
+          return NloptFunction([&constraints_only, k, bound, sign](const double* p, double* g) {
+            return SlsqpConstraint(constraints_only, k, bound, sign, p, g);
+          });
+        });
+    NloptRunSettings run;
+    run.algorithm = NloptAlgorithm::kLdSlsqp;
+    SetUnitBox(nlp.n(), &run);
+    run.x_tolerance_rel = 1e-14;
+    run.max_evaluations = 100;
     std::vector<double> p = *s;
-    double f = 0.0;
-    try {
-      opt.optimize(p, f);
-    } catch (const nlopt::roundoff_limited&) {
-      // p holds the best point: judged below like any other
-    }
+    const NloptRunOutcome outcome = RunNlopt(distance, constraints, run, &p);
+    // A normal end or round-off (p holds the best point) is judged below; other stops keep *s.
+    if (outcome.raw_status < 0 && outcome.raw_status != kNloptRoundoffLimited) return;
     for (double& v : p) v = std::clamp(v, 0.0, 1.0);
     if (!constraints_only.Evaluate(p.data(), false)) return;
     if (constraints_only.Violation() < before) *s = p;
@@ -235,60 +194,42 @@ void ProjectOntoConstraints(const ScaledDesignNlp& nlp, const LocalSolveSettings
   }
 }
 
-// Adds every constraint of `nlp` to `opt` as NLopt constraints on the scaled problem:
-// equalities as one equality, ranges as one or two inequalities (g - upper <= 0,
-// lower - g <= 0). `constraints` keeps their callback data alive (reserved up front so the
-// pointers stay valid). Constraint is NloptConstraint or CobylaConstraint.
-template <typename Context, typename Constraint>
-void AddConstraints(nlopt::opt& opt, ScaledDesignNlp& nlp, Context* context, double tol,
-                    nlopt::func value, std::vector<Constraint>* constraints) {
-  std::vector<double> lower, upper;
-  nlp.ConstraintBounds(&lower, &upper);
-  constraints->reserve(2 * static_cast<std::size_t>(nlp.m()));
-  for (int k = 0; k < nlp.m(); ++k) {
-    const auto kk = static_cast<std::size_t>(k);
-    if (lower[kk] == upper[kk]) {
-      constraints->push_back({context, k, upper[kk], 1.0});
-      opt.add_equality_constraint(value, &constraints->back(), tol);
-      continue;
-    }
-    if (std::isfinite(upper[kk])) {
-      constraints->push_back({context, k, upper[kk], 1.0});
-      opt.add_inequality_constraint(value, &constraints->back(), tol);
-    }
-    if (std::isfinite(lower[kk])) {
-      constraints->push_back({context, k, lower[kk], -1.0});
-      opt.add_inequality_constraint(value, &constraints->back(), tol);
-    }
-  }
-}
-
-// Runs opt.optimize from s (left at the point NLopt returns) and maps every NLopt exception
-// to its result code, with the exception's text in *message where it has one.
-int RunOptimize(nlopt::opt& opt, std::vector<double>& s, std::string* message) {
-  double f = 0.0;
-  try {
-    return opt.optimize(s, f);
-  } catch (const nlopt::roundoff_limited&) {
-    return nlopt::ROUNDOFF_LIMITED;  // s holds the best point: keep it
-  } catch (const nlopt::forced_stop&) {
-    return nlopt::FORCED_STOP;
-  } catch (const std::invalid_argument& e) {
-    *message = e.what();
-    return nlopt::INVALID_ARGS;
-  } catch (const std::bad_alloc&) {
-    return nlopt::OUT_OF_MEMORY;
-  } catch (const std::runtime_error& e) {
-    *message = e.what();
-    return nlopt::FAILURE;
-  }
-}
-
 // NLopt's time budget: what is left until the deadline (at least 1 ms), s.
 double SecondsLeft(const LocalSolveSettings& settings) {
   const double left_s =
       std::chrono::duration<double>(settings.deadline - std::chrono::steady_clock::now()).count();
   return std::max(left_s, 1e-3);
+}
+
+// The trampoline's settings shared by both backends: the unit box, the deadline, the progress
+// and NLopt's time budget.
+NloptRunSettings RunSettings(NloptAlgorithm algorithm, const ScaledDesignNlp& nlp,
+                             const LocalSolveSettings& settings) {
+  NloptRunSettings run;
+  run.algorithm = algorithm;
+  SetUnitBox(nlp.n(), &run);
+  run.deadline = settings.deadline;
+  run.progress = settings.progress;
+  run.max_time_s = SecondsLeft(settings);
+  return run;
+}
+
+// The outcome fields both backends fill the same way from a run.
+void FillOutcome(const NloptRunOutcome& run, std::vector<double> s, LocalSolveOutcome* out) {
+  for (double& v : s) v = std::clamp(v, 0.0, 1.0);
+  out->s = std::move(s);
+  out->has_point = true;
+  out->raw_status = run.raw_status;
+  out->status_name = NloptResultName(run.raw_status);
+  out->iterations = run.evaluations;
+  out->message = run.message;
+  out->cancelled = run.cancelled;
+  // NLopt's maxtime is the budget left: reaching it is the deadline too.
+  out->deadline_reached = run.deadline_reached || run.raw_status == kNloptMaxtimeReached;
+  out->termination = TerminationFromNloptResult(run.raw_status);
+  if (run.raw_status == kNloptRoundoffLimited || run.cancelled || run.deadline_reached) {
+    out->termination = Termination::kNoConvergence;  // the best point so far is kept
+  }
 }
 
 }  // namespace
@@ -300,46 +241,30 @@ LocalSolveOutcome SolveWithCobyla(ScaledDesignNlp& nlp, const std::vector<double
   CobylaContext context;
   context.nlp = &nlp;
   context.settings = &settings;
+  NloptRunSettings run = RunSettings(NloptAlgorithm::kLnCobyla, nlp, settings);
+  const double rel = std::max(settings.tolerance, kDerivativeFreeTolerance);
+  run.f_tolerance_rel = rel;
+  run.x_tolerance_rel = rel;
+  run.max_evaluations = settings.max_iterations;  // one evaluation per COBYLA iteration
+  const NloptFunction objective = [&context](const double* s, double* /*grad*/) {
+    return CobylaObjective(&context, s);
+  };
+  const auto constraints = ConstraintsOf(
+      nlp, settings.constraint_tolerance, [&context](int k, double bound, double sign) {
+        return NloptFunction([&context, k, bound, sign](const double* s, double* /*grad*/) {
+          return CobylaConstraintValue(&context, k, bound, sign, s);
+        });
+      });
   std::vector<double> s = s0;
-  for (double& v : s) v = std::clamp(v, 0.0, 1.0);
-  int status = nlopt::FAILURE;
-  try {
-    const auto n = static_cast<unsigned>(nlp.n());
-    nlopt::opt opt(nlopt::LN_COBYLA, n);
-    opt.set_lower_bounds(std::vector<double>(n, 0.0));
-    opt.set_upper_bounds(std::vector<double>(n, 1.0));
-    opt.set_min_objective(CobylaObjective, &context);
-    std::vector<CobylaConstraint> constraints;
-    AddConstraints(opt, nlp, &context, settings.constraint_tolerance, CobylaConstraintValue,
-                   &constraints);
-    const double rel = std::max(settings.tolerance, kDerivativeFreeTolerance);
-    opt.set_ftol_rel(rel);
-    opt.set_xtol_rel(rel);
-    opt.set_maxeval(settings.max_iterations);  // one evaluation per COBYLA iteration
-    opt.set_maxtime(SecondsLeft(settings));
-    status = RunOptimize(opt, s, &out.message);
-    out.iterations = opt.get_numevals();
-  } catch (const std::exception& e) {
-    status = nlopt::FAILURE;
-    out.message = std::string("exception: ") + e.what();
-  }
+  const NloptRunOutcome result = RunNlopt(objective, constraints, run, &s);
   // A normal end is COBYLA's own answer; after any other stop, the best point evaluated.
-  const bool normal_end = status == nlopt::SUCCESS || status == nlopt::FTOL_REACHED ||
-                          status == nlopt::XTOL_REACHED || status == nlopt::STOPVAL_REACHED;
+  const int status = result.raw_status;
+  const bool normal_end = status == kNloptSuccess || status == kNloptFtolReached ||
+                          status == kNloptXtolReached || status == kNloptStopvalReached;
   if (!normal_end && !context.best_s.empty()) s = context.best_s;
   for (double& v : s) v = std::clamp(v, 0.0, 1.0);
   ProjectOntoConstraints(nlp, settings, &s);
-  out.s = s;
-  out.has_point = true;
-  out.raw_status = status;
-  out.status_name = NloptResultName(status);
-  out.cancelled = context.cancelled;
-  // NLopt's maxtime is the budget left: reaching it is the deadline too.
-  out.deadline_reached = context.deadline || status == nlopt::MAXTIME_REACHED;
-  out.termination = TerminationFromNloptResult(status);
-  if (status == nlopt::ROUNDOFF_LIMITED || context.cancelled || context.deadline) {
-    out.termination = Termination::kNoConvergence;  // the best point so far is kept
-  }
+  FillOutcome(result, std::move(s), &out);
   if (context.failures > 0) {
     const std::string note = std::to_string(context.failures) +
                              " evaluation(s) had no objective value (the model refused the "
@@ -354,41 +279,24 @@ LocalSolveOutcome SolveWithNlopt(ScaledDesignNlp& nlp, const std::vector<double>
                                  const LocalSolveSettings& settings) {
   LocalSolveOutcome out;
   const int evaluations_before = nlp.evaluations();
-  NloptContext context{&nlp, &settings};
+  NloptRunSettings run = RunSettings(NloptAlgorithm::kLdSlsqp, nlp, settings);
+  run.f_tolerance_rel = settings.tolerance;
+  run.x_tolerance_rel = settings.tolerance;
+  // SLSQP counts evaluations, not iterations: allow a few per iteration.
+  run.max_evaluations = 20 * settings.max_iterations;
+  const NloptFunction objective = [&nlp](const double* s, double* grad) {
+    return SlsqpObjective(nlp, s, grad);
+  };
+  const auto constraints =
+      ConstraintsOf(nlp, settings.constraint_tolerance, [&nlp](int k, double bound, double sign) {
+        return NloptFunction([&nlp, k, bound, sign](const double* s, double* grad) {
+          return SlsqpConstraint(nlp, k, bound, sign, s, grad);
+        });
+      });
   std::vector<double> s = s0;
   for (double& v : s) v = std::clamp(v, 0.0, 1.0);
-  int status = nlopt::FAILURE;
-  try {
-    const auto n = static_cast<unsigned>(nlp.n());
-    nlopt::opt opt(nlopt::LD_SLSQP, n);
-    opt.set_lower_bounds(std::vector<double>(n, 0.0));
-    opt.set_upper_bounds(std::vector<double>(n, 1.0));
-    opt.set_min_objective(Objective, &context);
-    std::vector<NloptConstraint> constraints;
-    AddConstraints(opt, nlp, &context, settings.constraint_tolerance, Constraint, &constraints);
-    opt.set_ftol_rel(settings.tolerance);
-    opt.set_xtol_rel(settings.tolerance);
-    // SLSQP counts evaluations, not iterations: allow a few per iteration.
-    opt.set_maxeval(20 * settings.max_iterations);
-    opt.set_maxtime(SecondsLeft(settings));
-    status = RunOptimize(opt, s, &out.message);
-    out.iterations = opt.get_numevals();
-  } catch (const std::exception& e) {
-    status = nlopt::FAILURE;
-    out.message = std::string("exception: ") + e.what();
-  }
-  for (double& v : s) v = std::clamp(v, 0.0, 1.0);
-  out.s = s;
-  out.has_point = true;
-  out.raw_status = status;
-  out.status_name = NloptResultName(status);
-  out.cancelled = context.cancelled;
-  // NLopt's maxtime is the budget left: reaching it is the deadline too.
-  out.deadline_reached = context.deadline || status == nlopt::MAXTIME_REACHED;
-  out.termination = TerminationFromNloptResult(status);
-  if (status == nlopt::ROUNDOFF_LIMITED || context.cancelled || context.deadline) {
-    out.termination = Termination::kNoConvergence;  // the best point so far is kept
-  }
+  const NloptRunOutcome result = RunNlopt(objective, constraints, run, &s);
+  FillOutcome(result, std::move(s), &out);
   out.evaluations = nlp.evaluations() - evaluations_before;
   return out;
 }

@@ -302,39 +302,6 @@ TEST(OptimizeModel, IpoptDerivativeCheckerFindsNoErrors) {
   }
 }
 
-TEST(OptimizeStatus, EveryIpoptStatusMapsToATermination) {
-  const struct {
-    int status;
-    const char* name;
-    Termination termination;
-  } cases[] = {
-      {0, "Solve_Succeeded", Termination::kConverged},
-      {1, "Solved_To_Acceptable_Level", Termination::kConverged},
-      {2, "Infeasible_Problem_Detected", Termination::kInfeasible},
-      {3, "Search_Direction_Becomes_Too_Small", Termination::kNoConvergence},
-      {4, "Diverging_Iterates", Termination::kFailure},
-      {5, "User_Requested_Stop", Termination::kNoConvergence},
-      {6, "Feasible_Point_Found", Termination::kNoConvergence},
-      {-1, "Maximum_Iterations_Exceeded", Termination::kNoConvergence},
-      {-2, "Restoration_Failed", Termination::kFailure},
-      {-3, "Error_In_Step_Computation", Termination::kFailure},
-      {-4, "Maximum_CpuTime_Exceeded", Termination::kNoConvergence},
-      {-10, "Not_Enough_Degrees_Of_Freedom", Termination::kInvalidInput},
-      {-11, "Invalid_Problem_Definition", Termination::kInvalidInput},
-      {-12, "Invalid_Option", Termination::kInvalidInput},
-      {-13, "Invalid_Number_Detected", Termination::kFailure},
-      {-100, "Unrecoverable_Exception", Termination::kFailure},
-      {-101, "NonIpopt_Exception_Thrown", Termination::kFailure},
-      {-102, "Insufficient_Memory", Termination::kFailure},
-      {-199, "Internal_Error", Termination::kFailure},
-      {42, "Unknown", Termination::kFailure},
-  };
-  for (const auto& c : cases) {
-    EXPECT_EQ(TerminationFromIpoptStatus(c.status), c.termination) << c.status;
-    EXPECT_STREQ(IpoptStatusName(c.status), c.name);
-  }
-}
-
 // Max iterations reached maps to no_convergence with the point kept; Ipopt's raw status is kept.
 TEST(OptimizeStatus, IterationLimitIsNoConvergenceWithTheRawStatus) {
   DesignOptions o;

@@ -264,24 +264,6 @@ TEST(Collide, WithoutBatGeometryTheSurfaceIsRigidAndSaysSo) {
             "no bat geometry in the scene: the bat surface is taken as rigid");
 }
 
-TEST(NloptBackend, EveryResultCodeMapsToATermination) {
-  EXPECT_EQ(TerminationFromNloptResult(1), Termination::kConverged);      // SUCCESS
-  EXPECT_EQ(TerminationFromNloptResult(2), Termination::kConverged);      // STOPVAL_REACHED
-  EXPECT_EQ(TerminationFromNloptResult(3), Termination::kConverged);      // FTOL_REACHED
-  EXPECT_EQ(TerminationFromNloptResult(4), Termination::kConverged);      // XTOL_REACHED
-  EXPECT_EQ(TerminationFromNloptResult(5), Termination::kNoConvergence);  // MAXEVAL_REACHED
-  EXPECT_EQ(TerminationFromNloptResult(6), Termination::kNoConvergence);  // MAXTIME_REACHED
-  EXPECT_EQ(TerminationFromNloptResult(-1), Termination::kFailure);       // FAILURE
-  EXPECT_EQ(TerminationFromNloptResult(-2), Termination::kInvalidInput);  // INVALID_ARGS
-  EXPECT_EQ(TerminationFromNloptResult(-3), Termination::kFailure);       // OUT_OF_MEMORY
-  EXPECT_EQ(TerminationFromNloptResult(-4),
-            Termination::kNoConvergence);                            // ROUNDOFF_LIMITED: point kept
-  EXPECT_EQ(TerminationFromNloptResult(-5), Termination::kFailure);  // FORCED_STOP
-  EXPECT_EQ(TerminationFromNloptResult(42), Termination::kFailure);  // unknown
-  EXPECT_STREQ(NloptResultName(-4), "ROUNDOFF_LIMITED");
-  EXPECT_STREQ(NloptResultName(7), "UNKNOWN");
-}
-
 TEST(NloptBackend, NewuoaIsNotOfferedIn1D) {
   std::string why;
   EXPECT_FALSE(ParseNloptAlgorithm("LN_NEWUOA", &why).has_value());

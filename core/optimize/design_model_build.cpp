@@ -1,0 +1,358 @@
+// DesignModel::Build, by concern: the scene and objective checks, the base design, the
+// parameters and variables, the rule sets, and the objective with the scales; the constraints
+// are in design_model_constraints.cpp. See design_model.hpp.
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/optimize/design_model_builder.hpp"
+
+namespace sweetspot::core {
+namespace design_detail {
+
+// Scene and objective.
+bool ModelBuilder::CheckScene() {
+  if (ParseDesignObjective(DesignObjectiveName(problem.objective)) != problem.objective) {
+    return Fail(why, "objective: not a known objective");
+  }
+  if (!problem.ball.IsValid(inner_ptr)) return Fail(why, inner);
+  if (!problem.swing.IsValid(inner_ptr)) return Fail(why, inner);
+  if (!(std::isfinite(problem.swing_weight_exponent) && problem.swing_weight_exponent >= 0.0 &&
+        problem.swing_weight_exponent <= 0.5)) {
+    return Refuse(why, "swing_weight_exponent", problem.swing_weight_exponent,
+                  "must be in [0, 0.5]");
+  }
+  if (!(std::isfinite(problem.sweet_zone_tolerance_mps) &&
+        problem.sweet_zone_tolerance_mps > 0.0)) {
+    return Refuse(why, "sweet_zone_tolerance_mps", problem.sweet_zone_tolerance_mps,
+                  "must be finite and positive");
+  }
+  exit_speed_objective = problem.objective != DesignObjective::kMinMoi;
+  if (exit_speed_objective && problem.ball.speed_mps == 0.0 &&
+      problem.swing.angular_speed_rad_s == 0.0) {
+    return Fail(why,
+                "ball.speed_mps = 0 and swing.angular_speed_rad_s = 0: nothing moves, the "
+                "exit speed is 0 everywhere (objective " +
+                    std::string(DesignObjectiveName(problem.objective)) + ")");
+  }
+  if (problem.inertia_model != InertiaModel::kRigidBody &&
+      problem.inertia_model != InertiaModel::kSlenderRod) {
+    return Fail(why, "inertia_model: not a known inertia model");
+  }
+  if (problem.objective == DesignObjective::kMinSting && !problem.flexible.IsValid(inner_ptr)) {
+    return Fail(why, inner);
+  }
+
+  return true;
+}
+
+// The base design and the COR.
+bool ModelBuilder::BaseDesign() {
+  base = problem.bat;
+  if (problem.three_segment.has_value()) {
+    if (!problem.three_segment->IsValid(inner_ptr)) return Fail(why, "three_segment." + inner);
+    base.knots = problem.three_segment->Knots();
+  }
+  if (!base.IsValid(inner_ptr)) return Fail(why, "bat." + inner);
+  if (problem.cor.has_value()) {
+    if (!(std::isfinite(*problem.cor) && *problem.cor >= 0.0 && *problem.cor <= 1.0)) {
+      return Refuse(why, "cor", *problem.cor, "must be in [0, 1]");
+    }
+    model.cor_ = *problem.cor;
+  } else if (base.material.cor.has_value()) {
+    model.cor_ = *base.material.cor;
+  } else if (exit_speed_objective) {
+    return Fail(why,
+                "cor: not given, and material '" + base.material.name + "' has no default COR");
+  } else {
+    model.cor_ = 0.5;  // unused by min_moi; the rules' BBCOR check uses it only if given
+  }
+
+  return true;
+}
+
+// The design parameters of the base design.
+void ModelBuilder::Parameters() {
+  model.base_bat_ = base;
+  model.base_shape_ = problem.three_segment;
+  model.hollow_ = base.IsHollow();
+  model.has_fill_ = base.fill.has_value();
+  model.rigid_ = problem.inertia_model == InertiaModel::kRigidBody;
+  if (problem.three_segment.has_value()) {
+    const ThreeSegmentShape& s = *problem.three_segment;
+    Bat four = base;
+    four.knots = {{0.0, s.handle_radius_m},
+                  {s.taper_start_m, s.handle_radius_m},
+                  {s.taper_end_m, s.barrel_radius_m},
+                  {s.length_m, s.barrel_radius_m}};
+    const Eigen::VectorXd p = DesignParameters(four);
+    model.base_parameters_.assign(p.data(), p.data() + p.size());
+    model.num_knots_ = 4;
+  } else {
+    const Eigen::VectorXd p = DesignParameters(base);
+    model.base_parameters_.assign(p.data(), p.data() + p.size());
+    model.num_knots_ = static_cast<int>(base.knots.size());
+  }
+  lay = DesignParameterLayout{model.num_knots_};
+  model.parameter_variable_.assign(static_cast<std::size_t>(lay.Size()), -1);
+}
+
+// The parameters a variable moves, with the flags the rules need.
+std::vector<int> ModelBuilder::ParametersOf(const DesignVariableRef& ref) {
+  switch (ref.kind) {
+    case DesignVariableKind::kKnotRadius:
+      return {lay.KnotRadius(ref.knot)};
+    case DesignVariableKind::kKnotPosition:
+      return {lay.KnotPosition(ref.knot)};
+    case DesignVariableKind::kLength:
+      return {lay.KnotPosition(3)};
+    case DesignVariableKind::kHandleRadius:
+      return {lay.KnotRadius(0), lay.KnotRadius(1)};
+    case DesignVariableKind::kBarrelRadius:
+      return {lay.KnotRadius(2), lay.KnotRadius(3)};
+    case DesignVariableKind::kTaperStart:
+      return {lay.KnotPosition(1)};
+    case DesignVariableKind::kTaperEnd:
+      return {lay.KnotPosition(2)};
+    case DesignVariableKind::kDensity:
+      density_variable = true;
+      return {lay.Density()};
+    case DesignVariableKind::kWallThickness:
+      wall_variable = true;
+      return {lay.WallThickness()};
+    case DesignVariableKind::kFillDiameter:
+      return {lay.FillDiameter()};
+    case DesignVariableKind::kFillDepth:
+      return {lay.FillDepth()};
+    case DesignVariableKind::kFillDensity:
+      fill_density_variable = true;
+      return {lay.FillDensity()};
+  }
+  return {};
+}
+
+// Variable i checked against the design (refused with the reason in *why).
+bool ModelBuilder::CheckVariable(std::size_t i, const DesignVariable& v,
+                                 const std::optional<DesignVariableRef>& ref,
+                                 std::set<std::string>* seen) {
+  const std::string field = IndexedField("variables", i, "");
+  const std::string path_field = field + "path = " + v.path + ": ";
+  if (!ref.has_value()) {
+    return Fail(why, path_field +
+                         "not a design variable (known: profile.knots[i].radius_m, "
+                         "profile.knots[i].x_m, three_segment.length_m, "
+                         "three_segment.handle_radius_m, three_segment.barrel_radius_m, "
+                         "three_segment.taper_start_m, three_segment.taper_end_m, "
+                         "material.density_kg_m3, wall_thickness_m, fill.diameter_m, "
+                         "fill.depth_m, fill.material.density_kg_m3)");
+  }
+  if (!seen->insert(v.path).second) return Fail(why, path_field + "appears more than once");
+  if (IsProfileKind(ref->kind) && problem.three_segment.has_value()) {
+    return Fail(why, path_field + "the design is a three_segment shape (use three_segment.*)");
+  }
+  if (IsThreeSegmentKind(ref->kind) && !problem.three_segment.has_value()) {
+    return Fail(why, path_field + "the design is a profile, not a three_segment shape");
+  }
+  if (IsProfileKind(ref->kind) && ref->knot >= model.num_knots_) {
+    return Fail(why, path_field + "the profile has " + std::to_string(model.num_knots_) + " knots");
+  }
+  if (ref->kind == DesignVariableKind::kKnotPosition && ref->knot == 0) {
+    return Fail(why, path_field + "must stay 0 (positions are measured from the knob)");
+  }
+  if (IsFillKind(ref->kind) && !base.fill.has_value()) {
+    return Fail(why, path_field + "the bat has no fill");
+  }
+  if (!std::isfinite(v.min)) {
+    return Refuse(why, field + "min", v.min,
+                  "must be finite (an optimisation needs bounded variables)");
+  }
+  if (!std::isfinite(v.max)) {
+    return Refuse(why, field + "max", v.max,
+                  "must be finite (an optimisation needs bounded variables)");
+  }
+  if (!(v.max > v.min)) {
+    return Refuse(why, field + "max", v.max,
+                  "must be greater than " + field + "min = " + Num(v.min));
+  }
+  if (NeedsPositive(ref->kind) && !(v.min > 0.0)) {
+    return Refuse(why, field + "min", v.min,
+                  "must be positive for " + v.path +
+                      (ref->kind == DesignVariableKind::kWallThickness
+                           ? " (the bat stays hollow: wall = 0 is a solid bat, a jump)"
+                           : ""));
+  }
+  if (!NeedsPositive(ref->kind) && v.min < 0.0) {
+    return Refuse(why, field + "min", v.min, "must be non-negative for " + v.path);
+  }
+  return true;
+}
+
+// Variable i: checked, then added with its parameters.
+bool ModelBuilder::AddVariable(std::size_t i, std::set<std::string>* seen) {
+  const DesignVariable& v = problem.variables[i];
+  const std::optional<DesignVariableRef> ref = ParseDesignVariablePath(v.path);
+  if (!CheckVariable(i, v, ref, seen)) return false;
+  DesignVariableSpec spec;
+  spec.path = v.path;
+  spec.ref = *ref;
+  spec.lower = v.min;
+  spec.upper = v.max;
+  spec.parameters = ParametersOf(*ref);
+  spec.base = Param(spec.parameters.front());
+  for (int idx : spec.parameters) {
+    model.parameter_variable_[static_cast<std::size_t>(idx)] =
+        static_cast<int>(model.variables_.size());
+  }
+  model.variables_.push_back(spec);
+  return true;
+}
+
+// Every variable.
+bool ModelBuilder::Variables() {
+  if (problem.variables.empty() ||
+      problem.variables.size() > static_cast<std::size_t>(kMaxVariables)) {
+    return Refuse(why, "variables.size()", static_cast<double>(problem.variables.size()),
+                  "must be between 1 and 200");
+  }
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < problem.variables.size(); ++i) {
+    if (!AddVariable(i, &seen)) return false;
+  }
+  if (wall_variable) model.hollow_ = true;
+  if (fill_density_variable) {
+    Material f = base.fill->material;
+    f.density_kg_m3 = 1.0;  // check the other fields: the fill may become non-empty
+    if (!f.IsValid(inner_ptr)) {
+      return Fail(why, "fill.material." + inner +
+                           " (fill.material.density_kg_m3 is a variable, so the fill material must "
+                           "be complete)");
+    }
+  }
+
+  return true;
+}
+
+// Rules: the discrete limits.
+bool ModelBuilder::Rules() {
+  {
+    std::set<RuleSet> rules_seen;
+    for (std::size_t i = 0; i < problem.constraints.rules.size(); ++i) {
+      const RuleSet rule = problem.constraints.rules[i];
+      if (!ParseRuleSet(RuleSetName(rule)).has_value()) {
+        return Fail(why, IndexedField("constraints.rules", i, "") + ": not a known rule set");
+      }
+      if (!rules_seen.insert(rule).second) {
+        return Fail(why, "constraints.rules: " + std::string(RuleSetName(rule)) +
+                             " appears more than once");
+      }
+      RuleFacts facts;
+      facts.material = base.material;
+      facts.density_variable = density_variable;
+      facts.wall_thickness_m = base.wall_thickness_m;
+      facts.wall_variable = wall_variable;
+      facts.has_fill = base.fill.has_value();
+      facts.fill_density_kg_m3 = base.fill.has_value() ? base.fill->material.density_kg_m3 : 0.0;
+      facts.fill_density_variable = fill_density_variable;
+      facts.cor = model.cor_;
+      if (!RuleAllowsDesign(rule, facts, inner_ptr)) return Fail(why, inner);
+    }
+  }
+
+  return true;
+}
+
+// Scene numbers and references.
+bool ModelBuilder::SceneNumbers() {
+  model.ball_mass_kg_ = problem.ball.mass_kg;
+  model.ball_speed_mps_ = problem.ball.speed_mps;
+  model.omega0_rad_s_ = problem.swing.angular_speed_rad_s;
+  model.pivot_from_knob_m_ = problem.swing.pivot_from_knob_m;
+  model.swing_weight_exponent_ = problem.swing_weight_exponent;
+  model.zone_tolerance_mps_ = problem.sweet_zone_tolerance_mps;
+  model.objective_kind_ = problem.objective;
+  if (problem.objective == DesignObjective::kMinSting) {
+    model.sting_scene_.ball = problem.ball;
+    model.sting_scene_.swing = problem.swing;
+    model.sting_scene_.cor = model.cor_;
+    model.sting_scene_.inertia_model = problem.inertia_model;
+    model.sting_scene_.flexible = problem.flexible;
+    model.sting_scene_.flexible.modes_cache = nullptr;  // the model's own cache instead
+    model.sting_modes_ = std::make_shared<ModesCache>(kStingModesCacheEntries);
+  }
+  const MassProperties base_properties = ComputeMassProperties(base, problem.inertia_model);
+  model.c0_ = base_properties.balance_point_m;
+  model.i6_ref_ = base_properties.MoiSixInchKgM2();
+  if (!(std::isfinite(model.c0_) && model.i6_ref_ > 0.0)) {
+    return Fail(why, "bat: its mass properties are not finite");
+  }
+
+  return true;
+}
+
+// Objective and the scales.
+bool ModelBuilder::Objective() {
+  model.objective_.function = DesignFunction::kObjective;
+  model.maximize_ = problem.objective != DesignObjective::kMinMoi &&
+                    problem.objective != DesignObjective::kMinSting;
+  model.objective_unit_ = problem.objective == DesignObjective::kMinMoi            ? "kg_m2"
+                          : problem.objective == DesignObjective::kWidestSweetZone ? "m"
+                          : problem.objective == DesignObjective::kMinSting        ? "j"
+                                                                                   : "mps";
+  const std::vector<double> x0 = model.BaseX();
+  double f0 = kNaN;
+  if (problem.objective == DesignObjective::kMinSting) {
+    // The flexible model refuses some bats (too stubby for a beam, ...): say so by name.
+    const StingEvaluation sting = model.StingOf(model.BatAt(x0.data()), false);
+    if (!sting.ok) {
+      return Fail(why,
+                  "objective = min_sting: the sting of the start (the base design clamped "
+                  "into the variables' bounds) cannot be computed: " +
+                      sting.message);
+    }
+    f0 = sting.sting_j;
+  } else {
+    f0 = model.Value(model.objective_, x0.data());
+  }
+  if (!std::isfinite(f0)) {
+    return Fail(why,
+                "variables: the objective is not finite at the start (the base design "
+                "clamped into the variables' bounds)");
+  }
+  model.objective_scale_ = std::abs(f0) > 0.0 ? std::abs(f0) : 1.0;
+  for (DesignConstraintSpec& c : model.constraints_) {
+    double s = std::abs(model.Value(c.f, x0.data()));
+    if (!std::isfinite(s)) s = 0.0;
+    if (std::isfinite(c.lower)) s = std::max(s, std::abs(c.lower));
+    if (std::isfinite(c.upper)) s = std::max(s, std::abs(c.upper));
+    c.scale = std::max(s, ScaleFloor(c.unit));
+  }
+  return true;
+}
+
+// Every step in order.
+bool ModelBuilder::Run() {
+  if (!CheckScene() || !BaseDesign()) return false;
+  Parameters();
+  if (!Variables() || !Rules() || !SceneNumbers()) return false;
+  if (!LengthConstraint() || !PropertyConstraints()) return false;
+  RadiusKnots();
+  if (!DiameterConstraints() || !TaperConstraints()) return false;
+  CupConstraints();
+  ValidityConstraints();
+  return Objective();
+}
+
+}  // namespace design_detail
+
+bool DesignModel::Build(const DesignProblem& problem, const DesignOptions& options,
+                        DesignModel* out, std::string* why) {
+  design_detail::ModelBuilder builder(problem, options, why);
+  if (!builder.Run()) return false;
+  *out = std::move(builder.model);
+  return true;
+}
+
+}  // namespace sweetspot::core

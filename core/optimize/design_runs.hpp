@@ -1,0 +1,63 @@
+// Internal to core/optimize: the pieces of OptimizeDesign shared by design.cpp (the
+// multi-start and the answer), design_runs.cpp (local solves, the choice among them, the
+// multipliers and active constraints) and design_explain.cpp (why a request is infeasible).
+#pragma once
+
+#include <chrono>
+#include <limits>
+#include <vector>
+
+#include "core/optimize/design_backends.hpp"
+#include "core/optimize/design_model.hpp"
+#include "core/optimize/design_problem.hpp"
+#include "core/progress.hpp"
+
+namespace sweetspot::core::design_detail {
+
+using Clock = std::chrono::steady_clock;
+/// A point is feasible when every constraint is met to this, relative to its scale.
+inline constexpr double kFeasibleRelative = 1e-6;
+
+/// One finished local solve.
+struct Run {
+  LocalSolveOutcome outcome;  ///< What the solver returned.
+  std::vector<double> x;      ///< The point, user units, clamped into the bounds.
+  double objective = std::numeric_limits<double>::quiet_NaN();  ///< Model objective at x.
+  double violation = std::numeric_limits<double>::infinity();   ///< Largest scaled violation.
+  bool feasible = false;  ///< violation <= kFeasibleRelative.
+};
+
+/// Evaluates the end of a local solve (clamped into the bounds, objective, violation).
+Run Finish(const DesignModel& model, LocalSolveOutcome outcome);
+/// Index of the run to answer with: feasible and converged by objective, then feasible by
+/// objective, then the least violation (-1 when no run has a finite violation).
+int ChooseRun(const DesignModel& model, const std::vector<Run>& runs);
+/// One local solve from s0 with `backend`.
+LocalSolveOutcome Solve(DesignBackend backend, ScaledDesignNlp& nlp, const std::vector<double>& s0,
+                        const LocalSolveSettings& settings);
+/// The backend of the design's local solves: min_sting has no derivative, so COBYLA whatever
+/// was asked.
+DesignBackend MainBackend(const DesignProblem& problem, const DesignOptions& options);
+/// The backend of the infeasibility analysis (smooth sub-problems): the requested gradient
+/// solver, Ipopt when COBYLA was asked.
+DesignBackend SmoothBackend(const DesignOptions& options);
+/// The summary's name of a backend ("ipopt", "nlopt:LD_SLSQP", "nlopt:LN_COBYLA").
+const char* BackendName(DesignBackend backend);
+/// The local solves' settings from the options.
+LocalSolveSettings SettingsFrom(const DesignOptions& options, Clock::time_point deadline,
+                                Progress* progress);
+/// How far v lies outside constraint c's bounds (0 inside, +inf when not finite), its unit.
+double Violation(const DesignConstraintSpec& c, double v);
+/// Fills result->active_constraints (with the multipliers, sensitivities of the objective) at
+/// x, the answer of solve `o`, and result->summary.error_estimate with the KKT residual (NaN
+/// for min_sting, which has no derivative: a warning says so).
+void ReportActiveConstraints(const DesignModel& model, const std::vector<double>& x,
+                             const LocalSolveOutcome& o, DesignResult* result);
+/// Why no design meets the constraints: single constraints that cannot be met within the
+/// variable bounds and the geometric constraints, then pairs of property constraints.
+std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOptions& options,
+                                    Clock::time_point deadline, Progress* progress,
+                                    const Run& least_violating, bool solver_says_infeasible,
+                                    int* evaluations, int* iterations);
+
+}  // namespace sweetspot::core::design_detail
