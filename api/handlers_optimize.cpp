@@ -40,7 +40,7 @@ bool ReadRange(ObjectReader& reader, const char* key, const NumberRule& rule,
   r.min = range.MaybeNumber("min", rule);
   r.max = range.MaybeNumber("max", rule);
   if (!range.Finish()) return false;
-  if (!r.min && !r.max) return range.Fail("min", "give min, max or both", "MissingField");
+  if (!r.min && !r.max) return range.Fail("min", "give min, max or both", ErrorCode::kMissingField);
   if (r.min && r.max && *r.min > *r.max) {
     return range.Fail("max", "must be >= min = " + Show(Json(*r.min)));
   }
@@ -303,7 +303,7 @@ Response HandleOptimize(const Request& request, const Context& context) {
     v.Number("max", Between(-1e12, 1e12), &variable.max);
     if (!v.Finish()) return ToResponse(error);
     if (!core::ParseDesignVariablePath(variable.path)) {
-      SetError(&error, "InvalidValue", where + ".path", &(*variables)[i]["path"],
+      SetError(&error, ErrorCode::kInvalidValue, where + ".path", &(*variables)[i]["path"],
                "is not a design variable (profile.knots[i].radius_m, profile.knots[i].x_m, "
                "three_segment.<field>, material.density_kg_m3, wall_thickness_m, "
                "fill.diameter_m, fill.depth_m, fill.material.density_kg_m3, or material with "
@@ -353,7 +353,7 @@ Response HandleOptimize(const Request& request, const Context& context) {
     out = chosen != nullptr ? ResultToJson(*chosen, *bat_json) : Json::object();
     out["materials"] = std::move(per_material);
     if (chosen == nullptr) {
-      return ErrorResponse(422, "Infeasible",
+      return ErrorResponse(422, ErrorCode::kInfeasible,
                            "no material gives a usable design: " + choice.summary.message,
                            "variables");
     }
@@ -374,7 +374,7 @@ Response HandleOptimize(const Request& request, const Context& context) {
       std::string message = "no design meets the constraints";
       if (!chosen->conflicts.empty()) message += ": " + chosen->conflicts.front().message;
       return {422,
-              {{"code", "Infeasible"},
+              {{"code", ErrorCodeName(ErrorCode::kInfeasible)},
                {"message", message},
                {"field", "constraints"},
                {"closest", std::move(out)}}};

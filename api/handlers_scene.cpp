@@ -139,7 +139,7 @@ Response HandleCompare(const Request& request, const Context& context) {
                 "has " + std::to_string(variants->size()) +
                     " variants, over the limit max_variants = " +
                     std::to_string(context.limits.max_variants),
-                "TooBig");
+                ErrorCode::kTooBig);
     return ToResponse(error);
   }
   std::vector<std::pair<std::string, BatSpec>> bats = {{"baseline", *baseline}};
@@ -159,7 +159,7 @@ Response HandleCompare(const Request& request, const Context& context) {
   Json base_row;
   for (std::size_t i = 0; i < bats.size(); ++i) {
     if (core::IsCancelled(context.progress)) {
-      return ErrorResponse(409, "Cancelled", "the comparison was cancelled");
+      return ErrorResponse(409, ErrorCode::kCancelled, "the comparison was cancelled");
     }
     core::Scene bat_scene = scene;
     bat_scene.bat = bats[i].second.bat;

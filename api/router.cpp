@@ -128,20 +128,20 @@ Response Dispatch(const Request& request, const Context& context, std::string* r
       return response;
     } catch (...) {
       // The one place an unexpected exception becomes a 500, without details.
-      return ErrorResponse(500, "InternalError", "internal error");
+      return ErrorResponse(500, ErrorCode::kInternalError, "internal error");
     }
   }
   if (route_pattern != nullptr) *route_pattern = path_known ? "method_not_allowed" : "unmatched";
   if (path_known) {
-    return ErrorResponse(405, "MethodNotAllowed",
+    return ErrorResponse(405, ErrorCode::kMethodNotAllowed,
                          "method " + request.method + " is not allowed on " + request.path +
                              " (allowed: " + allowed + ")");
   }
-  return ErrorResponse(404, "NotFound", "no endpoint at path " + request.path);
+  return ErrorResponse(404, ErrorCode::kNotFound, "no endpoint at path " + request.path);
 }
 
-Response ErrorResponse(int status, std::string_view code, std::string message, std::string field) {
-  nlohmann::json body{{"code", code}, {"message", std::move(message)}};
+Response ErrorResponse(int status, ErrorCode code, std::string message, std::string field) {
+  nlohmann::json body{{"code", ErrorCodeName(code)}, {"message", std::move(message)}};
   body["field"] = field.empty() ? nlohmann::json(nullptr) : nlohmann::json(std::move(field));
   return {status, std::move(body)};
 }

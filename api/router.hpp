@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "api/error_code.hpp"
 #include "api/limits.hpp"
 #include "api/response.hpp"
 #include "core/progress.hpp"
@@ -92,8 +93,8 @@ Response Dispatch(const Request& request, const Context& context,
 Workload ClassifyWorkload(std::string_view method, std::string_view path, std::string_view body,
                           const Context& context);
 
-/// The error envelope {"code", "message", "field"} with `status`.
-Response ErrorResponse(int status, std::string_view code, std::string message,
-                       std::string field = {});
+/// The error envelope {"code", "message", "field"} with `status` (pass
+/// ErrorCodeStatus(code) unless a documented exception applies).
+Response ErrorResponse(int status, ErrorCode code, std::string message, std::string field = {});
 
 }  // namespace sweetspot::api

@@ -227,7 +227,7 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
                          "has " + std::to_string(positions->size()) +
                              " positions, over the limit max_curve_samples = " +
                              std::to_string(static_cast<long long>(max_samples)),
-                         "TooBig");
+                         ErrorCode::kTooBig);
     }
     for (std::size_t i = 0; i < positions->size(); ++i) {
       const Json& p = (*positions)[i];
@@ -259,7 +259,7 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
 Response CoreFailure(const core::Summary& summary, const std::string& missing_model,
                      const std::string& field, bool options_object) {
   if (!missing_model.empty()) {
-    return ErrorResponse(501, "NotImplemented", summary.message, field);
+    return ErrorResponse(501, ErrorCode::kNotImplemented, summary.message, field);
   }
   if (summary.termination == core::Termination::kInvalidInput) {
     std::string core_field = FieldOf(summary.message);
@@ -268,12 +268,12 @@ Response CoreFailure(const core::Summary& summary, const std::string& missing_mo
         head != "swing" && head != "cor" && head != "outputs" && head != "inertia_model") {
       core_field = "options." + core_field;
     }
-    return ErrorResponse(400, "InvalidValue", summary.message,
+    return ErrorResponse(400, ErrorCode::kInvalidValue, summary.message,
                          core_field.empty() ? field : core_field);
   }
   // The model ran and could not finish with these inputs and settings (e.g. a
   // step or evaluation budget): the client's to change, so 422, not a 500.
-  return ErrorResponse(422, "ModelFailed", "the model failed: " + summary.message, field);
+  return ErrorResponse(422, ErrorCode::kModelFailed, "the model failed: " + summary.message, field);
 }
 
 Response SceneFailure(const core::Summary& summary, const std::string& missing_model,

@@ -88,22 +88,22 @@ void WriteApiResponse(const api::Response& response, httplib::Response& res) {
 }
 
 // The code of the error envelope for an HTTP status httplib produced itself.
-const char* CodeForStatus(int status) {
+api::ErrorCode CodeForStatus(int status) {
   switch (status) {
     case 400:
-      return "InvalidValue";
+      return api::ErrorCode::kInvalidValue;
     case 404:
-      return "NotFound";
+      return api::ErrorCode::kNotFound;
     case 405:
-      return "MethodNotAllowed";
+      return api::ErrorCode::kMethodNotAllowed;
     case 408:
-      return "Timeout";
+      return api::ErrorCode::kTimeout;
     case 413:
-      return "TooBig";
+      return api::ErrorCode::kTooBig;
     case 414:
-      return "TooBig";
+      return api::ErrorCode::kTooBig;
     default:
-      return status >= 500 ? "InternalError" : "InvalidValue";
+      return status >= 500 ? api::ErrorCode::kInternalError : api::ErrorCode::kInvalidValue;
   }
 }
 
@@ -152,7 +152,7 @@ void WriteStaticResponse(const httplib::Request& req, const StaticFiles& files,
                 "\" (build with -DSWEETSPOT_BUILD_WEB=ON, or set --web-root); the API under /v1/ "
                 "is unaffected";
     }
-    WriteApiResponse(api::ErrorResponse(404, "NotFound", message), res);
+    WriteApiResponse(api::ErrorResponse(404, api::ErrorCode::kNotFound, message), res);
     return;
   }
   res.set_header("Cache-Control", file->cache_control);
@@ -287,7 +287,7 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     if (!config_.auth_token.empty() && req.path != "/health" &&
         !IsStaticRequest(req, *impl_->static_files) &&
         !TokenMatches(req.get_header_value("Authorization"), config_.auth_token)) {
-      WriteApiResponse(api::ErrorResponse(401, "Unauthorized",
+      WriteApiResponse(api::ErrorResponse(401, api::ErrorCode::kUnauthorized,
                                           "header Authorization: must be \"Bearer <token>\" "
                                           "with the server's token (everything but /health "
                                           "and the explorer's static files needs it)",
@@ -298,7 +298,7 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     }
     // A chunked body bypasses the payload limit in 0.11.4 (pitfalls.md): refuse it.
     if (req.has_header("Transfer-Encoding")) {
-      WriteApiResponse(api::ErrorResponse(411, "InvalidValue",
+      WriteApiResponse(api::ErrorResponse(411, api::ErrorCode::kInvalidValue,
                                           "header Transfer-Encoding = \"" +
                                               req.get_header_value("Transfer-Encoding") +
                                               "\": chunked bodies are not accepted; send "
@@ -422,7 +422,8 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
   // Never send an exception's text to the client (pitfalls.md).
   http.set_exception_handler(
       [](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
-        WriteApiResponse(api::ErrorResponse(500, "InternalError", "internal error"), res);
+        WriteApiResponse(api::ErrorResponse(500, api::ErrorCode::kInternalError, "internal error"),
+                         res);
       });
 }
 
@@ -494,10 +495,10 @@ bool Server::Bind(std::string* error) {
                ? Pool::kCompute
                : Pool::kLight;
   };
-  hooks.error_body = [](int status, const char* code, const std::string& message) {
+  hooks.error_body = [](int status, api::ErrorCode code, const std::string& message) {
     return Serialize(api::ErrorResponse(status, code, message).body) + "\n";
   };
-  hooks.refused = [this](int status, const char* /*code*/, const std::string& method,
+  hooks.refused = [this](int status, api::ErrorCode /*code*/, const std::string& method,
                          const std::string& path) {
     impl_->metrics.Begin();
     impl_->metrics.End("unrouted", method, status, 0.0);
