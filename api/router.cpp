@@ -104,6 +104,17 @@ std::string PathParameter(std::string_view pattern, std::string_view path) {
   return parameter;
 }
 
+namespace {
+
+// 500 InternalError without details; `what` goes to Response::internal_error.
+Response InternalErrorResponse(std::string what) {
+  Response response = ErrorResponse(500, ErrorCode::kInternalError, "internal error");
+  response.internal_error = what.empty() ? "an exception with an empty what()" : std::move(what);
+  return response;
+}
+
+}  // namespace
+
 Response Dispatch(const Request& request, const Context& context, std::string* route_pattern,
                   bool allow_stream) {
   bool path_known = false;
@@ -126,9 +137,12 @@ Response Dispatch(const Request& request, const Context& context, std::string* r
         response.stream = nullptr;
       }
       return response;
+    } catch (const std::exception& caught) {
+      // The one place an unexpected exception becomes a 500: no details in
+      // the body, the text kept for the log.
+      return InternalErrorResponse(caught.what());
     } catch (...) {
-      // The one place an unexpected exception becomes a 500, without details.
-      return ErrorResponse(500, ErrorCode::kInternalError, "internal error");
+      return InternalErrorResponse("an exception not derived from std::exception");
     }
   }
   if (route_pattern != nullptr) *route_pattern = path_known ? "method_not_allowed" : "unmatched";

@@ -77,7 +77,8 @@ std::string PathParameter(std::string_view pattern, std::string_view path);
 /// Routes `request`: 404 NotFound for an unknown path, 405 MethodNotAllowed
 /// for a known path with another method. `route_pattern`, if non-null, gets
 /// the matched pattern (or "unmatched") for metrics and logs. Never throws:
-/// an escaping exception becomes a 500 InternalError without details. With
+/// an escaping exception becomes a 500 InternalError without details in the
+/// body and its what() in Response::internal_error (for the log). With
 /// `allow_stream`, a handler may answer with Response::stream (the server
 /// writes it chunked); otherwise streamed bodies are collected into `text`.
 Response Dispatch(const Request& request, const Context& context,
