@@ -275,8 +275,10 @@ Response HandleOptimize(const Request& request, const Context& context) {
   const Json* variables = reader.Get("variables");
   if (reader.ok() && variables == nullptr) reader.Missing("variables");
   if (!reader.ok()) return ToResponse(error);
-  if (!variables->is_array() || variables->empty() || variables->size() > 200) {
-    reader.Fail("variables", "must be an array of 1 to 200 {\"path\", \"min\", \"max\"}");
+  const std::size_t max_variables = context.limits.max_design_variables;
+  if (!variables->is_array() || variables->empty() || variables->size() > max_variables) {
+    reader.Fail("variables", "must be an array of 1 to " + std::to_string(max_variables) +
+                                 " {\"path\", \"min\", \"max\"}");
     return ToResponse(error);
   }
   for (std::size_t i = 0; i < variables->size(); ++i) {

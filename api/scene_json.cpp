@@ -1,6 +1,8 @@
 #include "api/scene_json.hpp"
 
 #include <algorithm>
+#include <cstddef>
+#include <limits>
 
 #include "api/bat_json.hpp"
 #include "api/router.hpp"
@@ -91,6 +93,9 @@ void ClampToLimits(const ApiLimits& limits, core::FlexibleOptions* options) {
 void ClampToLimits(const ApiLimits& limits, core::SceneOptions* options) {
   options->nlopt.max_time_s = std::min(options->nlopt.max_time_s, limits.max_time_s);
   options->nlopt.max_evaluations = std::min(options->nlopt.max_evaluations, limits.max_iterations);
+  // The configured limit is the only cap on curve points (core checks against it).
+  options->max_curve_points = static_cast<int>(std::min<std::size_t>(
+      limits.max_curve_samples, static_cast<std::size_t>(std::numeric_limits<int>::max())));
   ClampToLimits(limits, &options->hertz);
   ClampToLimits(limits, &options->flexible);
 }
@@ -213,8 +218,7 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
     reader.OptionalNumber("sweet_zone_tolerance_mps", NonNegative(1e3),
                           &options->sweet_zone_tolerance);
   }
-  const double max_samples =
-      static_cast<double>(std::min<std::size_t>(limits.max_curve_samples, 10000));
+  const double max_samples = static_cast<double>(options->max_curve_points);
   long long samples = options->curve_samples;
   reader.OptionalInteger("curve_samples", 2, static_cast<long long>(max_samples), &samples);
   options->curve_samples = static_cast<int>(samples);
