@@ -45,18 +45,18 @@ std::optional<std::vector<core::ProfileKnot>> ParseProfile(const Json& value,
   }
   const std::string knots_path = JoinPath(path, "knots");
   if (!knots->is_array()) {
-    SetError(error, "InvalidValue", knots_path, knots, "must be an array of {x_m, radius_m}");
+    SetError(error, ErrorCode::kInvalidValue, knots_path, knots,
+             "must be an array of {x_m, radius_m}");
     return std::nullopt;
   }
   if (knots->size() < 2) {
-    SetError(error, "InvalidValue", knots_path, knots, "must have at least 2 knots");
+    SetError(error, ErrorCode::kInvalidValue, knots_path, knots, "must have at least 2 knots");
     return std::nullopt;
   }
   if (knots->size() > limits.max_knots) {
-    SetError(error, "TooBig", knots_path, nullptr,
-             "has " + std::to_string(knots->size()) + " knots, over the limit max_knots = " +
-                 std::to_string(limits.max_knots),
-             413);
+    SetError(error, ErrorCode::kTooBig, knots_path, nullptr,
+             "has " + std::to_string(knots->size()) +
+                 " knots, over the limit max_knots = " + std::to_string(limits.max_knots));
     return std::nullopt;
   }
   std::vector<core::ProfileKnot> out;
@@ -101,7 +101,7 @@ std::optional<core::Material> ParseMaterial(const Json& value, const std::string
     std::string names;
     for (const auto& m : core::MaterialCatalogue()) names += (names.empty() ? "" : ", ") + m.name;
     if (allow_empty) names += ", empty";
-    SetError(error, "InvalidValue", path, &value,
+    SetError(error, ErrorCode::kInvalidValue, path, &value,
              "is not a catalogue material (GET /v1/materials lists: " + names + ")");
     return std::nullopt;
   }
@@ -154,7 +154,7 @@ std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& pa
     return std::nullopt;
   }
   if (!preset && !has_three && !has_profile) {
-    SetError(error, "MissingField", path, nullptr,
+    SetError(error, ErrorCode::kMissingField, path, nullptr,
              "needs a shape: one of preset, three_segment or profile");
     return std::nullopt;
   }
@@ -211,7 +211,7 @@ bool CheckComputable(const core::MassProperties& p, const std::string& path, Api
       p.moi_centroid_kg_m2 > 0) {
     return true;
   }
-  return SetError(error, "InvalidValue", path, nullptr,
+  return SetError(error, ErrorCode::kInvalidValue, path, nullptr,
                   "is too small or too light to compute with: its mass or moment of inertia is "
                   "not a positive finite number (use SI units: metres, kg/m3)");
 }

@@ -33,7 +33,7 @@ DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
   }
   scene.outputs = outputs.scene;
   std::string why;
-  if (error.code.empty()) {
+  if (!error.code) {
     // A row of properties only names no scene output; the scene (bat, ball,
     // swing, cor) must still be valid, so it is checked as if it named one.
     core::Scene check = scene;
@@ -41,9 +41,11 @@ DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
     if (!check.IsValid(&why)) CoreRefusal(why, "", &error);
   }
   const auto error_json = [](const ApiError& e) {
-    return Json{{"code", e.code}, {"message", e.message}, {"field", e.field}};
+    return Json{{"code", ErrorCodeName(e.code.value_or(ErrorCode::kInternalError))},
+                {"message", e.message},
+                {"field", e.field}};
   };
-  if (!error.code.empty()) return refused(error_json(error));
+  if (error.code) return refused(error_json(error));
   Json row{{"feasible", true}};
   core::TimingBook book;
   core::SceneResult result;

@@ -149,7 +149,7 @@ Response HandleBatFit(const Request& request, const Context& context) {
     problem.targets.balance_point_m = t.MaybeNumber("balance_point_m", Positive(100.0));
     if (!t.Finish()) return ToResponse(error);
     if (!problem.targets.mass_kg && !problem.targets.balance_point_m) {
-      SetError(&error, "MissingField", "targets", nullptr,
+      SetError(&error, ErrorCode::kMissingField, "targets", nullptr,
                "needs mass_kg, balance_point_m or both");
       return ToResponse(error);
     }
@@ -205,7 +205,7 @@ Response HandleBatFit(const Request& request, const Context& context) {
     return ToResponse(error);
   }
   if (fit.summary.termination == core::Termination::kFailure) {
-    return ErrorResponse(500, "InternalError", "the fit failed: " + fit.summary.message);
+    return ErrorResponse(500, ErrorCode::kInternalError, "the fit failed: " + fit.summary.message);
   }
   nlohmann::json unknown_values = nlohmann::json::object();
   for (std::size_t i = 0; i < problem.unknowns.size() && i < fit.values.size(); ++i) {
@@ -244,10 +244,10 @@ Response HandleBatFit(const Request& request, const Context& context) {
   // the closest feasible bat and its properties.
   const bool infeasible = fit.summary.termination == core::Termination::kInfeasible;
   nlohmann::json out{
-      {"code", infeasible ? "Infeasible" : "Timeout"},
-      {"message", infeasible ? "no bat of this family meets the targets: " + fit.summary.message
-                             : "the fit stopped before meeting the targets: " +
-                                   fit.summary.message},
+      {"code", ErrorCodeName(infeasible ? ErrorCode::kInfeasible : ErrorCode::kTimeout)},
+      {"message", infeasible
+                      ? "no bat of this family meets the targets: " + fit.summary.message
+                      : "the fit stopped before meeting the targets: " + fit.summary.message},
       {"field", "targets"},
       {"closest", std::move(result)}};
   return {422, std::move(out)};

@@ -43,7 +43,7 @@ bool IsKnownField(const Json& probe, const ApiLimits& limits, ApiError* unknown)
   if (bat != nullptr && ParseBatGeometry(*bat, "bat", limits, &error)) {
     ReadSceneCommon(reader, &scene);
   }
-  if (error.code != "UnknownField") return true;
+  if (error.code != ErrorCode::kUnknownField) return true;
   *unknown = std::move(error);
   return false;
 }
@@ -218,11 +218,12 @@ Response HandleExplore(const Request& request, const Context& context) {
     auto steps = ParseJsonPath(path, &why);
     Json probe = base;
     if (!steps || !SetNumberAtPath(&probe, *steps, dimension.min, &why)) {
-      SetError(&error, "InvalidValue", where + ".path", &(*params)[i]["path"], why);
+      SetError(&error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"], why);
       return ToResponse(error);
     }
     if (ApiError unknown; !IsKnownField(probe, context.limits, &unknown)) {
-      SetError(&error, "InvalidValue", where + ".path", &(*params)[i]["path"], unknown.message);
+      SetError(&error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
+               unknown.message);
       return ToResponse(error);
     }
     parameter.steps = std::move(*steps);
@@ -310,7 +311,7 @@ Response HandleExplore(const Request& request, const Context& context) {
   }
   const std::uint64_t total = plan.DesignCount();
   if (total > context.limits.max_samples) {
-    SetError(&error, "TooBig", "parameters", nullptr,
+    SetError(&error, ErrorCode::kTooBig, "parameters", nullptr,
              "describe " + std::to_string(total) + " designs, over the limit max_samples = " +
                  std::to_string(context.limits.max_samples));
     return ToResponse(error);
@@ -353,8 +354,10 @@ Response HandleExplore(const Request& request, const Context& context) {
           RunSweep(*sweep, progress, [&line](Json row) { return line(row); });
       if (outcome.stopped) return false;
       if (outcome.cancelled) {
-        return line(
-            {{"error", {{"code", "Cancelled"}, {"message", outcome.message}, {"field", nullptr}}}});
+        return line({{"error",
+                      {{"code", ErrorCodeName(ErrorCode::kCancelled)},
+                       {"message", outcome.message},
+                       {"field", nullptr}}}});
       }
       return line({{"summary", outcome.summary}});
     };
@@ -365,7 +368,7 @@ Response HandleExplore(const Request& request, const Context& context) {
     rows.push_back(std::move(row));
     return true;
   });
-  if (outcome.cancelled) return ErrorResponse(409, "Cancelled", outcome.message);
+  if (outcome.cancelled) return ErrorResponse(409, ErrorCode::kCancelled, outcome.message);
   return {200, {{"rows", std::move(rows)}, {"summary", outcome.summary}}};
 }
 

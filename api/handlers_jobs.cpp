@@ -8,7 +8,7 @@ namespace sweetspot::api {
 namespace {
 
 Response NoJobs() {
-  return ErrorResponse(501, "NotImplemented",
+  return ErrorResponse(501, ErrorCode::kNotImplemented,
                        "jobs run inside the server (sweetspot-server); the CLI answers "
                        "requests directly, so send the inner request to its own path");
 }
@@ -35,12 +35,13 @@ Response HandleJobSubmit(const Request& request, const Context& context) {
     if (route.jobbable && route.path == path) target = &route;
   }
   if (target == nullptr) {
-    SetError(&error, "InvalidValue", "path", &(*body)["path"],
+    SetError(&error, ErrorCode::kInvalidValue, "path", &(*body)["path"],
              "must name an endpoint that can run as a job: " + jobbable);
     return ToResponse(error);
   }
   if (!inner_body->is_object()) {
-    SetError(&error, "InvalidValue", "body", inner_body, "must be the endpoint's request object");
+    SetError(&error, ErrorCode::kInvalidValue, "body", inner_body,
+             "must be the endpoint's request object");
     return ToResponse(error);
   }
   return context.jobs->Submit({target->method, target->path, inner_body->dump()});

@@ -18,7 +18,7 @@ Response HandleOpenApi(const Request&, const Context&) {
 
 Response HandleMetrics(const Request&, const Context& context) {
   if (!context.metrics_text) {
-    return ErrorResponse(501, "NotImplemented",
+    return ErrorResponse(501, ErrorCode::kNotImplemented,
                          "metrics are kept by the running server (sweetspot-server), not the CLI");
   }
   return Response::Text(200, context.metrics_text(), "text/plain; version=0.0.4; charset=utf-8");
@@ -71,7 +71,8 @@ std::optional<nlohmann::json> ParseObjectBody(const Request& request, const Cont
   ApiError error;
   std::optional<nlohmann::json> body = ParseBody(request.body, context.limits, &error);
   if (body.has_value() && body->is_object()) return body;
-  if (body.has_value()) SetError(&error, "InvalidValue", "", &*body, "must be a JSON object");
+  if (body.has_value())
+    SetError(&error, ErrorCode::kInvalidValue, "", &*body, "must be a JSON object");
   *error_response = ToResponse(error);
   return std::nullopt;
 }

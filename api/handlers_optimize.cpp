@@ -40,7 +40,7 @@ bool ReadRange(ObjectReader& reader, const char* key, const NumberRule& rule,
   r.min = range.MaybeNumber("min", rule);
   r.max = range.MaybeNumber("max", rule);
   if (!range.Finish()) return false;
-  if (!r.min && !r.max) return range.Fail("min", "give min, max or both", "MissingField");
+  if (!r.min && !r.max) return range.Fail("min", "give min, max or both", ErrorCode::kMissingField);
   if (r.min && r.max && *r.min > *r.max) {
     return range.Fail("max", "must be >= min = " + Show(Json(*r.min)));
   }
@@ -275,8 +275,10 @@ Response HandleOptimize(const Request& request, const Context& context) {
   const Json* variables = reader.Get("variables");
   if (reader.ok() && variables == nullptr) reader.Missing("variables");
   if (!reader.ok()) return ToResponse(error);
-  if (!variables->is_array() || variables->empty() || variables->size() > 200) {
-    reader.Fail("variables", "must be an array of 1 to 200 {\"path\", \"min\", \"max\"}");
+  const std::size_t max_variables = context.limits.max_design_variables;
+  if (!variables->is_array() || variables->empty() || variables->size() > max_variables) {
+    reader.Fail("variables", "must be an array of 1 to " + std::to_string(max_variables) +
+                                 " {\"path\", \"min\", \"max\"}");
     return ToResponse(error);
   }
   for (std::size_t i = 0; i < variables->size(); ++i) {
@@ -303,7 +305,7 @@ Response HandleOptimize(const Request& request, const Context& context) {
     v.Number("max", Between(-1e12, 1e12), &variable.max);
     if (!v.Finish()) return ToResponse(error);
     if (!core::ParseDesignVariablePath(variable.path)) {
-      SetError(&error, "InvalidValue", where + ".path", &(*variables)[i]["path"],
+      SetError(&error, ErrorCode::kInvalidValue, where + ".path", &(*variables)[i]["path"],
                "is not a design variable (profile.knots[i].radius_m, profile.knots[i].x_m, "
                "three_segment.<field>, material.density_kg_m3, wall_thickness_m, "
                "fill.diameter_m, fill.depth_m, fill.material.density_kg_m3, or material with "
@@ -353,7 +355,7 @@ Response HandleOptimize(const Request& request, const Context& context) {
     out = chosen != nullptr ? ResultToJson(*chosen, *bat_json) : Json::object();
     out["materials"] = std::move(per_material);
     if (chosen == nullptr) {
-      return ErrorResponse(422, "Infeasible",
+      return ErrorResponse(422, ErrorCode::kInfeasible,
                            "no material gives a usable design: " + choice.summary.message,
                            "variables");
     }
@@ -374,7 +376,7 @@ Response HandleOptimize(const Request& request, const Context& context) {
       std::string message = "no design meets the constraints";
       if (!chosen->conflicts.empty()) message += ": " + chosen->conflicts.front().message;
       return {422,
-              {{"code", "Infeasible"},
+              {{"code", ErrorCodeName(ErrorCode::kInfeasible)},
                {"message", message},
                {"field", "constraints"},
                {"closest", std::move(out)}}};

@@ -113,6 +113,34 @@ Response HandleCollision(const Request& request, const Context& context) {
   return {200, std::move(out)};
 }
 
+namespace {
+
+// A /v1/compare row's deltas, variant minus baseline, from the core results
+// (both evaluated with the same outputs): the mass properties, and the
+// positions and speeds of the sweet spots both have.
+Json CompareDeltas(const core::SceneResult& variant, const core::SceneResult& base) {
+  const core::MassProperties& v = variant.mass_properties;
+  const core::MassProperties& b = base.mass_properties;
+  Json deltas{{"mass_kg", v.mass_kg - b.mass_kg},
+              {"balance_point_m", v.balance_point_m - b.balance_point_m},
+              {"moi_knob_kg_m2", v.moi_knob_kg_m2 - b.moi_knob_kg_m2},
+              {"moi_six_inch_kg_m2", v.MoiSixInchKgM2() - b.MoiSixInchKgM2()},
+              {"moi_centroid_kg_m2", v.moi_centroid_kg_m2 - b.moi_centroid_kg_m2}};
+  if (variant.max_exit_speed && base.max_exit_speed) {
+    deltas["max_exit_speed_position_m"] =
+        variant.max_exit_speed->position_from_knob_m - base.max_exit_speed->position_from_knob_m;
+    deltas["max_exit_speed_mps"] =
+        variant.max_exit_speed->exit_speed_mps - base.max_exit_speed->exit_speed_mps;
+  }
+  if (variant.center_of_percussion && base.center_of_percussion) {
+    deltas["center_of_percussion_m"] = variant.center_of_percussion->position_from_knob_m -
+                                       base.center_of_percussion->position_from_knob_m;
+  }
+  return deltas;
+}
+
+}  // namespace
+
 Response HandleCompare(const Request& request, const Context& context) {
   const auto start = std::chrono::steady_clock::now();
   Response failure;
@@ -139,7 +167,7 @@ Response HandleCompare(const Request& request, const Context& context) {
                 "has " + std::to_string(variants->size()) +
                     " variants, over the limit max_variants = " +
                     std::to_string(context.limits.max_variants),
-                "TooBig");
+                ErrorCode::kTooBig);
     return ToResponse(error);
   }
   std::vector<std::pair<std::string, BatSpec>> bats = {{"baseline", *baseline}};
@@ -156,10 +184,10 @@ Response HandleCompare(const Request& request, const Context& context) {
   options.flexible.modes_cache = context.modes_cache;
 
   Json rows = Json::array();
-  Json base_row;
+  core::SceneResult base;
   for (std::size_t i = 0; i < bats.size(); ++i) {
     if (core::IsCancelled(context.progress)) {
-      return ErrorResponse(409, "Cancelled", "the comparison was cancelled");
+      return ErrorResponse(409, ErrorCode::kCancelled, "the comparison was cancelled");
     }
     core::Scene bat_scene = scene;
     bat_scene.bat = bats[i].second.bat;
@@ -168,7 +196,7 @@ Response HandleCompare(const Request& request, const Context& context) {
       CoreRefusal(why, "", &error);
       return ToResponse(error);
     }
-    const core::SceneResult result = core::EvaluateScene(bat_scene, options);
+    core::SceneResult result = core::EvaluateScene(bat_scene, options);
     if (!result.summary.IsSolutionUsable()) {
       return SceneFailure(result.summary, result.missing_model, result.mass_properties,
                           i == 0 ? field : field + ".bat",
@@ -180,27 +208,9 @@ Response HandleCompare(const Request& request, const Context& context) {
     row["bat"] = bats[i].second.request_form;
     row["properties"] = PropertiesToJson(result.mass_properties, result.length_m);
     if (i == 0) {
-      base_row = row;
+      base = std::move(result);
     } else {
-      Json deltas = Json::object();
-      for (const char* key : {"mass_kg", "balance_point_m", "moi_knob_kg_m2",
-                              "moi_six_inch_kg_m2", "moi_centroid_kg_m2"}) {
-        deltas[key] = row["properties"][key].get<double>() -
-                      base_row["properties"][key].get<double>();
-      }
-      if (row.contains("max_exit_speed")) {
-        deltas["max_exit_speed_position_m"] =
-            row["max_exit_speed"]["position_from_knob_m"].get<double>() -
-            base_row["max_exit_speed"]["position_from_knob_m"].get<double>();
-        deltas["max_exit_speed_mps"] = row["max_exit_speed"]["exit_speed_mps"].get<double>() -
-                                       base_row["max_exit_speed"]["exit_speed_mps"].get<double>();
-      }
-      if (row.contains("center_of_percussion")) {
-        deltas["center_of_percussion_m"] =
-            row["center_of_percussion"]["position_from_knob_m"].get<double>() -
-            base_row["center_of_percussion"]["position_from_knob_m"].get<double>();
-      }
-      row["deltas"] = std::move(deltas);
+      row["deltas"] = CompareDeltas(result, base);
     }
     rows.push_back(std::move(row));
     if (context.progress != nullptr) {

@@ -23,7 +23,8 @@ class LimitedSax : public nlohmann::detail::json_sax_dom_parser<Json> {
   bool number_integer(Json::number_integer_t n) { return Value() && Base::number_integer(n); }
   bool number_unsigned(Json::number_unsigned_t n) { return Value() && Base::number_unsigned(n); }
   bool number_float(Json::number_float_t n, const Json::string_t& s) {
-    if (!std::isfinite(n)) return Refuse(400, "InvalidValue", "number " + s + " is out of range");
+    if (!std::isfinite(n))
+      return Refuse(400, ErrorCode::kInvalidValue, "number " + s + " is out of range");
     return Value() && Base::number_float(n, s);
   }
   bool string(Json::string_t& s) {
@@ -47,14 +48,15 @@ class LimitedSax : public nlohmann::detail::json_sax_dom_parser<Json> {
   }
   bool parse_error(std::size_t position, const std::string& last_token,
                    const nlohmann::detail::exception& ex) {
-    if (!error_->code.empty()) return false;
+    if (error_->code) return false;
     std::string what = ex.what();
     // "[json.exception.parse_error.101] parse error at line 1, column 2: ..." -> after "] ".
     if (const auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
     if (ex.id == 406) {
-      return Refuse(400, "InvalidValue", "number " + last_token + " is out of range of a double");
+      return Refuse(400, ErrorCode::kInvalidValue,
+                    "number " + last_token + " is out of range of a double");
     }
-    return Refuse(400, "InvalidJson",
+    return Refuse(400, ErrorCode::kInvalidJson,
                   "body is not valid JSON at byte " + std::to_string(position) + ": " + what);
   }
 
@@ -64,12 +66,12 @@ class LimitedSax : public nlohmann::detail::json_sax_dom_parser<Json> {
     std::size_t count;
   };
 
-  bool Refuse(int status, const char* code, std::string message) {
-    if (error_->code.empty()) *error_ = ApiError{status, code, std::move(message), ""};
+  bool Refuse(int status, ErrorCode code, std::string message) {
+    if (!error_->code) *error_ = ApiError{status, code, std::move(message), ""};
     return false;
   }
   bool TooLong(const char* what, std::size_t size) {
-    return Refuse(413, "TooBig",
+    return Refuse(413, ErrorCode::kTooBig,
                   std::string("a ") + what + " of " + std::to_string(size) +
                       " bytes exceeds the limit max_string_length = " +
                       std::to_string(limits_.max_string_length));
@@ -78,7 +80,7 @@ class LimitedSax : public nlohmann::detail::json_sax_dom_parser<Json> {
   bool Value() {
     if (!containers_.empty() && containers_.back().is_array &&
         ++containers_.back().count > limits_.max_array_length) {
-      return Refuse(413, "TooBig",
+      return Refuse(413, ErrorCode::kTooBig,
                     "an array exceeds the limit max_array_length = " +
                         std::to_string(limits_.max_array_length));
     }
@@ -87,9 +89,9 @@ class LimitedSax : public nlohmann::detail::json_sax_dom_parser<Json> {
   bool Open(bool is_array) {
     if (!Value()) return false;
     if (static_cast<int>(containers_.size()) >= limits_.max_json_depth) {
-      return Refuse(413, "TooBig",
-                    "nesting exceeds the limit max_json_depth = " +
-                        std::to_string(limits_.max_json_depth));
+      return Refuse(
+          413, ErrorCode::kTooBig,
+          "nesting exceeds the limit max_json_depth = " + std::to_string(limits_.max_json_depth));
     }
     containers_.push_back({is_array, 0});
     return true;
@@ -110,7 +112,8 @@ std::string FormatNumber(double value) {
 }  // namespace
 
 Response ToResponse(const ApiError& error) {
-  nlohmann::json body{{"code", error.code}, {"message", error.message}};
+  nlohmann::json body{{"code", ErrorCodeName(error.code.value_or(ErrorCode::kInternalError))},
+                      {"message", error.message}};
   body["field"] = error.field.empty() ? nlohmann::json(nullptr) : nlohmann::json(error.field);
   return {error.status, std::move(body)};
 }
@@ -122,8 +125,8 @@ std::optional<nlohmann::json> ParseBody(std::string_view body, const ApiLimits& 
   Json root;
   LimitedSax sax(root, limits, error);
   const bool ok = Json::sax_parse(body.begin(), body.end(), &sax);
-  if (!ok || !error->code.empty()) {
-    if (error->code.empty()) *error = ApiError{400, "InvalidJson", "body is not valid JSON", ""};
+  if (!ok || error->code) {
+    if (!error->code) *error = ApiError{400, ErrorCode::kInvalidJson, "body is not valid JSON", ""};
     return std::nullopt;
   }
   return root;
@@ -174,25 +177,25 @@ bool CoreRefusal(const std::string& why, const std::string& prefix, ApiError* er
   const std::string full_field = field.empty() ? prefix : JoinPath(prefix, field);
   const std::string message =
       field.empty() ? (prefix.empty() ? why : prefix + ": " + why) : JoinPath(prefix, why);
-  if (error->code.empty()) *error = ApiError{400, "InvalidValue", message, full_field};
+  if (!error->code) *error = ApiError{400, ErrorCode::kInvalidValue, message, full_field};
   return false;
 }
 
-bool SetError(ApiError* error, std::string code, const std::string& path,
-              const nlohmann::json* value, const std::string& rule, int status) {
-  if (!error->code.empty()) return false;
-  if (code == "TooBig") status = 413;
+bool SetError(ApiError* error, ErrorCode code, const std::string& path, const nlohmann::json* value,
+              const std::string& rule) {
+  if (error->code) return false;
+  const int status = ErrorCodeStatus(code);
   std::string message = path.empty() ? "body" : path;
   if (value != nullptr) message += " = " + Show(*value);
   message += value != nullptr ? ": " + rule : " " + rule;
-  *error = ApiError{status, std::move(code), std::move(message), path};
+  *error = ApiError{status, code, std::move(message), path};
   return false;
 }
 
 ObjectReader::ObjectReader(const nlohmann::json& value, std::string path, ApiError* error)
     : value_(&value), path_(std::move(path)), error_(error) {
   if (!value.is_object()) {
-    SetError(error_, "InvalidValue", path_, &value, "must be an object");
+    SetError(error_, ErrorCode::kInvalidValue, path_, &value, "must be an object");
   }
 }
 
@@ -207,15 +210,15 @@ const nlohmann::json* ObjectReader::Get(std::string_view key) {
   return &(*value_)[std::string(key)];
 }
 
-bool ObjectReader::Fail(std::string_view key, const std::string& rule, std::string code) {
+bool ObjectReader::Fail(std::string_view key, const std::string& rule, ErrorCode code) {
   const nlohmann::json* value = value_->is_object() && value_->contains(key)
                                     ? &(*value_)[std::string(key)]
                                     : nullptr;
-  return SetError(error_, std::move(code), PathOf(key), value, rule);
+  return SetError(error_, code, PathOf(key), value, rule);
 }
 
 bool ObjectReader::Missing(std::string_view key) {
-  return SetError(error_, "MissingField", PathOf(key), nullptr, "is required");
+  return SetError(error_, ErrorCode::kMissingField, PathOf(key), nullptr, "is required");
 }
 
 bool ObjectReader::Number(std::string_view key, const NumberRule& rule, double* out) {
@@ -299,10 +302,10 @@ bool ObjectReader::Finish() {
     if (known_.count(item.key()) == 0) {
       std::string list;
       for (const auto& k : known_) list += (list.empty() ? "" : ", ") + k;
-      return SetError(error_, "UnknownField", PathOf(item.key()), nullptr,
-                      "is not a known field" +
-                          (list.empty() ? std::string(" (this object takes no fields)")
-                                        : " (known: " + list + ")"));
+      return SetError(
+          error_, ErrorCode::kUnknownField, PathOf(item.key()), nullptr,
+          "is not a known field" + (list.empty() ? std::string(" (this object takes no fields)")
+                                                 : " (known: " + list + ")"));
     }
   }
   return true;

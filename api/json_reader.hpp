@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "api/error_code.hpp"
 #include "api/limits.hpp"
 #include "api/response.hpp"
 
@@ -19,10 +20,10 @@ namespace sweetspot::api {
 
 /// A client error (or, with status 500, an internal one) in the contract's envelope.
 struct ApiError {
-  int status = 400;     ///< HTTP status.
-  std::string code;     ///< InvalidJson, InvalidValue, UnknownField, MissingField, TooBig, ...
-  std::string message;  ///< Names the field, the value and the rule.
-  std::string field;    ///< Dotted path of the field ("" = none).
+  int status = 400;               ///< HTTP status (usually ErrorCodeStatus(*code)).
+  std::optional<ErrorCode> code;  ///< The error's code; nullopt = no error recorded yet.
+  std::string message;            ///< Names the field, the value and the rule.
+  std::string field;              ///< Dotted path of the field ("" = none).
 };
 
 /// The envelope {"code", "message", "field"} with the error's status.
@@ -73,7 +74,7 @@ class ObjectReader {
   ObjectReader(const nlohmann::json& value, std::string path, ApiError* error);
 
   /// True while no error has been recorded (by this reader or another).
-  bool ok() const { return error_->code.empty(); }
+  bool ok() const { return !error_->code.has_value(); }
   /// The error this reader records into (share it with sub-readers).
   ApiError* error() const { return error_; }
   /// The path of `key` in this object.
@@ -101,7 +102,8 @@ class ObjectReader {
   /// Marks `key` as read without reading it (the caller reads it itself).
   void Skip(std::string_view key) { known_.insert(std::string(key)); }
   /// Records an error about `key` with `rule`, quoting its value.
-  bool Fail(std::string_view key, const std::string& rule, std::string code = "InvalidValue");
+  bool Fail(std::string_view key, const std::string& rule,
+            ErrorCode code = ErrorCode::kInvalidValue);
   /// Records MissingField for `key`.
   bool Missing(std::string_view key);
   /// Refuses unread fields (UnknownField, listing the known ones). Returns ok().
@@ -118,9 +120,9 @@ class ObjectReader {
 /// InvalidValue error with the field re-rooted at `prefix` (e.g. "bat").
 bool CoreRefusal(const std::string& why, const std::string& prefix, ApiError* error);
 
-/// Records an error at `path` ("field = value: rule") unless one is recorded.
-/// The status is 413 for code TooBig, else `status`.
-bool SetError(ApiError* error, std::string code, const std::string& path,
-              const nlohmann::json* value, const std::string& rule, int status = 400);
+/// Records an error at `path` ("field = value: rule") unless one is recorded,
+/// with the code's status (ErrorCodeStatus).
+bool SetError(ApiError* error, ErrorCode code, const std::string& path, const nlohmann::json* value,
+              const std::string& rule);
 
 }  // namespace sweetspot::api

@@ -16,9 +16,14 @@ bool ApiLimits::IsValid(std::string* why) const {
   const std::pair<const char*, std::size_t> sizes[] = {
       {"max_array_length", max_array_length},   {"max_string_length", max_string_length},
       {"max_knots", max_knots},                 {"max_variants", max_variants},
-      {"max_curve_samples", max_curve_samples}, {"max_samples", max_samples}};
+      {"max_curve_samples", max_curve_samples}, {"max_samples", max_samples},
+      {"max_design_variables", max_design_variables}};
   for (const auto& [name, value] : sizes) {
     if (value < 1) return fail(std::string(name) + " = 0: must be at least 1");
+  }
+  if (max_curve_samples < 2) {
+    return fail("max_curve_samples = " + std::to_string(max_curve_samples) +
+                ": must be at least 2 (a curve has two ends)");
   }
   if (max_knots < 2) return fail("max_knots = " + std::to_string(max_knots) + ": must be at least 2");
   if (max_iterations < 1) {

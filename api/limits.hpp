@@ -14,8 +14,11 @@ struct ApiLimits {
   std::size_t max_string_length = 256;     ///< Longest string value or key (bytes).
   std::size_t max_knots = 256;             ///< Knots of a profile.
   std::size_t max_variants = 64;           ///< Variants in /v1/compare.
-  std::size_t max_curve_samples = 10001;   ///< Points of an exit-speed curve.
+  std::size_t max_curve_samples = 10000;   ///< Points of an exit-speed curve (>= 2).
   std::size_t max_samples = 100000;        ///< Designs in one /v1/explore request.
+  /// Variables of one /v1/optimize design. The optimiser has its own ceiling
+  /// of 200 (core/optimize): a larger limit lets such requests reach it.
+  std::size_t max_design_variables = 200;
   int max_iterations = 10000;              ///< Solver iterations a request may ask for.
   double max_time_s = 60.0;                ///< Solver wall time a request may ask for, s.
   long long max_integration_steps = 10000000;  ///< ODE steps of one impact (hertz, flexible).

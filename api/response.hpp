@@ -40,6 +40,10 @@ struct Response {
   /// Only Dispatch(..., allow_stream = true) returns one; every other caller
   /// gets the chunks collected into `text`.
   std::function<bool(const ChunkSink&)> stream;
+  /// What the top-level handler caught when it answered 500 InternalError
+  /// (the exception's what()); empty otherwise. Never sent to the client:
+  /// the server and the CLI write it to their stderr log.
+  std::string internal_error;
 };
 
 /// GET /health: {"status": "ok"}.

@@ -104,6 +104,17 @@ std::string PathParameter(std::string_view pattern, std::string_view path) {
   return parameter;
 }
 
+namespace {
+
+// 500 InternalError without details; `what` goes to Response::internal_error.
+Response InternalErrorResponse(std::string what) {
+  Response response = ErrorResponse(500, ErrorCode::kInternalError, "internal error");
+  response.internal_error = what.empty() ? "an exception with an empty what()" : std::move(what);
+  return response;
+}
+
+}  // namespace
+
 Response Dispatch(const Request& request, const Context& context, std::string* route_pattern,
                   bool allow_stream) {
   bool path_known = false;
@@ -126,22 +137,25 @@ Response Dispatch(const Request& request, const Context& context, std::string* r
         response.stream = nullptr;
       }
       return response;
+    } catch (const std::exception& caught) {
+      // The one place an unexpected exception becomes a 500: no details in
+      // the body, the text kept for the log.
+      return InternalErrorResponse(caught.what());
     } catch (...) {
-      // The one place an unexpected exception becomes a 500, without details.
-      return ErrorResponse(500, "InternalError", "internal error");
+      return InternalErrorResponse("an exception not derived from std::exception");
     }
   }
   if (route_pattern != nullptr) *route_pattern = path_known ? "method_not_allowed" : "unmatched";
   if (path_known) {
-    return ErrorResponse(405, "MethodNotAllowed",
+    return ErrorResponse(405, ErrorCode::kMethodNotAllowed,
                          "method " + request.method + " is not allowed on " + request.path +
                              " (allowed: " + allowed + ")");
   }
-  return ErrorResponse(404, "NotFound", "no endpoint at path " + request.path);
+  return ErrorResponse(404, ErrorCode::kNotFound, "no endpoint at path " + request.path);
 }
 
-Response ErrorResponse(int status, std::string_view code, std::string message, std::string field) {
-  nlohmann::json body{{"code", code}, {"message", std::move(message)}};
+Response ErrorResponse(int status, ErrorCode code, std::string message, std::string field) {
+  nlohmann::json body{{"code", ErrorCodeName(code)}, {"message", std::move(message)}};
   body["field"] = field.empty() ? nlohmann::json(nullptr) : nlohmann::json(std::move(field));
   return {status, std::move(body)};
 }

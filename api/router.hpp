@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "api/error_code.hpp"
 #include "api/limits.hpp"
 #include "api/response.hpp"
 #include "core/progress.hpp"
@@ -76,7 +77,8 @@ std::string PathParameter(std::string_view pattern, std::string_view path);
 /// Routes `request`: 404 NotFound for an unknown path, 405 MethodNotAllowed
 /// for a known path with another method. `route_pattern`, if non-null, gets
 /// the matched pattern (or "unmatched") for metrics and logs. Never throws:
-/// an escaping exception becomes a 500 InternalError without details. With
+/// an escaping exception becomes a 500 InternalError without details in the
+/// body and its what() in Response::internal_error (for the log). With
 /// `allow_stream`, a handler may answer with Response::stream (the server
 /// writes it chunked); otherwise streamed bodies are collected into `text`.
 Response Dispatch(const Request& request, const Context& context,
@@ -92,8 +94,8 @@ Response Dispatch(const Request& request, const Context& context,
 Workload ClassifyWorkload(std::string_view method, std::string_view path, std::string_view body,
                           const Context& context);
 
-/// The error envelope {"code", "message", "field"} with `status`.
-Response ErrorResponse(int status, std::string_view code, std::string message,
-                       std::string field = {});
+/// The error envelope {"code", "message", "field"} with `status` (pass
+/// ErrorCodeStatus(code) unless a documented exception applies).
+Response ErrorResponse(int status, ErrorCode code, std::string message, std::string field = {});
 
 }  // namespace sweetspot::api

@@ -1,6 +1,8 @@
 #include "api/scene_json.hpp"
 
 #include <algorithm>
+#include <cstddef>
+#include <limits>
 
 #include "api/bat_json.hpp"
 #include "api/router.hpp"
@@ -91,6 +93,9 @@ void ClampToLimits(const ApiLimits& limits, core::FlexibleOptions* options) {
 void ClampToLimits(const ApiLimits& limits, core::SceneOptions* options) {
   options->nlopt.max_time_s = std::min(options->nlopt.max_time_s, limits.max_time_s);
   options->nlopt.max_evaluations = std::min(options->nlopt.max_evaluations, limits.max_iterations);
+  // The configured limit is the only cap on curve points (core checks against it).
+  options->max_curve_points = static_cast<int>(std::min<std::size_t>(
+      limits.max_curve_samples, static_cast<std::size_t>(std::numeric_limits<int>::max())));
   ClampToLimits(limits, &options->hertz);
   ClampToLimits(limits, &options->flexible);
 }
@@ -213,8 +218,7 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
     reader.OptionalNumber("sweet_zone_tolerance_mps", NonNegative(1e3),
                           &options->sweet_zone_tolerance);
   }
-  const double max_samples =
-      static_cast<double>(std::min<std::size_t>(limits.max_curve_samples, 10000));
+  const double max_samples = static_cast<double>(options->max_curve_points);
   long long samples = options->curve_samples;
   reader.OptionalInteger("curve_samples", 2, static_cast<long long>(max_samples), &samples);
   options->curve_samples = static_cast<int>(samples);
@@ -227,7 +231,7 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
                          "has " + std::to_string(positions->size()) +
                              " positions, over the limit max_curve_samples = " +
                              std::to_string(static_cast<long long>(max_samples)),
-                         "TooBig");
+                         ErrorCode::kTooBig);
     }
     for (std::size_t i = 0; i < positions->size(); ++i) {
       const Json& p = (*positions)[i];
@@ -259,7 +263,7 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
 Response CoreFailure(const core::Summary& summary, const std::string& missing_model,
                      const std::string& field, bool options_object) {
   if (!missing_model.empty()) {
-    return ErrorResponse(501, "NotImplemented", summary.message, field);
+    return ErrorResponse(501, ErrorCode::kNotImplemented, summary.message, field);
   }
   if (summary.termination == core::Termination::kInvalidInput) {
     std::string core_field = FieldOf(summary.message);
@@ -268,12 +272,12 @@ Response CoreFailure(const core::Summary& summary, const std::string& missing_mo
         head != "swing" && head != "cor" && head != "outputs" && head != "inertia_model") {
       core_field = "options." + core_field;
     }
-    return ErrorResponse(400, "InvalidValue", summary.message,
+    return ErrorResponse(400, ErrorCode::kInvalidValue, summary.message,
                          core_field.empty() ? field : core_field);
   }
   // The model ran and could not finish with these inputs and settings (e.g. a
   // step or evaluation budget): the client's to change, so 422, not a 500.
-  return ErrorResponse(422, "ModelFailed", "the model failed: " + summary.message, field);
+  return ErrorResponse(422, ErrorCode::kModelFailed, "the model failed: " + summary.message, field);
 }
 
 Response SceneFailure(const core::Summary& summary, const std::string& missing_model,

@@ -201,13 +201,17 @@ inline Verdict RunParseBody(std::string_view input) {
   api::ApiError error;
   const auto value = api::ParseBody(input, limits, &error);
   if (!value) {
-    if (error.code.empty()) return {"ParseBody refused without an error code", ""};
+    if (!error.code) return {"ParseBody refused without an error code", ""};
     if (error.status != 400 && error.status != 413) {
       return {"ParseBody refused with status " + std::to_string(error.status), ""};
     }
     return {};
   }
-  if (!error.code.empty()) return {"ParseBody returned a value and the error " + error.code, ""};
+  if (error.code) {
+    return {"ParseBody returned a value and the error " +
+                std::string(api::ErrorCodeName(*error.code)),
+            ""};
+  }
   if (internal::Depth(*value) > limits.max_json_depth) {
     return {"ParseBody accepted depth " + std::to_string(internal::Depth(*value)) +
                 " over max_json_depth = " + std::to_string(limits.max_json_depth),
@@ -237,13 +241,16 @@ inline Verdict RunParseBat(std::string_view input) {
   if (!value) return {};
   const auto spec = api::ParseBat(*value, "bat", limits, &error);
   if (!spec) {
-    if (error.code.empty()) return {"ParseBat refused without an error code", ""};
+    if (!error.code) return {"ParseBat refused without an error code", ""};
     if (error.status != 400 && error.status != 413) {
       return {"ParseBat refused with status " + std::to_string(error.status), ""};
     }
     return {};
   }
-  if (!error.code.empty()) return {"ParseBat returned a bat and the error " + error.code, ""};
+  if (error.code) {
+    return {"ParseBat returned a bat and the error " + std::string(api::ErrorCodeName(*error.code)),
+            ""};
+  }
   std::string why;
   if (!spec->bat.IsValid(&why)) return {"ParseBat returned an invalid bat: " + why, ""};
   const double length = spec->bat.LengthM();

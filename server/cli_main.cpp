@@ -187,6 +187,14 @@ int main(int argc, char** argv) {
     body = request->dump();
   }
   const auto response = sweetspot::api::Dispatch({method, full_path, body}, context);
+  if (!response.internal_error.empty()) {
+    // What the top-level handler caught: on stderr, never in the printed body.
+    std::cerr << nlohmann::json{{"path", full_path},
+                                {"status", response.status},
+                                {"error", response.internal_error}}
+                     .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
+              << "\n";
+  }
   if (!response.content_type.empty()) {
     std::cout << response.text;
   } else {

@@ -226,7 +226,7 @@ const std::vector<Option>& Options() {
          return SetSize(&c->limits.max_variants, v, rule);
        }},
       {"--max-curve-samples", "SWEETSPOT_MAX_CURVE_SAMPLES",
-       "points of an exit-speed curve (default 10001)", true,
+       "points of an exit-speed curve (default 10000)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->limits.max_curve_samples, v, rule);
        }},
@@ -234,6 +234,11 @@ const std::vector<Option>& Options() {
        true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->limits.max_samples, v, rule);
+       }},
+      {"--max-design-variables", "SWEETSPOT_MAX_DESIGN_VARIABLES",
+       "variables of one /v1/optimize design (default 200, the optimiser's ceiling)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_design_variables, v, rule);
        }},
       {"--max-iterations", "SWEETSPOT_MAX_ITERATIONS",
        "solver iterations a request may ask for (default 10000)", true,

@@ -299,7 +299,7 @@ struct ConnectionLoop::Impl {
   }
 
   // Answers `c` with an error envelope of its own, then lingers.
-  void Refuse(Connection& c, int status, const char* code, Reason reason,
+  void Refuse(Connection& c, int status, api::ErrorCode code, Reason reason,
               const std::string& message, Clock::time_point now) {
     closed_by[static_cast<int>(reason)].fetch_add(1, std::memory_order_relaxed);
     const std::string body = hooks.error_body ? hooks.error_body(status, code, message) : "";
@@ -362,7 +362,7 @@ struct ConnectionLoop::Impl {
         continue;
       }
       if (over) {
-        Refuse(*c, 503, "TooBusy", Reason::kOverLimit,
+        Refuse(*c, 503, api::ErrorCode::kTooBusy, Reason::kOverLimit,
                "the server has " + std::to_string(options.max_connections) +
                    " connections open (limit max_connections); retry later",
                now);
@@ -418,7 +418,7 @@ struct ConnectionLoop::Impl {
       const HeadScan scan = ScanRequestHead(c.in, options.max_head_bytes, &c.scanned, &c.head);
       if (scan == HeadScan::kIncomplete) return AwaitMore(c);
       if (scan == HeadScan::kTooLarge) {
-        Refuse(c, 431, "TooBig", Reason::kHeadTooLarge,
+        Refuse(c, 431, api::ErrorCode::kTooBig, Reason::kHeadTooLarge,
                "the request head is over max_head_bytes = " +
                    std::to_string(options.max_head_bytes) + " bytes",
                now);
@@ -426,7 +426,7 @@ struct ConnectionLoop::Impl {
       }
       RequestHead& head = c.head;
       if (head.bad_content_length) {
-        Refuse(c, 400, "InvalidValue", Reason::kBadRequest,
+        Refuse(c, 400, api::ErrorCode::kInvalidValue, Reason::kBadRequest,
                "header Content-Length: must be one decimal number of bytes", now);
         return Step::kWait;
       }
@@ -682,7 +682,7 @@ struct ConnectionLoop::Impl {
       RefuseSilent(c, "head", now);
       return;
     }
-    Refuse(c, 408, "Timeout", Reason::kHeaderTimeout,
+    Refuse(c, 408, api::ErrorCode::kTimeout, Reason::kHeaderTimeout,
            "the request head did not arrive within header_timeout_s = " +
                FormatSeconds(options.header_timeout_s) + " s",
            now);
@@ -690,7 +690,7 @@ struct ConnectionLoop::Impl {
 
   void ExpireBody(Connection& c, Clock::time_point now) {
     if (now >= c.body_deadline) {
-      Refuse(c, 408, "Timeout", Reason::kBodyTooSlow,
+      Refuse(c, 408, api::ErrorCode::kTimeout, Reason::kBodyTooSlow,
              "the request body of " + std::to_string(c.head.content_length) +
                  " bytes did not arrive within header_timeout_s + bytes / "
                  "body_min_rate_bytes_per_s = " +
@@ -705,7 +705,7 @@ struct ConnectionLoop::Impl {
 
   // 408 for a request that sent nothing for read_timeout_s, in its head or body (`part`).
   void RefuseSilent(Connection& c, const char* part, Clock::time_point now) {
-    Refuse(c, 408, "Timeout", Reason::kReadTimeout,
+    Refuse(c, 408, api::ErrorCode::kTimeout, Reason::kReadTimeout,
            std::string("no byte of the request ") + part + " arrived for read_timeout_s = " +
                FormatSeconds(options.read_timeout_s) + " s (read timeout)",
            now);

@@ -31,6 +31,7 @@
 #include <string>
 #include <string_view>
 
+#include "api/error_code.hpp"
 #include "server/request_stream.hpp"
 
 namespace sweetspot::server {
@@ -76,10 +77,11 @@ struct ConnectionLoopHooks {
   std::function<Pool(std::string_view method, std::string_view path, std::string_view body)>
       classify;
   /// The JSON error envelope (with its trailing newline) for an answer the loop gives itself.
-  std::function<std::string(int status, const char* code, const std::string& message)> error_body;
+  std::function<std::string(int status, api::ErrorCode code, const std::string& message)>
+      error_body;
   /// Called after the loop answered a request itself: status, code, the
   /// request's method and path when known ("" otherwise). May be empty.
-  std::function<void(int status, const char* code, const std::string& method,
+  std::function<void(int status, api::ErrorCode code, const std::string& method,
                      const std::string& path)>
       refused;
 };

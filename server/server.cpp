@@ -11,12 +11,14 @@
 
 #include <chrono>
 #include <cstdio>
+#include <exception>
 #include <iostream>
 #include <mutex>
 #include <thread>
 
 #include "server/jobs/job_manager.hpp"
 #include "api/router.hpp"
+#include "server/access_log.hpp"
 #include "server/connection_loop.hpp"
 #include "server/metrics.hpp"
 #include "server/request_stream.hpp"
@@ -30,6 +32,18 @@ namespace {
 // Writes one JSON body: never throws on invalid UTF-8 (replaced instead).
 std::string Serialize(const nlohmann::json& body) {
   return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// The text of a caught exception, for the log.
+std::string WhatOf(const std::exception_ptr& caught) {
+  try {
+    if (caught) std::rethrow_exception(caught);
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "an exception not derived from std::exception";
+  }
+  return "no exception";
 }
 
 // A streamed body is sent with chunked transfer encoding, in chunks of about
@@ -88,22 +102,22 @@ void WriteApiResponse(const api::Response& response, httplib::Response& res) {
 }
 
 // The code of the error envelope for an HTTP status httplib produced itself.
-const char* CodeForStatus(int status) {
+api::ErrorCode CodeForStatus(int status) {
   switch (status) {
     case 400:
-      return "InvalidValue";
+      return api::ErrorCode::kInvalidValue;
     case 404:
-      return "NotFound";
+      return api::ErrorCode::kNotFound;
     case 405:
-      return "MethodNotAllowed";
+      return api::ErrorCode::kMethodNotAllowed;
     case 408:
-      return "Timeout";
+      return api::ErrorCode::kTimeout;
     case 413:
-      return "TooBig";
+      return api::ErrorCode::kTooBig;
     case 414:
-      return "TooBig";
+      return api::ErrorCode::kTooBig;
     default:
-      return status >= 500 ? "InternalError" : "InvalidValue";
+      return status >= 500 ? api::ErrorCode::kInternalError : api::ErrorCode::kInvalidValue;
   }
 }
 
@@ -152,7 +166,7 @@ void WriteStaticResponse(const httplib::Request& req, const StaticFiles& files,
                 "\" (build with -DSWEETSPOT_BUILD_WEB=ON, or set --web-root); the API under /v1/ "
                 "is unaffected";
     }
-    WriteApiResponse(api::ErrorResponse(404, "NotFound", message), res);
+    WriteApiResponse(api::ErrorResponse(404, api::ErrorCode::kNotFound, message), res);
     return;
   }
   res.set_header("Cache-Control", file->cache_control);
@@ -287,7 +301,7 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     if (!config_.auth_token.empty() && req.path != "/health" &&
         !IsStaticRequest(req, *impl_->static_files) &&
         !TokenMatches(req.get_header_value("Authorization"), config_.auth_token)) {
-      WriteApiResponse(api::ErrorResponse(401, "Unauthorized",
+      WriteApiResponse(api::ErrorResponse(401, api::ErrorCode::kUnauthorized,
                                           "header Authorization: must be \"Bearer <token>\" "
                                           "with the server's token (everything but /health "
                                           "and the explorer's static files needs it)",
@@ -298,7 +312,7 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     }
     // A chunked body bypasses the payload limit in 0.11.4 (pitfalls.md): refuse it.
     if (req.has_header("Transfer-Encoding")) {
-      WriteApiResponse(api::ErrorResponse(411, "InvalidValue",
+      WriteApiResponse(api::ErrorResponse(411, api::ErrorCode::kInvalidValue,
                                           "header Transfer-Encoding = \"" +
                                               req.get_header_value("Transfer-Encoding") +
                                               "\": chunked bodies are not accepted; send "
@@ -317,11 +331,19 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
   // Jobs run the same router with the job's cancel flag and progress, on a
   // copy of the context taken now: loaded jobs may start before this
   // constructor returns, and jobbable requests need neither jobs nor metrics.
-  const JobRunner runner = [context = impl_->context](const api::Request& inner,
-                                                           core::Progress* progress) {
+  const JobRunner runner = [context = impl_->context, impl = impl_.get()](
+                               const api::Request& inner, core::Progress* progress) {
     api::Context job_context = context;
     job_context.progress = progress;
-    return api::Dispatch(inner, job_context);
+    api::Response response = api::Dispatch(inner, job_context);
+    if (!response.internal_error.empty()) {
+      // A job's 500 is logged like a request's: the job's path and the caught text.
+      const std::string line = AccessLogLine({inner.method, inner.path, "job", response.status,
+                                              0.0, inner.body.size(), response.internal_error});
+      std::lock_guard<std::mutex> lock(impl->log_mutex);
+      std::cerr << line << "\n";
+    }
+    return response;
   };
   auto log_store_error = [impl = impl_.get()](const std::string& message) {
     std::lock_guard<std::mutex> lock(impl->log_mutex);
@@ -360,24 +382,26 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     const auto start = std::chrono::steady_clock::now();
     impl_->metrics.Begin();
     std::string route;
+    std::string internal_error;
     if (IsStaticRequest(req, *impl_->static_files)) {
       route = kStaticRoute;
       WriteStaticResponse(req, *impl_->static_files, res);
     } else {
-      WriteApiResponse(api::Dispatch({req.method, req.path, req.body}, impl_->context, &route,
-                                     /*allow_stream=*/true),
-                       res);
+      api::Response response = api::Dispatch({req.method, req.path, req.body}, impl_->context,
+                                             &route, /*allow_stream=*/true);
+      internal_error = std::move(response.internal_error);
+      WriteApiResponse(response, res);
     }
     const double duration_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     impl_->metrics.End(route, req.method, res.status, duration_s);
     request_was_routed = true;
-    if (config_.access_log) {
-      const nlohmann::json line{{"method", req.method},     {"path", req.path},
-                                {"route", route},           {"status", res.status},
-                                {"duration_s", duration_s}, {"bytes_in", req.body.size()}};
+    // A caught exception is always logged, also with the access log off.
+    if (config_.access_log || !internal_error.empty()) {
+      const std::string line = AccessLogLine({req.method, req.path, route, res.status, duration_s,
+                                              req.body.size(), std::move(internal_error)});
       std::lock_guard<std::mutex> lock(impl_->log_mutex);
-      std::cerr << Serialize(line) << "\n";
+      std::cerr << line << "\n";
     }
   };
   for (const char* pattern : {".*"}) {
@@ -419,11 +443,16 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
       std::cerr << Serialize(line) << "\n";
     }
   });
-  // Never send an exception's text to the client (pitfalls.md).
-  http.set_exception_handler(
-      [](const httplib::Request&, httplib::Response& res, std::exception_ptr) {
-        WriteApiResponse(api::ErrorResponse(500, "InternalError", "internal error"), res);
-      });
+  // Never send an exception's text to the client (pitfalls.md); log it.
+  http.set_exception_handler([this](const httplib::Request& req, httplib::Response& res,
+                                    std::exception_ptr caught) {
+    WriteApiResponse(api::ErrorResponse(500, api::ErrorCode::kInternalError, "internal error"),
+                     res);
+    const std::string line = AccessLogLine(
+        {req.method, req.path, "unrouted", 500, 0.0, req.body.size(), WhatOf(caught)});
+    std::lock_guard<std::mutex> lock(impl_->log_mutex);
+    std::cerr << line << "\n";
+  });
 }
 
 Server::~Server() {
@@ -494,10 +523,10 @@ bool Server::Bind(std::string* error) {
                ? Pool::kCompute
                : Pool::kLight;
   };
-  hooks.error_body = [](int status, const char* code, const std::string& message) {
+  hooks.error_body = [](int status, api::ErrorCode code, const std::string& message) {
     return Serialize(api::ErrorResponse(status, code, message).body) + "\n";
   };
-  hooks.refused = [this](int status, const char* /*code*/, const std::string& method,
+  hooks.refused = [this](int status, api::ErrorCode /*code*/, const std::string& method,
                          const std::string& path) {
     impl_->metrics.Begin();
     impl_->metrics.End("unrouted", method, status, 0.0);

@@ -41,8 +41,6 @@ void FreeAdvance(const Rhs& rhs, double dtau, State* y) {
   }
 }
 
-
-
 // Samples the hands' loads along free motion from y over [0, window] (scaled) and updates the
 // peaks (rotation recurrences: no trigonometry per sample).
 void FreeHandsPeaks(const Rhs& rhs, const State& y, double window, double dtau, RawRun* run) {
@@ -106,7 +104,8 @@ double FindRecontact(const Rhs& rhs, const State& y, std::vector<std::string>* w
     warnings->push_back(
         "after a separation the ball does not move away from the bat's rigid-body recoil (a "
         "soft, far-from-the-centre impact); a later contact was looked for during " +
-        FormatNumber17(kMaxFreeFlightS) + " s only, beyond which the swing's rotation would matter");
+        FormatNumber17(kMaxFreeFlightS) +
+        " s only, beyond which the swing's rotation would matter");
   }
   if (!(horizon > 0.0)) return -1.0;
   const double dtau = om_max > 0.0 ? kTwoPi / (kSamplesPerPeriod * om_max) : horizon;

@@ -7,12 +7,12 @@
 #include <exception>
 #include <limits>
 #include <span>
-#include <sstream>
 #include <utility>
 
 #include "core/collision/contact_law.hpp"
 #include "core/collision/flexible_modal_system.hpp"
 #include "core/flexible/static_flexibility.hpp"
+#include "core/geometry_format.hpp"
 #include "core/numerics/event_integrator.hpp"
 #include "core/units.hpp"
 
@@ -29,13 +29,6 @@ using flexible_detail::Rhs;
 using flexible_detail::State;
 
 constexpr double kTwoPi = 2.0 * kPi;
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
 
 bool Fail(std::string* why, const std::string& m) {
   if (why != nullptr) *why = m;
@@ -218,13 +211,14 @@ bool FlexibleImpactOptions::IsValid(std::string* why) const {
     return Fail(why, "flexible.max_modes = " + std::to_string(max_modes) + ": must be in [1, 50]");
   if (!(std::isfinite(frequency_tolerance) && frequency_tolerance >= 1e-9 &&
         frequency_tolerance <= 0.1))
-    return Fail(why, "flexible.frequency_tolerance = " + Num(frequency_tolerance) +
+    return Fail(why, "flexible.frequency_tolerance = " + FormatNumber17(frequency_tolerance) +
                          ": must be in [1e-9, 0.1]");
   if (!(std::isfinite(cutoff_factor) && cutoff_factor >= 1.0 && cutoff_factor <= 1000.0))
-    return Fail(why, "flexible.cutoff_factor = " + Num(cutoff_factor) + ": must be in [1, 1000]");
+    return Fail(why, "flexible.cutoff_factor = " + FormatNumber17(cutoff_factor) +
+                         ": must be in [1, 1000]");
   if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-13 &&
         relative_tolerance <= 1e-2))
-    return Fail(why, "flexible.relative_tolerance = " + Num(relative_tolerance) +
+    return Fail(why, "flexible.relative_tolerance = " + FormatNumber17(relative_tolerance) +
                          ": must be in [1e-13, 1e-2]");
   if (max_steps < 10)
     return Fail(why, "flexible.max_steps = " + std::to_string(max_steps) + ": must be >= 10");
@@ -233,35 +227,42 @@ bool FlexibleImpactOptions::IsValid(std::string* why) const {
         why, "flexible.max_contacts = " + std::to_string(max_contacts) + ": must be in [1, 1000]");
   if (!(std::isfinite(hands_grip_length_m) && hands_grip_length_m >= 0.0 &&
         hands_grip_length_m <= 10.0))
-    return Fail(
-        why, "flexible.hands_grip_length_m = " + Num(hands_grip_length_m) + ": must be in [0, 10]");
+    return Fail(why, "flexible.hands_grip_length_m = " + FormatNumber17(hands_grip_length_m) +
+                         ": must be in [0, 10]");
   if (!(std::isfinite(sting_window_s) && sting_window_s >= 0.0 && sting_window_s <= 1.0))
-    return Fail(why, "flexible.sting_window_s = " + Num(sting_window_s) + ": must be in [0, 1]");
+    return Fail(
+        why, "flexible.sting_window_s = " + FormatNumber17(sting_window_s) + ": must be in [0, 1]");
   return true;
 }
 
 bool FlexibleImpactInputs::IsValid(std::string* why) const {
   auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!std::isfinite(impact_from_knob_m))
-    return Fail(why, "impact_from_knob_m = " + Num(impact_from_knob_m) + ": must be finite");
+    return Fail(why,
+                "impact_from_knob_m = " + FormatNumber17(impact_from_knob_m) + ": must be finite");
   if (!std::isfinite(hands_from_knob_m))
-    return Fail(why, "swing.hands_from_knob_m = " + Num(hands_from_knob_m) + ": must be finite");
+    return Fail(
+        why, "swing.hands_from_knob_m = " + FormatNumber17(hands_from_knob_m) + ": must be finite");
   if (!finite_pos(ball_mass_kg))
-    return Fail(why, "ball.mass_kg = " + Num(ball_mass_kg) + ": must be finite and > 0");
+    return Fail(why, "ball.mass_kg = " + FormatNumber17(ball_mass_kg) + ": must be finite and > 0");
   if (!(std::isfinite(ball_speed_mps) && ball_speed_mps >= 0.0))
-    return Fail(why, "ball.speed_mps = " + Num(ball_speed_mps) + ": must be finite and >= 0");
+    return Fail(why,
+                "ball.speed_mps = " + FormatNumber17(ball_speed_mps) + ": must be finite and >= 0");
   if (!finite_pos(approach_speed_mps))
     return Fail(why,
-                "approach_speed_mps = " + Num(approach_speed_mps) +
+                "approach_speed_mps = " + FormatNumber17(approach_speed_mps) +
                     ": must be finite and > 0 (the ball and the bat must approach each other)");
   if (!finite_pos(ball_stiffness))
-    return Fail(why, "ball.stiffness = " + Num(ball_stiffness) + ": must be finite and > 0");
+    return Fail(why,
+                "ball.stiffness = " + FormatNumber17(ball_stiffness) + ": must be finite and > 0");
   if (!(std::isfinite(ball_exponent) && ball_exponent >= 1.0 && ball_exponent <= 3.0))
-    return Fail(why, "ball.stiffness_exponent = " + Num(ball_exponent) + ": must be in [1, 3]");
+    return Fail(
+        why, "ball.stiffness_exponent = " + FormatNumber17(ball_exponent) + ": must be in [1, 3]");
   if (!(std::isfinite(surface_stiffness) && surface_stiffness >= 0.0))
-    return Fail(why, "surface_stiffness = " + Num(surface_stiffness) + ": must be finite and >= 0");
+    return Fail(why, "surface_stiffness = " + FormatNumber17(surface_stiffness) +
+                         ": must be finite and >= 0");
   if (!(std::isfinite(cor) && cor >= 0.0 && cor <= 1.0))
-    return Fail(why, "cor = " + Num(cor) + ": must be in [0, 1]");
+    return Fail(why, "cor = " + FormatNumber17(cor) + ": must be in [0, 1]");
   return true;
 }
 
@@ -291,13 +292,13 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     }
     const double length = modes.length_m;
     if (!(in.impact_from_knob_m >= 0.0 && in.impact_from_knob_m <= length)) {
-      s.message = "impact_from_knob_m = " + Num(in.impact_from_knob_m) +
-                  ": must be within the bat [0, " + Num(length) + "]";
+      s.message = "impact_from_knob_m = " + FormatNumber17(in.impact_from_knob_m) +
+                  ": must be within the bat [0, " + FormatNumber17(length) + "]";
       return finish();
     }
     if (!(in.hands_from_knob_m >= 0.0 && in.hands_from_knob_m <= length)) {
-      s.message = "swing.hands_from_knob_m = " + Num(in.hands_from_knob_m) +
-                  ": must be within the bat [0, " + Num(length) + "]";
+      s.message = "swing.hands_from_knob_m = " + FormatNumber17(in.hands_from_knob_m) +
+                  ": must be within the bat [0, " + FormatNumber17(length) + "]";
       return finish();
     }
     out.theory = modes.theory;
@@ -320,7 +321,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     out.cutoff_hz = o.cutoff_factor / out.contact_time_estimate_s;
     if (!(std::isfinite(delta_s) && delta_s > 0.0 && std::isfinite(out.cutoff_hz))) {
       s.termination = Termination::kFailure;
-      s.message = "contact scales are not finite (delta_s = " + Num(delta_s) + " m)";
+      s.message = "contact scales are not finite (delta_s = " + FormatNumber17(delta_s) + " m)";
       return finish();
     }
     const double t_s = delta_s / v0;
@@ -338,7 +339,8 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
       s.warnings.push_back(
           "the mode cutoff (cutoff_factor / contact time) is above the highest "
           "computed mode (" +
-          std::to_string(available) + " modes, up to " + Num(modes.modes.back().frequency_hz) +
+          std::to_string(available) + " modes, up to " +
+          FormatNumber17(modes.modes.back().frequency_hz) +
           " Hz): every computed mode is used, the static correction stands for "
           "the rest; raise flexible.max_modes to include more");
     }
@@ -529,7 +531,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     }
     s.iterations = out.steps;
     s.termination = Termination::kConverged;
-    s.message = "contact ended after " + Num(out.contact_time_s) + " s (" +
+    s.message = "contact ended after " + FormatNumber17(out.contact_time_s) + " s (" +
                 std::to_string(out.contacts) + (out.contacts == 1 ? " contact" : " contacts") +
                 ", " + std::to_string(n_used) + " bending modes)";
     s.objective = out.exit_speed_mps;

@@ -7,24 +7,17 @@
 #include <chrono>
 #include <cmath>
 #include <span>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/collision/contact_law.hpp"
+#include "core/geometry_format.hpp"
 #include "core/numerics/event_integrator.hpp"
 
 namespace sweetspot::core {
 namespace {
 
 using State = std::array<double, 6>;  // scaled: delta1, delta1', delta2, delta2', P1, P_hands
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
 
 struct RawRun {
   bool ok = false;
@@ -162,8 +155,8 @@ RawRun Integrate(const HertzProblem& p, double tol, int max_steps) {
   sys.p_s = v0 / p.c11_per_kg;
   if (!(std::isfinite(sys.delta_s) && sys.delta_s > 0.0 && std::isfinite(sys.t_s) &&
         sys.t_s > 0.0)) {
-    out.message = "contact scales are not finite (delta_s = " + Num(sys.delta_s) +
-                  " m, t_s = " + Num(sys.t_s) + " s)";
+    out.message = "contact scales are not finite (delta_s = " + FormatNumber17(sys.delta_s) +
+                  " m, t_s = " + FormatNumber17(sys.t_s) + " s)";
     return out;
   }
   EventIntegratorOptions o;
@@ -182,7 +175,7 @@ RawRun Integrate(const HertzProblem& p, double tol, int max_steps) {
     out.ok = false;
     out.message = integrator.summary().message;
     if (integrator.summary().termination == EventTermination::kStepBound) {
-      out.message += " (delta1 = " + Num(y[0] * sys.delta_s) + " m)";
+      out.message += " (delta1 = " + FormatNumber17(y[0] * sys.delta_s) + " m)";
     }
     return out;
   }
@@ -217,41 +210,48 @@ bool HertzProblem::IsValid(std::string* why) const {
   auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
   if (!finite_pos(approach_speed_mps))
     return Fail(why,
-                "hertz.approach_speed_mps = " + Num(approach_speed_mps) +
+                "hertz.approach_speed_mps = " + FormatNumber17(approach_speed_mps) +
                     ": must be finite and > 0 (the ball and the bat must approach each other)");
   if (!finite_nonneg(ball_speed_mps))
-    return Fail(why, "hertz.ball_speed_mps = " + Num(ball_speed_mps) + ": must be finite and >= 0");
+    return Fail(why, "hertz.ball_speed_mps = " + FormatNumber17(ball_speed_mps) +
+                         ": must be finite and >= 0");
   if (!finite_pos(ball_mass_kg))
-    return Fail(why, "hertz.ball_mass_kg = " + Num(ball_mass_kg) + ": must be finite and > 0");
+    return Fail(
+        why, "hertz.ball_mass_kg = " + FormatNumber17(ball_mass_kg) + ": must be finite and > 0");
   if (!finite_pos(c11_per_kg))
-    return Fail(why, "hertz.c11_per_kg = " + Num(c11_per_kg) + ": must be finite and > 0");
+    return Fail(why,
+                "hertz.c11_per_kg = " + FormatNumber17(c11_per_kg) + ": must be finite and > 0");
   if (!std::isfinite(c12_per_kg))
-    return Fail(why, "hertz.c12_per_kg = " + Num(c12_per_kg) + ": must be finite");
+    return Fail(why, "hertz.c12_per_kg = " + FormatNumber17(c12_per_kg) + ": must be finite");
   if (!finite_pos(c22_per_kg))
-    return Fail(why, "hertz.c22_per_kg = " + Num(c22_per_kg) + ": must be finite and > 0");
+    return Fail(why,
+                "hertz.c22_per_kg = " + FormatNumber17(c22_per_kg) + ": must be finite and > 0");
   if (law == ContactLaw::kPaperConstants) {
     if (!finite_pos(paper.k1))
-      return Fail(why, "hertz.paper.k1 = " + Num(paper.k1) + ": must be finite and > 0");
+      return Fail(why, "hertz.paper.k1 = " + FormatNumber17(paper.k1) + ": must be finite and > 0");
     if (!finite_nonneg(paper.k2))
-      return Fail(why, "hertz.paper.k2 = " + Num(paper.k2) + ": must be finite and >= 0");
+      return Fail(why,
+                  "hertz.paper.k2 = " + FormatNumber17(paper.k2) + ": must be finite and >= 0");
     if (!std::isfinite(paper.k3))
-      return Fail(why, "hertz.paper.k3 = " + Num(paper.k3) + ": must be finite");
+      return Fail(why, "hertz.paper.k3 = " + FormatNumber17(paper.k3) + ": must be finite");
     return true;
   }
   if (!finite_pos(ball_stiffness))
-    return Fail(why, "ball.stiffness = " + Num(ball_stiffness) + ": must be finite and > 0");
+    return Fail(why,
+                "ball.stiffness = " + FormatNumber17(ball_stiffness) + ": must be finite and > 0");
   if (!(std::isfinite(ball_exponent) && ball_exponent >= 1.0 && ball_exponent <= 3.0))
-    return Fail(why, "ball.stiffness_exponent = " + Num(ball_exponent) + ": must be in [1, 3]");
-  if (!finite_nonneg(surface_stiffness))
     return Fail(
-        why, "hertz.surface_stiffness = " + Num(surface_stiffness) + ": must be finite and >= 0");
+        why, "ball.stiffness_exponent = " + FormatNumber17(ball_exponent) + ": must be in [1, 3]");
+  if (!finite_nonneg(surface_stiffness))
+    return Fail(why, "hertz.surface_stiffness = " + FormatNumber17(surface_stiffness) +
+                         ": must be finite and >= 0");
   if (!(std::isfinite(cor) && cor >= 0.0 && cor <= 1.0))
-    return Fail(why, "cor = " + Num(cor) + ": must be in [0, 1]");
+    return Fail(why, "cor = " + FormatNumber17(cor) + ": must be in [0, 1]");
   if (!finite_nonneg(hands_stiffness_n_m))
-    return Fail(why, "hertz.hands_stiffness_n_m = " + Num(hands_stiffness_n_m) +
+    return Fail(why, "hertz.hands_stiffness_n_m = " + FormatNumber17(hands_stiffness_n_m) +
                          ": must be finite and >= 0");
   if (!finite_nonneg(hands_damping_n_s_m))
-    return Fail(why, "hertz.hands_damping_n_s_m = " + Num(hands_damping_n_s_m) +
+    return Fail(why, "hertz.hands_damping_n_s_m = " + FormatNumber17(hands_damping_n_s_m) +
                          ": must be finite and >= 0");
   return true;
 }
@@ -259,7 +259,7 @@ bool HertzProblem::IsValid(std::string* why) const {
 bool HertzSolverOptions::IsValid(std::string* why) const {
   if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-13 &&
         relative_tolerance <= 1e-2))
-    return Fail(why, "hertz.relative_tolerance = " + Num(relative_tolerance) +
+    return Fail(why, "hertz.relative_tolerance = " + FormatNumber17(relative_tolerance) +
                          ": must be in [1e-13, 1e-2]");
   if (max_steps < 10)
     return Fail(why, "hertz.max_steps = " + std::to_string(max_steps) + ": must be >= 10");
@@ -268,18 +268,19 @@ bool HertzSolverOptions::IsValid(std::string* why) const {
 
 bool HertzOptions::IsValid(std::string* why) const {
   if (!(std::isfinite(hands_stiffness_n_m) && hands_stiffness_n_m >= 0.0))
-    return Fail(why, "hertz.hands_stiffness_n_m = " + Num(hands_stiffness_n_m) +
+    return Fail(why, "hertz.hands_stiffness_n_m = " + FormatNumber17(hands_stiffness_n_m) +
                          ": must be finite and >= 0");
   if (!(std::isfinite(hands_damping_n_s_m) && hands_damping_n_s_m >= 0.0))
-    return Fail(why, "hertz.hands_damping_n_s_m = " + Num(hands_damping_n_s_m) +
+    return Fail(why, "hertz.hands_damping_n_s_m = " + FormatNumber17(hands_damping_n_s_m) +
                          ": must be finite and >= 0");
   if (law == ContactLaw::kPaperConstants) {
     if (!(std::isfinite(paper.k1) && paper.k1 > 0.0))
-      return Fail(why, "hertz.paper.k1 = " + Num(paper.k1) + ": must be finite and > 0");
+      return Fail(why, "hertz.paper.k1 = " + FormatNumber17(paper.k1) + ": must be finite and > 0");
     if (!(std::isfinite(paper.k2) && paper.k2 >= 0.0))
-      return Fail(why, "hertz.paper.k2 = " + Num(paper.k2) + ": must be finite and >= 0");
+      return Fail(why,
+                  "hertz.paper.k2 = " + FormatNumber17(paper.k2) + ": must be finite and >= 0");
     if (!std::isfinite(paper.k3))
-      return Fail(why, "hertz.paper.k3 = " + Num(paper.k3) + ": must be finite");
+      return Fail(why, "hertz.paper.k3 = " + FormatNumber17(paper.k3) + ": must be finite");
   }
   return solver.IsValid(why);
 }
@@ -343,7 +344,7 @@ HertzImpact SolveHertzImpact(const HertzProblem& problem, const HertzSolverOptio
     }
   }
   s.termination = Termination::kConverged;
-  s.message = "contact ended after " + Num(out.contact_time_s) + " s";
+  s.message = "contact ended after " + FormatNumber17(out.contact_time_s) + " s";
   s.objective = out.exit_speed_mps;
   s.error_estimate = out.error_estimate_exit_speed_mps;
   return finish();

@@ -6,23 +6,16 @@
 #include <cmath>
 #include <exception>
 #include <limits>
-#include <sstream>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <boost/math/tools/roots.hpp>
 
+#include "core/geometry_format.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
 namespace {
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
 
 bool Fail(std::string* why, const std::string& m) {
   if (why != nullptr) *why = m;
@@ -58,7 +51,7 @@ bool SubspaceIteration(const SparseMatrix& k, const SparseMatrix& m, int wanted,
   const SparseMatrix shifted = k + sigma * m;
   Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(shifted);
   if (ldlt.info() != Eigen::Success) {
-    *why = "the factorisation of K + sigma M failed (sigma = " + Num(sigma) + ")";
+    *why = "the factorisation of K + sigma M failed (sigma = " + FormatNumber17(sigma) + ")";
     return false;
   }
   Eigen::VectorXd lambda;
@@ -199,7 +192,8 @@ bool SolveLevel(const Bat& bat, const BeamModesOptions& o, BeamMesh mesh, const 
   if (!(std::isfinite(lambda2) && lambda2 > 0.0) ||
       std::max(std::abs(lambda[0]), std::abs(lambda[1])) > 1e-3 * lambda2) {
     *why = "expected two rigid-body modes (eigenvalues ~0) below the first bending mode, got " +
-           Num(lambda[0]) + ", " + Num(lambda[1]) + " and " + Num(lambda2) + " rad^2/s^2";
+           FormatNumber17(lambda[0]) + ", " + FormatNumber17(lambda[1]) + " and " +
+           FormatNumber17(lambda2) + " rad^2/s^2";
     return false;
   }
   out->frequencies_hz.clear();
@@ -210,7 +204,8 @@ bool SolveLevel(const Bat& bat, const BeamModesOptions& o, BeamMesh mesh, const 
   for (int k = 0; k < o.num_modes; ++k) {
     const double l = lambda[k + 2];
     if (!(std::isfinite(l) && l > 0.0)) {
-      *why = "mode " + std::to_string(k + 1) + " has a non-positive eigenvalue " + Num(l);
+      *why =
+          "mode " + std::to_string(k + 1) + " has a non-positive eigenvalue " + FormatNumber17(l);
       return false;
     }
     out->frequencies_hz.push_back(std::sqrt(l) / (2.0 * kPi));
@@ -258,8 +253,8 @@ bool BeamModesOptions::IsValid(std::string* why) const {
     return Fail(why, "num_modes = " + std::to_string(num_modes) + ": must be in [1, 50]");
   if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-9 &&
         relative_tolerance <= 0.1))
-    return Fail(why,
-                "relative_tolerance = " + Num(relative_tolerance) + ": must be in [1e-9, 0.1]");
+    return Fail(why, "relative_tolerance = " + FormatNumber17(relative_tolerance) +
+                         ": must be in [1e-9, 0.1]");
   if (initial_elements < 1 || initial_elements > 4096)
     return Fail(
         why, "initial_elements = " + std::to_string(initial_elements) + ": must be in [1, 4096]");
@@ -365,9 +360,9 @@ BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
     double r_max = 0.0;
     for (const ProfileKnot& k : bat.knots) r_max = std::max(r_max, k.radius_m);
     if (!(out.length_m >= 4.0 * r_max)) {
-      s.message = "bat.length_m = " + Num(out.length_m) +
+      s.message = "bat.length_m = " + FormatNumber17(out.length_m) +
                   ": the beam model needs a slender bat (length at least 4 x the largest radius " +
-                  Num(r_max) + " m)";
+                  FormatNumber17(r_max) + " m)";
       return finish();
     }
     const int n0 = std::max(options.initial_elements, 2 * options.num_modes + 4);
@@ -509,19 +504,20 @@ BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
     if (converged) {
       s.termination = Termination::kConverged;
       s.message = std::to_string(options.num_modes) + " modes to a relative frequency error of " +
-                  Num(out.max_relative_error) + " with " + std::to_string(out.Elements()) +
-                  " elements";
+                  FormatNumber17(out.max_relative_error) + " with " +
+                  std::to_string(out.Elements()) + " elements";
     } else {
       s.termination = Termination::kNoConvergence;
       s.message = round_off_limited
                       ? "round-off limits the relative frequency error to about " +
-                            Num(out.max_relative_error) + " (" + std::to_string(out.Elements()) +
+                            FormatNumber17(out.max_relative_error) + " (" +
+                            std::to_string(out.Elements()) +
                             " elements; a finer mesh would be worse), above the tolerance " +
-                            Num(options.relative_tolerance)
+                            FormatNumber17(options.relative_tolerance)
                       : "max_elements = " + std::to_string(options.max_elements) +
                             " reached before the relative tolerance " +
-                            Num(options.relative_tolerance) + " (estimated error " +
-                            Num(out.max_relative_error) + " with " +
+                            FormatNumber17(options.relative_tolerance) + " (estimated error " +
+                            FormatNumber17(out.max_relative_error) + " with " +
                             std::to_string(out.Elements()) + " elements)";
       s.warnings.push_back(s.message);
     }

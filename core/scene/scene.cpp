@@ -7,7 +7,6 @@
 namespace sweetspot::core {
 namespace {
 
-constexpr int kMaxCurvePoints = 10000;
 
 bool Fail(std::string* why, const std::string& m) {
   if (why != nullptr) *why = m;
@@ -85,13 +84,16 @@ bool SceneOptions::IsValid(std::string* why) const {
   if (!(std::isfinite(sweet_zone_tolerance) && sweet_zone_tolerance >= 0.0))
     return Fail(
         why, "sweet_zone_tolerance = " + FormatNumber17(sweet_zone_tolerance) + ": must be >= 0");
-  if (curve_positions_from_knob_m.empty() && (curve_samples < 2 || curve_samples > kMaxCurvePoints))
+  if (max_curve_points < 2)
+    return Fail(why, "max_curve_points = " + std::to_string(max_curve_points) + ": must be >= 2");
+  if (curve_positions_from_knob_m.empty() &&
+      (curve_samples < 2 || curve_samples > max_curve_points))
     return Fail(why, "curve_samples = " + std::to_string(curve_samples) + ": must be in [2, " +
-                         std::to_string(kMaxCurvePoints) + "]");
-  if (curve_positions_from_knob_m.size() > static_cast<size_t>(kMaxCurvePoints))
+                         std::to_string(max_curve_points) + "]");
+  if (curve_positions_from_knob_m.size() > static_cast<size_t>(max_curve_points))
     return Fail(
         why, "curve_positions_from_knob_m: " + std::to_string(curve_positions_from_knob_m.size()) +
-                 " positions: must be at most " + std::to_string(kMaxCurvePoints));
+                 " positions: must be at most " + std::to_string(max_curve_points));
   for (size_t i = 0; i < curve_positions_from_knob_m.size(); ++i) {
     if (!std::isfinite(curve_positions_from_knob_m[i]))
       return Fail(why, "curve_positions_from_knob_m[" + std::to_string(i) + "] = " +

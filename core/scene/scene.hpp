@@ -126,9 +126,12 @@ struct SceneOptions {
   ScalarSearchOptions nlopt;          ///< The NLopt search (algorithm, tolerances, budget).
   double sweet_zone_tolerance = 1.0;  ///< Sweet-zone tolerance (>= 0), in `sweet_zone_unit`.
   ToleranceUnit sweet_zone_unit = ToleranceUnit::kMetersPerSecond;  ///< m/s or percent.
-  int curve_samples = 41;  ///< Evenly spaced curve samples from knob to tip (2..10000).
+  int curve_samples = 41;  ///< Evenly spaced curve samples from knob to tip (2..max_curve_points).
   std::vector<double> curve_positions_from_knob_m;  ///< Explicit curve positions, m (overrides
-                                                    ///< curve_samples; at most 10000).
+                                                    ///< curve_samples; at most max_curve_points).
+  /// The most curve points (curve_samples or explicit positions) a scene may
+  /// ask for (>= 2); the api sets it from its configured max_curve_samples.
+  int max_curve_points = 10000;
   HertzOptions hertz;                               ///< Contact-model settings (model = kHertz).
   FlexibleOptions flexible;  ///< Flexible-beam settings (vibration_node, flexible, sting).
 

@@ -87,19 +87,21 @@ nlohmann::json JobJson(const JobView& job) {
 std::string QuoteJobId(const std::string& id) { return api::Show(nlohmann::json(id)); }
 
 api::Response JobNotFound(const std::string& id) {
-  return api::ToResponse(api::ApiError{404, "NotFound", "no job with id " + QuoteJobId(id), ""});
+  return api::ToResponse(
+      api::ApiError{404, api::ErrorCode::kNotFound, "no job with id " + QuoteJobId(id), ""});
 }
 
 api::Response JobNotReady(const std::string& id, const std::string& state) {
-  return api::ToResponse(api::ApiError{409, "NotReady",
+  return api::ToResponse(api::ApiError{409, api::ErrorCode::kNotReady,
                                        "job " + QuoteJobId(id) + " is " + state +
                                            ": its result is ready once its state is done or failed",
                                        ""});
 }
 
 api::Response JobWasCancelled(const std::string& id) {
-  return api::ToResponse(api::ApiError{
-      409, "Cancelled", "job " + QuoteJobId(id) + " was cancelled: it has no result", ""});
+  return api::ToResponse(api::ApiError{409, api::ErrorCode::kCancelled,
+                                       "job " + QuoteJobId(id) + " was cancelled: it has no result",
+                                       ""});
 }
 
 std::string InterruptedMessage(const std::string& resumes, int max_resumes) {
@@ -110,7 +112,7 @@ std::string InterruptedMessage(const std::string& resumes, int max_resumes) {
 
 api::Response JobInterrupted(int resumes, int max_resumes, std::string* message) {
   *message = InterruptedMessage(std::to_string(resumes), max_resumes);
-  return api::ToResponse(api::ApiError{503, "Interrupted", *message, ""});
+  return api::ToResponse(api::ApiError{503, api::ErrorCode::kInterrupted, *message, ""});
 }
 
 std::string IsoUtc(std::chrono::system_clock::time_point time) {

@@ -85,15 +85,15 @@ Response JobManager::Submit(const Request& inner) {
     const Clock::time_point now = Clock::now();
     EvictLocked(now);
     if (stopping_) {
-      return ToResponse(
-          ApiError{503, "ShuttingDown", "the server is shutting down and accepts no new jobs", ""});
+      return ToResponse(ApiError{503, api::ErrorCode::kShuttingDown,
+                                 "the server is shutting down and accepts no new jobs", ""});
     }
     // Jobs an idle worker is about to take do not count as waiting, so the
     // limit does not depend on how fast the workers wake up.
     const std::size_t idle = static_cast<std::size_t>(config_.workers - busy_);
     const std::size_t waiting = queue_.size() > idle ? queue_.size() - idle : 0;
     if (waiting >= config_.max_queued) {
-      return ToResponse(ApiError{429, "TooBusy",
+      return ToResponse(ApiError{429, api::ErrorCode::kTooBusy,
                                  "job queue is full: " + std::to_string(waiting) +
                                      " jobs queued (limit max_queued = " +
                                      std::to_string(config_.max_queued) + "); retry later",
@@ -104,8 +104,9 @@ Response JobManager::Submit(const Request& inner) {
     // Saved before it is visible: a 202 means the job survives a restart. The
     // store's own message goes to the log, never to the client.
     if (!SaveLocked(*job)) {
-      return ToResponse(ApiError{
-          503, "Unavailable", "the job could not be saved in the jobs database; retry later", ""});
+      return ToResponse(ApiError{503, api::ErrorCode::kUnavailable,
+                                 "the job could not be saved in the jobs database; retry later",
+                                 ""});
     }
     jobs_.emplace(job->id, job);
     queue_.push_back(job->id);
@@ -297,7 +298,7 @@ void JobManager::WorkerLoop() {
       continue;
     } else if (threw) {
       job->error = "internal error";
-      job->result = ToResponse(ApiError{500, "InternalError", job->error, ""});
+      job->result = ToResponse(ApiError{500, api::ErrorCode::kInternalError, job->error, ""});
       FinishLocked(*job, State::kFailed, now);
     } else if (response.status >= 200 && response.status < 300) {
       job->result = std::move(response);
@@ -467,7 +468,7 @@ void JobManager::LoadFromStore() {
         if (body.is_discarded()) {  // Only a damaged database gets here.
           job->state = State::kFailed;
           job->error = "the stored result of this job could not be read";
-          body = ToResponse(ApiError{500, "InternalError", job->error, ""}).body;
+          body = ToResponse(ApiError{500, api::ErrorCode::kInternalError, job->error, ""}).body;
           record.status = 500;
         }
         job->result = Response(record.status, std::move(body));

@@ -156,8 +156,8 @@ std::string LeaseOwner() {
 }
 
 api::Response Unavailable() {
-  return api::ToResponse(api::ApiError{
-      503, "Unavailable", "the jobs database cannot be reached; retry later", ""});
+  return api::ToResponse(api::ApiError{503, api::ErrorCode::kUnavailable,
+                                       "the jobs database cannot be reached; retry later", ""});
 }
 
 }  // namespace
@@ -548,7 +548,7 @@ bool PostgresJobService::Impl::ClaimAndRun() {
     if (threw) {
       state = "failed";
       error = "internal error";
-      response = api::ToResponse(api::ApiError{500, "InternalError", error, ""});
+      response = api::ToResponse(api::ApiError{500, api::ErrorCode::kInternalError, error, ""});
     } else if (response.status < 200 || response.status >= 300) {
       state = "failed";
       error = FailureMessage(response);
@@ -566,7 +566,7 @@ bool PostgresJobService::Impl::ClaimAndRun() {
               " bytes, more than the jobs database keeps (max_result_bytes = " +
               std::to_string(config.max_result_bytes) +
               "): ask for fewer rows or outputs, or raise --job-max-result-bytes";
-      response = api::ToResponse(api::ApiError{413, "TooBig", error, ""});
+      response = api::ToResponse(api::ApiError{413, api::ErrorCode::kTooBig, error, ""});
       json = SerializeJobBody(response.body);
       text.clear();
       content_type.clear();
@@ -718,8 +718,9 @@ api::Response PostgresJobService::Submit(const api::Request& inner) {
   {
     std::lock_guard lock(self.mutex);
     if (self.stopping) {
-      return api::ToResponse(api::ApiError{
-          503, "ShuttingDown", "the server is shutting down and accepts no new jobs", ""});
+      return api::ToResponse(api::ApiError{503, api::ErrorCode::kShuttingDown,
+                                           "the server is shutting down and accepts no new jobs",
+                                           ""});
     }
     id = NewJobId(self.random);
   }
@@ -748,12 +749,12 @@ api::Response PostgresJobService::Submit(const api::Request& inner) {
       if (!self.Query("SELECT count(*) FROM sweetspot_jobs WHERE state = 'queued'", {}, &queued)) {
         return Unavailable();
       }
-      return api::ToResponse(api::ApiError{
-          429, "TooBusy",
-          "job queue is full: " + Text(queued.get(), 0, 0) +
-              " jobs queued on all replicas (limit max_queued = " +
-              std::to_string(self.config.max_queued) + "); retry later",
-          ""});
+      return api::ToResponse(api::ApiError{429, api::ErrorCode::kTooBusy,
+                                           "job queue is full: " + Text(queued.get(), 0, 0) +
+                                               " jobs queued on all replicas (limit max_queued = " +
+                                               std::to_string(self.config.max_queued) +
+                                               "); retry later",
+                                           ""});
     }
     inserted = std::move(found);
   }
@@ -812,8 +813,8 @@ api::Response PostgresJobService::Result(const std::string& id) const {
   }
   nlohmann::json body = nlohmann::json::parse(Text(found.get(), 0, 2), nullptr, false);
   if (body.is_discarded()) {  // Only a damaged database gets here.
-    return api::ToResponse(
-        api::ApiError{500, "InternalError", "the stored result of this job could not be read", ""});
+    return api::ToResponse(api::ApiError{500, api::ErrorCode::kInternalError,
+                                         "the stored result of this job could not be read", ""});
   }
   return {status, std::move(body)};
 }

@@ -26,19 +26,19 @@ TEST(ParseBodyTest, EmptyBodyIsAnEmptyObject) {
 TEST(ParseBodyTest, InvalidJsonNamesThePosition) {
   const ApiError error = ParseError("{\"a\": }");
   EXPECT_EQ(error.status, 400);
-  EXPECT_EQ(error.code, "InvalidJson");
+  EXPECT_EQ(error.code, ErrorCode::kInvalidJson);
   EXPECT_EQ(error.message.rfind("body is not valid JSON at byte 7: ", 0), 0u) << error.message;
 }
 
 TEST(ParseBodyTest, NanAndInfinityTokensAreInvalidJson) {
-  EXPECT_EQ(ParseError("{\"x\": NaN}").code, "InvalidJson");
-  EXPECT_EQ(ParseError("{\"x\": Infinity}").code, "InvalidJson");
-  EXPECT_EQ(ParseError("{\"x\": -Infinity}").code, "InvalidJson");
+  EXPECT_EQ(ParseError("{\"x\": NaN}").code, ErrorCode::kInvalidJson);
+  EXPECT_EQ(ParseError("{\"x\": Infinity}").code, ErrorCode::kInvalidJson);
+  EXPECT_EQ(ParseError("{\"x\": -Infinity}").code, ErrorCode::kInvalidJson);
 }
 
 TEST(ParseBodyTest, NumberOutOfDoubleRangeIsInvalidValue) {
   const ApiError error = ParseError("{\"x\": 1e400}");
-  EXPECT_EQ(error.code, "InvalidValue");
+  EXPECT_EQ(error.code, ErrorCode::kInvalidValue);
   EXPECT_EQ(error.message, "number 1e400 is out of range of a double");
 }
 
@@ -48,7 +48,7 @@ TEST(ParseBodyTest, DeepNestingIsRefusedWithoutBuildingIt) {
   const std::string bomb = std::string(200000, '[') + std::string(200000, ']');
   const ApiError error = ParseError(bomb);
   EXPECT_EQ(error.status, 413);
-  EXPECT_EQ(error.code, "TooBig");
+  EXPECT_EQ(error.code, ErrorCode::kTooBig);
   EXPECT_EQ(error.message, "nesting exceeds the limit max_json_depth = 32");
 }
 
@@ -57,7 +57,7 @@ TEST(ParseBodyTest, DepthAtTheLimitIsAccepted) {
   limits.max_json_depth = 4;
   ApiError error;
   EXPECT_TRUE(ParseBody("[[[[1]]]]", limits, &error).has_value()) << error.message;
-  EXPECT_EQ(ParseError("[[[[[1]]]]]", limits).code, "TooBig");
+  EXPECT_EQ(ParseError("[[[[[1]]]]]", limits).code, ErrorCode::kTooBig);
 }
 
 TEST(ParseBodyTest, LongArraysAndStringsAreRefused) {
@@ -82,7 +82,7 @@ TEST(ObjectReaderTest, ReadsNumbersAndRefusesUnknownFields) {
   EXPECT_TRUE(reader.Number("mass_kg", Positive(), &mass));
   EXPECT_EQ(mass, 0.145);
   EXPECT_FALSE(reader.Finish());
-  EXPECT_EQ(error.code, "UnknownField");
+  EXPECT_EQ(error.code, ErrorCode::kUnknownField);
   EXPECT_EQ(error.field, "ball.masss_kg");
   EXPECT_EQ(error.message, "ball.masss_kg is not a known field (known: mass_kg)");
 }
@@ -97,7 +97,7 @@ TEST(ObjectReaderTest, MessagesNameFieldValueAndRule) {
     EXPECT_FALSE(reader.Number("speed_mps", NonNegative(200), &speed));
     EXPECT_EQ(error.message, "ball.speed_mps = -3: must be a number in [0, 200]");
     EXPECT_EQ(error.field, "ball.speed_mps");
-    EXPECT_EQ(error.code, "InvalidValue");
+    EXPECT_EQ(error.code, ErrorCode::kInvalidValue);
   }
   {
     ApiError error;
@@ -128,7 +128,7 @@ TEST(ObjectReaderTest, MissingRequiredFieldIsMissingField) {
   ObjectReader reader(value, "bat.three_segment", &error);
   double length = 0;
   EXPECT_FALSE(reader.Number("length_m", Positive(), &length));
-  EXPECT_EQ(error.code, "MissingField");
+  EXPECT_EQ(error.code, ErrorCode::kMissingField);
   EXPECT_EQ(error.message, "bat.three_segment.length_m is required");
 }
 

@@ -48,6 +48,18 @@ TEST(ConfigTest, SolverLimitsFromFlagsAndEnvironment) {
             "option --max-integration-steps = \"9\": must be an integer in [10, 1000000000]");
 }
 
+TEST(ConfigTest, RequestCapsFromFlagsAndEnvironment) {
+  const auto parsed = Parse({"--max-curve-samples", "20000"},
+                            {{"SWEETSPOT_MAX_DESIGN_VARIABLES", "12"}});
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_EQ(parsed.config.limits.max_curve_samples, 20000u);
+  EXPECT_EQ(parsed.config.limits.max_design_variables, 12u);
+  EXPECT_EQ(Parse({"--max-design-variables", "7"}).config.limits.max_design_variables, 7u);
+  const std::string usage = Usage("sweetspot-server");
+  EXPECT_NE(usage.find("--max-design-variables"), std::string::npos);
+  EXPECT_NE(usage.find("SWEETSPOT_MAX_DESIGN_VARIABLES"), std::string::npos);
+}
+
 TEST(ConfigTest, BadValuesNameFlagValueAndRule) {
   EXPECT_EQ(Parse({"--port", "70000"}).error,
             "option --port = \"70000\": must be an integer in [0, 65535]");
