@@ -25,7 +25,8 @@ if(SWEETSPOT_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
   if(SWEETSPOT_CCACHE_EXECUTABLE)
     get_filename_component(sweetspot_checkouts ${PROJECT_SOURCE_DIR} DIRECTORY)
     set(CMAKE_CXX_COMPILER_LAUNCHER
-        ${CMAKE_COMMAND} -E env CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
+        ${CMAKE_COMMAND} -E env
+        CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
         CCACHE_BASEDIR=${sweetspot_checkouts} ${SWEETSPOT_CCACHE_EXECUTABLE})
     message(STATUS "Compiling through ${SWEETSPOT_CCACHE_EXECUTABLE}")
   endif()
