@@ -49,8 +49,13 @@ const char* const kSweetSpotBody =
 // about 10 times fewer requests (the 64-client run: 2.0k/s against 20k/s,
 // measured), and a first answer took 147 ms once, so there the bound is 5 times
 // the issue's: still far below what a starved client waits (seconds), but not a
-// measure of the instrumentation.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+// measure of the instrumentation. ThreadSanitizer slows this server more (its
+// documented slowdown is 5-15x): 16 new clients beside 200 idle connections were
+// answered within 15 ms in Release and 472-567 ms under TSan (four runs of the
+// same tree), so under TSan the bound is 10 times the (1 s).
+#if defined(__SANITIZE_THREAD__)
+constexpr double kLatencyScale = 10.0;
+#elif defined(__SANITIZE_ADDRESS__)
 constexpr double kLatencyScale = 5.0;
 #else
 constexpr double kLatencyScale = 1.0;
