@@ -351,27 +351,32 @@ double ShapeFitModel::Objective(const double* s, double* grad) {
 double ShapeFitModel::Constraint(FitConstraint kind, const double* s, double* grad) const {
   const std::vector<double> t = ToParameters(s);
   if (grad == nullptr) return ConstraintOf<double>(kind, t.data(), hollow_) / length_scale_;
-  using J = jet::Jet<kNumFitParameters, false>;
+  // Jet variable j is unknown j: the chain rule over the parameters it sets (two for a radius)
+  // is the AD's own.
+  using J = jet::Jet<kNumFitVariables, false>;
   std::array<J, kNumFitParameters> tj;
-  for (int p = 0; p < kNumFitParameters; ++p) {
-    tj[static_cast<std::size_t>(p)] = J::Variable(t[static_cast<std::size_t>(p)], p);
+  for (int p = 0; p < kNumFitParameters; ++p) tj[static_cast<std::size_t>(p)] = J(At(t, p));
+  for (int j = 0; j < n(); ++j) {
+    for (int p : variables_[static_cast<std::size_t>(j)]) {
+      tj[static_cast<std::size_t>(p)] = J::Variable(At(t, p), j);
+    }
   }
   const J g = ConstraintOf<J>(kind, tj.data(), hollow_);
   for (int j = 0; j < n(); ++j) {
     const std::size_t k = static_cast<std::size_t>(j);
-    double d = 0.0;
-    for (int p : variables_[k]) d += g.g[static_cast<std::size_t>(p)];
-    grad[j] = d * (hi_[k] - lo_[k]) / length_scale_;
+    grad[j] = g.g[k] * (hi_[k] - lo_[k]) / length_scale_;
   }
   return g.v / length_scale_;
 }
 
 double ShapeFitModel::MaxViolationM(const double* s) const {
+  if (constraints_.empty()) return 0.0;
+  const std::vector<double> t = ToParameters(s);
   double worst = -std::numeric_limits<double>::infinity();
   for (FitConstraint kind : constraints_) {
-    worst = std::max(worst, Constraint(kind, s, nullptr) * length_scale_);
+    worst = std::max(worst, ConstraintOf<double>(kind, t.data(), hollow_));
   }
-  return constraints_.empty() ? 0.0 : worst;
+  return worst;
 }
 
 // ---------------------------------------------------------------------------------------------
