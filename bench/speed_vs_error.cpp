@@ -41,7 +41,7 @@
 #include "core/collision/collide.hpp"
 #include "core/mass_properties.hpp"
 #include "core/material.hpp"
-#include "core/nlopt_search.hpp"
+#include "core/optimize/nlopt_search.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "core/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
@@ -392,7 +392,7 @@ void RigidAndFreeSweetSpotRows(const TimingOptions& timing, bool quick, Report* 
        "and the request default are rigid_pivot. With method = nlopt the default algorithm is "
        "LD_SLSQP and x_tolerance_m = " +
            Tol(default_search.x_tolerance_m) +
-           " (core::ScalarSearchOptions, core/nlopt_search.hpp)"});
+           " (core::ScalarSearchOptions, core/optimize/nlopt_search.hpp)"});
   core::SceneOptions closed;
   closed.model = core::CollisionModel::kRigidPivot;
   SweetSpotRows("rigid_pivot_sweet_spot", core::CollisionModel::kRigidPivot, true, {}, closed, all,

@@ -18,6 +18,9 @@
 // Method: a deterministic low-discrepancy scan of the bounds, NLopt SLSQP
 // (exact gradients) from the best feasible scan points, then Gauss-Newton on
 // the residuals to reach machine precision when the targets are attainable.
+// The problem is a least-squares design problem over the design code's
+// variables of the same fields (three_segment.*, material.density_kg_m3, ...):
+// core/optimize/shape_fit_model.hpp.
 #pragma once
 
 #include <optional>

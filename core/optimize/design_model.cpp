@@ -13,6 +13,7 @@
 #include "core/collision/rigid_pivot.hpp"
 #include "core/geometry_format.hpp"
 #include "core/geometry_integrals.hpp"
+#include "core/optimize/design_integrals.hpp"
 #include "core/optimize/jet.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
@@ -66,15 +67,6 @@ T MoiAbout(const T* p, double c0, double pivot) {
 // ---------------------------------------------------------------------------------------------
 // Integrals and their derivatives.
 
-namespace {
-
-struct Integrals {
-  std::array<double, 4> p{};                    // M, S1, S2, L
-  Eigen::Matrix<double, 4, Eigen::Dynamic> dp;  // dP/dx (when requested)
-};
-
-}  // namespace
-
 std::vector<double> DesignModel::ParametersAt(const double* x) const {
   std::vector<double> t = base_parameters_;
   for (std::size_t j = 0; j < variables_.size(); ++j) {
@@ -113,19 +105,61 @@ LocalMap FillMap(const DesignParameterLayout& lay) {
 
 }  // namespace
 
-// Computes P and (optionally) dP/dx; with hessian_weights, adds
-// sum_c w_c d2P_c/dx2 (c = M, S1, S2) into *hessian.
+// The parametrisation and the integrals (design_integrals.hpp).
 namespace design_detail {
 
-struct IntegralContext {
-  const std::vector<double>& t;
-  const std::vector<int>& parameter_variable;
-  int num_knots;
-  bool hollow;
-  bool has_fill;
-  bool rigid;
-  double c0;
-};
+std::vector<double> ThreeSegmentParameters(const Bat& base, const ThreeSegmentShape& s) {
+  Bat four = base;
+  four.knots = {{0.0, s.handle_radius_m},
+                {s.taper_start_m, s.handle_radius_m},
+                {s.taper_end_m, s.barrel_radius_m},
+                {s.length_m, s.barrel_radius_m}};
+  const Eigen::VectorXd p = DesignParameters(four);
+  return {p.data(), p.data() + p.size()};
+}
+
+ThreeSegmentShape ThreeSegmentShapeAt(const std::vector<double>& t, ThreeSegmentShape shape) {
+  const DesignParameterLayout lay{4};
+  shape.length_m = t[static_cast<std::size_t>(lay.KnotPosition(3))];
+  shape.handle_radius_m = t[static_cast<std::size_t>(lay.KnotRadius(0))];
+  shape.barrel_radius_m = t[static_cast<std::size_t>(lay.KnotRadius(2))];
+  // Solvers meet x1 <= x2 <= L and 0 <= x1 to their tolerance: remove that round-off.
+  shape.taper_start_m = std::max(t[static_cast<std::size_t>(lay.KnotPosition(1))], 0.0);
+  shape.taper_end_m = std::min(t[static_cast<std::size_t>(lay.KnotPosition(2))], shape.length_m);
+  shape.taper_start_m = std::min(shape.taper_start_m, shape.taper_end_m);
+  return shape;
+}
+
+std::vector<int> DesignParametersOf(const DesignVariableRef& ref,
+                                    const DesignParameterLayout& lay) {
+  switch (ref.kind) {
+    case DesignVariableKind::kKnotRadius:
+      return {lay.KnotRadius(ref.knot)};
+    case DesignVariableKind::kKnotPosition:
+      return {lay.KnotPosition(ref.knot)};
+    case DesignVariableKind::kLength:
+      return {lay.KnotPosition(3)};
+    case DesignVariableKind::kHandleRadius:
+      return {lay.KnotRadius(0), lay.KnotRadius(1)};
+    case DesignVariableKind::kBarrelRadius:
+      return {lay.KnotRadius(2), lay.KnotRadius(3)};
+    case DesignVariableKind::kTaperStart:
+      return {lay.KnotPosition(1)};
+    case DesignVariableKind::kTaperEnd:
+      return {lay.KnotPosition(2)};
+    case DesignVariableKind::kDensity:
+      return {lay.Density()};
+    case DesignVariableKind::kWallThickness:
+      return {lay.WallThickness()};
+    case DesignVariableKind::kFillDiameter:
+      return {lay.FillDiameter()};
+    case DesignVariableKind::kFillDepth:
+      return {lay.FillDepth()};
+    case DesignVariableKind::kFillDensity:
+      return {lay.FillDensity()};
+  }
+  return {};
+}
 
 void ComputeIntegrals(const IntegralContext& c, int n, bool gradients, Integrals* out) {
   const DesignParameterLayout lay{c.num_knots};
@@ -333,7 +367,7 @@ double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
     for (const auto& [idx, k] : f.terms) v += k * t[static_cast<std::size_t>(idx)];
     return v;
   }
-  Integrals in;
+  design_detail::Integrals in;
   design_detail::ComputeIntegrals(
       {t, parameter_variable_, num_knots_, hollow_, has_fill_, rigid_, c0_}, n(), false, &in);
   if (!(in.p[0] > 0.0)) return kNaN;
@@ -343,7 +377,7 @@ double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
 
 bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* out) const {
   const std::vector<double> t = ParametersAt(x);
-  Integrals in;
+  design_detail::Integrals in;
   const design_detail::IntegralContext context{
       t, parameter_variable_, num_knots_, hollow_, has_fill_, rigid_, c0_};
   design_detail::ComputeIntegrals(context, n(), with_gradients, &in);
@@ -416,7 +450,7 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
                           const double* constraint_weights, Eigen::MatrixXd* out) const {
   if (derivative_free() && objective_weight != 0.0) return false;
   const std::vector<double> t = ParametersAt(x);
-  Integrals in;
+  design_detail::Integrals in;
   const design_detail::IntegralContext context{
       t, parameter_variable_, num_knots_, hollow_, has_fill_, rigid_, c0_};
   design_detail::ComputeIntegrals(context, n(), true, &in);
@@ -450,17 +484,7 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
 
 std::optional<ThreeSegmentShape> DesignModel::ShapeAt(const double* x) const {
   if (!base_shape_.has_value()) return std::nullopt;
-  const std::vector<double> t = ParametersAt(x);
-  const DesignParameterLayout lay{num_knots_};
-  ThreeSegmentShape s = *base_shape_;
-  s.length_m = t[static_cast<std::size_t>(lay.KnotPosition(3))];
-  s.handle_radius_m = t[static_cast<std::size_t>(lay.KnotRadius(0))];
-  s.barrel_radius_m = t[static_cast<std::size_t>(lay.KnotRadius(2))];
-  // The solver meets x1 <= x2 <= L and 0 <= x1 to its tolerance: remove that round-off.
-  s.taper_start_m = std::max(t[static_cast<std::size_t>(lay.KnotPosition(1))], 0.0);
-  s.taper_end_m = std::min(t[static_cast<std::size_t>(lay.KnotPosition(2))], s.length_m);
-  s.taper_start_m = std::min(s.taper_start_m, s.taper_end_m);
-  return s;
+  return design_detail::ThreeSegmentShapeAt(ParametersAt(x), *base_shape_);
 }
 
 Bat DesignModel::BatAt(const double* x) const {

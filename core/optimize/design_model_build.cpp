@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/optimize/design_integrals.hpp"
 #include "core/optimize/design_model_builder.hpp"
 
 namespace sweetspot::core {
@@ -82,14 +83,7 @@ void ModelBuilder::Parameters() {
   model.has_fill_ = base.fill.has_value();
   model.rigid_ = problem.inertia_model == InertiaModel::kRigidBody;
   if (problem.three_segment.has_value()) {
-    const ThreeSegmentShape& s = *problem.three_segment;
-    Bat four = base;
-    four.knots = {{0.0, s.handle_radius_m},
-                  {s.taper_start_m, s.handle_radius_m},
-                  {s.taper_end_m, s.barrel_radius_m},
-                  {s.length_m, s.barrel_radius_m}};
-    const Eigen::VectorXd p = DesignParameters(four);
-    model.base_parameters_.assign(p.data(), p.data() + p.size());
+    model.base_parameters_ = ThreeSegmentParameters(base, *problem.three_segment);
     model.num_knots_ = 4;
   } else {
     const Eigen::VectorXd p = DesignParameters(base);
@@ -102,36 +96,10 @@ void ModelBuilder::Parameters() {
 
 // The parameters a variable moves, with the flags the rules need.
 std::vector<int> ModelBuilder::ParametersOf(const DesignVariableRef& ref) {
-  switch (ref.kind) {
-    case DesignVariableKind::kKnotRadius:
-      return {lay.KnotRadius(ref.knot)};
-    case DesignVariableKind::kKnotPosition:
-      return {lay.KnotPosition(ref.knot)};
-    case DesignVariableKind::kLength:
-      return {lay.KnotPosition(3)};
-    case DesignVariableKind::kHandleRadius:
-      return {lay.KnotRadius(0), lay.KnotRadius(1)};
-    case DesignVariableKind::kBarrelRadius:
-      return {lay.KnotRadius(2), lay.KnotRadius(3)};
-    case DesignVariableKind::kTaperStart:
-      return {lay.KnotPosition(1)};
-    case DesignVariableKind::kTaperEnd:
-      return {lay.KnotPosition(2)};
-    case DesignVariableKind::kDensity:
-      density_variable = true;
-      return {lay.Density()};
-    case DesignVariableKind::kWallThickness:
-      wall_variable = true;
-      return {lay.WallThickness()};
-    case DesignVariableKind::kFillDiameter:
-      return {lay.FillDiameter()};
-    case DesignVariableKind::kFillDepth:
-      return {lay.FillDepth()};
-    case DesignVariableKind::kFillDensity:
-      fill_density_variable = true;
-      return {lay.FillDensity()};
-  }
-  return {};
+  density_variable = density_variable || ref.kind == DesignVariableKind::kDensity;
+  wall_variable = wall_variable || ref.kind == DesignVariableKind::kWallThickness;
+  fill_density_variable = fill_density_variable || ref.kind == DesignVariableKind::kFillDensity;
+  return DesignParametersOf(ref, lay);
 }
 
 // Variable i checked against the design (refused with the reason in *why).

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/nlopt_search.hpp"
+#include "core/optimize/nlopt_search.hpp"
 #include "core/progress.hpp"
 
 namespace sweetspot::core {

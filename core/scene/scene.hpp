@@ -17,7 +17,7 @@
 #include "core/flexible/modes.hpp"
 #include "core/flexible/modes_cache.hpp"
 #include "core/mass_properties.hpp"
-#include "core/nlopt_search.hpp"
+#include "core/optimize/nlopt_search.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "core/nlopt_search.hpp"
+#include "core/optimize/nlopt_search.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {

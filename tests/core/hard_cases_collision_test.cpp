@@ -8,7 +8,7 @@
 #include "core/collision/collide.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
-#include "core/nlopt_search.hpp"
+#include "core/optimize/nlopt_search.hpp"
 #include "core/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"

@@ -50,7 +50,7 @@ TEST(LayeringTest, SolverHeadersStayInCoreSources) {
   for (const char* folder : {"core", "api", "server"}) {
     for (const auto& inc : IncludesUnder(folder)) {
       // The libraries' own headers (<nlopt.hpp>, <coin/IpTNLP.hpp>, <IpIpoptApplication.hpp>),
-      // not our wrappers such as "core/nlopt_search.hpp".
+      // not our wrappers such as "core/optimize/nlopt_search.hpp".
       const bool solver = Mentions(inc.header, "<nlopt") || Mentions(inc.header, "<Ip") ||
                           Mentions(inc.header, "<coin/") || Mentions(inc.header, "\"Ip");
       if (!solver) continue;

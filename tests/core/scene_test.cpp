@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/nlopt_search.hpp"
+#include "core/optimize/nlopt_search.hpp"
 #include "core/presets.hpp"
 
 namespace sweetspot::core {

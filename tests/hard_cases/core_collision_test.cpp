@@ -1,5 +1,5 @@
 // Hard cases of the collision models and sweet spots (core/collision/*, core/sweet_spot.*,
-// core/nlopt_search.*, core/scene.*): extreme masses, speeds and CORs against long double
+// core/optimize/nlopt_search.*, core/scene.*): extreme masses, speeds and CORs against long double
 // closed forms, stiff and soft contacts against the exact power-law contact, and every NLopt
 // algorithm on a flat objective.
 #include <gtest/gtest.h>
@@ -12,7 +12,7 @@
 #include "core/collision/free_bat.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
-#include "core/nlopt_search.hpp"
+#include "core/optimize/nlopt_search.hpp"
 #include "core/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"

@@ -1,4 +1,4 @@
-#include "core/nlopt_search.hpp"
+#include "core/optimize/nlopt_search.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -1,10 +1,11 @@
 // A one-dimensional maximiser over the impact position, backed by NLopt. Used as the
 // independent path for models with a closed form (rigid_pivot, free_bat) and as the only
-// path for models without one (hertz). NLopt's headers stay in nlopt_search.cpp.
+// path for models without one (hertz). No NLopt header here or in nlopt_search.cpp.
 //
-// Every call builds its own nlopt::opt, sets maxeval and maxtime, seeds NLopt's per-thread
-// random state right before optimize() for stochastic algorithms, catches everything NLopt
-// or the objective throws, and returns a Summary whatever happens.
+// Every stage runs through the one NLopt trampoline (RunNlopt, nlopt_run.hpp: its own
+// nlopt::opt, maxeval and maxtime, seeding of stochastic algorithms, the exception ladder) and
+// maps NLopt's result with the one termination table (termination.hpp); a call returns a
+// Summary whatever happens.
 #pragma once
 
 #include <functional>
