@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 
 #include "core/geometry_format.hpp"
@@ -18,43 +17,32 @@ bool CollisionOptions::IsValid(std::string* why) const {
 CollisionResult Collide(const Scene& scene, double impact_from_knob_m, CollisionModel model,
                         const CollisionOptions& options) {
   constexpr double kEps = std::numeric_limits<double>::epsilon();
-  const auto t0 = std::chrono::steady_clock::now();
-  CollisionResult out;
-  Summary& s = out.summary;
-  s.termination = Termination::kInvalidInput;
-  s.backend = "closed_form";
-  TimingBook book;
-  out.impact_from_knob_m = impact_from_knob_m;
-  auto finish = [&]() -> CollisionResult& {
-    out.timings = book.timings();
-    s.models_used = book.Models();
-    s.solve_time_s = SecondsSince(t0);
-    return out;
-  };
-  try {
+  return TimedRequest<CollisionResult>("closed_form", [&](CollisionResult& out, TimingBook& book) {
+    Summary& s = out.summary;
+    out.impact_from_knob_m = impact_from_knob_m;
     std::string why;
     if (!options.IsValid(&why)) {
       s.message = why;
-      return finish();
+      return;
     }
     if (model == CollisionModel::kFlexible && !scene.bat.has_value()) {
       out.model = model;
       s.message =
           "bat: model = flexible needs the bat's geometry (a bat, not only mass_properties)";
-      return finish();
+      return;
     }
     ResolvedScene r;
     const bool resolved = ResolveScene(scene, /*needs_cor=*/true, &book, &r, &s);
     // Also when refused: the caller can then tell properties that are not usable (the bat's).
     out.mass_properties = r.mass_properties;
-    if (!resolved) return finish();
+    if (!resolved) return;
     out.cor = *r.cor;
     if (!(std::isfinite(impact_from_knob_m) && impact_from_knob_m >= 0.0 &&
           impact_from_knob_m <= r.length_m)) {
       s.termination = Termination::kInvalidInput;
       s.message = "impact_from_knob_m = " + FormatNumber17(impact_from_knob_m) +
                   ": must be within the bat [0, " + FormatNumber17(r.length_m) + "]";
-      return finish();
+      return;
     }
     if (model == CollisionModel::kAuto) {
       if (options.want_contact_details) {
@@ -111,7 +99,7 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
         FlexibleModes flexible_modes(scene, options.flexible, &book);
         const auto& modes = flexible_modes.Impact();
         out.modes_cache_hit = flexible_modes.impact_hit();
-        if (FlexibleModesRefused(*modes, &s)) return finish();
+        if (FlexibleModesRefused(*modes, &s)) return;
         const auto tf = std::chrono::steady_clock::now();
         const FlexibleImpactInputs in =
             FlexibleImpactInputsFor(scene, r, impact_from_knob_m, options.hertz);
@@ -133,7 +121,7 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
         book.Add(CollisionModelName(model), SecondsSince(tf), 1);
         s.objective = out.exit_speed_mps;
         s.error_estimate = out.error_estimate_mps;
-        return finish();
+        return;
       }
       default:
         s.termination = Termination::kFailure;
@@ -143,14 +131,7 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
     book.Add(CollisionModelName(model), SecondsSince(tm), 1);
     s.objective = out.exit_speed_mps;
     s.error_estimate = out.error_estimate_mps;
-  } catch (const std::exception& e) {
-    s.termination = Termination::kFailure;
-    s.message = std::string("internal error: ") + e.what();
-  } catch (...) {
-    s.termination = Termination::kFailure;
-    s.message = "internal error";
-  }
-  return finish();
+  });
 }
 
 }  // namespace sweetspot::core

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <span>
 #include <string>
@@ -13,6 +12,7 @@
 #include "core/collision/contact_law.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/event_integrator.hpp"
+#include "core/scene/timing_book.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -286,68 +286,53 @@ bool HertzOptions::IsValid(std::string* why) const {
 }
 
 HertzImpact SolveHertzImpact(const HertzProblem& problem, const HertzSolverOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  HertzImpact out;
-  out.problem = problem;
-  Summary& s = out.summary;
-  s.backend = "odeint:runge_kutta_dopri5";
-  s.models_used = {"hertz"};
-  s.termination = Termination::kInvalidInput;
-  auto finish = [&]() -> HertzImpact& {
-    s.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return out;
-  };
-  std::string why;
-  if (!problem.IsValid(&why) || !options.IsValid(&why)) {
-    s.message = why;
-    return finish();
-  }
-  const RefinedRuns<RawRun> runs = SolveWithRefineCheck<RawRun>(
-      options.relative_tolerance, options.refine_check,
-      [&](double tol) { return Integrate(problem, tol, options.max_steps); });
-  const RawRun& a = runs.coarse;
-  s.iterations = a.steps;
-  s.evaluations = static_cast<int>(a.evaluations);
-  out.steps = a.steps;
-  if (!a.ok) {
-    s.termination = Termination::kFailure;
-    s.message = a.message;
-    return finish();
-  }
-  out.contact_time_s = a.contact_time_s;
-  out.max_compression_m = a.max_compression_m;
-  out.peak_force_n = a.peak_force_n;
-  out.ball_impulse_n_s = a.ball_impulse_n_s;
-  out.hands_impulse_n_s = a.hands_impulse_n_s;
-  out.separation_speed_mps = a.separation_speed_mps;
-  out.apparent_cor = a.separation_speed_mps / problem.approach_speed_mps;
-  out.exit_speed_mps = -problem.ball_speed_mps + a.ball_impulse_n_s / problem.ball_mass_kg;
-  out.unloading_exponent = a.q;
-  s.warnings = a.warnings;
-  if (runs.refined) {
-    const RawRun& b = runs.fine;
-    out.steps += b.steps;
-    s.iterations = out.steps;
-    s.evaluations += static_cast<int>(b.evaluations);
-    if (!b.ok) {
-      s.warnings.push_back(RefineFailedWarning(b.message) +
-                           "; error estimates are the tolerance only");
-      out.error_estimate_contact_time_s = options.relative_tolerance * a.contact_time_s;
-      out.error_estimate_exit_speed_mps =
-          options.relative_tolerance * (problem.ball_speed_mps + std::abs(out.exit_speed_mps));
-      out.error_estimate_peak_force_n = options.relative_tolerance * a.peak_force_n;
-    } else {
-      out.error_estimate_contact_time_s = std::abs(a.contact_time_s - b.contact_time_s);
-      const double vb = -problem.ball_speed_mps + b.ball_impulse_n_s / problem.ball_mass_kg;
-      out.error_estimate_exit_speed_mps = std::abs(out.exit_speed_mps - vb);
-      out.error_estimate_peak_force_n = std::abs(a.peak_force_n - b.peak_force_n);
+  return TimedSolve<HertzImpact>([&](HertzImpact& out) {
+    out.problem = problem;
+    Summary& s = out.summary;
+    s.backend = "odeint:runge_kutta_dopri5";
+    s.models_used = {"hertz"};
+    std::string why;
+    if (!problem.IsValid(&why) || !options.IsValid(&why)) {
+      s.message = why;
+      return;
     }
-  }
-  s.termination = Termination::kConverged;
-  s.message = "contact ended after " + FormatNumber17(out.contact_time_s) + " s";
-  s.objective = out.exit_speed_mps;
-  s.error_estimate = out.error_estimate_exit_speed_mps;
-  return finish();
+    const RefinedRuns<RawRun> runs = SolveWithRefineCheck<RawRun>(
+        options.relative_tolerance, options.refine_check,
+        [&](double tol) { return Integrate(problem, tol, options.max_steps); });
+    out.steps = CountRefinedRuns(runs, &s);
+    if (!runs.coarse.ok) return;
+    const RawRun& a = runs.coarse;
+    out.contact_time_s = a.contact_time_s;
+    out.max_compression_m = a.max_compression_m;
+    out.peak_force_n = a.peak_force_n;
+    out.ball_impulse_n_s = a.ball_impulse_n_s;
+    out.hands_impulse_n_s = a.hands_impulse_n_s;
+    out.separation_speed_mps = a.separation_speed_mps;
+    out.apparent_cor = a.separation_speed_mps / problem.approach_speed_mps;
+    out.exit_speed_mps = -problem.ball_speed_mps + a.ball_impulse_n_s / problem.ball_mass_kg;
+    out.unloading_exponent = a.q;
+    s.warnings = a.warnings;
+    if (runs.refined) {
+      const RawRun& b = runs.fine;
+      if (!b.ok) {
+        s.warnings.push_back(RefineFailedWarning(b.message) +
+                             "; error estimates are the tolerance only");
+        out.error_estimate_contact_time_s = options.relative_tolerance * a.contact_time_s;
+        out.error_estimate_exit_speed_mps =
+            options.relative_tolerance * (problem.ball_speed_mps + std::abs(out.exit_speed_mps));
+        out.error_estimate_peak_force_n = options.relative_tolerance * a.peak_force_n;
+      } else {
+        out.error_estimate_contact_time_s = std::abs(a.contact_time_s - b.contact_time_s);
+        const double vb = -problem.ball_speed_mps + b.ball_impulse_n_s / problem.ball_mass_kg;
+        out.error_estimate_exit_speed_mps = std::abs(out.exit_speed_mps - vb);
+        out.error_estimate_peak_force_n = std::abs(a.peak_force_n - b.peak_force_n);
+      }
+    }
+    s.termination = Termination::kConverged;
+    s.message = "contact ended after " + FormatNumber17(out.contact_time_s) + " s";
+    s.objective = out.exit_speed_mps;
+    s.error_estimate = out.error_estimate_exit_speed_mps;
+  });
 }
 
 }  // namespace sweetspot::core
