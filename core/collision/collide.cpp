@@ -67,7 +67,20 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
       s.termination = Termination::kConverged;
       s.message = "closed form";
     };
-    const auto tm = std::chrono::steady_clock::now();
+    // An integrated impact (hertz, flexible): its report becomes the collision's (termination,
+    // message, backend, counts; its warnings after those already noted).
+    const auto integrated = [&](const auto& impact) {
+      const Summary& is = impact.summary;
+      s.termination = is.termination;
+      s.message = is.message;
+      s.backend = is.backend;
+      s.iterations = is.iterations;
+      s.evaluations = is.evaluations;
+      for (const auto& w : is.warnings) s.warnings.push_back(w);
+      out.exit_speed_mps = impact.exit_speed_mps;
+      out.error_estimate_mps = impact.error_estimate_exit_speed_mps;
+    };
+    auto tm = std::chrono::steady_clock::now();
     switch (model) {
       case CollisionModel::kRigidPivot:
         out.rigid_pivot = RigidPivotImpactAt(RigidPivotInputsFor(scene, r), impact_from_knob_m);
@@ -83,16 +96,8 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
             HertzProblemFor(scene, r, impact_from_knob_m, options.hertz, &warnings);
         out.approach_speed_mps = p.approach_speed_mps;
         out.hertz = SolveHertzImpact(p, options.hertz.solver);
-        const Summary& hs = out.hertz->summary;
-        s.termination = hs.termination;
-        s.message = hs.message;
-        s.backend = hs.backend;
-        s.iterations = hs.iterations;
-        s.evaluations = hs.evaluations;
         s.warnings = warnings;
-        for (const auto& w : hs.warnings) s.warnings.push_back(w);
-        out.exit_speed_mps = out.hertz->exit_speed_mps;
-        out.error_estimate_mps = out.hertz->error_estimate_exit_speed_mps;
+        integrated(*out.hertz);
         break;
       }
       case CollisionModel::kFlexible: {
@@ -100,28 +105,18 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
         const auto& modes = flexible_modes.Impact();
         out.modes_cache_hit = flexible_modes.impact_hit();
         if (FlexibleModesRefused(*modes, &s)) return;
-        const auto tf = std::chrono::steady_clock::now();
+        tm = std::chrono::steady_clock::now();  // the modes have their own timing
         const FlexibleImpactInputs in =
             FlexibleImpactInputsFor(scene, r, impact_from_knob_m, options.hertz);
         out.approach_speed_mps = in.approach_speed_mps;
         out.flexible = SolveFlexibleImpact(*scene.bat, *modes, in, options.flexible.impact);
-        const Summary& fs = out.flexible->summary;
-        s.termination = fs.termination;
-        if (fs.IsSolutionUsable() && modes->summary.termination == Termination::kNoConvergence) {
+        for (const auto& w : modes->summary.warnings) s.warnings.push_back("flexible_beam: " + w);
+        integrated(*out.flexible);
+        if (out.flexible->summary.IsSolutionUsable() &&
+            modes->summary.termination == Termination::kNoConvergence) {
           s.termination = Termination::kNoConvergence;
         }
-        s.message = fs.message;
-        s.backend = fs.backend;
-        s.iterations = fs.iterations;
-        s.evaluations = fs.evaluations;
-        for (const auto& w : modes->summary.warnings) s.warnings.push_back("flexible_beam: " + w);
-        for (const auto& w : fs.warnings) s.warnings.push_back(w);
-        out.exit_speed_mps = out.flexible->exit_speed_mps;
-        out.error_estimate_mps = out.flexible->error_estimate_exit_speed_mps;
-        book.Add(CollisionModelName(model), SecondsSince(tf), 1);
-        s.objective = out.exit_speed_mps;
-        s.error_estimate = out.error_estimate_mps;
-        return;
+        break;
       }
       default:
         s.termination = Termination::kFailure;

@@ -7,6 +7,7 @@
 #include <span>
 #include <utility>
 
+#include "core/collision/contact_integration.hpp"
 #include "core/collision/contact_law.hpp"
 #include "core/collision/flexible_modal_system.hpp"
 #include "core/flexible/static_flexibility.hpp"
@@ -34,13 +35,6 @@ bool Fail(std::string* why, const std::string& m) {
   return false;
 }
 
-// The events of one contact (each crosses from > 0 to <= 0): the compression rate falls through
-// 0 (maximum compression), the compression falls through 0 (separation), the compression rises
-// back above its maximum (reload; it may already be above it when an unloading step begins).
-enum EventId : int { kMaxCompression, kEnd, kReload };
-constexpr EventSpec kLoadingEvents[] = {{kMaxCompression, false}, {kEnd, false}};
-constexpr EventSpec kUnloadingEvents[] = {{kEnd, false}, {kReload, true}};
-
 // One contact as the event integrator sees it: the right-hand side of Rhs, its events, the
 // hands' loads sampled on every step and the branch changes at the events.
 struct FlexibleSystem {
@@ -52,10 +46,7 @@ struct FlexibleSystem {
   bool plastic = false;
 
   void operator()(const State& y, State& dy, double t) const { (*rhs)(y, dy, t); }
-  std::span<const EventSpec> ActiveEvents() const {
-    if (rhs->branch.unloading) return kUnloadingEvents;
-    return kLoadingEvents;
-  }
+  std::span<const EventSpec> ActiveEvents() const { return ContactEvents(rhs->branch.unloading); }
   double EventFunction(int id, const State& s) const {
     switch (id) {
       case kMaxCompression:
@@ -132,13 +123,7 @@ RawRun Integrate(const Model& model, const BallPowerLaw& law, const FlexibleImpa
   sys.cor = in.cor;
   sys.out = &out;
   sys.sample.assign(size, 0.0);
-  EventIntegratorOptions io;
-  io.relative_tolerance = tol;
-  io.absolute_tolerance = tol;
-  io.max_steps = o.max_steps;
-  io.time_unit_s = rhs.t_s;
-  io.subject = "the contact";
-  EventIntegrator<State> integrator(io);
+  EventIntegrator<State> integrator(ContactIntegratorOptions(tol, o.max_steps, rhs.t_s));
   while (true) {
     ++out.contacts;
     rhs.branch = ContactBranch{};
@@ -270,13 +255,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
                                          const FlexibleImpactOptions& o) {
   return TimedSolve<FlexibleImpactResult>([&](FlexibleImpactResult& out) {
     Summary& s = out.summary;
-    s.backend = "odeint:runge_kutta_dopri5";
-    s.models_used = {"flexible"};
-    std::string why;
-    if (!o.IsValid(&why) || !in.IsValid(&why)) {
-      s.message = why;
-      return;
-    }
+    if (!StartContactSolve("flexible", &s, o, in)) return;
     if (!modes.summary.IsSolutionUsable() || modes.modes.empty() || modes.nodes_m.size() < 2) {
       s.termination = Termination::kFailure;
       s.message = "the bat's modes are not usable: " + modes.summary.message;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/collision/contact_integration.hpp"
 #include "core/collision/contact_law.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/event_integrator.hpp"
@@ -33,13 +34,6 @@ struct RawRun {
   int steps = 0;
   long evaluations = 0;
 };
-
-// The events (each crosses from > 0 to <= 0): delta1' falls through 0 (maximum compression),
-// delta1 falls through 0 (separation), delta1 rises back above delta_max (reload; it may
-// already be above it when an unloading step begins).
-enum EventId : int { kMaxCompression, kEnd, kReload };
-constexpr EventSpec kLoadingEvents[] = {{kMaxCompression, false}, {kEnd, false}};
-constexpr EventSpec kUnloadingEvents[] = {{kEnd, false}, {kReload, true}};
 
 // The contact as the event integrator sees it, on the scaled state. Scales: lengths by
 // delta_s, speeds by v0, time by t_s = delta_s / v0, impulses by p_s = v0 / c11.
@@ -85,10 +79,8 @@ struct HertzSystem {
     dy[5] = fh * t_s / p_s;
   }
 
-  std::span<const EventSpec> ActiveEvents() const {
-    if (branch.unloading) return kUnloadingEvents;
-    return kLoadingEvents;
-  }
+  std::span<const EventSpec> ActiveEvents() const { return ContactEvents(branch.unloading); }
+  // The contact's events on the compression delta1 (ContactEventId).
   double EventFunction(int id, const State& s) const {
     switch (id) {
       case kMaxCompression:
@@ -159,13 +151,7 @@ RawRun Integrate(const HertzProblem& p, double tol, int max_steps) {
                   " m, t_s = " + FormatNumber17(sys.t_s) + " s)";
     return out;
   }
-  EventIntegratorOptions o;
-  o.relative_tolerance = tol;
-  o.absolute_tolerance = tol;
-  o.max_steps = max_steps;
-  o.time_unit_s = sys.t_s;
-  o.subject = "the contact";
-  EventIntegrator<State> integrator(o);
+  EventIntegrator<State> integrator(ContactIntegratorOptions(tol, max_steps, sys.t_s));
   State y{0.0, 1.0, 0.0, 0.0, 0.0, 0.0};
   double t = 0.0;
   const bool stopped = integrator.Run(sys, &y, &t);
@@ -289,13 +275,7 @@ HertzImpact SolveHertzImpact(const HertzProblem& problem, const HertzSolverOptio
   return TimedSolve<HertzImpact>([&](HertzImpact& out) {
     out.problem = problem;
     Summary& s = out.summary;
-    s.backend = "odeint:runge_kutta_dopri5";
-    s.models_used = {"hertz"};
-    std::string why;
-    if (!problem.IsValid(&why) || !options.IsValid(&why)) {
-      s.message = why;
-      return;
-    }
+    if (!StartContactSolve("hertz", &s, problem, options)) return;
     const RefinedRuns<RawRun> runs = SolveWithRefineCheck<RawRun>(
         options.relative_tolerance, options.refine_check,
         [&](double tol) { return Integrate(problem, tol, options.max_steps); });
