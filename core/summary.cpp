@@ -1,5 +1,6 @@
 #include "core/summary.hpp"
 
+#include <exception>
 #include <sstream>
 
 namespace sweetspot::core {
@@ -18,6 +19,16 @@ const char* TerminationName(Termination t) {
       return "invalid_input";
   }
   return "failure";
+}
+
+std::string InternalErrorMessage() {
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    return std::string("internal error: ") + e.what();
+  } catch (...) {
+    return "internal error";
+  }
 }
 
 std::string Summary::BriefReport() const {

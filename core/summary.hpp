@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace sweetspot::core {
@@ -44,5 +45,21 @@ struct Summary {
   /// Every field, one per line.
   std::string FullReport() const;
 };
+
+/// The message of the exception being handled: "internal error: " + what() for a
+/// std::exception, "internal error" for anything else. Call only inside a catch block.
+std::string InternalErrorMessage();
+
+/// Runs `body()`; what it throws makes `*summary` a failure with InternalErrorMessage(), so
+/// that no exception leaves a solve.
+template <class Body>
+void CatchInternalError(Summary* summary, Body&& body) {
+  try {
+    std::forward<Body>(body)();
+  } catch (...) {
+    summary->termination = Termination::kFailure;
+    summary->message = InternalErrorMessage();
+  }
+}
 
 }  // namespace sweetspot::core

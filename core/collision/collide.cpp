@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 
 #include "core/geometry_format.hpp"
@@ -18,43 +17,32 @@ bool CollisionOptions::IsValid(std::string* why) const {
 CollisionResult Collide(const Scene& scene, double impact_from_knob_m, CollisionModel model,
                         const CollisionOptions& options) {
   constexpr double kEps = std::numeric_limits<double>::epsilon();
-  const auto t0 = std::chrono::steady_clock::now();
-  CollisionResult out;
-  Summary& s = out.summary;
-  s.termination = Termination::kInvalidInput;
-  s.backend = "closed_form";
-  TimingBook book;
-  out.impact_from_knob_m = impact_from_knob_m;
-  auto finish = [&]() -> CollisionResult& {
-    out.timings = book.timings();
-    s.models_used = book.Models();
-    s.solve_time_s = SecondsSince(t0);
-    return out;
-  };
-  try {
+  return TimedRequest<CollisionResult>("closed_form", [&](CollisionResult& out, TimingBook& book) {
+    Summary& s = out.summary;
+    out.impact_from_knob_m = impact_from_knob_m;
     std::string why;
     if (!options.IsValid(&why)) {
       s.message = why;
-      return finish();
+      return;
     }
     if (model == CollisionModel::kFlexible && !scene.bat.has_value()) {
       out.model = model;
       s.message =
           "bat: model = flexible needs the bat's geometry (a bat, not only mass_properties)";
-      return finish();
+      return;
     }
     ResolvedScene r;
     const bool resolved = ResolveScene(scene, /*needs_cor=*/true, &book, &r, &s);
     // Also when refused: the caller can then tell properties that are not usable (the bat's).
     out.mass_properties = r.mass_properties;
-    if (!resolved) return finish();
+    if (!resolved) return;
     out.cor = *r.cor;
     if (!(std::isfinite(impact_from_knob_m) && impact_from_knob_m >= 0.0 &&
           impact_from_knob_m <= r.length_m)) {
       s.termination = Termination::kInvalidInput;
       s.message = "impact_from_knob_m = " + FormatNumber17(impact_from_knob_m) +
                   ": must be within the bat [0, " + FormatNumber17(r.length_m) + "]";
-      return finish();
+      return;
     }
     if (model == CollisionModel::kAuto) {
       if (options.want_contact_details) {
@@ -79,7 +67,20 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
       s.termination = Termination::kConverged;
       s.message = "closed form";
     };
-    const auto tm = std::chrono::steady_clock::now();
+    // An integrated impact (hertz, flexible): its report becomes the collision's (termination,
+    // message, backend, counts; its warnings after those already noted).
+    const auto integrated = [&](const auto& impact) {
+      const Summary& is = impact.summary;
+      s.termination = is.termination;
+      s.message = is.message;
+      s.backend = is.backend;
+      s.iterations = is.iterations;
+      s.evaluations = is.evaluations;
+      for (const auto& w : is.warnings) s.warnings.push_back(w);
+      out.exit_speed_mps = impact.exit_speed_mps;
+      out.error_estimate_mps = impact.error_estimate_exit_speed_mps;
+    };
+    auto tm = std::chrono::steady_clock::now();
     switch (model) {
       case CollisionModel::kRigidPivot:
         out.rigid_pivot = RigidPivotImpactAt(RigidPivotInputsFor(scene, r), impact_from_knob_m);
@@ -95,45 +96,27 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
             HertzProblemFor(scene, r, impact_from_knob_m, options.hertz, &warnings);
         out.approach_speed_mps = p.approach_speed_mps;
         out.hertz = SolveHertzImpact(p, options.hertz.solver);
-        const Summary& hs = out.hertz->summary;
-        s.termination = hs.termination;
-        s.message = hs.message;
-        s.backend = hs.backend;
-        s.iterations = hs.iterations;
-        s.evaluations = hs.evaluations;
         s.warnings = warnings;
-        for (const auto& w : hs.warnings) s.warnings.push_back(w);
-        out.exit_speed_mps = out.hertz->exit_speed_mps;
-        out.error_estimate_mps = out.hertz->error_estimate_exit_speed_mps;
+        integrated(*out.hertz);
         break;
       }
       case CollisionModel::kFlexible: {
         FlexibleModes flexible_modes(scene, options.flexible, &book);
         const auto& modes = flexible_modes.Impact();
         out.modes_cache_hit = flexible_modes.impact_hit();
-        if (FlexibleModesRefused(*modes, &s)) return finish();
-        const auto tf = std::chrono::steady_clock::now();
+        if (FlexibleModesRefused(*modes, &s)) return;
+        tm = std::chrono::steady_clock::now();  // the modes have their own timing
         const FlexibleImpactInputs in =
             FlexibleImpactInputsFor(scene, r, impact_from_knob_m, options.hertz);
         out.approach_speed_mps = in.approach_speed_mps;
         out.flexible = SolveFlexibleImpact(*scene.bat, *modes, in, options.flexible.impact);
-        const Summary& fs = out.flexible->summary;
-        s.termination = fs.termination;
-        if (fs.IsSolutionUsable() && modes->summary.termination == Termination::kNoConvergence) {
+        for (const auto& w : modes->summary.warnings) s.warnings.push_back("flexible_beam: " + w);
+        integrated(*out.flexible);
+        if (out.flexible->summary.IsSolutionUsable() &&
+            modes->summary.termination == Termination::kNoConvergence) {
           s.termination = Termination::kNoConvergence;
         }
-        s.message = fs.message;
-        s.backend = fs.backend;
-        s.iterations = fs.iterations;
-        s.evaluations = fs.evaluations;
-        for (const auto& w : modes->summary.warnings) s.warnings.push_back("flexible_beam: " + w);
-        for (const auto& w : fs.warnings) s.warnings.push_back(w);
-        out.exit_speed_mps = out.flexible->exit_speed_mps;
-        out.error_estimate_mps = out.flexible->error_estimate_exit_speed_mps;
-        book.Add(CollisionModelName(model), SecondsSince(tf), 1);
-        s.objective = out.exit_speed_mps;
-        s.error_estimate = out.error_estimate_mps;
-        return finish();
+        break;
       }
       default:
         s.termination = Termination::kFailure;
@@ -143,14 +126,7 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
     book.Add(CollisionModelName(model), SecondsSince(tm), 1);
     s.objective = out.exit_speed_mps;
     s.error_estimate = out.error_estimate_mps;
-  } catch (const std::exception& e) {
-    s.termination = Termination::kFailure;
-    s.message = std::string("internal error: ") + e.what();
-  } catch (...) {
-    s.termination = Termination::kFailure;
-    s.message = "internal error";
-  }
-  return finish();
+  });
 }
 
 }  // namespace sweetspot::core

@@ -2,18 +2,18 @@
 #include "core/collision/flexible_impact.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <span>
 #include <utility>
 
+#include "core/collision/contact_integration.hpp"
 #include "core/collision/contact_law.hpp"
 #include "core/collision/flexible_modal_system.hpp"
 #include "core/flexible/static_flexibility.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/event_integrator.hpp"
+#include "core/scene/timing_book.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -35,13 +35,6 @@ bool Fail(std::string* why, const std::string& m) {
   return false;
 }
 
-// The events of one contact (each crosses from > 0 to <= 0): the compression rate falls through
-// 0 (maximum compression), the compression falls through 0 (separation), the compression rises
-// back above its maximum (reload; it may already be above it when an unloading step begins).
-enum EventId : int { kMaxCompression, kEnd, kReload };
-constexpr EventSpec kLoadingEvents[] = {{kMaxCompression, false}, {kEnd, false}};
-constexpr EventSpec kUnloadingEvents[] = {{kEnd, false}, {kReload, true}};
-
 // One contact as the event integrator sees it: the right-hand side of Rhs, its events, the
 // hands' loads sampled on every step and the branch changes at the events.
 struct FlexibleSystem {
@@ -53,10 +46,7 @@ struct FlexibleSystem {
   bool plastic = false;
 
   void operator()(const State& y, State& dy, double t) const { (*rhs)(y, dy, t); }
-  std::span<const EventSpec> ActiveEvents() const {
-    if (rhs->branch.unloading) return kUnloadingEvents;
-    return kLoadingEvents;
-  }
+  std::span<const EventSpec> ActiveEvents() const { return ContactEvents(rhs->branch.unloading); }
   double EventFunction(int id, const State& s) const {
     switch (id) {
       case kMaxCompression:
@@ -133,13 +123,7 @@ RawRun Integrate(const Model& model, const BallPowerLaw& law, const FlexibleImpa
   sys.cor = in.cor;
   sys.out = &out;
   sys.sample.assign(size, 0.0);
-  EventIntegratorOptions io;
-  io.relative_tolerance = tol;
-  io.absolute_tolerance = tol;
-  io.max_steps = o.max_steps;
-  io.time_unit_s = rhs.t_s;
-  io.subject = "the contact";
-  EventIntegrator<State> integrator(io);
+  EventIntegrator<State> integrator(ContactIntegratorOptions(tol, o.max_steps, rhs.t_s));
   while (true) {
     ++out.contacts;
     rhs.branch = ContactBranch{};
@@ -269,37 +253,24 @@ bool FlexibleImpactInputs::IsValid(std::string* why) const {
 FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
                                          const FlexibleImpactInputs& in,
                                          const FlexibleImpactOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  FlexibleImpactResult out;
-  Summary& s = out.summary;
-  s.backend = "odeint:runge_kutta_dopri5";
-  s.models_used = {"flexible"};
-  s.termination = Termination::kInvalidInput;
-  auto finish = [&]() -> FlexibleImpactResult& {
-    s.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return out;
-  };
-  try {
-    std::string why;
-    if (!o.IsValid(&why) || !in.IsValid(&why)) {
-      s.message = why;
-      return finish();
-    }
+  return TimedSolve<FlexibleImpactResult>([&](FlexibleImpactResult& out) {
+    Summary& s = out.summary;
+    if (!StartContactSolve("flexible", &s, o, in)) return;
     if (!modes.summary.IsSolutionUsable() || modes.modes.empty() || modes.nodes_m.size() < 2) {
       s.termination = Termination::kFailure;
       s.message = "the bat's modes are not usable: " + modes.summary.message;
-      return finish();
+      return;
     }
     const double length = modes.length_m;
     if (!(in.impact_from_knob_m >= 0.0 && in.impact_from_knob_m <= length)) {
       s.message = "impact_from_knob_m = " + FormatNumber17(in.impact_from_knob_m) +
                   ": must be within the bat [0, " + FormatNumber17(length) + "]";
-      return finish();
+      return;
     }
     if (!(in.hands_from_knob_m >= 0.0 && in.hands_from_knob_m <= length)) {
       s.message = "swing.hands_from_knob_m = " + FormatNumber17(in.hands_from_knob_m) +
                   ": must be within the bat [0, " + FormatNumber17(length) + "]";
-      return finish();
+      return;
     }
     out.theory = modes.theory;
     out.elements = modes.Elements();
@@ -322,7 +293,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     if (!(std::isfinite(delta_s) && delta_s > 0.0 && std::isfinite(out.cutoff_hz))) {
       s.termination = Termination::kFailure;
       s.message = "contact scales are not finite (delta_s = " + FormatNumber17(delta_s) + " m)";
-      return finish();
+      return;
     }
     const double t_s = delta_s / v0;
     const int available = static_cast<int>(modes.modes.size());
@@ -372,7 +343,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
       if (!std::isfinite(flexibility)) {
         s.termination = Termination::kFailure;
         s.message = "the static flexibility at the impact point could not be computed";
-        return finish();
+        return;
       }
     }
     auto residual_for = [&](int n_flex) {
@@ -417,6 +388,11 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     // Energies and sting of one run.
     struct Outcome {
       double exit = 0.0, vib = 0.0, hands = 0.0;
+      // |this - other| per quantity: the change between two runs.
+      Outcome DistanceTo(const Outcome& other) const {
+        return {std::abs(exit - other.exit), std::abs(vib - other.vib),
+                std::abs(hands - other.hands)};
+      }
     };
     const double e_scale = m * v0 * v0;  // scaled energy -> J
     auto outcome_of = [&](const Model& md, const RawRun& r) {
@@ -450,15 +426,9 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     const RefinedRuns<RawRun> runs = SolveWithRefineCheck<RawRun>(
         o.relative_tolerance, o.refine_check,
         [&](double tol) { return Integrate(full, law, in, delta_s, tol, o, window); });
+    out.steps = CountRefinedRuns(runs, &s);
+    if (!runs.coarse.ok) return;
     const RawRun& a = runs.coarse;
-    s.iterations = a.steps;
-    s.evaluations = static_cast<int>(a.evaluations);
-    out.steps = a.steps;
-    if (!a.ok) {
-      s.termination = Termination::kFailure;
-      s.message = a.message;
-      return finish();
-    }
     const Outcome oa = outcome_of(full, a);
     const State& y = a.final_state;
     out.exit_speed_mps = oa.exit;
@@ -493,39 +463,31 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
 
     if (runs.refined) {
       const RawRun& fine = runs.fine;
-      out.steps += fine.steps;
-      s.evaluations += static_cast<int>(fine.evaluations);
-      double de = 0.0, dv = 0.0, dh = 0.0;
+      Outcome integration;  // the change with the finer tolerance
       if (fine.ok) {
-        const Outcome of = outcome_of(full, fine);
-        de = std::abs(of.exit - oa.exit);
-        dv = std::abs(of.vib - oa.vib);
-        dh = std::abs(of.hands - oa.hands);
+        integration = outcome_of(full, fine).DistanceTo(oa);
       } else {
         s.warnings.push_back(RefineFailedWarning(fine.message));
-        de = o.relative_tolerance * (u + std::abs(oa.exit));
+        integration.exit = o.relative_tolerance * (u + std::abs(oa.exit));
       }
-      out.integration_error_exit_speed_mps = de;
+      out.integration_error_exit_speed_mps = integration.exit;
       const int n_half = count_below(0.5 * out.cutoff_hz);
-      double te = 0.0, tv = 0.0, th = 0.0;
+      Outcome truncation;  // the change with half the cutoff
       if (n_half < n_used) {
         const Model half = subset(n_half);
         RawRun hr = Integrate(half, law, in, delta_s, o.relative_tolerance, o, window);
         out.steps += hr.steps;
         s.evaluations += static_cast<int>(hr.evaluations);
         if (hr.ok) {
-          const Outcome oh = outcome_of(half, hr);
-          te = std::abs(oh.exit - oa.exit);
-          tv = std::abs(oh.vib - oa.vib);
-          th = std::abs(oh.hands - oa.hands);
+          truncation = outcome_of(half, hr).DistanceTo(oa);
         } else {
           s.warnings.push_back("the truncation check with half the cutoff failed: " + hr.message);
         }
       }
-      out.truncation_error_exit_speed_mps = te;
-      out.error_estimate_exit_speed_mps = de + te;
-      out.error_estimate_vibration_energy_j = dv + tv;
-      out.error_estimate_hands_energy_j = dh + th;
+      out.truncation_error_exit_speed_mps = truncation.exit;
+      out.error_estimate_exit_speed_mps = integration.exit + truncation.exit;
+      out.error_estimate_vibration_energy_j = integration.vib + truncation.vib;
+      out.error_estimate_hands_energy_j = integration.hands + truncation.hands;
     } else {
       out.error_estimate_exit_speed_mps = o.relative_tolerance * (u + std::abs(oa.exit));
     }
@@ -536,14 +498,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
                 ", " + std::to_string(n_used) + " bending modes)";
     s.objective = out.exit_speed_mps;
     s.error_estimate = out.error_estimate_exit_speed_mps;
-  } catch (const std::exception& ex) {
-    s.termination = Termination::kFailure;
-    s.message = std::string("internal error: ") + ex.what();
-  } catch (...) {
-    s.termination = Termination::kFailure;
-    s.message = "internal error";
-  }
-  return finish();
+  });
 }
 
 }  // namespace sweetspot::core

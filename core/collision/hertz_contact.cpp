@@ -4,15 +4,16 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "core/collision/contact_integration.hpp"
 #include "core/collision/contact_law.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/event_integrator.hpp"
+#include "core/scene/timing_book.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -33,13 +34,6 @@ struct RawRun {
   int steps = 0;
   long evaluations = 0;
 };
-
-// The events (each crosses from > 0 to <= 0): delta1' falls through 0 (maximum compression),
-// delta1 falls through 0 (separation), delta1 rises back above delta_max (reload; it may
-// already be above it when an unloading step begins).
-enum EventId : int { kMaxCompression, kEnd, kReload };
-constexpr EventSpec kLoadingEvents[] = {{kMaxCompression, false}, {kEnd, false}};
-constexpr EventSpec kUnloadingEvents[] = {{kEnd, false}, {kReload, true}};
 
 // The contact as the event integrator sees it, on the scaled state. Scales: lengths by
 // delta_s, speeds by v0, time by t_s = delta_s / v0, impulses by p_s = v0 / c11.
@@ -85,10 +79,8 @@ struct HertzSystem {
     dy[5] = fh * t_s / p_s;
   }
 
-  std::span<const EventSpec> ActiveEvents() const {
-    if (branch.unloading) return kUnloadingEvents;
-    return kLoadingEvents;
-  }
+  std::span<const EventSpec> ActiveEvents() const { return ContactEvents(branch.unloading); }
+  // The contact's events on the compression delta1 (ContactEventId).
   double EventFunction(int id, const State& s) const {
     switch (id) {
       case kMaxCompression:
@@ -159,13 +151,7 @@ RawRun Integrate(const HertzProblem& p, double tol, int max_steps) {
                   " m, t_s = " + FormatNumber17(sys.t_s) + " s)";
     return out;
   }
-  EventIntegratorOptions o;
-  o.relative_tolerance = tol;
-  o.absolute_tolerance = tol;
-  o.max_steps = max_steps;
-  o.time_unit_s = sys.t_s;
-  o.subject = "the contact";
-  EventIntegrator<State> integrator(o);
+  EventIntegrator<State> integrator(ContactIntegratorOptions(tol, max_steps, sys.t_s));
   State y{0.0, 1.0, 0.0, 0.0, 0.0, 0.0};
   double t = 0.0;
   const bool stopped = integrator.Run(sys, &y, &t);
@@ -286,68 +272,47 @@ bool HertzOptions::IsValid(std::string* why) const {
 }
 
 HertzImpact SolveHertzImpact(const HertzProblem& problem, const HertzSolverOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  HertzImpact out;
-  out.problem = problem;
-  Summary& s = out.summary;
-  s.backend = "odeint:runge_kutta_dopri5";
-  s.models_used = {"hertz"};
-  s.termination = Termination::kInvalidInput;
-  auto finish = [&]() -> HertzImpact& {
-    s.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return out;
-  };
-  std::string why;
-  if (!problem.IsValid(&why) || !options.IsValid(&why)) {
-    s.message = why;
-    return finish();
-  }
-  const RefinedRuns<RawRun> runs = SolveWithRefineCheck<RawRun>(
-      options.relative_tolerance, options.refine_check,
-      [&](double tol) { return Integrate(problem, tol, options.max_steps); });
-  const RawRun& a = runs.coarse;
-  s.iterations = a.steps;
-  s.evaluations = static_cast<int>(a.evaluations);
-  out.steps = a.steps;
-  if (!a.ok) {
-    s.termination = Termination::kFailure;
-    s.message = a.message;
-    return finish();
-  }
-  out.contact_time_s = a.contact_time_s;
-  out.max_compression_m = a.max_compression_m;
-  out.peak_force_n = a.peak_force_n;
-  out.ball_impulse_n_s = a.ball_impulse_n_s;
-  out.hands_impulse_n_s = a.hands_impulse_n_s;
-  out.separation_speed_mps = a.separation_speed_mps;
-  out.apparent_cor = a.separation_speed_mps / problem.approach_speed_mps;
-  out.exit_speed_mps = -problem.ball_speed_mps + a.ball_impulse_n_s / problem.ball_mass_kg;
-  out.unloading_exponent = a.q;
-  s.warnings = a.warnings;
-  if (runs.refined) {
-    const RawRun& b = runs.fine;
-    out.steps += b.steps;
-    s.iterations = out.steps;
-    s.evaluations += static_cast<int>(b.evaluations);
-    if (!b.ok) {
-      s.warnings.push_back(RefineFailedWarning(b.message) +
-                           "; error estimates are the tolerance only");
-      out.error_estimate_contact_time_s = options.relative_tolerance * a.contact_time_s;
-      out.error_estimate_exit_speed_mps =
-          options.relative_tolerance * (problem.ball_speed_mps + std::abs(out.exit_speed_mps));
-      out.error_estimate_peak_force_n = options.relative_tolerance * a.peak_force_n;
-    } else {
-      out.error_estimate_contact_time_s = std::abs(a.contact_time_s - b.contact_time_s);
-      const double vb = -problem.ball_speed_mps + b.ball_impulse_n_s / problem.ball_mass_kg;
-      out.error_estimate_exit_speed_mps = std::abs(out.exit_speed_mps - vb);
-      out.error_estimate_peak_force_n = std::abs(a.peak_force_n - b.peak_force_n);
+  return TimedSolve<HertzImpact>([&](HertzImpact& out) {
+    out.problem = problem;
+    Summary& s = out.summary;
+    if (!StartContactSolve("hertz", &s, problem, options)) return;
+    const RefinedRuns<RawRun> runs = SolveWithRefineCheck<RawRun>(
+        options.relative_tolerance, options.refine_check,
+        [&](double tol) { return Integrate(problem, tol, options.max_steps); });
+    out.steps = CountRefinedRuns(runs, &s);
+    if (!runs.coarse.ok) return;
+    const RawRun& a = runs.coarse;
+    out.contact_time_s = a.contact_time_s;
+    out.max_compression_m = a.max_compression_m;
+    out.peak_force_n = a.peak_force_n;
+    out.ball_impulse_n_s = a.ball_impulse_n_s;
+    out.hands_impulse_n_s = a.hands_impulse_n_s;
+    out.separation_speed_mps = a.separation_speed_mps;
+    out.apparent_cor = a.separation_speed_mps / problem.approach_speed_mps;
+    out.exit_speed_mps = -problem.ball_speed_mps + a.ball_impulse_n_s / problem.ball_mass_kg;
+    out.unloading_exponent = a.q;
+    s.warnings = a.warnings;
+    if (runs.refined) {
+      const RawRun& b = runs.fine;
+      if (!b.ok) {
+        s.warnings.push_back(RefineFailedWarning(b.message) +
+                             "; error estimates are the tolerance only");
+        out.error_estimate_contact_time_s = options.relative_tolerance * a.contact_time_s;
+        out.error_estimate_exit_speed_mps =
+            options.relative_tolerance * (problem.ball_speed_mps + std::abs(out.exit_speed_mps));
+        out.error_estimate_peak_force_n = options.relative_tolerance * a.peak_force_n;
+      } else {
+        out.error_estimate_contact_time_s = std::abs(a.contact_time_s - b.contact_time_s);
+        const double vb = -problem.ball_speed_mps + b.ball_impulse_n_s / problem.ball_mass_kg;
+        out.error_estimate_exit_speed_mps = std::abs(out.exit_speed_mps - vb);
+        out.error_estimate_peak_force_n = std::abs(a.peak_force_n - b.peak_force_n);
+      }
     }
-  }
-  s.termination = Termination::kConverged;
-  s.message = "contact ended after " + FormatNumber17(out.contact_time_s) + " s";
-  s.objective = out.exit_speed_mps;
-  s.error_estimate = out.error_estimate_exit_speed_mps;
-  return finish();
+    s.termination = Termination::kConverged;
+    s.message = "contact ended after " + FormatNumber17(out.contact_time_s) + " s";
+    s.objective = out.exit_speed_mps;
+    s.error_estimate = out.error_estimate_exit_speed_mps;
+  });
 }
 
 }  // namespace sweetspot::core

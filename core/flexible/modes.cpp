@@ -2,7 +2,6 @@
 #include "core/flexible/modes.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -12,6 +11,7 @@
 #include <boost/math/tools/roots.hpp>
 
 #include "core/geometry_format.hpp"
+#include "core/scene/timing_book.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -333,28 +333,21 @@ std::vector<double> DisplacementZeros(const BatModes& modes, const Eigen::Vector
 }
 
 BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  BatModes out;
-  Summary& s = out.summary;
-  s.backend = "eigen:generalized_self_adjoint";
-  s.models_used = {"flexible_beam"};
-  s.termination = Termination::kInvalidInput;
-  out.theory = options.theory;
-  out.rotary_inertia = options.rotary_inertia && options.theory == BeamTheory::kTimoshenko;
-  out.tolerance = options.relative_tolerance;
-  auto finish = [&]() -> BatModes& {
-    s.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return out;
-  };
-  try {
+  return TimedSolve<BatModes>([&](BatModes& out) {
+    Summary& s = out.summary;
+    s.backend = "eigen:generalized_self_adjoint";
+    s.models_used = {"flexible_beam"};
+    out.theory = options.theory;
+    out.rotary_inertia = options.rotary_inertia && options.theory == BeamTheory::kTimoshenko;
+    out.tolerance = options.relative_tolerance;
     std::string why;
     if (!options.IsValid(&why)) {
       s.message = why;
-      return finish();
+      return;
     }
     if (!bat.IsValid(&why)) {
       s.message = "bat." + why;
-      return finish();
+      return;
     }
     out.length_m = bat.LengthM();
     double r_max = 0.0;
@@ -363,7 +356,7 @@ BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
       s.message = "bat.length_m = " + FormatNumber17(out.length_m) +
                   ": the beam model needs a slender bat (length at least 4 x the largest radius " +
                   FormatNumber17(r_max) + " m)";
-      return finish();
+      return;
     }
     const int n0 = std::max(options.initial_elements, 2 * options.num_modes + 4);
     std::vector<Level> levels;
@@ -380,7 +373,7 @@ BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
                       ": the bat needs at least " + std::to_string(mesh.Elements()) +
                       " elements (one per profile segment, and " + std::to_string(n0) +
                       " for the modes asked for)";
-          return finish();
+          return;
         }
         break;
       }
@@ -389,7 +382,7 @@ BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
                       &why)) {
         s.termination = Termination::kFailure;
         s.message = why;
-        return finish();
+        return;
       }
       out.refinement_elements.push_back(lv.mesh.Elements());
       levels.push_back(std::move(lv));
@@ -521,14 +514,7 @@ BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
                             std::to_string(out.Elements()) + " elements)";
       s.warnings.push_back(s.message);
     }
-  } catch (const std::exception& e) {
-    s.termination = Termination::kFailure;
-    s.message = std::string("internal error: ") + e.what();
-  } catch (...) {
-    s.termination = Termination::kFailure;
-    s.message = "internal error";
-  }
-  return finish();
+  });
 }
 
 }  // namespace sweetspot::core

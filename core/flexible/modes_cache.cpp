@@ -2,7 +2,6 @@
 #include "core/flexible/modes_cache.hpp"
 
 #include <cstring>
-#include <exception>
 
 namespace sweetspot::core {
 namespace {
@@ -119,15 +118,10 @@ std::shared_ptr<const BatModes> CachedBatModes(const Bat& bat, const BeamModesOp
     auto modes = std::make_shared<const BatModes>(ComputeBatModes(bat, options));
     if (cache != nullptr && modes->summary.IsSolutionUsable()) cache->Insert(key, modes);
     return modes;
-  } catch (const std::exception& e) {
-    auto failed = std::make_shared<BatModes>();
-    failed->summary.termination = Termination::kFailure;
-    failed->summary.message = std::string("internal error: ") + e.what();
-    return failed;
   } catch (...) {
     auto failed = std::make_shared<BatModes>();
     failed->summary.termination = Termination::kFailure;
-    failed->summary.message = "internal error";
+    failed->summary.message = InternalErrorMessage();
     return failed;
   }
 }

@@ -29,6 +29,8 @@
 #include <boost/math/tools/roots.hpp>
 #include <boost/numeric/odeint.hpp>
 
+#include "core/summary.hpp"
+
 namespace sweetspot::core {
 
 /// Settings of one event integrator (the time unit is the system's own, often a scaled time).
@@ -171,6 +173,22 @@ RefinedRuns<Run> SolveWithRefineCheck(double tolerance, bool refine_check, Solve
     out.fine = solve(tolerance / kRefineToleranceDivisor);
   }
   return out;
+}
+
+/// Counts the runs of a refine check into a model's `summary`: iterations = the steps of both
+/// runs (also returned, for the result's own step count), evaluations = theirs. A failed coarse
+/// run makes `summary` a failure with the run's message (Run::ok, Run::message).
+template <class Run>
+int CountRefinedRuns(const RefinedRuns<Run>& runs, Summary* summary) {
+  const int steps = runs.coarse.steps + (runs.refined ? runs.fine.steps : 0);
+  summary->iterations = steps;
+  summary->evaluations = static_cast<int>(runs.coarse.evaluations);
+  if (runs.refined) summary->evaluations += static_cast<int>(runs.fine.evaluations);
+  if (!runs.coarse.ok) {
+    summary->termination = Termination::kFailure;
+    summary->message = runs.coarse.message;
+  }
+  return steps;
 }
 
 /// "the refinement run at tolerance / 16 failed: <message>".

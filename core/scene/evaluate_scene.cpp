@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <exception>
 
 #include "core/geometry_format.hpp"
 #include "core/scene/resolved_scene.hpp"
@@ -100,23 +99,12 @@ std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model
 }
 
 SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  SceneResult out;
-  Summary& s = out.summary;
-  s.backend = "scene";
-  s.termination = Termination::kInvalidInput;
-  TimingBook book;
-  auto finish = [&]() -> SceneResult& {
-    out.timings = book.timings();
-    s.models_used = book.Models();
-    s.solve_time_s = SecondsSince(t0);
-    return out;
-  };
-  try {
+  return TimedRequest<SceneResult>("scene", [&](SceneResult& out, TimingBook& book) {
+    Summary& s = out.summary;
     std::string why;
     if (!options.IsValid(&why)) {
       s.message = why;
-      return finish();
+      return;
     }
     std::vector<SceneOutput> wanted;
     for (SceneOutput o : scene.outputs) {
@@ -131,14 +119,14 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
           s.message = std::string("bat: ") + SceneOutputName(o) +
                       " needs the bat's geometry (a bat, not only mass_properties)";
           out.refused_field = "bat";
-          return finish();
+          return;
         }
       }
       if (flexible_exit) {
         s.message =
             "bat: model = flexible needs the bat's geometry (a bat, not only mass_properties)";
         out.refused_field = "bat";
-        return finish();
+        return;
       }
     }
     ResolvedScene r;
@@ -146,7 +134,7 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
     const bool resolved = ResolveScene(scene, needs_cor, &book, &r, &s);
     // Also when refused: the caller can then tell properties that are not usable (the bat's).
     out.mass_properties = r.mass_properties;
-    if (!resolved) return finish();
+    if (!resolved) return;
     out.cor = r.cor;
     out.cor_source = r.cor_source;
     out.length_m = r.length_m;
@@ -157,7 +145,7 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
         s.message = "curve_positions_from_knob_m[" + std::to_string(i) +
                     "] = " + FormatNumber17(x) + ": must be within the bat [0, " +
                     FormatNumber17(r.length_m) + "]";
-        return finish();
+        return;
       }
     }
     CollisionModel model = options.model;
@@ -184,7 +172,7 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
         const auto& modes = flexible_modes.Impact();
         if (FlexibleModesRefused(*modes, &s)) {
           if (s.termination == Termination::kInvalidInput) out.refused_field = "bat";
-          return finish();
+          return;
         }
         for (const auto& w : modes->summary.warnings) s.warnings.push_back("flexible_beam: " + w);
         exit_model.emplace(model, scene, r, options.hertz, &book, &options.flexible, modes);
@@ -339,14 +327,7 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
       worst_err = std::max(worst_err, out.least_sting_zone->error_estimate_m);
     }
     s.error_estimate = worst_err;
-  } catch (const std::exception& e) {
-    s.termination = Termination::kFailure;
-    s.message = std::string("internal error: ") + e.what();
-  } catch (...) {
-    s.termination = Termination::kFailure;
-    s.message = "internal error";
-  }
-  return finish();
+  });
 }
 
 }  // namespace sweetspot::core

@@ -1,9 +1,13 @@
-// The time spent per model within one request, and the models_used list it implies.
+// The time spent per model within one request, and the models_used list it implies; the
+// frame of a timed solve (its wall time, and no exception leaving it).
 #pragma once
 
 #include <chrono>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "core/summary.hpp"
 
 namespace sweetspot::core {
 
@@ -45,5 +49,33 @@ class TimingBook {
  private:
   std::vector<ModelTiming> timings_;
 };
+
+/// Runs one solve: `body(out)` fills a fresh `Result` (a struct with a `Summary summary`),
+/// whose termination starts as invalid input; what `body` throws becomes an internal error
+/// (CatchInternalError); summary.solve_time_s is the wall time of it all, s.
+template <class Result, class Body>
+Result TimedSolve(Body&& body) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Result out;
+  out.summary.termination = Termination::kInvalidInput;
+  CatchInternalError(&out.summary, [&] { body(out); });
+  out.summary.solve_time_s = SecondsSince(t0);
+  return out;
+}
+
+/// Runs one request as TimedSolve does, with `backend` as the summary's backend and a fresh
+/// TimingBook for `body(out, book)`: the result's `timings` and summary.models_used are the
+/// book's, however the request ended.
+template <class Result, class Body>
+Result TimedRequest(const char* backend, Body&& body) {
+  TimingBook book;
+  Result out = TimedSolve<Result>([&](Result& r) {
+    r.summary.backend = backend;
+    body(r, book);
+  });
+  out.timings = book.timings();
+  out.summary.models_used = book.Models();
+  return out;
+}
 
 }  // namespace sweetspot::core

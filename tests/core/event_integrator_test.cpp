@@ -261,6 +261,36 @@ TEST(EventIntegrator, TheRefineCheckRunsAtASixteenthOfTheTolerance) {
   EXPECT_STREQ(EventTerminationName(EventTermination::kStepBound), "step_bound");
 }
 
+struct CountedRun {
+  bool ok = false;
+  int steps = 0;
+  long evaluations = 0;
+  std::string message;
+};
+
+TEST(EventIntegrator, CountRefinedRunsAddsBothRunsAndReportsAFailedCoarseRun) {
+  RefinedRuns<CountedRun> runs;
+  runs.coarse = {true, 40, 250, ""};
+  runs.fine = {false, 90, 560, "the step bound"};
+  Summary s;
+  EXPECT_EQ(CountRefinedRuns(runs, &s), 40);  // the fine run was not made
+  EXPECT_EQ(s.iterations, 40);
+  EXPECT_EQ(s.evaluations, 250);
+  EXPECT_EQ(s.termination, Termination::kInvalidInput);
+  runs.refined = true;  // a failed fine run is counted, and is the caller's warning
+  EXPECT_EQ(CountRefinedRuns(runs, &s), 130);
+  EXPECT_EQ(s.iterations, 130);
+  EXPECT_EQ(s.evaluations, 810);
+  EXPECT_EQ(s.termination, Termination::kInvalidInput);
+  EXPECT_EQ(s.message, "");
+  runs = RefinedRuns<CountedRun>{};
+  runs.coarse = {false, 12, 80, "the contact: non-finite state"};
+  EXPECT_EQ(CountRefinedRuns(runs, &s), 12);
+  EXPECT_EQ(s.evaluations, 80);
+  EXPECT_EQ(s.termination, Termination::kFailure);
+  EXPECT_EQ(s.message, "the contact: non-finite state");
+}
+
 }  // namespace
 }  // namespace event_integrator_test
 }  // namespace sweetspot::core

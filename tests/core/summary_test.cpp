@@ -1,5 +1,7 @@
 #include "core/summary.hpp"
 
+#include <stdexcept>
+
 #include <gtest/gtest.h>
 
 #include "core/version.hpp"
@@ -48,6 +50,35 @@ TEST(SummaryTest, ReportsNameEveryField) {
   for (const char* field : {"termination: converged", "backend: closed_form", "iterations: 3",
                             "models_used: mass_properties rigid_pivot"}) {
     EXPECT_NE(full.find(field), std::string::npos) << field;
+  }
+}
+
+TEST(SummaryTest, CatchInternalErrorTurnsWhatIsThrownIntoAFailure) {
+  Summary summary;
+  summary.termination = Termination::kConverged;
+  summary.message = "kept";
+  CatchInternalError(&summary, [] {});
+  EXPECT_EQ(summary.termination, Termination::kConverged);
+  EXPECT_EQ(summary.message, "kept");
+  CatchInternalError(&summary, [] { throw std::runtime_error("the mesh is empty"); });
+  EXPECT_EQ(summary.termination, Termination::kFailure);
+  EXPECT_EQ(summary.message, "internal error: the mesh is empty");
+  summary = Summary{};
+  CatchInternalError(&summary, [] { throw 42; });
+  EXPECT_EQ(summary.termination, Termination::kFailure);
+  EXPECT_EQ(summary.message, "internal error");
+}
+
+TEST(SummaryTest, InternalErrorMessageNamesTheStandardException) {
+  try {
+    throw std::out_of_range("index 7");
+  } catch (...) {
+    EXPECT_EQ(InternalErrorMessage(), "internal error: index 7");
+  }
+  try {
+    throw "text";
+  } catch (...) {
+    EXPECT_EQ(InternalErrorMessage(), "internal error");
   }
 }
 

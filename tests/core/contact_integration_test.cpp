@@ -1,0 +1,65 @@
+// What the two contact models share around the event integrator
+// (core/collision/contact_integration.hpp): the events of one contact, the integrator's settings
+// for a contact and the opening of a solve.
+#include "core/collision/contact_integration.hpp"
+
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace contact_integration_test {
+namespace {
+
+struct Checked {
+  bool valid = true;
+  std::string why;
+  bool IsValid(std::string* out) const {
+    if (!valid) *out = why;
+    return valid;
+  }
+};
+
+TEST(ContactIntegrationTest, LoadingWatchesMaximumCompressionUnloadingTheReload) {
+  const auto loading = ContactEvents(false);
+  ASSERT_EQ(loading.size(), 2u);
+  EXPECT_EQ(loading[0].id, kMaxCompression);
+  EXPECT_EQ(loading[1].id, kEnd);
+  const auto unloading = ContactEvents(true);
+  ASSERT_EQ(unloading.size(), 2u);
+  EXPECT_EQ(unloading[0].id, kEnd);
+  EXPECT_EQ(unloading[1].id, kReload);
+  EXPECT_TRUE(unloading[1].fires_if_already_passed);
+  EXPECT_FALSE(loading[0].fires_if_already_passed);
+}
+
+TEST(ContactIntegrationTest, IntegratorSettingsAreValidForAContact) {
+  const EventIntegratorOptions o = ContactIntegratorOptions(1e-9, 2000, 3e-5);
+  EXPECT_EQ(o.relative_tolerance, 1e-9);
+  EXPECT_EQ(o.absolute_tolerance, 1e-9);
+  EXPECT_EQ(o.max_steps, 2000);
+  EXPECT_EQ(o.time_unit_s, 3e-5);
+  EXPECT_STREQ(o.subject, "the contact");
+  std::string why;
+  EXPECT_TRUE(o.IsValid(&why)) << why;
+}
+
+TEST(ContactIntegrationTest, StartContactSolveRefusesWithTheFirstInvalidInput) {
+  Summary s;
+  EXPECT_TRUE(StartContactSolve("hertz", &s, Checked{}, Checked{}));
+  EXPECT_EQ(s.backend, "odeint:runge_kutta_dopri5");
+  EXPECT_EQ(s.models_used, std::vector<std::string>{"hertz"});
+  EXPECT_EQ(s.message, "");
+  s = Summary{};
+  EXPECT_FALSE(StartContactSolve("flexible", &s, Checked{true, "a"}, Checked{false, "b = 0: rule"},
+                                 Checked{false, "c = 0: rule"}));
+  EXPECT_EQ(s.termination, Termination::kInvalidInput);
+  EXPECT_EQ(s.message, "b = 0: rule");
+  EXPECT_EQ(s.models_used, std::vector<std::string>{"flexible"});
+}
+
+}  // namespace
+}  // namespace contact_integration_test
+}  // namespace sweetspot::core
