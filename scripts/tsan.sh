@@ -15,7 +15,7 @@ filter="${SWEETSPOT_TSAN_FILTER:-Job*:*Concurrent*:ServerTest.*:ServerLimits*:Ex
 build=build-tsan
 
 echo "== ThreadSanitizer build in $build/" >&2
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g -O1" \
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g1 -O1" \
   -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" -DSWEETSPOT_BUILD_BENCH=OFF \
   -DSWEETSPOT_BUILD_WEB=OFF >/dev/null

@@ -176,10 +176,16 @@ TEST(OptimizeSting, TheSameSeedGivesTheSameAnswer) {
   o.backend = DesignBackend::kNloptCobyla;
   o.starts = 3;
   o.seed = 7;
+  // Determinism, not speed: the default 10 s budget cut a run short on a starved machine under
+  // the sanitizers (each solve takes ~4-6 s of CPU there), and a cut run differs from a whole one.
+  o.max_time_s = 120.0;
   const DesignResult a = OptimizeDesign(p, o);
   const DesignResult b = OptimizeDesign(p, o);
   ASSERT_EQ(a.summary.termination, Termination::kConverged) << a.summary.FullReport();
   ASSERT_EQ(a.spread.runs.size(), 3u);
+  // b must have run every start too before its runs are compared one by one (a b cut short by
+  // the time budget on a starved machine ran fewer).
+  ASSERT_EQ(b.spread.runs.size(), a.spread.runs.size()) << b.summary.FullReport();
   EXPECT_EQ(TaperEnd(a), TaperEnd(b));
   EXPECT_EQ(a.objective_value, b.objective_value);
   for (std::size_t i = 0; i < a.spread.runs.size(); ++i) {

@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "tests/sanitizers.hpp"
 #include "tests/server/server_process.hpp"
 
 namespace sweetspot {
@@ -131,7 +132,7 @@ TEST(LoadTest, SixtyFourConnectionsMixedRequestsNoServerErrors) {
   // resident size may move only by allocator slack: 32 MiB bounds that for the
   // worker threads (glibc gives each thread its own arena).
   ASSERT_GT(rss_before, 0);
-#if defined(__SANITIZE_ADDRESS__)
+#if SWEETSPOT_UNDER_ASAN
   // Under AddressSanitizer freed memory sits in its quarantine (256 MiB by
   // default), so resident size says nothing about leaks there; LeakSanitizer
   // checks leaks at exit instead.

@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "tests/sanitizers.hpp"
 #include "tests/server/job_client.hpp"
 #include "tests/server/postgres_cluster.hpp"
 #include "tests/server/server_process.hpp"
@@ -47,7 +48,7 @@ using testing::jobs::WithoutTimings;
 // The "within a second" as asserted. Under AddressSanitizer or
 // ThreadSanitizer the instrumented server runs the sweep (and everything else)
 // about 10 times slower, so the bound there is 5 times the issue's.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if SWEETSPOT_UNDER_ASAN || SWEETSPOT_UNDER_TSAN
 constexpr double kSlowdown = 5.0;
 #else
 constexpr double kSlowdown = 1.0;

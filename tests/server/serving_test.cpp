@@ -27,6 +27,7 @@
 #include <thread>
 #include <vector>
 
+#include "tests/sanitizers.hpp"
 #include "tests/server/server_process.hpp"
 #include "tests/server/wire.hpp"
 
@@ -53,9 +54,9 @@ const char* const kSweetSpotBody =
 // documented slowdown is 5-15x): 16 new clients beside 200 idle connections were
 // answered within 15 ms in Release and 472-567 ms under TSan (four runs of the
 // same tree), so under TSan the bound is 10 times the (1 s).
-#if defined(__SANITIZE_THREAD__)
+#if SWEETSPOT_UNDER_TSAN
 constexpr double kLatencyScale = 10.0;
-#elif defined(__SANITIZE_ADDRESS__)
+#elif SWEETSPOT_UNDER_ASAN
 constexpr double kLatencyScale = 5.0;
 #else
 constexpr double kLatencyScale = 1.0;
