@@ -9,7 +9,7 @@
 
 #include <cmath>
 
-#include "core/optimize/jet.hpp"
+#include "core/numerics/jet.hpp"
 
 namespace sweetspot::core::exit_speed {
 

@@ -14,7 +14,7 @@
 #include "core/geometry_format.hpp"
 #include "core/geometry_integrals.hpp"
 #include "core/optimize/design_integrals.hpp"
-#include "core/optimize/jet.hpp"
+#include "core/numerics/jet.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 #include "core/units.hpp"

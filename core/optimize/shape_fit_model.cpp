@@ -11,7 +11,7 @@
 
 #include "core/geometry_format.hpp"
 #include "core/optimize/design_integrals.hpp"
-#include "core/optimize/jet.hpp"
+#include "core/numerics/jet.hpp"
 
 namespace sweetspot::core::fit_detail {
 namespace {

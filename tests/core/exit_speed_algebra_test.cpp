@@ -13,7 +13,7 @@
 
 #include "core/collision/exit_speed_profile.hpp"
 #include "core/collision/rigid_pivot.hpp"
-#include "core/optimize/jet.hpp"
+#include "core/numerics/jet.hpp"
 
 namespace sweetspot::core {
 namespace {

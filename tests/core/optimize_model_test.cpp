@@ -13,7 +13,7 @@
 
 #include "core/mass_properties.hpp"
 #include "core/material.hpp"
-#include "core/optimize/jet.hpp"
+#include "core/numerics/jet.hpp"
 #include "core/presets.hpp"
 
 namespace sweetspot::core {
