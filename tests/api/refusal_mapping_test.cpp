@@ -1,19 +1,16 @@
 // The one mapping from core's refusals (core/refusal.hpp) to the request's fields
-// (api/json_reader.hpp: CoreRefusal), and the configured cap on design variables.
+// (api/json_reader.hpp: CoreRefusal).
 #include <gtest/gtest.h>
 
 #include <string>
 
 #include "api/json_reader.hpp"
-#include "api/router.hpp"
 #include "core/refusal.hpp"
 
 namespace sweetspot::api {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
 namespace refusal_mapping_test {
 namespace {
-
-using Json = nlohmann::json;
 
 TEST(RefusalMappingTest, ACoreFieldMapsToTheRequestPath) {
   ApiError error;
@@ -60,37 +57,6 @@ TEST(RefusalMappingTest, SceneFieldsAreTheSceneHeads) {
   for (const char* field : {"", "curve_samples", "flexible.max_elements", "hertz.k3", "bats"}) {
     EXPECT_FALSE(IsSceneField(field)) << field;
   }
-}
-
-Json OptimizeWithVariables(int n) {
-  const char* const paths[] = {"three_segment.length_m", "three_segment.handle_radius_m",
-                               "three_segment.barrel_radius_m", "three_segment.taper_start_m"};
-  const double bounds[][2] = {{0.84, 0.88}, {0.011, 0.014}, {0.030, 0.034}, {0.2, 0.4}};
-  Json list = Json::array();
-  for (int i = 0; i < n; ++i) {
-    list.push_back({{"path", paths[i]}, {"min", bounds[i][0]}, {"max", bounds[i][1]}});
-  }
-  return {{"bat",
-           {{"three_segment",
-             {{"length_m", 0.8636},
-              {"handle_radius_m", 0.0125},
-              {"barrel_radius_m", 0.033},
-              {"taper_start_m", 0.30},
-              {"taper_end_m", 0.55}}},
-            {"material", "ash"}}},
-          {"variables", list},
-          {"objective", "max_exit_speed"}};
-}
-
-TEST(RefusalMappingTest, AConfiguredVariableCapBelow200IsEnforced) {
-  Context context;
-  context.limits.max_design_variables = 3;
-  const Response r = Dispatch({"POST", "/v1/optimize", OptimizeWithVariables(4).dump()}, context);
-  EXPECT_EQ(r.status, 400) << r.body.dump();
-  EXPECT_EQ(r.body.at("code"), "InvalidValue");
-  EXPECT_EQ(r.body.at("field"), "variables");
-  const std::string message = r.body.at("message");
-  EXPECT_NE(message.find("must be an array of 1 to 3 "), std::string::npos) << message;
 }
 
 }  // namespace
