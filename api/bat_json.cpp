@@ -24,9 +24,8 @@ std::optional<core::ThreeSegmentShape> ParseThreeSegment(const Json& value,
   reader.Number("taper_start_m", position, &shape.taper_start_m);
   reader.Number("taper_end_m", position, &shape.taper_end_m);
   if (!reader.Finish()) return std::nullopt;
-  std::string why;
-  if (!shape.IsValid(&why)) {
-    CoreRefusal(why, path, error);
+  if (core::Refusal refusal; !shape.Validate(&refusal)) {
+    CoreRefusal(refusal, path, error);
     return std::nullopt;
   }
   return shape;
@@ -117,9 +116,8 @@ std::optional<core::Material> ParseMaterial(const Json& value, const std::string
                         &material.poissons_ratio);
   if (auto cor = reader.MaybeNumber("cor", Between(0.0, 1.0))) material.cor = *cor;
   if (!reader.Finish()) return std::nullopt;
-  std::string why;
-  if (!material.IsValid(&why)) {
-    CoreRefusal(why, path, error);
+  if (core::Refusal refusal; !material.Validate(&refusal)) {
+    CoreRefusal(refusal, path, error);
     return std::nullopt;
   }
   return material;
@@ -189,13 +187,12 @@ std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& pa
     }
   }
   if (!reader.Finish()) return std::nullopt;
-  std::string why;
-  if (!spec.bat.IsValid(&why)) {
+  if (core::Refusal refusal; !spec.bat.Validate(&refusal)) {
     // Knot refusals belong under the profile (or the preset's/three-segment's knots).
-    const std::string prefix =
-        why.rfind("knots[", 0) == 0 && spec.shape_form == "profile" ? JoinPath(path, "profile")
-                                                                     : path;
-    CoreRefusal(why, prefix, error);
+    const std::string prefix = refusal.field.rfind("knots[", 0) == 0 && spec.shape_form == "profile"
+                                   ? JoinPath(path, "profile")
+                                   : path;
+    CoreRefusal(refusal, prefix, error);
     return std::nullopt;
   }
   return spec;

@@ -32,13 +32,12 @@ DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
     ReadSceneCommon(reader, &scene);
   }
   scene.outputs = outputs.scene;
-  std::string why;
   if (!error.code) {
     // A row of properties only names no scene output; the scene (bat, ball,
     // swing, cor) must still be valid, so it is checked as if it named one.
     core::Scene check = scene;
     if (check.outputs.empty()) check.outputs = {core::SceneOutput::kMaxExitSpeed};
-    if (!check.IsValid(&why)) CoreRefusal(why, "", &error);
+    if (core::Refusal refusal; !check.Validate(&refusal)) CoreRefusal(refusal, "", &error);
   }
   const auto error_json = [](const ApiError& e) {
     return Json{{"code", ErrorCodeName(e.code.value_or(ErrorCode::kInternalError))},

@@ -296,17 +296,16 @@ Response HandleExplore(const Request& request, const Context& context) {
     sr.OptionalInteger("count", 1, 1LL << 40, &count);
     if (!sr.Finish()) return ToResponse(error);
     shard = {static_cast<std::uint64_t>(index), static_cast<std::uint64_t>(count)};
-    std::string why;
-    if (!shard.IsValid(&why)) {
-      CoreRefusal(why, "", &error);
+    if (core::Refusal refusal; !shard.Validate(&refusal)) {
+      CoreRefusal(refusal, "", &error);
       return ToResponse(error);
     }
   }
   std::string format = "json";
   reader.OptionalString("format", &format, {"json", "ndjson"});
   if (!reader.Finish()) return ToResponse(error);
-  if (std::string why; !plan.IsValid(&why)) {
-    CoreRefusal(why, "", &error);
+  if (core::Refusal refusal; !plan.Validate(&refusal)) {
+    CoreRefusal(refusal, "", &error);
     return ToResponse(error);
   }
   const std::uint64_t total = plan.DesignCount();

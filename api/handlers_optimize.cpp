@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
+#include <limits>
 
 #include "api/bat_json.hpp"
 #include "api/handlers.hpp"
@@ -102,6 +104,9 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
   // Defaults never exceed the configured limits.
   o->max_iterations = std::min(o->max_iterations, limits.max_iterations);
   o->max_time_s = std::min(o->max_time_s, limits.max_time_s);
+  // Core enforces the configured cap on the variables (--max-design-variables).
+  o->max_variables = static_cast<int>(std::min<std::size_t>(
+      limits.max_design_variables, static_cast<std::size_t>(std::numeric_limits<int>::max())));
   ClampToLimits(limits, flexible);
   const bool sting = objective == core::DesignObjective::kMinSting;
   if (sting) o->backend = core::DesignBackend::kNloptCobyla;
@@ -140,7 +145,9 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
     }
   }
   if (!reader.Finish()) return false;
-  if (std::string why; !o->IsValid(&why)) return CoreRefusal(why, "options", top.error());
+  if (core::Refusal refusal; !o->Validate(&refusal)) {
+    return CoreRefusal(refusal, "options", top.error());
+  }
   return true;
 }
 
@@ -332,8 +339,8 @@ Response HandleOptimize(const Request& request, const Context& context) {
     reader.Fail("variables", "needs at least one continuous variable besides a material choice");
     return ToResponse(error);
   }
-  if (std::string why; !problem.IsValid(&why)) {
-    CoreRefusal(why, "", &error);
+  if (core::Refusal refusal; !problem.Validate(&refusal)) {
+    CoreRefusal(refusal, "", &error);
     return ToResponse(error);
   }
 

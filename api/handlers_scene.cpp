@@ -31,9 +31,9 @@ std::optional<BatSpec> ReadBat(ObjectReader& reader, const char* key, const ApiL
 
 // Validates the assembled scene with core's rules (e.g. the hands within the bat).
 bool CheckScene(const core::Scene& scene, ApiError* error) {
-  std::string why;
-  if (scene.IsValid(&why)) return true;
-  return CoreRefusal(why, "", error);
+  core::Refusal refusal;
+  if (scene.Validate(&refusal)) return true;
+  return CoreRefusal(refusal, "", error);
 }
 
 }  // namespace
@@ -192,8 +192,8 @@ Response HandleCompare(const Request& request, const Context& context) {
     core::Scene bat_scene = scene;
     bat_scene.bat = bats[i].second.bat;
     const std::string field = i == 0 ? "baseline" : "variants[" + std::to_string(i - 1) + "]";
-    if (std::string why; !bat_scene.IsValid(&why)) {
-      CoreRefusal(why, "", &error);
+    if (core::Refusal refusal; !bat_scene.Validate(&refusal)) {
+      CoreRefusal(refusal, "", &error);
       return ToResponse(error);
     }
     core::SceneResult result = core::EvaluateScene(bat_scene, options);

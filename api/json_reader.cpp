@@ -171,13 +171,36 @@ std::string JoinPath(std::string_view parent, std::string_view key) {
   return std::string(parent) + "." + std::string(key);
 }
 
+std::string RequestField(const core::Refusal& refusal, std::string_view prefix) {
+  return refusal.field.empty() ? std::string(prefix) : JoinPath(prefix, refusal.field);
+}
+
+bool CoreRefusal(const core::Refusal& refusal, const std::string& prefix, ApiError* error) {
+  if (error->code) return false;
+  const std::string why = refusal.Message();
+  std::string message;
+  if (!refusal.field.empty()) {
+    message = JoinPath(prefix, why);
+  } else {
+    message = prefix.empty() ? why : prefix + ": " + why;
+  }
+  *error =
+      ApiError{400, ErrorCode::kInvalidValue, std::move(message), RequestField(refusal, prefix)};
+  return false;
+}
+
 bool CoreRefusal(const std::string& why, const std::string& prefix, ApiError* error) {
-  const auto eq = why.find(" = ");
-  const std::string field = eq == std::string::npos ? std::string() : why.substr(0, eq);
-  const std::string full_field = field.empty() ? prefix : JoinPath(prefix, field);
-  const std::string message =
-      field.empty() ? (prefix.empty() ? why : prefix + ": " + why) : JoinPath(prefix, why);
-  if (!error->code) *error = ApiError{400, ErrorCode::kInvalidValue, message, full_field};
+  return CoreRefusal(core::RefusalFromMessage(why), prefix, error);
+}
+
+bool IsSceneField(std::string_view core_field) {
+  // The heads of core::Scene's fields; every other core field of a scene request is an option.
+  constexpr std::string_view kSceneHeads[] = {"bat", "ball",    "swing",
+                                              "cor", "outputs", "inertia_model"};
+  const std::string_view head = core_field.substr(0, core_field.find_first_of(".["));
+  for (const std::string_view h : kSceneHeads) {
+    if (head == h) return true;
+  }
   return false;
 }
 

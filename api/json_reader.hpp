@@ -15,6 +15,7 @@
 #include "api/error_code.hpp"
 #include "api/limits.hpp"
 #include "api/response.hpp"
+#include "core/refusal.hpp"
 
 namespace sweetspot::api {
 
@@ -116,9 +117,24 @@ class ObjectReader {
   std::set<std::string, std::less<>> known_;
 };
 
-/// Records a core validation message ("field = value: rule") as an
-/// InvalidValue error with the field re-rooted at `prefix` (e.g. "bat").
+/// The request path of a core refusal's field under `prefix` (e.g. "bat"): prefix.field
+/// ("bat.wall_thickness_m"), or `prefix` itself when the refusal names no field.
+std::string RequestField(const core::Refusal& refusal, std::string_view prefix);
+
+/// Records a core refusal as an InvalidValue error (400): the field is RequestField(refusal,
+/// prefix), the message core's Message() under `prefix` ("bat.wall_thickness_m = -1: ...";
+/// "options: <message>" when the refusal names no field). The one mapping from core's field
+/// names to the request's. Returns false.
+bool CoreRefusal(const core::Refusal& refusal, const std::string& prefix, ApiError* error);
+
+/// CoreRefusal for a validator or summary that still reports text ("field = value: rule"),
+/// read with core::RefusalFromMessage.
 bool CoreRefusal(const std::string& why, const std::string& prefix, ApiError* error);
+
+/// True when a core refusal's field names a part of the scene (bat, ball, swing, cor, outputs,
+/// inertia_model) rather than of the computation's options: such fields sit at the top level
+/// of a request, the others under its "options" object.
+bool IsSceneField(std::string_view core_field);
 
 /// Records an error at `path` ("field = value: rule") unless one is recorded,
 /// with the code's status (ErrorCodeStatus).

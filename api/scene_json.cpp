@@ -30,13 +30,6 @@ bool ReadSwing(const Json& value, const std::string& path, core::Swing* swing, A
   return reader.Finish();
 }
 
-// Core validation messages read "field = value: rule" with the request's own
-// field names ("ball.mass_kg", "swing.hands_from_knob_m", ...).
-std::string FieldOf(const std::string& message) {
-  const auto eq = message.find(" = ");
-  return eq == std::string::npos ? std::string() : message.substr(0, eq);
-}
-
 Json PlacementJson(core::Placement placement) { return core::PlacementName(placement); }
 
 }  // namespace
@@ -255,8 +248,8 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
     }
   }
   if (!reader.Finish()) return false;
-  std::string why;
-  if (!options->IsValid(&why)) return CoreRefusal(why, top.PathOf("options"), top.error());
+  core::Refusal refusal;
+  if (!options->Validate(&refusal)) return CoreRefusal(refusal, top.PathOf("options"), top.error());
   return true;
 }
 
@@ -266,14 +259,11 @@ Response CoreFailure(const core::Summary& summary, const std::string& missing_mo
     return ErrorResponse(501, ErrorCode::kNotImplemented, summary.message, field);
   }
   if (summary.termination == core::Termination::kInvalidInput) {
-    std::string core_field = FieldOf(summary.message);
-    const std::string head = core_field.substr(0, core_field.find_first_of(".["));
-    if (options_object && !core_field.empty() && head != "bat" && head != "ball" &&
-        head != "swing" && head != "cor" && head != "outputs" && head != "inertia_model") {
-      core_field = "options." + core_field;
-    }
+    // The summary names the field in its message ("field = value: rule"), read by core.
+    const core::Refusal refusal = core::RefusalFromMessage(summary.message);
+    const std::string prefix = options_object && !IsSceneField(refusal.field) ? "options" : "";
     return ErrorResponse(400, ErrorCode::kInvalidValue, summary.message,
-                         core_field.empty() ? field : core_field);
+                         refusal.field.empty() ? field : RequestField(refusal, prefix));
   }
   // The model ran and could not finish with these inputs and settings (e.g. a
   // step or evaluation budget): the client's to change, so 422, not a 500.

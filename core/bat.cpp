@@ -3,24 +3,20 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "core/geometry_format.hpp"
+#include "core/refusal.hpp"
 
 namespace sweetspot::core {
 namespace {
 
-bool Refuse(std::string* why, std::string_view field, double value, std::string_view rule) {
-  if (why != nullptr) *why = RefusalMessage(field, value, rule);
-  return false;
-}
-
-// Checks a material and prefixes its refusal with `prefix` ("material.").
-bool CheckMaterial(const Material& m, std::string_view prefix, std::string* why) {
-  if (why == nullptr) return m.IsValid(nullptr);
-  std::string inner;
-  if (m.IsValid(&inner)) return true;
-  *why = std::string(prefix) + inner;
-  return false;
+// Checks a material and prefixes its refusal's field with `prefix` ("material.").
+bool CheckMaterial(const Material& m, std::string_view prefix, Refusal* out) {
+  if (out == nullptr) return m.Validate(nullptr);
+  Refusal inner;
+  if (m.Validate(&inner)) return true;
+  return Refuse(out, Prefixed(prefix, std::move(inner)));
 }
 
 // Outer radius of a valid knot list at x in [x_0, x_last].
@@ -38,6 +34,10 @@ double Interpolate(const std::vector<ProfileKnot>& knots, double x) {
 }  // namespace
 
 bool ThreeSegmentShape::IsValid(std::string* why) const {
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool ThreeSegmentShape::Validate(Refusal* why) const {
   const struct {
     const char* name;
     double value;
@@ -60,18 +60,12 @@ bool ThreeSegmentShape::IsValid(std::string* why) const {
     return Refuse(why, "taper_start_m", taper_start_m, "must be non-negative");
   }
   if (taper_start_m > taper_end_m) {
-    if (why != nullptr) {
-      *why = RefusalMessage("taper_start_m", taper_start_m,
-                            "must not exceed taper_end_m = " + FormatNumber(taper_end_m));
-    }
-    return false;
+    return Refuse(why, "taper_start_m", taper_start_m,
+                  "must not exceed taper_end_m = " + FormatNumber(taper_end_m));
   }
   if (taper_end_m > length_m) {
-    if (why != nullptr) {
-      *why = RefusalMessage("taper_end_m", taper_end_m,
-                            "must not exceed length_m = " + FormatNumber(length_m));
-    }
-    return false;
+    return Refuse(why, "taper_end_m", taper_end_m,
+                  "must not exceed length_m = " + FormatNumber(length_m));
   }
   return true;
 }
@@ -101,6 +95,10 @@ std::vector<ProfileKnot> ThreeSegmentShape::Knots() const {
 }
 
 bool Bat::IsValid(std::string* why) const {
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool Bat::Validate(Refusal* why) const {
   const std::size_t n = knots.size();
   if (n < 2) {
     return Refuse(why, "knots.size()", static_cast<double>(n), "must be at least 2");
@@ -123,12 +121,10 @@ bool Bat::IsValid(std::string* why) const {
   }
   for (std::size_t i = 1; i < n; ++i) {
     if (!(knots[i].x_m > knots[i - 1].x_m)) {
-      if (why != nullptr) {
-        *why = RefusalMessage(IndexedField("knots", i, "x_m"), knots[i].x_m,
-                              "must be greater than " + IndexedField("knots", i - 1, "x_m") +
-                                  " = " + FormatNumber(knots[i - 1].x_m));
-      }
-      return false;
+      return why == nullptr ? false
+                            : Refuse(why, IndexedField("knots", i, "x_m"), knots[i].x_m,
+                                     "must be greater than " + IndexedField("knots", i - 1, "x_m") +
+                                         " = " + FormatNumber(knots[i - 1].x_m));
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
@@ -148,12 +144,8 @@ bool Bat::IsValid(std::string* why) const {
   }
   const double min_radius = MinRadiusM();
   if (wall_thickness_m >= min_radius) {
-    if (why != nullptr) {
-      *why =
-          RefusalMessage("wall_thickness_m", wall_thickness_m,
-                         "must be less than the smallest outer radius " + FormatNumber(min_radius));
-    }
-    return false;
+    return Refuse(why, "wall_thickness_m", wall_thickness_m,
+                  "must be less than the smallest outer radius " + FormatNumber(min_radius));
   }
 
   if (fill.has_value()) {
@@ -175,11 +167,8 @@ bool Bat::IsValid(std::string* why) const {
     if (f.depth_m < 0.0) return Refuse(why, "fill.depth_m", f.depth_m, "must be non-negative");
     const double length = LengthM();
     if (f.depth_m > length) {
-      if (why != nullptr) {
-        *why = RefusalMessage("fill.depth_m", f.depth_m,
-                              "must not exceed the bat's length " + FormatNumber(length));
-      }
-      return false;
+      return Refuse(why, "fill.depth_m", f.depth_m,
+                    "must not exceed the bat's length " + FormatNumber(length));
     }
     // The material around the bore is thinnest at a knot inside the fill's
     // range or at the bore's bottom (the profile is piecewise linear).
@@ -194,14 +183,13 @@ bool Bat::IsValid(std::string* why) const {
     }
     const double around = worst_r - wall_thickness_m;  // wall is 0 for a solid bat
     if (!(f.RadiusM() < around)) {
-      if (why != nullptr) {
-        *why = RefusalMessage(
-            "fill.diameter_m", f.diameter_m,
-            "the bore radius " + FormatNumber(f.RadiusM()) + " must be less than the " +
-                (IsHollow() ? "inner" : "outer") + " radius " + FormatNumber(around) +
-                " at x_m = " + FormatNumber(worst_x) + " (over the fill's depth)");
-      }
-      return false;
+      return why == nullptr
+                 ? false
+                 : Refuse(why, "fill.diameter_m", f.diameter_m,
+                          "the bore radius " + FormatNumber(f.RadiusM()) +
+                              " must be less than the " + (IsHollow() ? "inner" : "outer") +
+                              " radius " + FormatNumber(around) +
+                              " at x_m = " + FormatNumber(worst_x) + " (over the fill's depth)");
     }
   }
   return true;

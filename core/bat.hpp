@@ -54,6 +54,8 @@ struct ThreeSegmentShape {
   /// True when the shape is well formed (finite; L, r1, r2 > 0;
   /// 0 <= x1 <= x2 <= L); otherwise "field = value: rule" in *why (if non-null).
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
   /// The knots of this shape, x strictly increasing: (0, r1), (x1, r1),
   /// (x2, r2), (L, r2) with coincident knots merged (x1 = 0: no handle knot;
   /// x2 = L: no barrel knot; x1 = x2 with r1 = r2: one knot; x1 = x2 = 0 or
@@ -95,6 +97,9 @@ struct Bat {
   /// the fill's depth, an invalid non-empty fill material.
   /// Does not allocate when why is null and the bat is valid.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): core's field name
+  /// ("wall_thickness_m", "knots[2].x_m", "fill.material.density_kg_m3"), value and rule.
+  bool Validate(Refusal* refusal) const;
   /// L, m (the last knot's x; 0 without knots).
   double LengthM() const;
   /// Outer radius at x (from the knob), m; 0 outside [0, L].

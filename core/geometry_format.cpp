@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/refusal.hpp"
+
 namespace sweetspot::core {
 
 std::string FormatNumber(double value) {
@@ -22,12 +24,7 @@ std::string FormatNumber17(double value) {
 }
 
 std::string RefusalMessage(std::string_view field, double value, std::string_view rule) {
-  std::string out(field);
-  out += " = ";
-  out += FormatNumber(value);
-  out += ": ";
-  out += rule;
-  return out;
+  return NumberRefusal(field, value, rule).Message();
 }
 
 std::string IndexedField(std::string_view prefix, std::size_t index, std::string_view member) {

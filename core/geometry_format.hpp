@@ -16,7 +16,8 @@ std::string FormatNumber(double value);
 /// spots' messages write numbers.
 std::string FormatNumber17(double value);
 
-/// "field = value: rule", the message format of every IsValid in core.
+/// "field = value: rule", the message format of every IsValid in core: the Message() of
+/// NumberRefusal(field, value, rule) (core/refusal.hpp).
 std::string RefusalMessage(std::string_view field, double value, std::string_view rule);
 
 /// "prefix[index].member", e.g. IndexedField("knots", 3, "x_m") == "knots[3].x_m".

@@ -3,15 +3,10 @@
 #include <cmath>
 
 #include "core/geometry_format.hpp"
+#include "core/refusal.hpp"
 
 namespace sweetspot::core {
 namespace {
-
-// Writes the refusal to *why (if non-null) and returns false.
-bool Refuse(std::string* why, std::string_view field, double value, std::string_view rule) {
-  if (why != nullptr) *why = RefusalMessage(field, value, rule);
-  return false;
-}
 
 // Wood: Forest Products Laboratory, "Wood Handbook: Wood as an Engineering
 // Material", General Technical Report FPL-GTR-190, USDA Forest Service (2010).
@@ -127,6 +122,10 @@ std::vector<Material> BuildCatalogue() {
 }  // namespace
 
 bool Material::IsValid(std::string* why) const {
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool Material::Validate(Refusal* why) const {
   if (!std::isfinite(density_kg_m3))
     return Refuse(why, "density_kg_m3", density_kg_m3, "must be finite");
   if (!(density_kg_m3 > 0.0))
@@ -168,12 +167,8 @@ bool Material::IsValid(std::string* why) const {
     return Refuse(why, "density_max_kg_m3", density_max_kg_m3, "must be non-negative (0 = none)");
   }
   if (density_min_kg_m3 > 0.0 && density_max_kg_m3 > 0.0 && density_min_kg_m3 > density_max_kg_m3) {
-    if (why != nullptr) {
-      *why =
-          RefusalMessage("density_min_kg_m3", density_min_kg_m3,
-                         "must not exceed density_max_kg_m3 = " + FormatNumber(density_max_kg_m3));
-    }
-    return false;
+    return Refuse(why, "density_min_kg_m3", density_min_kg_m3,
+                  "must not exceed density_max_kg_m3 = " + FormatNumber(density_max_kg_m3));
   }
   return true;
 }

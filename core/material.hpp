@@ -6,6 +6,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/refusal.hpp"
+
 namespace sweetspot::core {
 
 /// An isotropic material (for wood: the longitudinal modulus and the
@@ -31,6 +33,8 @@ struct Material {
   /// min <= max when both are given. The density range is informational: a
   /// density outside it is accepted (sweeps and custom materials use that).
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
   /// Shear modulus in Pa: shear_modulus_pa if set, else E / (2 (1 + nu)).
   double EffectiveShearModulusPa() const;
 };

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "core/geometry_format.hpp"
+#include "core/refusal.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -53,31 +54,33 @@ std::optional<SamplingMethod> ParseSamplingMethod(const std::string& name) {
 }
 
 bool SweepPlan::IsValid(std::string* why) const {
-  auto fail = [why](std::string text) {
-    if (why != nullptr) *why = std::move(text);
-    return false;
-  };
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool SweepPlan::Validate(Refusal* why) const {
   if (dimensions.empty() || dimensions.size() > 32) {
-    return fail(RefusalMessage("dimensions", static_cast<double>(dimensions.size()),
-                               "must have 1 to 32 parameters"));
+    return Refuse(why, "dimensions", static_cast<double>(dimensions.size()),
+                  "must have 1 to 32 parameters");
   }
   for (std::size_t i = 0; i < dimensions.size(); ++i) {
     const SweepDimension& d = dimensions[i];
-    if (!std::isfinite(d.min)) return fail(RefusalMessage(IndexedField("dimensions", i, "min"), d.min, "must be finite"));
+    if (!std::isfinite(d.min)) {
+      return Refuse(why, IndexedField("dimensions", i, "min"), d.min, "must be finite");
+    }
     if (!std::isfinite(d.max) || d.max < d.min) {
-      return fail(RefusalMessage(IndexedField("dimensions", i, "max"), d.max,
-                                 "must be finite and >= min = " + FormatNumber(d.min)));
+      return Refuse(why, IndexedField("dimensions", i, "max"), d.max,
+                    "must be finite and >= min = " + FormatNumber(d.min));
     }
     if (method == SamplingMethod::kGrid && d.count < 1) {
-      return fail(RefusalMessage(IndexedField("dimensions", i, "count"), d.count, "must be >= 1"));
+      return Refuse(why, IndexedField("dimensions", i, "count"), d.count, "must be >= 1");
     }
   }
   if (method != SamplingMethod::kGrid && samples < 1) {
-    return fail(RefusalMessage("samples", static_cast<double>(samples), "must be >= 1"));
+    return Refuse(why, "samples", static_cast<double>(samples), "must be >= 1");
   }
   if (method == SamplingMethod::kSobol && dimensions.size() > 32) {
-    return fail(RefusalMessage("dimensions", static_cast<double>(dimensions.size()),
-                               "Sobol sampling supports at most 32 parameters"));
+    return Refuse(why, "dimensions", static_cast<double>(dimensions.size()),
+                  "Sobol sampling supports at most 32 parameters");
   }
   return true;
 }
@@ -96,16 +99,14 @@ std::uint64_t SweepPlan::DesignCount() const {
 }
 
 bool Shard::IsValid(std::string* why) const {
-  if (count < 1) {
-    if (why != nullptr) *why = RefusalMessage("shard.count", static_cast<double>(count), "must be >= 1");
-    return false;
-  }
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool Shard::Validate(Refusal* why) const {
+  if (count < 1) return Refuse(why, "shard.count", static_cast<double>(count), "must be >= 1");
   if (index >= count) {
-    if (why != nullptr) {
-      *why = RefusalMessage("shard.index", static_cast<double>(index),
-                            "must be below shard.count = " + std::to_string(count));
-    }
-    return false;
+    return Refuse(why, "shard.index", static_cast<double>(index),
+                  "must be below shard.count = " + std::to_string(count));
   }
   return true;
 }

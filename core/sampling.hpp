@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "core/refusal.hpp"
+
 namespace sweetspot::core {
 
 /// One swept parameter: the interval [min, max] and, for grids, its count.
@@ -38,6 +40,8 @@ struct SweepPlan {
 
   /// True when well formed; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
   /// Number of designs: the grid's product of counts, or `samples` (saturates at UINT64_MAX).
   std::uint64_t DesignCount() const;
 };
@@ -50,6 +54,8 @@ struct Shard {
 
   /// True when index < count and count >= 1; otherwise "field = value: rule".
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
   /// True when design `i` belongs to this shard.
   bool Contains(std::uint64_t i) const { return i % count == index; }
 };

@@ -4,38 +4,31 @@
 #include <cmath>
 
 #include "core/geometry_format.hpp"
+#include "core/refusal.hpp"
 
 namespace sweetspot::core {
-namespace {
-
-bool Fail(std::string* why, const std::string& m) {
-  if (why != nullptr) *why = m;
-  return false;
-}
-
-}  // namespace
 
 bool EventIntegratorOptions::IsValid(std::string* why) const {
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  const char* const kPositive = "must be finite and > 0";
   if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-15 &&
         relative_tolerance <= 1.0))
-    return Fail(why, "relative_tolerance = " + FormatNumber17(relative_tolerance) +
-                         ": must be in [1e-15, 1]");
+    return RefuseMessage(
+        why, Number17Refusal("relative_tolerance", relative_tolerance, "must be in [1e-15, 1]"));
   if (!positive(absolute_tolerance))
-    return Fail(why, "absolute_tolerance = " + FormatNumber17(absolute_tolerance) +
-                         ": must be finite and > 0");
-  if (!positive(max_step))
-    return Fail(why, "max_step = " + FormatNumber17(max_step) + ": must be finite and > 0");
+    return RefuseMessage(why, Number17Refusal("absolute_tolerance", absolute_tolerance, kPositive));
+  if (!positive(max_step)) return RefuseMessage(why, Number17Refusal("max_step", max_step, kPositive));
   if (!positive(initial_step))
-    return Fail(why, "initial_step = " + FormatNumber17(initial_step) + ": must be finite and > 0");
+    return RefuseMessage(why, Number17Refusal("initial_step", initial_step, kPositive));
   if (!positive(min_restart_step))
-    return Fail(
-        why, "min_restart_step = " + FormatNumber17(min_restart_step) + ": must be finite and > 0");
-  if (max_steps < 1)
-    return Fail(why, "max_steps = " + std::to_string(max_steps) + ": must be >= 1");
+    return RefuseMessage(why, Number17Refusal("min_restart_step", min_restart_step, kPositive));
+  if (max_steps < 1) return RefuseMessage(why, IntegerRefusal("max_steps", max_steps, "must be >= 1"));
   if (!positive(time_unit_s))
-    return Fail(why, "time_unit_s = " + FormatNumber17(time_unit_s) + ": must be finite and > 0");
-  if (subject == nullptr) return Fail(why, "subject = null: must name what is integrated");
+    return RefuseMessage(why, Number17Refusal("time_unit_s", time_unit_s, kPositive));
+  if (subject == nullptr) {
+    return RefuseMessage(why, Refusal{"subject", std::numeric_limits<double>::quiet_NaN(), "null",
+                               "must name what is integrated"});
+  }
   return true;
 }
 

@@ -181,9 +181,9 @@ bool ModelBuilder::AddVariable(std::size_t i, std::set<std::string>* seen) {
 // Every variable.
 bool ModelBuilder::Variables() {
   if (problem.variables.empty() ||
-      problem.variables.size() > static_cast<std::size_t>(kMaxVariables)) {
+      problem.variables.size() > static_cast<std::size_t>(options.max_variables)) {
     return Refuse(why, "variables.size()", static_cast<double>(problem.variables.size()),
-                  "must be between 1 and 200");
+                  "must be between 1 and " + std::to_string(options.max_variables));
   }
   std::set<std::string> seen;
   for (std::size_t i = 0; i < problem.variables.size(); ++i) {

@@ -13,6 +13,7 @@
 
 #include "core/geometry_format.hpp"
 #include "core/optimize/design_model.hpp"
+#include "core/refusal.hpp"
 
 namespace sweetspot::core::design_detail {
 
@@ -21,21 +22,16 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Relative margin that turns the strict validity rules (wall < radius, bore inside the
 // material) into closed constraints the solver can sit on.
 constexpr double kStrictMargin = 1e-6;
-constexpr int kMaxVariables = 200;
 // min_sting: modes kept per solve (the start, the end and the points evaluated twice).
 constexpr std::size_t kStingModesCacheEntries = 16;
 
 inline std::string Num(double v) { return FormatNumber(v); }
 
-inline bool Fail(std::string* why, const std::string& text) {
-  if (why != nullptr) *why = text;
-  return false;
-}
-
+// Refusals (core/refusal.hpp): Refuse writes "field = value: rule", Fail a composed message.
 inline bool Refuse(std::string* why, std::string_view field, double value, std::string_view rule) {
-  if (why != nullptr) *why = RefusalMessage(field, value, rule);
-  return false;
+  return RefuseMessage(why, field, value, rule);
 }
+inline bool Fail(std::string* why, std::string text) { return RefuseMessage(why, std::move(text)); }
 
 // Floor of a constraint's scale by unit, so that a constraint whose value and bounds are 0
 // still gets a sensible magnitude.

@@ -3,9 +3,11 @@
 
 #include <charconv>
 #include <cmath>
+#include <limits>
 
 #include "core/geometry_format.hpp"
 #include "core/optimize/design_model.hpp"
+#include "core/refusal.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -40,11 +42,6 @@ constexpr ObjectiveName kObjectiveNames[] = {
     {DesignObjective::kMinMoi, "min_moi"},
     {DesignObjective::kMinSting, "min_sting"},
 };
-
-bool Refuse(std::string* why, std::string_view field, double value, std::string_view rule) {
-  if (why != nullptr) *why = RefusalMessage(field, value, rule);
-  return false;
-}
 
 }  // namespace
 
@@ -102,7 +99,18 @@ bool DesignProblem::IsValid(std::string* why) const {
   return DesignModel::Build(*this, DesignOptions{}, &model, why);
 }
 
+bool DesignProblem::Validate(Refusal* refusal) const {
+  if (refusal == nullptr) return IsValid(nullptr);
+  std::string why;
+  if (IsValid(&why)) return true;
+  return Refuse(refusal, RefusalFromMessage(why));
+}
+
 bool DesignOptions::IsValid(std::string* why) const {
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool DesignOptions::Validate(Refusal* why) const {
   if (max_iterations < 1 || max_iterations > 100000) {
     return Refuse(why, "max_iterations", max_iterations, "must be between 1 and 100000");
   }
@@ -123,17 +131,15 @@ bool DesignOptions::IsValid(std::string* why) const {
   if (!std::isfinite(min_knot_gap_m) || !(min_knot_gap_m > 0.0) || min_knot_gap_m > 0.1) {
     return Refuse(why, "min_knot_gap_m", min_knot_gap_m, "must be in (0, 0.1]");
   }
+  if (max_variables < 1) return Refuse(why, "max_variables", max_variables, "must be >= 1");
   if (derivative_check == DerivativeCheck::kSecondOrder && hessian != HessianMode::kExact) {
-    if (why != nullptr) {
-      *why =
-          "derivative_check = second-order: needs hessian = exact (the limited-memory "
-          "approximation has no second derivatives to check)";
-    }
-    return false;
+    return Refuse(
+        why, Refusal{"derivative_check", std::numeric_limits<double>::quiet_NaN(), "second-order",
+                     "needs hessian = exact (the limited-memory approximation has no "
+                     "second derivatives to check)"});
   }
   if (derivative_check != DerivativeCheck::kNone && backend != DesignBackend::kIpopt) {
-    if (why != nullptr) *why = "derivative_check: Ipopt's checker needs backend = ipopt";
-    return false;
+    return Refuse(why, TextRefusal("derivative_check", "Ipopt's checker needs backend = ipopt"));
   }
   return true;
 }

@@ -152,6 +152,9 @@ struct DesignProblem {
   /// finite and ordered, constraints finite, the base bat valid, the rules' discrete limits
   /// met); otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule. The
+  /// model's nested checks still compose text, read back with RefusalFromMessage.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// How the Lagrangian's Hessian is obtained (Ipopt).
@@ -204,9 +207,14 @@ struct DesignOptions {
   /// solves).
   bool explain_infeasibility = true;
   DerivativeCheck derivative_check = DerivativeCheck::kNone;  ///< Ipopt's checker (first start).
+  /// Most continuous variables a problem may have (>= 1). The api sets it from its configured
+  /// limit (ApiLimits::max_design_variables, server flag --max-design-variables).
+  int max_variables = 200;
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// Smallest relative tolerance (ftol_rel and xtol_rel of the scaled problem) COBYLA is run

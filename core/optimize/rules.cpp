@@ -1,6 +1,7 @@
 #include "core/optimize/rules.hpp"
 
 #include "core/geometry_format.hpp"
+#include "core/refusal.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -18,11 +19,6 @@ constexpr RuleName kRuleNames[] = {
 };
 
 constexpr const char* kWoods[] = {"ash", "hard-maple", "yellow-birch", "paper-wood"};
-
-bool Fail(std::string* why, const std::string& text) {
-  if (why != nullptr) *why = text;
-  return false;
-}
 
 }  // namespace
 
@@ -93,27 +89,29 @@ bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, std::string* why) {
   const std::string prefix = std::string("rules.") + RuleSetName(rule) + ": ";
   if (limits.solid_wood_only) {
     if (!IsWoodMaterial(facts.material)) {
-      return Fail(why, prefix + "one piece of solid wood: material '" + facts.material.name +
-                           "' is not a wood of the catalogue (ash, hard-maple, yellow-birch, "
-                           "paper-wood)");
+      return RefuseMessage(why,
+                           prefix + "one piece of solid wood: material '" + facts.material.name +
+                               "' is not a wood of the catalogue (ash, hard-maple, yellow-birch, "
+                               "paper-wood)");
     }
     if (facts.wall_thickness_m > 0.0 || facts.wall_variable) {
-      return Fail(why, prefix + "one piece of solid wood: wall_thickness_m = " +
-                           FormatNumber(facts.wall_thickness_m) +
-                           (facts.wall_variable ? " (a design variable)" : "") +
-                           " makes a hollow shell");
+      return RefuseMessage(why, prefix + "one piece of solid wood: wall_thickness_m = " +
+                                    FormatNumber(facts.wall_thickness_m) +
+                                    (facts.wall_variable ? " (a design variable)" : "") +
+                                    " makes a hollow shell");
     }
     if (facts.has_fill && (facts.fill_density_kg_m3 != 0.0 || facts.fill_density_variable)) {
-      return Fail(why, prefix + "one piece of solid wood: fill.material.density_kg_m3 = " +
-                           FormatNumber(facts.fill_density_kg_m3) +
-                           (facts.fill_density_variable ? " (a design variable)" : "") +
-                           " puts a foreign substance in the bat (only an empty cup is allowed)");
+      return RefuseMessage(
+          why, prefix + "one piece of solid wood: fill.material.density_kg_m3 = " +
+                   FormatNumber(facts.fill_density_kg_m3) +
+                   (facts.fill_density_variable ? " (a design variable)" : "") +
+                   " puts a foreign substance in the bat (only an empty cup is allowed)");
     }
   }
   if (limits.max_bbcor.has_value() && facts.cor > *limits.max_bbcor) {
-    return Fail(why, prefix + "cor = " + FormatNumber(facts.cor) + " exceeds the BBCOR limit " +
-                         FormatNumber(*limits.max_bbcor) +
-                         " (for a rigid bat the BBCOR-style value equals the COR)");
+    return RefuseMessage(why, prefix + "cor = " + FormatNumber(facts.cor) +
+                                  " exceeds the BBCOR limit " + FormatNumber(*limits.max_bbcor) +
+                                  " (for a rigid bat the BBCOR-style value equals the COR)");
   }
   return true;
 }

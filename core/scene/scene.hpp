@@ -18,6 +18,7 @@
 #include "core/flexible/modes_cache.hpp"
 #include "core/mass_properties.hpp"
 #include "core/optimize/nlopt_search.hpp"
+#include "core/refusal.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {
@@ -41,6 +42,8 @@ struct Ball {
 
   /// True when every field is in range; otherwise "ball.field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// The swing just before impact. Defaults: the paper's Table 3 and the standard grip.
@@ -51,6 +54,8 @@ struct Swing {
 
   /// True when every field is finite and in range; otherwise "swing.field = value: rule".
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// A scene: what is hit, how, and what is wanted.
@@ -68,6 +73,8 @@ struct Scene {
 
   /// True when the scene is well formed; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// A collision model.
@@ -112,6 +119,8 @@ struct FlexibleOptions {
 
   /// True when every field is in range; otherwise "flexible.field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
   /// The modes options of vibration_node (2 modes to frequency_tolerance).
   BeamModesOptions VibrationModes() const;
   /// The modes options of flexible impacts (impact.max_modes to impact.frequency_tolerance).
@@ -137,6 +146,8 @@ struct SceneOptions {
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 }  // namespace sweetspot::core

@@ -115,6 +115,18 @@ TEST(ConfiguredCapsTest, DesignVariablesFollowTheConfiguredLimit) {
   EXPECT_EQ(message.substr(message.size() - rule.size()), rule) << message;
 }
 
+TEST(ConfiguredCapsTest, AVariableLimitBelow200IsEnforced) {
+  // The limit also reaches core (DesignOptions::max_variables): 4 variables over a limit of 3.
+  Context context;
+  context.limits.max_design_variables = 3;
+  const Response r = Post("/v1/optimize", OptimizeWith(4), context);
+  EXPECT_EQ(r.status, 400) << r.body.dump();
+  EXPECT_EQ(r.body.at("code"), "InvalidValue");
+  EXPECT_EQ(r.body.at("field"), "variables");
+  const std::string message = r.body.at("message");
+  EXPECT_NE(message.find(": must be an array of 1 to 3 "), std::string::npos) << message;
+}
+
 TEST(ConfiguredCapsTest, LimitsRefuseCurvesOfFewerThanTwoPointsAndZeroVariables) {
   ApiLimits limits;
   std::string why;

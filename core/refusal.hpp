@@ -1,0 +1,78 @@
+// A refusal: why core's validation refused an input, as data (the field in core's own names,
+// the value, the rule) rather than as text. Message() writes it the one way every IsValid
+// writes it ("field = value: rule"); the api maps `field` to the request's path with one
+// function (api/json_reader.hpp: CoreRefusal) instead of reading the text back.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <string_view>
+
+namespace sweetspot::core {
+
+/// Why an input was refused: "field = shown: rule" as data.
+struct Refusal {
+  /// The refused field in core's names ("wall_thickness_m", "knots[2].x_m", "ball.mass_kg",
+  /// "fill.material.density_kg_m3"); "" when the refusal is about no one field.
+  std::string field;
+  /// The refused value (problem units); NaN when the refusal quotes no number.
+  double value = std::numeric_limits<double>::quiet_NaN();
+  /// The value as the message writes it ("0.05", "3", "second-order"); "" when the message
+  /// quotes no value ("bat: missing ...").
+  std::string shown;
+  /// What the field must satisfy ("must be non-negative (0 = solid)").
+  std::string rule;
+
+  /// True when the message quotes the field's value ("field = shown: rule").
+  bool QuotesValue() const { return !shown.empty(); }
+  /// "field = shown: rule"; "field: rule" when no value is quoted; "rule" without a field.
+  std::string Message() const;
+};
+
+/// A refusal of `field` = `value` (written with FormatNumber, the shortest exact decimal).
+Refusal NumberRefusal(std::string_view field, double value, std::string_view rule);
+/// A refusal of `field` = `value` written with 17 significant digits (FormatNumber17), as the
+/// scene's messages write their numbers.
+Refusal Number17Refusal(std::string_view field, double value, std::string_view rule);
+/// A refusal of the integer `field` = `value` (written as an integer: "4096", not "4096.0").
+Refusal IntegerRefusal(std::string_view field, long long value, std::string_view rule);
+/// A refusal that quotes no value: "field: rule" ("bat: missing ...").
+Refusal TextRefusal(std::string_view field, std::string_view rule);
+
+/// `inner` moved under `prefix` ("material." + "density_kg_m3"): the field and so the message
+/// gain the prefix; the value and the rule are kept.
+Refusal Prefixed(std::string_view prefix, Refusal inner);
+
+/// Stores `refusal` in *out (if non-null) and returns false: the one way core's validators
+/// refuse (`return Refuse(out, NumberRefusal("length_m", length_m, "must be positive"));`).
+bool Refuse(Refusal* out, Refusal refusal);
+/// Refuse(out, NumberRefusal(field, value, rule)) without formatting when `out` is null.
+bool Refuse(Refusal* out, std::string_view field, double value, std::string_view rule);
+/// The string forms (named apart from Refuse so that a file's own helpers do not collide):
+/// stores refusal.Message() in *why (if non-null) and returns false.
+bool RefuseMessage(std::string* why, const Refusal& refusal);
+/// "field = value: rule" (NumberRefusal) in *why (if non-null; nothing is formatted when null).
+bool RefuseMessage(std::string* why, std::string_view field, double value, std::string_view rule);
+/// Stores a message composed by the caller in *why (if non-null) and returns false: for the
+/// validators that still compose text (the design model's nested checks, the rule sets).
+bool RefuseMessage(std::string* why, std::string message);
+
+/// The refusal a "field = value: rule" message states: the inverse of Message() (field = the
+/// text before the first " = ", shown = up to the next ": ", rule = the rest; a message
+/// without " = " is all rule). For the validators and summaries that still hand over text
+/// (nlopt, Hertz, flexible impact, the design model's nested checks, shape fitting); the api
+/// gets it from core rather than parsing the text itself.
+Refusal RefusalFromMessage(std::string_view message);
+
+/// The string form of a structured validator: `validate(Refusal*)` run with *why as the
+/// message (nothing is formatted when `why` is null).
+template <typename Validate>
+bool ExplainRefusal(std::string* why, Validate&& validate) {
+  if (why == nullptr) return validate(nullptr);
+  Refusal refusal;
+  if (validate(&refusal)) return true;
+  *why = refusal.Message();
+  return false;
+}
+
+}  // namespace sweetspot::core

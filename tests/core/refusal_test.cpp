@@ -1,0 +1,167 @@
+// Refusals as data (core/refusal.hpp): each validator's Validate names core's field, the value
+// and the rule, and its Message() is IsValid's text byte for byte.
+#include "core/refusal.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "core/bat.hpp"
+#include "core/geometry_format.hpp"
+#include "core/material.hpp"
+#include "core/optimize/design_model.hpp"
+#include "core/optimize/design_problem.hpp"
+#include "core/sampling.hpp"
+#include "core/scene/scene.hpp"
+
+namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace refusal_test {
+namespace {
+
+// A valid hollow bat: two knots of radius 0.0125 and 0.033 m, ash, a wall of 3 mm.
+Bat HollowBat() {
+  Bat bat;
+  bat.knots = {{0.0, 0.0125}, {0.86, 0.033}};
+  bat.material = *FindMaterial("ash");
+  bat.wall_thickness_m = 0.003;
+  return bat;
+}
+
+// Validate's refusal, checked against IsValid's message.
+template <typename T>
+Refusal RefusalOf(const T& value) {
+  Refusal refusal;
+  EXPECT_FALSE(value.Validate(&refusal));
+  std::string why;
+  EXPECT_FALSE(value.IsValid(&why));
+  EXPECT_EQ(refusal.Message(), why);
+  EXPECT_FALSE(value.Validate(nullptr));
+  return refusal;
+}
+
+TEST(RefusalTest, ABatRefusalNamesFieldValueAndRule) {
+  Bat bat = HollowBat();
+  ASSERT_TRUE(bat.Validate(nullptr));
+  bat.wall_thickness_m = -0.001;
+  const Refusal r = RefusalOf(bat);
+  EXPECT_EQ(r.field, "wall_thickness_m");
+  EXPECT_EQ(r.value, -0.001);
+  EXPECT_EQ(r.shown, "-0.001");
+  EXPECT_EQ(r.rule, "must be non-negative (0 = solid)");
+  EXPECT_EQ(r.Message(), "wall_thickness_m = -0.001: must be non-negative (0 = solid)");
+}
+
+TEST(RefusalTest, NestedFieldsKeepTheirPath) {
+  Bat bat = HollowBat();
+  bat.material.density_kg_m3 = -5.0;
+  Refusal r = RefusalOf(bat);
+  EXPECT_EQ(r.field, "material.density_kg_m3");
+  EXPECT_EQ(r.value, -5.0);
+  EXPECT_EQ(r.rule, "must be positive");
+
+  bat = HollowBat();
+  bat.knots[1].x_m = 0.0;
+  r = RefusalOf(bat);
+  EXPECT_EQ(r.field, "knots[1].x_m");
+  EXPECT_EQ(r.rule, "must be greater than knots[0].x_m = 0");
+
+  ThreeSegmentShape shape{0.86, 0.0125, 0.033, 0.6, 0.5};
+  r = RefusalOf(shape);
+  EXPECT_EQ(r.field, "taper_start_m");
+  EXPECT_EQ(r.value, 0.6);
+  EXPECT_EQ(r.rule, "must not exceed taper_end_m = 0.5");
+}
+
+TEST(RefusalTest, SceneRefusalsKeepTheirNumberFormats) {
+  Scene scene;
+  scene.bat = HollowBat();
+  scene.ball.speed_mps = -0.1;  // written with 17 significant digits, as before
+  Refusal r = RefusalOf(scene);
+  EXPECT_EQ(r.field, "ball.speed_mps");
+  EXPECT_EQ(r.value, -0.1);
+  EXPECT_EQ(r.Message(), "ball.speed_mps = -0.10000000000000001: must be >= 0");
+
+  scene = Scene{};
+  r = RefusalOf(scene);  // no bat: a refusal that quotes no value
+  EXPECT_EQ(r.field, "bat");
+  EXPECT_FALSE(r.QuotesValue());
+  EXPECT_TRUE(std::isnan(r.value));
+  EXPECT_EQ(r.Message(), "bat: missing (give a bat or precomputed mass_properties)");
+
+  SceneOptions options;
+  options.flexible.max_elements = 1;  // integers are written as integers
+  r = RefusalOf(options);
+  EXPECT_EQ(r.field, "flexible.max_elements");
+  EXPECT_EQ(r.value, 1.0);
+  EXPECT_EQ(r.Message(), "flexible.max_elements = 1: must be in [2, 4096]");
+}
+
+TEST(RefusalTest, SamplingAndDesignOptions) {
+  Shard shard{3, 2};
+  Refusal r = RefusalOf(shard);
+  EXPECT_EQ(r.field, "shard.index");
+  EXPECT_EQ(r.value, 3.0);
+  EXPECT_EQ(r.rule, "must be below shard.count = 2");
+
+  DesignOptions options;
+  options.max_variables = 0;
+  r = RefusalOf(options);
+  EXPECT_EQ(r.field, "max_variables");
+  EXPECT_EQ(r.Message(), "max_variables = 0: must be >= 1");
+  options = DesignOptions{};
+  EXPECT_EQ(options.max_variables, 200);
+  options.backend = DesignBackend::kNloptCobyla;
+  options.derivative_check = DerivativeCheck::kFirstOrder;
+  r = RefusalOf(options);
+  EXPECT_EQ(r.field, "derivative_check");
+  EXPECT_EQ(r.Message(), "derivative_check: Ipopt's checker needs backend = ipopt");
+}
+
+TEST(RefusalTest, TheDesignModelEnforcesTheConfiguredVariableCap) {
+  DesignProblem p;
+  p.three_segment = ThreeSegmentShape{0.86, 0.0125, 0.033, 0.30, 0.55};
+  p.bat.material = *FindMaterial("ash");
+  p.variables = {{"three_segment.length_m", 0.84, 0.88},
+                 {"three_segment.handle_radius_m", 0.011, 0.014},
+                 {"three_segment.barrel_radius_m", 0.030, 0.034},
+                 {"three_segment.taper_start_m", 0.2, 0.4}};
+  p.swing.pivot_from_knob_m = 0.1;
+  p.objective = DesignObjective::kMinMoi;
+  DesignModel model;
+  std::string why;
+  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why;
+  DesignOptions three;
+  three.max_variables = 3;
+  EXPECT_FALSE(DesignModel::Build(p, three, &model, &why));
+  EXPECT_EQ(why, "variables.size() = 4: must be between 1 and 3");
+}
+
+TEST(RefusalTest, FromMessageIsTheInverseOfMessage) {
+  for (const char* message :
+       {"wall_thickness_m = -0.001: must be non-negative (0 = solid)",
+        "derivative_check = second-order: needs hessian = exact (no second derivatives)",
+        "shard.index = 3: must be below shard.count = 2", "field = 5", "no field at all"}) {
+    EXPECT_EQ(RefusalFromMessage(message).Message(), message);
+  }
+  const Refusal r = RefusalFromMessage("fill.depth_m = 1.5: must not exceed the bat's length 0.86");
+  EXPECT_EQ(r.field, "fill.depth_m");
+  EXPECT_EQ(r.value, 1.5);
+  EXPECT_EQ(r.shown, "1.5");
+  EXPECT_EQ(r.rule, "must not exceed the bat's length 0.86");
+  const Refusal text = RefusalFromMessage("objective: not a known objective");
+  EXPECT_EQ(text.field, "");
+  EXPECT_EQ(text.rule, "objective: not a known objective");
+  EXPECT_TRUE(std::isnan(RefusalFromMessage("derivative_check = second-order: x").value));
+}
+
+TEST(RefusalTest, RefusalMessageIsNumberRefusalsMessage) {
+  EXPECT_EQ(RefusalMessage("knots.size()", 1.0, "must be at least 2"),
+            NumberRefusal("knots.size()", 1.0, "must be at least 2").Message());
+  EXPECT_EQ(Prefixed("fill.", NumberRefusal("depth_m", 2.0, "r")).Message(), "fill.depth_m = 2: r");
+}
+
+}  // namespace
+}  // namespace refusal_test
+}  // namespace sweetspot::core
