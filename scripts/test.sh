@@ -40,7 +40,7 @@ UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
   stage "asan: ctest" ctest --test-dir build-asan --output-on-failure -j"$jobs"
 
 echo "== libFuzzer: every target for a few seconds (scripts/fuzz.sh, on build-asan/)" >&2
-SWEETSPOT_FUZZ_BUILD=build-asan SWEETSPOT_JOBS="$jobs" stage "fuzz: run" scripts/fuzz.sh
+SWEETSPOT_FUZZ_BUILD=build-asan SWEETSPOT_JOBS="$jobs" stage "fuzz: build and run" scripts/fuzz.sh
 
 echo "== ThreadSanitizer: the concurrency tests (scripts/tsan.sh)" >&2
 SWEETSPOT_JOBS="$jobs" stage "tsan: build and run" scripts/tsan.sh
