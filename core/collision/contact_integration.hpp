@@ -4,10 +4,13 @@
 // included by .cpp files only, not part of core's API.
 #pragma once
 
+#include <cmath>
 #include <span>
 #include <string>
+#include <string_view>
 
 #include "core/numerics/event_integrator.hpp"
+#include "core/refusal.hpp"
 #include "core/summary.hpp"
 
 namespace sweetspot::core {
@@ -39,6 +42,35 @@ inline EventIntegratorOptions ContactIntegratorOptions(double tolerance, int max
   o.time_unit_s = time_unit_s;
   o.subject = "the contact";
   return o;
+}
+
+/// The integrator rules both contact models' options share, checked in this order:
+/// `relative_tolerance` in [1e-13, 1e-2] (dimensionless), `max_steps` >= 10. `model` ("hertz",
+/// "flexible") prefixes the field names. False, with "model.field = value: rule" in *why (if
+/// non-null), when one is broken.
+inline bool ContactIntegrationIsValid(std::string_view model, double relative_tolerance,
+                                      int max_steps, std::string* why) {
+  const std::string prefix = std::string(model) + ".";
+  if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-13 &&
+        relative_tolerance <= 1e-2))
+    return RefuseMessage(why, Number17Refusal(prefix + "relative_tolerance", relative_tolerance,
+                                              "must be in [1e-13, 1e-2]"));
+  if (max_steps < 10)
+    return RefuseMessage(why, IntegerRefusal(prefix + "max_steps", max_steps, "must be >= 10"));
+  return true;
+}
+
+/// The ball law's rules both contact models check, in this order: `ball_stiffness` (the power
+/// law's constant, N/m^exponent) finite and > 0, `ball_exponent` in [1, 3]. False, with
+/// "ball.field = value: rule" in *why (if non-null), when one is broken.
+inline bool BallLawIsValid(double ball_stiffness, double ball_exponent, std::string* why) {
+  if (!(std::isfinite(ball_stiffness) && ball_stiffness > 0.0))
+    return RefuseMessage(
+        why, Number17Refusal("ball.stiffness", ball_stiffness, "must be finite and > 0"));
+  if (!(std::isfinite(ball_exponent) && ball_exponent >= 1.0 && ball_exponent <= 3.0))
+    return RefuseMessage(
+        why, Number17Refusal("ball.stiffness_exponent", ball_exponent, "must be in [1, 3]"));
+  return true;
 }
 
 /// Opens the summary of a contact model's solve: backend "odeint:runge_kutta_dopri5",

@@ -13,6 +13,7 @@
 #include "core/flexible/static_flexibility.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/event_integrator.hpp"
+#include "core/refusal.hpp"
 #include "core/scene/timing_book.hpp"
 #include "core/units.hpp"
 
@@ -29,11 +30,6 @@ using flexible_detail::Rhs;
 using flexible_detail::State;
 
 constexpr double kTwoPi = 2.0 * kPi;
-
-bool Fail(std::string* why, const std::string& m) {
-  if (why != nullptr) *why = m;
-  return false;
-}
 
 // One contact as the event integrator sees it: the right-hand side of Rhs, its events, the
 // hands' loads sampled on every step and the branch changes at the events.
@@ -192,29 +188,25 @@ void IntegrateAlong(const BatModes& modes, double a, double b, F&& f) {
 
 bool FlexibleImpactOptions::IsValid(std::string* why) const {
   if (max_modes < 1 || max_modes > 50)
-    return Fail(why, "flexible.max_modes = " + std::to_string(max_modes) + ": must be in [1, 50]");
+    return RefuseMessage(
+        why, "flexible.max_modes = " + std::to_string(max_modes) + ": must be in [1, 50]");
   if (!(std::isfinite(frequency_tolerance) && frequency_tolerance >= 1e-9 &&
         frequency_tolerance <= 0.1))
-    return Fail(why, "flexible.frequency_tolerance = " + FormatNumber17(frequency_tolerance) +
-                         ": must be in [1e-9, 0.1]");
+    return RefuseMessage(why, "flexible.frequency_tolerance = " +
+                                  FormatNumber17(frequency_tolerance) + ": must be in [1e-9, 0.1]");
   if (!(std::isfinite(cutoff_factor) && cutoff_factor >= 1.0 && cutoff_factor <= 1000.0))
-    return Fail(why, "flexible.cutoff_factor = " + FormatNumber17(cutoff_factor) +
-                         ": must be in [1, 1000]");
-  if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-13 &&
-        relative_tolerance <= 1e-2))
-    return Fail(why, "flexible.relative_tolerance = " + FormatNumber17(relative_tolerance) +
-                         ": must be in [1e-13, 1e-2]");
-  if (max_steps < 10)
-    return Fail(why, "flexible.max_steps = " + std::to_string(max_steps) + ": must be >= 10");
+    return RefuseMessage(why, "flexible.cutoff_factor = " + FormatNumber17(cutoff_factor) +
+                                  ": must be in [1, 1000]");
+  if (!ContactIntegrationIsValid("flexible", relative_tolerance, max_steps, why)) return false;
   if (max_contacts < 1 || max_contacts > 1000)
-    return Fail(
+    return RefuseMessage(
         why, "flexible.max_contacts = " + std::to_string(max_contacts) + ": must be in [1, 1000]");
   if (!(std::isfinite(hands_grip_length_m) && hands_grip_length_m >= 0.0 &&
         hands_grip_length_m <= 10.0))
-    return Fail(why, "flexible.hands_grip_length_m = " + FormatNumber17(hands_grip_length_m) +
-                         ": must be in [0, 10]");
+    return RefuseMessage(why, "flexible.hands_grip_length_m = " +
+                                  FormatNumber17(hands_grip_length_m) + ": must be in [0, 10]");
   if (!(std::isfinite(sting_window_s) && sting_window_s >= 0.0 && sting_window_s <= 1.0))
-    return Fail(
+    return RefuseMessage(
         why, "flexible.sting_window_s = " + FormatNumber17(sting_window_s) + ": must be in [0, 1]");
   return true;
 }
@@ -222,31 +214,27 @@ bool FlexibleImpactOptions::IsValid(std::string* why) const {
 bool FlexibleImpactInputs::IsValid(std::string* why) const {
   auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!std::isfinite(impact_from_knob_m))
-    return Fail(why,
-                "impact_from_knob_m = " + FormatNumber17(impact_from_knob_m) + ": must be finite");
+    return RefuseMessage(
+        why, "impact_from_knob_m = " + FormatNumber17(impact_from_knob_m) + ": must be finite");
   if (!std::isfinite(hands_from_knob_m))
-    return Fail(
+    return RefuseMessage(
         why, "swing.hands_from_knob_m = " + FormatNumber17(hands_from_knob_m) + ": must be finite");
   if (!finite_pos(ball_mass_kg))
-    return Fail(why, "ball.mass_kg = " + FormatNumber17(ball_mass_kg) + ": must be finite and > 0");
+    return RefuseMessage(
+        why, "ball.mass_kg = " + FormatNumber17(ball_mass_kg) + ": must be finite and > 0");
   if (!(std::isfinite(ball_speed_mps) && ball_speed_mps >= 0.0))
-    return Fail(why,
-                "ball.speed_mps = " + FormatNumber17(ball_speed_mps) + ": must be finite and >= 0");
+    return RefuseMessage(
+        why, "ball.speed_mps = " + FormatNumber17(ball_speed_mps) + ": must be finite and >= 0");
   if (!finite_pos(approach_speed_mps))
-    return Fail(why,
-                "approach_speed_mps = " + FormatNumber17(approach_speed_mps) +
-                    ": must be finite and > 0 (the ball and the bat must approach each other)");
-  if (!finite_pos(ball_stiffness))
-    return Fail(why,
-                "ball.stiffness = " + FormatNumber17(ball_stiffness) + ": must be finite and > 0");
-  if (!(std::isfinite(ball_exponent) && ball_exponent >= 1.0 && ball_exponent <= 3.0))
-    return Fail(
-        why, "ball.stiffness_exponent = " + FormatNumber17(ball_exponent) + ": must be in [1, 3]");
+    return RefuseMessage(
+        why, "approach_speed_mps = " + FormatNumber17(approach_speed_mps) +
+                 ": must be finite and > 0 (the ball and the bat must approach each other)");
+  if (!BallLawIsValid(ball_stiffness, ball_exponent, why)) return false;
   if (!(std::isfinite(surface_stiffness) && surface_stiffness >= 0.0))
-    return Fail(why, "surface_stiffness = " + FormatNumber17(surface_stiffness) +
-                         ": must be finite and >= 0");
+    return RefuseMessage(why, "surface_stiffness = " + FormatNumber17(surface_stiffness) +
+                                  ": must be finite and >= 0");
   if (!(std::isfinite(cor) && cor >= 0.0 && cor <= 1.0))
-    return Fail(why, "cor = " + FormatNumber17(cor) + ": must be in [0, 1]");
+    return RefuseMessage(why, "cor = " + FormatNumber17(cor) + ": must be in [0, 1]");
   return true;
 }
 

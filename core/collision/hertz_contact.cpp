@@ -13,6 +13,7 @@
 #include "core/collision/contact_law.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/event_integrator.hpp"
+#include "core/refusal.hpp"
 #include "core/scene/timing_book.hpp"
 
 namespace sweetspot::core {
@@ -174,11 +175,6 @@ RawRun Integrate(const HertzProblem& p, double tol, int max_steps) {
   return out;
 }
 
-bool Fail(std::string* why, const std::string& m) {
-  if (why != nullptr) *why = m;
-  return false;
-}
-
 }  // namespace
 
 const char* ContactLawName(ContactLaw law) {
@@ -195,78 +191,72 @@ bool HertzProblem::IsValid(std::string* why) const {
   auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
   auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
   if (!finite_pos(approach_speed_mps))
-    return Fail(why,
-                "hertz.approach_speed_mps = " + FormatNumber17(approach_speed_mps) +
-                    ": must be finite and > 0 (the ball and the bat must approach each other)");
+    return RefuseMessage(
+        why, "hertz.approach_speed_mps = " + FormatNumber17(approach_speed_mps) +
+                 ": must be finite and > 0 (the ball and the bat must approach each other)");
   if (!finite_nonneg(ball_speed_mps))
-    return Fail(why, "hertz.ball_speed_mps = " + FormatNumber17(ball_speed_mps) +
-                         ": must be finite and >= 0");
+    return RefuseMessage(why, "hertz.ball_speed_mps = " + FormatNumber17(ball_speed_mps) +
+                                  ": must be finite and >= 0");
   if (!finite_pos(ball_mass_kg))
-    return Fail(
+    return RefuseMessage(
         why, "hertz.ball_mass_kg = " + FormatNumber17(ball_mass_kg) + ": must be finite and > 0");
   if (!finite_pos(c11_per_kg))
-    return Fail(why,
-                "hertz.c11_per_kg = " + FormatNumber17(c11_per_kg) + ": must be finite and > 0");
+    return RefuseMessage(
+        why, "hertz.c11_per_kg = " + FormatNumber17(c11_per_kg) + ": must be finite and > 0");
   if (!std::isfinite(c12_per_kg))
-    return Fail(why, "hertz.c12_per_kg = " + FormatNumber17(c12_per_kg) + ": must be finite");
+    return RefuseMessage(why,
+                         "hertz.c12_per_kg = " + FormatNumber17(c12_per_kg) + ": must be finite");
   if (!finite_pos(c22_per_kg))
-    return Fail(why,
-                "hertz.c22_per_kg = " + FormatNumber17(c22_per_kg) + ": must be finite and > 0");
+    return RefuseMessage(
+        why, "hertz.c22_per_kg = " + FormatNumber17(c22_per_kg) + ": must be finite and > 0");
   if (law == ContactLaw::kPaperConstants) {
     if (!finite_pos(paper.k1))
-      return Fail(why, "hertz.paper.k1 = " + FormatNumber17(paper.k1) + ": must be finite and > 0");
+      return RefuseMessage(
+          why, "hertz.paper.k1 = " + FormatNumber17(paper.k1) + ": must be finite and > 0");
     if (!finite_nonneg(paper.k2))
-      return Fail(why,
-                  "hertz.paper.k2 = " + FormatNumber17(paper.k2) + ": must be finite and >= 0");
+      return RefuseMessage(
+          why, "hertz.paper.k2 = " + FormatNumber17(paper.k2) + ": must be finite and >= 0");
     if (!std::isfinite(paper.k3))
-      return Fail(why, "hertz.paper.k3 = " + FormatNumber17(paper.k3) + ": must be finite");
+      return RefuseMessage(why,
+                           "hertz.paper.k3 = " + FormatNumber17(paper.k3) + ": must be finite");
     return true;
   }
-  if (!finite_pos(ball_stiffness))
-    return Fail(why,
-                "ball.stiffness = " + FormatNumber17(ball_stiffness) + ": must be finite and > 0");
-  if (!(std::isfinite(ball_exponent) && ball_exponent >= 1.0 && ball_exponent <= 3.0))
-    return Fail(
-        why, "ball.stiffness_exponent = " + FormatNumber17(ball_exponent) + ": must be in [1, 3]");
+  if (!BallLawIsValid(ball_stiffness, ball_exponent, why)) return false;
   if (!finite_nonneg(surface_stiffness))
-    return Fail(why, "hertz.surface_stiffness = " + FormatNumber17(surface_stiffness) +
-                         ": must be finite and >= 0");
+    return RefuseMessage(why, "hertz.surface_stiffness = " + FormatNumber17(surface_stiffness) +
+                                  ": must be finite and >= 0");
   if (!(std::isfinite(cor) && cor >= 0.0 && cor <= 1.0))
-    return Fail(why, "cor = " + FormatNumber17(cor) + ": must be in [0, 1]");
+    return RefuseMessage(why, "cor = " + FormatNumber17(cor) + ": must be in [0, 1]");
   if (!finite_nonneg(hands_stiffness_n_m))
-    return Fail(why, "hertz.hands_stiffness_n_m = " + FormatNumber17(hands_stiffness_n_m) +
-                         ": must be finite and >= 0");
+    return RefuseMessage(why, "hertz.hands_stiffness_n_m = " + FormatNumber17(hands_stiffness_n_m) +
+                                  ": must be finite and >= 0");
   if (!finite_nonneg(hands_damping_n_s_m))
-    return Fail(why, "hertz.hands_damping_n_s_m = " + FormatNumber17(hands_damping_n_s_m) +
-                         ": must be finite and >= 0");
+    return RefuseMessage(why, "hertz.hands_damping_n_s_m = " + FormatNumber17(hands_damping_n_s_m) +
+                                  ": must be finite and >= 0");
   return true;
 }
 
 bool HertzSolverOptions::IsValid(std::string* why) const {
-  if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-13 &&
-        relative_tolerance <= 1e-2))
-    return Fail(why, "hertz.relative_tolerance = " + FormatNumber17(relative_tolerance) +
-                         ": must be in [1e-13, 1e-2]");
-  if (max_steps < 10)
-    return Fail(why, "hertz.max_steps = " + std::to_string(max_steps) + ": must be >= 10");
-  return true;
+  return ContactIntegrationIsValid("hertz", relative_tolerance, max_steps, why);
 }
 
 bool HertzOptions::IsValid(std::string* why) const {
   if (!(std::isfinite(hands_stiffness_n_m) && hands_stiffness_n_m >= 0.0))
-    return Fail(why, "hertz.hands_stiffness_n_m = " + FormatNumber17(hands_stiffness_n_m) +
-                         ": must be finite and >= 0");
+    return RefuseMessage(why, "hertz.hands_stiffness_n_m = " + FormatNumber17(hands_stiffness_n_m) +
+                                  ": must be finite and >= 0");
   if (!(std::isfinite(hands_damping_n_s_m) && hands_damping_n_s_m >= 0.0))
-    return Fail(why, "hertz.hands_damping_n_s_m = " + FormatNumber17(hands_damping_n_s_m) +
-                         ": must be finite and >= 0");
+    return RefuseMessage(why, "hertz.hands_damping_n_s_m = " + FormatNumber17(hands_damping_n_s_m) +
+                                  ": must be finite and >= 0");
   if (law == ContactLaw::kPaperConstants) {
     if (!(std::isfinite(paper.k1) && paper.k1 > 0.0))
-      return Fail(why, "hertz.paper.k1 = " + FormatNumber17(paper.k1) + ": must be finite and > 0");
+      return RefuseMessage(
+          why, "hertz.paper.k1 = " + FormatNumber17(paper.k1) + ": must be finite and > 0");
     if (!(std::isfinite(paper.k2) && paper.k2 >= 0.0))
-      return Fail(why,
-                  "hertz.paper.k2 = " + FormatNumber17(paper.k2) + ": must be finite and >= 0");
+      return RefuseMessage(
+          why, "hertz.paper.k2 = " + FormatNumber17(paper.k2) + ": must be finite and >= 0");
     if (!std::isfinite(paper.k3))
-      return Fail(why, "hertz.paper.k3 = " + FormatNumber17(paper.k3) + ": must be finite");
+      return RefuseMessage(why,
+                           "hertz.paper.k3 = " + FormatNumber17(paper.k3) + ": must be finite");
   }
   return solver.IsValid(why);
 }

@@ -2,6 +2,8 @@
 // (core/collision/contact_integration.hpp): the events of one contact, the integrator's settings
 // for a contact and the opening of a solve.
 #include "core/collision/contact_integration.hpp"
+#include "core/collision/flexible_impact.hpp"
+#include "core/collision/hertz_contact.hpp"
 
 #include <string>
 #include <vector>
@@ -58,6 +60,32 @@ TEST(ContactIntegrationTest, StartContactSolveRefusesWithTheFirstInvalidInput) {
   EXPECT_EQ(s.termination, Termination::kInvalidInput);
   EXPECT_EQ(s.message, "b = 0: rule");
   EXPECT_EQ(s.models_used, std::vector<std::string>{"flexible"});
+}
+
+// The integrator's and the ball law's rules are written once (ContactIntegrationIsValid,
+// BallLawIsValid) and both models refuse with them, each under its own field prefix; the texts
+// are the ones the api and the hard-case tables assert.
+TEST(ContactIntegrationTest, BothModelsRefuseTheSharedRulesWithTheirOwnPrefix) {
+  std::string hertz_why, flexible_why;
+  HertzSolverOptions hertz;
+  hertz.max_steps = 9;
+  FlexibleImpactOptions flexible;
+  flexible.max_steps = 9;
+  EXPECT_FALSE(hertz.IsValid(&hertz_why));
+  EXPECT_FALSE(flexible.IsValid(&flexible_why));
+  EXPECT_EQ(hertz_why, "hertz.max_steps = 9: must be >= 10");
+  EXPECT_EQ(flexible_why, "flexible.max_steps = 9: must be >= 10");
+
+  hertz = HertzSolverOptions{};
+  hertz.relative_tolerance = 0.5;
+  EXPECT_FALSE(hertz.IsValid(&hertz_why));
+  EXPECT_EQ(hertz_why, "hertz.relative_tolerance = 0.5: must be in [1e-13, 1e-2]");
+
+  std::string ball_why;
+  EXPECT_TRUE(BallLawIsValid(1e7, 1.5, &ball_why));
+  EXPECT_FALSE(BallLawIsValid(1e7, 3.5, &ball_why));
+  EXPECT_EQ(ball_why, "ball.stiffness_exponent = 3.5: must be in [1, 3]");
+  EXPECT_FALSE(BallLawIsValid(0.0, 1.5, nullptr));  // nothing to write, still refused
 }
 
 }  // namespace
