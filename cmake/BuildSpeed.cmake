@@ -11,14 +11,24 @@
 #   batch). A helper in a file's anonymous namespace must therefore not share a name with
 #   one of another file of the same program: the compiler says so at once ("redefinition
 #   of ..."). SWEETSPOT_UNITY_BATCH sets the batch size.
-# - sweetspot_test_flags(<target>): test programs compile at -O1 in optimised builds. The
-#   code under test keeps the build type's flags (-O3 in Release): only the test drivers
-#   are cheaper to compile. Benchmarks keep the build type's flags (they time header code).
+# - sweetspot_test_flags(<target>): test programs compile at SWEETSPOT_TEST_OPTIMIZE (-O1
+#   in optimised builds by default). The code under test keeps the build type's flags (-O3
+#   in Release, -O1 in the sanitizer builds): only the test drivers are cheaper to compile.
+#   scripts/test.sh passes -O0 to its sanitizer builds, where a test program compiled at -O1
+#   costs about 2.5 times the compile time of -O0 (README "Build times"). Benchmarks keep the
+#   build type's flags (they time header code).
 
 option(SWEETSPOT_CCACHE "Compile through ccache when it is installed" ON)
 option(SWEETSPOT_PCH "Precompile the heavy third-party headers" ON)
 option(SWEETSPOT_UNITY_TESTS "Compile test and benchmark programs as unity builds" ON)
 set(SWEETSPOT_UNITY_BATCH 8 CACHE STRING "Source files per unity batch of a test program")
+if(CMAKE_BUILD_TYPE MATCHES "^(Release|RelWithDebInfo)$")
+  set(sweetspot_test_optimize_default -O1)
+else()
+  set(sweetspot_test_optimize_default "")
+endif()
+set(SWEETSPOT_TEST_OPTIMIZE "${sweetspot_test_optimize_default}" CACHE STRING
+    "Optimisation flag of the test programs (empty: the build type's)")
 
 if(SWEETSPOT_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
   find_program(SWEETSPOT_CCACHE_EXECUTABLE ccache)
@@ -48,11 +58,11 @@ function(sweetspot_unity target)
   endif()
 endfunction()
 
-# sweetspot_test_flags(<target>): -O1 for a test program in optimised builds.
+# sweetspot_test_flags(<target>): SWEETSPOT_TEST_OPTIMIZE for a test program.
 function(sweetspot_test_flags target)
-  if(CMAKE_BUILD_TYPE MATCHES "^(Release|RelWithDebInfo)$")
-    # Appended after the build type's -O3/-O2, so it wins; the libraries keep theirs.
-    target_compile_options(${target} PRIVATE -O1)
+  if(SWEETSPOT_TEST_OPTIMIZE)
+    # Appended after the build type's -O3/-O1, so it wins; the libraries keep theirs.
+    target_compile_options(${target} PRIVATE ${SWEETSPOT_TEST_OPTIMIZE})
   endif()
 endfunction()
 

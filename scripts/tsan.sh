@@ -7,19 +7,26 @@
 #
 #   SWEETSPOT_TSAN_FILTER='Job*'   gtest filter (default below)
 #   SWEETSPOT_JOBS=N               build parallelism (default: nproc)
+#   SWEETSPOT_TSAN_STEP=build|run  only build, or only run what is built (default: both;
+#                                  scripts/test.sh builds while the ASan tests run)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/stages.sh
 jobs="${SWEETSPOT_JOBS:-$(nproc)}"
 filter="${SWEETSPOT_TSAN_FILTER:-Job*:*Concurrent*:ServerTest.*:ServerLimits*:ExploreStream*:FaultsTest.*:ServingTest.ConnectionsPast*:ServingTest.IdleKeepAlive*:PostgresJobsTest.*}"
+step="${SWEETSPOT_TSAN_STEP:-all}"
 build=build-tsan
 
-echo "== ThreadSanitizer build in $build/" >&2
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g1 -O1" \
-  -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
-  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" -DSWEETSPOT_BUILD_BENCH=OFF \
-  -DSWEETSPOT_BUILD_WEB=OFF >/dev/null
-stage "tsan: build" cmake --build "$build" -j"$jobs" --target api_tests server_tests
+if [ "$step" != run ]; then
+  echo "== ThreadSanitizer build in $build/" >&2
+  # The test drivers at -O0: they only call the code under test, which keeps -O1.
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g1 -O1" \
+    -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
+    -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" -DSWEETSPOT_TEST_OPTIMIZE=-O0 \
+    -DSWEETSPOT_BUILD_BENCH=OFF -DSWEETSPOT_BUILD_WEB=OFF >/dev/null
+  stage "tsan: build" cmake --build "$build" -j"$jobs" --target api_tests server_tests
+fi
+[ "$step" = build ] && exit 0
 
 logs="$build/tsan-logs"
 rm -rf "$logs"
