@@ -1,8 +1,8 @@
 // POST /v1/bat/properties and POST /v1/bat/fit.
 #include <algorithm>
-#include <chrono>
 
 #include "api/bat_json.hpp"
+#include "api/endpoint.hpp"
 #include "api/handlers.hpp"
 #include "core/presets.hpp"
 #include "core/shape_fit.hpp"
@@ -10,40 +10,56 @@
 namespace sweetspot::api {
 namespace {
 
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+// A parsed /v1/bat/properties request: the bat, the optional pivot and the inertia model.
+struct PropertiesRequest {
+  BatSpec spec;
+  std::optional<double> pivot_from_knob_m;
+  core::InertiaModel inertia_model = core::InertiaModel::kRigidBody;
+};
+
+std::optional<PropertiesRequest> ParseProperties(const nlohmann::json& body, const Context& context,
+                                                 ApiError* error) {
+  ObjectReader reader(body, "", error);
+  const nlohmann::json* bat_json = reader.Get("bat");
+  if (bat_json == nullptr) {
+    reader.Missing("bat");
+    return std::nullopt;
+  }
+  auto spec = ParseBat(*bat_json, "bat", context.limits, error);
+  if (!spec) return std::nullopt;
+  PropertiesRequest request{std::move(*spec), {}, core::InertiaModel::kRigidBody};
+  request.pivot_from_knob_m = reader.MaybeNumber("pivot_from_knob_m", Between(-100.0, 100.0));
+  std::string inertia_model = "rigid_body";
+  reader.OptionalString("inertia_model", &inertia_model, {"rigid_body", "slender_rod"});
+  if (!reader.Finish()) return std::nullopt;
+  if (inertia_model == "slender_rod") request.inertia_model = core::InertiaModel::kSlenderRod;
+  return request;
+}
+
+// A closed form: no summary and no provenance, as documented in docs/api.md.
+const Endpoint<PropertiesRequest, core::MassProperties>& PropertiesEndpoint() {
+  static const auto endpoint = [] {
+    Endpoint<PropertiesRequest, core::MassProperties> e;
+    e.parse = ParseProperties;
+    e.run = [](const PropertiesRequest& request, const Context&) {
+      return core::ComputeMassProperties(request.spec.bat, request.inertia_model);
+    };
+    e.render = [](const PropertiesRequest& request, const core::MassProperties& properties) {
+      nlohmann::json out =
+          PropertiesToJson(properties, request.spec.bat.LengthM(), request.pivot_from_knob_m);
+      out["models_used"] = {"mass_properties"};
+      out["method"] = "closed_form";
+      return out;
+    };
+    return e;
+  }();
+  return endpoint;
 }
 
 }  // namespace
 
 Response HandleBatProperties(const Request& request, const Context& context) {
-  const auto start = std::chrono::steady_clock::now();
-  Response failure;
-  const auto body = ParseObjectBody(request, context, &failure);
-  if (!body) return failure;
-  ApiError error;
-  ObjectReader reader(*body, "", &error);
-  const nlohmann::json* bat_json = reader.Get("bat");
-  if (bat_json == nullptr) {
-    reader.Missing("bat");
-    return ToResponse(error);
-  }
-  const auto spec = ParseBat(*bat_json, "bat", context.limits, &error);
-  if (!spec) return ToResponse(error);
-  std::optional<double> pivot = reader.MaybeNumber("pivot_from_knob_m", Between(-100.0, 100.0));
-  std::string inertia_model = "rigid_body";
-  reader.OptionalString("inertia_model", &inertia_model, {"rigid_body", "slender_rod"});
-  if (!reader.Finish()) return ToResponse(error);
-
-  const core::InertiaModel model = inertia_model == "slender_rod"
-                                       ? core::InertiaModel::kSlenderRod
-                                       : core::InertiaModel::kRigidBody;
-  const core::MassProperties properties = core::ComputeMassProperties(spec->bat, model);
-  nlohmann::json out = PropertiesToJson(properties, spec->bat.LengthM(), pivot);
-  out["models_used"] = {"mass_properties"};
-  out["method"] = "closed_form";
-  out["timing_s"] = SecondsSince(start);
-  return {200, std::move(out)};
+  return ServeEndpoint(PropertiesEndpoint(), request, context);
 }
 
 }  // namespace sweetspot::api
@@ -94,8 +110,8 @@ nlohmann::json FittedBatJson(const core::ShapeFitResult& fit, const BatSpec& spe
   }
   if (fit.wall_thickness_m > 0) bat["wall_thickness_m"] = fit.wall_thickness_m;
   if (fit.fill) {
-    const bool fill_density_fitted = spec.bat.fill && fit.fill->material.density_kg_m3 !=
-                                                          spec.bat.fill->material.density_kg_m3;
+    const bool fill_density_fitted =
+        spec.bat.fill && fit.fill->material.density_kg_m3 != spec.bat.fill->material.density_kg_m3;
     nlohmann::json fill_material =
         fit.fill->IsEmpty() ? nlohmann::json("empty") : nlohmann::json(fit.fill->material.name);
     if (fill_density_fitted) {
@@ -111,102 +127,121 @@ nlohmann::json FittedBatJson(const core::ShapeFitResult& fit, const BatSpec& spe
   return bat;
 }
 
-}  // namespace
+// A parsed /v1/bat/fit request: the bat as given, the fit problem and the solver's options.
+struct FitRequest {
+  BatSpec spec;
+  core::ShapeFitProblem problem;
+  core::ShapeFitOptions options;
+};
 
-Response HandleBatFit(const Request& request, const Context& context) {
-  const auto start = std::chrono::steady_clock::now();
-  Response failure;
-  const auto body = ParseObjectBody(request, context, &failure);
-  if (!body) return failure;
-  ApiError error;
-  ObjectReader reader(*body, "", &error);
+// Reads "unknowns" (default: the paper's question, where the taper starts and ends).
+bool ReadFitUnknowns(ObjectReader& reader, const core::ThreeSegmentShape& shape,
+                     core::ShapeFitProblem* problem) {
+  const nlohmann::json* unknowns = reader.Get("unknowns");
+  if (unknowns == nullptr) {
+    problem->unknowns = {{core::FitVariable::kTaperStart, 0.0, shape.length_m},
+                         {core::FitVariable::kTaperEnd, 0.0, shape.length_m}};
+    return reader.ok();
+  }
+  if (!unknowns->is_array() || unknowns->empty() || unknowns->size() > 10) {
+    return reader.Fail("unknowns", "must be an array of 1 to 10 {\"name\", \"min\", \"max\"}");
+  }
+  for (std::size_t i = 0; i < unknowns->size(); ++i) {
+    ObjectReader u((*unknowns)[i], "unknowns[" + std::to_string(i) + "]", reader.error());
+    std::string name;
+    u.String("name", &name,
+             {"taper_start_m", "taper_end_m", "length_m", "handle_radius_m", "barrel_radius_m",
+              "density_kg_m3", "wall_thickness_m", "fill.diameter_m", "fill.depth_m",
+              "fill.density_kg_m3"});
+    core::FitUnknown unknown;
+    u.Number("min", Between(0.0, 1e5), &unknown.min);
+    u.Number("max", Between(0.0, 1e5), &unknown.max);
+    if (!u.Finish()) return false;
+    unknown.variable = *core::FitVariableFromName(name);
+    problem->unknowns.push_back(unknown);
+  }
+  return true;
+}
+
+// Reads "options" over defaults that never exceed the configured limits.
+bool ReadFitOptions(ObjectReader& reader, const ApiLimits& limits, core::ShapeFitOptions* options) {
+  options->max_time_s = std::min(options->max_time_s, limits.max_time_s);
+  options->max_evaluations = std::min(options->max_evaluations, limits.max_iterations);
+  const nlohmann::json* o = reader.Get("options");
+  if (o == nullptr) return reader.ok();
+  ObjectReader opt(*o, "options", reader.error());
+  opt.OptionalNumber("mass_scale_kg", NonNegative(1e4), &options->mass_scale_kg);
+  opt.OptionalNumber("balance_point_scale_m", NonNegative(100.0), &options->balance_point_scale_m);
+  opt.OptionalNumber("tolerance", Between(1e-15, 1e-1), &options->tolerance);
+  long long max_evaluations = options->max_evaluations;
+  opt.OptionalInteger("max_evaluations", 1, limits.max_iterations, &max_evaluations);
+  options->max_evaluations = static_cast<int>(max_evaluations);
+  opt.OptionalNumber("max_time_s", Positive(limits.max_time_s), &options->max_time_s);
+  return opt.Finish();
+}
+
+std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& context,
+                                   ApiError* error) {
+  ObjectReader reader(body, "", error);
   const nlohmann::json* bat_json = reader.Get("bat");
   if (bat_json == nullptr) {
     reader.Missing("bat");
-    return ToResponse(error);
+    return std::nullopt;
   }
-  const auto spec = ParseBat(*bat_json, "bat", context.limits, &error);
-  if (!spec) return ToResponse(error);
+  auto spec = ParseBat(*bat_json, "bat", context.limits, error);
+  if (!spec) return std::nullopt;
   const auto shape = ThreeSegmentOf(*spec);
   if (!shape) {
     reader.Fail("bat",
                 "must be a three-segment bat (three_segment, or the paper-wood presets): the fit "
                 "solves three-segment dimensions");
-    return ToResponse(error);
+    return std::nullopt;
   }
-  core::ShapeFitProblem problem;
+  FitRequest request{std::move(*spec), {}, {}};
+  core::ShapeFitProblem& problem = request.problem;
   problem.shape = *shape;
-  problem.material = spec->bat.material;
-  problem.wall_thickness_m = spec->bat.wall_thickness_m;
-  problem.fill = spec->bat.fill;
+  problem.material = request.spec.bat.material;
+  problem.wall_thickness_m = request.spec.bat.wall_thickness_m;
+  problem.fill = request.spec.bat.fill;
 
   const nlohmann::json* targets = reader.Get("targets");
   if (reader.ok() && targets == nullptr) reader.Missing("targets");
-  if (!reader.ok()) return ToResponse(error);
-  {
-    ObjectReader t(*targets, "targets", &error);
-    problem.targets.mass_kg = t.MaybeNumber("mass_kg", Positive(1e4));
-    problem.targets.balance_point_m = t.MaybeNumber("balance_point_m", Positive(100.0));
-    if (!t.Finish()) return ToResponse(error);
-    if (!problem.targets.mass_kg && !problem.targets.balance_point_m) {
-      SetError(&error, ErrorCode::kMissingField, "targets", nullptr,
-               "needs mass_kg, balance_point_m or both");
-      return ToResponse(error);
-    }
+  if (!reader.ok()) return std::nullopt;
+  ObjectReader t(*targets, "targets", error);
+  problem.targets.mass_kg = t.MaybeNumber("mass_kg", Positive(1e4));
+  problem.targets.balance_point_m = t.MaybeNumber("balance_point_m", Positive(100.0));
+  if (!t.Finish()) return std::nullopt;
+  if (!problem.targets.mass_kg && !problem.targets.balance_point_m) {
+    SetError(error, ErrorCode::kMissingField, "targets", nullptr,
+             "needs mass_kg, balance_point_m or both");
+    return std::nullopt;
   }
-  if (const nlohmann::json* unknowns = reader.Get("unknowns")) {
-    if (!unknowns->is_array() || unknowns->empty() || unknowns->size() > 10) {
-      reader.Fail("unknowns", "must be an array of 1 to 10 {\"name\", \"min\", \"max\"}");
-      return ToResponse(error);
-    }
-    for (std::size_t i = 0; i < unknowns->size(); ++i) {
-      ObjectReader u((*unknowns)[i], "unknowns[" + std::to_string(i) + "]", &error);
-      std::string name;
-      u.String("name", &name,
-               {"taper_start_m", "taper_end_m", "length_m", "handle_radius_m", "barrel_radius_m",
-                "density_kg_m3", "wall_thickness_m", "fill.diameter_m", "fill.depth_m",
-                "fill.density_kg_m3"});
-      core::FitUnknown unknown;
-      u.Number("min", Between(0.0, 1e5), &unknown.min);
-      u.Number("max", Between(0.0, 1e5), &unknown.max);
-      if (!u.Finish()) return ToResponse(error);
-      unknown.variable = *core::FitVariableFromName(name);
-      problem.unknowns.push_back(unknown);
-    }
-  } else {
-    // The paper's question: where do the taper start and end lie?
-    problem.unknowns = {{core::FitVariable::kTaperStart, 0.0, shape->length_m},
-                        {core::FitVariable::kTaperEnd, 0.0, shape->length_m}};
+  if (!ReadFitUnknowns(reader, *shape, &problem) ||
+      !ReadFitOptions(reader, context.limits, &request.options) || !reader.Finish()) {
+    return std::nullopt;
   }
-  core::ShapeFitOptions options;
-  // Defaults never exceed the configured limits.
-  options.max_time_s = std::min(options.max_time_s, context.limits.max_time_s);
-  options.max_evaluations = std::min(options.max_evaluations, context.limits.max_iterations);
-  if (const nlohmann::json* o = reader.Get("options")) {
-    ObjectReader opt(*o, "options", &error);
-    opt.OptionalNumber("mass_scale_kg", NonNegative(1e4), &options.mass_scale_kg);
-    opt.OptionalNumber("balance_point_scale_m", NonNegative(100.0), &options.balance_point_scale_m);
-    opt.OptionalNumber("tolerance", Between(1e-15, 1e-1), &options.tolerance);
-    long long max_evaluations = options.max_evaluations;
-    opt.OptionalInteger("max_evaluations", 1, context.limits.max_iterations, &max_evaluations);
-    options.max_evaluations = static_cast<int>(max_evaluations);
-    opt.OptionalNumber("max_time_s", Positive(context.limits.max_time_s), &options.max_time_s);
-    if (!opt.Finish()) return ToResponse(error);
-  }
-  if (!reader.Finish()) return ToResponse(error);
   if (std::string why; !problem.IsValid(&why)) {
-    CoreRefusal(why, "", &error);
-    return ToResponse(error);
+    CoreRefusal(why, "", error);
+    return std::nullopt;
   }
+  return request;
+}
 
-  const core::ShapeFitResult fit = core::FitShape(problem, options);
+// A refused problem is the client's (400); a failed fit is ours (500).
+std::optional<Response> FitFailure(const FitRequest&, const core::ShapeFitResult& fit) {
   if (fit.summary.termination == core::Termination::kInvalidInput) {
+    ApiError error;
     CoreRefusal(fit.summary.message, "", &error);
     return ToResponse(error);
   }
   if (fit.summary.termination == core::Termination::kFailure) {
     return ErrorResponse(500, ErrorCode::kInternalError, "the fit failed: " + fit.summary.message);
   }
+  return std::nullopt;
+}
+
+nlohmann::json RenderFit(const FitRequest& request, const core::ShapeFitResult& fit) {
+  const core::ShapeFitProblem& problem = request.problem;
   nlohmann::json unknown_values = nlohmann::json::object();
   for (std::size_t i = 0; i < problem.unknowns.size() && i < fit.values.size(); ++i) {
     unknown_values[core::FitVariableName(problem.unknowns[i].variable)] = fit.values[i];
@@ -223,34 +258,59 @@ Response HandleBatFit(const Request& request, const Context& context) {
                          {"metric", fit.metric},
                          {"kkt_error", fit.kkt_error},
                          {"warnings", fit.summary.warnings}};
-  nlohmann::json options_json{{"tolerance", options.tolerance},
-                              {"max_evaluations", options.max_evaluations},
-                              {"max_time_s", options.max_time_s},
-                              {"scan_points", options.scan_points},
-                              {"local_starts", options.local_starts}};
-  nlohmann::json result{
-      {"bat", FittedBatJson(fit, *spec)},
-      {"unknowns", std::move(unknown_values)},
-      {"properties", PropertiesToJson(fit.properties, fit.bat.LengthM())},
-      {"residuals", std::move(residuals)},
-      {"metric",
-       "((M - M*) / s_M)^2 + ((C - C*) / s_C)^2 over the targets given; s_M = M*, s_C = C* "
-       "unless options set mass_scale_kg, balance_point_scale_m"},
-      {"summary", std::move(summary)},
-      {"provenance", Provenance(*body, options_json)},
-      {"timing_s", SecondsSince(start)}};
-  if (fit.summary.termination == core::Termination::kConverged) return {200, std::move(result)};
-  // No bat of this family meets the targets (or the budget ran out): 422 with
-  // the closest feasible bat and its properties.
+  return {{"bat", FittedBatJson(fit, request.spec)},
+          {"unknowns", std::move(unknown_values)},
+          {"properties", PropertiesToJson(fit.properties, fit.bat.LengthM())},
+          {"residuals", std::move(residuals)},
+          {"metric",
+           "((M - M*) / s_M)^2 + ((C - C*) / s_C)^2 over the targets given; s_M = M*, s_C = C* "
+           "unless options set mass_scale_kg, balance_point_scale_m"},
+          {"summary", std::move(summary)}};
+}
+
+// The provenance records the options the fit ran with (defaults included), not the body's.
+ProvenanceInputs FitProvenance(const FitRequest& request, const nlohmann::json&) {
+  const core::ShapeFitOptions& options = request.options;
+  ProvenanceInputs inputs;
+  inputs.options = {{"tolerance", options.tolerance},
+                    {"max_evaluations", options.max_evaluations},
+                    {"max_time_s", options.max_time_s},
+                    {"scan_points", options.scan_points},
+                    {"local_starts", options.local_starts}};
+  return inputs;
+}
+
+// No bat of this family meets the targets (or the budget ran out): 422 with the closest
+// feasible bat and its properties.
+std::optional<Unmet> FitUnmet(const FitRequest&, const core::ShapeFitResult& fit) {
+  if (fit.summary.termination == core::Termination::kConverged) return std::nullopt;
   const bool infeasible = fit.summary.termination == core::Termination::kInfeasible;
-  nlohmann::json out{
-      {"code", ErrorCodeName(infeasible ? ErrorCode::kInfeasible : ErrorCode::kTimeout)},
-      {"message", infeasible
-                      ? "no bat of this family meets the targets: " + fit.summary.message
-                      : "the fit stopped before meeting the targets: " + fit.summary.message},
-      {"field", "targets"},
-      {"closest", std::move(result)}};
-  return {422, std::move(out)};
+  return Unmet{infeasible ? ErrorCode::kInfeasible : ErrorCode::kTimeout,
+               infeasible ? "no bat of this family meets the targets: " + fit.summary.message
+                          : "the fit stopped before meeting the targets: " + fit.summary.message,
+               "targets"};
+}
+
+const Endpoint<FitRequest, core::ShapeFitResult>& FitEndpoint() {
+  static const auto endpoint = [] {
+    Endpoint<FitRequest, core::ShapeFitResult> e;
+    e.parse = ParseFit;
+    e.run = [](const FitRequest& request, const Context&) {
+      return core::FitShape(request.problem, request.options);
+    };
+    e.failure = FitFailure;
+    e.render = RenderFit;
+    e.provenance = FitProvenance;
+    e.unmet = FitUnmet;
+    return e;
+  }();
+  return endpoint;
+}
+
+}  // namespace
+
+Response HandleBatFit(const Request& request, const Context& context) {
+  return ServeEndpoint(FitEndpoint(), request, context);
 }
 
 }  // namespace sweetspot::api

@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 
+#include "api/endpoint.hpp"
 #include "api/explore_design.hpp"
 #include "api/explore_shards.hpp"
 #include "api/handlers.hpp"
@@ -145,15 +146,15 @@ SweepOutcome RunSweep(const Sweep& sweep, core::Progress* progress,
   return outcome;
 }
 
-}  // namespace
+// A parsed /v1/explore request: the sweep, ready to run, and the answer's format.
+struct ExploreRequest {
+  std::shared_ptr<Sweep> sweep;
+  std::string format;  // "json" or "ndjson"
+};
 
-Response HandleExplore(const Request& request, const Context& context) {
-  const auto start = std::chrono::steady_clock::now();
-  Response failure;
-  const auto body = ParseObjectBody(request, context, &failure);
-  if (!body) return failure;
-  ApiError error;
-  ObjectReader reader(*body, "", &error);
+std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& context,
+                                           ApiError* error) {
+  ObjectReader reader(body, "", error);
 
   // The design template: the bat and the scene fields, as written.
   Json base = Json::object();
@@ -162,13 +163,13 @@ Response HandleExplore(const Request& request, const Context& context) {
   }
   if (!base.contains("bat")) {
     reader.Missing("bat");
-    return ToResponse(error);
+    return std::nullopt;
   }
   {  // The template itself must be a valid bat and scene.
     core::Scene scene;
-    ObjectReader check(base, "", &error);
-    const auto spec = ParseBat(base["bat"], "bat", context.limits, &error);
-    if (!spec || !ReadSceneCommon(check, &scene)) return ToResponse(error);
+    ObjectReader check(base, "", error);
+    const auto spec = ParseBat(base["bat"], "bat", context.limits, error);
+    if (!spec || !ReadSceneCommon(check, &scene)) return std::nullopt;
   }
 
   core::SweepPlan plan;
@@ -188,14 +189,14 @@ Response HandleExplore(const Request& request, const Context& context) {
   std::vector<Parameter> parameters;
   const Json* params = reader.Get("parameters");
   if (reader.ok() && params == nullptr) reader.Missing("parameters");
-  if (!reader.ok()) return ToResponse(error);
+  if (!reader.ok()) return std::nullopt;
   if (!params->is_array() || params->empty() || params->size() > 32) {
     reader.Fail("parameters", "must be an array of 1 to 32 {\"path\", \"min\", \"max\"}");
-    return ToResponse(error);
+    return std::nullopt;
   }
   for (std::size_t i = 0; i < params->size(); ++i) {
     const std::string where = "parameters[" + std::to_string(i) + "]";
-    ObjectReader p((*params)[i], where, &error);
+    ObjectReader p((*params)[i], where, error);
     Parameter parameter;
     core::SweepDimension dimension;
     p.String("path", &parameter.path);
@@ -204,10 +205,10 @@ Response HandleExplore(const Request& request, const Context& context) {
     long long count = plan.method == core::SamplingMethod::kGrid ? 2 : 1;
     p.OptionalInteger("count", 1, 1000000000, &count);  // the total is checked against max_samples
     dimension.count = static_cast<int>(count);
-    if (!p.Finish()) return ToResponse(error);
+    if (!p.Finish()) return std::nullopt;
     if (dimension.max < dimension.min) {
       p.Fail("max", "must be >= min = " + Show(Json(dimension.min)));
-      return ToResponse(error);
+      return std::nullopt;
     }
     std::string path = parameter.path;
     const std::string head = path.substr(0, path.find_first_of(".["));
@@ -218,13 +219,13 @@ Response HandleExplore(const Request& request, const Context& context) {
     auto steps = ParseJsonPath(path, &why);
     Json probe = base;
     if (!steps || !SetNumberAtPath(&probe, *steps, dimension.min, &why)) {
-      SetError(&error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"], why);
-      return ToResponse(error);
+      SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"], why);
+      return std::nullopt;
     }
     if (ApiError unknown; !IsKnownField(probe, context.limits, &unknown)) {
-      SetError(&error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
+      SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
                unknown.message);
-      return ToResponse(error);
+      return std::nullopt;
     }
     parameter.steps = std::move(*steps);
     parameters.push_back(std::move(parameter));
@@ -237,7 +238,7 @@ Response HandleExplore(const Request& request, const Context& context) {
   if (const Json* list = reader.Get("outputs")) {
     if (!list->is_array() || list->empty()) {
       reader.Fail("outputs", "must be a non-empty array of output names");
-      return ToResponse(error);
+      return std::nullopt;
     }
     outputs = RowOutputs{};
     for (std::size_t i = 0; i < list->size(); ++i) {
@@ -254,7 +255,7 @@ Response HandleExplore(const Request& request, const Context& context) {
                                    " is not one of properties, max_exit_speed, "
                                    "center_of_percussion, vibration_node, sweet_zone, "
                                    "exit_speed_curve, least_sting_zone, collision_efficiency");
-        return ToResponse(error);
+        return std::nullopt;
       }
     }
     if (outputs.collision_efficiency &&
@@ -264,23 +265,23 @@ Response HandleExplore(const Request& request, const Context& context) {
     }
   }
   core::SceneOptions options;
-  if (!ReadSceneOptions(reader, context.limits, &options)) return ToResponse(error);
+  if (!ReadSceneOptions(reader, context.limits, &options)) return std::nullopt;
 
   std::vector<ParetoObjective> objectives;
   if (const Json* pareto = reader.Get("pareto")) {
-    ObjectReader p(*pareto, "pareto", &error);
+    ObjectReader p(*pareto, "pareto", error);
     const Json* list = p.Get("objectives");
     if (p.ok() && (list == nullptr || !list->is_array() || list->size() < 2 || list->size() > 8)) {
       p.Fail("objectives", "must be an array of 2 to 8 {\"output\", \"sense\"}");
     }
-    if (!p.Finish()) return ToResponse(error);
+    if (!p.Finish()) return std::nullopt;
     for (std::size_t i = 0; i < list->size(); ++i) {
-      ObjectReader o((*list)[i], "pareto.objectives[" + std::to_string(i) + "]", &error);
+      ObjectReader o((*list)[i], "pareto.objectives[" + std::to_string(i) + "]", error);
       ParetoObjective objective;
       std::string sense;
       o.String("output", &objective.output);
       o.String("sense", &sense, {"max", "min"});
-      if (!o.Finish()) return ToResponse(error);
+      if (!o.Finish()) return std::nullopt;
       objective.sense = sense == "max" ? core::Sense::kMaximize : core::Sense::kMinimize;
       // "parameters.<path>" names a swept parameter (its path may hold dots);
       // anything else is a dotted path into the row, e.g. "max_exit_speed.exit_speed_mps".
@@ -290,30 +291,30 @@ Response HandleExplore(const Request& request, const Context& context) {
   }
   core::Shard shard;
   if (const Json* s = reader.Get("shard")) {
-    ObjectReader sr(*s, "shard", &error);
+    ObjectReader sr(*s, "shard", error);
     long long index = 0, count = 1;
     sr.OptionalInteger("index", 0, 1LL << 40, &index);
     sr.OptionalInteger("count", 1, 1LL << 40, &count);
-    if (!sr.Finish()) return ToResponse(error);
+    if (!sr.Finish()) return std::nullopt;
     shard = {static_cast<std::uint64_t>(index), static_cast<std::uint64_t>(count)};
     if (core::Refusal refusal; !shard.Validate(&refusal)) {
-      CoreRefusal(refusal, "", &error);
-      return ToResponse(error);
+      CoreRefusal(refusal, "", error);
+      return std::nullopt;
     }
   }
   std::string format = "json";
   reader.OptionalString("format", &format, {"json", "ndjson"});
-  if (!reader.Finish()) return ToResponse(error);
+  if (!reader.Finish()) return std::nullopt;
   if (core::Refusal refusal; !plan.Validate(&refusal)) {
-    CoreRefusal(refusal, "", &error);
-    return ToResponse(error);
+    CoreRefusal(refusal, "", error);
+    return std::nullopt;
   }
   const std::uint64_t total = plan.DesignCount();
   if (total > context.limits.max_samples) {
-    SetError(&error, ErrorCode::kTooBig, "parameters", nullptr,
+    SetError(error, ErrorCode::kTooBig, "parameters", nullptr,
              "describe " + std::to_string(total) + " designs, over the limit max_samples = " +
                  std::to_string(context.limits.max_samples));
-    return ToResponse(error);
+    return std::nullopt;
   }
 
   auto sweep = std::make_shared<Sweep>();
@@ -328,18 +329,30 @@ Response HandleExplore(const Request& request, const Context& context) {
   sweep->total = total;
   // The sweep's identity: the request without its shard and format, so that
   // every shard of one sweep carries the same provenance (explore-merge checks it).
-  Json identity = *body;
+  Json identity = body;
   identity.erase("shard");
   identity.erase("format");
   sweep->provenance = Provenance(identity, Json::object(), sweep->plan.seed);
-  sweep->start = start;
   // Designs: grids are enumerated by index; LHS and Sobol are drawn in full
   // (every shard draws the same sequence) and then filtered by shard.
   if (sweep->plan.method != core::SamplingMethod::kGrid) {
     sweep->drawn = core::GenerateDesigns(sweep->plan);
   }
 
-  if (format == "ndjson") {
+  return ExploreRequest{std::move(sweep), std::move(format)};
+}
+
+}  // namespace
+
+Response HandleExplore(const Request& request, const Context& context) {
+  const auto start = std::chrono::steady_clock::now();
+  Response failure;
+  const auto parsed = ParseRequest<ExploreRequest>(request, context, ParseExplore, &failure);
+  if (!parsed) return failure;
+  // The sweep's timing_s, in its summary, counts from the request's arrival.
+  const std::shared_ptr<Sweep>& sweep = parsed->sweep;
+  sweep->start = start;
+  if (parsed->format == "ndjson") {
     // Streamed: a line per design as soon as it is evaluated, then the summary
     // line. The sweep runs while the server writes (after this returns), so it
     // owns copies of everything; a client that goes away stops it.

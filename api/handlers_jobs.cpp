@@ -1,6 +1,7 @@
 // POST /v1/jobs, GET /v1/jobs, GET /v1/jobs/{id}, GET /v1/jobs/{id}/result,
 // DELETE /v1/jobs/{id}: any long POST endpoint run as a job (api/job_service.hpp
 // has the states and JSON; the server implements the service).
+#include "api/endpoint.hpp"
 #include "api/handlers.hpp"
 #include "api/job_service.hpp"
 
@@ -13,20 +14,19 @@ Response NoJobs() {
                        "requests directly, so send the inner request to its own path");
 }
 
-}  // namespace
+// A parsed POST /v1/jobs request: the endpoint to run and the request it gets.
+struct JobRequest {
+  const Route* target = nullptr;
+  std::string body;  // the inner request, as JSON text
+};
 
-Response HandleJobSubmit(const Request& request, const Context& context) {
-  if (context.jobs == nullptr) return NoJobs();
-  Response failure;
-  const auto body = ParseObjectBody(request, context, &failure);
-  if (!body) return failure;
-  ApiError error;
-  ObjectReader reader(*body, "", &error);
+std::optional<JobRequest> ParseJob(const nlohmann::json& body, const Context&, ApiError* error) {
+  ObjectReader reader(body, "", error);
   std::string path;
   reader.String("path", &path);
   const nlohmann::json* inner_body = reader.Get("body");
   if (reader.ok() && inner_body == nullptr) reader.Missing("body");
-  if (!reader.Finish()) return ToResponse(error);
+  if (!reader.Finish()) return std::nullopt;
   if (path.rfind("/", 0) != 0) path = "/v1/" + path;  // "sweet-spot" -> "/v1/sweet-spot"
   std::string jobbable;
   const Route* target = nullptr;
@@ -35,16 +35,28 @@ Response HandleJobSubmit(const Request& request, const Context& context) {
     if (route.jobbable && route.path == path) target = &route;
   }
   if (target == nullptr) {
-    SetError(&error, ErrorCode::kInvalidValue, "path", &(*body)["path"],
+    SetError(error, ErrorCode::kInvalidValue, "path", &body["path"],
              "must name an endpoint that can run as a job: " + jobbable);
-    return ToResponse(error);
+    return std::nullopt;
   }
   if (!inner_body->is_object()) {
-    SetError(&error, ErrorCode::kInvalidValue, "body", inner_body,
+    SetError(error, ErrorCode::kInvalidValue, "body", inner_body,
              "must be the endpoint's request object");
-    return ToResponse(error);
+    return std::nullopt;
   }
-  return context.jobs->Submit({target->method, target->path, inner_body->dump()});
+  return JobRequest{target, inner_body->dump()};
+}
+
+}  // namespace
+
+// A job's answer is its state (202), not a typed endpoint's result: only the parsing is
+// shared (ParseRequest).
+Response HandleJobSubmit(const Request& request, const Context& context) {
+  if (context.jobs == nullptr) return NoJobs();
+  Response failure;
+  const auto job = ParseRequest<JobRequest>(request, context, ParseJob, &failure);
+  if (!job) return failure;
+  return context.jobs->Submit({job->target->method, job->target->path, job->body});
 }
 
 Response HandleJobList(const Request&, const Context& context) {

@@ -2,10 +2,11 @@
 #include "api/handlers_modes.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+#include <memory>
 
 #include "api/bat_json.hpp"
+#include "api/endpoint.hpp"
 #include "api/handlers.hpp"
 #include "api/scene_json.hpp"
 #include "core/flexible/modes_cache.hpp"
@@ -14,10 +15,6 @@ namespace sweetspot::api {
 namespace {
 
 using Json = nlohmann::json;
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // One mode: frequency, nodes and the shape sampled at `samples` evenly spaced positions,
 // scaled so that the largest |displacement| is 1 (tip positive).
@@ -51,23 +48,31 @@ Json ModeToJson(const core::BatModes& modes, std::size_t k, int samples) {
           {"shape", std::move(shape)}};
 }
 
-}  // namespace
+// A parsed /v1/bat/modes request: the bat, the modes' options and the shape's samples.
+struct ModesRequest {
+  BatSpec spec;
+  core::BeamModesOptions options;
+  int shape_samples = 41;
+};
 
-Response HandleBatModes(const Request& request, const Context& context) {
-  const auto start = std::chrono::steady_clock::now();
-  Response failure;
-  const auto body = ParseObjectBody(request, context, &failure);
-  if (!body) return failure;
-  ApiError error;
-  ObjectReader reader(*body, "", &error);
+// What the modes' core call returns: the modes (shared with the cache) and whether the
+// cache had them.
+struct ModesResult {
+  std::shared_ptr<const core::BatModes> modes;
+  bool cache_hit = false;
+};
+
+std::optional<ModesRequest> ParseModes(const Json& body, const Context& context, ApiError* error) {
+  ObjectReader reader(body, "", error);
   const Json* bat_json = reader.Get("bat");
   if (bat_json == nullptr) {
     reader.Missing("bat");
-    return ToResponse(error);
+    return std::nullopt;
   }
-  const auto spec = ParseBat(*bat_json, "bat", context.limits, &error);
-  if (!spec) return ToResponse(error);
-  core::BeamModesOptions options;
+  auto spec = ParseBat(*bat_json, "bat", context.limits, error);
+  if (!spec) return std::nullopt;
+  ModesRequest request{std::move(*spec), {}, 41};
+  core::BeamModesOptions& options = request.options;
   std::string theory = "timoshenko";
   reader.OptionalString("theory", &theory, {"timoshenko", "euler_bernoulli"});
   options.theory = core::ParseBeamTheory(theory).value_or(core::BeamTheory::kTimoshenko);
@@ -77,47 +82,75 @@ Response HandleBatModes(const Request& request, const Context& context) {
   reader.OptionalNumber("tolerance", Between(1e-9, 0.1), &options.relative_tolerance);
   long long samples = 41;
   reader.OptionalInteger("shape_samples", 2, 1001, &samples);
+  request.shape_samples = static_cast<int>(samples);
   long long max_elements = options.max_elements;
   reader.OptionalInteger("max_elements", 2, 4096, &max_elements);
   options.max_elements = static_cast<int>(max_elements);
-  if (!reader.Finish()) return ToResponse(error);
+  if (!reader.Finish()) return std::nullopt;
+  return request;
+}
 
-  bool cache_hit = false;
-  const auto result = core::CachedBatModes(spec->bat, options, context.modes_cache, &cache_hit);
-  const core::Summary& s = result->summary;
-  if (!s.IsSolutionUsable()) return CoreFailure(s, "", "bat");
-
+Json RenderModes(const ModesRequest& request, const ModesResult& modes) {
+  const core::BatModes& result = *modes.modes;
   Json out = Json::object();
   Json frequencies = Json::array(), errors = Json::array(), list = Json::array();
-  for (std::size_t k = 0; k < result->modes.size(); ++k) {
-    frequencies.push_back(result->modes[k].frequency_hz);
-    errors.push_back(result->modes[k].error_estimate_hz);
-    list.push_back(ModeToJson(*result, k, static_cast<int>(samples)));
+  for (std::size_t k = 0; k < result.modes.size(); ++k) {
+    frequencies.push_back(result.modes[k].frequency_hz);
+    errors.push_back(result.modes[k].error_estimate_hz);
+    list.push_back(ModeToJson(result, k, request.shape_samples));
   }
-  out["theory"] = core::BeamTheoryName(result->theory);
+  out["theory"] = core::BeamTheoryName(result.theory);
   out["boundary_conditions"] = "free-free";
   out["frequencies_hz"] = std::move(frequencies);
   out["modes"] = std::move(list);
-  const core::BeamMode& first = result->modes.front();
+  const core::BeamMode& first = result.modes.front();
   if (!first.nodes_from_knob_m.empty()) {
     out["vibration_node"] = {{"position_from_knob_m", first.nodes_from_knob_m.back()},
                              {"frequency_hz", first.frequency_hz},
                              {"other_node_from_knob_m", first.nodes_from_knob_m.front()}};
   }
-  out["elements"] = result->Elements();
-  out["refinement_elements"] = result->refinement_elements;
-  out["tolerance"] = result->tolerance;
-  out["error_estimate"] = {{"frequency_relative", result->max_relative_error},
+  out["elements"] = result.Elements();
+  out["refinement_elements"] = result.refinement_elements;
+  out["tolerance"] = result.tolerance;
+  out["error_estimate"] = {{"frequency_relative", result.max_relative_error},
                            {"frequencies_hz", std::move(errors)}};
-  out["rigid_body"] = {{"mass_kg", result->mass_kg},
-                       {"balance_point_m", result->balance_point_m},
-                       {"moi_centroid_kg_m2", result->moi_centroid_kg_m2}};
+  out["rigid_body"] = {{"mass_kg", result.mass_kg},
+                       {"balance_point_m", result.balance_point_m},
+                       {"moi_centroid_kg_m2", result.moi_centroid_kg_m2}};
   out["models_used"] = {core::kFlexibleBeamModel};
-  out["cache_hit"] = cache_hit;
-  out["summary"] = SummaryToJson(s);
-  out["provenance"] = Provenance(*body, Json::object());
-  out["timing_s"] = SecondsSince(start);
-  return {200, std::move(out)};
+  out["cache_hit"] = modes.cache_hit;
+  return out;
+}
+
+const Endpoint<ModesRequest, ModesResult>& ModesEndpoint() {
+  static const auto endpoint = [] {
+    Endpoint<ModesRequest, ModesResult> e;
+    e.parse = ParseModes;
+    e.run = [](const ModesRequest& request, const Context& context) {
+      ModesResult result;
+      result.modes = core::CachedBatModes(request.spec.bat, request.options, context.modes_cache,
+                                          &result.cache_hit);
+      return result;
+    };
+    e.failure = [](const ModesRequest&, const ModesResult& result) -> std::optional<Response> {
+      const core::Summary& s = result.modes->summary;
+      if (s.IsSolutionUsable()) return std::nullopt;
+      return CoreFailure(s, "", "bat");
+    };
+    e.render = RenderModes;
+    e.summary = [](const ModesResult& result) -> const core::Summary& {
+      return result.modes->summary;
+    };
+    e.provenance = [](const ModesRequest&, const Json&) { return ProvenanceInputs{}; };
+    return e;
+  }();
+  return endpoint;
+}
+
+}  // namespace
+
+Response HandleBatModes(const Request& request, const Context& context) {
+  return ServeEndpoint(ModesEndpoint(), request, context);
 }
 
 }  // namespace sweetspot::api

@@ -4,12 +4,12 @@
 // answer's bat is in the request's own form, so it can be sent straight back
 // to /v1/bat/properties.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <limits>
 
 #include "api/bat_json.hpp"
+#include "api/endpoint.hpp"
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
 #include "api/scene_json.hpp"
@@ -19,10 +19,6 @@ namespace sweetspot::api {
 namespace {
 
 using Json = nlohmann::json;
-
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 Json Finite(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
@@ -87,8 +83,8 @@ bool ReadConstraints(ObjectReader& top, core::DesignConstraints* c) {
       return reader.Fail("rules", "must be a rule-set name or an array of names");
     }
     for (const Json& name : names) {
-      const auto rule = name.is_string() ? core::ParseRuleSet(name.get<std::string>())
-                                         : std::nullopt;
+      const auto rule =
+          name.is_string() ? core::ParseRuleSet(name.get<std::string>()) : std::nullopt;
       if (!rule) return reader.Fail("rules", "must name rule sets among mlb-wood, bbcor, usssa");
       c->rules.push_back(*rule);
     }
@@ -252,146 +248,201 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
   return out;
 }
 
-}  // namespace
-
-Response HandleOptimize(const Request& request, const Context& context) {
-  const auto start = std::chrono::steady_clock::now();
-  Response failure;
-  const auto body = ParseObjectBody(request, context, &failure);
-  if (!body) return failure;
-  ApiError error;
-  ObjectReader reader(*body, "", &error);
-  const Json* bat_json = reader.Get("bat");
-  if (bat_json == nullptr) {
-    reader.Missing("bat");
-    return ToResponse(error);
-  }
-  const auto spec = ParseBat(*bat_json, "bat", context.limits, &error);
-  if (!spec) return ToResponse(error);
+// A parsed /v1/optimize request: the problem, the solver's options, the materials to choose
+// among (empty = no choice), the objective's name and the bat as written (the answer's bat
+// is given back in its form).
+struct OptimizeRequest {
   core::DesignProblem problem;
-  problem.bat = spec->bat;
-  problem.three_segment = spec->three_segment;
-  core::Scene scene;
-  if (!ReadSceneCommon(reader, &scene)) return ToResponse(error);
-  problem.ball = scene.ball;
-  problem.swing = scene.swing;
-  problem.cor = scene.cor;
-  problem.inertia_model = scene.inertia_model;
-
+  core::DesignOptions options;
   std::vector<core::Material> material_choices;
+  std::string objective;
+  Json request_bat;
+};
+
+// What the optimiser returned: one design, or one per material and the best of them.
+struct OptimizeResult {
+  bool by_material = false;
+  core::MaterialChoiceResult choice;  // by_material
+  core::DesignResult single;          // otherwise
+
+  // The design answered with; null when no material gives a usable design.
+  const core::DesignResult* Chosen() const {
+    if (!by_material) return &single;
+    if (choice.best < 0) return nullptr;
+    return &choice.per_material[static_cast<std::size_t>(choice.best)].result;
+  }
+};
+
+// Reads "variables": continuous design variables into `problem`, a "material" choice into
+// `material_choices`.
+bool ReadVariables(ObjectReader& reader, const ApiLimits& limits, core::DesignProblem* problem,
+                   std::vector<core::Material>* material_choices) {
+  ApiError* error = reader.error();
   const Json* variables = reader.Get("variables");
   if (reader.ok() && variables == nullptr) reader.Missing("variables");
-  if (!reader.ok()) return ToResponse(error);
-  const std::size_t max_variables = context.limits.max_design_variables;
+  if (!reader.ok()) return false;
+  const std::size_t max_variables = limits.max_design_variables;
   if (!variables->is_array() || variables->empty() || variables->size() > max_variables) {
-    reader.Fail("variables", "must be an array of 1 to " + std::to_string(max_variables) +
-                                 " {\"path\", \"min\", \"max\"}");
-    return ToResponse(error);
+    return reader.Fail("variables", "must be an array of 1 to " + std::to_string(max_variables) +
+                                        " {\"path\", \"min\", \"max\"}");
   }
   for (std::size_t i = 0; i < variables->size(); ++i) {
     const std::string where = "variables[" + std::to_string(i) + "]";
-    ObjectReader v((*variables)[i], where, &error);
+    ObjectReader v((*variables)[i], where, error);
     core::DesignVariable variable;
     v.String("path", &variable.path);
     if (v.ok() && variable.path == "material") {  // a discrete choice among materials
       const Json* choices = v.Get("choices");
       if (choices == nullptr || !choices->is_array() || choices->empty() || choices->size() > 16) {
-        v.Fail("choices", "must be an array of 1 to 16 material names");
-        return ToResponse(error);
+        return v.Fail("choices", "must be an array of 1 to 16 material names");
       }
       for (std::size_t k = 0; k < choices->size(); ++k) {
-        auto m = ParseMaterial((*choices)[k], where + ".choices[" + std::to_string(k) + "]",
-                               false, &error);
-        if (!m) return ToResponse(error);
-        material_choices.push_back(*m);
+        auto m = ParseMaterial((*choices)[k], where + ".choices[" + std::to_string(k) + "]", false,
+                               error);
+        if (!m) return false;
+        material_choices->push_back(*m);
       }
-      if (!v.Finish()) return ToResponse(error);
+      if (!v.Finish()) return false;
       continue;
     }
     v.Number("min", Between(-1e12, 1e12), &variable.min);
     v.Number("max", Between(-1e12, 1e12), &variable.max);
-    if (!v.Finish()) return ToResponse(error);
+    if (!v.Finish()) return false;
     if (!core::ParseDesignVariablePath(variable.path)) {
-      SetError(&error, ErrorCode::kInvalidValue, where + ".path", &(*variables)[i]["path"],
-               "is not a design variable (profile.knots[i].radius_m, profile.knots[i].x_m, "
-               "three_segment.<field>, material.density_kg_m3, wall_thickness_m, "
-               "fill.diameter_m, fill.depth_m, fill.material.density_kg_m3, or material with "
-               "choices)");
-      return ToResponse(error);
+      return SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*variables)[i]["path"],
+                      "is not a design variable (profile.knots[i].radius_m, profile.knots[i].x_m, "
+                      "three_segment.<field>, material.density_kg_m3, wall_thickness_m, "
+                      "fill.diameter_m, fill.depth_m, fill.material.density_kg_m3, or material "
+                      "with choices)");
     }
-    problem.variables.push_back(variable);
+    problem->variables.push_back(variable);
   }
-  if (!ReadConstraints(reader, &problem.constraints)) return ToResponse(error);
-  std::string objective = "max_exit_speed";
-  reader.OptionalString("objective", &objective,
+  return true;
+}
+
+std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& context,
+                                             ApiError* error) {
+  ObjectReader reader(body, "", error);
+  const Json* bat_json = reader.Get("bat");
+  if (bat_json == nullptr) {
+    reader.Missing("bat");
+    return std::nullopt;
+  }
+  const auto spec = ParseBat(*bat_json, "bat", context.limits, error);
+  if (!spec) return std::nullopt;
+  OptimizeRequest request;
+  request.request_bat = *bat_json;
+  core::DesignProblem& problem = request.problem;
+  problem.bat = spec->bat;
+  problem.three_segment = spec->three_segment;
+  core::Scene scene;
+  if (!ReadSceneCommon(reader, &scene)) return std::nullopt;
+  problem.ball = scene.ball;
+  problem.swing = scene.swing;
+  problem.cor = scene.cor;
+  problem.inertia_model = scene.inertia_model;
+  if (!ReadVariables(reader, context.limits, &problem, &request.material_choices) ||
+      !ReadConstraints(reader, &problem.constraints)) {
+    return std::nullopt;
+  }
+  request.objective = "max_exit_speed";
+  reader.OptionalString("objective", &request.objective,
                         {"max_exit_speed", "max_exit_speed_swing_weight", "widest_sweet_zone",
                          "min_moi", "min_sting"});
-  problem.objective = *core::ParseDesignObjective(objective);
+  problem.objective = *core::ParseDesignObjective(request.objective);
   reader.OptionalNumber("swing_weight_exponent", Between(0.0, 0.5), &problem.swing_weight_exponent);
   reader.OptionalNumber("sweet_zone_tolerance_mps", Positive(100.0),
                         &problem.sweet_zone_tolerance_mps);
-  core::DesignOptions options;
-  if (!ReadOptions(reader, context.limits, problem.objective, &options, &problem.flexible) ||
+  if (!ReadOptions(reader, context.limits, problem.objective, &request.options,
+                   &problem.flexible) ||
       !reader.Finish()) {
-    return ToResponse(error);
+    return std::nullopt;
   }
   if (problem.variables.empty()) {
     reader.Fail("variables", "needs at least one continuous variable besides a material choice");
-    return ToResponse(error);
+    return std::nullopt;
   }
   if (core::Refusal refusal; !problem.Validate(&refusal)) {
-    CoreRefusal(refusal, "", &error);
+    CoreRefusal(refusal, "", error);
+    return std::nullopt;
+  }
+  return request;
+}
+
+OptimizeResult RunOptimize(const OptimizeRequest& request, const Context& context) {
+  OptimizeResult result;
+  result.by_material = !request.material_choices.empty();
+  if (result.by_material) {
+    result.choice = core::OptimizeOverMaterials(request.problem, request.material_choices,
+                                                request.options, context.progress);
+  } else {
+    result.single = core::OptimizeDesign(request.problem, request.options, context.progress);
+  }
+  return result;
+}
+
+// No usable material (422), or a problem the optimiser refused (400).
+std::optional<Response> OptimizeFailure(const OptimizeRequest&, const OptimizeResult& result) {
+  const core::DesignResult* chosen = result.Chosen();
+  if (chosen == nullptr) {
+    return ErrorResponse(422, ErrorCode::kInfeasible,
+                         "no material gives a usable design: " + result.choice.summary.message,
+                         "variables");
+  }
+  if (chosen->summary.termination == core::Termination::kInvalidInput) {
+    ApiError error;
+    CoreRefusal(chosen->summary.message, "", &error);
     return ToResponse(error);
   }
+  return std::nullopt;
+}
 
-  const Json options_json = body->contains("options") ? (*body)["options"] : Json::object();
-  Json out;
-  const core::DesignResult* chosen = nullptr;
-  core::MaterialChoiceResult choice;
-  core::DesignResult single;
-  if (!material_choices.empty()) {
-    choice = core::OptimizeOverMaterials(problem, material_choices, options, context.progress);
+Json RenderOptimize(const OptimizeRequest& request, const OptimizeResult& result) {
+  Json out = ResultToJson(*result.Chosen(), request.request_bat);
+  if (result.by_material) {
     Json per_material = Json::array();
-    for (const auto& m : choice.per_material) {
+    for (const auto& m : result.choice.per_material) {
       per_material.push_back({{"material", m.material},
                               {"termination", core::TerminationName(m.result.summary.termination)},
                               {"message", m.result.summary.message},
                               {"objective_value", Finite(m.result.objective_value)}});
     }
-    if (choice.best >= 0) chosen = &choice.per_material[static_cast<std::size_t>(choice.best)].result;
-    out = chosen != nullptr ? ResultToJson(*chosen, *bat_json) : Json::object();
     out["materials"] = std::move(per_material);
-    if (chosen == nullptr) {
-      return ErrorResponse(422, ErrorCode::kInfeasible,
-                           "no material gives a usable design: " + choice.summary.message,
-                           "variables");
-    }
-  } else {
-    single = core::OptimizeDesign(problem, options, context.progress);
-    chosen = &single;
-    out = ResultToJson(single, *bat_json);
   }
-  out["objective"] = objective;
-  out["provenance"] = Provenance(*body, options_json, options.seed);
-  out["timing_s"] = SecondsSince(start);
-  switch (chosen->summary.termination) {
-    case core::Termination::kInvalidInput: {
-      CoreRefusal(chosen->summary.message, "", &error);
-      return ToResponse(error);
-    }
-    case core::Termination::kInfeasible: {
-      std::string message = "no design meets the constraints";
-      if (!chosen->conflicts.empty()) message += ": " + chosen->conflicts.front().message;
-      return {422,
-              {{"code", ErrorCodeName(ErrorCode::kInfeasible)},
-               {"message", message},
-               {"field", "constraints"},
-               {"closest", std::move(out)}}};
-    }
-    default:
-      // converged, no_convergence and failure: the summary says which.
-      return {200, std::move(out)};
-  }
+  out["objective"] = request.objective;
+  return out;
+}
+
+// Infeasible: 422 with the closest design. Converged, no_convergence and failure are 200s
+// whose summary says which.
+std::optional<Unmet> OptimizeUnmet(const OptimizeRequest&, const OptimizeResult& result) {
+  const core::DesignResult& chosen = *result.Chosen();
+  if (chosen.summary.termination != core::Termination::kInfeasible) return std::nullopt;
+  std::string message = "no design meets the constraints";
+  if (!chosen.conflicts.empty()) message += ": " + chosen.conflicts.front().message;
+  return Unmet{ErrorCode::kInfeasible, std::move(message), "constraints"};
+}
+
+const Endpoint<OptimizeRequest, OptimizeResult>& OptimizeEndpoint() {
+  static const auto endpoint = [] {
+    Endpoint<OptimizeRequest, OptimizeResult> e;
+    e.parse = ParseOptimize;
+    e.run = RunOptimize;
+    e.failure = OptimizeFailure;
+    e.render = RenderOptimize;
+    e.provenance = [](const OptimizeRequest& request, const Json& body) {
+      return BodyOptions(body, request.options.seed);
+    };
+    e.unmet = OptimizeUnmet;
+    return e;
+  }();
+  return endpoint;
+}
+
+}  // namespace
+
+Response HandleOptimize(const Request& request, const Context& context) {
+  return ServeEndpoint(OptimizeEndpoint(), request, context);
 }
 
 }  // namespace sweetspot::api

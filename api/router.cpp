@@ -115,6 +115,29 @@ Response InternalErrorResponse(std::string what) {
 
 }  // namespace
 
+Response CallRoute(const Route& route, const Request& request, const Context& context,
+                   bool allow_stream) {
+  try {
+    Response response = route.handler(request, context);
+    if (response.stream && !allow_stream) {
+      std::string text;
+      response.stream([&text](std::string_view chunk) {
+        text.append(chunk);
+        return true;
+      });
+      response.text = std::move(text);
+      response.stream = nullptr;
+    }
+    return response;
+  } catch (const std::exception& caught) {
+    // The one place an unexpected exception becomes a 500: no details in
+    // the body, the text kept for the log.
+    return InternalErrorResponse(caught.what());
+  } catch (...) {
+    return InternalErrorResponse("an exception not derived from std::exception");
+  }
+}
+
 Response Dispatch(const Request& request, const Context& context, std::string* route_pattern,
                   bool allow_stream) {
   bool path_known = false;
@@ -125,25 +148,7 @@ Response Dispatch(const Request& request, const Context& context, std::string* r
     allowed += (allowed.empty() ? "" : ", ") + route.method;
     if (route.method != request.method) continue;
     if (route_pattern != nullptr) *route_pattern = route.path;
-    try {
-      Response response = route.handler(request, context);
-      if (response.stream && !allow_stream) {
-        std::string text;
-        response.stream([&text](std::string_view chunk) {
-          text.append(chunk);
-          return true;
-        });
-        response.text = std::move(text);
-        response.stream = nullptr;
-      }
-      return response;
-    } catch (const std::exception& caught) {
-      // The one place an unexpected exception becomes a 500: no details in
-      // the body, the text kept for the log.
-      return InternalErrorResponse(caught.what());
-    } catch (...) {
-      return InternalErrorResponse("an exception not derived from std::exception");
-    }
+    return CallRoute(route, request, context, allow_stream);
   }
   if (route_pattern != nullptr) *route_pattern = path_known ? "method_not_allowed" : "unmatched";
   if (path_known) {

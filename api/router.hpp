@@ -30,11 +30,11 @@ struct Request {
 /// What handlers may use besides the request: limits, and what only a
 /// running server has (jobs, metrics). Null members mean "not available here".
 struct Context {
-  ApiLimits limits;                          ///< Request limits (configuration).
-  JobService* jobs = nullptr;                ///< The jobs (server only; server/jobs/).
-  std::function<std::string()> metrics_text; ///< Prometheus text (server only).
-  core::Progress* progress = nullptr;        ///< Cancel flag and progress (inside a job).
-  core::ModesCache* modes_cache = nullptr;   ///< Bending modes kept across requests (server only).
+  ApiLimits limits;                           ///< Request limits (configuration).
+  JobService* jobs = nullptr;                 ///< The jobs (server only; server/jobs/).
+  std::function<std::string()> metrics_text;  ///< Prometheus text (server only).
+  core::Progress* progress = nullptr;         ///< Cancel flag and progress (inside a job).
+  core::ModesCache* modes_cache = nullptr;    ///< Bending modes kept across requests (server only).
 };
 
 /// What answering a request costs, for the server's choice of worker pool.
@@ -58,7 +58,7 @@ struct Route {
   std::string path;     ///< Path pattern.
   std::string summary;  ///< One line for --help and OpenAPI.
   std::function<Response(const Request&, const Context&)> handler;  ///< The handler.
-  bool jobbable = false;  ///< True when POST /v1/jobs may run it.
+  bool jobbable = false;                           ///< True when POST /v1/jobs may run it.
   RouteWorkload workload = RouteWorkload::kLight;  ///< What answering it costs.
 };
 
@@ -83,6 +83,13 @@ std::string PathParameter(std::string_view pattern, std::string_view path);
 /// writes it chunked); otherwise streamed bodies are collected into `text`.
 Response Dispatch(const Request& request, const Context& context,
                   std::string* route_pattern = nullptr, bool allow_stream = false);
+
+/// Calls `route`'s handler as Dispatch does once the route matched: an escaping exception
+/// becomes a 500 InternalError without details in the body (its what() in
+/// Response::internal_error), and without `allow_stream` a streamed body is collected into
+/// `text`. Never throws.
+Response CallRoute(const Route& route, const Request& request, const Context& context,
+                   bool allow_stream = false);
 
 /// The workload of `request`: kCompute for routes that always run models
 /// (explore, optimize, fit, modes) and for scene routes (sweet-spot, collision,
