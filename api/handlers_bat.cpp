@@ -194,14 +194,14 @@ Response HandleBatFit(const Request& request, const Context& context) {
     if (!opt.Finish()) return ToResponse(error);
   }
   if (!reader.Finish()) return ToResponse(error);
-  if (std::string why; !problem.IsValid(&why)) {
+  if (core::Refusal why; !problem.Validate(&why)) {
     CoreRefusal(why, "", &error);
     return ToResponse(error);
   }
 
   const core::ShapeFitResult fit = core::FitShape(problem, options);
   if (fit.summary.termination == core::Termination::kInvalidInput) {
-    CoreRefusal(fit.summary.message, "", &error);
+    CoreRefusal(fit.summary, "", &error);
     return ToResponse(error);
   }
   if (fit.summary.termination == core::Termination::kFailure) {

@@ -376,7 +376,7 @@ Response HandleOptimize(const Request& request, const Context& context) {
   out["timing_s"] = SecondsSince(start);
   switch (chosen->summary.termination) {
     case core::Termination::kInvalidInput: {
-      CoreRefusal(chosen->summary.message, "", &error);
+      CoreRefusal(chosen->summary, "", &error);
       return ToResponse(error);
     }
     case core::Termination::kInfeasible: {

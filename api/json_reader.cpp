@@ -189,8 +189,9 @@ bool CoreRefusal(const core::Refusal& refusal, const std::string& prefix, ApiErr
   return false;
 }
 
-bool CoreRefusal(const std::string& why, const std::string& prefix, ApiError* error) {
-  return CoreRefusal(core::RefusalFromMessage(why), prefix, error);
+bool CoreRefusal(const core::Summary& summary, const std::string& prefix, ApiError* error) {
+  if (summary.refusal.has_value()) return CoreRefusal(*summary.refusal, prefix, error);
+  return CoreRefusal(core::TextRefusal("", summary.message), prefix, error);
 }
 
 bool IsSceneField(std::string_view core_field) {

@@ -16,6 +16,7 @@
 #include "api/limits.hpp"
 #include "api/response.hpp"
 #include "core/refusal.hpp"
+#include "core/summary.hpp"
 
 namespace sweetspot::api {
 
@@ -127,9 +128,10 @@ std::string RequestField(const core::Refusal& refusal, std::string_view prefix);
 /// names to the request's. Returns false.
 bool CoreRefusal(const core::Refusal& refusal, const std::string& prefix, ApiError* error);
 
-/// CoreRefusal for a validator or summary that still reports text ("field = value: rule"),
-/// read with core::RefusalFromMessage.
-bool CoreRefusal(const std::string& why, const std::string& prefix, ApiError* error);
+/// CoreRefusal for a solve that refused its input: the summary's refusal (core::Summary::
+/// refusal); a summary without one is reported with its message under `prefix`, the field
+/// `prefix`.
+bool CoreRefusal(const core::Summary& summary, const std::string& prefix, ApiError* error);
 
 /// True when a core refusal's field names a part of the scene (bat, ball, swing, cor, outputs,
 /// inertia_model) rather than of the computation's options: such fields sit at the top level

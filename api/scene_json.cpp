@@ -259,11 +259,14 @@ Response CoreFailure(const core::Summary& summary, const std::string& missing_mo
     return ErrorResponse(501, ErrorCode::kNotImplemented, summary.message, field);
   }
   if (summary.termination == core::Termination::kInvalidInput) {
-    // The summary names the field in its message ("field = value: rule"), read by core.
-    const core::Refusal refusal = core::RefusalFromMessage(summary.message);
+    // The summary's refusal names the field in core's names; without one, `field` is reported.
+    if (!summary.refusal.has_value() || summary.refusal->field.empty()) {
+      return ErrorResponse(400, ErrorCode::kInvalidValue, summary.message, field);
+    }
+    const core::Refusal& refusal = *summary.refusal;
     const std::string prefix = options_object && !IsSceneField(refusal.field) ? "options" : "";
     return ErrorResponse(400, ErrorCode::kInvalidValue, summary.message,
-                         refusal.field.empty() ? field : RequestField(refusal, prefix));
+                         RequestField(refusal, prefix));
   }
   // The model ran and could not finish with these inputs and settings (e.g. a
   // step or evaluation budget): the client's to change, so 422, not a 500.

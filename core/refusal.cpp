@@ -33,6 +33,14 @@ Refusal IntegerRefusal(std::string_view field, long long value, std::string_view
                  std::string(rule)};
 }
 
+Refusal QuotedRefusal(std::string_view field, std::string_view shown, std::string_view rule) {
+  Refusal out;
+  out.field = field;
+  out.shown = shown;
+  out.rule = rule;
+  return out;
+}
+
 Refusal TextRefusal(std::string_view field, std::string_view rule) {
   Refusal out;
   out.field = field;
@@ -42,6 +50,11 @@ Refusal TextRefusal(std::string_view field, std::string_view rule) {
 
 Refusal Prefixed(std::string_view prefix, Refusal inner) {
   inner.field.insert(0, prefix);
+  return inner;
+}
+
+Refusal Noted(Refusal inner, std::string_view note) {
+  inner.rule += note;
   return inner;
 }
 

@@ -36,12 +36,19 @@ Refusal NumberRefusal(std::string_view field, double value, std::string_view rul
 Refusal Number17Refusal(std::string_view field, double value, std::string_view rule);
 /// A refusal of the integer `field` = `value` (written as an integer: "4096", not "4096.0").
 Refusal IntegerRefusal(std::string_view field, long long value, std::string_view rule);
+/// A refusal quoting a value that is no number, as written (`shown`: a path, a name, "0 and
+/// ..."): "field = shown: rule"; value NaN.
+Refusal QuotedRefusal(std::string_view field, std::string_view shown, std::string_view rule);
 /// A refusal that quotes no value: "field: rule" ("bat: missing ...").
 Refusal TextRefusal(std::string_view field, std::string_view rule);
 
 /// `inner` moved under `prefix` ("material." + "density_kg_m3"): the field and so the message
 /// gain the prefix; the value and the rule are kept.
 Refusal Prefixed(std::string_view prefix, Refusal inner);
+
+/// `inner` with `note` appended to its rule, so that its message ends with the note
+/// ("... (model = flexible)"); the field and the value are kept.
+Refusal Noted(Refusal inner, std::string_view note);
 
 /// Stores `refusal` in *out (if non-null) and returns false: the one way core's validators
 /// refuse (`return Refuse(out, NumberRefusal("length_m", length_m, "must be positive"));`).

@@ -88,6 +88,8 @@ struct HertzSolverOptions {
 
   /// True when the options are in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// Default hands (grip) stiffness, N/m: an order-of-magnitude grip; with a bat of about 0.9 kg
@@ -107,6 +109,8 @@ struct HertzOptions {
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// What the contact model knows about one impact.

@@ -350,24 +350,26 @@ bool NloptAlgorithmIsGlobal(NloptAlgorithm a) { return Info(a).name[0] == 'G'; }
 bool NloptAlgorithmIsStochastic(NloptAlgorithm a) { return a == NloptAlgorithm::kGnCrs2Lm; }
 
 bool ScalarSearchOptions::IsValid(std::string* why) const {
-  auto fail = [why](const std::string& m) {
-    if (why != nullptr) *why = m;
-    return false;
-  };
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool ScalarSearchOptions::Validate(Refusal* why) const {
   if (!(std::isfinite(x_tolerance_m) && x_tolerance_m > 0.0))
-    return fail("nlopt.x_tolerance_m = " + Num(x_tolerance_m) + ": must be finite and > 0");
+    return Refuse(why,
+                  Number17Refusal("nlopt.x_tolerance_m", x_tolerance_m, "must be finite and > 0"));
   if (max_evaluations < 10)
-    return fail("nlopt.max_evaluations = " + std::to_string(max_evaluations) + ": must be >= 10");
+    return Refuse(why, IntegerRefusal("nlopt.max_evaluations", max_evaluations, "must be >= 10"));
   if (!(std::isfinite(max_time_s) && max_time_s > 0.0))
-    return fail("nlopt.max_time_s = " + Num(max_time_s) + ": must be finite and > 0");
+    return Refuse(why, Number17Refusal("nlopt.max_time_s", max_time_s, "must be finite and > 0"));
   if (start_samples < 2)
-    return fail("nlopt.start_samples = " + std::to_string(start_samples) + ": must be >= 2");
+    return Refuse(why, IntegerRefusal("nlopt.start_samples", start_samples, "must be >= 2"));
   if (start_samples > max_evaluations)
-    return fail("nlopt.start_samples = " + std::to_string(start_samples) +
-                ": must be <= nlopt.max_evaluations (" + std::to_string(max_evaluations) + ")");
+    return Refuse(why, IntegerRefusal("nlopt.start_samples", start_samples,
+                                      "must be <= nlopt.max_evaluations (" +
+                                          std::to_string(max_evaluations) + ")"));
   if (global_max_evaluations < 10)
-    return fail("nlopt.global_max_evaluations = " + std::to_string(global_max_evaluations) +
-                ": must be >= 10");
+    return Refuse(why, IntegerRefusal("nlopt.global_max_evaluations", global_max_evaluations,
+                                      "must be >= 10"));
   return true;
 }
 
