@@ -64,13 +64,6 @@ bool RefuseMessage(std::string* why, std::string_view field, double value, std::
 /// validators that still compose text (the design model's nested checks, the rule sets).
 bool RefuseMessage(std::string* why, std::string message);
 
-/// The refusal a "field = value: rule" message states: the inverse of Message() (field = the
-/// text before the first " = ", shown = up to the next ": ", rule = the rest; a message
-/// without " = " is all rule). For the validators and summaries that still hand over text
-/// (nlopt, Hertz, flexible impact, the design model's nested checks, shape fitting); the api
-/// gets it from core rather than parsing the text itself.
-Refusal RefusalFromMessage(std::string_view message);
-
 /// The string form of a structured validator: `validate(Refusal*)` run with *why as the
 /// message (nothing is formatted when `why` is null).
 template <typename Validate>

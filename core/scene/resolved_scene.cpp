@@ -24,10 +24,13 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
     r->cor = *scene.bat->material.cor;
     r->cor_source = "material:" + scene.bat->material.name;
   } else {
+    // About the scene's COR and the bat's material together, so no one field: the api names
+    // the part of the request it was evaluating (the bat, a compared variant).
     s->SetRefusal(TextRefusal(
-        "cor", scene.bat.has_value()
-                   ? "not given, and material '" + scene.bat->material.name + "' has no default COR"
-                   : "not given, and there is no bat material to take it from"));
+        "",
+        scene.bat.has_value()
+            ? "cor: not given, and material '" + scene.bat->material.name + "' has no default COR"
+            : "cor: not given, and there is no bat material to take it from"));
     return false;
   }
   if (scene.mass_properties.has_value()) {

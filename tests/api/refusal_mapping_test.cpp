@@ -30,7 +30,7 @@ TEST(RefusalMappingTest, ACoreFieldMapsToTheRequestPath) {
 
   // A refusal that names no field names the object it was found in.
   error = ApiError{};
-  CoreRefusal(core::RefusalFromMessage("objective: not a known objective"), "options", &error);
+  CoreRefusal(core::TextRefusal("", "objective: not a known objective"), "options", &error);
   EXPECT_EQ(error.field, "options");
   EXPECT_EQ(error.message, "options: objective: not a known objective");
 
