@@ -153,6 +153,7 @@ bool NumberRule::Accepts(double value) const {
   return true;
 }
 
+NumberRule AnyNumber() { return NumberRule{}; }
 NumberRule Positive(double max) { return NumberRule{0.0, max, true, false, false}; }
 NumberRule NonNegative(double max) { return NumberRule{0.0, max, false, false, false}; }
 NumberRule Between(double min, double max) { return NumberRule{min, max, false, false, false}; }
@@ -171,13 +172,36 @@ std::string JoinPath(std::string_view parent, std::string_view key) {
   return std::string(parent) + "." + std::string(key);
 }
 
+std::string RequestName(std::string_view core_field) {
+  // Core's name (its head) -> the request's. Only where the two differ.
+  struct Renamed {
+    std::string_view core;
+    std::string_view request;
+  };
+  constexpr Renamed kRenamed[] = {
+      {"hertz.paper.", "hertz.paper_constants."},
+  };
+  for (const Renamed& r : kRenamed) {
+    if (core_field.substr(0, r.core.size()) == r.core) {
+      return std::string(r.request) + std::string(core_field.substr(r.core.size()));
+    }
+  }
+  return std::string(core_field);
+}
+
 std::string RequestField(const core::Refusal& refusal, std::string_view prefix) {
-  return refusal.field.empty() ? std::string(prefix) : JoinPath(prefix, refusal.field);
+  return refusal.field.empty() ? std::string(prefix) : JoinPath(prefix, RequestName(refusal.field));
+}
+
+std::string RequestMessage(const core::Refusal& refusal) {
+  core::Refusal renamed = refusal;
+  renamed.field = RequestName(refusal.field);
+  return renamed.Message();
 }
 
 bool CoreRefusal(const core::Refusal& refusal, const std::string& prefix, ApiError* error) {
   if (error->code) return false;
-  const std::string why = refusal.Message();
+  const std::string why = RequestMessage(refusal);
   std::string message;
   if (!refusal.field.empty()) {
     message = JoinPath(prefix, why);

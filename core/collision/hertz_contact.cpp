@@ -249,20 +249,26 @@ bool HertzOptions::IsValid(std::string* why) const {
 }
 
 bool HertzOptions::Validate(Refusal* why) const {
+  // The ranges a request may choose (the api checks only that the numbers are numbers).
   if (!(std::isfinite(hands_stiffness_n_m) && hands_stiffness_n_m >= 0.0))
     return Refuse(why, Number17Refusal("hertz.hands_stiffness_n_m", hands_stiffness_n_m,
                                        "must be finite and >= 0"));
+  if (hands_stiffness_n_m > kMaxHandsStiffnessNM)
+    return Refuse(why, Number17Refusal("hertz.hands_stiffness_n_m", hands_stiffness_n_m,
+                                       "must be at most 1e12"));
   if (!(std::isfinite(hands_damping_n_s_m) && hands_damping_n_s_m >= 0.0))
     return Refuse(why, Number17Refusal("hertz.hands_damping_n_s_m", hands_damping_n_s_m,
                                        "must be finite and >= 0"));
-  if (law == ContactLaw::kPaperConstants) {
-    if (!(std::isfinite(paper.k1) && paper.k1 > 0.0))
-      return Refuse(why, Number17Refusal("hertz.paper.k1", paper.k1, "must be finite and > 0"));
-    if (!(std::isfinite(paper.k2) && paper.k2 >= 0.0))
-      return Refuse(why, Number17Refusal("hertz.paper.k2", paper.k2, "must be finite and >= 0"));
-    if (!std::isfinite(paper.k3))
-      return Refuse(why, Number17Refusal("hertz.paper.k3", paper.k3, "must be finite"));
-  }
+  if (hands_damping_n_s_m > kMaxHandsDampingNSM)
+    return Refuse(why, Number17Refusal("hertz.hands_damping_n_s_m", hands_damping_n_s_m,
+                                       "must be at most 1e12"));
+  // The paper's constants are checked whatever the law, as a request's are.
+  if (!(std::isfinite(paper.k1) && paper.k1 > 0.0 && paper.k1 <= kMaxPaperConstant))
+    return Refuse(why, Number17Refusal("hertz.paper.k1", paper.k1, "must be in (0, 1e20]"));
+  if (!(std::isfinite(paper.k2) && paper.k2 >= 0.0 && paper.k2 <= kMaxPaperConstant))
+    return Refuse(why, Number17Refusal("hertz.paper.k2", paper.k2, "must be in [0, 1e20]"));
+  if (!(std::isfinite(paper.k3) && paper.k3 >= 0.0 && paper.k3 <= kMaxPaperConstant))
+    return Refuse(why, Number17Refusal("hertz.paper.k3", paper.k3, "must be in [0, 1e20]"));
   return solver.Validate(why);
 }
 

@@ -96,6 +96,13 @@ struct HertzSolverOptions {
 /// the hands' period (~25 ms) is far longer than the ~1 ms contact, so results barely depend on it.
 inline constexpr double kDefaultHandsStiffnessNM = 5.0e4;
 
+/// Largest hands (grip) stiffness HertzOptions accepts, N/m.
+inline constexpr double kMaxHandsStiffnessNM = 1e12;
+/// Largest hands (grip) damping HertzOptions accepts, N s/m.
+inline constexpr double kMaxHandsDampingNSM = 1e12;
+/// Largest paper constant K1..K3 HertzOptions accepts (the paper's units).
+inline constexpr double kMaxPaperConstant = 1e20;
+
 /// Scene-level settings of the contact model (what a request may choose).
 struct HertzOptions {
   ContactLaw law =

@@ -49,6 +49,17 @@ TEST(RefusalMappingTest, ACoreFieldMapsToTheRequestPath) {
             "bat.profile.knots[2].x_m");
 }
 
+TEST(RefusalMappingTest, TheTableRenamesCoreFieldsTheRequestNamesOtherwise) {
+  EXPECT_EQ(RequestName("hertz.paper.k3"), "hertz.paper_constants.k3");
+  EXPECT_EQ(RequestName("hertz.hands_stiffness_n_m"), "hertz.hands_stiffness_n_m");
+  EXPECT_EQ(RequestName("ball.mass_kg"), "ball.mass_kg");
+  ApiError error;
+  CoreRefusal(core::Number17Refusal("hertz.paper.k3", -1, "must be in [0, 1e20]"), "options",
+              &error);
+  EXPECT_EQ(error.field, "options.hertz.paper_constants.k3");
+  EXPECT_EQ(error.message, "options.hertz.paper_constants.k3 = -1: must be in [0, 1e20]");
+}
+
 TEST(RefusalMappingTest, SceneFieldsAreTheSceneHeads) {
   for (const char* field :
        {"bat", "ball.mass_kg", "swing.hands_from_knob_m", "cor", "outputs", "inertia_model"}) {

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/bat.hpp"
+#include "core/collision/hertz_contact.hpp"
 #include "core/geometry_format.hpp"
 #include "core/material.hpp"
 #include "core/optimize/design_model.hpp"
@@ -189,6 +190,32 @@ TEST(RefusalTest, SummariesCarryTheRefusalTheirMessageStates) {
   done.SetRefusal(TextRefusal("cor", "not given"));
   EXPECT_EQ(done.termination, Termination::kInvalidInput);
   EXPECT_EQ(done.message, "cor: not given");
+}
+
+TEST(RefusalTest, TheContactOptionsOwnTheRangesARequestGets) {
+  // The ranges the api checked before (now only core does): the paper's constants in
+  // [0, 1e20] (K1 > 0) whatever the law, the hands' stiffness and damping finite, >= 0 and at
+  // most 1e12.
+  HertzOptions h;
+  Refusal refusal;
+  EXPECT_TRUE(h.Validate(&refusal));
+  h.paper.k3 = -1.0;
+  ASSERT_FALSE(h.Validate(&refusal));
+  EXPECT_EQ(refusal.field, "hertz.paper.k3");
+  EXPECT_EQ(refusal.Message(), "hertz.paper.k3 = -1: must be in [0, 1e20]");
+  h.paper.k3 = 2e20;
+  EXPECT_FALSE(h.Validate(nullptr));
+  h.paper.k3 = 1e20;
+  EXPECT_TRUE(h.Validate(nullptr));
+  h.paper.k1 = 0.0;
+  ASSERT_FALSE(h.Validate(&refusal));
+  EXPECT_EQ(refusal.field, "hertz.paper.k1");
+  h = HertzOptions{};
+  h.hands_stiffness_n_m = 1e12;  // the bound itself is accepted
+  EXPECT_TRUE(h.Validate(nullptr));
+  h.hands_damping_n_s_m = 2e12;
+  ASSERT_FALSE(h.Validate(&refusal));
+  EXPECT_EQ(refusal.Message(), "hertz.hands_damping_n_s_m = 2000000000000: must be at most 1e12");
 }
 
 TEST(RefusalTest, NotedAppendsToTheRule) {
