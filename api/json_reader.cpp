@@ -1,8 +1,9 @@
 #include "api/json_reader.hpp"
 
 #include <cmath>
-#include <sstream>
 #include <utility>
+
+#include "core/geometry_format.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -102,13 +103,6 @@ class LimitedSax : public nlohmann::detail::json_sax_dom_parser<Json> {
   std::vector<Container> containers_;
 };
 
-std::string FormatNumber(double value) {
-  std::ostringstream out;
-  out.precision(15);
-  out << value;
-  return out.str();
-}
-
 }  // namespace
 
 Response ToResponse(const ApiError& error) {
@@ -137,11 +131,13 @@ std::string NumberRule::Describe() const {
   const bool has_max = max < 1e299;
   std::string kind = integer ? "an integer" : "a number";
   if (has_min && has_max) {
-    return "must be " + kind + " in " + (min_exclusive ? "(" : "[") + FormatNumber(min) + ", " +
-           FormatNumber(max) + (max_exclusive ? ")" : "]");
+    return "must be " + kind + " in " + (min_exclusive ? "(" : "[") + core::FormatNumber(min) +
+           ", " + core::FormatNumber(max) + (max_exclusive ? ")" : "]");
   }
-  if (has_min) return "must be " + kind + (min_exclusive ? " > " : " >= ") + FormatNumber(min);
-  if (has_max) return "must be " + kind + (max_exclusive ? " < " : " <= ") + FormatNumber(max);
+  if (has_min)
+    return "must be " + kind + (min_exclusive ? " > " : " >= ") + core::FormatNumber(min);
+  if (has_max)
+    return "must be " + kind + (max_exclusive ? " < " : " <= ") + core::FormatNumber(max);
   return "must be " + kind;
 }
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <exception>
 #include <limits>
-#include <sstream>
 
+#include "core/geometry_format.hpp"
 #include "core/optimize/nlopt_run.hpp"
 #include "core/optimize/termination.hpp"
 
@@ -42,13 +42,6 @@ const AlgorithmInfo& Info(NloptAlgorithm a) {
   return kAlgorithms[0];
 }
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
-
 double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -74,7 +67,7 @@ struct Tracker {
       ++evaluations;
       if (!std::isfinite(v) || (grad != nullptr && !std::isfinite(g))) {
         failed = true;
-        error = "the objective returned a non-finite value at x = " + Num(x);
+        error = "the objective returned a non-finite value at x = " + FormatNumber17(x);
         return false;
       }
       *value = v;
@@ -292,16 +285,16 @@ void ScalarSearch::Certify(ScalarSearchResult* result) {
     if (has_gradient && ((out.at_lower_bound && g > 0.0 && !out.at_upper_bound) ||
                          (out.at_upper_bound && g < 0.0 && !out.at_lower_bound))) {
       s.termination = Termination::kNoConvergence;
-      s.warnings.push_back("stopped at a bound where the derivative points inside (f' = " + Num(g) +
-                           ")");
+      s.warnings.push_back(
+          "stopped at a bound where the derivative points inside (f' = " + FormatNumber17(g) + ")");
     }
   } else if (has_gradient) {
     const double newton = curvature < 0.0 ? std::abs(g / curvature) : range;
     out.error_estimate_x = std::max(options.x_tolerance_m, newton);
     if (newton > 1e-6 * range) {
       s.termination = Termination::kNoConvergence;
-      s.warnings.push_back("first-order check failed: f' = " + Num(g) +
-                           " at the reported point (Newton step " + Num(newton) + ")");
+      s.warnings.push_back("first-order check failed: f' = " + FormatNumber17(g) +
+                           " at the reported point (Newton step " + FormatNumber17(newton) + ")");
     }
   } else {
     // Without derivatives the position is resolvable only to sqrt(noise / |f''|).
@@ -397,7 +390,7 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
     return finish();
   }
   if (!(std::isfinite(lower) && std::isfinite(upper) && lower <= upper)) {
-    s.message = "search interval = [" + Num(lower) + ", " + Num(upper) +
+    s.message = "search interval = [" + FormatNumber17(lower) + ", " + FormatNumber17(upper) +
                 "]: must be finite with lower <= upper";
     return finish();
   }
