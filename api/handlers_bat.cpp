@@ -220,7 +220,7 @@ std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& co
       !ReadFitOptions(reader, context.limits, &request.options) || !reader.Finish()) {
     return std::nullopt;
   }
-  if (std::string why; !problem.IsValid(&why)) {
+  if (core::Refusal why; !problem.Validate(&why)) {
     CoreRefusal(why, "", error);
     return std::nullopt;
   }
@@ -231,7 +231,7 @@ std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& co
 std::optional<Response> FitFailure(const FitRequest&, const core::ShapeFitResult& fit) {
   if (fit.summary.termination == core::Termination::kInvalidInput) {
     ApiError error;
-    CoreRefusal(fit.summary.message, "", &error);
+    CoreRefusal(fit.summary, "", &error);
     return ToResponse(error);
   }
   if (fit.summary.termination == core::Termination::kFailure) {

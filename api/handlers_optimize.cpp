@@ -391,7 +391,7 @@ std::optional<Response> OptimizeFailure(const OptimizeRequest&, const OptimizeRe
   }
   if (chosen->summary.termination == core::Termination::kInvalidInput) {
     ApiError error;
-    CoreRefusal(chosen->summary.message, "", &error);
+    CoreRefusal(chosen->summary, "", &error);
     return ToResponse(error);
   }
   return std::nullopt;

@@ -1,8 +1,9 @@
 #include "api/json_reader.hpp"
 
 #include <cmath>
-#include <sstream>
 #include <utility>
+
+#include "core/geometry_format.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -102,13 +103,6 @@ class LimitedSax : public nlohmann::detail::json_sax_dom_parser<Json> {
   std::vector<Container> containers_;
 };
 
-std::string FormatNumber(double value) {
-  std::ostringstream out;
-  out.precision(15);
-  out << value;
-  return out.str();
-}
-
 }  // namespace
 
 Response ToResponse(const ApiError& error) {
@@ -137,11 +131,13 @@ std::string NumberRule::Describe() const {
   const bool has_max = max < 1e299;
   std::string kind = integer ? "an integer" : "a number";
   if (has_min && has_max) {
-    return "must be " + kind + " in " + (min_exclusive ? "(" : "[") + FormatNumber(min) + ", " +
-           FormatNumber(max) + (max_exclusive ? ")" : "]");
+    return "must be " + kind + " in " + (min_exclusive ? "(" : "[") + core::FormatNumber(min) +
+           ", " + core::FormatNumber(max) + (max_exclusive ? ")" : "]");
   }
-  if (has_min) return "must be " + kind + (min_exclusive ? " > " : " >= ") + FormatNumber(min);
-  if (has_max) return "must be " + kind + (max_exclusive ? " < " : " <= ") + FormatNumber(max);
+  if (has_min)
+    return "must be " + kind + (min_exclusive ? " > " : " >= ") + core::FormatNumber(min);
+  if (has_max)
+    return "must be " + kind + (max_exclusive ? " < " : " <= ") + core::FormatNumber(max);
   return "must be " + kind;
 }
 
@@ -153,6 +149,7 @@ bool NumberRule::Accepts(double value) const {
   return true;
 }
 
+NumberRule AnyNumber() { return NumberRule{}; }
 NumberRule Positive(double max) { return NumberRule{0.0, max, true, false, false}; }
 NumberRule NonNegative(double max) { return NumberRule{0.0, max, false, false, false}; }
 NumberRule Between(double min, double max) { return NumberRule{min, max, false, false, false}; }
@@ -171,13 +168,36 @@ std::string JoinPath(std::string_view parent, std::string_view key) {
   return std::string(parent) + "." + std::string(key);
 }
 
+std::string RequestName(std::string_view core_field) {
+  // Core's name (its head) -> the request's. Only where the two differ.
+  struct Renamed {
+    std::string_view core;
+    std::string_view request;
+  };
+  constexpr Renamed kRenamed[] = {
+      {"hertz.paper.", "hertz.paper_constants."},
+  };
+  for (const Renamed& r : kRenamed) {
+    if (core_field.substr(0, r.core.size()) == r.core) {
+      return std::string(r.request) + std::string(core_field.substr(r.core.size()));
+    }
+  }
+  return std::string(core_field);
+}
+
 std::string RequestField(const core::Refusal& refusal, std::string_view prefix) {
-  return refusal.field.empty() ? std::string(prefix) : JoinPath(prefix, refusal.field);
+  return refusal.field.empty() ? std::string(prefix) : JoinPath(prefix, RequestName(refusal.field));
+}
+
+std::string RequestMessage(const core::Refusal& refusal) {
+  core::Refusal renamed = refusal;
+  renamed.field = RequestName(refusal.field);
+  return renamed.Message();
 }
 
 bool CoreRefusal(const core::Refusal& refusal, const std::string& prefix, ApiError* error) {
   if (error->code) return false;
-  const std::string why = refusal.Message();
+  const std::string why = RequestMessage(refusal);
   std::string message;
   if (!refusal.field.empty()) {
     message = JoinPath(prefix, why);
@@ -189,8 +209,9 @@ bool CoreRefusal(const core::Refusal& refusal, const std::string& prefix, ApiErr
   return false;
 }
 
-bool CoreRefusal(const std::string& why, const std::string& prefix, ApiError* error) {
-  return CoreRefusal(core::RefusalFromMessage(why), prefix, error);
+bool CoreRefusal(const core::Summary& summary, const std::string& prefix, ApiError* error) {
+  if (summary.refusal.has_value()) return CoreRefusal(*summary.refusal, prefix, error);
+  return CoreRefusal(core::TextRefusal("", summary.message), prefix, error);
 }
 
 bool IsSceneField(std::string_view core_field) {

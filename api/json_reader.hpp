@@ -16,6 +16,7 @@
 #include "api/limits.hpp"
 #include "api/response.hpp"
 #include "core/refusal.hpp"
+#include "core/summary.hpp"
 
 namespace sweetspot::api {
 
@@ -52,6 +53,8 @@ struct NumberRule {
   bool Accepts(double value) const;
 };
 
+/// Any finite number: the type only, for a field whose range core checks.
+NumberRule AnyNumber();
 /// A value > 0 with an optional upper bound.
 NumberRule Positive(double max = 1e300);
 /// A value >= 0 with an optional upper bound.
@@ -117,9 +120,18 @@ class ObjectReader {
   std::set<std::string, std::less<>> known_;
 };
 
-/// The request path of a core refusal's field under `prefix` (e.g. "bat"): prefix.field
-/// ("bat.wall_thickness_m"), or `prefix` itself when the refusal names no field.
+/// The request's name of a core field: core's name except where the request names it
+/// otherwise (the one table: "hertz.paper.k3" -> "hertz.paper_constants.k3").
+std::string RequestName(std::string_view core_field);
+
+/// The request path of a core refusal's field under `prefix` (e.g. "bat"):
+/// prefix.RequestName(field) ("bat.wall_thickness_m"), or `prefix` itself when the refusal
+/// names no field.
 std::string RequestField(const core::Refusal& refusal, std::string_view prefix);
+
+/// The message of a core refusal in the request's names: Message() with the field renamed
+/// by RequestName (no prefix added).
+std::string RequestMessage(const core::Refusal& refusal);
 
 /// Records a core refusal as an InvalidValue error (400): the field is RequestField(refusal,
 /// prefix), the message core's Message() under `prefix` ("bat.wall_thickness_m = -1: ...";
@@ -127,9 +139,10 @@ std::string RequestField(const core::Refusal& refusal, std::string_view prefix);
 /// names to the request's. Returns false.
 bool CoreRefusal(const core::Refusal& refusal, const std::string& prefix, ApiError* error);
 
-/// CoreRefusal for a validator or summary that still reports text ("field = value: rule"),
-/// read with core::RefusalFromMessage.
-bool CoreRefusal(const std::string& why, const std::string& prefix, ApiError* error);
+/// CoreRefusal for a solve that refused its input: the summary's refusal (core::Summary::
+/// refusal); a summary without one is reported with its message under `prefix`, the field
+/// `prefix`.
+bool CoreRefusal(const core::Summary& summary, const std::string& prefix, ApiError* error);
 
 /// True when a core refusal's field names a part of the scene (bat, ball, swing, cor, outputs,
 /// inertia_model) rather than of the computation's options: such fields sit at the top level

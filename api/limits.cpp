@@ -1,7 +1,8 @@
 #include "api/limits.hpp"
 
 #include <cmath>
-#include <sstream>
+
+#include "core/geometry_format.hpp"
 
 namespace sweetspot::api {
 
@@ -34,9 +35,7 @@ bool ApiLimits::IsValid(std::string* why) const {
                 ": must be at least 10");
   }
   if (!std::isfinite(max_time_s) || max_time_s <= 0) {
-    std::ostringstream text;
-    text << "max_time_s = " << max_time_s << ": must be > 0";
-    return fail(text.str());
+    return fail("max_time_s = " + core::FormatNumber(max_time_s) + ": must be > 0");
   }
   return true;
 }

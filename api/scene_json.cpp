@@ -140,16 +140,17 @@ bool ReadHertzOptions(const Json& value, const std::string& path, const ApiLimit
                                           : core::ContactLaw::kBallPowerLaw;
   if (const Json* paper = reader.Get("paper_constants")) {
     ObjectReader k(*paper, reader.PathOf("paper_constants"), error);
-    k.OptionalNumber("k1", Positive(1e20), &options->paper.k1);
-    k.OptionalNumber("k2", NonNegative(1e20), &options->paper.k2);
-    k.OptionalNumber("k3", NonNegative(1e20), &options->paper.k3);
+    // Numbers only: their ranges are core's (core::HertzOptions::Validate).
+    k.OptionalNumber("k1", AnyNumber(), &options->paper.k1);
+    k.OptionalNumber("k2", AnyNumber(), &options->paper.k2);
+    k.OptionalNumber("k3", AnyNumber(), &options->paper.k3);
     if (!k.Finish()) return false;
   }
-  reader.OptionalNumber("hands_stiffness_n_m", NonNegative(1e12), &options->hands_stiffness_n_m);
-  reader.OptionalNumber("hands_damping_n_s_m", NonNegative(1e12), &options->hands_damping_n_s_m);
+  reader.OptionalNumber("hands_stiffness_n_m", AnyNumber(), &options->hands_stiffness_n_m);
+  reader.OptionalNumber("hands_damping_n_s_m", AnyNumber(), &options->hands_damping_n_s_m);
   reader.OptionalBool("bat_surface_compliance", &options->bat_surface_compliance);
-  reader.OptionalNumber("relative_tolerance", Between(1e-13, 1e-2),
-                        &options->solver.relative_tolerance);
+  // Its range is core's (ContactIntegrationValidate: [1e-13, 1e-2]).
+  reader.OptionalNumber("relative_tolerance", AnyNumber(), &options->solver.relative_tolerance);
   long long max_steps = options->solver.max_steps;
   reader.OptionalInteger("max_steps", 10, limits.max_integration_steps, &max_steps);
   options->solver.max_steps = static_cast<int>(max_steps);
@@ -259,11 +260,19 @@ Response CoreFailure(const core::Summary& summary, const std::string& missing_mo
     return ErrorResponse(501, ErrorCode::kNotImplemented, summary.message, field);
   }
   if (summary.termination == core::Termination::kInvalidInput) {
-    // The summary names the field in its message ("field = value: rule"), read by core.
-    const core::Refusal refusal = core::RefusalFromMessage(summary.message);
+    // The summary's refusal names the field in core's names; without one, `field` is reported.
+    if (!summary.refusal.has_value() || summary.refusal->field.empty()) {
+      return ErrorResponse(400, ErrorCode::kInvalidValue, summary.message, field);
+    }
+    const core::Refusal& refusal = *summary.refusal;
     const std::string prefix = options_object && !IsSceneField(refusal.field) ? "options" : "";
-    return ErrorResponse(400, ErrorCode::kInvalidValue, summary.message,
-                         refusal.field.empty() ? field : RequestField(refusal, prefix));
+    // The message in the request's names where core's differ (RequestName); the rest as is.
+    std::string message = summary.message;
+    const std::string core_text = refusal.Message();
+    if (message.compare(0, core_text.size(), core_text) == 0) {
+      message.replace(0, core_text.size(), RequestMessage(refusal));
+    }
+    return ErrorResponse(400, ErrorCode::kInvalidValue, message, RequestField(refusal, prefix));
   }
   // The model ran and could not finish with these inputs and settings (e.g. a
   // step or evaluation budget): the client's to change, so 422, not a 500.

@@ -1,6 +1,5 @@
 #include "core/refusal.hpp"
 
-#include <charconv>
 #include <utility>
 
 #include "core/geometry_format.hpp"
@@ -33,6 +32,14 @@ Refusal IntegerRefusal(std::string_view field, long long value, std::string_view
                  std::string(rule)};
 }
 
+Refusal QuotedRefusal(std::string_view field, std::string_view shown, std::string_view rule) {
+  Refusal out;
+  out.field = field;
+  out.shown = shown;
+  out.rule = rule;
+  return out;
+}
+
 Refusal TextRefusal(std::string_view field, std::string_view rule) {
   Refusal out;
   out.field = field;
@@ -42,6 +49,11 @@ Refusal TextRefusal(std::string_view field, std::string_view rule) {
 
 Refusal Prefixed(std::string_view prefix, Refusal inner) {
   inner.field.insert(0, prefix);
+  return inner;
+}
+
+Refusal Noted(Refusal inner, std::string_view note) {
+  inner.rule += note;
   return inner;
 }
 
@@ -69,25 +81,6 @@ bool RefuseMessage(std::string* why, std::string_view field, double value,
 bool RefuseMessage(std::string* why, std::string message) {
   if (why != nullptr) *why = std::move(message);
   return false;
-}
-
-Refusal RefusalFromMessage(std::string_view message) {
-  Refusal out;
-  const auto eq = message.find(" = ");
-  if (eq == std::string_view::npos) {
-    out.rule = message;
-    return out;
-  }
-  out.field = message.substr(0, eq);
-  const std::string_view rest = message.substr(eq + 3);
-  const auto colon = rest.find(": ");
-  out.shown = rest.substr(0, colon);
-  double value = 0.0;
-  const char* end = out.shown.data() + out.shown.size();
-  const auto parsed = std::from_chars(out.shown.data(), end, value);
-  if (parsed.ec == std::errc() && parsed.ptr == end) out.value = value;
-  if (colon != std::string_view::npos) out.rule = rest.substr(colon + 2);
-  return out;
 }
 
 }  // namespace sweetspot::core

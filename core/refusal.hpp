@@ -36,12 +36,19 @@ Refusal NumberRefusal(std::string_view field, double value, std::string_view rul
 Refusal Number17Refusal(std::string_view field, double value, std::string_view rule);
 /// A refusal of the integer `field` = `value` (written as an integer: "4096", not "4096.0").
 Refusal IntegerRefusal(std::string_view field, long long value, std::string_view rule);
+/// A refusal quoting a value that is no number, as written (`shown`: a path, a name, "0 and
+/// ..."): "field = shown: rule"; value NaN.
+Refusal QuotedRefusal(std::string_view field, std::string_view shown, std::string_view rule);
 /// A refusal that quotes no value: "field: rule" ("bat: missing ...").
 Refusal TextRefusal(std::string_view field, std::string_view rule);
 
 /// `inner` moved under `prefix` ("material." + "density_kg_m3"): the field and so the message
 /// gain the prefix; the value and the rule are kept.
 Refusal Prefixed(std::string_view prefix, Refusal inner);
+
+/// `inner` with `note` appended to its rule, so that its message ends with the note
+/// ("... (model = flexible)"); the field and the value are kept.
+Refusal Noted(Refusal inner, std::string_view note);
 
 /// Stores `refusal` in *out (if non-null) and returns false: the one way core's validators
 /// refuse (`return Refuse(out, NumberRefusal("length_m", length_m, "must be positive"));`).
@@ -56,13 +63,6 @@ bool RefuseMessage(std::string* why, std::string_view field, double value, std::
 /// Stores a message composed by the caller in *why (if non-null) and returns false: for the
 /// validators that still compose text (the design model's nested checks, the rule sets).
 bool RefuseMessage(std::string* why, std::string message);
-
-/// The refusal a "field = value: rule" message states: the inverse of Message() (field = the
-/// text before the first " = ", shown = up to the next ": ", rule = the rest; a message
-/// without " = " is all rule). For the validators and summaries that still hand over text
-/// (nlopt, Hertz, flexible impact, the design model's nested checks, shape fitting); the api
-/// gets it from core rather than parsing the text itself.
-Refusal RefusalFromMessage(std::string_view message);
 
 /// The string form of a structured validator: `validate(Refusal*)` run with *why as the
 /// message (nothing is formatted when `why` is null).

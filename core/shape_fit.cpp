@@ -10,6 +10,7 @@
 #include <limits>
 #include <new>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -97,11 +98,6 @@ std::string DescribeUnknowns(const ShapeFitProblem& problem) {
 // less than this can overflow to inf.
 constexpr double kMinMetricScale = 1e-6;
 
-bool Refuse(std::string* why, std::string_view field, double value, std::string_view rule) {
-  if (why != nullptr) *why = RefusalMessage(field, value, rule);
-  return false;
-}
-
 }  // namespace
 
 const char* FitVariableName(FitVariable variable) {
@@ -117,6 +113,10 @@ std::optional<FitVariable> FitVariableFromName(std::string_view name) {
 }
 
 bool ShapeFitOptions::IsValid(std::string* why) const {
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool ShapeFitOptions::Validate(Refusal* why) const {
   if (!std::isfinite(mass_scale_kg) || mass_scale_kg < 0.0) {
     return Refuse(why, "mass_scale_kg", mass_scale_kg,
                   "must be finite and non-negative (0 = the target)");
@@ -151,9 +151,12 @@ bool ShapeFitOptions::IsValid(std::string* why) const {
 }
 
 bool ShapeFitProblem::IsValid(std::string* why) const {
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool ShapeFitProblem::Validate(Refusal* why) const {
   if (!targets.mass_kg.has_value() && !targets.balance_point_m.has_value()) {
-    if (why != nullptr) *why = "targets: must give mass_kg, balance_point_m or both";
-    return false;
+    return Refuse(why, TextRefusal("targets", "must give mass_kg, balance_point_m or both"));
   }
   if (targets.mass_kg.has_value() && !(std::isfinite(*targets.mass_kg) && *targets.mass_kg > 0.0)) {
     return Refuse(why, "targets.mass_kg", *targets.mass_kg, "must be finite and positive");
@@ -184,17 +187,13 @@ bool ShapeFitProblem::IsValid(std::string* why) const {
     }
     const char* name = kVariableName[idx];
     if (unknown[static_cast<std::size_t>(idx)]) {
-      if (why != nullptr) {
-        *why = IndexedField("unknowns", i, "variable") + " = " + name + ": appears more than once";
-      }
-      return false;
+      return Refuse(why, QuotedRefusal(IndexedField("unknowns", i, "variable"), name,
+                                       "appears more than once"));
     }
     unknown[static_cast<std::size_t>(idx)] = true;
     if (fit_detail::IsFillVariable(u.variable) && !fill.has_value()) {
-      if (why != nullptr) {
-        *why = IndexedField("unknowns", i, "variable") + " = " + name + ": the bat has no fill";
-      }
-      return false;
+      return Refuse(
+          why, QuotedRefusal(IndexedField("unknowns", i, "variable"), name, "the bat has no fill"));
     }
     if (!std::isfinite(u.min)) {
       return why == nullptr
@@ -246,28 +245,24 @@ bool ShapeFitProblem::IsValid(std::string* why) const {
   }
   Material m = material;
   m.density_kg_m3 = fit_detail::FitValue(t, FitVariable::kDensity);
-  std::string inner;
-  if (!m.IsValid(why != nullptr ? &inner : nullptr)) {
-    if (why != nullptr) *why = "material." + inner;
-    return false;
-  }
+  Refusal inner;
+  if (!m.Validate(why != nullptr ? &inner : nullptr))
+    return Refuse(why, Prefixed("material.", inner));
   if (fill.has_value()) {
     Material f = fill->material;
     if (unknown[static_cast<std::size_t>(FitVariable::kFillDensity)]) {
       // check the other fields
       f.density_kg_m3 = std::max(fit_detail::FitValue(t, FitVariable::kFillDensity), 1.0);
     }
-    if (f.density_kg_m3 != 0.0 && !f.IsValid(why != nullptr ? &inner : nullptr)) {
-      if (why != nullptr) *why = "fill.material." + inner;
-      return false;
+    if (f.density_kg_m3 != 0.0 && !f.Validate(why != nullptr ? &inner : nullptr)) {
+      return Refuse(why, Prefixed("fill.material.", inner));
     }
   }
   const bool hollow = fit_detail::HollowOf(*this);
   for (FitConstraint kind : fit_detail::ApplicableConstraints(hollow, fill.has_value())) {
     if (!fit_detail::ConstraintInvolves(kind, unknown) &&
         fit_detail::ConstraintValue(kind, t, hollow) > 0.0) {
-      if (why != nullptr) *why = fit_detail::ConstraintMessage(kind, t, hollow);
-      return false;
+      return Refuse(why, fit_detail::ConstraintRefusal(kind, t, hollow));
     }
   }
   return true;
@@ -282,17 +277,16 @@ ShapeFitResult FitShape(const ShapeFitProblem& problem, const ShapeFitOptions& o
   Summary& summary = result.summary;
   summary.models_used = {"mass_properties"};
   summary.backend = "nlopt:slsqp+gauss_newton";
-  std::string why;
+  Refusal why;
   bool invalid = false;
-  if (!options.IsValid(&why)) {
+  if (!options.Validate(&why)) {
     invalid = true;
-    why = "options." + why;
-  } else if (!problem.IsValid(&why)) {
+    why = Prefixed("options.", std::move(why));
+  } else if (!problem.Validate(&why)) {
     invalid = true;
   }
   if (invalid) {
-    summary.termination = Termination::kInvalidInput;
-    summary.message = why;
+    summary.SetRefusal(std::move(why));
     BuildBat(problem, fit_detail::BaseParameters(problem), &result);
     result.metric = result.mass_residual_kg = result.balance_point_residual_m = kNaN;
     summary.objective = kNaN;
@@ -317,10 +311,11 @@ ShapeFitResult FitShape(const ShapeFitProblem& problem, const ShapeFitOptions& o
       candidates.emplace_back(model.Objective(s.data(), nullptr), s);
     }
     if (candidates.empty()) {
-      summary.termination = Termination::kInvalidInput;
-      summary.message = "the unknowns' bounds (" + DescribeUnknowns(problem) +
-                        ") admit no valid bat: every one of " +
-                        std::to_string(options.scan_points + 1) + " points tried is invalid";
+      // About the unknowns' bounds together, not one field.
+      summary.SetRefusal(TextRefusal("", "the unknowns' bounds (" + DescribeUnknowns(problem) +
+                                             ") admit no valid bat: every one of " +
+                                             std::to_string(options.scan_points + 1) +
+                                             " points tried is invalid"));
       BuildBat(problem, fit_detail::BaseParameters(problem), &result);
       summary.evaluations = model.evaluations();
       summary.solve_time_s = elapsed_s();

@@ -79,6 +79,8 @@ struct ShapeFitProblem {
 
   /// True when the problem can be solved; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// How the fit runs. Defaults are valid.
@@ -97,6 +99,8 @@ struct ShapeFitOptions {
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// The fitted (or closest) bat and how it was found. The summary is always

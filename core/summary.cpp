@@ -2,6 +2,7 @@
 
 #include <exception>
 #include <sstream>
+#include <utility>
 
 namespace sweetspot::core {
 
@@ -19,6 +20,12 @@ const char* TerminationName(Termination t) {
       return "invalid_input";
   }
   return "failure";
+}
+
+void Summary::SetRefusal(Refusal why) {
+  termination = Termination::kInvalidInput;
+  message = why.Message();
+  refusal = std::move(why);
 }
 
 std::string InternalErrorMessage() {

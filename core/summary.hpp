@@ -3,9 +3,12 @@
 // the model(s) used. Solvers never throw; they fill a Summary.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "core/refusal.hpp"
 
 namespace sweetspot::core {
 
@@ -35,6 +38,14 @@ struct Summary {
   double solve_time_s = -1.0;      ///< Wall time of the solve, s.
   std::vector<std::string> models_used;  ///< Models evaluated, e.g. {"mass_properties", "rigid_pivot"}.
   std::vector<std::string> warnings;     ///< Non-fatal notes (e.g. NLopt round-off limited).
+  /// For invalid input, the refusal as data (core's field names, the value, the rule): the
+  /// one `message` states (or, for a solve that reports several outcomes, the first refused
+  /// one). Empty when the solve did not refuse its input as data.
+  std::optional<Refusal> refusal;
+
+  /// Refuses the input: termination kInvalidInput, message = refusal.Message(), and the
+  /// refusal kept as data.
+  void SetRefusal(Refusal why);
 
   /// True when the result may be used (converged, or no_convergence with a kept point).
   bool IsSolutionUsable() const {

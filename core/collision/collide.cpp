@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "core/geometry_format.hpp"
 #include "core/scene/resolved_scene.hpp"
@@ -11,7 +12,11 @@
 namespace sweetspot::core {
 
 bool CollisionOptions::IsValid(std::string* why) const {
-  return hertz.IsValid(why) && flexible.IsValid(why);
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool CollisionOptions::Validate(Refusal* why) const {
+  return hertz.Validate(why) && flexible.Validate(why);
 }
 
 CollisionResult Collide(const Scene& scene, double impact_from_knob_m, CollisionModel model,
@@ -20,15 +25,14 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
   return TimedRequest<CollisionResult>("closed_form", [&](CollisionResult& out, TimingBook& book) {
     Summary& s = out.summary;
     out.impact_from_knob_m = impact_from_knob_m;
-    std::string why;
-    if (!options.IsValid(&why)) {
-      s.message = why;
+    if (Refusal refusal; !options.Validate(&refusal)) {
+      s.SetRefusal(std::move(refusal));
       return;
     }
     if (model == CollisionModel::kFlexible && !scene.bat.has_value()) {
       out.model = model;
-      s.message =
-          "bat: model = flexible needs the bat's geometry (a bat, not only mass_properties)";
+      s.SetRefusal(TextRefusal(
+          "bat", "model = flexible needs the bat's geometry (a bat, not only mass_properties)"));
       return;
     }
     ResolvedScene r;
@@ -39,9 +43,9 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
     out.cor = *r.cor;
     if (!(std::isfinite(impact_from_knob_m) && impact_from_knob_m >= 0.0 &&
           impact_from_knob_m <= r.length_m)) {
-      s.termination = Termination::kInvalidInput;
-      s.message = "impact_from_knob_m = " + FormatNumber17(impact_from_knob_m) +
-                  ": must be within the bat [0, " + FormatNumber17(r.length_m) + "]";
+      s.SetRefusal(
+          Number17Refusal("impact_from_knob_m", impact_from_knob_m,
+                          "must be within the bat [0, " + FormatNumber17(r.length_m) + "]"));
       return;
     }
     if (model == CollisionModel::kAuto) {

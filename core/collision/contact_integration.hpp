@@ -46,18 +46,26 @@ inline EventIntegratorOptions ContactIntegratorOptions(double tolerance, int max
 
 /// The integrator rules both contact models' options share, checked in this order:
 /// `relative_tolerance` in [1e-13, 1e-2] (dimensionless), `max_steps` >= 10. `model` ("hertz",
-/// "flexible") prefixes the field names. False, with "model.field = value: rule" in *why (if
+/// "flexible") prefixes the field names. False, with the refusal ("model.field") in *why (if
 /// non-null), when one is broken.
-inline bool ContactIntegrationIsValid(std::string_view model, double relative_tolerance,
-                                      int max_steps, std::string* why) {
+inline bool ContactIntegrationValidate(std::string_view model, double relative_tolerance,
+                                       int max_steps, Refusal* why) {
   const std::string prefix = std::string(model) + ".";
   if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-13 &&
         relative_tolerance <= 1e-2))
-    return RefuseMessage(why, Number17Refusal(prefix + "relative_tolerance", relative_tolerance,
-                                              "must be in [1e-13, 1e-2]"));
+    return Refuse(why, Number17Refusal(prefix + "relative_tolerance", relative_tolerance,
+                                       "must be in [1e-13, 1e-2]"));
   if (max_steps < 10)
-    return RefuseMessage(why, IntegerRefusal(prefix + "max_steps", max_steps, "must be >= 10"));
+    return Refuse(why, IntegerRefusal(prefix + "max_steps", max_steps, "must be >= 10"));
   return true;
+}
+
+/// ContactIntegrationValidate with "model.field = value: rule" in *why (if non-null).
+inline bool ContactIntegrationIsValid(std::string_view model, double relative_tolerance,
+                                      int max_steps, std::string* why) {
+  return ExplainRefusal(why, [&](Refusal* out) {
+    return ContactIntegrationValidate(model, relative_tolerance, max_steps, out);
+  });
 }
 
 /// The ball law's rules both contact models check, in this order: `ball_stiffness` (the power

@@ -187,27 +187,30 @@ void IntegrateAlong(const BatModes& modes, double a, double b, F&& f) {
 }  // namespace
 
 bool FlexibleImpactOptions::IsValid(std::string* why) const {
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool FlexibleImpactOptions::Validate(Refusal* why) const {
   if (max_modes < 1 || max_modes > 50)
-    return RefuseMessage(
-        why, "flexible.max_modes = " + std::to_string(max_modes) + ": must be in [1, 50]");
+    return Refuse(why, IntegerRefusal("flexible.max_modes", max_modes, "must be in [1, 50]"));
   if (!(std::isfinite(frequency_tolerance) && frequency_tolerance >= 1e-9 &&
         frequency_tolerance <= 0.1))
-    return RefuseMessage(why, "flexible.frequency_tolerance = " +
-                                  FormatNumber17(frequency_tolerance) + ": must be in [1e-9, 0.1]");
+    return Refuse(why, Number17Refusal("flexible.frequency_tolerance", frequency_tolerance,
+                                       "must be in [1e-9, 0.1]"));
   if (!(std::isfinite(cutoff_factor) && cutoff_factor >= 1.0 && cutoff_factor <= 1000.0))
-    return RefuseMessage(why, "flexible.cutoff_factor = " + FormatNumber17(cutoff_factor) +
-                                  ": must be in [1, 1000]");
-  if (!ContactIntegrationIsValid("flexible", relative_tolerance, max_steps, why)) return false;
+    return Refuse(why,
+                  Number17Refusal("flexible.cutoff_factor", cutoff_factor, "must be in [1, 1000]"));
+  if (!ContactIntegrationValidate("flexible", relative_tolerance, max_steps, why)) return false;
   if (max_contacts < 1 || max_contacts > 1000)
-    return RefuseMessage(
-        why, "flexible.max_contacts = " + std::to_string(max_contacts) + ": must be in [1, 1000]");
+    return Refuse(why,
+                  IntegerRefusal("flexible.max_contacts", max_contacts, "must be in [1, 1000]"));
   if (!(std::isfinite(hands_grip_length_m) && hands_grip_length_m >= 0.0 &&
         hands_grip_length_m <= 10.0))
-    return RefuseMessage(why, "flexible.hands_grip_length_m = " +
-                                  FormatNumber17(hands_grip_length_m) + ": must be in [0, 10]");
+    return Refuse(why, Number17Refusal("flexible.hands_grip_length_m", hands_grip_length_m,
+                                       "must be in [0, 10]"));
   if (!(std::isfinite(sting_window_s) && sting_window_s >= 0.0 && sting_window_s <= 1.0))
-    return RefuseMessage(
-        why, "flexible.sting_window_s = " + FormatNumber17(sting_window_s) + ": must be in [0, 1]");
+    return Refuse(why,
+                  Number17Refusal("flexible.sting_window_s", sting_window_s, "must be in [0, 1]"));
   return true;
 }
 

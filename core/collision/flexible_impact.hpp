@@ -61,6 +61,8 @@ struct FlexibleImpactOptions {
 
   /// True when every field is in range; otherwise "flexible.field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// One impact's inputs besides the bat and its modes (SI).

@@ -237,28 +237,39 @@ bool HertzProblem::IsValid(std::string* why) const {
 }
 
 bool HertzSolverOptions::IsValid(std::string* why) const {
-  return ContactIntegrationIsValid("hertz", relative_tolerance, max_steps, why);
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool HertzSolverOptions::Validate(Refusal* why) const {
+  return ContactIntegrationValidate("hertz", relative_tolerance, max_steps, why);
 }
 
 bool HertzOptions::IsValid(std::string* why) const {
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool HertzOptions::Validate(Refusal* why) const {
+  // The ranges a request may choose (the api checks only that the numbers are numbers).
   if (!(std::isfinite(hands_stiffness_n_m) && hands_stiffness_n_m >= 0.0))
-    return RefuseMessage(why, "hertz.hands_stiffness_n_m = " + FormatNumber17(hands_stiffness_n_m) +
-                                  ": must be finite and >= 0");
+    return Refuse(why, Number17Refusal("hertz.hands_stiffness_n_m", hands_stiffness_n_m,
+                                       "must be finite and >= 0"));
+  if (hands_stiffness_n_m > kMaxHandsStiffnessNM)
+    return Refuse(why, Number17Refusal("hertz.hands_stiffness_n_m", hands_stiffness_n_m,
+                                       "must be at most 1e12"));
   if (!(std::isfinite(hands_damping_n_s_m) && hands_damping_n_s_m >= 0.0))
-    return RefuseMessage(why, "hertz.hands_damping_n_s_m = " + FormatNumber17(hands_damping_n_s_m) +
-                                  ": must be finite and >= 0");
-  if (law == ContactLaw::kPaperConstants) {
-    if (!(std::isfinite(paper.k1) && paper.k1 > 0.0))
-      return RefuseMessage(
-          why, "hertz.paper.k1 = " + FormatNumber17(paper.k1) + ": must be finite and > 0");
-    if (!(std::isfinite(paper.k2) && paper.k2 >= 0.0))
-      return RefuseMessage(
-          why, "hertz.paper.k2 = " + FormatNumber17(paper.k2) + ": must be finite and >= 0");
-    if (!std::isfinite(paper.k3))
-      return RefuseMessage(why,
-                           "hertz.paper.k3 = " + FormatNumber17(paper.k3) + ": must be finite");
-  }
-  return solver.IsValid(why);
+    return Refuse(why, Number17Refusal("hertz.hands_damping_n_s_m", hands_damping_n_s_m,
+                                       "must be finite and >= 0"));
+  if (hands_damping_n_s_m > kMaxHandsDampingNSM)
+    return Refuse(why, Number17Refusal("hertz.hands_damping_n_s_m", hands_damping_n_s_m,
+                                       "must be at most 1e12"));
+  // The paper's constants are checked whatever the law, as a request's are.
+  if (!(std::isfinite(paper.k1) && paper.k1 > 0.0 && paper.k1 <= kMaxPaperConstant))
+    return Refuse(why, Number17Refusal("hertz.paper.k1", paper.k1, "must be in (0, 1e20]"));
+  if (!(std::isfinite(paper.k2) && paper.k2 >= 0.0 && paper.k2 <= kMaxPaperConstant))
+    return Refuse(why, Number17Refusal("hertz.paper.k2", paper.k2, "must be in [0, 1e20]"));
+  if (!(std::isfinite(paper.k3) && paper.k3 >= 0.0 && paper.k3 <= kMaxPaperConstant))
+    return Refuse(why, Number17Refusal("hertz.paper.k3", paper.k3, "must be in [0, 1e20]"));
+  return solver.Validate(why);
 }
 
 HertzImpact SolveHertzImpact(const HertzProblem& problem, const HertzSolverOptions& options) {

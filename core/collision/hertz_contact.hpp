@@ -88,11 +88,20 @@ struct HertzSolverOptions {
 
   /// True when the options are in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// Default hands (grip) stiffness, N/m: an order-of-magnitude grip; with a bat of about 0.9 kg
 /// the hands' period (~25 ms) is far longer than the ~1 ms contact, so results barely depend on it.
 inline constexpr double kDefaultHandsStiffnessNM = 5.0e4;
+
+/// Largest hands (grip) stiffness HertzOptions accepts, N/m.
+inline constexpr double kMaxHandsStiffnessNM = 1e12;
+/// Largest hands (grip) damping HertzOptions accepts, N s/m.
+inline constexpr double kMaxHandsDampingNSM = 1e12;
+/// Largest paper constant K1..K3 HertzOptions accepts (the paper's units).
+inline constexpr double kMaxPaperConstant = 1e20;
 
 /// Scene-level settings of the contact model (what a request may choose).
 struct HertzOptions {
@@ -107,6 +116,8 @@ struct HertzOptions {
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// What the contact model knows about one impact.

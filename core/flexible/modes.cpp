@@ -5,6 +5,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <utility>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
@@ -16,11 +17,6 @@
 
 namespace sweetspot::core {
 namespace {
-
-bool Fail(std::string* why, const std::string& m) {
-  if (why != nullptr) *why = m;
-  return false;
-}
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
@@ -249,17 +245,21 @@ bool SolveLevel(const Bat& bat, const BeamModesOptions& o, BeamMesh mesh, const 
 }  // namespace
 
 bool BeamModesOptions::IsValid(std::string* why) const {
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool BeamModesOptions::Validate(Refusal* why) const {
   if (num_modes < 1 || num_modes > 50)
-    return Fail(why, "num_modes = " + std::to_string(num_modes) + ": must be in [1, 50]");
+    return Refuse(why, IntegerRefusal("num_modes", num_modes, "must be in [1, 50]"));
   if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-9 &&
         relative_tolerance <= 0.1))
-    return Fail(why, "relative_tolerance = " + FormatNumber17(relative_tolerance) +
-                         ": must be in [1e-9, 0.1]");
+    return Refuse(
+        why, Number17Refusal("relative_tolerance", relative_tolerance, "must be in [1e-9, 0.1]"));
   if (initial_elements < 1 || initial_elements > 4096)
-    return Fail(
-        why, "initial_elements = " + std::to_string(initial_elements) + ": must be in [1, 4096]");
+    return Refuse(why,
+                  IntegerRefusal("initial_elements", initial_elements, "must be in [1, 4096]"));
   if (max_elements < 2 || max_elements > 4096)
-    return Fail(why, "max_elements = " + std::to_string(max_elements) + ": must be in [2, 4096]");
+    return Refuse(why, IntegerRefusal("max_elements", max_elements, "must be in [2, 4096]"));
   return true;
 }
 
@@ -340,22 +340,23 @@ BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
     out.theory = options.theory;
     out.rotary_inertia = options.rotary_inertia && options.theory == BeamTheory::kTimoshenko;
     out.tolerance = options.relative_tolerance;
+    if (Refusal refusal; !options.Validate(&refusal)) {
+      s.SetRefusal(std::move(refusal));
+      return;
+    }
+    if (Refusal refusal; !bat.Validate(&refusal)) {
+      s.SetRefusal(Prefixed("bat.", std::move(refusal)));
+      return;
+    }
     std::string why;
-    if (!options.IsValid(&why)) {
-      s.message = why;
-      return;
-    }
-    if (!bat.IsValid(&why)) {
-      s.message = "bat." + why;
-      return;
-    }
     out.length_m = bat.LengthM();
     double r_max = 0.0;
     for (const ProfileKnot& k : bat.knots) r_max = std::max(r_max, k.radius_m);
     if (!(out.length_m >= 4.0 * r_max)) {
-      s.message = "bat.length_m = " + FormatNumber17(out.length_m) +
-                  ": the beam model needs a slender bat (length at least 4 x the largest radius " +
-                  FormatNumber17(r_max) + " m)";
+      s.SetRefusal(Number17Refusal(
+          "bat.length_m", out.length_m,
+          "the beam model needs a slender bat (length at least 4 x the largest radius " +
+              FormatNumber17(r_max) + " m)"));
       return;
     }
     const int n0 = std::max(options.initial_elements, 2 * options.num_modes + 4);
@@ -369,10 +370,10 @@ BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
       BeamMesh mesh = MakeBeamMesh(bat, n0, level);
       if (mesh.Elements() > options.max_elements) {
         if (levels.empty()) {
-          s.message = "max_elements = " + std::to_string(options.max_elements) +
-                      ": the bat needs at least " + std::to_string(mesh.Elements()) +
-                      " elements (one per profile segment, and " + std::to_string(n0) +
-                      " for the modes asked for)";
+          s.SetRefusal(IntegerRefusal("max_elements", options.max_elements,
+                                      "the bat needs at least " + std::to_string(mesh.Elements()) +
+                                          " elements (one per profile segment, and " +
+                                          std::to_string(n0) + " for the modes asked for)"));
           return;
         }
         break;

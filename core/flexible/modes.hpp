@@ -44,6 +44,8 @@ struct BeamModesOptions {
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// One flexible mode.

@@ -397,24 +397,23 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
   summary.evaluations = 0;
   result.objective_unit = ObjectiveUnit(problem.objective);
 
-  std::string why;
+  Refusal why;
   DesignModel model;
   bool invalid = false;
-  if (!options.IsValid(&why)) {
+  if (!options.Validate(&why)) {
     invalid = true;
-    why = "options." + why;
+    why = Prefixed("options.", std::move(why));
   } else if (sting && options.derivative_check != DerivativeCheck::kNone) {
     invalid = true;
-    why =
-        "options.derivative_check: objective = min_sting has no derivatives to check (it is "
-        "solved derivative-free by COBYLA)";
+    why = TextRefusal("options.derivative_check",
+                      "objective = min_sting has no derivatives to check (it is solved "
+                      "derivative-free by COBYLA)");
   } else if (!DesignModel::Build(problem, options, &model, &why)) {
     invalid = true;
   }
   if (invalid) {
     FillBase(problem, &result);
-    summary.termination = Termination::kInvalidInput;
-    summary.message = why;
+    summary.SetRefusal(std::move(why));
     summary.objective = kNaN;
     summary.constraint_violation = kNaN;
     summary.error_estimate = kNaN;
@@ -511,8 +510,7 @@ MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,
   out.summary.evaluations = 0;
   out.summary.objective = kNaN;
   if (materials.empty()) {
-    out.summary.termination = Termination::kInvalidInput;
-    out.summary.message = "materials: give at least one material";
+    out.summary.SetRefusal(TextRefusal("materials", "give at least one material"));
     out.summary.solve_time_s = 0.0;
     return out;
   }

@@ -545,9 +545,11 @@ StingEvaluation EvaluateSting(const Bat& bat, const StingScene& scene, bool refi
     out.sting_j = r.flexible->hands_vibration_energy_j;
     out.ok = std::isfinite(out.sting_j);
     if (!out.ok) out.message = "the hands' vibration energy is not finite";
-  } catch (const std::exception& e) {
+  } catch (...) {
+    // Whatever is thrown (a std::exception or not): no exception leaves the evaluation.
     out.ok = false;
-    out.message = std::string("internal error: ") + e.what();
+    out.termination = Termination::kFailure;
+    out.message = InternalErrorMessage();
   }
   if (!out.ok) out.sting_j = kNaN;
   return out;

@@ -124,6 +124,9 @@ class DesignModel {
   /// built and fixed_violations() names it.
   static bool Build(const DesignProblem& problem, const DesignOptions& options, DesignModel* out,
                     std::string* why);
+  /// Build with the refusal as data in *why (if non-null): field (core's names), value, rule.
+  static bool Build(const DesignProblem& problem, const DesignOptions& options, DesignModel* out,
+                    Refusal* why);
 
   int n() const { return static_cast<int>(variables_.size()); }                    ///< Variables.
   int m() const { return static_cast<int>(constraints_.size()); }                  ///< Constraints.

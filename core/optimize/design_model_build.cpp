@@ -17,10 +17,9 @@ namespace design_detail {
 // Scene and objective.
 bool ModelBuilder::CheckScene() {
   if (ParseDesignObjective(DesignObjectiveName(problem.objective)) != problem.objective) {
-    return Fail(why, "objective: not a known objective");
+    return Refuse(why, TextRefusal("objective", "not a known objective"));
   }
-  if (!problem.ball.IsValid(inner_ptr)) return Fail(why, inner);
-  if (!problem.swing.IsValid(inner_ptr)) return Fail(why, inner);
+  if (!problem.ball.Validate(why) || !problem.swing.Validate(why)) return false;
   if (!(std::isfinite(problem.swing_weight_exponent) && problem.swing_weight_exponent >= 0.0 &&
         problem.swing_weight_exponent <= 0.5)) {
     return Refuse(why, "swing_weight_exponent", problem.swing_weight_exponent,
@@ -34,17 +33,17 @@ bool ModelBuilder::CheckScene() {
   exit_speed_objective = problem.objective != DesignObjective::kMinMoi;
   if (exit_speed_objective && problem.ball.speed_mps == 0.0 &&
       problem.swing.angular_speed_rad_s == 0.0) {
-    return Fail(why,
-                "ball.speed_mps = 0 and swing.angular_speed_rad_s = 0: nothing moves, the "
-                "exit speed is 0 everywhere (objective " +
-                    std::string(DesignObjectiveName(problem.objective)) + ")");
+    return Refuse(why,
+                  QuotedRefusal("ball.speed_mps", "0 and swing.angular_speed_rad_s = 0",
+                                "nothing moves, the exit speed is 0 everywhere (objective " +
+                                    std::string(DesignObjectiveName(problem.objective)) + ")"));
   }
   if (problem.inertia_model != InertiaModel::kRigidBody &&
       problem.inertia_model != InertiaModel::kSlenderRod) {
-    return Fail(why, "inertia_model: not a known inertia model");
+    return Refuse(why, TextRefusal("inertia_model", "not a known inertia model"));
   }
-  if (problem.objective == DesignObjective::kMinSting && !problem.flexible.IsValid(inner_ptr)) {
-    return Fail(why, inner);
+  if (problem.objective == DesignObjective::kMinSting && !problem.flexible.Validate(why)) {
+    return false;
   }
 
   return true;
@@ -54,10 +53,12 @@ bool ModelBuilder::CheckScene() {
 bool ModelBuilder::BaseDesign() {
   base = problem.bat;
   if (problem.three_segment.has_value()) {
-    if (!problem.three_segment->IsValid(inner_ptr)) return Fail(why, "three_segment." + inner);
+    if (!problem.three_segment->Validate(inner_ptr)) {
+      return Refuse(why, Prefixed("three_segment.", inner));
+    }
     base.knots = problem.three_segment->Knots();
   }
-  if (!base.IsValid(inner_ptr)) return Fail(why, "bat." + inner);
+  if (!base.Validate(inner_ptr)) return Refuse(why, Prefixed("bat.", inner));
   if (problem.cor.has_value()) {
     if (!(std::isfinite(*problem.cor) && *problem.cor >= 0.0 && *problem.cor <= 1.0)) {
       return Refuse(why, "cor", *problem.cor, "must be in [0, 1]");
@@ -66,8 +67,8 @@ bool ModelBuilder::BaseDesign() {
   } else if (base.material.cor.has_value()) {
     model.cor_ = *base.material.cor;
   } else if (exit_speed_objective) {
-    return Fail(why,
-                "cor: not given, and material '" + base.material.name + "' has no default COR");
+    return Refuse(why, TextRefusal("cor", "not given, and material '" + base.material.name +
+                                              "' has no default COR"));
   } else {
     model.cor_ = 0.5;  // unused by min_moi; the rules' BBCOR check uses it only if given
   }
@@ -107,31 +108,34 @@ bool ModelBuilder::CheckVariable(std::size_t i, const DesignVariable& v,
                                  const std::optional<DesignVariableRef>& ref,
                                  std::set<std::string>* seen) {
   const std::string field = IndexedField("variables", i, "");
-  const std::string path_field = field + "path = " + v.path + ": ";
+  // "variables[i].path = <path>: rule".
+  auto refuse_path = [&](const std::string& rule) {
+    return Refuse(why, QuotedRefusal(field + "path", v.path, rule));
+  };
   if (!ref.has_value()) {
-    return Fail(why, path_field +
-                         "not a design variable (known: profile.knots[i].radius_m, "
-                         "profile.knots[i].x_m, three_segment.length_m, "
-                         "three_segment.handle_radius_m, three_segment.barrel_radius_m, "
-                         "three_segment.taper_start_m, three_segment.taper_end_m, "
-                         "material.density_kg_m3, wall_thickness_m, fill.diameter_m, "
-                         "fill.depth_m, fill.material.density_kg_m3)");
+    return refuse_path(
+        "not a design variable (known: profile.knots[i].radius_m, "
+        "profile.knots[i].x_m, three_segment.length_m, "
+        "three_segment.handle_radius_m, three_segment.barrel_radius_m, "
+        "three_segment.taper_start_m, three_segment.taper_end_m, "
+        "material.density_kg_m3, wall_thickness_m, fill.diameter_m, "
+        "fill.depth_m, fill.material.density_kg_m3)");
   }
-  if (!seen->insert(v.path).second) return Fail(why, path_field + "appears more than once");
+  if (!seen->insert(v.path).second) return refuse_path("appears more than once");
   if (IsProfileKind(ref->kind) && problem.three_segment.has_value()) {
-    return Fail(why, path_field + "the design is a three_segment shape (use three_segment.*)");
+    return refuse_path("the design is a three_segment shape (use three_segment.*)");
   }
   if (IsThreeSegmentKind(ref->kind) && !problem.three_segment.has_value()) {
-    return Fail(why, path_field + "the design is a profile, not a three_segment shape");
+    return refuse_path("the design is a profile, not a three_segment shape");
   }
   if (IsProfileKind(ref->kind) && ref->knot >= model.num_knots_) {
-    return Fail(why, path_field + "the profile has " + std::to_string(model.num_knots_) + " knots");
+    return refuse_path("the profile has " + std::to_string(model.num_knots_) + " knots");
   }
   if (ref->kind == DesignVariableKind::kKnotPosition && ref->knot == 0) {
-    return Fail(why, path_field + "must stay 0 (positions are measured from the knob)");
+    return refuse_path("must stay 0 (positions are measured from the knob)");
   }
   if (IsFillKind(ref->kind) && !base.fill.has_value()) {
-    return Fail(why, path_field + "the bat has no fill");
+    return refuse_path("the bat has no fill");
   }
   if (!std::isfinite(v.min)) {
     return Refuse(why, field + "min", v.min,
@@ -193,10 +197,10 @@ bool ModelBuilder::Variables() {
   if (fill_density_variable) {
     Material f = base.fill->material;
     f.density_kg_m3 = 1.0;  // check the other fields: the fill may become non-empty
-    if (!f.IsValid(inner_ptr)) {
-      return Fail(why, "fill.material." + inner +
-                           " (fill.material.density_kg_m3 is a variable, so the fill material must "
-                           "be complete)");
+    if (!f.Validate(inner_ptr)) {
+      return Refuse(why, Noted(Prefixed("fill.material.", inner),
+                               " (fill.material.density_kg_m3 is a variable, so the fill "
+                               "material must be complete)"));
     }
   }
 
@@ -210,11 +214,12 @@ bool ModelBuilder::Rules() {
     for (std::size_t i = 0; i < problem.constraints.rules.size(); ++i) {
       const RuleSet rule = problem.constraints.rules[i];
       if (!ParseRuleSet(RuleSetName(rule)).has_value()) {
-        return Fail(why, IndexedField("constraints.rules", i, "") + ": not a known rule set");
+        return Refuse(
+            why, TextRefusal(IndexedField("constraints.rules", i, ""), "not a known rule set"));
       }
       if (!rules_seen.insert(rule).second) {
-        return Fail(why, "constraints.rules: " + std::string(RuleSetName(rule)) +
-                             " appears more than once");
+        return Refuse(why, TextRefusal("constraints.rules",
+                                       std::string(RuleSetName(rule)) + " appears more than once"));
       }
       RuleFacts facts;
       facts.material = base.material;
@@ -225,7 +230,7 @@ bool ModelBuilder::Rules() {
       facts.fill_density_kg_m3 = base.fill.has_value() ? base.fill->material.density_kg_m3 : 0.0;
       facts.fill_density_variable = fill_density_variable;
       facts.cor = model.cor_;
-      if (!RuleAllowsDesign(rule, facts, inner_ptr)) return Fail(why, inner);
+      if (!RuleAllowsDesign(rule, facts, why)) return false;
     }
   }
 
@@ -254,7 +259,7 @@ bool ModelBuilder::SceneNumbers() {
   model.c0_ = base_properties.balance_point_m;
   model.i6_ref_ = base_properties.MoiSixInchKgM2();
   if (!(std::isfinite(model.c0_) && model.i6_ref_ > 0.0)) {
-    return Fail(why, "bat: its mass properties are not finite");
+    return Refuse(why, TextRefusal("bat", "its mass properties are not finite"));
   }
 
   return true;
@@ -275,19 +280,19 @@ bool ModelBuilder::Objective() {
     // The flexible model refuses some bats (too stubby for a beam, ...): say so by name.
     const StingEvaluation sting = model.StingOf(model.BatAt(x0.data()), false);
     if (!sting.ok) {
-      return Fail(why,
-                  "objective = min_sting: the sting of the start (the base design clamped "
-                  "into the variables' bounds) cannot be computed: " +
-                      sting.message);
+      return Refuse(why, QuotedRefusal("objective", "min_sting",
+                                       "the sting of the start (the base design clamped into "
+                                       "the variables' bounds) cannot be computed: " +
+                                           sting.message));
     }
     f0 = sting.sting_j;
   } else {
     f0 = model.Value(model.objective_, x0.data());
   }
   if (!std::isfinite(f0)) {
-    return Fail(why,
-                "variables: the objective is not finite at the start (the base design "
-                "clamped into the variables' bounds)");
+    return Refuse(why, TextRefusal("variables",
+                                   "the objective is not finite at the start (the base design "
+                                   "clamped into the variables' bounds)"));
   }
   model.objective_scale_ = std::abs(f0) > 0.0 ? std::abs(f0) : 1.0;
   for (DesignConstraintSpec& c : model.constraints_) {
@@ -317,6 +322,12 @@ bool ModelBuilder::Run() {
 
 bool DesignModel::Build(const DesignProblem& problem, const DesignOptions& options,
                         DesignModel* out, std::string* why) {
+  return ExplainRefusal(why,
+                        [&](Refusal* refusal) { return Build(problem, options, out, refusal); });
+}
+
+bool DesignModel::Build(const DesignProblem& problem, const DesignOptions& options,
+                        DesignModel* out, Refusal* why) {
   design_detail::ModelBuilder builder(problem, options, why);
   if (!builder.Run()) return false;
   *out = std::move(builder.model);

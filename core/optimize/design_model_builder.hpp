@@ -27,11 +27,8 @@ constexpr std::size_t kStingModesCacheEntries = 16;
 
 inline std::string Num(double v) { return FormatNumber(v); }
 
-// Refusals (core/refusal.hpp): Refuse writes "field = value: rule", Fail a composed message.
-inline bool Refuse(std::string* why, std::string_view field, double value, std::string_view rule) {
-  return RefuseMessage(why, field, value, rule);
-}
-inline bool Fail(std::string* why, std::string text) { return RefuseMessage(why, std::move(text)); }
+// Refusals are core's (core/refusal.hpp): Refuse(why, field, value, rule) for a number,
+// Refuse(why, TextRefusal(...)) or QuotedRefusal(...) for the others.
 
 // Floor of a constraint's scale by unit, so that a constraint whose value and bounds are 0
 // still gets a sensible magnitude.
@@ -81,14 +78,14 @@ inline std::string RangeText(double lower, double upper) {
 // The state of one Build: the request, the model being filled, and what later steps need of
 // earlier ones. Each step returns false with the reason in *why when the request is refused.
 struct ModelBuilder {
-  ModelBuilder(const DesignProblem& p, const DesignOptions& o, std::string* w)
+  ModelBuilder(const DesignProblem& p, const DesignOptions& o, Refusal* w)
       : problem(p), options(o), why(w) {}
 
   const DesignProblem& problem;
   const DesignOptions& options;
-  std::string* why;
-  std::string inner;
-  std::string* inner_ptr = why != nullptr ? &inner : nullptr;
+  Refusal* why;
+  Refusal inner;
+  Refusal* inner_ptr = why != nullptr ? &inner : nullptr;
   DesignModel model;
   bool exit_speed_objective = true;
   Bat base;

@@ -79,7 +79,7 @@ bool ModelBuilder::RangeOf(const char* field, const DesignRange& r, double* lowe
   *lower = r.min.value_or(-kInf);
   *upper = r.max.value_or(kInf);
   if (!r.min.has_value() && !r.max.has_value()) {
-    return Fail(why, std::string("constraints.") + field + ": give min, max or both");
+    return Refuse(why, TextRefusal(std::string("constraints.") + field, "give min, max or both"));
   }
   if (r.min.has_value() && !std::isfinite(*r.min)) {
     return Refuse(why, std::string("constraints.") + field + ".min", *r.min, "must be finite");

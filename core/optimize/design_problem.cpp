@@ -100,10 +100,8 @@ bool DesignProblem::IsValid(std::string* why) const {
 }
 
 bool DesignProblem::Validate(Refusal* refusal) const {
-  if (refusal == nullptr) return IsValid(nullptr);
-  std::string why;
-  if (IsValid(&why)) return true;
-  return Refuse(refusal, RefusalFromMessage(why));
+  DesignModel model;
+  return DesignModel::Build(*this, DesignOptions{}, &model, refusal);
 }
 
 bool DesignOptions::IsValid(std::string* why) const {

@@ -152,8 +152,7 @@ struct DesignProblem {
   /// finite and ordered, constraints finite, the base bat valid, the rules' discrete limits
   /// met); otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule. The
-  /// model's nested checks still compose text, read back with RefusalFromMessage.
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
   bool Validate(Refusal* refusal) const;
 };
 

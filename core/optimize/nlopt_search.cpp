@@ -5,8 +5,8 @@
 #include <cmath>
 #include <exception>
 #include <limits>
-#include <sstream>
 
+#include "core/geometry_format.hpp"
 #include "core/optimize/nlopt_run.hpp"
 #include "core/optimize/termination.hpp"
 
@@ -42,13 +42,6 @@ const AlgorithmInfo& Info(NloptAlgorithm a) {
   return kAlgorithms[0];
 }
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
-
 double SecondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -74,7 +67,7 @@ struct Tracker {
       ++evaluations;
       if (!std::isfinite(v) || (grad != nullptr && !std::isfinite(g))) {
         failed = true;
-        error = "the objective returned a non-finite value at x = " + Num(x);
+        error = "the objective returned a non-finite value at x = " + FormatNumber17(x);
         return false;
       }
       *value = v;
@@ -292,16 +285,16 @@ void ScalarSearch::Certify(ScalarSearchResult* result) {
     if (has_gradient && ((out.at_lower_bound && g > 0.0 && !out.at_upper_bound) ||
                          (out.at_upper_bound && g < 0.0 && !out.at_lower_bound))) {
       s.termination = Termination::kNoConvergence;
-      s.warnings.push_back("stopped at a bound where the derivative points inside (f' = " + Num(g) +
-                           ")");
+      s.warnings.push_back(
+          "stopped at a bound where the derivative points inside (f' = " + FormatNumber17(g) + ")");
     }
   } else if (has_gradient) {
     const double newton = curvature < 0.0 ? std::abs(g / curvature) : range;
     out.error_estimate_x = std::max(options.x_tolerance_m, newton);
     if (newton > 1e-6 * range) {
       s.termination = Termination::kNoConvergence;
-      s.warnings.push_back("first-order check failed: f' = " + Num(g) +
-                           " at the reported point (Newton step " + Num(newton) + ")");
+      s.warnings.push_back("first-order check failed: f' = " + FormatNumber17(g) +
+                           " at the reported point (Newton step " + FormatNumber17(newton) + ")");
     }
   } else {
     // Without derivatives the position is resolvable only to sqrt(noise / |f''|).
@@ -350,24 +343,26 @@ bool NloptAlgorithmIsGlobal(NloptAlgorithm a) { return Info(a).name[0] == 'G'; }
 bool NloptAlgorithmIsStochastic(NloptAlgorithm a) { return a == NloptAlgorithm::kGnCrs2Lm; }
 
 bool ScalarSearchOptions::IsValid(std::string* why) const {
-  auto fail = [why](const std::string& m) {
-    if (why != nullptr) *why = m;
-    return false;
-  };
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool ScalarSearchOptions::Validate(Refusal* why) const {
   if (!(std::isfinite(x_tolerance_m) && x_tolerance_m > 0.0))
-    return fail("nlopt.x_tolerance_m = " + Num(x_tolerance_m) + ": must be finite and > 0");
+    return Refuse(why,
+                  Number17Refusal("nlopt.x_tolerance_m", x_tolerance_m, "must be finite and > 0"));
   if (max_evaluations < 10)
-    return fail("nlopt.max_evaluations = " + std::to_string(max_evaluations) + ": must be >= 10");
+    return Refuse(why, IntegerRefusal("nlopt.max_evaluations", max_evaluations, "must be >= 10"));
   if (!(std::isfinite(max_time_s) && max_time_s > 0.0))
-    return fail("nlopt.max_time_s = " + Num(max_time_s) + ": must be finite and > 0");
+    return Refuse(why, Number17Refusal("nlopt.max_time_s", max_time_s, "must be finite and > 0"));
   if (start_samples < 2)
-    return fail("nlopt.start_samples = " + std::to_string(start_samples) + ": must be >= 2");
+    return Refuse(why, IntegerRefusal("nlopt.start_samples", start_samples, "must be >= 2"));
   if (start_samples > max_evaluations)
-    return fail("nlopt.start_samples = " + std::to_string(start_samples) +
-                ": must be <= nlopt.max_evaluations (" + std::to_string(max_evaluations) + ")");
+    return Refuse(why, IntegerRefusal("nlopt.start_samples", start_samples,
+                                      "must be <= nlopt.max_evaluations (" +
+                                          std::to_string(max_evaluations) + ")"));
   if (global_max_evaluations < 10)
-    return fail("nlopt.global_max_evaluations = " + std::to_string(global_max_evaluations) +
-                ": must be >= 10");
+    return Refuse(why, IntegerRefusal("nlopt.global_max_evaluations", global_max_evaluations,
+                                      "must be >= 10"));
   return true;
 }
 
@@ -395,7 +390,7 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
     return finish();
   }
   if (!(std::isfinite(lower) && std::isfinite(upper) && lower <= upper)) {
-    s.message = "search interval = [" + Num(lower) + ", " + Num(upper) +
+    s.message = "search interval = [" + FormatNumber17(lower) + ", " + FormatNumber17(upper) +
                 "]: must be finite with lower <= upper";
     return finish();
   }

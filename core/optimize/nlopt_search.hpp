@@ -64,6 +64,8 @@ struct ScalarSearchOptions {
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
+  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  bool Validate(Refusal* refusal) const;
 };
 
 /// f(x) and, when `gradient` is not null, df/dx into *gradient. Should not throw (if it does,

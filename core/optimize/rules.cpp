@@ -85,33 +85,43 @@ bool IsWoodMaterial(const Material& material) {
 }
 
 bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, std::string* why) {
+  return ExplainRefusal(why, [&](Refusal* out) { return RuleAllowsDesign(rule, facts, out); });
+}
+
+bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why) {
   const RuleSetLimits limits = LimitsOf(rule);
-  const std::string prefix = std::string("rules.") + RuleSetName(rule) + ": ";
+  // "rules.<name>: what is broken": the field is the rule set (the api maps it to the
+  // request's constraints.rules).
+  const std::string field = std::string("rules.") + RuleSetName(rule);
   if (limits.solid_wood_only) {
     if (!IsWoodMaterial(facts.material)) {
-      return RefuseMessage(why,
-                           prefix + "one piece of solid wood: material '" + facts.material.name +
-                               "' is not a wood of the catalogue (ash, hard-maple, yellow-birch, "
-                               "paper-wood)");
+      return Refuse(why,
+                    TextRefusal(field, "one piece of solid wood: material '" + facts.material.name +
+                                           "' is not a wood of the catalogue (ash, "
+                                           "hard-maple, yellow-birch, paper-wood)"));
     }
     if (facts.wall_thickness_m > 0.0 || facts.wall_variable) {
-      return RefuseMessage(why, prefix + "one piece of solid wood: wall_thickness_m = " +
-                                    FormatNumber(facts.wall_thickness_m) +
-                                    (facts.wall_variable ? " (a design variable)" : "") +
-                                    " makes a hollow shell");
+      return Refuse(why,
+                    TextRefusal(field, "one piece of solid wood: wall_thickness_m = " +
+                                           FormatNumber(facts.wall_thickness_m) +
+                                           (facts.wall_variable ? " (a design variable)" : "") +
+                                           " makes a hollow shell"));
     }
     if (facts.has_fill && (facts.fill_density_kg_m3 != 0.0 || facts.fill_density_variable)) {
-      return RefuseMessage(
-          why, prefix + "one piece of solid wood: fill.material.density_kg_m3 = " +
-                   FormatNumber(facts.fill_density_kg_m3) +
-                   (facts.fill_density_variable ? " (a design variable)" : "") +
-                   " puts a foreign substance in the bat (only an empty cup is allowed)");
+      return Refuse(
+          why, TextRefusal(field, "one piece of solid wood: fill.material.density_kg_m3 = " +
+                                      FormatNumber(facts.fill_density_kg_m3) +
+                                      (facts.fill_density_variable ? " (a design variable)" : "") +
+                                      " puts a foreign substance in the bat (only an empty cup "
+                                      "is allowed)"));
     }
   }
   if (limits.max_bbcor.has_value() && facts.cor > *limits.max_bbcor) {
-    return RefuseMessage(why, prefix + "cor = " + FormatNumber(facts.cor) +
-                                  " exceeds the BBCOR limit " + FormatNumber(*limits.max_bbcor) +
-                                  " (for a rigid bat the BBCOR-style value equals the COR)");
+    return Refuse(
+        why, TextRefusal(field, "cor = " + FormatNumber(facts.cor) + " exceeds the BBCOR limit " +
+                                    FormatNumber(*limits.max_bbcor) +
+                                    " (for a rigid bat the BBCOR-style value equals the "
+                                    "COR)"));
   }
   return true;
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/material.hpp"
+#include "core/refusal.hpp"
 
 namespace sweetspot::core {
 
@@ -63,5 +64,8 @@ struct RuleFacts {
 /// the rule ("rules.mlb-wood: ..."). The continuous limits are not checked here (they are
 /// constraints of the design problem).
 bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, std::string* why);
+/// RuleAllowsDesign with the refusal as data in *why (if non-null): field "rules.<name>", the
+/// rule the broken part.
+bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why);
 
 }  // namespace sweetspot::core

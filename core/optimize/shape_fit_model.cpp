@@ -206,7 +206,7 @@ double ConstraintValue(FitConstraint kind, const std::vector<double>& t, bool ho
   return ConstraintOf<double>(kind, t.data(), hollow);
 }
 
-std::string ConstraintMessage(FitConstraint kind, const std::vector<double>& t, bool hollow) {
+Refusal ConstraintRefusal(FitConstraint kind, const std::vector<double>& t, bool hollow) {
   const auto field = [](FitVariable v) { return FitVariableField(v); };
   const double x1 = At(t, kIndex.x1);
   const double x2 = At(t, kIndex.x2);
@@ -216,36 +216,40 @@ std::string ConstraintMessage(FitConstraint kind, const std::vector<double>& t, 
   const double depth = At(t, kIndex.depth);
   switch (kind) {
     case FitConstraint::kStart:
-      return RefusalMessage(field(FitVariable::kTaperStart), x1, "must be non-negative");
+      return NumberRefusal(field(FitVariable::kTaperStart), x1, "must be non-negative");
     case FitConstraint::kOrder:
-      return RefusalMessage(field(FitVariable::kTaperStart), x1,
-                            std::string("must not exceed shape.taper_end_m = ") + FormatNumber(x2));
+      return NumberRefusal(field(FitVariable::kTaperStart), x1,
+                           std::string("must not exceed shape.taper_end_m = ") + FormatNumber(x2));
     case FitConstraint::kEnd:
-      return RefusalMessage(field(FitVariable::kTaperEnd), x2,
-                            "must not exceed shape.length_m = " + FormatNumber(length));
+      return NumberRefusal(field(FitVariable::kTaperEnd), x2,
+                           "must not exceed shape.length_m = " + FormatNumber(length));
     case FitConstraint::kWallHandle:
-      return RefusalMessage(
+      return NumberRefusal(
           field(FitVariable::kWallThickness), wall,
           "must be less than shape.handle_radius_m = " + FormatNumber(At(t, kIndex.r1)));
     case FitConstraint::kWallBarrel:
-      return RefusalMessage(
+      return NumberRefusal(
           field(FitVariable::kWallThickness), wall,
           "must be less than shape.barrel_radius_m = " + FormatNumber(At(t, kIndex.r2)));
     case FitConstraint::kFillDepth:
-      return RefusalMessage(field(FitVariable::kFillDepth), depth,
-                            "must not exceed shape.length_m = " + FormatNumber(length));
+      return NumberRefusal(field(FitVariable::kFillDepth), depth,
+                           "must not exceed shape.length_m = " + FormatNumber(length));
     case FitConstraint::kBoreBottom:
     case FitConstraint::kBoreTip: {
       const double y = kind == FitConstraint::kBoreTip ? length : length - depth;
       const double around = FamilyRadiusAt<double>(t.data(), y) - (hollow ? wall : 0.0);
-      return RefusalMessage(field(FitVariable::kFillDiameter), diameter,
-                            "the bore radius " + FormatNumber(0.5 * diameter) +
-                                " must be less than the " + (hollow ? "inner" : "outer") +
-                                " radius " + FormatNumber(around) + " at x_m = " + FormatNumber(y) +
-                                " (over the fill's depth)");
+      return NumberRefusal(field(FitVariable::kFillDiameter), diameter,
+                           "the bore radius " + FormatNumber(0.5 * diameter) +
+                               " must be less than the " + (hollow ? "inner" : "outer") +
+                               " radius " + FormatNumber(around) + " at x_m = " + FormatNumber(y) +
+                               " (over the fill's depth)");
     }
   }
-  return "";
+  return Refusal{};
+}
+
+std::string ConstraintMessage(FitConstraint kind, const std::vector<double>& t, bool hollow) {
+  return ConstraintRefusal(kind, t, hollow).Message();
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -60,7 +60,9 @@ std::vector<FitConstraint> ApplicableConstraints(bool hollow, bool has_fill);
 bool ConstraintInvolves(FitConstraint kind, const std::vector<bool>& unknown);
 /// g(t), m (<= 0 when it holds).
 double ConstraintValue(FitConstraint kind, const std::vector<double>& t, bool hollow);
-/// "field = value: rule" for the violated constraint at the fixed values t.
+/// The refusal of the violated constraint at the fixed values t (field, value, rule).
+Refusal ConstraintRefusal(FitConstraint kind, const std::vector<double>& t, bool hollow);
+/// ConstraintRefusal as "field = value: rule".
 std::string ConstraintMessage(FitConstraint kind, const std::vector<double>& t, bool hollow);
 
 /// The fit in scaled unknowns s in [0, 1]^n: x_j = lo_j (1 - s_j) + hi_j s_j. Counts its

@@ -101,9 +101,8 @@ std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model
 SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
   return TimedRequest<SceneResult>("scene", [&](SceneResult& out, TimingBook& book) {
     Summary& s = out.summary;
-    std::string why;
-    if (!options.IsValid(&why)) {
-      s.message = why;
+    if (Refusal refusal; !options.Validate(&refusal)) {
+      s.SetRefusal(std::move(refusal));
       return;
     }
     std::vector<SceneOutput> wanted;
@@ -116,15 +115,16 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
     if (!scene.bat.has_value()) {
       for (SceneOutput o : {SceneOutput::kVibrationNode, SceneOutput::kLeastStingZone}) {
         if (Wants(wanted, o)) {
-          s.message = std::string("bat: ") + SceneOutputName(o) +
-                      " needs the bat's geometry (a bat, not only mass_properties)";
+          s.SetRefusal(TextRefusal("bat", std::string(SceneOutputName(o)) +
+                                              " needs the bat's geometry (a bat, not only "
+                                              "mass_properties)"));
           out.refused_field = "bat";
           return;
         }
       }
       if (flexible_exit) {
-        s.message =
-            "bat: model = flexible needs the bat's geometry (a bat, not only mass_properties)";
+        s.SetRefusal(TextRefusal(
+            "bat", "model = flexible needs the bat's geometry (a bat, not only mass_properties)"));
         out.refused_field = "bat";
         return;
       }
@@ -141,10 +141,9 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
     for (size_t i = 0; i < options.curve_positions_from_knob_m.size(); ++i) {
       const double x = options.curve_positions_from_knob_m[i];
       if (!(x >= 0.0 && x <= r.length_m)) {
-        s.termination = Termination::kInvalidInput;
-        s.message = "curve_positions_from_knob_m[" + std::to_string(i) +
-                    "] = " + FormatNumber17(x) + ": must be within the bat [0, " +
-                    FormatNumber17(r.length_m) + "]";
+        s.SetRefusal(
+            Number17Refusal("curve_positions_from_knob_m[" + std::to_string(i) + "]", x,
+                            "must be within the bat [0, " + FormatNumber17(r.length_m) + "]"));
         return;
       }
     }
@@ -163,6 +162,11 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
     auto note = [&](Termination t, const std::string& what) {
       s.termination = Worse(s.termination, t);
       if (!what.empty()) messages.push_back(what);
+    };
+    // An output refused for its input: the first such refusal is the summary's.
+    auto refuse = [&](Refusal why) {
+      note(Termination::kInvalidInput, why.Message());
+      if (!s.refusal.has_value()) s.refusal = std::move(why);
     };
 
     FlexibleModes flexible_modes(scene, options.flexible, &book);
@@ -231,12 +235,12 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
       }
     }
     if (std::find(wanted.begin(), wanted.end(), SceneOutput::kCenterOfPercussion) != wanted.end()) {
-      std::string cop_why;
+      Refusal cop_why;
       auto cop = CenterOfPercussion(r.mass_properties, scene.swing.hands_from_knob_m, r.length_m,
                                     &cop_why);
       if (!cop.has_value()) {
         // The core message first ("swing.hands_from_knob_m = ...: rule"): it names the field.
-        note(Termination::kInvalidInput, cop_why + " (center_of_percussion)");
+        refuse(Noted(std::move(cop_why), " (center_of_percussion)"));
       } else {
         if (cop->placement == Placement::kBeyondTip) {
           s.warnings.push_back("center_of_percussion: beyond the tip (" +
@@ -258,8 +262,12 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
         const bool invalid = modes->summary.termination == Termination::kInvalidInput;
         // Invalid input keeps the core message first ("bat.length_m = ...: rule"): it names
         // the field.
-        note(invalid ? Termination::kInvalidInput : Termination::kFailure,
-             invalid ? error + " (vibration_node)" : "vibration_node: " + error);
+        if (invalid && modes->summary.refusal.has_value()) {
+          refuse(Noted(*modes->summary.refusal, " (vibration_node)"));
+        } else {
+          note(invalid ? Termination::kInvalidInput : Termination::kFailure,
+               invalid ? error + " (vibration_node)" : "vibration_node: " + error);
+        }
         if (invalid) out.refused_field = "bat";
       }
     }
@@ -267,9 +275,13 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
       const auto& modes = flexible_modes.Impact();
       if (!modes->summary.IsSolutionUsable()) {
         const bool invalid = modes->summary.termination == Termination::kInvalidInput;
-        note(invalid ? Termination::kInvalidInput : Termination::kFailure,
-             invalid ? modes->summary.message + " (least_sting_zone)"
-                     : "least_sting_zone: the bat's modes: " + modes->summary.message);
+        if (invalid && modes->summary.refusal.has_value()) {
+          refuse(Noted(*modes->summary.refusal, " (least_sting_zone)"));
+        } else {
+          note(invalid ? Termination::kInvalidInput : Termination::kFailure,
+               invalid ? modes->summary.message + " (least_sting_zone)"
+                       : "least_sting_zone: the bat's modes: " + modes->summary.message);
+        }
         if (invalid) out.refused_field = "bat";
       } else {
         LeastStingZoneResult zone;

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <utility>
 
 #include "core/geometry_format.hpp"
 
@@ -10,10 +11,8 @@ namespace sweetspot::core {
 
 bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, ResolvedScene* r,
                   Summary* s) {
-  std::string why;
-  if (!scene.IsValid(&why)) {
-    s->termination = Termination::kInvalidInput;
-    s->message = why;
+  if (Refusal refusal; !scene.Validate(&refusal)) {
+    s->SetRefusal(std::move(refusal));
     return false;
   }
   if (!needs_cor) {
@@ -25,11 +24,13 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
     r->cor = *scene.bat->material.cor;
     r->cor_source = "material:" + scene.bat->material.name;
   } else {
-    s->termination = Termination::kInvalidInput;
-    s->message =
+    // About the scene's COR and the bat's material together, so no one field: the api names
+    // the part of the request it was evaluating (the bat, a compared variant).
+    s->SetRefusal(TextRefusal(
+        "",
         scene.bat.has_value()
             ? "cor: not given, and material '" + scene.bat->material.name + "' has no default COR"
-            : "cor: not given, and there is no bat material to take it from";
+            : "cor: not given, and there is no bat material to take it from"));
     return false;
   }
   if (scene.mass_properties.has_value()) {
@@ -56,9 +57,9 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
   r->length_m = scene.bat.has_value() ? scene.bat->LengthM() : scene.length_m;
   const double h = scene.swing.hands_from_knob_m;
   if (!(h >= 0.0 && h <= r->length_m)) {
-    s->termination = Termination::kInvalidInput;
-    s->message = "swing.hands_from_knob_m = " + FormatNumber17(h) +
-                 ": must be within the bat [0, " + FormatNumber17(r->length_m) + "]";
+    s->SetRefusal(
+        Number17Refusal("swing.hands_from_knob_m", h,
+                        "must be within the bat [0, " + FormatNumber17(r->length_m) + "]"));
     return false;
   }
   return true;

@@ -12,15 +12,6 @@ bool Refuse17(Refusal* out, std::string_view field, double value, std::string_vi
   return out == nullptr ? false : Refuse(out, Number17Refusal(field, value, rule));
 }
 
-// A nested validator that still reports text (nlopt, Hertz, flexible impact), as a refusal.
-template <typename Options>
-bool CheckText(const Options& options, Refusal* out) {
-  if (out == nullptr) return options.IsValid(nullptr);
-  std::string why;
-  if (options.IsValid(&why)) return true;
-  return Refuse(out, RefusalFromMessage(why));
-}
-
 }  // namespace
 
 bool Ball::IsValid(std::string* why) const {
@@ -101,7 +92,7 @@ bool SceneOptions::IsValid(std::string* why) const {
 }
 
 bool SceneOptions::Validate(Refusal* why) const {
-  if (!CheckText(nlopt, why)) return false;
+  if (!nlopt.Validate(why)) return false;
   if (!(std::isfinite(sweet_zone_tolerance) && sweet_zone_tolerance >= 0.0))
     return Refuse17(why, "sweet_zone_tolerance", sweet_zone_tolerance, "must be >= 0");
   if (max_curve_points < 2)
@@ -120,7 +111,7 @@ bool SceneOptions::Validate(Refusal* why) const {
       return Refuse17(why, "curve_positions_from_knob_m[" + std::to_string(i) + "]",
                       curve_positions_from_knob_m[i], "must be finite");
   }
-  if (!CheckText(hertz, why)) return false;
+  if (!hertz.Validate(why)) return false;
   return flexible.Validate(why);
 }
 
@@ -142,7 +133,7 @@ bool FlexibleOptions::Validate(Refusal* why) const {
   if (!(std::isfinite(sting_zone_fraction) && sting_zone_fraction > 0.0 &&
         sting_zone_fraction <= 1.0))
     return Refuse17(why, "flexible.sting_zone_fraction", sting_zone_fraction, "must be in (0, 1]");
-  return CheckText(impact, why);
+  return impact.Validate(why);
 }
 
 BeamModesOptions FlexibleOptions::VibrationModes() const {

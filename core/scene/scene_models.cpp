@@ -26,9 +26,9 @@ std::shared_ptr<const BatModes> FlexibleModes::Get(const BeamModesOptions& o, bo
   // Here the mesh bound is the scene's flexible.max_elements: name it so (a refusal's
   // message starts with its field, which the API reports).
   if (modes && modes->summary.termination == Termination::kInvalidInput &&
-      modes->summary.message.rfind("max_elements = ", 0) == 0) {
+      modes->summary.refusal.has_value() && modes->summary.refusal->field == "max_elements") {
     auto renamed = std::make_shared<BatModes>(*modes);
-    renamed->summary.message = "flexible." + renamed->summary.message;
+    renamed->summary.SetRefusal(Prefixed("flexible.", *modes->summary.refusal));
     modes = std::move(renamed);
   }
   return modes;
@@ -37,6 +37,10 @@ std::shared_ptr<const BatModes> FlexibleModes::Get(const BeamModesOptions& o, bo
 bool FlexibleModesRefused(const BatModes& modes, Summary* summary) {
   if (modes.summary.IsSolutionUsable()) return false;
   const bool invalid = modes.summary.termination == Termination::kInvalidInput;
+  if (invalid && modes.summary.refusal.has_value()) {
+    summary->SetRefusal(Noted(*modes.summary.refusal, " (model = flexible)"));
+    return true;
+  }
   summary->termination = invalid ? Termination::kInvalidInput : Termination::kFailure;
   summary->message = invalid ? modes.summary.message + " (model = flexible)"
                              : "model = flexible: the bat's modes: " + modes.summary.message;

@@ -157,13 +157,22 @@ SweetZoneResult ClosedFormSweetZone(const ExitSpeedProfile& profile, double leng
 std::optional<CenterOfPercussionResult> CenterOfPercussion(const MassProperties& mass_properties,
                                                            double hands_from_knob_m,
                                                            double length_m, std::string* why) {
+  Refusal refusal;
+  auto out = CenterOfPercussion(mass_properties, hands_from_knob_m, length_m, &refusal);
+  if (!out.has_value() && why != nullptr) *why = refusal.Message();
+  return out;
+}
+
+std::optional<CenterOfPercussionResult> CenterOfPercussion(const MassProperties& mass_properties,
+                                                           double hands_from_knob_m,
+                                                           double length_m, Refusal* why) {
   const double arm = mass_properties.balance_point_m - hands_from_knob_m;
   if (!(arm > 0.0)) {
     if (why != nullptr) {
-      *why = "swing.hands_from_knob_m = " + FormatNumber17(hands_from_knob_m) +
-             ": must be closer to the knob than the balance point (" +
-             FormatNumber17(mass_properties.balance_point_m) +
-             " m) for a centre of percussion to exist";
+      *why = Number17Refusal("swing.hands_from_knob_m", hands_from_knob_m,
+                             "must be closer to the knob than the balance point (" +
+                                 FormatNumber17(mass_properties.balance_point_m) +
+                                 " m) for a centre of percussion to exist");
     }
     return std::nullopt;
   }

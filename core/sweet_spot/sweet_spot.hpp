@@ -168,5 +168,9 @@ SweetZoneResult ClosedFormSweetZone(const ExitSpeedProfile& profile, double leng
 std::optional<CenterOfPercussionResult> CenterOfPercussion(const MassProperties& mass_properties,
                                                            double hands_from_knob_m,
                                                            double length_m, std::string* why);
+/// CenterOfPercussion with the reason as data (field "swing.hands_from_knob_m") in *why.
+std::optional<CenterOfPercussionResult> CenterOfPercussion(const MassProperties& mass_properties,
+                                                           double hands_from_knob_m,
+                                                           double length_m, Refusal* why);
 
 }  // namespace sweetspot::core

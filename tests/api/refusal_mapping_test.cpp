@@ -30,7 +30,7 @@ TEST(RefusalMappingTest, ACoreFieldMapsToTheRequestPath) {
 
   // A refusal that names no field names the object it was found in.
   error = ApiError{};
-  CoreRefusal(core::RefusalFromMessage("objective: not a known objective"), "options", &error);
+  CoreRefusal(core::TextRefusal("", "objective: not a known objective"), "options", &error);
   EXPECT_EQ(error.field, "options");
   EXPECT_EQ(error.message, "options: objective: not a known objective");
 
@@ -47,6 +47,17 @@ TEST(RefusalMappingTest, ACoreFieldMapsToTheRequestPath) {
   EXPECT_EQ(error.field, "options.derivative_check");
   EXPECT_EQ(RequestField(core::NumberRefusal("knots[2].x_m", 1, "r"), "bat.profile"),
             "bat.profile.knots[2].x_m");
+}
+
+TEST(RefusalMappingTest, TheTableRenamesCoreFieldsTheRequestNamesOtherwise) {
+  EXPECT_EQ(RequestName("hertz.paper.k3"), "hertz.paper_constants.k3");
+  EXPECT_EQ(RequestName("hertz.hands_stiffness_n_m"), "hertz.hands_stiffness_n_m");
+  EXPECT_EQ(RequestName("ball.mass_kg"), "ball.mass_kg");
+  ApiError error;
+  CoreRefusal(core::Number17Refusal("hertz.paper.k3", -1, "must be in [0, 1e20]"), "options",
+              &error);
+  EXPECT_EQ(error.field, "options.hertz.paper_constants.k3");
+  EXPECT_EQ(error.message, "options.hertz.paper_constants.k3 = -1: must be in [0, 1e20]");
 }
 
 TEST(RefusalMappingTest, SceneFieldsAreTheSceneHeads) {

@@ -272,6 +272,33 @@ TEST(SweetSpotEndpointTest, CoreRefusalsOfOptionsNameTheRequestField) {
   EXPECT_EQ(s.body["field"], "swing.hands_from_knob_m") << s.body.dump();
 }
 
+TEST(SweetSpotEndpointTest, CoreChecksThePaperConstantsUnderTheRequestsNames) {
+  // The range is core's (hertz.paper.k3); the request names the field paper_constants.k3.
+  const Response r = Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"},
+      "options": {"hertz": {"paper_constants": {"k3": -1}}}})");
+  EXPECT_EQ(r.status, 400) << r.body.dump();
+  EXPECT_EQ(r.body["code"], "InvalidValue") << r.body.dump();
+  EXPECT_EQ(r.body["field"], "options.hertz.paper_constants.k3") << r.body.dump();
+  EXPECT_EQ(r.body["message"], "options.hertz.paper_constants.k3 = -1: must be in [0, 1e20]");
+  // /v1/collision reads the contact options at the top level; core refuses them in Collide.
+  const Response c = Post("/v1/collision", R"({"bat": {"preset": "paper-wood"},
+      "impact_from_knob_m": 0.7, "model": "hertz", "hertz": {"paper_constants": {"k3": -1}}})");
+  EXPECT_EQ(c.status, 400) << c.body.dump();
+  EXPECT_EQ(c.body["field"], "hertz.paper_constants.k3") << c.body.dump();
+  EXPECT_EQ(c.body["message"], "hertz.paper_constants.k3 = -1: must be in [0, 1e20]");
+  // The integrator's tolerance likewise (core's ContactIntegrationValidate).
+  const Response tol = Post("/v1/collision", R"({"bat": {"preset": "paper-wood"},
+      "impact_from_knob_m": 0.7, "model": "hertz", "hertz": {"relative_tolerance": 1}})");
+  EXPECT_EQ(tol.status, 400) << tol.body.dump();
+  EXPECT_EQ(tol.body["field"], "hertz.relative_tolerance") << tol.body.dump();
+  EXPECT_EQ(tol.body["message"], "hertz.relative_tolerance = 1: must be in [1e-13, 1e-2]");
+  // A type error is still the api's.
+  const Response t = Post("/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"},
+      "options": {"hertz": {"paper_constants": {"k3": "big"}}}})");
+  EXPECT_EQ(t.status, 400) << t.body.dump();
+  EXPECT_EQ(t.body["field"], "options.hertz.paper_constants.k3") << t.body.dump();
+}
+
 TEST(CompareEndpointTest, TooManyVariantsIs413) {
   std::string variants;
   for (int i = 0; i < 65; ++i) {

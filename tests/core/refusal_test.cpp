@@ -8,11 +8,13 @@
 #include <string>
 
 #include "core/bat.hpp"
+#include "core/collision/hertz_contact.hpp"
 #include "core/geometry_format.hpp"
 #include "core/material.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "core/sampling.hpp"
+#include "core/scene/evaluate_scene.hpp"
 #include "core/scene/scene.hpp"
 
 namespace sweetspot::core {
@@ -138,22 +140,89 @@ TEST(RefusalTest, TheDesignModelEnforcesTheConfiguredVariableCap) {
   EXPECT_EQ(why, "variables.size() = 4: must be between 1 and 3");
 }
 
-TEST(RefusalTest, FromMessageIsTheInverseOfMessage) {
-  for (const char* message :
-       {"wall_thickness_m = -0.001: must be non-negative (0 = solid)",
-        "derivative_check = second-order: needs hessian = exact (no second derivatives)",
-        "shard.index = 3: must be below shard.count = 2", "field = 5", "no field at all"}) {
-    EXPECT_EQ(RefusalFromMessage(message).Message(), message);
-  }
-  const Refusal r = RefusalFromMessage("fill.depth_m = 1.5: must not exceed the bat's length 0.86");
-  EXPECT_EQ(r.field, "fill.depth_m");
-  EXPECT_EQ(r.value, 1.5);
-  EXPECT_EQ(r.shown, "1.5");
-  EXPECT_EQ(r.rule, "must not exceed the bat's length 0.86");
-  const Refusal text = RefusalFromMessage("objective: not a known objective");
-  EXPECT_EQ(text.field, "");
-  EXPECT_EQ(text.rule, "objective: not a known objective");
-  EXPECT_TRUE(std::isnan(RefusalFromMessage("derivative_check = second-order: x").value));
+TEST(RefusalTest, TheDesignModelHandsOverItsRefusalAsData) {
+  DesignProblem p;
+  p.three_segment = ThreeSegmentShape{0.86, 0.0125, 0.033, 0.30, 0.55};
+  p.bat.material = *FindMaterial("ash");
+  p.variables = {{"three_segment.length_m", 0.84, 0.88}, {"three_segment.length_m", 0.84, 0.88}};
+  p.swing.pivot_from_knob_m = 0.1;
+  p.objective = DesignObjective::kMinMoi;
+  Refusal refusal;
+  ASSERT_FALSE(p.Validate(&refusal));
+  // A value that is no number is quoted as written.
+  EXPECT_EQ(refusal.field, "variables[1].path");
+  EXPECT_EQ(refusal.shown, "three_segment.length_m");
+  EXPECT_TRUE(std::isnan(refusal.value));
+  EXPECT_EQ(refusal.rule, "appears more than once");
+  std::string why;
+  EXPECT_FALSE(p.IsValid(&why));
+  EXPECT_EQ(why, refusal.Message());
+  // A nested check (the ball's) keeps its own field.
+  p.variables.pop_back();
+  p.ball.mass_kg = 0.0;
+  ASSERT_FALSE(p.Validate(&refusal));
+  EXPECT_EQ(refusal.field, "ball.mass_kg");
+  EXPECT_EQ(refusal.value, 0.0);
+}
+
+TEST(RefusalTest, SummariesCarryTheRefusalTheirMessageStates) {
+  // Refused for an option nested in the scene's options (nlopt), then for the scene itself.
+  SceneOptions options;
+  options.nlopt.max_evaluations = 5;
+  const Summary by_options = EvaluateScene(Scene{}, options).summary;
+  EXPECT_EQ(by_options.termination, Termination::kInvalidInput);
+  ASSERT_TRUE(by_options.refusal.has_value());
+  EXPECT_EQ(by_options.refusal->field, "nlopt.max_evaluations");
+  EXPECT_EQ(by_options.refusal->value, 5.0);
+  EXPECT_EQ(by_options.message, "nlopt.max_evaluations = 5: must be >= 10");
+  EXPECT_EQ(by_options.message, by_options.refusal->Message());
+
+  const Summary by_scene = EvaluateScene(Scene{}, SceneOptions{}).summary;
+  EXPECT_EQ(by_scene.termination, Termination::kInvalidInput);
+  ASSERT_TRUE(by_scene.refusal.has_value());
+  EXPECT_EQ(by_scene.refusal->field, "bat");
+  EXPECT_EQ(by_scene.message, by_scene.refusal->Message());
+
+  // A converged solve carries none.
+  Summary done;
+  done.termination = Termination::kConverged;
+  EXPECT_FALSE(done.refusal.has_value());
+  done.SetRefusal(TextRefusal("cor", "not given"));
+  EXPECT_EQ(done.termination, Termination::kInvalidInput);
+  EXPECT_EQ(done.message, "cor: not given");
+}
+
+TEST(RefusalTest, TheContactOptionsOwnTheRangesARequestGets) {
+  // The ranges the api checked before (now only core does): the paper's constants in
+  // [0, 1e20] (K1 > 0) whatever the law, the hands' stiffness and damping finite, >= 0 and at
+  // most 1e12.
+  HertzOptions h;
+  Refusal refusal;
+  EXPECT_TRUE(h.Validate(&refusal));
+  h.paper.k3 = -1.0;
+  ASSERT_FALSE(h.Validate(&refusal));
+  EXPECT_EQ(refusal.field, "hertz.paper.k3");
+  EXPECT_EQ(refusal.Message(), "hertz.paper.k3 = -1: must be in [0, 1e20]");
+  h.paper.k3 = 2e20;
+  EXPECT_FALSE(h.Validate(nullptr));
+  h.paper.k3 = 1e20;
+  EXPECT_TRUE(h.Validate(nullptr));
+  h.paper.k1 = 0.0;
+  ASSERT_FALSE(h.Validate(&refusal));
+  EXPECT_EQ(refusal.field, "hertz.paper.k1");
+  h = HertzOptions{};
+  h.hands_stiffness_n_m = 1e12;  // the bound itself is accepted
+  EXPECT_TRUE(h.Validate(nullptr));
+  h.hands_damping_n_s_m = 2e12;
+  ASSERT_FALSE(h.Validate(&refusal));
+  EXPECT_EQ(refusal.Message(), "hertz.hands_damping_n_s_m = 2000000000000: must be at most 1e12");
+}
+
+TEST(RefusalTest, NotedAppendsToTheRule) {
+  const Refusal r = Noted(NumberRefusal("bat.length_m", 0.1, "too short"), " (model = flexible)");
+  EXPECT_EQ(r.field, "bat.length_m");
+  EXPECT_EQ(r.Message(), "bat.length_m = 0.1: too short (model = flexible)");
+  EXPECT_EQ(QuotedRefusal("objective", "min_sting", "r").Message(), "objective = min_sting: r");
 }
 
 TEST(RefusalTest, RefusalMessageIsNumberRefusalsMessage) {
