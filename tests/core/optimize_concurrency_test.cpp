@@ -36,6 +36,9 @@ TEST(OptimizeConcurrency, EightThreadsTimesTenSolvesAllMatchTheSerialAnswers) {
   DesignOptions options;
   options.starts = 1;
   options.hessian = HessianMode::kExact;  // fewer iterations: keeps the test fast under ASan
+  // Equality with the serial answers, not speed: a solve cut by the time budget (10 s by
+  // default, reached on a loaded machine under the sanitizers) would differ from a whole one.
+  options.max_time_s = 120.0;
   std::vector<DesignResult> serial;
   for (int i = 0; i < kSolves; ++i) serial.push_back(OptimizeDesign(Problem(i), options));
   for (const DesignResult& r : serial) {
@@ -86,6 +89,7 @@ TEST(OptimizeConcurrency, StingSolvesBesideIpoptSolvesMatchTheSerialAnswer) {
   sting.constraints.mass_kg = DesignRange::Between(0.85, 1.25);
   DesignOptions options;
   options.hessian = HessianMode::kExact;
+  options.max_time_s = 120.0;  // as above: whole solves only
   const DesignResult serial = OptimizeDesign(sting, options);
   const DesignResult serial_ipopt = OptimizeDesign(Problem(0), options);
   ASSERT_EQ(serial.summary.termination, Termination::kConverged) << serial.summary.FullReport();

@@ -79,10 +79,20 @@ bool HasWarning(const DesignResult& r, const std::string& text) {
 
 // (1) The optimum is the least sting: below the base design, both bounds and every point of a
 // grid over the whole range, and a local minimum when probed on either side.
+// Options whose time budget never decides the answer: these tests assert what a whole solve
+// finds, and each COBYLA solve over the flexible beam takes 4-6 s of CPU under the sanitizers,
+// so the default 10 s budget cut runs short on a loaded machine (ASan ctest beside other work).
+DesignOptions StingTestOptions() {
+  DesignOptions o;
+  o.max_time_s = 120.0;
+  return o;
+}
+
 TEST(OptimizeSting, TheTaperEndWithTheLeastStingBeatsEveryGridDesign) {
   // Every design of the range meets the mass range: the sting alone decides.
   const DesignProblem p = TaperEndProblem(0.85, 1.25);
-  const DesignResult r = OptimizeDesign(p);  // backend ipopt asked (the default): COBYLA runs
+  // backend ipopt asked (the default): COBYLA runs
+  const DesignResult r = OptimizeDesign(p, StingTestOptions());
   ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.FullReport();
   EXPECT_EQ(r.summary.backend, "nlopt:LN_COBYLA");
   EXPECT_TRUE(HasWarning(r, "solved by NLopt LN_COBYLA, not ipopt")) << r.summary.FullReport();
@@ -138,7 +148,7 @@ TEST(OptimizeSting, TheTaperEndWithTheLeastStingBeatsEveryGridDesign) {
 // linear in the taper's end, so the design on the limit is known in closed form.
 TEST(OptimizeSting, AMassLimitThatBindsHoldsWhenRecomputed) {
   const DesignProblem p = TaperEndProblem(0.90, 1.05);
-  DesignOptions o;
+  DesignOptions o = StingTestOptions();
   o.backend = DesignBackend::kNloptCobyla;
   const DesignResult r = OptimizeDesign(p, o);
   ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.FullReport();
@@ -172,13 +182,11 @@ TEST(OptimizeSting, AMassLimitThatBindsHoldsWhenRecomputed) {
 // deterministic; the random starts come from the seed).
 TEST(OptimizeSting, TheSameSeedGivesTheSameAnswer) {
   const DesignProblem p = TaperEndProblem(0.85, 1.25);
-  DesignOptions o;
+  // Determinism, not speed: a run cut by the time budget differs from a whole one.
+  DesignOptions o = StingTestOptions();
   o.backend = DesignBackend::kNloptCobyla;
   o.starts = 3;
   o.seed = 7;
-  // Determinism, not speed: the default 10 s budget cut a run short on a starved machine under
-  // the sanitizers (each solve takes ~4-6 s of CPU there), and a cut run differs from a whole one.
-  o.max_time_s = 120.0;
   const DesignResult a = OptimizeDesign(p, o);
   const DesignResult b = OptimizeDesign(p, o);
   ASSERT_EQ(a.summary.termination, Termination::kConverged) << a.summary.FullReport();
@@ -269,7 +277,7 @@ TEST(OptimizeSting, RefusalsNameTheField) {
 // the mass alone) names the conflict and the lightest reachable bat.
 TEST(OptimizeSting, AnImpossibleMassIsExplained) {
   const DesignProblem p = TaperEndProblem(0.50, 0.60);
-  const DesignResult r = OptimizeDesign(p);
+  const DesignResult r = OptimizeDesign(p, StingTestOptions());
   EXPECT_EQ(r.summary.termination, Termination::kInfeasible) << r.summary.FullReport();
   ASSERT_FALSE(r.conflicts.empty());
   EXPECT_EQ(r.conflicts[0].constraints, (std::vector<std::string>{"mass_kg"}));
@@ -284,7 +292,8 @@ TEST(OptimizeSting, AnImpossibleMassIsExplained) {
 TEST(OptimizeSting, TheMaterialWithTheLeastStingIsChosen) {
   const DesignProblem p = TaperEndProblem(0.70, 1.25);
   const MaterialChoiceResult r =
-      OptimizeOverMaterials(p, {*FindMaterial("ash"), *FindMaterial("hard-maple")});
+      OptimizeOverMaterials(p, {*FindMaterial("ash"), *FindMaterial("hard-maple")},
+                            StingTestOptions());
   ASSERT_EQ(r.per_material.size(), 2u);
   ASSERT_GE(r.best, 0);
   EXPECT_EQ(r.summary.backend, "nlopt:LN_COBYLA");
