@@ -1,6 +1,6 @@
 // Internal: the exact integrals behind the mass properties, written once as
-// templates on the scalar type (double for values; Eigen AutoDiffScalar with a
-// fixed-size derivative vector for exact gradients, so no heap allocation).
+// templates on the scalar type (double for values; jet::Jet, core/numerics/jet.hpp, for exact
+// first and second derivatives, with fixed-size storage, so no heap allocation).
 // Included only by core's .cpp files.
 //
 // A profile segment [x_a, x_b] of length h has the outer radius

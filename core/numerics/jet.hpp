@@ -2,25 +2,36 @@
 // and (when kSecond) its Hessian with respect to N local variables (truncated Taylor
 // arithmetic). Products, quotients and smooth unary functions propagate the exact first and
 // second derivatives of the operations performed: the derivatives are exact up to rounding,
-// like the value itself, and not a difference quotient. Used by the design model to
-// differentiate the closed-form mass integrals (N = 6 per profile segment, 5 for the fill)
-// and the closed-form sweet spot (N = 4: mass, first and second moments, length).
-// Included only by core's .cpp files.
+// like the value itself, and not a difference quotient. Used by the mass properties' gradient
+// (N = 5 per profile segment, 4 for the fill), the design model (the closed-form mass
+// integrals: N = 6 per profile segment, 5 for the fill; the closed-form sweet spot: N = 4)
+// and the shape fit. Included only by core's .cpp files.
+//
+// Speed: every operation writes a fresh result element by element from its operands, taken by
+// const reference (no operand copied by value and then updated in place: GCC then moves the
+// copies through the stack in 16-byte pieces that straddle the value and the gradient, and
+// the loads stall on the stores), and a double operand has its own overload (a scale or a
+// shift, never a full Jet product). A first-order Jet stores no Hessian at all.
 #pragma once
 
 #include <array>
 #include <cmath>
+#include <type_traits>
 
 namespace sweetspot::core::jet {
+
+/// The Hessian's storage of a first-order Jet: nothing.
+struct NoHessian {};
 
 /// Value, gradient and (when kSecond) the symmetric Hessian, stored in full (row-major).
 template <int N, bool kSecond>
 struct Jet {
   static constexpr int kHessianSize = kSecond ? N * N : 0;
 
-  double v = 0.0;                        ///< The value.
-  std::array<double, N> g{};             ///< d value / d variable i.
-  std::array<double, kHessianSize> h{};  ///< d2 value / d variable i d variable j, h[i * N + j].
+  std::array<double, N> g{};  ///< d value / d variable i.
+  double v = 0.0;             ///< The value.
+  /// d2 value / d variable i d variable j, h[i * N + j] (kSecond only).
+  [[no_unique_address]] std::conditional_t<kSecond, std::array<double, N * N>, NoHessian> h{};
 
   Jet() = default;
   /// A constant (zero derivatives). Implicit so that the integrals' templates can mix doubles in.
@@ -45,47 +56,53 @@ struct Jet {
     return out;
   }
 
-  Jet& operator+=(const Jet& b) {
-    v += b.v;
-    for (int i = 0; i < N; ++i) g[i] += b.g[i];
-    for (int i = 0; i < kHessianSize; ++i) h[i] += b.h[i];
-    return *this;
+  Jet& operator+=(const Jet& b) { return *this = *this + b; }
+  Jet& operator-=(const Jet& b) { return *this = *this - b; }
+  Jet& operator*=(double s) { return *this = *this * s; }
+
+  /// a s + b t: the sum, difference and scalings below are this one loop.
+  static Jet Combine(const Jet& a, double s, const Jet& b, double t) {
+    Jet out(s * a.v + t * b.v);
+    for (int i = 0; i < N; ++i) out.g[i] = s * a.g[i] + t * b.g[i];
+    if constexpr (kSecond) {
+      for (int i = 0; i < kHessianSize; ++i) out.h[i] = s * a.h[i] + t * b.h[i];
+    }
+    return out;
   }
-  Jet& operator-=(const Jet& b) {
-    v -= b.v;
-    for (int i = 0; i < N; ++i) g[i] -= b.g[i];
-    for (int i = 0; i < kHessianSize; ++i) h[i] -= b.h[i];
-    return *this;
-  }
-  Jet& operator*=(double s) {
-    v *= s;
-    for (int i = 0; i < N; ++i) g[i] *= s;
-    for (int i = 0; i < kHessianSize; ++i) h[i] *= s;
-    return *this;
+  /// s a + c for doubles s and c.
+  static Jet Affine(double s, const Jet& a, double c) {
+    Jet out(s * a.v + c);
+    for (int i = 0; i < N; ++i) out.g[i] = s * a.g[i];
+    if constexpr (kSecond) {
+      for (int i = 0; i < kHessianSize; ++i) out.h[i] = s * a.h[i];
+    }
+    return out;
   }
 
-  friend Jet operator+(Jet a, const Jet& b) { return a += b; }
-  friend Jet operator-(Jet a, const Jet& b) { return a -= b; }
-  friend Jet operator-(Jet a) { return a *= -1.0; }
-  friend Jet operator+(Jet a, double b) {
-    a.v += b;
-    return a;
+  friend Jet operator+(const Jet& a, const Jet& b) {
+    Jet out(a.v + b.v);
+    for (int i = 0; i < N; ++i) out.g[i] = a.g[i] + b.g[i];
+    if constexpr (kSecond) {
+      for (int i = 0; i < kHessianSize; ++i) out.h[i] = a.h[i] + b.h[i];
+    }
+    return out;
   }
-  friend Jet operator+(double a, Jet b) {
-    b.v += a;
-    return b;
+  friend Jet operator-(const Jet& a, const Jet& b) {
+    Jet out(a.v - b.v);
+    for (int i = 0; i < N; ++i) out.g[i] = a.g[i] - b.g[i];
+    if constexpr (kSecond) {
+      for (int i = 0; i < kHessianSize; ++i) out.h[i] = a.h[i] - b.h[i];
+    }
+    return out;
   }
-  friend Jet operator-(Jet a, double b) {
-    a.v -= b;
-    return a;
-  }
-  friend Jet operator-(double a, Jet b) {
-    b *= -1.0;
-    b.v += a;
-    return b;
-  }
-  friend Jet operator*(Jet a, double s) { return a *= s; }
-  friend Jet operator*(double s, Jet a) { return a *= s; }
+  friend Jet operator-(const Jet& a) { return Affine(-1.0, a, 0.0); }
+  friend Jet operator+(const Jet& a, double b) { return Affine(1.0, a, b); }
+  friend Jet operator+(double a, const Jet& b) { return Affine(1.0, b, a); }
+  friend Jet operator-(const Jet& a, double b) { return Affine(1.0, a, -b); }
+  friend Jet operator-(double a, const Jet& b) { return Affine(-1.0, b, a); }
+  friend Jet operator*(const Jet& a, double s) { return Affine(s, a, 0.0); }
+  friend Jet operator*(double s, const Jet& a) { return Affine(s, a, 0.0); }
+  friend Jet operator/(const Jet& a, double s) { return Affine(1.0 / s, a, 0.0); }
   friend Jet operator*(const Jet& a, const Jet& b) {
     Jet out(a.v * b.v);
     for (int i = 0; i < N; ++i) out.g[i] = a.v * b.g[i] + b.v * a.g[i];
@@ -103,7 +120,6 @@ struct Jet {
     const double inv = 1.0 / b.v;
     return a * b.Apply(inv, -inv * inv, 2.0 * inv * inv * inv);
   }
-  friend Jet operator/(Jet a, double s) { return a *= 1.0 / s; }
   friend Jet operator/(double a, const Jet& b) {
     const double inv = 1.0 / b.v;
     return b.Apply(a * inv, -a * inv * inv, 2.0 * a * inv * inv * inv);

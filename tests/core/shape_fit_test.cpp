@@ -29,7 +29,7 @@ ShapeFitProblem Table2Problem() {
 }
 
 // The metric of the fit, evaluated through the public mass properties (an
-// independent path: Knots() + ComputeMassProperties, not the fit's AutoDiff).
+// independent path: Knots() + ComputeMassProperties, not the fit's jets).
 double Table2Metric(double x1, double x2) {
   ThreeSegmentShape shape = PaperThreeSegmentShape();
   shape.taper_start_m = x1;
