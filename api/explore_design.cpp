@@ -11,8 +11,9 @@
 #include "core/collision/collide.hpp"
 
 namespace sweetspot::api {
-
+namespace {
 using Json = nlohmann::json;
+}  // namespace
 
 DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
                          const core::SceneOptions& options, const ApiLimits& limits) {

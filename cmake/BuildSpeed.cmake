@@ -6,22 +6,31 @@
 # - sweetspot_precompile(<target> <headers>...): the heavy third-party headers (Eigen,
 #   nlohmann-json, GoogleTest, Boost.Odeint) are parsed once per target instead of once per
 #   source file.
-# - sweetspot_unity(<target>): test and benchmark programs are unity builds (their sources
-#   compiled in batches, so the headers and the templates they share are compiled once per
-#   batch). A helper in a file's anonymous namespace must therefore not share a name with
-#   one of another file of the same program: the compiler says so at once ("redefinition
-#   of ..."). SWEETSPOT_UNITY_BATCH sets the batch size.
+# - sweetspot_unity(<target>): the libraries, test and benchmark programs are unity builds
+#   (their sources compiled in batches, so the headers and the templates they share are
+#   compiled once per batch: core, api and the server library compile in about half the
+#   time, README "Build times"). A name in a file's anonymous namespace must therefore not
+#   be declared by another file of the same target: the compiler says so at once
+#   ("redefinition of ...", "ambiguous"); shared constants live in one header
+#   (core/numerics/limits.hpp). SWEETSPOT_UNITY_BATCH sets the batch size;
+#   -DSWEETSPOT_UNITY=OFF compiles file by file (quicker rebuilds while editing one file).
 # - sweetspot_test_flags(<target>): test programs compile at SWEETSPOT_TEST_OPTIMIZE (-O1
 #   in optimised builds by default). The code under test keeps the build type's flags (-O3
 #   in Release, -O1 in the sanitizer builds): only the test drivers are cheaper to compile.
 #   scripts/test.sh passes -O0 to its sanitizer builds, where a test program compiled at -O1
 #   costs about 2.5 times the compile time of -O0 (README "Build times"). Benchmarks keep the
 #   build type's flags (they time header code).
+# - sweetspot_libraries_first(<target> <libraries>...): a test program links the code under
+#   test ahead of its own objects, so the optimised library's copy of each shared template
+#   function (Eigen's kernels) is the one the linker keeps. Otherwise the first copy the
+#   linker meets wins, the test driver's unoptimised one, and the library's calls go to it:
+#   under ASan that made OptimizeSting.TheSameSeedGivesTheSameAnswer take 55 s instead of
+#   22 s (README "Build times").
 
 option(SWEETSPOT_CCACHE "Compile through ccache when it is installed" ON)
 option(SWEETSPOT_PCH "Precompile the heavy third-party headers" ON)
-option(SWEETSPOT_UNITY_TESTS "Compile test and benchmark programs as unity builds" ON)
-set(SWEETSPOT_UNITY_BATCH 8 CACHE STRING "Source files per unity batch of a test program")
+option(SWEETSPOT_UNITY "Compile the libraries, test and benchmark programs as unity builds" ON)
+set(SWEETSPOT_UNITY_BATCH 8 CACHE STRING "Source files per unity batch")
 if(CMAKE_BUILD_TYPE MATCHES "^(Release|RelWithDebInfo)$")
   set(sweetspot_test_optimize_default -O1)
 else()
@@ -50,11 +59,16 @@ function(sweetspot_precompile target)
   endif()
 endfunction()
 
-# sweetspot_unity(<target>): compiles a test or benchmark program in unity batches.
+# sweetspot_unity(<target>): compiles a library, test or benchmark program in unity batches.
 function(sweetspot_unity target)
-  if(SWEETSPOT_UNITY_TESTS)
+  if(SWEETSPOT_UNITY)
     set_target_properties(${target} PROPERTIES UNITY_BUILD ON
                                                UNITY_BUILD_BATCH_SIZE ${SWEETSPOT_UNITY_BATCH})
+    if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+      # In a batch every source is an included file, so GCC takes a class with a field of
+      # its file's anonymous-namespace type for a header's (-Wsubobject-linkage): not so here.
+      target_compile_options(${target} PRIVATE -Wno-subobject-linkage)
+    endif()
   endif()
 endfunction()
 
@@ -72,3 +86,31 @@ set(SWEETSPOT_PCH_STD <algorithm> <chrono> <cmath> <functional> <limits> <map> <
 set(SWEETSPOT_PCH_CORE ${SWEETSPOT_PCH_STD} <Eigen/Core> <Eigen/Dense>)
 set(SWEETSPOT_PCH_API ${SWEETSPOT_PCH_CORE} <nlohmann/json.hpp>)
 set(SWEETSPOT_PCH_TESTS ${SWEETSPOT_PCH_API} <gtest/gtest.h>)
+
+# sweetspot_libraries_first(<target> <library>...): links the static libraries <library>... and
+# the sweetspot_* static libraries they depend on, whole, ahead of <target>'s own objects
+# (see the top of this file). They stay in the ordinary link list too, where they add nothing.
+function(sweetspot_libraries_first target)
+  set(pending ${ARGN})
+  set(archives)
+  while(pending)
+    list(POP_FRONT pending library)
+    if(NOT library MATCHES "^sweetspot_" OR NOT TARGET ${library})
+      continue()
+    endif()
+    get_target_property(type ${library} TYPE)
+    if(NOT type STREQUAL "STATIC_LIBRARY" OR "$<TARGET_FILE:${library}>" IN_LIST archives)
+      continue()
+    endif()
+    list(APPEND archives "$<TARGET_FILE:${library}>")
+    get_target_property(dependencies ${library} LINK_LIBRARIES)
+    if(dependencies)
+      list(APPEND pending ${dependencies})
+    endif()
+  endwhile()
+  if(archives)
+    string(REPLACE ";" "," archive_list "${archives}")
+    target_link_options(${target} BEFORE PRIVATE
+                        "LINKER:--whole-archive,${archive_list},--no-whole-archive")
+  endif()
+endfunction()

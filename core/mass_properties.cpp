@@ -5,11 +5,10 @@
 
 #include "core/geometry_integrals.hpp"
 #include "core/numerics/jet.hpp"
+#include "core/numerics/limits.hpp"
 
 namespace sweetspot::core {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 MassProperties NanProperties(InertiaModel model) {
   MassProperties out;

@@ -16,6 +16,7 @@
 #include <Eigen/Dense>
 
 #include "core/geometry_format.hpp"
+#include "core/numerics/limits.hpp"
 #include "core/optimize/design_integrals.hpp"
 #include "core/optimize/nlopt_run.hpp"
 #include "core/optimize/shape_fit_model.hpp"
@@ -32,8 +33,6 @@ constexpr const char* kVariableName[kNumFitVariables] = {
     "taper_start_m",   "taper_end_m",       "length_m",         "handle_radius_m",
     "barrel_radius_m", "density_kg_m3",     "wall_thickness_m", "fill.diameter_m",
     "fill.depth_m",    "fill.density_kg_m3"};
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Builds the bat of the family at parameters t (DesignParameterLayout{4}).
 void BuildBat(const ShapeFitProblem& problem, const std::vector<double>& t, ShapeFitResult* out) {

@@ -29,7 +29,7 @@ using Clock = std::chrono::steady_clock;
 
 // How often deadlines are checked, and so how late past its deadline a slow
 // connection may be closed.
-constexpr auto kSweepInterval = std::chrono::milliseconds(25);
+constexpr auto kConnectionSweepInterval = std::chrono::milliseconds(25);
 // Bytes read from a socket per recv.
 constexpr std::size_t kReadChunk = 64 * 1024;
 
@@ -772,7 +772,7 @@ bool ConnectionLoop::Run() {
 
   // This thread keeps the deadlines until Stop().
   while (!m.stopping.load()) {
-    std::this_thread::sleep_for(kSweepInterval);
+    std::this_thread::sleep_for(kConnectionSweepInterval);
     const Clock::time_point now = Clock::now();
     m.Sweep(now);
     if (m.accept_paused.load() && now.time_since_epoch().count() >= m.accept_resume_ns.load()) {

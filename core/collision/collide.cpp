@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "core/geometry_format.hpp"
+#include "core/numerics/limits.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/scene/scene_models.hpp"
 
@@ -21,7 +22,6 @@ bool CollisionOptions::Validate(Refusal* why) const {
 
 CollisionResult Collide(const Scene& scene, double impact_from_knob_m, CollisionModel model,
                         const CollisionOptions& options) {
-  constexpr double kEps = std::numeric_limits<double>::epsilon();
   return TimedRequest<CollisionResult>("closed_form", [&](CollisionResult& out, TimingBook& book) {
     Summary& s = out.summary;
     out.impact_from_knob_m = impact_from_knob_m;

@@ -6,12 +6,10 @@
 #include <limits>
 
 #include "core/collision/exit_speed_algebra.hpp"
+#include "core/numerics/limits.hpp"
 
 namespace sweetspot::core {
 namespace {
-
-constexpr double kEps = std::numeric_limits<double>::epsilon();
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 exit_speed::Form<double> FormOf(const ExitSpeedProfile& p) {
   return {p.ball_speed_mps, p.gain_kg_m2,   p.approach_mps,

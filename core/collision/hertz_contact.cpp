@@ -19,9 +19,9 @@
 namespace sweetspot::core {
 namespace {
 
-using State = std::array<double, 6>;  // scaled: delta1, delta1', delta2, delta2', P1, P_hands
+using HertzState = std::array<double, 6>;  // scaled: delta1, delta1', delta2, delta2', P1, P_hands
 
-struct RawRun {
+struct HertzRun {
   bool ok = false;
   std::string message;
   std::vector<std::string> warnings;
@@ -46,7 +46,7 @@ struct HertzSystem {
   double delta_s = 1.0, v0 = 1.0, t_s = 1.0, p_s = 1.0;
   double peak_d = 0.0;  // scaled
   double peak_f = 0.0;  // N
-  RawRun* out = nullptr;
+  HertzRun* out = nullptr;
 
   // Contact force F1 at compression d (m), N.
   double ContactForce(double d) const {
@@ -55,7 +55,7 @@ struct HertzSystem {
     return branch.Force(law, d);
   }
 
-  void operator()(const State& y, State& dy, double /*t*/) const {
+  void operator()(const HertzState& y, HertzState& dy, double /*t*/) const {
     const double d1 = y[0] * delta_s;
     const double d2 = y[2] * delta_s;
     const double v2 = y[3] * v0;
@@ -82,7 +82,7 @@ struct HertzSystem {
 
   std::span<const EventSpec> ActiveEvents() const { return ContactEvents(branch.unloading); }
   // The contact's events on the compression delta1 (ContactEventId).
-  double EventFunction(int id, const State& s) const {
+  double EventFunction(int id, const HertzState& s) const {
     switch (id) {
       case kMaxCompression:
         return s[1];
@@ -92,10 +92,10 @@ struct HertzSystem {
         return branch.delta_max_m / delta_s - s[0];
     }
   }
-  void OnStep(const DenseStep<State>& step) { peak_d = std::max(peak_d, (*step.y_end)[0]); }
+  void OnStep(const DenseStep<HertzState>& step) { peak_d = std::max(peak_d, (*step.y_end)[0]); }
 
   // Records the end of the contact at (te, ye).
-  void End(double te, const State& ye, double separation_scaled) {
+  void End(double te, const HertzState& ye, double separation_scaled) {
     out->ok = true;
     out->contact_time_s = te * t_s;
     out->separation_speed_mps = separation_scaled * v0;
@@ -103,7 +103,7 @@ struct HertzSystem {
     out->hands_impulse_n_s = ye[5] * p_s;
   }
 
-  EventAction OnEvent(int id, double te, const State& ye) {
+  EventAction OnEvent(int id, double te, const HertzState& ye) {
     peak_d = std::max(peak_d, ye[0]);
     const double d_e = std::max(0.0, ye[0]) * delta_s;
     if (id == kEnd) {
@@ -130,8 +130,8 @@ struct HertzSystem {
   }
 };
 
-RawRun Integrate(const HertzProblem& p, double tol, int max_steps) {
-  RawRun out;
+HertzRun Integrate(const HertzProblem& p, double tol, int max_steps) {
+  HertzRun out;
   HertzSystem sys;
   sys.p = &p;
   sys.out = &out;
@@ -152,8 +152,8 @@ RawRun Integrate(const HertzProblem& p, double tol, int max_steps) {
                   " m, t_s = " + FormatNumber17(sys.t_s) + " s)";
     return out;
   }
-  EventIntegrator<State> integrator(ContactIntegratorOptions(tol, max_steps, sys.t_s));
-  State y{0.0, 1.0, 0.0, 0.0, 0.0, 0.0};
+  EventIntegrator<HertzState> integrator(ContactIntegratorOptions(tol, max_steps, sys.t_s));
+  HertzState y{0.0, 1.0, 0.0, 0.0, 0.0, 0.0};
   double t = 0.0;
   const bool stopped = integrator.Run(sys, &y, &t);
   out.steps = integrator.summary().steps;
@@ -277,12 +277,12 @@ HertzImpact SolveHertzImpact(const HertzProblem& problem, const HertzSolverOptio
     out.problem = problem;
     Summary& s = out.summary;
     if (!StartContactSolve("hertz", &s, problem, options)) return;
-    const RefinedRuns<RawRun> runs = SolveWithRefineCheck<RawRun>(
+    const RefinedRuns<HertzRun> runs = SolveWithRefineCheck<HertzRun>(
         options.relative_tolerance, options.refine_check,
         [&](double tol) { return Integrate(problem, tol, options.max_steps); });
     out.steps = CountRefinedRuns(runs, &s);
     if (!runs.coarse.ok) return;
-    const RawRun& a = runs.coarse;
+    const HertzRun& a = runs.coarse;
     out.contact_time_s = a.contact_time_s;
     out.max_compression_m = a.max_compression_m;
     out.peak_force_n = a.peak_force_n;
@@ -294,7 +294,7 @@ HertzImpact SolveHertzImpact(const HertzProblem& problem, const HertzSolverOptio
     out.unloading_exponent = a.q;
     s.warnings = a.warnings;
     if (runs.refined) {
-      const RawRun& b = runs.fine;
+      const HertzRun& b = runs.fine;
       if (!b.ok) {
         s.warnings.push_back(RefineFailedWarning(b.message) +
                              "; error estimates are the tolerance only");

@@ -16,6 +16,7 @@
 
 #include "core/collision/rigid_pivot.hpp"
 #include "core/geometry_format.hpp"
+#include "core/numerics/limits.hpp"
 #include "core/optimize/design_backends.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
@@ -38,7 +39,6 @@ using design_detail::Run;
 using design_detail::SettingsFrom;
 using design_detail::Solve;
 using design_detail::Violation;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A uniform double in [0, 1) from the generator's top 53 bits (the same on every platform,
 // unlike std::uniform_real_distribution).

@@ -7,17 +7,14 @@
 #include <vector>
 
 #include "core/geometry_format.hpp"
+#include "core/numerics/limits.hpp"
 #include "core/optimize/design_runs.hpp"
 
 namespace sweetspot::core::design_detail {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string Num(double v) { return FormatNumber(v); }
-
 std::string WithUnit(double v, const std::string& unit) {
-  return Num(v) + (unit.empty() ? "" : " " + unit);
+  return FormatNumber(v) + (unit.empty() ? "" : " " + unit);
 }
 
 // Words for the ends of a property's range in the conflict messages.
@@ -49,7 +46,7 @@ std::string Requested(const DesignConstraintSpec& c) {
   if (c.lower == c.upper) return c.name + " = " + WithUnit(c.lower, c.unit);
   if (!std::isfinite(c.lower)) return c.max_name + " = " + WithUnit(c.upper, c.unit);
   if (!std::isfinite(c.upper)) return c.min_name + " = " + WithUnit(c.lower, c.unit);
-  return c.name + " in [" + Num(c.lower) + ", " + WithUnit(c.upper, c.unit) + "]";
+  return c.name + " in [" + FormatNumber(c.lower) + ", " + WithUnit(c.upper, c.unit) + "]";
 }
 
 // Least and largest value of constraint k's function under the constraints `keep`.

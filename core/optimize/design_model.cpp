@@ -13,16 +13,15 @@
 #include "core/collision/rigid_pivot.hpp"
 #include "core/geometry_format.hpp"
 #include "core/geometry_integrals.hpp"
-#include "core/optimize/design_integrals.hpp"
 #include "core/numerics/jet.hpp"
+#include "core/numerics/limits.hpp"
+#include "core/optimize/design_integrals.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Integrals of one segment or of the fill, in the scalar type T.
 template <typename T>

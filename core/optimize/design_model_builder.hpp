@@ -12,13 +12,12 @@
 #include <vector>
 
 #include "core/geometry_format.hpp"
+#include "core/numerics/limits.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/refusal.hpp"
 
 namespace sweetspot::core::design_detail {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Relative margin that turns the strict validity rules (wall < radius, bore inside the
 // material) into closed constraints the solver can sit on.
 constexpr double kStrictMargin = 1e-6;

@@ -2,6 +2,8 @@
 // backends, the multipliers and the active constraints. See design_runs.hpp.
 #include "core/optimize/design_runs.hpp"
 
+#include "core/numerics/limits.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -13,8 +15,6 @@
 namespace sweetspot::core::design_detail {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
 // A constraint is reported active when within this of a limit, relative to its scale; a
 // variable when within this fraction of its range of a bound.
 constexpr double kActiveRelative = 1e-6;

@@ -7,13 +7,13 @@
 #include <limits>
 
 #include "core/geometry_format.hpp"
+#include "core/numerics/limits.hpp"
 #include "core/optimize/nlopt_run.hpp"
 #include "core/optimize/termination.hpp"
+#include "core/scene/timing_book.hpp"
 
 namespace sweetspot::core {
 namespace {
-
-constexpr double kEps = std::numeric_limits<double>::epsilon();
 
 struct AlgorithmInfo {
   NloptAlgorithm id;
@@ -40,10 +40,6 @@ const AlgorithmInfo& Info(NloptAlgorithm a) {
     if (info.id == a) return info;
   }
   return kAlgorithms[0];
-}
-
-double SecondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 // Evaluation bookkeeping shared with the NLopt callback. The callback never lets an

@@ -10,8 +10,9 @@
 #include <Eigen/Dense>
 
 #include "core/geometry_format.hpp"
-#include "core/optimize/design_integrals.hpp"
 #include "core/numerics/jet.hpp"
+#include "core/numerics/limits.hpp"
+#include "core/optimize/design_integrals.hpp"
 
 namespace sweetspot::core::fit_detail {
 namespace {
@@ -401,7 +402,6 @@ double KktError(ShapeFitModel& model, const std::vector<double>& s) {
   // of size 1 + |r|), e.g. where a taper between equal radii starts and ends. Every point is
   // then stationary; without this, rounding noise divided by a scale made of the same noise
   // read as a first-order residual of ~1 (a flat fit was reported as not certified).
-  constexpr double kEps = std::numeric_limits<double>::epsilon();
   if (jac.lpNorm<Eigen::Infinity>() <= 64.0 * kEps * (1.0 + r.lpNorm<Eigen::Infinity>())) {
     return 0.0;
   }

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/geometry_format.hpp"
+#include "core/numerics/limits.hpp"
 
 namespace sweetspot::core {
 
@@ -66,7 +67,6 @@ ExitSpeedModel::ExitSpeedModel(CollisionModel model, const Scene& scene,
 }
 
 bool ExitSpeedModel::Eval(double s, double* v, double* grad, double* err, std::string* why) {
-  constexpr double kEps = std::numeric_limits<double>::epsilon();
   const auto t0 = std::chrono::steady_clock::now();
   bool ok = true;
   if (profile_.has_value()) {

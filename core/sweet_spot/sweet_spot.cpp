@@ -5,11 +5,10 @@
 #include <limits>
 
 #include "core/geometry_format.hpp"
+#include "core/numerics/limits.hpp"
 
 namespace sweetspot::core {
 namespace {
-
-constexpr double kEps = std::numeric_limits<double>::epsilon();
 
 struct OutputName {
   SceneOutput output;
