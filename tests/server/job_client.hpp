@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 
+#include "tests/sanitizers.hpp"
 #include "tests/server/server_process.hpp"
 
 namespace sweetspot::testing::jobs {
@@ -23,28 +24,51 @@ using Clock = std::chrono::steady_clock;
 // few seconds; a passing Release run needs about one.
 inline constexpr auto kMustHappen = std::chrono::seconds(120);
 
-// A slow request with a small answer: 400 designs, each a Hertz-contact exit
-// speed maximised by NLopt (~1.5 ms each in Release, so ~0.6 s; several times
-// that under sanitizers), checking its cancel flag between designs. Its
-// numbers are deterministic, so running it again gives the same rows.
+// The sweeps below are sized to the build: a test needs a job that is still running when it
+// acts (kills, cancels, stops the database), not a given number of designs. Under a sanitizer
+// each design costs about 9 times what it costs in Release (a 400-design Hertz sweep through
+// the CLI: 0.43 s Release, 3.8 s ASan, 4.8 s TSan), so there the sweeps have a quarter of the
+// designs and still run about twice as long as in Release. They were the slowest tests of
+// both sanitizer passes (PostgresJobsTest.EveryJobIsVisible... 35 s under TSan, 5.6 s Release).
+#if SWEETSPOT_UNDER_ASAN || SWEETSPOT_UNDER_TSAN
+#define SWEETSPOT_SLOW_SWEEP_COUNT "10"
+#define SWEETSPOT_LONG_SWEEP_COUNT "20"
+inline constexpr std::size_t kSlowSweepRows = 100;
+inline constexpr std::size_t kLongSweepRows = 400;
+#else
+#define SWEETSPOT_SLOW_SWEEP_COUNT "20"
+#define SWEETSPOT_LONG_SWEEP_COUNT "40"
+inline constexpr std::size_t kSlowSweepRows = 400;
+inline constexpr std::size_t kLongSweepRows = 1600;
+#endif
+
+// A slow request with a small answer: kSlowSweepRows designs (400 in Release), each a
+// Hertz-contact exit speed maximised by NLopt (~1.5 ms each in Release, so ~0.6 s), checking
+// its cancel flag between designs. Its numbers are deterministic, so running it again gives
+// the same rows.
 inline const char* const kSlowSweep = R"({
   "bat": {"preset": "paper-wood",
           "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
-  "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 20},
-                 {"path": "fill.diameter_m", "min": 0.01, "max": 0.03, "count": 20}],
+  "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": )" SWEETSPOT_SLOW_SWEEP_COUNT
+                                      R"(},
+                 {"path": "fill.diameter_m", "min": 0.01, "max": 0.03, "count": )" SWEETSPOT_SLOW_SWEEP_COUNT
+                                      R"(}],
   "outputs": ["max_exit_speed"],
   "options": {"model": "hertz"}})";
-inline constexpr std::size_t kSlowSweepRows = 400;
 
-// A longer sweep than kSlowSweep (1600 designs, ~2.5 s in Release): long
+// A longer sweep than kSlowSweep (kLongSweepRows designs, 1600 and ~2.5 s in Release): long
 // enough to be killed or cancelled while it runs, and to report progress.
 inline const char* const kLongSweep = R"({
   "bat": {"preset": "paper-wood",
           "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
-  "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 40},
-                 {"path": "fill.diameter_m", "min": 0.01, "max": 0.03, "count": 40}],
+  "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": )" SWEETSPOT_LONG_SWEEP_COUNT
+                                      R"(},
+                 {"path": "fill.diameter_m", "min": 0.01, "max": 0.03, "count": )" SWEETSPOT_LONG_SWEEP_COUNT
+                                      R"(}],
   "outputs": ["max_exit_speed"],
   "options": {"model": "hertz"}})";
+#undef SWEETSPOT_SLOW_SWEEP_COUNT
+#undef SWEETSPOT_LONG_SWEEP_COUNT
 
 // A quick job's inner request.
 inline const char* const kQuick = R"({"bat": {"preset": "paper-wood"}})";
@@ -81,7 +105,7 @@ inline Answer PostJson(ServerProcess& server, const std::string& path, const std
 
 // Submits `inner` (JSON text) to `path` as a job; returns its id ("" on failure).
 inline std::string SubmitJob(ServerProcess& server, const std::string& path,
-                      const std::string& inner) {
+                             const std::string& inner) {
   const Answer answer =
       PostJson(server, "/v1/jobs", R"({"path": ")" + path + R"(", "body": )" + inner + "}");
   EXPECT_EQ(answer.status, 202) << answer.body.dump();
@@ -112,6 +136,5 @@ inline Json WithoutTimings(Json json) {
   }
   return json;
 }
-
 
 }  // namespace sweetspot::testing::jobs

@@ -10,8 +10,8 @@
 #include <signal.h>
 
 #include <atomic>
-#include <iostream>
 #include <chrono>
+#include <iostream>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -36,6 +36,7 @@ using testing::jobs::Delete;
 using testing::jobs::Get;
 using testing::jobs::Json;
 using testing::jobs::kLongSweep;
+using testing::jobs::kLongSweepRows;
 using testing::jobs::kMustHappen;
 using testing::jobs::kQuick;
 using testing::jobs::kSlowSweep;
@@ -53,7 +54,6 @@ constexpr double kSlowdown = 5.0;
 #else
 constexpr double kSlowdown = 1.0;
 #endif
-
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -124,7 +124,7 @@ TEST_F(PostgresJobsTest, EveryJobIsVisibleFromEveryReplicaAndTheQueueIsShared) {
   }
   for (const std::string& id : slow) {
     WaitForState(*replicas[1], id, "done");
-    EXPECT_EQ(Get(*replicas[0], "/v1/jobs/" + id + "/result").body["rows"].size(), 1600u);
+    EXPECT_EQ(Get(*replicas[0], "/v1/jobs/" + id + "/result").body["rows"].size(), kLongSweepRows);
   }
 }
 
@@ -219,9 +219,9 @@ TEST_F(PostgresJobsTest, ReplicasStartingAtOnceMigrateTheDatabaseOnce) {
     applied += replica->log().find("applied schema migration 1") != std::string::npos ? 1 : 0;
   }
   EXPECT_EQ(applied, 1);
-  EXPECT_EQ(cluster_.Psql("SELECT count(*), max(version) FROM sweetspot_schema_migrations",
-                          "fresh"),
-            "1|1");
+  EXPECT_EQ(
+      cluster_.Psql("SELECT count(*), max(version) FROM sweetspot_schema_migrations", "fresh"),
+      "1|1");
   // And every replica works on it.
   const std::string id = SubmitJob(*replicas[3], "/v1/bat/properties", kQuick);
   WaitForState(*replicas[0], id, "done");
@@ -325,7 +325,7 @@ TEST_F(PostgresJobsTest, DatabaseStoppedAndRestartedUnderLoadLosesNothing) {
   }
   const Json long_done = WaitForState(*b, long_id, "done");
   EXPECT_EQ(long_done["resumes"], 0) << "the running job was run again: " << long_done.dump();
-  EXPECT_EQ(Get(*b, "/v1/jobs/" + long_id + "/result").body["rows"].size(), 1600u);
+  EXPECT_EQ(Get(*b, "/v1/jobs/" + long_id + "/result").body["rows"].size(), kLongSweepRows);
   EXPECT_NE(a->log().find("reachable again"), std::string::npos) << a->log();
   EXPECT_NE(logs().find("job " + long_id + " committed"), std::string::npos) << logs();
   std::cout << "[ measured ] database away " << outage_s << " s; " << accepted.size()
@@ -335,7 +335,8 @@ TEST_F(PostgresJobsTest, DatabaseStoppedAndRestartedUnderLoadLosesNothing) {
 
 TEST_F(PostgresJobsTest, AResultOverTheLimitFailsTheJobWholeNeverTruncated) {
   auto replica = Replica({"--job-max-result-bytes", "4096"});
-  // The 400-row sweep's answer is far over 4 KiB; the properties' is under it.
+  // The sweep's answer (kSlowSweepRows rows, at least 100) is far over 4 KiB; the
+  // properties' is under it.
   const std::string big = SubmitJob(*replica, "/v1/explore", kSlowSweep);
   const Json failed = WaitForState(*replica, big, "failed");
   EXPECT_EQ(failed["status"], 413);
