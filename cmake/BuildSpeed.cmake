@@ -14,12 +14,12 @@
 #   ("redefinition of ...", "ambiguous"); shared constants live in one header
 #   (core/numerics/limits.hpp). SWEETSPOT_UNITY_BATCH sets the batch size;
 #   -DSWEETSPOT_UNITY=OFF compiles file by file (quicker rebuilds while editing one file).
-# - sweetspot_test_flags(<target>): test programs compile at SWEETSPOT_TEST_OPTIMIZE (-O1
-#   in optimised builds by default). The code under test keeps the build type's flags (-O3
-#   in Release, -O1 in the sanitizer builds): only the test drivers are cheaper to compile.
-#   scripts/test.sh passes -O0 to its sanitizer builds, where a test program compiled at -O1
-#   costs about 2.5 times the compile time of -O0 (README "Build times"). Benchmarks keep the
-#   build type's flags (they time header code).
+# - sweetspot_test_flags(<target>): test programs compile at SWEETSPOT_TEST_OPTIMIZE (-O0 by
+#   default). The code under test keeps the build type's flags (-O3 in Release, -O2 in the
+#   ASan build, -O1 in the TSan build): only the test drivers are cheaper to compile (a test
+#   program's batch compiles in about 40 % of its time at -O1, README "Build times"), and
+#   sweetspot_libraries_first keeps their unoptimised copies of shared templates out of the
+#   libraries' way. Benchmarks keep the build type's flags (they time header code).
 # - sweetspot_libraries_first(<target> <libraries>...): a test program links the code under
 #   test ahead of its own objects, so the optimised library's copy of each shared template
 #   function (Eigen's kernels) is the one the linker keeps. Otherwise the first copy the
@@ -31,12 +31,7 @@ option(SWEETSPOT_CCACHE "Compile through ccache when it is installed" ON)
 option(SWEETSPOT_PCH "Precompile the heavy third-party headers" ON)
 option(SWEETSPOT_UNITY "Compile the libraries, test and benchmark programs as unity builds" ON)
 set(SWEETSPOT_UNITY_BATCH 8 CACHE STRING "Source files per unity batch")
-if(CMAKE_BUILD_TYPE MATCHES "^(Release|RelWithDebInfo)$")
-  set(sweetspot_test_optimize_default -O1)
-else()
-  set(sweetspot_test_optimize_default "")
-endif()
-set(SWEETSPOT_TEST_OPTIMIZE "${sweetspot_test_optimize_default}" CACHE STRING
+set(SWEETSPOT_TEST_OPTIMIZE -O0 CACHE STRING
     "Optimisation flag of the test programs (empty: the build type's)")
 
 if(SWEETSPOT_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
