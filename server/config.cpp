@@ -6,6 +6,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/geometry_format.hpp"
+
 namespace sweetspot::server {
 namespace {
 
@@ -199,8 +201,8 @@ const std::vector<Option>& Options() {
          c->keep_alive_max_requests = static_cast<int>(n);
          return true;
        }},
-      {"--max-json-depth", "SWEETSPOT_MAX_JSON_DEPTH", "deepest JSON nesting in a body (default 32)",
-       true,
+      {"--max-json-depth", "SWEETSPOT_MAX_JSON_DEPTH",
+       "deepest JSON nesting in a body (default 32)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          long long n = 0;
          if (!ParseLong(v, 2, 512, &n, rule)) return false;
@@ -230,8 +232,8 @@ const std::vector<Option>& Options() {
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->limits.max_curve_samples, v, rule);
        }},
-      {"--max-samples", "SWEETSPOT_MAX_SAMPLES", "designs in one /v1/explore request (default 100000)",
-       true,
+      {"--max-samples", "SWEETSPOT_MAX_SAMPLES",
+       "designs in one /v1/explore request (default 100000)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->limits.max_samples, v, rule);
        }},
@@ -253,8 +255,8 @@ const std::vector<Option>& Options() {
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return ParseLong(v, 10, 1000000000, &c->limits.max_integration_steps, rule);
        }},
-      {"--max-time-s", "SWEETSPOT_MAX_TIME_S", "solver wall time a request may ask for, s (default 60)",
-       true,
+      {"--max-time-s", "SWEETSPOT_MAX_TIME_S",
+       "solver wall time a request may ask for, s (default 60)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return ParseSeconds(v, &c->limits.max_time_s, rule);
        }},
@@ -273,8 +275,8 @@ const std::vector<Option>& Options() {
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->jobs.max_kept, v, rule);
        }},
-      {"--job-keep-s", "SWEETSPOT_JOB_KEEP_S", "how long a finished job's result is kept, s (default 3600)",
-       true,
+      {"--job-keep-s", "SWEETSPOT_JOB_KEEP_S",
+       "how long a finished job's result is kept, s (default 3600)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return ParseSeconds(v, &c->jobs.keep_results_s, rule);
        }},
@@ -370,7 +372,8 @@ bool ServerConfig::IsValid(std::string* why) const {
     return false;
   };
   if (host.empty()) return fail("host = \"\": must not be empty");
-  if (port < 0 || port > 65535) return fail("port = " + std::to_string(port) + ": must be in [0, 65535]");
+  if (port < 0 || port > 65535)
+    return fail("port = " + std::to_string(port) + ": must be in [0, 65535]");
   if (threads < 1 || threads > 1024) {
     return fail("threads = " + std::to_string(threads) + ": must be in [1, 1024]");
   }
@@ -382,9 +385,8 @@ bool ServerConfig::IsValid(std::string* why) const {
     return fail("max_head_bytes = " + std::to_string(max_head_bytes) + ": must be at least 256");
   }
   if (!std::isfinite(body_min_rate_bytes_per_s) || body_min_rate_bytes_per_s < 1) {
-    std::ostringstream text;
-    text << "body_min_rate_bytes_per_s = " << body_min_rate_bytes_per_s << ": must be at least 1";
-    return fail(text.str());
+    return fail("body_min_rate_bytes_per_s = " + core::FormatNumber(body_min_rate_bytes_per_s) +
+                ": must be at least 1");
   }
   if (max_connections < 1) {
     return fail("max_connections = " + std::to_string(max_connections) + ": must be at least 1");
@@ -393,14 +395,12 @@ bool ServerConfig::IsValid(std::string* why) const {
     return fail("auth_token: must have at least 16 characters");
   }
   if (max_body_bytes < 1) return fail("max_body_bytes = 0: must be at least 1");
-  for (const auto& [name, value] : {std::pair{"header_timeout_s", header_timeout_s},
-                                    std::pair{"read_timeout_s", read_timeout_s},
-                                    std::pair{"write_timeout_s", write_timeout_s},
-                                    std::pair{"keep_alive_timeout_s", keep_alive_timeout_s}}) {
+  for (const auto& [name, value] :
+       {std::pair{"header_timeout_s", header_timeout_s},
+        std::pair{"read_timeout_s", read_timeout_s}, std::pair{"write_timeout_s", write_timeout_s},
+        std::pair{"keep_alive_timeout_s", keep_alive_timeout_s}}) {
     if (!std::isfinite(value) || value <= 0 || value > 3600) {
-      std::ostringstream text;
-      text << name << " = " << value << ": must be in (0, 3600]";
-      return fail(text.str());
+      return fail(std::string(name) + " = " + core::FormatNumber(value) + ": must be in (0, 3600]");
     }
   }
   if (std::string limits_why; !limits.IsValid(&limits_why)) return fail("limits." + limits_why);
@@ -410,9 +410,8 @@ bool ServerConfig::IsValid(std::string* why) const {
                 std::string(kNoJobsDb) + "\" for no persistence");
   }
   if (!std::isfinite(shutdown_grace_s) || shutdown_grace_s < 0 || shutdown_grace_s > 3600) {
-    std::ostringstream text;
-    text << "shutdown_grace_s = " << shutdown_grace_s << ": must be in [0, 3600]";
-    return fail(text.str());
+    return fail("shutdown_grace_s = " + core::FormatNumber(shutdown_grace_s) +
+                ": must be in [0, 3600]");
   }
   if (keep_alive_max_requests < 1) {
     return fail("keep_alive_max_requests = " + std::to_string(keep_alive_max_requests) +

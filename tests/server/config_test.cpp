@@ -49,8 +49,8 @@ TEST(ConfigTest, SolverLimitsFromFlagsAndEnvironment) {
 }
 
 TEST(ConfigTest, RequestCapsFromFlagsAndEnvironment) {
-  const auto parsed = Parse({"--max-curve-samples", "20000"},
-                            {{"SWEETSPOT_MAX_DESIGN_VARIABLES", "12"}});
+  const auto parsed =
+      Parse({"--max-curve-samples", "20000"}, {{"SWEETSPOT_MAX_DESIGN_VARIABLES", "12"}});
   ASSERT_EQ(parsed.error, "");
   EXPECT_EQ(parsed.config.limits.max_curve_samples, 20000u);
   EXPECT_EQ(parsed.config.limits.max_design_variables, 12u);
@@ -83,6 +83,10 @@ TEST(ConfigTest, IsValidRefusesOutOfRange) {
   config.read_timeout_s = -1;
   EXPECT_FALSE(config.IsValid(&why));
   EXPECT_EQ(why, "read_timeout_s = -1: must be in (0, 3600]");
+  // The value as given, every digit (an ostream's 6 digits wrote "3600" here).
+  config.read_timeout_s = 3600.0001;
+  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_EQ(why, "read_timeout_s = 3600.0001: must be in (0, 3600]");
 }
 
 TEST(ConfigTest, ServingLimitsFromFlagsAndEnvironment) {
