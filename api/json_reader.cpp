@@ -1,6 +1,7 @@
 #include "api/json_reader.hpp"
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "core/geometry_format.hpp"
@@ -169,30 +170,53 @@ std::string JoinPath(std::string_view parent, std::string_view key) {
 }
 
 std::string RequestName(std::string_view core_field) {
-  // Core's name (its head) -> the request's. Only where the two differ.
+  // Core's name -> the request's, only where the two differ. An entry ending in '.'
+  // renames a head (every field below it); any other renames that one field.
   struct Renamed {
     std::string_view core;
     std::string_view request;
   };
   constexpr Renamed kRenamed[] = {
       {"hertz.paper.", "hertz.paper_constants."},
+      {"flexible.impact.frequency_tolerance", "flexible.mode_frequency_tolerance"},
+      {"ball.stiffness", "ball.stiffness_n_m_p"},
   };
   for (const Renamed& r : kRenamed) {
-    if (core_field.substr(0, r.core.size()) == r.core) {
+    const bool head = r.core.back() == '.';
+    if (head ? core_field.substr(0, r.core.size()) == r.core : core_field == r.core) {
       return std::string(r.request) + std::string(core_field.substr(r.core.size()));
     }
   }
   return std::string(core_field);
 }
 
+namespace {
+
+// `refusal` in the request's names. A design's rule set ("rules.mlb-wood", core's name) is
+// an entry of the request's constraints.rules: the refusal quotes the set's name as its value.
+core::Refusal InRequestNames(const core::Refusal& refusal) {
+  core::Refusal out = refusal;
+  constexpr std::string_view kRules = "rules.";
+  const std::string_view field = refusal.field;
+  if (field.substr(0, kRules.size()) == kRules &&
+      field.find('.', kRules.size()) == std::string_view::npos && !refusal.QuotesValue()) {
+    out.field = "constraints.rules";
+    out.shown = "\"" + std::string(field.substr(kRules.size())) + "\"";
+    return out;
+  }
+  out.field = RequestName(refusal.field);
+  return out;
+}
+
+}  // namespace
+
 std::string RequestField(const core::Refusal& refusal, std::string_view prefix) {
-  return refusal.field.empty() ? std::string(prefix) : JoinPath(prefix, RequestName(refusal.field));
+  return refusal.field.empty() ? std::string(prefix)
+                               : JoinPath(prefix, InRequestNames(refusal).field);
 }
 
 std::string RequestMessage(const core::Refusal& refusal) {
-  core::Refusal renamed = refusal;
-  renamed.field = RequestName(refusal.field);
-  return renamed.Message();
+  return InRequestNames(refusal).Message();
 }
 
 bool CoreRefusal(const core::Refusal& refusal, const std::string& prefix, ApiError* error) {
@@ -255,9 +279,8 @@ const nlohmann::json* ObjectReader::Get(std::string_view key) {
 }
 
 bool ObjectReader::Fail(std::string_view key, const std::string& rule, ErrorCode code) {
-  const nlohmann::json* value = value_->is_object() && value_->contains(key)
-                                    ? &(*value_)[std::string(key)]
-                                    : nullptr;
+  const nlohmann::json* value =
+      value_->is_object() && value_->contains(key) ? &(*value_)[std::string(key)] : nullptr;
   return SetError(error_, code, PathOf(key), value, rule);
 }
 
@@ -301,6 +324,16 @@ bool ObjectReader::OptionalInteger(std::string_view key, long long min, long lon
   const double number = value->get<double>();
   if (!rule.Accepts(number)) return Fail(key, rule.Describe());
   *out = static_cast<long long>(number);
+  return true;
+}
+
+bool ObjectReader::OptionalInt(std::string_view key, int* out) {
+  long long value = *out;
+  if (!OptionalInteger(key, std::numeric_limits<int>::min(), std::numeric_limits<int>::max(),
+                       &value)) {
+    return false;
+  }
+  *out = static_cast<int>(value);
   return true;
 }
 

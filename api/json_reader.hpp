@@ -96,6 +96,9 @@ class ObjectReader {
   std::optional<double> MaybeNumber(std::string_view key, const NumberRule& rule);
   /// An optional integer in [min, max]; `*out` untouched when absent.
   bool OptionalInteger(std::string_view key, long long min, long long max, long long* out);
+  /// An optional integer that fits an int, for a field whose range core checks; `*out`
+  /// untouched when absent.
+  bool OptionalInt(std::string_view key, int* out);
   /// A required string; if `allowed` is non-empty it must be one of them.
   bool String(std::string_view key, std::string* out, const std::vector<std::string>& allowed = {});
   /// An optional string; `*out` untouched when absent.

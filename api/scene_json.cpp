@@ -12,21 +12,23 @@ namespace {
 
 using Json = nlohmann::json;
 
+// The ball's and the swing's numbers: their ranges are core's (core::Ball::Validate,
+// core::Swing::Validate), checked with the assembled scene.
 bool ReadBall(const Json& value, const std::string& path, core::Ball* ball, ApiError* error) {
   ObjectReader reader(value, path, error);
-  reader.OptionalNumber("mass_kg", Between(core::kMinBallMassKg, 1e3), &ball->mass_kg);
-  reader.OptionalNumber("radius_m", Between(core::kMinBallRadiusM, 10.0), &ball->radius_m);
-  reader.OptionalNumber("speed_mps", NonNegative(1e3), &ball->speed_mps);
-  reader.OptionalNumber("stiffness_n_m_p", Positive(1e15), &ball->stiffness);
-  reader.OptionalNumber("stiffness_exponent", Between(1.0, 3.0), &ball->stiffness_exponent);
+  reader.OptionalNumber("mass_kg", AnyNumber(), &ball->mass_kg);
+  reader.OptionalNumber("radius_m", AnyNumber(), &ball->radius_m);
+  reader.OptionalNumber("speed_mps", AnyNumber(), &ball->speed_mps);
+  reader.OptionalNumber("stiffness_n_m_p", AnyNumber(), &ball->stiffness);
+  reader.OptionalNumber("stiffness_exponent", AnyNumber(), &ball->stiffness_exponent);
   return reader.Finish();
 }
 
 bool ReadSwing(const Json& value, const std::string& path, core::Swing* swing, ApiError* error) {
   ObjectReader reader(value, path, error);
-  reader.OptionalNumber("angular_speed_rad_s", NonNegative(1e4), &swing->angular_speed_rad_s);
-  reader.OptionalNumber("pivot_from_knob_m", Between(-100.0, 100.0), &swing->pivot_from_knob_m);
-  reader.OptionalNumber("hands_from_knob_m", Between(-100.0, 100.0), &swing->hands_from_knob_m);
+  reader.OptionalNumber("angular_speed_rad_s", AnyNumber(), &swing->angular_speed_rad_s);
+  reader.OptionalNumber("pivot_from_knob_m", AnyNumber(), &swing->pivot_from_knob_m);
+  reader.OptionalNumber("hands_from_knob_m", AnyNumber(), &swing->hands_from_knob_m);
   return reader.Finish();
 }
 
@@ -95,39 +97,37 @@ void ClampToLimits(const ApiLimits& limits, core::SceneOptions* options) {
 
 bool ReadFlexibleOptions(const Json& value, const std::string& path, const ApiLimits& limits,
                          core::FlexibleOptions* options, ApiError* error) {
+  // Types only: the ranges are core's (core::FlexibleOptions::Validate, run by
+  // ReadSceneOptions), except max_steps, whose bound is configuration.
   ObjectReader reader(value, path, error);
   std::string theory = core::BeamTheoryName(options->theory);
   reader.OptionalString("theory", &theory, {"timoshenko", "euler_bernoulli"});
   options->theory = core::ParseBeamTheory(theory).value_or(core::BeamTheory::kTimoshenko);
-  reader.OptionalNumber("frequency_tolerance", Between(1e-9, 0.1), &options->frequency_tolerance);
-  long long max_elements = options->max_elements;
-  reader.OptionalInteger("max_elements", 2, 4096, &max_elements);
-  options->max_elements = static_cast<int>(max_elements);
+  reader.OptionalNumber("frequency_tolerance", AnyNumber(), &options->frequency_tolerance);
+  reader.OptionalInt("max_elements", &options->max_elements);
   core::FlexibleImpactOptions& impact = options->impact;
-  long long max_modes = impact.max_modes;
-  reader.OptionalInteger("max_modes", 1, 50, &max_modes);
-  impact.max_modes = static_cast<int>(max_modes);
-  reader.OptionalNumber("mode_frequency_tolerance", Between(1e-9, 0.1),
-                        &impact.frequency_tolerance);
-  reader.OptionalNumber("cutoff_factor", Between(1.0, 1000.0), &impact.cutoff_factor);
+  reader.OptionalInt("max_modes", &impact.max_modes);
+  reader.OptionalNumber("mode_frequency_tolerance", AnyNumber(), &impact.frequency_tolerance);
+  reader.OptionalNumber("cutoff_factor", AnyNumber(), &impact.cutoff_factor);
   reader.OptionalBool("static_correction", &impact.static_correction);
-  reader.OptionalNumber("relative_tolerance", Between(1e-13, 1e-2), &impact.relative_tolerance);
+  reader.OptionalNumber("relative_tolerance", AnyNumber(), &impact.relative_tolerance);
   ClampToLimits(limits, options);
   long long max_steps = impact.max_steps;
   reader.OptionalInteger("max_steps", 10, limits.max_integration_steps, &max_steps);
   impact.max_steps = static_cast<int>(max_steps);
-  long long max_contacts = impact.max_contacts;
-  reader.OptionalInteger("max_contacts", 1, 1000, &max_contacts);
-  impact.max_contacts = static_cast<int>(max_contacts);
+  reader.OptionalInt("max_contacts", &impact.max_contacts);
   reader.OptionalBool("refine_check", &impact.refine_check);
-  reader.OptionalNumber("hands_grip_length_m", Between(0.0, 10.0), &impact.hands_grip_length_m);
-  reader.OptionalNumber("sting_window_s", Between(0.0, 1.0), &impact.sting_window_s);
-  long long sting_samples = options->sting_samples;
-  reader.OptionalInteger("sting_samples", 3, 1001, &sting_samples);
-  options->sting_samples = static_cast<int>(sting_samples);
-  reader.OptionalNumber("sting_zone_fraction", NumberRule{0.0, 1.0, true, false, false},
-                        &options->sting_zone_fraction);
-  return reader.Finish();
+  reader.OptionalNumber("hands_grip_length_m", AnyNumber(), &impact.hands_grip_length_m);
+  reader.OptionalNumber("sting_window_s", AnyNumber(), &impact.sting_window_s);
+  reader.OptionalInt("sting_samples", &options->sting_samples);
+  reader.OptionalNumber("sting_zone_fraction", AnyNumber(), &options->sting_zone_fraction);
+  if (!reader.Finish()) return false;
+  // Core names the fields from "flexible." on: the refusal goes under this object's parent
+  // ("options" of "options.flexible"; "" of a top-level "flexible").
+  core::Refusal refusal;
+  if (options->Validate(&refusal)) return true;
+  const std::size_t dot = path.rfind('.');
+  return CoreRefusal(refusal, dot == std::string::npos ? "" : path.substr(0, dot), error);
 }
 
 bool ReadHertzOptions(const Json& value, const std::string& path, const ApiLimits& limits,
@@ -204,13 +204,13 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
     return reader.Fail("sweet_zone_tolerance_percent",
                        "cannot be given with sweet_zone_tolerance_mps (choose one unit)");
   }
+  // Its range is core's (SceneOptions::Validate), which names it by its unit too.
   if (has_percent) {
-    reader.OptionalNumber("sweet_zone_tolerance_percent", NonNegative(100.0),
+    reader.OptionalNumber("sweet_zone_tolerance_percent", AnyNumber(),
                           &options->sweet_zone_tolerance);
     options->sweet_zone_unit = core::ToleranceUnit::kPercent;
   } else {
-    reader.OptionalNumber("sweet_zone_tolerance_mps", NonNegative(1e3),
-                          &options->sweet_zone_tolerance);
+    reader.OptionalNumber("sweet_zone_tolerance_mps", AnyNumber(), &options->sweet_zone_tolerance);
   }
   const double max_samples = static_cast<double>(options->max_curve_points);
   long long samples = options->curve_samples;

@@ -27,14 +27,14 @@ bool ReadOutputs(ObjectReader& reader, core::Scene* scene);
 bool ReadSceneOptions(ObjectReader& reader, const ApiLimits& limits, core::SceneOptions* options);
 
 /// Reads a "flexible" options object at `path` (the flexible beam: theory, tolerances, modes,
-/// the impact's integrator and the sting settings; see docs/models.md).
+/// the impact's integrator and the sting settings; see docs/models.md) and checks it with
+/// core's rules. `path` ends in "flexible" ("options.flexible" or "flexible").
 bool ReadFlexibleOptions(const nlohmann::json& value, const std::string& path,
-                         const ApiLimits& limits, core::FlexibleOptions* options,
-                         ApiError* error);
+                         const ApiLimits& limits, core::FlexibleOptions* options, ApiError* error);
 
 /// Reads a "hertz" options object at `path`.
-bool ReadHertzOptions(const nlohmann::json& value, const std::string& path,
-                      const ApiLimits& limits, core::HertzOptions* options, ApiError* error);
+bool ReadHertzOptions(const nlohmann::json& value, const std::string& path, const ApiLimits& limits,
+                      core::HertzOptions* options, ApiError* error);
 
 /// Lowers the defaults of `options` (solver time, evaluations, integration steps)
 /// to the configured limits, so a default never exceeds what a request may ask for.

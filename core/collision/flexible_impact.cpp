@@ -195,7 +195,7 @@ bool FlexibleImpactOptions::Validate(Refusal* why) const {
     return Refuse(why, IntegerRefusal("flexible.max_modes", max_modes, "must be in [1, 50]"));
   if (!(std::isfinite(frequency_tolerance) && frequency_tolerance >= 1e-9 &&
         frequency_tolerance <= 0.1))
-    return Refuse(why, Number17Refusal("flexible.frequency_tolerance", frequency_tolerance,
+    return Refuse(why, Number17Refusal("flexible.impact.frequency_tolerance", frequency_tolerance,
                                        "must be in [1e-9, 0.1]"));
   if (!(std::isfinite(cutoff_factor) && cutoff_factor >= 1.0 && cutoff_factor <= 1000.0))
     return Refuse(why,

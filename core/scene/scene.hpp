@@ -31,13 +31,26 @@ inline constexpr double kDefaultBallStiffnessExponent = 1.5;
 inline constexpr double kMinBallMassKg = 1e-6;
 /// Smallest ball radius a scene accepts, m (1 µm).
 inline constexpr double kMinBallRadiusM = 1e-6;
+/// Largest ball mass a scene accepts, kg.
+inline constexpr double kMaxBallMassKg = 1e3;
+/// Largest ball radius a scene accepts, m.
+inline constexpr double kMaxBallRadiusM = 10.0;
+/// Largest incoming ball speed a scene accepts, m/s.
+inline constexpr double kMaxBallSpeedMps = 1e3;
+/// Largest ball stiffness k a scene accepts, N/m^p.
+inline constexpr double kMaxBallStiffness = 1e15;
+/// Largest swing angular speed a scene accepts, rad/s.
+inline constexpr double kMaxSwingAngularSpeedRadS = 1e4;
+/// Largest distance of the pivot or the hands from the knob a scene accepts, m (either side).
+inline constexpr double kMaxSwingOffsetM = 100.0;
 
 /// The ball. Defaults: a regulation baseball and the paper's Table 3 speed.
 struct Ball {
-  double mass_kg = 0.145;                    ///< Mass, kg (>= kMinBallMassKg).
-  double radius_m = 0.0366;                  ///< Radius, m (>= kMinBallRadiusM).
-  double speed_mps = 27.7;                   ///< Incoming speed towards the bat, m/s (>= 0).
-  double stiffness = kDefaultBallStiffness;  ///< Contact models: k in F = k delta^p, N/m^p (> 0).
+  double mass_kg = 0.145;    ///< Mass, kg, in [kMinBallMassKg, kMaxBallMassKg].
+  double radius_m = 0.0366;  ///< Radius, m, in [kMinBallRadiusM, kMaxBallRadiusM].
+  double speed_mps = 27.7;   ///< Incoming speed towards the bat, m/s, in [0, kMaxBallSpeedMps].
+  /// Contact models: k in F = k delta^p, N/m^p, in (0, kMaxBallStiffness].
+  double stiffness = kDefaultBallStiffness;
   double stiffness_exponent = kDefaultBallStiffnessExponent;  ///< Contact models: p, in [1, 3].
 
   /// True when every field is in range; otherwise "ball.field = value: rule" in *why.
@@ -48,8 +61,10 @@ struct Ball {
 
 /// The swing just before impact. Defaults: the paper's Table 3 and the standard grip.
 struct Swing {
-  double angular_speed_rad_s = 17.288;  ///< Angular speed about the pivot, rad/s (>= 0).
-  double pivot_from_knob_m = 0.0;     ///< The pivot, m from the knob (negative = behind the knob).
+  /// Angular speed about the pivot, rad/s, in [0, kMaxSwingAngularSpeedRadS].
+  double angular_speed_rad_s = 17.288;
+  /// The pivot, m from the knob (negative = behind the knob), within ±kMaxSwingOffsetM.
+  double pivot_from_knob_m = 0.0;
   double hands_from_knob_m = 0.1524;  ///< The hands, m from the knob (within the bat).
 
   /// True when every field is finite and in range; otherwise "swing.field = value: rule".
@@ -132,8 +147,9 @@ struct SceneOptions {
   CollisionModel model =
       CollisionModel::kRigidPivot;  ///< Exit-speed model for max/zone/curve (kAuto = rigid_pivot).
   SweetSpotMethod method = SweetSpotMethod::kClosedForm;  ///< Closed form or NLopt.
-  ScalarSearchOptions nlopt;          ///< The NLopt search (algorithm, tolerances, budget).
-  double sweet_zone_tolerance = 1.0;  ///< Sweet-zone tolerance (>= 0), in `sweet_zone_unit`.
+  ScalarSearchOptions nlopt;  ///< The NLopt search (algorithm, tolerances, budget).
+  /// Sweet-zone tolerance in `sweet_zone_unit`: [0, 1000] m/s or [0, 100] percent.
+  double sweet_zone_tolerance = 1.0;
   ToleranceUnit sweet_zone_unit = ToleranceUnit::kMetersPerSecond;  ///< m/s or percent.
   int curve_samples = 41;  ///< Evenly spaced curve samples from knob to tip (2..max_curve_points).
   std::vector<double> curve_positions_from_knob_m;  ///< Explicit curve positions, m (overrides
@@ -141,7 +157,7 @@ struct SceneOptions {
   /// The most curve points (curve_samples or explicit positions) a scene may
   /// ask for (>= 2); the api sets it from its configured max_curve_samples.
   int max_curve_points = 10000;
-  HertzOptions hertz;                               ///< Contact-model settings (model = kHertz).
+  HertzOptions hertz;        ///< Contact-model settings (model = kHertz).
   FlexibleOptions flexible;  ///< Flexible-beam settings (vibration_node, flexible, sting).
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.

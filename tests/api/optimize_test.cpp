@@ -123,6 +123,10 @@ TEST(OptimizeEndpointTest, InvalidRequestsAreNamed) {
   r = Post("/v1/optimize", body);
   EXPECT_EQ(r.status, 400) << r.body.dump();
   EXPECT_NE(r.body["message"].get<std::string>().find("mlb-wood"), std::string::npos);
+  // The field is where the request names the rule set, and the message quotes the set.
+  EXPECT_EQ(r.body["field"], "constraints.rules");
+  EXPECT_EQ(r.body["message"].get<std::string>().rfind("constraints.rules = \"mlb-wood\": ", 0), 0u)
+      << r.body.dump();
 }
 
 // min_sting: the hands' vibration energy (J) of an impact at the rigid sweet spot, minimised by
@@ -201,7 +205,8 @@ TEST(OptimizeEndpointTest, MinStingStopsAtTheTimeBudgetWithTheBestDesign) {
 
 TEST(OptimizeEndpointTest, MaterialChoiceSolvesEachAndPicksTheBest) {
   Json body = ContractExample();
-  body["variables"].push_back({{"path", "material"}, {"choices", {"ash", "hard-maple", "yellow-birch"}}});
+  body["variables"].push_back(
+      {{"path", "material"}, {"choices", {"ash", "hard-maple", "yellow-birch"}}});
   body["options"]["starts"] = 1;
   const Response r = Post("/v1/optimize", body);
   ASSERT_EQ(r.status, 200) << r.body.dump();

@@ -53,11 +53,32 @@ TEST(RefusalMappingTest, TheTableRenamesCoreFieldsTheRequestNamesOtherwise) {
   EXPECT_EQ(RequestName("hertz.paper.k3"), "hertz.paper_constants.k3");
   EXPECT_EQ(RequestName("hertz.hands_stiffness_n_m"), "hertz.hands_stiffness_n_m");
   EXPECT_EQ(RequestName("ball.mass_kg"), "ball.mass_kg");
+  // A field entry renames that field only: the exponent keeps its name.
+  EXPECT_EQ(RequestName("ball.stiffness"), "ball.stiffness_n_m_p");
+  EXPECT_EQ(RequestName("ball.stiffness_exponent"), "ball.stiffness_exponent");
+  EXPECT_EQ(RequestName("flexible.impact.frequency_tolerance"),
+            "flexible.mode_frequency_tolerance");
+  EXPECT_EQ(RequestName("flexible.frequency_tolerance"), "flexible.frequency_tolerance");
   ApiError error;
   CoreRefusal(core::Number17Refusal("hertz.paper.k3", -1, "must be in [0, 1e20]"), "options",
               &error);
   EXPECT_EQ(error.field, "options.hertz.paper_constants.k3");
   EXPECT_EQ(error.message, "options.hertz.paper_constants.k3 = -1: must be in [0, 1e20]");
+}
+
+TEST(RefusalMappingTest, ARuleSetIsAnEntryOfTheRequestsConstraintsRules) {
+  // core::RuleAllowsDesign names the rule set ("rules.mlb-wood"), which is no request path.
+  ApiError error;
+  CoreRefusal(core::TextRefusal("rules.mlb-wood",
+                                "one piece of solid wood: wall_thickness_m = 0.003 makes a "
+                                "hollow shell"),
+              "", &error);
+  EXPECT_EQ(error.field, "constraints.rules");
+  EXPECT_EQ(error.message,
+            "constraints.rules = \"mlb-wood\": one piece of solid wood: wall_thickness_m = 0.003 "
+            "makes a hollow shell");
+  // A limit of a rule set is a constraint's name, not a refusal field: left as it is.
+  EXPECT_EQ(RequestField(core::TextRefusal("rules.bbcor.drop", "x"), ""), "rules.bbcor.drop");
 }
 
 TEST(RefusalMappingTest, SceneFieldsAreTheSceneHeads) {

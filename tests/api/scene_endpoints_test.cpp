@@ -94,9 +94,8 @@ TEST(SweetSpotEndpointTest, VibrationNodeHasPositionAndFrequency) {
 
 TEST(SweetSpotEndpointTest, OutputsWithoutAnImpactNeedNoCor) {
   // paper-wood's shape and material numbers as a custom material: it has no default COR.
-  const std::string custom_bat =
-      R"({"preset": "paper-wood", "material": {"density_kg_m3": 649, )"
-      R"("youngs_modulus_pa": 1.814e10, "poissons_ratio": 0.25}})";
+  const std::string custom_bat = R"({"preset": "paper-wood", "material": {"density_kg_m3": 649, )"
+                                 R"("youngs_modulus_pa": 1.814e10, "poissons_ratio": 0.25}})";
   const Response r = Post("/v1/sweet-spot", R"({"bat": )" + custom_bat +
                                                 R"(, "outputs": ["center_of_percussion", )"
                                                 R"("vibration_node"]})");
@@ -171,7 +170,21 @@ TEST(SweetSpotEndpointTest, RefusalsNameTheField) {
       {R"({"bat": {"preset": "paper-wood"}, "outputs": ["best"]})", "outputs",
        "outputs = [\"best\"]: outputs[0] = \"best\" is not one of"},
       {R"({"bat": {"preset": "paper-wood"}, "ball": {"mass_kg": 0}})", "ball.mass_kg",
-       "ball.mass_kg = 0: must be a number in [1e-06, 1000]"},
+       "ball.mass_kg = 0: must be in [1e-06, 1000]"},
+      // Ranges are core's; its names are mapped back to the request's.
+      {R"({"bat": {"preset": "paper-wood"}, "ball": {"stiffness_n_m_p": 1e20}})",
+       "ball.stiffness_n_m_p", "ball.stiffness_n_m_p = 1e+20: must be in (0, 1e+15]"},
+      {R"({"bat": {"preset": "paper-wood"}, "swing": {"pivot_from_knob_m": -101}})",
+       "swing.pivot_from_knob_m", "swing.pivot_from_knob_m = -101: must be in [-100, 100]"},
+      {R"({"bat": {"preset": "paper-wood"}, "options": {"sweet_zone_tolerance_percent": 150}})",
+       "options.sweet_zone_tolerance_percent",
+       "options.sweet_zone_tolerance_percent = 150: must be in [0, 100]"},
+      {R"({"bat": {"preset": "paper-wood"},
+           "options": {"flexible": {"mode_frequency_tolerance": 0.5}}})",
+       "options.flexible.mode_frequency_tolerance",
+       "options.flexible.mode_frequency_tolerance = 0.5: must be in [1e-9, 0.1]"},
+      {R"({"bat": {"preset": "paper-wood"}, "options": {"flexible": {"max_modes": 2.5}}})",
+       "options.flexible.max_modes", "options.flexible.max_modes = 2.5: must be an integer"},
       {R"({"bat": {"preset": "paper-wood"}, "ball": {"speed": 3}})", "ball.speed",
        "ball.speed is not a known field"},
       {R"({"bat": {"preset": "paper-wood"}, "cor": 1.5})", "cor",
@@ -187,8 +200,7 @@ TEST(SweetSpotEndpointTest, RefusalsNameTheField) {
     const Response r = Post("/v1/sweet-spot", c.body);
     EXPECT_EQ(r.status, 400) << c.body;
     EXPECT_EQ(r.body["field"], c.field) << r.body.dump();
-    EXPECT_EQ(r.body["message"].get<std::string>().rfind(c.message_start, 0), 0u)
-        << r.body.dump();
+    EXPECT_EQ(r.body["message"].get<std::string>().rfind(c.message_start, 0), 0u) << r.body.dump();
   }
 }
 
@@ -226,8 +238,8 @@ TEST(CollisionEndpointTest, AutoWithContactDetailsPicksHertz) {
 }
 
 TEST(CollisionEndpointTest, ImpactOffTheBatIsRefusedAndFlexibleRuns) {
-  const Response off = Post("/v1/collision",
-                            R"({"bat": {"preset": "paper-wood"}, "impact_from_knob_m": 0.9})");
+  const Response off =
+      Post("/v1/collision", R"({"bat": {"preset": "paper-wood"}, "impact_from_knob_m": 0.9})");
   EXPECT_EQ(off.status, 400);
   EXPECT_EQ(off.body["message"], "impact_from_knob_m = 0.9: must be a number in [0, 0.855]");
   const Response flexible = Post("/v1/collision", R"({"bat": {"preset": "paper-wood"},
@@ -304,8 +316,8 @@ TEST(CompareEndpointTest, TooManyVariantsIs413) {
   for (int i = 0; i < 65; ++i) {
     variants += (i ? "," : "") + std::string(R"({"name": "v", "bat": {"preset": "paper-wood"}})");
   }
-  const Response r = Post("/v1/compare",
-                          R"({"baseline": {"preset": "paper-wood"}, "variants": [)" + variants + "]}");
+  const Response r = Post(
+      "/v1/compare", R"({"baseline": {"preset": "paper-wood"}, "variants": [)" + variants + "]}");
   EXPECT_EQ(r.status, 413);
   EXPECT_EQ(r.body["code"], "TooBig");
   EXPECT_EQ(r.body["field"], "variants");
@@ -333,8 +345,7 @@ TEST(FitEndpointTest, AttainableTargetsConvergeAndTheBatRoundTrips) {
   EXPECT_LT(std::abs(r.body["residuals"]["mass_kg"].get<double>()), 1e-9 * 0.95);
   EXPECT_LT(std::abs(r.body["residuals"]["balance_point_m"].get<double>()), 1e-9 * 0.60);
   // The fitted bat, sent back to /v1/bat/properties, has the target properties.
-  const Response again =
-      Post("/v1/bat/properties", nlohmann::json{{"bat", r.body["bat"]}}.dump());
+  const Response again = Post("/v1/bat/properties", nlohmann::json{{"bat", r.body["bat"]}}.dump());
   ASSERT_EQ(again.status, 200) << again.body.dump();
   EXPECT_NEAR(again.body["mass_kg"].get<double>(), 0.95, 1e-8);
   EXPECT_NEAR(again.body["balance_point_m"].get<double>(), 0.60, 1e-8);

@@ -269,11 +269,11 @@ TEST(HardCases, NonFiniteInputsAreRefusedWithTheirName) {
   s.ball.speed_mps = std::numeric_limits<double>::quiet_NaN();
   const SceneResult r = EvaluateScene(s, SceneOptions{});
   EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
-  EXPECT_EQ(r.summary.message, "ball.speed_mps = nan: must be >= 0");
+  EXPECT_EQ(r.summary.message, "ball.speed_mps = nan: must be in [0, 1000]");
   s = PaperWood();
   s.swing.angular_speed_rad_s = std::numeric_limits<double>::infinity();
   EXPECT_EQ(EvaluateScene(s, SceneOptions{}).summary.message,
-            "swing.angular_speed_rad_s = inf: must be >= 0");
+            "swing.angular_speed_rad_s = inf: must be in [0, 10000]");
 }
 
 }  // namespace

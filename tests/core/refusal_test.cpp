@@ -83,7 +83,7 @@ TEST(RefusalTest, SceneRefusalsKeepTheirNumberFormats) {
   Refusal r = RefusalOf(scene);
   EXPECT_EQ(r.field, "ball.speed_mps");
   EXPECT_EQ(r.value, -0.1);
-  EXPECT_EQ(r.Message(), "ball.speed_mps = -0.10000000000000001: must be >= 0");
+  EXPECT_EQ(r.Message(), "ball.speed_mps = -0.10000000000000001: must be in [0, 1000]");
 
   scene = Scene{};
   r = RefusalOf(scene);  // no bat: a refusal that quotes no value

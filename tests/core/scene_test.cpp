@@ -48,7 +48,7 @@ TEST(SceneValidation, ExactMessages) {
   s = PaperWood();
   s.ball.speed_mps = -3;
   EXPECT_FALSE(s.IsValid(&why));
-  EXPECT_EQ(why, "ball.speed_mps = -3: must be >= 0");
+  EXPECT_EQ(why, "ball.speed_mps = -3: must be in [0, 1000]");
   s = PaperWood();
   s.cor = 1.5;
   EXPECT_FALSE(s.IsValid(&why));
@@ -68,7 +68,11 @@ TEST(SceneValidation, ExactMessages) {
   o = SceneOptions{};
   o.sweet_zone_tolerance = -1;
   EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_EQ(why, "sweet_zone_tolerance = -1: must be >= 0");
+  EXPECT_EQ(why, "sweet_zone_tolerance_mps = -1: must be in [0, 1000]");
+  o.sweet_zone_unit = ToleranceUnit::kPercent;  // named by its unit, as in a request
+  o.sweet_zone_tolerance = 100.5;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_EQ(why, "sweet_zone_tolerance_percent = 100.5: must be in [0, 100]");
   o = SceneOptions{};
   o.nlopt.x_tolerance_m = 0;
   EXPECT_FALSE(o.IsValid(&why));

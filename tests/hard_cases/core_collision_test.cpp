@@ -428,14 +428,14 @@ std::vector<CoreCase> SceneCases() {
          return FromSummary(core::Collide(s, 0.7, core::CollisionModel::kFreeBat).summary, kNaN);
        },
        Refused("invalid_input",
-               "ball.mass_kg = 4.9406564584124654e-324: must be finite and >= 1e-06")},
+               "ball.mass_kg = 4.9406564584124654e-324: must be in [1e-06, 1000]")},
       {"ZeroBallRadiusIsRefused",
        [] {
          core::Scene s = PaperWood();
          s.ball.radius_m = 0.0;
          return FromSummary(core::Collide(s, 0.7, core::CollisionModel::kHertz).summary, kNaN);
        },
-       Refused("invalid_input", "ball.radius_m = 0: must be finite and >= 1e-06")},
+       Refused("invalid_input", "ball.radius_m = 0: must be in [1e-06, 10]")},
   };
 }
 
