@@ -3,7 +3,6 @@
 // of the same name would collide with its neighbours'.
 #pragma once
 
-#include "core/numerics/limits.hpp"
 #include <limits>
 
 namespace sweetspot::core {

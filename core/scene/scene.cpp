@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/geometry_format.hpp"
 #include "core/refusal.hpp"
 
 namespace sweetspot::core {
@@ -12,9 +13,12 @@ bool Refuse17(Refusal* out, std::string_view field, double value, std::string_vi
   return out == nullptr ? false : Refuse(out, Number17Refusal(field, value, rule));
 }
 
-// True when `value` is finite and in [lo, hi].
-bool InRange(double value, double lo, double hi) {
-  return std::isfinite(value) && value >= lo && value <= hi;
+// True when `value` is finite and in [lo, hi]; otherwise the refusal of `field` with the
+// rule "must be in [lo, hi]", written from the bounds themselves.
+bool CheckRange(Refusal* out, std::string_view field, double value, double lo, double hi) {
+  if (std::isfinite(value) && value >= lo && value <= hi) return true;
+  return Refuse17(out, field, value,
+                  "must be in [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
 }
 
 }  // namespace
@@ -26,14 +30,12 @@ bool Ball::IsValid(std::string* why) const {
 bool Ball::Validate(Refusal* why) const {
   // Floors of 1 mg and 1 µm: smaller values are not balls, and a subnormal
   // mass made 1/m infinite in the free-bat and Hertz models (found by fuzzing).
-  if (!InRange(mass_kg, kMinBallMassKg, kMaxBallMassKg))
-    return Refuse17(why, "ball.mass_kg", mass_kg, "must be in [1e-06, 1000]");
-  if (!InRange(radius_m, kMinBallRadiusM, kMaxBallRadiusM))
-    return Refuse17(why, "ball.radius_m", radius_m, "must be in [1e-06, 10]");
-  if (!InRange(speed_mps, 0.0, kMaxBallSpeedMps))
-    return Refuse17(why, "ball.speed_mps", speed_mps, "must be in [0, 1000]");
+  if (!CheckRange(why, "ball.mass_kg", mass_kg, kMinBallMassKg, kMaxBallMassKg)) return false;
+  if (!CheckRange(why, "ball.radius_m", radius_m, kMinBallRadiusM, kMaxBallRadiusM)) return false;
+  if (!CheckRange(why, "ball.speed_mps", speed_mps, 0.0, kMaxBallSpeedMps)) return false;
   if (!(std::isfinite(stiffness) && stiffness > 0.0 && stiffness <= kMaxBallStiffness))
-    return Refuse17(why, "ball.stiffness", stiffness, "must be in (0, 1e+15]");
+    return Refuse17(why, "ball.stiffness", stiffness,
+                    "must be in (0, " + FormatNumber(kMaxBallStiffness) + "]");
   if (!(std::isfinite(stiffness_exponent) && stiffness_exponent >= 1.0 &&
         stiffness_exponent <= 3.0))
     return Refuse17(why, "ball.stiffness_exponent", stiffness_exponent, "must be in [1, 3]");
@@ -45,13 +47,12 @@ bool Swing::IsValid(std::string* why) const {
 }
 
 bool Swing::Validate(Refusal* why) const {
-  if (!InRange(angular_speed_rad_s, 0.0, kMaxSwingAngularSpeedRadS))
-    return Refuse17(why, "swing.angular_speed_rad_s", angular_speed_rad_s, "must be in [0, 10000]");
-  if (!InRange(pivot_from_knob_m, -kMaxSwingOffsetM, kMaxSwingOffsetM))
-    return Refuse17(why, "swing.pivot_from_knob_m", pivot_from_knob_m, "must be in [-100, 100]");
-  if (!InRange(hands_from_knob_m, -kMaxSwingOffsetM, kMaxSwingOffsetM))
-    return Refuse17(why, "swing.hands_from_knob_m", hands_from_knob_m, "must be in [-100, 100]");
-  return true;
+  return CheckRange(why, "swing.angular_speed_rad_s", angular_speed_rad_s, 0.0,
+                    kMaxSwingAngularSpeedRadS) &&
+         CheckRange(why, "swing.pivot_from_knob_m", pivot_from_knob_m, -kMaxSwingOffsetM,
+                    kMaxSwingOffsetM) &&
+         CheckRange(why, "swing.hands_from_knob_m", hands_from_knob_m, -kMaxSwingOffsetM,
+                    kMaxSwingOffsetM);
 }
 
 bool Scene::IsValid(std::string* why) const {
@@ -99,13 +100,10 @@ bool SceneOptions::IsValid(std::string* why) const {
 bool SceneOptions::Validate(Refusal* why) const {
   if (!nlopt.Validate(why)) return false;
   // Named by its unit, as a request names it.
-  if (sweet_zone_unit == ToleranceUnit::kPercent) {
-    if (!InRange(sweet_zone_tolerance, 0.0, 100.0))
-      return Refuse17(why, "sweet_zone_tolerance_percent", sweet_zone_tolerance,
-                      "must be in [0, 100]");
-  } else if (!InRange(sweet_zone_tolerance, 0.0, 1e3)) {
-    return Refuse17(why, "sweet_zone_tolerance_mps", sweet_zone_tolerance, "must be in [0, 1000]");
-  }
+  const bool percent = sweet_zone_unit == ToleranceUnit::kPercent;
+  if (!CheckRange(why, percent ? "sweet_zone_tolerance_percent" : "sweet_zone_tolerance_mps",
+                  sweet_zone_tolerance, 0.0, percent ? 100.0 : 1e3))
+    return false;
   if (max_curve_points < 2)
     return Refuse(why, IntegerRefusal("max_curve_points", max_curve_points, "must be >= 2"));
   if (curve_positions_from_knob_m.empty() &&
