@@ -6,10 +6,10 @@
 # the reports are in build-tsan/tsan-logs/.
 #
 # Clang, as for the ASan build: the same TSan build took 238 CPU-seconds with
-# Clang 14 against 385 with GCC 12 (README "Build times"). Only server_tests: every
-# concurrency test of the api has its HTTP twin there, run by the server's own threads
-# (ServerLimitsTest.ConcurrentOptimisationsAllAgree is OptimizeEndpointTest's), so
-# api_tests is not built a third time for the one test this filter selected in it.
+# Clang 14 against 385 with GCC 12 (README "Build times"). Only server_tests: the one
+# concurrency test api_tests had (concurrent /v1/optimize solves) moved there as
+# ServerLimitsTest.ConcurrentOptimisationsAllAgree, run by the server's own threads, so
+# api_tests is not built a third time.
 #
 #   SWEETSPOT_TSAN_FILTER='Job*'   gtest filter (default below)
 #   SWEETSPOT_JOBS=N               build parallelism (default: nproc)

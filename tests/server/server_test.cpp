@@ -270,8 +270,9 @@ TEST(ServerLimitsTest, ConcurrentSweetSpotRequestsAllAgree) {
 TEST(ServerLimitsTest, ConcurrentOptimisationsAllAgree) {
   // Ipopt 3.11 + MUMPS is not thread-safe: core serialises every Ipopt solve under one lock
   // (pitfalls.md). Eight keep-alive clients posting /v1/optimize at once, each request on its
-  // own server thread, must all get the answer of the first, bit for bit. This is the
-  // ThreadSanitizer pass's check of that lock (scripts/tsan.sh runs server_tests only).
+  // own server thread, must all get the answer of the first, bit for bit. The one test of that
+  // lock through the api (it was OptimizeEndpointTest's, in-process), and the ThreadSanitizer
+  // pass's check of it (scripts/tsan.sh runs server_tests only).
   ServerConfig config;
   config.port = 0;
   config.threads = 8;
