@@ -156,11 +156,10 @@ class DesignTnlp : public Ipopt::TNLP {
         }
         return true;
       }
-      Eigen::MatrixXd h;
-      if (!nlp_.Hessian(x, obj_factor, lambda, &h)) return false;
+      if (!nlp_.Hessian(x, obj_factor, lambda, &hessian_)) return false;
       Index e = 0;
       for (Index i = 0; i < n; ++i) {
-        for (Index j = 0; j <= i; ++j) values[e++] = h(i, j);
+        for (Index j = 0; j <= i; ++j) values[e++] = hessian_(i, j);
       }
       return true;
     } catch (...) {
@@ -207,6 +206,7 @@ class DesignTnlp : public Ipopt::TNLP {
   std::vector<double> s0_;
   const LocalSolveSettings& settings_;
   LocalSolveOutcome* out_;
+  Eigen::MatrixXd hessian_;  // eval_h's scratch, kept between calls (no allocation per call)
 };
 
 // Counts the errors in the derivative checker's output ("Derivative checker detected 3
@@ -242,6 +242,15 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
                    "hessian_approximation",
                    settings.hessian == HessianMode::kExact ? "exact" : "limited-memory");
     ok = ok && options->SetStringValue("mu_strategy", "adaptive");
+    // Less work that is not the solve (bench/ipopt_phases.sh; docs/benchmarks.md, "Ipopt's
+    // overhead"). The probing oracle picks the adaptive barrier parameter from one affine
+    // step; the default quality-function oracle runs a golden-section search per iteration
+    // whose every trial Ipopt 3.11 times with getrusage (three fifths of a 16-knot solve).
+    // MUMPS's workspace is its estimate plus 10 % instead of plus 1000 %: that allocation,
+    // its page faults and its release came every factorisation. When MUMPS needs more, it
+    // says so and Ipopt raises the percentage and factorises again.
+    ok = ok && options->SetStringValue("mu_oracle", "probing");
+    ok = ok && options->SetIntegerValue("mumps_mem_percent", 10);
     // No relaxation of the bounds: a design at a bound (a variable or a constraint) then meets
     // it to round-off, not to 1e-8 of its scale (Ipopt's default relaxes both).
     ok = ok && options->SetNumericValue("bound_relax_factor", 0.0);
