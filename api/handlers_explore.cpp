@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "api/endpoint.hpp"
+#include "api/explore_columns.hpp"
 #include "api/explore_design.hpp"
 #include "api/explore_shards.hpp"
 #include "api/handlers.hpp"
@@ -149,8 +150,45 @@ SweepOutcome RunSweep(const Sweep& sweep, core::Progress* progress,
 // A parsed /v1/explore request: the sweep, ready to run, and the answer's format.
 struct ExploreRequest {
   std::shared_ptr<Sweep> sweep;
-  std::string format;  // "json" or "ndjson"
+  std::string format;                  // "json", "ndjson" or "csv"
+  std::vector<ExploreColumn> columns;  // "columns" (csv: the default set when not given)
 };
+
+// "columns": 1 to kMaxColumns distinct dotted paths, each naming a part of `shape` (what a
+// row of this sweep can have). Returns false with the error naming columns[i].
+constexpr std::size_t kMaxColumns = 1024;
+bool ParseColumns(const Json& list, const Json& shape, std::vector<ExploreColumn>* columns,
+                  ApiError* error) {
+  if (!list.is_array() || list.empty() || list.size() > kMaxColumns) {
+    SetError(error, ErrorCode::kInvalidValue, "columns", &list,
+             "must be an array of 1 to " + std::to_string(kMaxColumns) +
+                 " dotted paths into a row, e.g. \"max_exit_speed.exit_speed_mps\"");
+    return false;
+  }
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where = "columns[" + std::to_string(i) + "]";
+    const Json& item = list[i];
+    if (!item.is_string() || item.get_ref<const std::string&>().empty()) {
+      SetError(error, ErrorCode::kInvalidValue, where, &item,
+               "must be a non-empty string: a dotted path into a row");
+      return false;
+    }
+    ExploreColumn column = MakeColumn(item.get<std::string>());
+    for (std::size_t j = 0; j < columns->size(); ++j) {
+      if ((*columns)[j].path == column.path) {
+        SetError(error, ErrorCode::kInvalidValue, where, &item,
+                 "repeats columns[" + std::to_string(j) + "]: each column once");
+        return false;
+      }
+    }
+    if (std::string why; !CheckColumn(column, shape, &why)) {
+      SetError(error, ErrorCode::kInvalidValue, where, &item, why);
+      return false;
+    }
+    columns->push_back(std::move(column));
+  }
+  return true;
+}
 
 std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& context,
                                            ApiError* error) {
@@ -172,13 +210,18 @@ std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& cont
     if (!spec || !ReadSceneCommon(check, &scene)) return std::nullopt;
   }
 
+  // A batch (a job, the CLI) writes its rows to a result or a file, not to a waiting
+  // client: it has its own, larger limit.
+  const std::size_t limit =
+      context.batch ? context.limits.max_batch_samples : context.limits.max_samples;
+  const char* limit_name = context.batch ? "max_batch_samples" : "max_samples";
   core::SweepPlan plan;
   std::string sampling = "grid";
   reader.OptionalString("sampling", &sampling, {"grid", "lhs", "sobol"});
   plan.method = *core::ParseSamplingMethod(sampling);
   long long samples = 0, seed = 0;
-  reader.OptionalInteger("samples", 1, static_cast<long long>(context.limits.max_samples),
-                         &samples);
+  reader.OptionalInteger(
+      "samples", 1, static_cast<long long>(std::min<std::size_t>(limit, 1ULL << 53)), &samples);
   reader.OptionalInteger("seed", 0, 1LL << 53, &seed);
   plan.samples = static_cast<std::uint64_t>(samples);
   plan.seed = static_cast<std::uint64_t>(seed);
@@ -303,17 +346,30 @@ std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& cont
     }
   }
   std::string format = "json";
-  reader.OptionalString("format", &format, {"json", "ndjson"});
+  reader.OptionalString("format", &format, {"json", "ndjson", "csv"});
+  const Json* column_list = reader.Get("columns");
   if (!reader.Finish()) return std::nullopt;
+  // The columns are checked against what a row of this sweep can have, before any design.
+  std::vector<std::string> parameter_paths;
+  for (const Parameter& parameter : parameters) parameter_paths.push_back(parameter.path);
+  std::vector<ExploreColumn> columns;
+  if (column_list != nullptr || format == "csv") {
+    const Json shape = RowShape(parameter_paths, outputs);
+    if (column_list == nullptr) {
+      columns = DefaultCsvColumns(parameter_paths, shape);
+    } else if (!ParseColumns(*column_list, shape, &columns, error)) {
+      return std::nullopt;
+    }
+  }
   if (core::Refusal refusal; !plan.Validate(&refusal)) {
     CoreRefusal(refusal, "", error);
     return std::nullopt;
   }
   const std::uint64_t total = plan.DesignCount();
-  if (total > context.limits.max_samples) {
+  if (total > limit) {
     SetError(error, ErrorCode::kTooBig, "parameters", nullptr,
-             "describe " + std::to_string(total) + " designs, over the limit max_samples = " +
-                 std::to_string(context.limits.max_samples));
+             "describe " + std::to_string(total) + " designs, over the limit " + limit_name +
+                 " = " + std::to_string(limit));
     return std::nullopt;
   }
 
@@ -327,11 +383,13 @@ std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& cont
   sweep->objectives = std::move(objectives);
   sweep->shard = shard;
   sweep->total = total;
-  // The sweep's identity: the request without its shard and format, so that
-  // every shard of one sweep carries the same provenance (explore-merge checks it).
+  // The sweep's identity: the request without its shard, format and columns, so
+  // that every shard of one sweep carries the same provenance (explore-merge checks
+  // it), whatever form its rows take.
   Json identity = body;
   identity.erase("shard");
   identity.erase("format");
+  identity.erase("columns");
   sweep->provenance = Provenance(identity, Json::object(), sweep->plan.seed);
   // Designs: grids are enumerated by index; LHS and Sobol are drawn in full
   // (every shard draws the same sequence) and then filtered by shard.
@@ -339,7 +397,7 @@ std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& cont
     sweep->drawn = core::GenerateDesigns(sweep->plan);
   }
 
-  return ExploreRequest{std::move(sweep), std::move(format)};
+  return ExploreRequest{std::move(sweep), std::move(format), std::move(columns)};
 }
 
 }  // namespace
@@ -352,18 +410,42 @@ Response HandleExplore(const Request& request, const Context& context) {
   // The sweep's timing_s, in its summary, counts from the request's arrival.
   const std::shared_ptr<Sweep>& sweep = parsed->sweep;
   sweep->start = start;
+  if (parsed->format == "csv") {
+    // Streamed like NDJSON: the header row, then a row per design as soon as it is
+    // evaluated. Only rows: the summary is in the json and ndjson answers (docs/api.md).
+    Response streamed = Response::Text(200, std::string(), "text/csv");
+    core::Progress* progress = context.progress;
+    streamed.stream = [sweep, progress, columns = parsed->columns](const ChunkSink& sink) {
+      std::string text;
+      AppendCsvHeader(columns, &text);
+      if (!sink(text)) return false;
+      const SweepOutcome outcome = RunSweep(*sweep, progress, [&](Json row) {
+        text.clear();
+        AppendCsvRow(row, columns, &text);
+        return sink(text);
+      });
+      return !outcome.stopped && !outcome.cancelled;
+    };
+    return streamed;
+  }
+  // With "columns", a row is the flat object of those columns (ProjectRow).
+  // Owns its columns: the NDJSON stream runs after this handler returns.
+  const auto shaped = [columns = parsed->columns](Json row) {
+    if (columns.empty()) return row;
+    return ProjectRow(row, columns);
+  };
   if (parsed->format == "ndjson") {
     // Streamed: a line per design as soon as it is evaluated, then the summary
     // line. The sweep runs while the server writes (after this returns), so it
     // owns copies of everything; a client that goes away stops it.
     Response streamed = Response::Text(200, std::string(), "application/x-ndjson");
     core::Progress* progress = context.progress;
-    streamed.stream = [sweep, progress](const ChunkSink& sink) {
+    streamed.stream = [sweep, progress, shaped](const ChunkSink& sink) {
       const auto line = [&sink](const Json& value) {
         return sink(value.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n");
       };
       const SweepOutcome outcome =
-          RunSweep(*sweep, progress, [&line](Json row) { return line(row); });
+          RunSweep(*sweep, progress, [&](Json row) { return line(shaped(std::move(row))); });
       if (outcome.stopped) return false;
       if (outcome.cancelled) {
         return line({{"error",
@@ -376,8 +458,8 @@ Response HandleExplore(const Request& request, const Context& context) {
     return streamed;
   }
   Json rows = Json::array();
-  const SweepOutcome outcome = RunSweep(*sweep, context.progress, [&rows](Json row) {
-    rows.push_back(std::move(row));
+  const SweepOutcome outcome = RunSweep(*sweep, context.progress, [&](Json row) {
+    rows.push_back(shaped(std::move(row)));
     return true;
   });
   if (outcome.cancelled) return ErrorResponse(409, ErrorCode::kCancelled, outcome.message);

@@ -18,6 +18,7 @@ bool ApiLimits::IsValid(std::string* why) const {
       {"max_array_length", max_array_length},   {"max_string_length", max_string_length},
       {"max_knots", max_knots},                 {"max_variants", max_variants},
       {"max_curve_samples", max_curve_samples}, {"max_samples", max_samples},
+      {"max_batch_samples", max_batch_samples},
       {"max_design_variables", max_design_variables}};
   for (const auto& [name, value] : sizes) {
     if (value < 1) return fail(std::string(name) + " = 0: must be at least 1");

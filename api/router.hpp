@@ -35,6 +35,9 @@ struct Context {
   std::function<std::string()> metrics_text;  ///< Prometheus text (server only).
   core::Progress* progress = nullptr;         ///< Cancel flag and progress (inside a job).
   core::ModesCache* modes_cache = nullptr;    ///< Bending modes kept across requests (server only).
+  /// True when the answer goes to a job's result or the CLI's output rather than to a waiting
+  /// HTTP client: /v1/explore then allows limits.max_batch_samples designs, not max_samples.
+  bool batch = false;
 };
 
 /// What answering a request costs, for the server's choice of worker pool.

@@ -3,9 +3,12 @@
 // body to stdout and exits 0 for a 2xx answer, 2 for a 4xx answer, 1 otherwise.
 // `sweetspot explore --shard I/N FILE` runs shard I of N of a sweep (NDJSON);
 // `sweetspot explore-merge FILE...` merges the shards' outputs into the sweep's.
+// A sweep's rows (ndjson, csv) are written to stdout as they are evaluated.
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -19,7 +22,7 @@ namespace {
 
 std::string Usage() {
   std::ostringstream text;
-  text << "Usage: sweetspot [-X METHOD] PATH [FILE|-]\n"
+  text << "Usage: sweetspot [-X METHOD] [--max-batch-samples N|none] PATH [FILE|-]\n"
        << "       sweetspot explore --shard I/N [FILE|-]\n"
        << "       sweetspot explore-merge FILE...\n"
        << "       sweetspot serve [SERVER OPTIONS]   (as sweetspot-server; see its --help)\n"
@@ -29,6 +32,9 @@ std::string Usage() {
        << "        standard input. GET endpoints take no body.\n"
        << "  -X    the method when a path has several (default: POST if the path\n"
        << "        has one, else GET)\n"
+       << "  --max-batch-samples N|none  explore only: the most designs a sweep may have\n"
+       << "        (also SWEETSPOT_MAX_BATCH_SAMPLES; default none: no limit, the rows are\n"
+       << "        streamed to stdout)\n"
        << "  --shard I/N  explore only: run shard I (0-based) of N of the sweep, as\n"
        << "        NDJSON (the request's shard and format are set); design i is in\n"
        << "        shard i mod N\n"
@@ -102,6 +108,22 @@ bool ParseShard(const std::string& text, unsigned long long* index, unsigned lon
   return text[0] != '-' && *count >= 1 && *index < *count;
 }
 
+// "N" (1 to 10^15) or "none" (no limit).
+bool ParseBatchLimit(const std::string& text, std::size_t* limit) {
+  if (text == "none") {
+    *limit = std::numeric_limits<std::size_t>::max();
+    return true;
+  }
+  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos ||
+      text.size() > 16) {
+    return false;
+  }
+  const unsigned long long n = std::stoull(text);
+  if (n < 1 || n > 1000000000000000ULL) return false;
+  *limit = static_cast<std::size_t>(n);
+  return true;
+}
+
 int ExitCode(int status) {
   if (status >= 200 && status < 300) return 0;
   if (status >= 400 && status < 500) return 2;
@@ -127,14 +149,26 @@ int main(int argc, char** argv) {
     method = args[1];
     args.erase(args.begin(), args.begin() + 2);
   }
+  // The CLI's rows go to stdout as they are evaluated: a sweep has no limit unless told.
+  sweetspot::api::Context context;  // default limits; no jobs, no metrics
+  context.batch = true;
+  context.limits.max_batch_samples = std::numeric_limits<std::size_t>::max();
+  std::string batch_limit;
+  if (const char* env = std::getenv("SWEETSPOT_MAX_BATCH_SAMPLES")) batch_limit = env;
   std::string shard;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--shard" && i + 1 < args.size()) {
-      shard = args[i + 1];
+  for (std::size_t i = 0; i < args.size();) {
+    if ((args[i] == "--shard" || args[i] == "--max-batch-samples") && i + 1 < args.size()) {
+      (args[i] == "--shard" ? shard : batch_limit) = args[i + 1];
       args.erase(args.begin() + static_cast<std::ptrdiff_t>(i),
                  args.begin() + static_cast<std::ptrdiff_t>(i) + 2);
-      break;
+    } else {
+      ++i;
     }
+  }
+  if (!batch_limit.empty() && !ParseBatchLimit(batch_limit, &context.limits.max_batch_samples)) {
+    std::cerr << "sweetspot: --max-batch-samples (or SWEETSPOT_MAX_BATCH_SAMPLES) \"" << batch_limit
+              << "\": must be an integer in [1, 10^15] or none\n";
+    return 2;
   }
   if (args.empty() || args.size() > 2) {
     std::cerr << Usage();
@@ -158,7 +192,6 @@ int main(int argc, char** argv) {
     }
   }
 
-  const sweetspot::api::Context context;  // default limits; no jobs, no metrics
   std::string body;
   if (method == "POST" || method == "PUT" || method == "PATCH") {
     const std::string file = args.size() == 2 ? args[1] : "-";
@@ -186,7 +219,8 @@ int main(int argc, char** argv) {
     (*request)["format"] = "ndjson";
     body = request->dump();
   }
-  const auto response = sweetspot::api::Dispatch({method, full_path, body}, context);
+  const auto response = sweetspot::api::Dispatch({method, full_path, body}, context, nullptr,
+                                                 /*allow_stream=*/true);
   if (!response.internal_error.empty()) {
     // What the top-level handler caught: on stderr, never in the printed body.
     std::cerr << nlohmann::json{{"path", full_path},
@@ -195,7 +229,15 @@ int main(int argc, char** argv) {
                      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
               << "\n";
   }
-  if (!response.content_type.empty()) {
+  if (response.stream) {
+    // The same chunks the server sends, written as they come: memory stays bounded.
+    const bool finished = response.stream([](std::string_view chunk) {
+      std::cout.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+      return static_cast<bool>(std::cout);
+    });
+    std::cout.flush();
+    if (!finished) return 1;
+  } else if (!response.content_type.empty()) {
     std::cout << response.text;
   } else {
     std::cout << response.body.dump(2, ' ', false, nlohmann::json::error_handler_t::replace)

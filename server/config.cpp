@@ -237,6 +237,13 @@ const std::vector<Option>& Options() {
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->limits.max_samples, v, rule);
        }},
+      {"--max-batch-samples", "SWEETSPOT_MAX_BATCH_SAMPLES",
+       "designs in one /v1/explore run as a job, whose rows go to its result (default "
+       "1000000; synchronous requests keep --max-samples)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_batch_samples, v, rule);
+       }},
       {"--max-design-variables", "SWEETSPOT_MAX_DESIGN_VARIABLES",
        "variables of one /v1/optimize design (default 200, the optimiser's ceiling)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {

@@ -335,6 +335,7 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
                                const api::Request& inner, core::Progress* progress) {
     api::Context job_context = context;
     job_context.progress = progress;
+    job_context.batch = true;  // the rows go to the job's result: --max-batch-samples
     api::Response response = api::Dispatch(inner, job_context);
     if (!response.internal_error.empty()) {
       // A job's 500 is logged like a request's: the job's path and the caught text.

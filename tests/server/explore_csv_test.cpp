@@ -1,0 +1,191 @@
+// "format": "csv" for /v1/explore through every way in: streamed over real HTTP (chunked,
+// text/csv), printed by the CLI, kept as a job's result, all the same bytes; and a sweep larger
+// than a request may be (--max-samples) run by the CLI, whose batch limit is none by default.
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <sys/wait.h>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/server/running_server.hpp"
+
+namespace sweetspot::server {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace explore_csv_test {
+namespace {
+
+using Json = nlohmann::json;
+
+struct CliOutput {
+  int exit_code = -1;
+  std::string out;
+};
+
+// Runs the CLI with `args` (stderr dropped) and collects its stdout.
+CliOutput RunSweetspot(const std::string& args) {
+  const std::string command =
+      std::string(SWEETSPOT_BINARY_DIR) + "/server/sweetspot " + args + " 2>/dev/null";
+  CliOutput result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  std::array<char, 65536> buffer{};
+  std::size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    result.out.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+// Writes `text` to a new file in a new temporary folder; returns its path.
+std::string WriteTemporary(const std::string& name, const std::string& text) {
+  char folder[] = "/tmp/sweetspot-csv-XXXXXX";
+  if (mkdtemp(folder) == nullptr) return "";
+  const std::string path = std::string(folder) + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// The HTTP answer, the CLI's output and a job's result of one CSV sweep are the same bytes
+// (the CSV has no timing in it, so they are equal whole).
+TEST(ExploreCsvEndToEndTest, HttpCliAndJobGiveTheSameBytes) {
+  const Json sweep = Json::parse(R"({"bat": {"preset": "paper-wood",
+      "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
+    "parameters": [{"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 400},
+                   {"path": "cor", "min": 0.4, "max": 1.2, "count": 3}],
+    "outputs": ["max_exit_speed", "properties"], "format": "csv"})");
+  ServerConfig config;
+  config.threads = 4;
+  RunningServer server(config);
+  ASSERT_TRUE(server.bound());
+  httplib::Client client = server.Client();
+  client.set_read_timeout(std::chrono::seconds(120));
+
+  std::string streamed;
+  std::size_t chunks = 0;
+  httplib::Request request;
+  request.method = "POST";
+  request.path = "/v1/explore";
+  request.body = sweep.dump();
+  request.set_header("Content-Type", "application/json");
+  request.content_receiver = [&](const char* data, std::size_t length, std::uint64_t,
+                                 std::uint64_t) {
+    streamed.append(data, length);
+    ++chunks;
+    return true;
+  };
+  const auto http = client.send(request);
+  ASSERT_TRUE(http) << httplib::to_string(http.error());
+  ASSERT_EQ(http->status, 200);
+  EXPECT_EQ(http->get_header_value("Content-Type"), "text/csv");
+  EXPECT_EQ(http->get_header_value("Transfer-Encoding"), "chunked");
+  EXPECT_GT(chunks, 3u);  // 1200 rows of ~330 bytes in chunks of about 16 KiB
+  const std::vector<std::string> lines = Lines(streamed);
+  ASSERT_EQ(lines.size(), 1201u);
+  EXPECT_EQ(lines[0].rfind("index,parameters.fill.depth_m,parameters.cor,feasible,", 0), 0u)
+      << lines[0];
+  EXPECT_EQ(lines[3].substr(lines[3].rfind(',')), ",InvalidValue");  // cor 1.2 is refused
+
+  const std::string file = WriteTemporary("sweep.json", sweep.dump());
+  const CliOutput cli = RunSweetspot("explore " + file);
+  EXPECT_EQ(cli.exit_code, 0);
+  EXPECT_TRUE(cli.out == streamed) << "the CLI's output differs from the HTTP answer";
+
+  const auto submitted = client.Post(
+      "/v1/jobs", Json{{"path", "/v1/explore"}, {"body", sweep}}.dump(), "application/json");
+  ASSERT_TRUE(submitted);
+  ASSERT_EQ(submitted->status, 202) << submitted->body;
+  const std::string id = Json::parse(submitted->body)["id"].get<std::string>();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  std::string state;
+  while (state != "done" && std::chrono::steady_clock::now() < deadline) {
+    const auto status = client.Get("/v1/jobs/" + id);
+    ASSERT_TRUE(status);
+    state = Json::parse(status->body)["state"].get<std::string>();
+    ASSERT_NE(state, "failed") << status->body;
+    if (state != "done") std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(state, "done");
+  const auto result = client.Get("/v1/jobs/" + id + "/result");
+  ASSERT_TRUE(result);
+  EXPECT_EQ(result->status, 200);
+  EXPECT_EQ(result->get_header_value("Content-Type"), "text/csv");
+  EXPECT_TRUE(result->body == streamed) << "the job's result differs from the HTTP answer";
+}
+
+// 150,000 designs: over a request's limit (--max-samples, 100,000 by default), so the server
+// answers 413 TooBig; the CLI has no limit by default and streams them all, and its
+// --max-batch-samples refuses the same sweep when asked to.
+TEST(ExploreCsvEndToEndTest, TheCliRunsASweepLargerThanARequestMayBe) {
+  const Json sweep = Json::parse(R"({"bat": {"three_segment": {"length_m": 0.8636,
+        "handle_radius_m": 0.0125, "barrel_radius_m": 0.033, "taper_start_m": 0.30,
+        "taper_end_m": 0.55}, "material": "ash"},
+    "parameters": [{"path": "three_segment.taper_start_m", "min": 0.2, "max": 0.4, "count": 300},
+                   {"path": "three_segment.taper_end_m", "min": 0.5, "max": 0.7, "count": 500}],
+    "outputs": ["max_exit_speed"], "format": "csv",
+    "columns": ["parameters.three_segment.taper_end_m", "max_exit_speed.exit_speed_mps"]})");
+  {
+    RunningServer server(ServerConfig{});
+    ASSERT_TRUE(server.bound());
+    const auto refused = server.Client().Post("/v1/explore", sweep.dump(), "application/json");
+    ASSERT_TRUE(refused);
+    EXPECT_EQ(refused->status, 413);
+    const Json body = Json::parse(refused->body);
+    EXPECT_EQ(body["code"], "TooBig");
+    EXPECT_EQ(body["message"],
+              "parameters describe 150000 designs, over the limit max_samples = 100000");
+  }
+  const std::string file = WriteTemporary("sweep.json", sweep.dump());
+  const CliOutput cli = RunSweetspot("explore " + file);
+  ASSERT_EQ(cli.exit_code, 0);
+  const std::vector<std::string> lines = Lines(cli.out);
+  ASSERT_EQ(lines.size(), 150001u);
+  EXPECT_EQ(lines[0], "parameters.three_segment.taper_end_m,max_exit_speed.exit_speed_mps");
+  // Designs 0 and 499: taper_start_m 0.2 (the first of its 300 values) and taper_end_m the
+  // first and last of its 500. Their exit speeds are the single request's, bit for bit.
+  for (const std::size_t design : {std::size_t{0}, std::size_t{499}}) {
+    const std::string& line = lines[design + 1];
+    const std::size_t comma = line.find(',');
+    ASSERT_NE(comma, std::string::npos) << line;
+    const double taper_end_m = std::strtod(line.substr(0, comma).c_str(), nullptr);
+    const double exit_speed_mps = std::strtod(line.substr(comma + 1).c_str(), nullptr);
+    if (design == 0) {
+      EXPECT_EQ(line.substr(0, comma), "0.5");
+    }
+    EXPECT_NEAR(taper_end_m, design == 0 ? 0.5 : 0.7, 1e-15);
+    Json single = Json::parse(R"({"outputs": ["max_exit_speed"]})");
+    single["bat"] = sweep["bat"];
+    single["bat"]["three_segment"]["taper_start_m"] = 0.2;
+    single["bat"]["three_segment"]["taper_end_m"] = taper_end_m;
+    const CliOutput one = RunSweetspot("sweet-spot " + WriteTemporary("one.json", single.dump()));
+    ASSERT_EQ(one.exit_code, 0) << one.out;
+    const double expected = Json::parse(one.out)["max_exit_speed"]["exit_speed_mps"].get<double>();
+    EXPECT_EQ(std::memcmp(&exit_speed_mps, &expected, sizeof expected), 0)
+        << "design " << design << ": " << line << " against " << expected;
+  }
+  const CliOutput limited = RunSweetspot("explore --max-batch-samples 149999 " + file);
+  EXPECT_EQ(limited.exit_code, 2);
+  EXPECT_EQ(Json::parse(limited.out)["message"],
+            "parameters describe 150000 designs, over the limit max_batch_samples = 149999");
+}
+
+}  // namespace
+}  // namespace explore_csv_test
+}  // namespace sweetspot::server
