@@ -206,7 +206,9 @@ MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards) {
       for (const auto& [i, row] : rows) {
         std::vector<double> v;
         for (const ParetoObjective& o : objectives) {
-          const Json* value = FindAt(row, o.tokens);
+          // A row with "columns" is flat: the objective's path is one key.
+          const auto flat = row.find(o.output);
+          const Json* value = flat != row.end() ? &*flat : FindAt(row, o.tokens);
           v.push_back(value != nullptr && value->is_number() ? value->get<double>() : std::nan(""));
         }
         values.push_back(std::move(v));

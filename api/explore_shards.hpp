@@ -52,7 +52,8 @@ struct MergedSweep {
 /// shard index exactly once, each with all its rows (indices i with
 /// i mod count = its index, each once) and no error line. The summary is the
 /// unsharded sweep's: totals and failures summed, shard {0, 1}, the Pareto
-/// front over all rows, timing_s the sum of the shards' (CPU-like). Never throws.
+/// front over all rows, timing_s the sum of the shards' (CPU-like). Rows may be the flat rows
+/// of "columns" (with index, and the Pareto objectives' paths as keys). Never throws.
 MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards);
 
 }  // namespace sweetspot::api

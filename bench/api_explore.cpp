@@ -1,6 +1,7 @@
 // Throughput of /v1/explore with the rigid model (issue 7's target: at least a
-// million designs per minute per core, i.e. >= 16,667 designs/s), and of one
-// /v1/sweet-spot request through the handler (no network).
+// million designs per minute per core, i.e. >= 16,667 designs/s), per answer format
+// (json, ndjson, csv with two columns: issue 17), and of one /v1/sweet-spot request
+// through the handler (no network).
 #include <benchmark/benchmark.h>
 
 #include <string>
@@ -32,6 +33,31 @@ void BM_ExploreRigid(benchmark::State& state, const char* outputs) {
 }
 BENCHMARK_CAPTURE(BM_ExploreRigid, max_exit_speed, R"(["max_exit_speed"])")->Arg(1000);
 BENCHMARK_CAPTURE(BM_ExploreRigid, max_and_properties, R"(["max_exit_speed", "properties"])")
+    ->Arg(1000);
+
+// One answer format of the same 1000-design rigid sweep (max_exit_speed): the full json rows,
+// the full ndjson lines (streamed; collected here as the CLI and jobs do), and csv with two
+// columns. Items are designs, so items/s compares the formats per design.
+void BM_ExploreFormat(benchmark::State& state, const char* format, const char* columns) {
+  const int designs = static_cast<int>(state.range(0));
+  std::string body = Sweep(designs, R"(["max_exit_speed"])");
+  body.pop_back();  // the closing brace
+  body += std::string(R"(, "format": ")") + format + "\"" + columns + "}";
+  const Context context;
+  for (auto _ : state) {
+    auto response = Dispatch({"POST", "/v1/explore", body}, context);
+    if (response.status != 200) state.SkipWithError("explore failed");
+    benchmark::DoNotOptimize(response);
+  }
+  state.SetItemsProcessed(state.iterations() * designs);
+}
+BENCHMARK_CAPTURE(BM_ExploreFormat, json, "json", "")->Arg(1000);
+BENCHMARK_CAPTURE(BM_ExploreFormat, ndjson, "ndjson", "")->Arg(1000);
+BENCHMARK_CAPTURE(BM_ExploreFormat, csv_2_columns, "csv",
+                  R"(, "columns": ["parameters.fill.depth_m", "max_exit_speed.exit_speed_mps"])")
+    ->Arg(1000);
+BENCHMARK_CAPTURE(BM_ExploreFormat, ndjson_2_columns, "ndjson",
+                  R"(, "columns": ["parameters.fill.depth_m", "max_exit_speed.exit_speed_mps"])")
     ->Arg(1000);
 
 void BM_SweetSpotRequest(benchmark::State& state) {

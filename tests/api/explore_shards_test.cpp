@@ -83,6 +83,26 @@ TEST(ExploreShardsTest, MergeOfTheShardsEqualsTheUnshardedSweepRowForRowAndInIts
   }
 }
 
+// Shards whose rows are flat "columns" rows merge too: the same rows, and the same summary
+// (the Pareto front found from the objectives' flat keys).
+TEST(ExploreShardsTest, ShardsOfColumnRowsMergeWithTheSameFront) {
+  Json sweep = Sweep("grid");
+  sweep["columns"] = {"index", "parameters.fill.depth_m", "max_exit_speed.exit_speed_mps",
+                      "properties.mass_kg"};
+  const std::vector<Json> whole = Lines(Ndjson(sweep));
+  const MergedSweep merged = MergeExploreShards(Shards(sweep, 3));
+  ASSERT_TRUE(merged.ok) << merged.error;
+  const std::vector<Json> lines = Lines(merged.ndjson);
+  ASSERT_EQ(lines.size(), whole.size());
+  for (std::size_t i = 0; i + 1 < lines.size(); ++i) EXPECT_EQ(lines[i], whole[i]) << i;
+  Json merged_summary = lines.back()["summary"];
+  Json whole_summary = whole.back()["summary"];
+  merged_summary.erase("timing_s");
+  whole_summary.erase("timing_s");
+  EXPECT_EQ(merged_summary, whole_summary);
+  EXPECT_FALSE(whole_summary["pareto_front"].empty());
+}
+
 TEST(ExploreShardsTest, EveryShardCarriesTheSweepsProvenance) {
   const std::vector<ShardOutput> shards = Shards(Sweep("grid"), 3);
   const Json whole = Lines(Ndjson(Sweep("grid"))).back()["summary"]["provenance"];
