@@ -35,20 +35,25 @@ BENCHMARK_CAPTURE(BM_ExploreRigid, max_exit_speed, R"(["max_exit_speed"])")->Arg
 BENCHMARK_CAPTURE(BM_ExploreRigid, max_and_properties, R"(["max_exit_speed", "properties"])")
     ->Arg(1000);
 
-// One answer format of the same 1000-design rigid sweep (max_exit_speed): the full json rows,
-// the full ndjson lines (streamed; collected here as the CLI and jobs do), and csv with two
-// columns. Items are designs, so items/s compares the formats per design.
+// One answer format of the same 1000-design rigid sweep (max_exit_speed), as the bytes a
+// client gets: the full json rows (the body dumped, as the server and the CLI do), the full
+// ndjson lines (streamed; collected here as the CLI and jobs do), csv with two columns, and
+// ndjson with the same two columns. Items are designs: items/s compares the formats per design.
 void BM_ExploreFormat(benchmark::State& state, const char* format, const char* columns) {
   const int designs = static_cast<int>(state.range(0));
   std::string body = Sweep(designs, R"(["max_exit_speed"])");
   body.pop_back();  // the closing brace
   body += std::string(R"(, "format": ")") + format + "\"" + columns + "}";
   const Context context;
+  std::size_t bytes = 0;
   for (auto _ : state) {
     auto response = Dispatch({"POST", "/v1/explore", body}, context);
     if (response.status != 200) state.SkipWithError("explore failed");
-    benchmark::DoNotOptimize(response);
+    const std::string text = response.content_type.empty() ? response.body.dump() : response.text;
+    bytes = text.size();
+    benchmark::DoNotOptimize(text);
   }
+  state.counters["bytes_per_design"] = static_cast<double>(bytes) / designs;
   state.SetItemsProcessed(state.iterations() * designs);
 }
 BENCHMARK_CAPTURE(BM_ExploreFormat, json, "json", "")->Arg(1000);
