@@ -60,6 +60,21 @@ TEST(ConfigTest, RequestCapsFromFlagsAndEnvironment) {
   EXPECT_NE(usage.find("SWEETSPOT_MAX_DESIGN_VARIABLES"), std::string::npos);
 }
 
+// A synchronous request's designs (--max-samples) and a job's (--max-batch-samples) are two
+// limits.
+TEST(ConfigTest, RequestAndBatchSampleLimitsAreSeparate) {
+  EXPECT_EQ(ServerConfig{}.limits.max_samples, 100000u);
+  EXPECT_EQ(ServerConfig{}.limits.max_batch_samples, 1000000u);
+  const auto parsed = Parse({"--max-samples", "500"}, {{"SWEETSPOT_MAX_BATCH_SAMPLES", "5000000"}});
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_EQ(parsed.config.limits.max_samples, 500u);
+  EXPECT_EQ(parsed.config.limits.max_batch_samples, 5000000u);
+  EXPECT_EQ(Parse({"--max-batch-samples", "7"}).config.limits.max_batch_samples, 7u);
+  EXPECT_EQ(Parse({"--max-batch-samples", "0"}).error,
+            "option --max-batch-samples = \"0\": must be an integer in [1, 100000000]");
+  EXPECT_NE(Usage("sweetspot-server").find("SWEETSPOT_MAX_BATCH_SAMPLES"), std::string::npos);
+}
+
 TEST(ConfigTest, BadValuesNameFlagValueAndRule) {
   EXPECT_EQ(Parse({"--port", "70000"}).error,
             "option --port = \"70000\": must be an integer in [0, 65535]");

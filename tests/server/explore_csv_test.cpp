@@ -186,6 +186,53 @@ TEST(ExploreCsvEndToEndTest, TheCliRunsASweepLargerThanARequestMayBe) {
             "parameters describe 150000 designs, over the limit max_batch_samples = 149999");
 }
 
+// A job runs a sweep as a batch: over --max-samples but within --max-batch-samples, it is
+// done while the same request is refused; over --max-batch-samples, the job fails with 413.
+TEST(ExploreCsvEndToEndTest, AJobHasTheBatchLimit) {
+  ServerConfig config;
+  config.limits.max_samples = 10;
+  config.limits.max_batch_samples = 20;
+  RunningServer server(config);
+  ASSERT_TRUE(server.bound());
+  httplib::Client client = server.Client();
+  const auto sweep = [](int count) {
+    Json body = Json::parse(R"({"bat": {"preset": "paper-wood"}, "outputs": ["max_exit_speed"],
+        "format": "csv", "columns": ["index"]})");
+    body["parameters"] = {{{"path", "cor"}, {"min", 0.4}, {"max", 0.6}, {"count", count}}};
+    return body;
+  };
+  const auto refused = client.Post("/v1/explore", sweep(15).dump(), "application/json");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 413);
+  const auto run_job = [&client](const Json& body) {
+    const auto submitted = client.Post(
+        "/v1/jobs", Json{{"path", "/v1/explore"}, {"body", body}}.dump(), "application/json");
+    EXPECT_TRUE(submitted && submitted->status == 202);
+    if (!submitted || submitted->status != 202) return Json();
+    const std::string id = Json::parse(submitted->body)["id"].get<std::string>();
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    Json status;
+    do {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      const auto answer = client.Get("/v1/jobs/" + id);
+      if (!answer) break;
+      status = Json::parse(answer->body);
+    } while (status["state"] != "done" && status["state"] != "failed" &&
+             std::chrono::steady_clock::now() < deadline);
+    const auto result = client.Get("/v1/jobs/" + id + "/result");
+    if (result) status["result"] = result->body;
+    return status;
+  };
+  const Json done = run_job(sweep(15));
+  EXPECT_EQ(done["state"], "done") << done.dump();
+  EXPECT_EQ(Lines(done.value("result", "")).size(), 16u);
+  const Json failed = run_job(sweep(25));
+  EXPECT_EQ(failed["state"], "failed") << failed.dump();
+  EXPECT_EQ(failed["status"], 413);
+  EXPECT_EQ(failed["error"],
+            "parameters describe 25 designs, over the limit max_batch_samples = 20");
+}
+
 }  // namespace
 }  // namespace explore_csv_test
 }  // namespace sweetspot::server
