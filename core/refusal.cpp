@@ -1,5 +1,6 @@
 #include "core/refusal.hpp"
 
+#include <cmath>
 #include <utility>
 
 #include "core/geometry_format.hpp"
@@ -57,6 +58,27 @@ Refusal Noted(Refusal inner, std::string_view note) {
   return inner;
 }
 
+std::string RangeRule(double lo, double hi, bool lo_open) {
+  return std::string("must be in ") + (lo_open ? "(" : "[") + FormatNumber(lo) + ", " +
+         FormatNumber(hi) + "]";
+}
+
+bool CheckInRange(Refusal* out, std::string_view field, double value, double lo, double hi,
+                  bool lo_open, std::string_view note) {
+  if (std::isfinite(value) && (lo_open ? value > lo : value >= lo) && value <= hi) return true;
+  if (out == nullptr) return false;
+  return Refuse(out, NumberRefusal(field, value, RangeRule(lo, hi, lo_open) + std::string(note)));
+}
+
+bool CheckIntegerInRange(Refusal* out, std::string_view field, long long value, long long lo,
+                         long long hi) {
+  if (value >= lo && value <= hi) return true;
+  if (out == nullptr) return false;
+  return Refuse(
+      out, IntegerRefusal(field, value,
+                          "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]"));
+}
+
 bool Refuse(Refusal* out, Refusal refusal) {
   if (out != nullptr) *out = std::move(refusal);
   return false;
@@ -72,8 +94,7 @@ bool RefuseMessage(std::string* why, const Refusal& refusal) {
   return false;
 }
 
-bool RefuseMessage(std::string* why, std::string_view field, double value,
-                   std::string_view rule) {
+bool RefuseMessage(std::string* why, std::string_view field, double value, std::string_view rule) {
   if (why != nullptr) *why = NumberRefusal(field, value, rule).Message();
   return false;
 }

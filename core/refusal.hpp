@@ -50,6 +50,18 @@ Refusal Prefixed(std::string_view prefix, Refusal inner);
 /// ("... (model = flexible)"); the field and the value are kept.
 Refusal Noted(Refusal inner, std::string_view note);
 
+/// A range's rule written from its bounds, the one way every range is written: "must be in
+/// [lo, hi]", or "must be in (lo, hi]" when `lo_open` (the lower bound itself is refused).
+std::string RangeRule(double lo, double hi, bool lo_open = false);
+/// True when `value` is finite and in [lo, hi] ((lo, hi] when `lo_open`); otherwise refuses
+/// `field` = value (NumberRefusal) with RangeRule(lo, hi, lo_open) followed by `note`
+/// (" (0 = solid)"), and returns false.
+bool CheckInRange(Refusal* out, std::string_view field, double value, double lo, double hi,
+                  bool lo_open = false, std::string_view note = {});
+/// CheckInRange for an integer: "field = 21: must be in [1, 20]" (IntegerRefusal).
+bool CheckIntegerInRange(Refusal* out, std::string_view field, long long value, long long lo,
+                         long long hi);
+
 /// Stores `refusal` in *out (if non-null) and returns false: the one way core's validators
 /// refuse (`return Refuse(out, NumberRefusal("length_m", length_m, "must be positive"));`).
 bool Refuse(Refusal* out, Refusal refusal);

@@ -231,6 +231,23 @@ TEST(RefusalTest, RefusalMessageIsNumberRefusalsMessage) {
   EXPECT_EQ(Prefixed("fill.", NumberRefusal("depth_m", 2.0, "r")).Message(), "fill.depth_m = 2: r");
 }
 
+TEST(RefusalTest, RangesAreWrittenFromTheirBounds) {
+  EXPECT_EQ(RangeRule(0.0, 100.0), "must be in [0, 100]");
+  EXPECT_EQ(RangeRule(0.0, 1e5, /*lo_open=*/true), "must be in (0, 1e+05]");
+  Refusal r;
+  EXPECT_TRUE(CheckInRange(&r, "x_m", 100.0, 0.0, 100.0));  // the bounds themselves pass
+  EXPECT_TRUE(CheckInRange(&r, "x_m", 0.0, 0.0, 100.0));
+  EXPECT_FALSE(CheckInRange(&r, "x_m", 0.0, 0.0, 100.0, /*lo_open=*/true));
+  EXPECT_EQ(r.Message(), "x_m = 0: must be in (0, 100]");
+  EXPECT_FALSE(CheckInRange(&r, "wall_m", 11.0, 0.0, 10.0, false, " (0 = solid)"));
+  EXPECT_EQ(r.Message(), "wall_m = 11: must be in [0, 10] (0 = solid)");
+  EXPECT_EQ(r.value, 11.0);
+  EXPECT_FALSE(CheckInRange(nullptr, "x_m", std::nan(""), -1.0, 1.0));  // NaN is refused
+  EXPECT_FALSE(CheckIntegerInRange(&r, "modes", 21, 1, 20));
+  EXPECT_EQ(r.Message(), "modes = 21: must be in [1, 20]");
+  EXPECT_TRUE(CheckIntegerInRange(&r, "modes", 20, 1, 20));
+}
+
 }  // namespace
 }  // namespace refusal_test
 }  // namespace sweetspot::core
