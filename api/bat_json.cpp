@@ -10,21 +10,18 @@ namespace {
 
 using Json = nlohmann::json;
 
-std::optional<core::ThreeSegmentShape> ParseThreeSegment(const Json& value,
-                                                         const std::string& path,
+std::optional<core::ThreeSegmentShape> ParseThreeSegment(const Json& value, const std::string& path,
                                                          ApiError* error) {
   ObjectReader reader(value, path, error);
   core::ThreeSegmentShape shape;
-  const NumberRule length = Positive(100.0);  // m; a 100 m bat is already absurd
-  const NumberRule radius = Positive(10.0);
-  const NumberRule position = NonNegative(100.0);
-  reader.Number("length_m", length, &shape.length_m);
-  reader.Number("handle_radius_m", radius, &shape.handle_radius_m);
-  reader.Number("barrel_radius_m", radius, &shape.barrel_radius_m);
-  reader.Number("taper_start_m", position, &shape.taper_start_m);
-  reader.Number("taper_end_m", position, &shape.taper_end_m);
+  // Presence and types here; the ranges are core's (ThreeSegmentShape::ValidateSize).
+  reader.Number("length_m", AnyNumber(), &shape.length_m);
+  reader.Number("handle_radius_m", AnyNumber(), &shape.handle_radius_m);
+  reader.Number("barrel_radius_m", AnyNumber(), &shape.barrel_radius_m);
+  reader.Number("taper_start_m", AnyNumber(), &shape.taper_start_m);
+  reader.Number("taper_end_m", AnyNumber(), &shape.taper_end_m);
   if (!reader.Finish()) return std::nullopt;
-  if (core::Refusal refusal; !shape.Validate(&refusal)) {
+  if (core::Refusal refusal; !shape.ValidateSize(&refusal)) {
     CoreRefusal(refusal, path, error);
     return std::nullopt;
   }
@@ -63,8 +60,8 @@ std::optional<std::vector<core::ProfileKnot>> ParseProfile(const Json& value,
   for (std::size_t i = 0; i < knots->size(); ++i) {
     ObjectReader knot((*knots)[i], knots_path + "[" + std::to_string(i) + "]", error);
     core::ProfileKnot k;
-    knot.Number("x_m", NonNegative(100.0), &k.x_m);
-    knot.Number("radius_m", Positive(10.0), &k.radius_m);
+    knot.Number("x_m", AnyNumber(), &k.x_m);  // the ranges: core's Bat::ValidateSize
+    knot.Number("radius_m", AnyNumber(), &k.radius_m);
     if (!knot.Finish()) return std::nullopt;
     out.push_back(k);
   }
@@ -83,8 +80,8 @@ std::optional<core::Fill> ParseFill(const Json& value, const std::string& path, 
   auto parsed = ParseMaterial(*material, JoinPath(path, "material"), /*allow_empty=*/true, error);
   if (!parsed) return std::nullopt;
   fill.material = *parsed;
-  reader.Number("diameter_m", NonNegative(10.0), &fill.diameter_m);
-  reader.Number("depth_m", NonNegative(100.0), &fill.depth_m);
+  reader.Number("diameter_m", AnyNumber(), &fill.diameter_m);  // the ranges: Bat::ValidateSize
+  reader.Number("depth_m", AnyNumber(), &fill.depth_m);
   if (!reader.Finish()) return std::nullopt;
   return fill;
 }
@@ -109,14 +106,14 @@ std::optional<core::Material> ParseMaterial(const Json& value, const std::string
   material.name = "custom";
   material.source = "given in the request";
   reader.OptionalString("name", &material.name);
-  reader.Number("density_kg_m3", Positive(1e5), &material.density_kg_m3);
-  reader.Number("youngs_modulus_pa", Positive(1e13), &material.youngs_modulus_pa);
-  reader.OptionalNumber("shear_modulus_pa", NonNegative(1e13), &material.shear_modulus_pa);
-  reader.OptionalNumber("poissons_ratio", NumberRule{-1.0, 0.5, true, true, false},
-                        &material.poissons_ratio);
-  if (auto cor = reader.MaybeNumber("cor", Between(0.0, 1.0))) material.cor = *cor;
+  // Presence and types here; the ranges are core's (Material::ValidateSize, below).
+  reader.Number("density_kg_m3", AnyNumber(), &material.density_kg_m3);
+  reader.Number("youngs_modulus_pa", AnyNumber(), &material.youngs_modulus_pa);
+  reader.OptionalNumber("shear_modulus_pa", AnyNumber(), &material.shear_modulus_pa);
+  reader.OptionalNumber("poissons_ratio", AnyNumber(), &material.poissons_ratio);
+  if (auto cor = reader.MaybeNumber("cor", AnyNumber())) material.cor = *cor;
   if (!reader.Finish()) return std::nullopt;
-  if (core::Refusal refusal; !material.Validate(&refusal)) {
+  if (core::Refusal refusal; !material.ValidateSize(&refusal)) {
     CoreRefusal(refusal, path, error);
     return std::nullopt;
   }
@@ -157,8 +154,8 @@ std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& pa
     return std::nullopt;
   }
   if (has_three) {
-    auto shape = ParseThreeSegment(*reader.Get("three_segment"), JoinPath(path, "three_segment"),
-                                   error);
+    auto shape =
+        ParseThreeSegment(*reader.Get("three_segment"), JoinPath(path, "three_segment"), error);
     if (!shape) return std::nullopt;
     spec.bat.knots = shape->Knots();
     spec.three_segment = shape;
@@ -176,7 +173,7 @@ std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& pa
   } else if (!preset) {
     spec.bat.material = *core::FindMaterial("paper-wood");
   }
-  reader.OptionalNumber("wall_thickness_m", NonNegative(10.0), &spec.bat.wall_thickness_m);
+  reader.OptionalNumber("wall_thickness_m", AnyNumber(), &spec.bat.wall_thickness_m);
   if (const Json* fill = reader.Get("fill")) {
     if (fill->is_null()) {
       spec.bat.fill.reset();
@@ -187,7 +184,7 @@ std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& pa
     }
   }
   if (!reader.Finish()) return std::nullopt;
-  if (core::Refusal refusal; !spec.bat.Validate(&refusal)) {
+  if (core::Refusal refusal; !spec.bat.ValidateSize(&refusal)) {
     // Knot refusals belong under the profile (or the preset's/three-segment's knots).
     const std::string prefix = refusal.field.rfind("knots[", 0) == 0 && spec.shape_form == "profile"
                                    ? JoinPath(path, "profile")
@@ -253,9 +250,10 @@ Json BatToJson(const core::Bat& bat) {
   }
   if (bat.wall_thickness_m > 0) out["wall_thickness_m"] = bat.wall_thickness_m;
   if (bat.fill) {
-    out["fill"] = {{"material", bat.fill->IsEmpty() ? Json("empty") : Json(bat.fill->material.name)},
-                   {"diameter_m", bat.fill->diameter_m},
-                   {"depth_m", bat.fill->depth_m}};
+    out["fill"] = {
+        {"material", bat.fill->IsEmpty() ? Json("empty") : Json(bat.fill->material.name)},
+        {"diameter_m", bat.fill->diameter_m},
+        {"depth_m", bat.fill->depth_m}};
   }
   return out;
 }

@@ -28,10 +28,15 @@ std::optional<PropertiesRequest> ParseProperties(const nlohmann::json& body, con
   auto spec = ParseBat(*bat_json, "bat", context.limits, error);
   if (!spec) return std::nullopt;
   PropertiesRequest request{std::move(*spec), {}, core::InertiaModel::kRigidBody};
-  request.pivot_from_knob_m = reader.MaybeNumber("pivot_from_knob_m", Between(-100.0, 100.0));
+  request.pivot_from_knob_m = reader.MaybeNumber("pivot_from_knob_m", AnyNumber());
   std::string inertia_model = "rigid_body";
   reader.OptionalString("inertia_model", &inertia_model, {"rigid_body", "slender_rod"});
   if (!reader.Finish()) return std::nullopt;
+  if (core::Refusal refusal; request.pivot_from_knob_m.has_value() &&
+                             !core::ValidatePivotFromKnob(*request.pivot_from_knob_m, &refusal)) {
+    CoreRefusal(refusal, "", error);
+    return std::nullopt;
+  }
   if (inertia_model == "slender_rod") request.inertia_model = core::InertiaModel::kSlenderRod;
   return request;
 }
@@ -154,8 +159,8 @@ bool ReadFitUnknowns(ObjectReader& reader, const core::ThreeSegmentShape& shape,
               "density_kg_m3", "wall_thickness_m", "fill.diameter_m", "fill.depth_m",
               "fill.density_kg_m3"});
     core::FitUnknown unknown;
-    u.Number("min", Between(0.0, 1e5), &unknown.min);
-    u.Number("max", Between(0.0, 1e5), &unknown.max);
+    u.Number("min", AnyNumber(), &unknown.min);  // the bounds' ranges: core's problem.Validate
+    u.Number("max", AnyNumber(), &unknown.max);
     if (!u.Finish()) return false;
     unknown.variable = *core::FitVariableFromName(name);
     problem->unknowns.push_back(unknown);
@@ -170,9 +175,11 @@ bool ReadFitOptions(ObjectReader& reader, const ApiLimits& limits, core::ShapeFi
   const nlohmann::json* o = reader.Get("options");
   if (o == nullptr) return reader.ok();
   ObjectReader opt(*o, "options", reader.error());
-  opt.OptionalNumber("mass_scale_kg", NonNegative(1e4), &options->mass_scale_kg);
-  opt.OptionalNumber("balance_point_scale_m", NonNegative(100.0), &options->balance_point_scale_m);
-  opt.OptionalNumber("tolerance", Between(1e-15, 1e-1), &options->tolerance);
+  // The ranges are core's (ShapeFitOptions::Validate, in ParseFit); the budgets below are
+  // the server's configured limits.
+  opt.OptionalNumber("mass_scale_kg", AnyNumber(), &options->mass_scale_kg);
+  opt.OptionalNumber("balance_point_scale_m", AnyNumber(), &options->balance_point_scale_m);
+  opt.OptionalNumber("tolerance", AnyNumber(), &options->tolerance);
   long long max_evaluations = options->max_evaluations;
   opt.OptionalInteger("max_evaluations", 1, limits.max_iterations, &max_evaluations);
   options->max_evaluations = static_cast<int>(max_evaluations);
@@ -208,8 +215,8 @@ std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& co
   if (reader.ok() && targets == nullptr) reader.Missing("targets");
   if (!reader.ok()) return std::nullopt;
   ObjectReader t(*targets, "targets", error);
-  problem.targets.mass_kg = t.MaybeNumber("mass_kg", Positive(1e4));
-  problem.targets.balance_point_m = t.MaybeNumber("balance_point_m", Positive(100.0));
+  problem.targets.mass_kg = t.MaybeNumber("mass_kg", AnyNumber());  // ranges: problem.Validate
+  problem.targets.balance_point_m = t.MaybeNumber("balance_point_m", AnyNumber());
   if (!t.Finish()) return std::nullopt;
   if (!problem.targets.mass_kg && !problem.targets.balance_point_m) {
     SetError(error, ErrorCode::kMissingField, "targets", nullptr,
@@ -220,8 +227,12 @@ std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& co
       !ReadFitOptions(reader, context.limits, &request.options) || !reader.Finish()) {
     return std::nullopt;
   }
-  if (core::Refusal why; !problem.Validate(&why)) {
+  if (core::Refusal why; !problem.ValidateSize(&why)) {
     CoreRefusal(why, "", error);
+    return std::nullopt;
+  }
+  if (core::Refusal why; !request.options.Validate(&why)) {
+    CoreRefusal(why, "options", error);
     return std::nullopt;
   }
   return request;

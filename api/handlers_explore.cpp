@@ -208,6 +208,13 @@ std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& cont
     ObjectReader check(base, "", error);
     const auto spec = ParseBat(base["bat"], "bat", context.limits, error);
     if (!spec || !ReadSceneCommon(check, &scene)) return std::nullopt;
+    // The ranges (ball, swing, cor) are core's: checked as a design's row checks them.
+    scene.bat = spec->bat;
+    scene.outputs = {core::SceneOutput::kMaxExitSpeed};
+    if (core::Refusal refusal; !scene.Validate(&refusal)) {
+      CoreRefusal(refusal, "", error);
+      return std::nullopt;
+    }
   }
 
   // A batch (a job, the CLI) writes its rows to a result or a file, not to a waiting

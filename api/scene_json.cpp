@@ -43,7 +43,7 @@ bool ReadSceneCommon(ObjectReader& reader, core::Scene* scene) {
   if (const Json* swing = reader.Get("swing")) {
     if (!ReadSwing(*swing, reader.PathOf("swing"), &scene->swing, reader.error())) return false;
   }
-  if (auto cor = reader.MaybeNumber("cor", Between(0.0, 1.0))) scene->cor = *cor;
+  if (auto cor = reader.MaybeNumber("cor", AnyNumber())) scene->cor = *cor;
   std::string inertia = "rigid_body";
   reader.OptionalString("inertia_model", &inertia, {"rigid_body", "slender_rod"});
   scene->inertia_model =

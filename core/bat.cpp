@@ -19,6 +19,14 @@ bool CheckMaterial(const Material& m, std::string_view prefix, Refusal* out) {
   return Refuse(out, Prefixed(prefix, std::move(inner)));
 }
 
+// Material::ValidateSize with the refusal's field prefixed by `prefix`.
+bool CheckMaterialSize(const Material& m, std::string_view prefix, Refusal* out) {
+  if (out == nullptr) return m.ValidateSize(nullptr);
+  Refusal inner;
+  if (m.ValidateSize(&inner)) return true;
+  return Refuse(out, Prefixed(prefix, std::move(inner)));
+}
+
 // Outer radius of a valid knot list at x in [x_0, x_last].
 double Interpolate(const std::vector<ProfileKnot>& knots, double x) {
   const auto it = std::upper_bound(knots.begin(), knots.end(), x,
@@ -68,6 +76,14 @@ bool ThreeSegmentShape::Validate(Refusal* why) const {
                   "must not exceed length_m = " + FormatNumber(length_m));
   }
   return true;
+}
+
+bool ThreeSegmentShape::ValidateSize(Refusal* why) const {
+  // Validate holds x1 <= x2 <= L: the positions are then within the length's cap too.
+  return Validate(why) &&
+         CheckInRange(why, "length_m", length_m, 0.0, kMaxBatLengthM, /*lo_open=*/true) &&
+         CheckInRange(why, "handle_radius_m", handle_radius_m, 0.0, kMaxBatRadiusM, true) &&
+         CheckInRange(why, "barrel_radius_m", barrel_radius_m, 0.0, kMaxBatRadiusM, true);
 }
 
 std::vector<ProfileKnot> ThreeSegmentShape::Knots() const {
@@ -190,6 +206,33 @@ bool Bat::Validate(Refusal* why) const {
                               " must be less than the " + (IsHollow() ? "inner" : "outer") +
                               " radius " + FormatNumber(around) +
                               " at x_m = " + FormatNumber(worst_x) + " (over the fill's depth)");
+    }
+  }
+  return true;
+}
+
+bool Bat::ValidateSize(Refusal* why) const {
+  if (!Validate(why)) return false;
+  for (std::size_t i = 0; i < knots.size(); ++i) {
+    if (knots[i].x_m > kMaxBatLengthM) {
+      return why == nullptr ? false
+                            : CheckInRange(why, IndexedField("knots", i, "x_m"), knots[i].x_m, 0.0,
+                                           kMaxBatLengthM);
+    }
+    if (knots[i].radius_m > kMaxBatRadiusM) {
+      return why == nullptr
+                 ? false
+                 : CheckInRange(why, IndexedField("knots", i, "radius_m"), knots[i].radius_m, 0.0,
+                                kMaxBatRadiusM, /*lo_open=*/true);
+    }
+  }
+  // Validate holds the wall below the smallest radius and the fill no deeper than the bat: the
+  // caps on the radii and the length hold them too.
+  if (!CheckMaterialSize(material, "material.", why)) return false;
+  if (fill.has_value()) {
+    if (!fill->IsEmpty() && !CheckMaterialSize(fill->material, "fill.material.", why)) return false;
+    if (!CheckInRange(why, "fill.diameter_m", fill->diameter_m, 0.0, kMaxFillDiameterM)) {
+      return false;
     }
   }
   return true;

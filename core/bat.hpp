@@ -30,6 +30,16 @@
 
 namespace sweetspot::core {
 
+// The sizes a bat given from outside (a request) is held to, by ValidateSize. Core's numerics
+// work far beyond them (tests/hard_cases: a megametre bat); these say what is plausible.
+/// Largest length of a bat and largest position along one (knots, taper, fill depth), m: a
+/// 100 m bat is already absurd.
+inline constexpr double kMaxBatLengthM = 100.0;
+/// Largest radius of a bat (knots, handle, barrel; so also of its wall thickness), m.
+inline constexpr double kMaxBatRadiusM = 10.0;
+/// Largest diameter of a fill's bore, m.
+inline constexpr double kMaxFillDiameterM = 10.0;
+
 /// One knot of the outer radius profile.
 struct ProfileKnot {
   double x_m = 0.0;       ///< Position from the knob, m.
@@ -56,6 +66,10 @@ struct ThreeSegmentShape {
   bool IsValid(std::string* why) const;
   /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
   bool Validate(Refusal* refusal) const;
+  /// Validate, then the plausible sizes: L in (0, kMaxBatLengthM], r1, r2 in
+  /// (0, kMaxBatRadiusM] ("length_m = 200: must be in (0, 100]"); for a shape given from
+  /// outside.
+  bool ValidateSize(Refusal* refusal) const;
   /// The knots of this shape, x strictly increasing: (0, r1), (x1, r1),
   /// (x2, r2), (L, r2) with coincident knots merged (x1 = 0: no handle knot;
   /// x2 = L: no barrel knot; x1 = x2 with r1 = r2: one knot; x1 = x2 = 0 or
@@ -100,6 +114,12 @@ struct Bat {
   /// IsValid with the refusal as data in *refusal (if non-null): core's field name
   /// ("wall_thickness_m", "knots[2].x_m", "fill.material.density_kg_m3"), value and rule.
   bool Validate(Refusal* refusal) const;
+  /// Validate, then the plausible sizes: knots' x in [0, kMaxBatLengthM], radii in
+  /// (0, kMaxBatRadiusM] (so the wall, below the smallest radius, and the fill's depth, within
+  /// the length, are capped too), fill diameter in [0, kMaxFillDiameterM], the materials'
+  /// Material::ValidateSize ("knots[1].x_m = 150: must be in [0, 100]"); for a bat given from
+  /// outside.
+  bool ValidateSize(Refusal* refusal) const;
   /// L, m (the last knot's x; 0 without knots).
   double LengthM() const;
   /// Outer radius at x (from the knob), m; 0 outside [0, L].

@@ -84,6 +84,11 @@ struct ProfileSums {
 
 }  // namespace
 
+bool ValidatePivotFromKnob(double pivot_from_knob_m, Refusal* refusal) {
+  return CheckInRange(refusal, "pivot_from_knob_m", pivot_from_knob_m, -kMaxPivotFromKnobM,
+                      kMaxPivotFromKnobM);
+}
+
 double MassProperties::MoiAboutKgM2(double pivot_from_knob_m) const {
   const double d = pivot_from_knob_m - balance_point_m;
   return moi_centroid_kg_m2 + mass_kg * (d * d);

@@ -40,6 +40,15 @@ struct MassProperties {
   double MoiSixInchKgM2() const { return MoiAboutKgM2(kSixInchPivotM); }
 };
 
+/// Largest distance of a pivot from the knob, either way, m (no bat swings about a point
+/// 100 m away).
+inline constexpr double kMaxPivotFromKnobM = 100.0;
+
+/// True when `pivot_from_knob_m` (a pivot for MoiAboutKgM2, m from the knob) is finite and
+/// within ±kMaxPivotFromKnobM; otherwise "pivot_from_knob_m = value: must be in [-100, 100]"
+/// in *refusal (if non-null).
+bool ValidatePivotFromKnob(double pivot_from_knob_m, Refusal* refusal);
+
 /// Mass properties of `bat` (precondition: bat.IsValid(nullptr); for an
 /// invalid bat every field is NaN). Never throws, never allocates; O(knots).
 MassProperties ComputeMassProperties(const Bat& bat, InertiaModel model = InertiaModel::kRigidBody);

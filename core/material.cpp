@@ -173,6 +173,15 @@ bool Material::Validate(Refusal* why) const {
   return true;
 }
 
+bool Material::ValidateSize(Refusal* why) const {
+  if (!Validate(why)) return false;
+  return CheckInRange(why, "density_kg_m3", density_kg_m3, 0.0, kMaxDensityKgM3,
+                      /*lo_open=*/true) &&
+         CheckInRange(why, "youngs_modulus_pa", youngs_modulus_pa, 0.0, kMaxModulusPa, true) &&
+         CheckInRange(why, "shear_modulus_pa", shear_modulus_pa, 0.0, kMaxModulusPa, false,
+                      " (0 = derive from poissons_ratio)");
+}
+
 double Material::EffectiveShearModulusPa() const {
   if (shear_modulus_pa > 0.0) return shear_modulus_pa;
   return youngs_modulus_pa / (2.0 * (1.0 + poissons_ratio));

@@ -10,6 +10,13 @@
 
 namespace sweetspot::core {
 
+// The magnitudes a material given from outside (a request) is held to, by ValidateSize.
+// Core's numerics work beyond them (tests/hard_cases: 1e6 kg/m³, E x 1e6).
+/// Largest density of a material, kg/m³ (osmium, the densest element, has 22,590).
+inline constexpr double kMaxDensityKgM3 = 1e5;
+/// Largest Young's or shear modulus of a material, Pa (diamond's is about 1.2e12).
+inline constexpr double kMaxModulusPa = 1e13;
+
 /// An isotropic material (for wood: the longitudinal modulus and the
 /// longitudinal-radial shear modulus and Poisson's ratio). All values SI.
 struct Material {
@@ -35,6 +42,10 @@ struct Material {
   bool IsValid(std::string* why) const;
   /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
   bool Validate(Refusal* refusal) const;
+  /// Validate, then the plausible magnitudes: density in (0, kMaxDensityKgM3], E in
+  /// (0, kMaxModulusPa], G in [0, kMaxModulusPa] ("density_kg_m3 = 2e+05: must be in
+  /// (0, 1e+05]"); for a material given from outside.
+  bool ValidateSize(Refusal* refusal) const;
   /// Shear modulus in Pa: shear_modulus_pa if set, else E / (2 (1 + nu)).
   double EffectiveShearModulusPa() const;
 };

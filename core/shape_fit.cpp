@@ -124,6 +124,14 @@ bool ShapeFitOptions::Validate(Refusal* why) const {
     return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
                   "must be finite and non-negative (0 = the target)");
   }
+  if (mass_scale_kg > kMaxFitMassKg) {
+    return Refuse(why, "mass_scale_kg", mass_scale_kg,
+                  RangeRule(0.0, kMaxFitMassKg) + " (0 = the target)");
+  }
+  if (balance_point_scale_m > kMaxBatLengthM) {
+    return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
+                  RangeRule(0.0, kMaxBatLengthM) + " (0 = the target)");
+  }
   // Smaller scales overflow the scaled residuals to inf (found by fuzzing).
   if (mass_scale_kg > 0.0 && mass_scale_kg < kMinMetricScale) {
     return Refuse(why, "mass_scale_kg", mass_scale_kg, "must be 0 (the target) or at least 1e-06");
@@ -132,9 +140,7 @@ bool ShapeFitOptions::Validate(Refusal* why) const {
     return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
                   "must be 0 (the target) or at least 1e-06");
   }
-  if (!std::isfinite(tolerance) || !(tolerance > 0.0)) {
-    return Refuse(why, "tolerance", tolerance, "must be finite and positive");
-  }
+  if (!CheckInRange(why, "tolerance", tolerance, kMinFitTolerance, kMaxFitTolerance)) return false;
   if (!std::isfinite(kkt_tolerance) || !(kkt_tolerance > 0.0)) {
     return Refuse(why, "kkt_tolerance", kkt_tolerance, "must be finite and positive");
   }
@@ -172,6 +178,14 @@ bool ShapeFitProblem::Validate(Refusal* why) const {
   if (targets.balance_point_m.has_value() && *targets.balance_point_m < kMinMetricScale) {
     return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
                   "must be at least 1e-06");
+  }
+  if (targets.mass_kg.has_value() && *targets.mass_kg > kMaxFitMassKg) {
+    return Refuse(why, "targets.mass_kg", *targets.mass_kg,
+                  RangeRule(kMinMetricScale, kMaxFitMassKg));
+  }
+  if (targets.balance_point_m.has_value() && *targets.balance_point_m > kMaxBatLengthM) {
+    return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
+                  RangeRule(kMinMetricScale, kMaxBatLengthM));
   }
   if (unknowns.empty() || unknowns.size() > static_cast<std::size_t>(kNumFitVariables)) {
     return Refuse(why, "unknowns.size()", static_cast<double>(unknowns.size()),
@@ -262,6 +276,20 @@ bool ShapeFitProblem::Validate(Refusal* why) const {
     if (!fit_detail::ConstraintInvolves(kind, unknown) &&
         fit_detail::ConstraintValue(kind, t, hollow) > 0.0) {
       return Refuse(why, fit_detail::ConstraintRefusal(kind, t, hollow));
+    }
+  }
+  return true;
+}
+
+bool ShapeFitProblem::ValidateSize(Refusal* why) const {
+  if (!Validate(why)) return false;
+  for (std::size_t i = 0; i < unknowns.size(); ++i) {
+    const FitUnknown& u = unknowns[i];
+    if (u.min > kMaxFitBound || u.max > kMaxFitBound) {
+      const bool min = u.min > kMaxFitBound;
+      return why == nullptr ? false
+                            : Refuse(why, IndexedField("unknowns", i, min ? "min" : "max"),
+                                     min ? u.min : u.max, RangeRule(0.0, kMaxFitBound));
     }
   }
   return true;

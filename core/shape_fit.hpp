@@ -35,6 +35,16 @@
 
 namespace sweetspot::core {
 
+/// Largest bound of a fit's unknown given from outside (ShapeFitProblem::ValidateSize), in
+/// the unknown's unit (m or kg/m³); core fits beyond it (tests/hard_cases: 1e6 kg/m³).
+inline constexpr double kMaxFitBound = 1e5;
+/// Largest target mass and mass scale of a fit, kg.
+inline constexpr double kMaxFitMassKg = 1e4;
+/// Smallest tolerance of a fit's targets (scaled residual, dimensionless).
+inline constexpr double kMinFitTolerance = 1e-15;
+/// Largest tolerance of a fit's targets (scaled residual, dimensionless).
+inline constexpr double kMaxFitTolerance = 0.1;
+
 /// A dimension of a three-segment bat that the fit may change.
 enum class FitVariable {
   kTaperStart,     ///< "taper_start_m": x1, m.
@@ -57,14 +67,17 @@ std::optional<FitVariable> FitVariableFromName(std::string_view name);
 /// One unknown and its bounds, in the variable's unit.
 struct FitUnknown {
   FitVariable variable = FitVariable::kTaperStart;  ///< What is unknown.
-  double min = 0.0;                                 ///< Lower bound (unit of the variable).
-  double max = 0.0;                                 ///< Upper bound (unit of the variable; > min).
+  /// Lower bound (unit of the variable), >= 0 (ShapeFitProblem::ValidateSize: <= kMaxFitBound).
+  double min = 0.0;
+  /// Upper bound (unit of the variable; > min; ShapeFitProblem::ValidateSize: <= kMaxFitBound).
+  double max = 0.0;
 };
 
 /// What the fitted bat must weigh and where it must balance; at least one.
 struct FitTargets {
-  std::optional<double> mass_kg;          ///< Target mass, kg (> 0).
-  std::optional<double> balance_point_m;  ///< Target balance point from the knob, m (> 0).
+  std::optional<double> mass_kg;  ///< Target mass, kg, in [1e-6, kMaxFitMassKg].
+  /// Target balance point from the knob, m, in [1e-6, kMaxBatLengthM].
+  std::optional<double> balance_point_m;
 };
 
 /// The bat family and the unknowns. Fields that are unknowns give the
@@ -81,14 +94,19 @@ struct ShapeFitProblem {
   bool IsValid(std::string* why) const;
   /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
   bool Validate(Refusal* refusal) const;
+  /// Validate, then every unknown's bounds at most kMaxFitBound ("unknowns[0].max = 2e+05:
+  /// must be in [0, 1e+05]"); for a problem given from outside.
+  bool ValidateSize(Refusal* refusal) const;
 };
 
 /// How the fit runs. Defaults are valid.
 struct ShapeFitOptions {
-  double mass_scale_kg = 0.0;  ///< s_M of the metric, kg (>= 0; 0 = the target mass).
-  /// s_C of the metric, m (>= 0; 0 = the target balance point).
+  /// s_M of the metric, kg, in [0, kMaxFitMassKg] (0 = the target mass).
+  double mass_scale_kg = 0.0;
+  /// s_C of the metric, m, in [0, kMaxBatLengthM] (0 = the target balance point).
   double balance_point_scale_m = 0.0;
-  /// Targets are met when every scaled residual |value - target| / s is at most this (> 0).
+  /// Targets are met when every scaled residual |value - target| / s is at most this, in
+  /// [kMinFitTolerance, kMaxFitTolerance].
   double tolerance = 1e-9;
   /// Relative first-order (KKT) residual below which the closest bat is certified (> 0).
   double kkt_tolerance = 1e-6;

@@ -46,8 +46,8 @@ TEST(BatPropertiesTest, ThreeSegmentFormEqualsThePreset) {
 }
 
 TEST(BatPropertiesTest, PivotAddsMoiAboutThePivotByParallelAxes) {
-  const Response r = Post("/v1/bat/properties",
-                          R"({"bat": {"preset": "paper-wood"}, "pivot_from_knob_m": -0.1})");
+  const Response r =
+      Post("/v1/bat/properties", R"({"bat": {"preset": "paper-wood"}, "pivot_from_knob_m": -0.1})");
   ASSERT_EQ(r.status, 200);
   const double m = r.body["mass_kg"], c = r.body["balance_point_m"];
   const double icm = r.body["moi_centroid_kg_m2"];
@@ -107,7 +107,8 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, BatRefusalTest,
     ::testing::Values(
         Refusal{"missing_bat", "{}", 400, "MissingField", "bat", "bat is required"},
-        Refusal{"not_object", "[1]", 400, "InvalidValue", nullptr, "body = [1]: must be a JSON object"},
+        Refusal{"not_object", "[1]", 400, "InvalidValue", nullptr,
+                "body = [1]: must be a JSON object"},
         Refusal{"bad_json", "{\"bat\": ", 400, "InvalidJson", nullptr, "body is not valid JSON"},
         Refusal{"unknown_top", R"({"bat": {"preset": "paper-wood"}, "pivot": 1})", 400,
                 "UnknownField", "pivot", "pivot is not a known field"},
@@ -121,7 +122,71 @@ INSTANTIATE_TEST_SUITE_P(
                 R"({"bat": {"three_segment": {"length_m": -1, "handle_radius_m": 0.01,
                    "barrel_radius_m": 0.03, "taper_start_m": 0.2, "taper_end_m": 0.5}}})",
                 400, "InvalidValue", "bat.three_segment.length_m",
-                "bat.three_segment.length_m = -1: must be a number in (0, 100]"},
+                "bat.three_segment.length_m = -1: must be positive"},
+        // The ranges are core's (Bat, ThreeSegmentShape, Material validators); the api names
+        // the request's field, the value and core's rule.
+        Refusal{"length_cap",
+                R"({"bat": {"three_segment": {"length_m": 200, "handle_radius_m": 0.01,
+                   "barrel_radius_m": 0.03, "taper_start_m": 0.2, "taper_end_m": 0.5}}})",
+                400, "InvalidValue", "bat.three_segment.length_m",
+                "bat.three_segment.length_m = 200: must be in (0, 100]"},
+        Refusal{"radius_cap",
+                R"({"bat": {"three_segment": {"length_m": 0.8, "handle_radius_m": 0.01,
+                   "barrel_radius_m": 11, "taper_start_m": 0.2, "taper_end_m": 0.5}}})",
+                400, "InvalidValue", "bat.three_segment.barrel_radius_m",
+                "bat.three_segment.barrel_radius_m = 11: must be in (0, 10]"},
+        Refusal{"negative_taper_start",
+                R"({"bat": {"three_segment": {"length_m": 0.8, "handle_radius_m": 0.01,
+                   "barrel_radius_m": 0.03, "taper_start_m": -0.1, "taper_end_m": 0.5}}})",
+                400, "InvalidValue", "bat.three_segment.taper_start_m",
+                "bat.three_segment.taper_start_m = -0.1: must be non-negative"},
+        Refusal{"knot_position_cap",
+                R"({"bat": {"profile": {"knots": [{"x_m": 0, "radius_m": 0.02},
+                   {"x_m": 150, "radius_m": 0.02}]}}})",
+                400, "InvalidValue", "bat.profile.knots[1].x_m",
+                "bat.profile.knots[1].x_m = 150: must be in [0, 100]"},
+        Refusal{"knot_radius_cap",
+                R"({"bat": {"profile": {"knots": [{"x_m": 0, "radius_m": 0.02},
+                   {"x_m": 0.8, "radius_m": 11}]}}})",
+                400, "InvalidValue", "bat.profile.knots[1].radius_m",
+                "bat.profile.knots[1].radius_m = 11: must be in (0, 10]"},
+        // The wall is capped by the radii (it must be below the smallest).
+        Refusal{"wall_cap", R"({"bat": {"preset": "paper-wood", "wall_thickness_m": 11}})", 400,
+                "InvalidValue", "bat.wall_thickness_m",
+                "bat.wall_thickness_m = 11: must be less than the smallest outer radius"},
+        Refusal{"fill_diameter_cap", R"({"bat": {"profile": {"knots": [{"x_m": 0, "radius_m": 10},
+                   {"x_m": 0.8, "radius_m": 10}]}, "material": "ash",
+                   "fill": {"material": "cork", "diameter_m": 15, "depth_m": 0.2}}})",
+                400, "InvalidValue", "bat.fill.diameter_m",
+                "bat.fill.diameter_m = 15: must be in [0, 10]"},
+        Refusal{"fill_depth_cap", R"({"bat": {"preset": "paper-wood",
+                   "fill": {"material": "cork", "diameter_m": 0.02, "depth_m": 101}}})",
+                400, "InvalidValue", "bat.fill.depth_m",
+                "bat.fill.depth_m = 101: must not exceed the bat's length"},
+        Refusal{"density_cap", R"({"bat": {"preset": "paper-wood", "material":
+                   {"density_kg_m3": 2e5, "youngs_modulus_pa": 1e10}}})",
+                400, "InvalidValue", "bat.material.density_kg_m3",
+                "bat.material.density_kg_m3 = 2e+05: must be in (0, 1e+05]"},
+        Refusal{"youngs_modulus_cap", R"({"bat": {"preset": "paper-wood", "material":
+                   {"density_kg_m3": 600, "youngs_modulus_pa": 2e13}}})",
+                400, "InvalidValue", "bat.material.youngs_modulus_pa",
+                "bat.material.youngs_modulus_pa = 2e+13: must be in (0, 1e+13]"},
+        Refusal{"shear_modulus_cap", R"({"bat": {"preset": "paper-wood", "material":
+                   {"density_kg_m3": 600, "youngs_modulus_pa": 1e10, "shear_modulus_pa": 2e13}}})",
+                400, "InvalidValue", "bat.material.shear_modulus_pa",
+                "bat.material.shear_modulus_pa = 2e+13: must be in [0, 1e+13]"},
+        Refusal{"material_cor", R"({"bat": {"preset": "paper-wood", "material":
+                   {"density_kg_m3": 600, "youngs_modulus_pa": 1e10, "cor": 1.5}}})",
+                400, "InvalidValue", "bat.material.cor",
+                "bat.material.cor = 1.5: must be between 0 and 1"},
+        Refusal{"fill_material_density_cap", R"({"bat": {"preset": "paper-wood", "fill":
+                   {"material": {"density_kg_m3": 2e5, "youngs_modulus_pa": 1e10},
+                    "diameter_m": 0.02, "depth_m": 0.2}}})",
+                400, "InvalidValue", "bat.fill.material.density_kg_m3",
+                "bat.fill.material.density_kg_m3 = 2e+05: must be in (0, 1e+05]"},
+        Refusal{"pivot_cap", R"({"bat": {"preset": "paper-wood"}, "pivot_from_knob_m": -150})", 400,
+                "InvalidValue", "pivot_from_knob_m",
+                "pivot_from_knob_m = -150: must be in [-100, 100]"},
         Refusal{"taper_order",
                 R"({"bat": {"three_segment": {"length_m": 0.8, "handle_radius_m": 0.01,
                    "barrel_radius_m": 0.03, "taper_start_m": 0.6, "taper_end_m": 0.5}}})",
@@ -130,8 +195,7 @@ INSTANTIATE_TEST_SUITE_P(
         Refusal{"knots_not_increasing",
                 R"({"bat": {"profile": {"knots": [{"x_m": 0, "radius_m": 0.02},
                    {"x_m": 0.5, "radius_m": 0.02}, {"x_m": 0.4, "radius_m": 0.03}]}}})",
-                400, "InvalidValue", "bat.profile.knots[2].x_m",
-                "bat.profile.knots[2].x_m = 0.4"},
+                400, "InvalidValue", "bat.profile.knots[2].x_m", "bat.profile.knots[2].x_m = 0.4"},
         Refusal{"knot_string",
                 R"({"bat": {"profile": {"knots": [{"x_m": 0, "radius_m": "wide"},
                    {"x_m": 0.5, "radius_m": 0.02}]}}})",
@@ -147,8 +211,8 @@ INSTANTIATE_TEST_SUITE_P(
         Refusal{"fill_too_wide", R"({"bat": {"preset": "paper-wood",
                    "fill": {"material": "cork", "diameter_m": 0.08, "depth_m": 0.2}}})",
                 400, "InvalidValue", "bat.fill.diameter_m", "bat.fill.diameter_m = 0.08"},
-        Refusal{"unknown_material", R"({"bat": {"preset": "paper-wood", "material": "oak"}})",
-                400, "InvalidValue", "bat.material",
+        Refusal{"unknown_material", R"({"bat": {"preset": "paper-wood", "material": "oak"}})", 400,
+                "InvalidValue", "bat.material",
                 "bat.material = \"oak\": is not a catalogue material"},
         Refusal{"custom_material_incomplete",
                 R"({"bat": {"preset": "paper-wood", "material": {"density_kg_m3": 600}}})", 400,

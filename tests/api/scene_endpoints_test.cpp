@@ -187,8 +187,7 @@ TEST(SweetSpotEndpointTest, RefusalsNameTheField) {
        "options.flexible.max_modes", "options.flexible.max_modes = 2.5: must be an integer"},
       {R"({"bat": {"preset": "paper-wood"}, "ball": {"speed": 3}})", "ball.speed",
        "ball.speed is not a known field"},
-      {R"({"bat": {"preset": "paper-wood"}, "cor": 1.5})", "cor",
-       "cor = 1.5: must be a number in [0, 1]"},
+      {R"({"bat": {"preset": "paper-wood"}, "cor": 1.5})", "cor", "cor = 1.5: must be in [0, 1]"},
       {R"({"bat": {"preset": "paper-wood"}, "swing": {"angular_speed_rad_s": -1}})",
        "swing.angular_speed_rad_s", "swing.angular_speed_rad_s = -1"},
       {R"({"bat": {"preset": "paper-wood"}, "options": {"nlopt": {"algorithm": "LN_NEWUOA"}}})",
@@ -241,7 +240,16 @@ TEST(CollisionEndpointTest, ImpactOffTheBatIsRefusedAndFlexibleRuns) {
   const Response off =
       Post("/v1/collision", R"({"bat": {"preset": "paper-wood"}, "impact_from_knob_m": 0.9})");
   EXPECT_EQ(off.status, 400);
-  EXPECT_EQ(off.body["message"], "impact_from_knob_m = 0.9: must be a number in [0, 0.855]");
+  // The range is core's (Collide): the api reads the number, core refuses it by name.
+  EXPECT_EQ(off.body["code"], "InvalidValue");
+  EXPECT_EQ(off.body["field"], "impact_from_knob_m");
+  EXPECT_EQ(off.body["message"],
+            "impact_from_knob_m = 0.90000000000000002: must be within the bat [0, "
+            "0.85499999999999998]");
+  const Response behind =
+      Post("/v1/collision", R"({"bat": {"preset": "paper-wood"}, "impact_from_knob_m": -0.1})");
+  EXPECT_EQ(behind.status, 400);
+  EXPECT_EQ(behind.body["field"], "impact_from_knob_m");
   const Response flexible = Post("/v1/collision", R"({"bat": {"preset": "paper-wood"},
       "impact_from_knob_m": 0.7, "model": "flexible"})");
   ASSERT_EQ(flexible.status, 200) << flexible.body.dump();
@@ -349,6 +357,43 @@ TEST(FitEndpointTest, AttainableTargetsConvergeAndTheBatRoundTrips) {
   ASSERT_EQ(again.status, 200) << again.body.dump();
   EXPECT_NEAR(again.body["mass_kg"].get<double>(), 0.95, 1e-8);
   EXPECT_NEAR(again.body["balance_point_m"].get<double>(), 0.60, 1e-8);
+}
+
+// The fit's ranges are core's (ShapeFitProblem / ShapeFitOptions validators); the api names
+// the request's field, the value and core's rule.
+TEST(FitEndpointTest, CoreRangesAreRefusedUnderTheRequestsField) {
+  struct Case {
+    const char* body;
+    const char* field;
+    const char* message;
+  };
+  const Case cases[] = {
+      {R"({"bat": {"preset": "paper-wood"}, "targets": {"mass_kg": 2e4}})", "targets.mass_kg",
+       "targets.mass_kg = 20000: must be in [1e-06, 10000]"},
+      {R"({"bat": {"preset": "paper-wood"}, "targets": {"balance_point_m": 150}})",
+       "targets.balance_point_m", "targets.balance_point_m = 150: must be in [1e-06, 100]"},
+      {R"({"bat": {"preset": "paper-wood"}, "targets": {"mass_kg": 0.9},
+           "unknowns": [{"name": "taper_start_m", "min": 0, "max": 2e5}]})",
+       "unknowns[0].max", "unknowns[0].max = 2e+05: must be in [0, 1e+05]"},
+      {R"({"bat": {"preset": "paper-wood"}, "targets": {"mass_kg": 0.9},
+           "options": {"mass_scale_kg": 2e4}})",
+       "options.mass_scale_kg",
+       "options.mass_scale_kg = 20000: must be in [0, 10000] (0 = the target)"},
+      {R"({"bat": {"preset": "paper-wood"}, "targets": {"mass_kg": 0.9},
+           "options": {"balance_point_scale_m": 101}})",
+       "options.balance_point_scale_m",
+       "options.balance_point_scale_m = 101: must be in [0, 100] (0 = the target)"},
+      {R"({"bat": {"preset": "paper-wood"}, "targets": {"mass_kg": 0.9},
+           "options": {"tolerance": 0.5}})",
+       "options.tolerance", "options.tolerance = 0.5: must be in [1e-15, 0.1]"},
+  };
+  for (const Case& c : cases) {
+    const Response r = Post("/v1/bat/fit", c.body);
+    EXPECT_EQ(r.status, 400) << c.body << " -> " << r.body.dump();
+    EXPECT_EQ(r.body["code"], "InvalidValue") << c.body;
+    EXPECT_EQ(r.body["field"], c.field) << r.body.dump();
+    EXPECT_EQ(r.body["message"], c.message) << r.body.dump();
+  }
 }
 
 TEST(FitEndpointTest, GeneralProfileIsRefused) {

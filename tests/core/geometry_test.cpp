@@ -79,6 +79,76 @@ Bat PaperBat() {
                              *FindMaterial("paper-wood"));
 }
 
+TEST(GeometryThreeSegment, SizesGivenFromOutsideAreCapped) {
+  // Core computes beyond the caps (tests/hard_cases: a megametre bat); ValidateSize holds a
+  // shape given from outside to them.
+  Refusal r;
+  EXPECT_TRUE((ThreeSegmentShape{0.855, 0.0125, 0.035, 0.3459, 0.6423}.ValidateSize(&r)));
+  EXPECT_TRUE((ThreeSegmentShape{100.0, 10.0, 10.0, 0.0, 100.0}.ValidateSize(&r)));  // bounds
+  struct Case {
+    ThreeSegmentShape shape;
+    const char* message;
+  } cases[] = {
+      {{200.0, 0.0125, 0.035, 0.3, 0.6}, "length_m = 200: must be in (0, 100]"},
+      {{0.855, 10.5, 0.035, 0.3, 0.6}, "handle_radius_m = 10.5: must be in (0, 10]"},
+      {{0.855, 0.0125, 11.0, 0.3, 0.6}, "barrel_radius_m = 11: must be in (0, 10]"},
+      {{0.0, 0.0125, 0.035, 0.0, 0.0}, "length_m = 0: must be positive"},  // Validate's rule
+  };
+  for (const Case& c : cases) {
+    EXPECT_FALSE(c.shape.ValidateSize(&r)) << c.message;
+    EXPECT_EQ(r.Message(), c.message);
+  }
+}
+
+TEST(GeometryBat, SizesGivenFromOutsideAreCapped) {
+  struct Case {
+    void (*edit)(Bat&);
+    const char* message;
+  } cases[] = {
+      {[](Bat& b) {
+         b.knots = {{0, 0.02}, {50.0, 0.02}, {150.0, 0.03}, {250.0, 0.03}};
+       },
+       "knots[2].x_m = 150: must be in [0, 100]"},
+      {[](Bat& b) { b.knots[2].radius_m = 10.5; }, "knots[2].radius_m = 10.5: must be in (0, 10]"},
+      {[](Bat& b) {
+         b.knots = {{0, 20.0}, {0.8, 20.0}};
+         b.wall_thickness_m = 11.0;  // below the smallest radius; that radius is capped
+       },
+       "knots[0].radius_m = 20: must be in (0, 10]"},
+      {[](Bat& b) {
+         b.knots = {{0, 10.0}, {0.8, 10.0}};
+         b.fill = Fill{*FindMaterial("cork"), 15.0, 0.2};  // inside the radius, over the cap
+       },
+       "fill.diameter_m = 15: must be in [0, 10]"},
+      {[](Bat& b) {
+         b.knots = {{0, 10.0}, {50.0, 10.0}};
+         b.wall_thickness_m = 9.0;
+         b.fill = Fill{*FindMaterial("cork"), 0.02, 40.0};
+         b.fill->material.density_kg_m3 = 2e5;
+       },
+       "fill.material.density_kg_m3 = 2e+05: must be in (0, 1e+05]"},
+      {[](Bat& b) { b.material.youngs_modulus_pa = 2e13; },
+       "material.youngs_modulus_pa = 2e+13: must be in (0, 1e+13]"},
+      {[](Bat& b) { b.knots[1].radius_m = 0.0; },
+       "knots[1].radius_m = 0: must be positive"},  // Validate's rule first
+  };
+  for (const Case& c : cases) {
+    Bat bat = PaperBat();
+    c.edit(bat);
+    Refusal r;
+    EXPECT_FALSE(bat.ValidateSize(&r)) << c.message;
+    EXPECT_EQ(r.Message(), c.message);
+    EXPECT_FALSE(bat.ValidateSize(nullptr)) << c.message;
+  }
+  Refusal r;
+  EXPECT_TRUE(PaperBat().ValidateSize(&r)) << r.Message();
+  Bat big = PaperBat();  // every size at its bound is accepted
+  big.knots = {{0, kMaxBatRadiusM}, {kMaxBatLengthM, kMaxBatRadiusM}};
+  big.wall_thickness_m = 9.0;
+  big.fill = Fill{*FindMaterial("cork"), 0.5, kMaxBatLengthM};
+  EXPECT_TRUE(big.ValidateSize(&r)) << r.Message();
+}
+
 TEST(GeometryBat, RefusalsNameFieldValueAndRule) {
   struct Case {
     void (*edit)(Bat&);

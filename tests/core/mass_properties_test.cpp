@@ -568,6 +568,16 @@ TEST(MassPropertiesHard, TinyRelativePerturbationsGiveTinyChanges) {
   }
 }
 
+TEST(MassPropertiesPivot, APivotWithinAHundredMetresOfTheKnobIsValid) {
+  Refusal r;
+  EXPECT_TRUE(ValidatePivotFromKnob(0.1524, &r));
+  EXPECT_TRUE(ValidatePivotFromKnob(-kMaxPivotFromKnobM, &r));  // the bounds themselves pass
+  EXPECT_TRUE(ValidatePivotFromKnob(kMaxPivotFromKnobM, &r));
+  EXPECT_FALSE(ValidatePivotFromKnob(-150.0, &r));
+  EXPECT_EQ(r.Message(), "pivot_from_knob_m = -150: must be in [-100, 100]");
+  EXPECT_FALSE(ValidatePivotFromKnob(std::nan(""), nullptr));
+}
+
 }  // namespace
 }  // namespace mass_properties_test
 }  // namespace sweetspot::core

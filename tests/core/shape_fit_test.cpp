@@ -217,7 +217,12 @@ TEST(ShapeFitValidity, OptionRefusals) {
     void (*edit)(ShapeFitOptions&);
     const char* message;
   } cases[] = {
-      {[](ShapeFitOptions& o) { o.tolerance = 0.0; }, "tolerance = 0: must be finite and positive"},
+      {[](ShapeFitOptions& o) { o.tolerance = 0.0; }, "tolerance = 0: must be in [1e-15, 0.1]"},
+      {[](ShapeFitOptions& o) { o.tolerance = 0.5; }, "tolerance = 0.5: must be in [1e-15, 0.1]"},
+      {[](ShapeFitOptions& o) { o.mass_scale_kg = 2e4; },
+       "mass_scale_kg = 20000: must be in [0, 10000] (0 = the target)"},
+      {[](ShapeFitOptions& o) { o.balance_point_scale_m = 101.0; },
+       "balance_point_scale_m = 101: must be in [0, 100] (0 = the target)"},
       {[](ShapeFitOptions& o) { o.mass_scale_kg = -1.0; },
        "mass_scale_kg = -1: must be finite and non-negative (0 = the target)"},
       {[](ShapeFitOptions& o) { o.scan_points = 0; }, "scan_points = 0: must be at least 1"},
@@ -239,6 +244,25 @@ TEST(ShapeFitValidity, OptionRefusals) {
   }
 }
 
+TEST(ShapeFitValidity, BoundsGivenFromOutsideAreAtMostAHundredThousand) {
+  // Core fits beyond the cap (tests/hard_cases: a density of 1e6 kg/m³); ValidateSize holds a
+  // problem given from outside to it.
+  ShapeFitProblem p = Table2Problem();
+  Refusal r;
+  EXPECT_TRUE(p.ValidateSize(&r)) << r.Message();
+  p.unknowns[0].max = 2e5;
+  EXPECT_TRUE(p.Validate(nullptr));
+  ASSERT_FALSE(p.ValidateSize(&r));
+  EXPECT_EQ(r.Message(), "unknowns[0].max = 2e+05: must be in [0, 1e+05]");
+  p.unknowns[0].min = 1.5e5;
+  ASSERT_FALSE(p.ValidateSize(&r));
+  EXPECT_EQ(r.Message(), "unknowns[0].min = 150000: must be in [0, 1e+05]");
+  p.unknowns[0].max = 0.0;  // an invalid problem is refused by Validate's rule first
+  ASSERT_FALSE(p.ValidateSize(&r));
+  EXPECT_EQ(r.field, "unknowns[0].max");
+  EXPECT_EQ(r.rule.rfind("must be greater than", 0), 0u) << r.Message();
+}
+
 TEST(ShapeFitValidity, ProblemRefusals) {
   struct Case {
     void (*edit)(ShapeFitProblem&);
@@ -248,6 +272,10 @@ TEST(ShapeFitValidity, ProblemRefusals) {
        "targets: must give mass_kg, balance_point_m or both"},
       {[](ShapeFitProblem& p) { p.targets.mass_kg = -1.0; },
        "targets.mass_kg = -1: must be finite and positive"},
+      {[](ShapeFitProblem& p) { p.targets.mass_kg = 2e4; },
+       "targets.mass_kg = 20000: must be in [1e-06, 10000]"},
+      {[](ShapeFitProblem& p) { p.targets.balance_point_m = 150.0; },
+       "targets.balance_point_m = 150: must be in [1e-06, 100]"},
       {[](ShapeFitProblem& p) { p.unknowns.clear(); },
        "unknowns.size() = 0: must be between 1 and 10"},
       {[](ShapeFitProblem& p) { p.unknowns[1].variable = FitVariable::kTaperStart; },
