@@ -16,6 +16,11 @@ namespace {
 
 using Json = nlohmann::json;
 
+// The most modes one answer lists (core computes up to 50 for the flexible impact).
+constexpr long long kMaxListedModes = 20;
+// The most positions one mode's shape is sampled at in the answer.
+constexpr long long kMaxShapeSamples = 1001;
+
 // One mode: frequency, nodes and the shape sampled at `samples` evenly spaced positions,
 // scaled so that the largest |displacement| is 1 (tip positive).
 Json ModeToJson(const core::BatModes& modes, std::size_t k, int samples) {
@@ -76,17 +81,27 @@ std::optional<ModesRequest> ParseModes(const Json& body, const Context& context,
   std::string theory = "timoshenko";
   reader.OptionalString("theory", &theory, {"timoshenko", "euler_bernoulli"});
   options.theory = core::ParseBeamTheory(theory).value_or(core::BeamTheory::kTimoshenko);
+  // The answer's size, the api's to cap: at most kMaxListedModes modes (core computes up to
+  // 50 for the flexible impact), each sampled at 2 to kMaxShapeSamples positions (the
+  // sampling is the api's rendering, ModeToJson).
   long long modes = 4;
-  reader.OptionalInteger("modes", 1, 20, &modes);
+  reader.OptionalInteger("modes", 1, kMaxListedModes, &modes);
   options.num_modes = static_cast<int>(modes);
-  reader.OptionalNumber("tolerance", Between(1e-9, 0.1), &options.relative_tolerance);
   long long samples = 41;
-  reader.OptionalInteger("shape_samples", 2, 1001, &samples);
+  reader.OptionalInteger("shape_samples", 2, kMaxShapeSamples, &samples);
   request.shape_samples = static_cast<int>(samples);
-  long long max_elements = options.max_elements;
-  reader.OptionalInteger("max_elements", 2, 4096, &max_elements);
-  options.max_elements = static_cast<int>(max_elements);
+  // The solver's ranges are core's (BeamModesOptions::Validate).
+  reader.OptionalNumber("tolerance", AnyNumber(), &options.relative_tolerance);
+  reader.OptionalInt("max_elements", &options.max_elements);
   if (!reader.Finish()) return std::nullopt;
+  if (core::Refusal refusal; !options.Validate(&refusal)) {
+    // Core's names of this request's fields; no other request has them bare, so they are
+    // renamed here rather than in RequestName's table.
+    if (refusal.field == "relative_tolerance") refusal.field = "tolerance";
+    if (refusal.field == "num_modes") refusal.field = "modes";
+    CoreRefusal(refusal, "", error);
+    return std::nullopt;
+  }
   return request;
 }
 

@@ -83,6 +83,13 @@ TEST(BatModesHandlerTest, OptionsAreReadStrictly) {
                 "tolerance"},
            Case{R"({"bat": {"preset": "paper-wood"}, "shape_samples": 1})", 400, "InvalidValue",
                 "shape_samples"},
+           // Core's ranges (BeamModesOptions::Validate) under the request's names.
+           Case{R"({"bat": {"preset": "paper-wood"}, "tolerance": 0.5})", 400, "InvalidValue",
+                "tolerance"},
+           Case{R"({"bat": {"preset": "paper-wood"}, "max_elements": 1})", 400, "InvalidValue",
+                "max_elements"},
+           Case{R"({"bat": {"preset": "paper-wood"}, "max_elements": 4097})", 400, "InvalidValue",
+                "max_elements"},
            Case{R"({"bat": {"preset": "paper-wood"}, "mode": 2})", 400, "UnknownField", "mode"},
        }) {
     const Response r = Modes(c.body);
@@ -90,6 +97,16 @@ TEST(BatModesHandlerTest, OptionsAreReadStrictly) {
     EXPECT_EQ(r.body["code"], c.code) << c.body;
     EXPECT_EQ(r.body["field"], c.field) << c.body;
   }
+}
+
+TEST(BatModesHandlerTest, CoreRangesAreRefusedUnderTheRequestsNames) {
+  // core's relative_tolerance is the request's tolerance.
+  Response r = Modes(R"({"bat": {"preset": "paper-wood"}, "tolerance": 0.5})");
+  EXPECT_EQ(r.status, 400) << r.body.dump();
+  EXPECT_EQ(r.body["message"], "tolerance = 0.5: must be in [1e-9, 0.1]");
+  r = Modes(R"({"bat": {"preset": "paper-wood"}, "max_elements": 1})");
+  EXPECT_EQ(r.status, 400) << r.body.dump();
+  EXPECT_EQ(r.body["message"], "max_elements = 1: must be in [2, 4096]");
 }
 
 TEST(BatModesHandlerTest, ABatThatIsNoBeamIsRefusedNamingTheField) {
