@@ -22,9 +22,10 @@ using Json = nlohmann::json;
 
 Json Finite(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
-// A constraint: a number (equality) or {"min", "max"} (either optional).
-bool ReadRange(ObjectReader& reader, const char* key, const NumberRule& rule,
-               std::optional<core::DesignRange>* out) {
+// A constraint: a number (equality) or {"min", "max"} (either optional). The limits' ranges
+// are core's (DesignProblem::Validate).
+bool ReadRange(ObjectReader& reader, const char* key, std::optional<core::DesignRange>* out) {
+  const NumberRule rule = AnyNumber();
   const Json* value = reader.Get(key);
   if (value == nullptr || !reader.ok()) return reader.ok();
   if (value->is_number()) {
@@ -50,25 +51,23 @@ bool ReadConstraints(ObjectReader& top, core::DesignConstraints* c) {
   const Json* value = top.Get("constraints");
   if (value == nullptr || !top.ok()) return top.ok();
   ObjectReader reader(*value, "constraints", top.error());
-  ReadRange(reader, "length_m", Positive(100.0), &c->length_m);
-  ReadRange(reader, "mass_kg", Positive(1e4), &c->mass_kg);
-  ReadRange(reader, "balance_point_m", Positive(100.0), &c->balance_point_m);
-  ReadRange(reader, "moi_six_inch_kg_m2", Positive(1e4), &c->moi_six_inch_kg_m2);
-  c->max_barrel_diameter_m = reader.MaybeNumber("max_barrel_diameter_m", Positive(10.0));
-  c->min_handle_diameter_m = reader.MaybeNumber("min_handle_diameter_m", Positive(10.0));
+  // Presence and types here; the ranges are core's (DesignProblem::Validate).
+  ReadRange(reader, "length_m", &c->length_m);
+  ReadRange(reader, "mass_kg", &c->mass_kg);
+  ReadRange(reader, "balance_point_m", &c->balance_point_m);
+  ReadRange(reader, "moi_six_inch_kg_m2", &c->moi_six_inch_kg_m2);
+  c->max_barrel_diameter_m = reader.MaybeNumber("max_barrel_diameter_m", AnyNumber());
+  c->min_handle_diameter_m = reader.MaybeNumber("min_handle_diameter_m", AnyNumber());
   if (const Json* taper = reader.Get("taper")) {
     if (taper->is_string() && taper->get<std::string>() == "non_decreasing") {
       c->taper = core::TaperRule::kNonDecreasing;
     } else if (taper->is_object()) {
       ObjectReader t(*taper, "constraints.taper", top.error());
-      t.Number("max_slope", Positive(100.0), &c->max_taper_slope);
-      long long first = 0, last = -1;
-      t.OptionalInteger("first_knot", 0, 100000, &first);
-      t.OptionalInteger("last_knot", -1, 100000, &last);
+      t.Number("max_slope", AnyNumber(), &c->max_taper_slope);
+      t.OptionalInt("first_knot", &c->taper_first_knot);
+      t.OptionalInt("last_knot", &c->taper_last_knot);
       if (!t.Finish()) return false;
       c->taper = core::TaperRule::kMaxSlope;
-      c->taper_first_knot = static_cast<int>(first);
-      c->taper_last_knot = static_cast<int>(last);
     } else {
       return reader.Fail("taper", "must be \"non_decreasing\" or {\"max_slope\": dr/dx}");
     }
@@ -121,19 +120,19 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
   o->derivative_check = check == "first_order"    ? core::DerivativeCheck::kFirstOrder
                         : check == "second_order" ? core::DerivativeCheck::kSecondOrder
                                                   : core::DerivativeCheck::kNone;
+  // The budgets are the server's configured limits (checked here); the seed is any integer
+  // a JSON number holds exactly; the other ranges are core's (DesignOptions::Validate).
   long long iterations = o->max_iterations;
-  long long starts = o->starts, seed = 1;
+  long long seed = 1;
   reader.OptionalInteger("max_iterations", 1, limits.max_iterations, &iterations);
-  reader.OptionalInteger("starts", 1, 64, &starts);
+  reader.OptionalInt("starts", &o->starts);
   reader.OptionalInteger("seed", 0, 1LL << 53, &seed);
   o->max_iterations = static_cast<int>(iterations);
-  o->starts = static_cast<int>(starts);
   o->seed = static_cast<std::uint64_t>(seed);
   reader.OptionalNumber("max_time_s", Positive(limits.max_time_s), &o->max_time_s);
   reader.OptionalNumber("max_cpu_time_s", NonNegative(limits.max_time_s), &o->max_cpu_time_s);
-  reader.OptionalNumber("tolerance", NumberRule{0.0, 1.0, true, true, false}, &o->tolerance);
-  reader.OptionalNumber("constraint_tolerance", NumberRule{0.0, 1.0, true, true, false},
-                        &o->constraint_tolerance);
+  reader.OptionalNumber("tolerance", AnyNumber(), &o->tolerance);
+  reader.OptionalNumber("constraint_tolerance", AnyNumber(), &o->constraint_tolerance);
   reader.OptionalBool("explain_infeasibility", &o->explain_infeasibility);
   if (const Json* f = reader.Get("flexible")) {
     if (!ReadFlexibleOptions(*f, reader.PathOf("flexible"), limits, flexible, top.error())) {
@@ -305,8 +304,8 @@ bool ReadVariables(ObjectReader& reader, const ApiLimits& limits, core::DesignPr
       if (!v.Finish()) return false;
       continue;
     }
-    v.Number("min", Between(-1e12, 1e12), &variable.min);
-    v.Number("max", Between(-1e12, 1e12), &variable.max);
+    v.Number("min", AnyNumber(), &variable.min);  // the bounds' ranges: core's
+    v.Number("max", AnyNumber(), &variable.max);
     if (!v.Finish()) return false;
     if (!core::ParseDesignVariablePath(variable.path)) {
       return SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*variables)[i]["path"],
@@ -350,9 +349,8 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
                         {"max_exit_speed", "max_exit_speed_swing_weight", "widest_sweet_zone",
                          "min_moi", "min_sting"});
   problem.objective = *core::ParseDesignObjective(request.objective);
-  reader.OptionalNumber("swing_weight_exponent", Between(0.0, 0.5), &problem.swing_weight_exponent);
-  reader.OptionalNumber("sweet_zone_tolerance_mps", Positive(100.0),
-                        &problem.sweet_zone_tolerance_mps);
+  reader.OptionalNumber("swing_weight_exponent", AnyNumber(), &problem.swing_weight_exponent);
+  reader.OptionalNumber("sweet_zone_tolerance_mps", AnyNumber(), &problem.sweet_zone_tolerance_mps);
   if (!ReadOptions(reader, context.limits, problem.objective, &request.options,
                    &problem.flexible) ||
       !reader.Finish()) {

@@ -180,6 +180,9 @@ std::string RequestName(std::string_view core_field) {
       {"hertz.paper.", "hertz.paper_constants."},
       {"flexible.impact.frequency_tolerance", "flexible.mode_frequency_tolerance"},
       {"ball.stiffness", "ball.stiffness_n_m_p"},
+      {"constraints.max_taper_slope", "constraints.taper.max_slope"},
+      {"constraints.taper_first_knot", "constraints.taper.first_knot"},
+      {"constraints.taper_last_knot", "constraints.taper.last_knot"},
   };
   for (const Renamed& r : kRenamed) {
     const bool head = r.core.back() == '.';

@@ -25,10 +25,9 @@ bool ModelBuilder::CheckScene() {
     return Refuse(why, "swing_weight_exponent", problem.swing_weight_exponent,
                   "must be in [0, 0.5]");
   }
-  if (!(std::isfinite(problem.sweet_zone_tolerance_mps) &&
-        problem.sweet_zone_tolerance_mps > 0.0)) {
-    return Refuse(why, "sweet_zone_tolerance_mps", problem.sweet_zone_tolerance_mps,
-                  "must be finite and positive");
+  if (!CheckInRange(why, "sweet_zone_tolerance_mps", problem.sweet_zone_tolerance_mps, 0.0,
+                    kMaxDesignZoneToleranceMps, /*lo_open=*/true)) {
+    return false;
   }
   exit_speed_objective = problem.objective != DesignObjective::kMinMoi;
   if (exit_speed_objective && problem.ball.speed_mps == 0.0 &&
@@ -144,6 +143,10 @@ bool ModelBuilder::CheckVariable(std::size_t i, const DesignVariable& v,
   if (!std::isfinite(v.max)) {
     return Refuse(why, field + "max", v.max,
                   "must be finite (an optimisation needs bounded variables)");
+  }
+  if (!CheckInRange(why, field + "min", v.min, -kMaxDesignBound, kMaxDesignBound) ||
+      !CheckInRange(why, field + "max", v.max, -kMaxDesignBound, kMaxDesignBound)) {
+    return false;
   }
   if (!(v.max > v.min)) {
     return Refuse(why, field + "max", v.max,

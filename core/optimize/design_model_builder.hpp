@@ -129,7 +129,7 @@ struct ModelBuilder {
   void AddNonlinear(const std::string& name, const std::string& unit, DesignFunction f,
                     double lower, double upper);
   // A range from the request, checked.
-  bool RangeOf(const char* field, const DesignRange& r, double* lower, double* upper);
+  bool RangeOf(const char* field, const DesignRange& r, double cap, double* lower, double* upper);
   // Length: the request's range and the rules' maximum.
   bool LengthConstraint();
   // Mass properties and the rules' drop.

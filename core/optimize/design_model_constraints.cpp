@@ -75,7 +75,8 @@ void ModelBuilder::AddNonlinear(const std::string& name, const std::string& unit
 }
 
 // A range from the request, checked.
-bool ModelBuilder::RangeOf(const char* field, const DesignRange& r, double* lower, double* upper) {
+bool ModelBuilder::RangeOf(const char* field, const DesignRange& r, double cap, double* lower,
+                           double* upper) {
   *lower = r.min.value_or(-kInf);
   *upper = r.max.value_or(kInf);
   if (!r.min.has_value() && !r.max.has_value()) {
@@ -87,6 +88,13 @@ bool ModelBuilder::RangeOf(const char* field, const DesignRange& r, double* lowe
   if (r.max.has_value() && !std::isfinite(*r.max)) {
     return Refuse(why, std::string("constraints.") + field + ".max", *r.max, "must be finite");
   }
+  // Each limit in (0, cap]; an equality (a number in the request) is named without .min.
+  const std::string name = std::string("constraints.") + field;
+  if (r.min.has_value() && !CheckInRange(why, r.IsEquality() ? name : name + ".min", *r.min, 0.0,
+                                         cap, /*lo_open=*/true)) {
+    return false;
+  }
+  if (r.max.has_value() && !CheckInRange(why, name + ".max", *r.max, 0.0, cap, true)) return false;
   if (*lower > *upper) {
     return Refuse(
         why, std::string("constraints.") + field + ".max", *upper,
@@ -101,7 +109,7 @@ bool ModelBuilder::LengthConstraint() {
   std::string max_name = "length_m.max";
   bool equality = false;
   if (cons.length_m.has_value()) {
-    if (!RangeOf("length_m", *cons.length_m, &lower, &upper)) return false;
+    if (!RangeOf("length_m", *cons.length_m, kMaxBatLengthM, &lower, &upper)) return false;
     equality = cons.length_m->IsEquality();
   }
   for (RuleSet rule : cons.rules) {
@@ -136,16 +144,19 @@ bool ModelBuilder::PropertyConstraints() {
     const char* unit;
     const std::optional<DesignRange>* range;
     DesignFunction f;
+    double cap;  // the largest limit, unit of the quantity
   };
   const PropertyField properties[] = {
-      {"mass_kg", "kg", &cons.mass_kg, DesignFunction::kMass},
-      {"balance_point_m", "m", &cons.balance_point_m, DesignFunction::kBalancePoint},
-      {"moi_six_inch_kg_m2", "kg_m2", &cons.moi_six_inch_kg_m2, DesignFunction::kMoiSixInch},
+      {"mass_kg", "kg", &cons.mass_kg, DesignFunction::kMass, kMaxDesignMassKg},
+      {"balance_point_m", "m", &cons.balance_point_m, DesignFunction::kBalancePoint,
+       kMaxBatLengthM},
+      {"moi_six_inch_kg_m2", "kg_m2", &cons.moi_six_inch_kg_m2, DesignFunction::kMoiSixInch,
+       kMaxDesignMoiKgM2},
   };
   for (const PropertyField& pf : properties) {
     if (!pf.range->has_value()) continue;
     double lower = 0.0, upper = 0.0;
-    if (!RangeOf(pf.name, **pf.range, &lower, &upper)) return false;
+    if (!RangeOf(pf.name, **pf.range, pf.cap, &lower, &upper)) return false;
     AddNonlinear(pf.name, pf.unit, pf.f, lower, upper);
   }
   for (RuleSet rule : cons.rules) {
@@ -182,9 +193,9 @@ bool ModelBuilder::DiameterConstraints() {
   double max_d = kInf;
   std::string max_name;
   if (cons.max_barrel_diameter_m.has_value()) {
-    if (!(std::isfinite(*cons.max_barrel_diameter_m) && *cons.max_barrel_diameter_m > 0.0)) {
-      return Refuse(why, "constraints.max_barrel_diameter_m", *cons.max_barrel_diameter_m,
-                    "must be finite and positive");
+    if (!CheckInRange(why, "constraints.max_barrel_diameter_m", *cons.max_barrel_diameter_m, 0.0,
+                      kMaxDesignDiameterM, /*lo_open=*/true)) {
+      return false;
     }
     max_d = *cons.max_barrel_diameter_m;
     max_name = "max_barrel_diameter_m";
@@ -204,9 +215,9 @@ bool ModelBuilder::DiameterConstraints() {
     }
   }
   if (cons.min_handle_diameter_m.has_value()) {
-    if (!(std::isfinite(*cons.min_handle_diameter_m) && *cons.min_handle_diameter_m > 0.0)) {
-      return Refuse(why, "constraints.min_handle_diameter_m", *cons.min_handle_diameter_m,
-                    "must be finite and positive");
+    if (!CheckInRange(why, "constraints.min_handle_diameter_m", *cons.min_handle_diameter_m, 0.0,
+                      kMaxDesignDiameterM, /*lo_open=*/true)) {
+      return false;
     }
     for (std::size_t q = 0; q < radius_knots.size(); ++q) {
       const std::string n = "min_handle_diameter_m" + knot_suffix[q];
@@ -221,13 +232,23 @@ bool ModelBuilder::DiameterConstraints() {
 bool ModelBuilder::TaperPairs(std::vector<std::pair<int, int>>* pairs_out,
                               std::vector<std::string>* suffix_out) {
   if (cons.taper == TaperRule::kMaxSlope &&
-      !(std::isfinite(cons.max_taper_slope) && cons.max_taper_slope > 0.0)) {
-    return Refuse(why, "constraints.max_taper_slope", cons.max_taper_slope,
-                  "must be finite and positive");
+      !CheckInRange(why, "constraints.max_taper_slope", cons.max_taper_slope, 0.0, kMaxTaperSlope,
+                    /*lo_open=*/true)) {
+    return false;
   }
+
   std::vector<std::pair<int, int>> pairs;  // knot a, knot b (a before b)
   std::vector<std::string> suffix;
   if (problem.three_segment.has_value()) {
+    // The shape's own pair; the knot indices must still be indices (or -1 for the last).
+    if (cons.taper_first_knot < 0) {
+      return Refuse(why, IntegerRefusal("constraints.taper_first_knot", cons.taper_first_knot,
+                                        "must be a knot index (>= 0)"));
+    }
+    if (cons.taper_last_knot < -1) {
+      return Refuse(why, IntegerRefusal("constraints.taper_last_knot", cons.taper_last_knot,
+                                        "must be -1 (the last knot) or a knot index"));
+    }
     pairs = {{1, 2}};
     suffix = {".three_segment"};
   } else {

@@ -24,6 +24,19 @@
 
 namespace sweetspot::core {
 
+/// Largest magnitude of a design variable's bounds, in the field's unit (m or kg/m³).
+inline constexpr double kMaxDesignBound = 1e12;
+/// Largest mass a design constraint names (constraints.mass_kg), kg.
+inline constexpr double kMaxDesignMassKg = 1e4;
+/// Largest MOI a design constraint names (constraints.moi_six_inch_kg_m2), kg·m².
+inline constexpr double kMaxDesignMoiKgM2 = 1e4;
+/// Largest diameter a design constraint names (max_barrel_diameter_m, min_handle_diameter_m), m.
+inline constexpr double kMaxDesignDiameterM = 10.0;
+/// Largest taper slope a design constraint allows (constraints.max_taper_slope), m per m.
+inline constexpr double kMaxTaperSlope = 100.0;
+/// Largest sweet-zone tolerance of the widest_sweet_zone objective, m/s.
+inline constexpr double kMaxDesignZoneToleranceMps = 100.0;
+
 /// What a design variable changes. The stable name of each is the request path of the field.
 enum class DesignVariableKind {
   kKnotRadius,     ///< "profile.knots[i].radius_m": outer radius of knot i, m.
@@ -54,8 +67,8 @@ std::string DesignVariablePath(const DesignVariableRef& ref);
 /// A field the optimiser may change, with its bounds in the field's unit.
 struct DesignVariable {
   std::string path;  ///< The field (see DesignVariableKind), e.g. "three_segment.taper_start_m".
-  double min = 0.0;  ///< Lower bound, field unit (finite).
-  double max = 0.0;  ///< Upper bound, field unit (finite, > min).
+  double min = 0.0;  ///< Lower bound, field unit, in [-kMaxDesignBound, kMaxDesignBound].
+  double max = 0.0;  ///< Upper bound, field unit, in (min, kMaxDesignBound].
 };
 
 /// A constraint's allowed values: equality when min == max; either side may be open.
@@ -85,19 +98,25 @@ enum class TaperRule {
 /// What must hold. Names of the constraints (for active constraints and conflicts) are given
 /// per field; a range reports "<name>.min" / "<name>.max" when one side is active.
 struct DesignConstraints {
-  std::optional<DesignRange> length_m;            ///< "length_m": L, m.
-  std::optional<DesignRange> mass_kg;             ///< "mass_kg": kg.
-  std::optional<DesignRange> balance_point_m;     ///< "balance_point_m": from the knob, m.
-  std::optional<DesignRange> moi_six_inch_kg_m2;  ///< "moi_six_inch_kg_m2": about 0.1524 m, kg·m².
-  /// "max_barrel_diameter_m.knots[i]": every knot's diameter at most this, m.
+  /// "length_m": L, m; limits in (0, kMaxBatLengthM].
+  std::optional<DesignRange> length_m;
+  std::optional<DesignRange> mass_kg;  ///< "mass_kg": kg; limits in (0, kMaxDesignMassKg].
+  /// "balance_point_m": from the knob, m; limits in (0, kMaxBatLengthM].
+  std::optional<DesignRange> balance_point_m;
+  /// "moi_six_inch_kg_m2": about 0.1524 m, kg·m²; limits in (0, kMaxDesignMoiKgM2].
+  std::optional<DesignRange> moi_six_inch_kg_m2;
+  /// "max_barrel_diameter_m.knots[i]": every knot's diameter at most this, m, in
+  /// (0, kMaxDesignDiameterM].
   std::optional<double> max_barrel_diameter_m;
-  /// "min_handle_diameter_m.knots[i]": every knot's diameter at least this, m.
+  /// "min_handle_diameter_m.knots[i]": every knot's diameter at least this, m, in
+  /// (0, kMaxDesignDiameterM].
   std::optional<double> min_handle_diameter_m;
   TaperRule taper = TaperRule::kNone;  ///< "taper.knots[i]" / "max_slope.knots[i]" (i to i+1).
-  double max_taper_slope = 0.0;        ///< kMaxSlope: largest |dr/dx| (m per m, > 0).
-  int taper_first_knot = 0;            ///< Profile: the taper rule starts at this knot (>= 0).
-  int taper_last_knot = -1;            ///< Profile: ... and ends at this knot (-1 = the last).
-  std::vector<RuleSet> rules;          ///< League rule sets ("rules.<name>.<limit>").
+  /// kMaxSlope: largest |dr/dx|, m per m, in (0, kMaxTaperSlope].
+  double max_taper_slope = 0.0;
+  int taper_first_knot = 0;    ///< Profile: the taper rule starts at this knot (>= 0).
+  int taper_last_knot = -1;    ///< Profile: ... and ends at this knot (-1 = the last).
+  std::vector<RuleSet> rules;  ///< League rule sets ("rules.<name>.<limit>").
 };
 
 /// What to improve.
@@ -136,7 +155,8 @@ struct DesignProblem {
   /// kMaxExitSpeedSwingWeight: n in omega = omega0 (I6 / I6_ref)^-n, in [0, 0.5]; I6_ref is the
   /// base design's MOI about the 6-in point, so the base design swings at omega0.
   double swing_weight_exponent = 0.27;
-  /// kWidestSweetZone: the zone is where the exit speed is within this of the max, m/s (> 0).
+  /// kWidestSweetZone: the zone is where the exit speed is within this of the max, m/s, in
+  /// (0, kMaxDesignZoneToleranceMps].
   double sweet_zone_tolerance_mps = 1.0;
   Ball ball;  ///< The pitched ball.
   /// The swing (pivot and omega0); the hands (hands_from_knob_m) only for min_sting.

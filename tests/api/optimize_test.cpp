@@ -128,6 +128,89 @@ TEST(OptimizeEndpointTest, InvalidRequestsAreNamed) {
       << r.body.dump();
 }
 
+// The ranges of the constraints, the objective's settings, the variables' bounds and the
+// options are core's (DesignProblem / DesignOptions validators); the api names the request's
+// field, the value and core's rule.
+TEST(OptimizeEndpointTest, CoreRangesAreRefusedUnderTheRequestsField) {
+  struct Case {
+    const char* what;
+    void (*edit)(Json&);
+    const char* field;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"length cap", [](Json& b) { b["constraints"]["length_m"] = 150; }, "constraints.length_m",
+       "constraints.length_m = 150: must be in (0, 100]"},
+      {"mass 0",
+       [](Json& b) {
+         b["constraints"]["mass_kg"] = {{"min", 0}};
+       },
+       "constraints.mass_kg.min", "constraints.mass_kg.min = 0: must be in (0, 10000]"},
+      {"balance cap",
+       [](Json& b) {
+         b["constraints"]["balance_point_m"] = {{"max", 200}};
+       },
+       "constraints.balance_point_m.max",
+       "constraints.balance_point_m.max = 200: must be in (0, 100]"},
+      {"moi cap", [](Json& b) { b["constraints"]["moi_six_inch_kg_m2"] = 2e4; },
+       "constraints.moi_six_inch_kg_m2",
+       "constraints.moi_six_inch_kg_m2 = 20000: must be in (0, 10000]"},
+      {"barrel cap", [](Json& b) { b["constraints"]["max_barrel_diameter_m"] = 11; },
+       "constraints.max_barrel_diameter_m",
+       "constraints.max_barrel_diameter_m = 11: must be in (0, 10]"},
+      {"handle 0", [](Json& b) { b["constraints"]["min_handle_diameter_m"] = 0; },
+       "constraints.min_handle_diameter_m",
+       "constraints.min_handle_diameter_m = 0: must be in (0, 10]"},
+      {"slope cap",
+       [](Json& b) {
+         b["constraints"]["taper"] = {{"max_slope", 150}};
+       },
+       "constraints.taper.max_slope", "constraints.taper.max_slope = 150: must be in (0, 100]"},
+      {"first knot",
+       [](Json& b) {
+         b["constraints"]["taper"] = {{"max_slope", 0.1}, {"first_knot", -1}};
+       },
+       "constraints.taper.first_knot",
+       "constraints.taper.first_knot = -1: must be a knot index (>= 0)"},
+      {"last knot",
+       [](Json& b) {
+         b["constraints"]["taper"] = {{"max_slope", 0.1}, {"last_knot", -2}};
+       },
+       "constraints.taper.last_knot",
+       "constraints.taper.last_knot = -2: must be -1 (the last knot) or a knot index"},
+      {"exponent", [](Json& b) { b["swing_weight_exponent"] = 0.6; }, "swing_weight_exponent",
+       "swing_weight_exponent = 0.6: must be in [0, 0.5]"},
+      {"zone tolerance",
+       [](Json& b) {
+         b["objective"] = "widest_sweet_zone";
+         b["sweet_zone_tolerance_mps"] = 150;
+       },
+       "sweet_zone_tolerance_mps", "sweet_zone_tolerance_mps = 150: must be in (0, 100]"},
+      {"variable bound", [](Json& b) { b["variables"][1]["max"] = 2e12; }, "variables[1].max",
+       "variables[1].max = 2e+12: must be in [-1e+12, 1e+12]"},
+      {"starts", [](Json& b) { b["options"]["starts"] = 65; }, "options.starts",
+       "options.starts = 65: must be between 1 and 64"},
+      {"tolerance", [](Json& b) { b["options"]["tolerance"] = 1; }, "options.tolerance",
+       "options.tolerance = 1: must be in (0, 1)"},
+      {"cor", [](Json& b) { b["cor"] = 1.5; }, "cor", "cor = 1.5: must be in [0, 1]"},
+  };
+  for (const Case& c : cases) {
+    Json body = ContractExample();
+    c.edit(body);
+    const Response r = Post("/v1/optimize", body);
+    EXPECT_EQ(r.status, 400) << c.what << ": " << r.body.dump();
+    EXPECT_EQ(r.body["code"], "InvalidValue") << c.what;
+    EXPECT_EQ(r.body["field"], c.field) << c.what << ": " << r.body.dump();
+    EXPECT_EQ(r.body["message"], c.message) << c.what;
+  }
+  // The types are still the api's.
+  Json body = ContractExample();
+  body["options"]["starts"] = 2.5;
+  const Response r = Post("/v1/optimize", body);
+  EXPECT_EQ(r.status, 400);
+  EXPECT_EQ(r.body["field"], "options.starts");
+}
+
 // min_sting: the hands' vibration energy (J) of an impact at the rigid sweet spot, minimised by
 // NLopt COBYLA (the default backend for it); the value is the one /v1/sweet-spot and
 // /v1/collision (model flexible) give for the returned bat.

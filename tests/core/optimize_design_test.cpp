@@ -454,6 +454,62 @@ TEST(OptimizeInvalid, IllPosedRequestsAreRefusedByName) {
   with(
       "exponent", [](DesignProblem& p) { p.swing_weight_exponent = 0.6; },
       "swing_weight_exponent = 0.6: must be in [0, 0.5]");
+  // The ranges of the constraints and of the objective's settings are core's alone (the api
+  // reads their types): each written from its bound.
+  with(
+      "length cap", [](DesignProblem& p) { p.constraints.length_m = DesignRange::Equal(150.0); },
+      "constraints.length_m = 150: must be in (0, 100]");
+  with(
+      "mass limit 0",
+      [](DesignProblem& p) { p.constraints.mass_kg = DesignRange::Between(0.0, 1.0); },
+      "constraints.mass_kg.min = 0: must be in (0, 10000]");
+  with(
+      "balance cap",
+      [](DesignProblem& p) { p.constraints.balance_point_m = DesignRange::AtMost(200.0); },
+      "constraints.balance_point_m.max = 200: must be in (0, 100]");
+  with(
+      "moi cap",
+      [](DesignProblem& p) { p.constraints.moi_six_inch_kg_m2 = DesignRange::AtLeast(2e4); },
+      "constraints.moi_six_inch_kg_m2.min = 20000: must be in (0, 10000]");
+  with(
+      "barrel cap", [](DesignProblem& p) { p.constraints.max_barrel_diameter_m = 11.0; },
+      "constraints.max_barrel_diameter_m = 11: must be in (0, 10]");
+  with(
+      "handle 0", [](DesignProblem& p) { p.constraints.min_handle_diameter_m = 0.0; },
+      "constraints.min_handle_diameter_m = 0: must be in (0, 10]");
+  with(
+      "slope cap",
+      [](DesignProblem& p) {
+        p.constraints.taper = TaperRule::kMaxSlope;
+        p.constraints.max_taper_slope = 150.0;
+      },
+      "constraints.max_taper_slope = 150: must be in (0, 100]");
+  with(
+      "first knot",
+      [](DesignProblem& p) {
+        p.constraints.taper = TaperRule::kMaxSlope;
+        p.constraints.max_taper_slope = 0.1;
+        p.constraints.taper_first_knot = -1;
+      },
+      "constraints.taper_first_knot = -1: must be a knot index (>= 0)");
+  with(
+      "last knot",
+      [](DesignProblem& p) {
+        p.constraints.taper = TaperRule::kMaxSlope;
+        p.constraints.max_taper_slope = 0.1;
+        p.constraints.taper_last_knot = -2;
+      },
+      "constraints.taper_last_knot = -2: must be -1 (the last knot) or a knot index");
+  with(
+      "zone tolerance",
+      [](DesignProblem& p) {
+        p.objective = DesignObjective::kWidestSweetZone;
+        p.sweet_zone_tolerance_mps = 150.0;
+      },
+      "sweet_zone_tolerance_mps = 150: must be in (0, 100]");
+  with(
+      "variable bound", [](DesignProblem& p) { p.variables[1].max = 2e12; },
+      "variables[1].max = 2e+12: must be in [-1e+12, 1e+12]");
   for (const Case& c : cases) {
     std::string why;
     EXPECT_FALSE(c.problem.IsValid(&why)) << c.what;

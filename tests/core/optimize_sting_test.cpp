@@ -261,7 +261,7 @@ TEST(OptimizeSting, RefusalsNameTheField) {
             "solved derivative-free by COBYLA)");
 
   // A bat the beam model refuses at the start is refused by name.
-  p = TaperEndProblem(0.0, 100.0);
+  p = TaperEndProblem(1e-3, 100.0);  // the mass limits are in (0, 10000] kg
   p.three_segment = ThreeSegmentShape{0.12, 0.0125, 0.033, 0.03, 0.05};  // L < 4 x 0.033 m
   p.swing.hands_from_knob_m = 0.05;
   p.variables = {{"three_segment.taper_end_m", 0.04, 0.06}};
