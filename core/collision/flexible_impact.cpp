@@ -40,6 +40,7 @@ struct FlexibleSystem {
   State sample;  // dense-output samples for the hands' loads
   double peak_d = 0.0, peak_f = 0.0;
   bool plastic = false;
+  bool hands_loads = true;  // sample the hands' loads on every step
 
   void operator()(const State& y, State& dy, double t) const { (*rhs)(y, dy, t); }
   std::span<const EventSpec> ActiveEvents() const { return ContactEvents(rhs->branch.unloading); }
@@ -61,6 +62,7 @@ struct FlexibleSystem {
   }
   // The hands' loads at the quarter points and the end of each step.
   void OnStep(const DenseStep<State>& step) {
+    if (!hands_loads) return;
     for (int j = 1; j < 4; ++j) {
       step.StateAt(step.t_start + (step.t_end - step.t_start) * j / 4.0, &sample);
       SampleHands(sample);
@@ -118,6 +120,7 @@ RawRun Integrate(const Model& model, const BallPowerLaw& law, const FlexibleImpa
   sys.rhs = &rhs;
   sys.cor = in.cor;
   sys.out = &out;
+  sys.hands_loads = o.hands_loads;
   sys.sample.assign(size, 0.0);
   EventIntegrator<State> integrator(ContactIntegratorOptions(tol, o.max_steps, rhs.t_s));
   while (true) {
@@ -148,7 +151,7 @@ RawRun Integrate(const Model& model, const BallPowerLaw& law, const FlexibleImpa
     tau += dt_r;
   }
   // The hands' loads over the free ringing that follows.
-  if (om_max > 0.0) {
+  if (om_max > 0.0 && o.hands_loads) {
     FreeHandsPeaks(rhs, y, sting_window_s / rhs.t_s, kTwoPi / (kSamplesPerPeriod * om_max), &out);
   }
   out.peak_force_n = sys.peak_f;
@@ -350,17 +353,19 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     full.residual_compliance = residual_for(n_used);
     out.residual_compliance_m_n = full.residual_compliance;
     const bool rotary = modes.rotary_inertia;
-    IntegrateAlong(modes, 0.0, h, [&](double x, double wgt) {
-      const BeamSection sec = SectionAt(bat, x);
-      for (int k = 0; k < n_all; ++k) {
-        const std::size_t ks = static_cast<std::size_t>(k);
-        const BeamField f = EvaluateField(modes.theory, modes.nodes_m, vecs[ks], x);
-        const double w = f.bending_m + f.shear_m;
-        full.shear[ks] += wgt * sec.mass_per_length_kg_m * w;
-        full.moment[ks] += wgt * (sec.mass_per_length_kg_m * w * (x - h) +
-                                  (rotary ? sec.rotary_inertia_kg_m * f.rotation : 0.0));
-      }
-    });
+    // The knob-side segment's inertia: only the hands' loads need it.
+    if (o.hands_loads)
+      IntegrateAlong(modes, 0.0, h, [&](double x, double wgt) {
+        const BeamSection sec = SectionAt(bat, x);
+        for (int k = 0; k < n_all; ++k) {
+          const std::size_t ks = static_cast<std::size_t>(k);
+          const BeamField f = EvaluateField(modes.theory, modes.nodes_m, vecs[ks], x);
+          const double w = f.bending_m + f.shear_m;
+          full.shear[ks] += wgt * sec.mass_per_length_kg_m * w;
+          full.moment[ks] += wgt * (sec.mass_per_length_kg_m * w * (x - h) +
+                                    (rotary ? sec.rotary_inertia_kg_m * f.rotation : 0.0));
+        }
+      });
     const double g_lo = std::max(0.0, h - 0.5 * o.hands_grip_length_m);
     const double g_hi = std::min(length, h + 0.5 * o.hands_grip_length_m);
     IntegrateAlong(modes, g_lo, g_hi, [&](double x, double wgt) {
@@ -479,8 +484,10 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
       out.error_estimate_exit_speed_mps = integration.exit + truncation.exit;
       out.error_estimate_vibration_energy_j = integration.vib + truncation.vib;
       out.error_estimate_hands_energy_j = integration.hands + truncation.hands;
-    } else {
+    } else {  // the integration tolerance's share only
       out.error_estimate_exit_speed_mps = o.relative_tolerance * (u + std::abs(oa.exit));
+      out.error_estimate_vibration_energy_j = o.relative_tolerance * out.vibration_energy_j;
+      out.error_estimate_hands_energy_j = o.relative_tolerance * out.hands_vibration_energy_j;
     }
     s.iterations = out.steps;
     s.termination = Termination::kConverged;
