@@ -57,18 +57,22 @@ bool StingZone(const Scene& scene, const ResolvedScene& r, const SceneOptions& o
              ": the sweep runs from the hands to the tip, so the hands must be before the tip";
     return false;
   }
-  FlexibleImpactOptions quick = fo.impact;
-  quick.refine_check = false;  // the refinement is reported on the samples
-  const StingImpact impact = [&](double s, bool refine) {
+  FlexibleImpactOptions sample = fo.impact;
+  sample.refine_check = false;  // the refinement check runs at the least-sting impact
+  FlexibleImpactOptions search = sample;
+  search.hands_loads = false;  // the searches read the hands' energy only
+  const StingImpact impact = [&](double s, StingRun run) {
     const auto t0 = std::chrono::steady_clock::now();
     FlexibleImpactResult fr =
         SolveFlexibleImpact(*scene.bat, modes, FlexibleImpactInputsFor(scene, r, s, options.hertz),
-                            refine ? fo.impact : quick);
+                            run == StingRun::kChecked  ? fo.impact
+                            : run == StingRun::kSample ? sample
+                                                       : search);
     book->Add(CollisionModelName(CollisionModel::kFlexible), SecondsSince(t0), 1);
     return fr;
   };
-  if (!LeastStingZone(impact, hands, r.length_m, fo.sting_samples, fo.sting_zone_fraction, warnings,
-                      out, error)) {
+  if (!LeastStingZone(impact, hands, r.length_m, fo.sting_samples, fo.sting_zone_fraction,
+                      fo.search.x_tolerance_m, warnings, out, error)) {
     return false;
   }
   out->elements = modes.Elements();
@@ -199,6 +203,10 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
         mx.summary.solve_time_s = SecondsSince(tm);
         mx.summary.models_used = {exit_model->name()};
         book.Add(exit_model->name(), mx.summary.solve_time_s, 1);
+      } else if (model == CollisionModel::kFlexible &&
+                 options.method == SweetSpotMethod::kClosedForm) {
+        mx = BracketMaxExitSpeed(&*exit_model, r.length_m, options.flexible.search);
+        mx.summary.models_used = {exit_model->name()};
       } else {
         mx = SearchMaxExitSpeed(&*exit_model, r.length_m, options.nlopt);
         mx.summary.models_used = {exit_model->name()};

@@ -142,6 +142,10 @@ bool FlexibleOptions::Validate(Refusal* why) const {
   if (!(std::isfinite(sting_zone_fraction) && sting_zone_fraction > 0.0 &&
         sting_zone_fraction <= 1.0))
     return Refuse17(why, "flexible.sting_zone_fraction", sting_zone_fraction, "must be in (0, 1]");
+  if (!search.Validate(why)) {
+    if (why != nullptr) *why = Prefixed("flexible.search.", std::move(*why));
+    return false;
+  }
   return impact.Validate(why);
 }
 

@@ -19,6 +19,7 @@
 #include "core/mass_properties.hpp"
 #include "core/optimize/nlopt_search.hpp"
 #include "core/refusal.hpp"
+#include "core/sweet_spot/numeric.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {
@@ -108,8 +109,10 @@ std::optional<CollisionModel> ParseCollisionModel(std::string_view name);
 
 /// How the sweet spot is found.
 enum class SweetSpotMethod {
-  kClosedForm,  ///< Closed form where the model has one (rigid_pivot, free_bat), NLopt otherwise.
-  kNlopt,       ///< Always the NLopt search (the independent path).
+  /// Closed form where the model has one (rigid_pivot, free_bat); otherwise the bracketing
+  /// search (flexible) or NLopt (hertz).
+  kClosedForm,
+  kNlopt,  ///< Always the NLopt search (the independent path).
 };
 
 /// The unit of the sweet-zone tolerance.
@@ -125,9 +128,15 @@ struct FlexibleOptions {
   double frequency_tolerance = 1e-4;
   int max_elements = 512;        ///< Mesh bound of every modes computation, in [2, 4096].
   FlexibleImpactOptions impact;  ///< Flexible impacts (model = flexible, least_sting_zone).
-  int sting_samples = 41;  ///< least_sting_zone: impacts from the hands to the tip, in [3, 1001].
+  /// least_sting_zone: impacts from the hands to the tip, in [3, 1001]. 21 (every other one of
+  /// the former 41): they only bracket the minimum and the ends, which the searches refine.
+  int sting_samples = 21;
   /// least_sting_zone: the zone is E <= E_min + fraction (E_max - E_min), in (0, 1].
   double sting_zone_fraction = 0.1;
+  /// max_exit_speed with model = flexible and method closed_form (the default): the
+  /// bracketing search's samples, tolerance and budget (method nlopt runs the NLopt search).
+  /// Its x_tolerance_m is also least_sting_zone's tolerance of the minimum and the ends.
+  BracketSearchOptions search;
   /// Cross-request cache of modes, owned by the caller (the API's server context); null = none.
   /// Within a request the modes are computed once whatever this is.
   ModesCache* modes_cache = nullptr;

@@ -111,6 +111,28 @@ bool ExitSpeedModel::Eval(double s, double* v, double* grad, double* err, std::s
   return ok;
 }
 
+bool ExitSpeedModel::EvalFast(double s, double* v, double* noise, std::string* why) {
+  if (model_ != CollisionModel::kFlexible) return Eval(s, v, nullptr, noise, why);
+  const auto t0 = std::chrono::steady_clock::now();
+  FlexibleImpactOptions fast = flexible_->impact;
+  fast.refine_check = false;
+  fast.hands_loads = false;
+  const FlexibleImpactResult fr = SolveFlexibleImpact(
+      *scene_.bat, *modes_, FlexibleImpactInputsFor(scene_, r_, s, hertz_), fast);
+  for (auto& w : fr.summary.warnings) AddWarning(w);
+  const bool ok = fr.summary.IsSolutionUsable();
+  if (!ok) {
+    if (why != nullptr) {
+      *why = "flexible at " + FormatNumber17(s) + " m from the knob: " + fr.summary.message;
+    }
+  } else {
+    *v = fr.exit_speed_mps;
+    if (noise != nullptr) *noise = fr.error_estimate_exit_speed_mps;
+  }
+  book_->Add(name(), SecondsSince(t0), 1);
+  return ok;
+}
+
 void ExitSpeedModel::AddWarning(const std::string& w) {
   if (std::find(warnings_.begin(), warnings_.end(), w) == warnings_.end()) warnings_.push_back(w);
 }

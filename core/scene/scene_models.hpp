@@ -59,6 +59,9 @@ class ExitSpeedModel : public ExitSpeedFunction {
   const char* name() const override { return CollisionModelName(model_); }
   bool has_gradient() const override { return profile_.has_value(); }
   bool Eval(double s, double* v, double* grad, double* err, std::string* why) override;
+  /// flexible: one impact without the refinement check and the hands' loads (the value Eval
+  /// gives; the noise is the integration tolerance's share); other models: Eval.
+  bool EvalFast(double s, double* v, double* noise, std::string* why) override;
   /// The closed-form profile (rigid_pivot, free_bat), or nullopt.
   const std::optional<ExitSpeedProfile>& profile() const { return profile_; }
   /// The models' warnings so far, each once.

@@ -12,13 +12,13 @@
 namespace sweetspot::core {
 
 bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob_m, int samples,
-                    double fraction, std::vector<std::string>* warnings, LeastStingZoneResult* out,
-                    std::string* error) {
+                    double fraction, double x_tolerance_m, std::vector<std::string>* warnings,
+                    LeastStingZoneResult* out, std::string* error) {
   const double lo = from_knob_m;
   const double hi = to_knob_m;
   bool failed = false;
-  auto impact = [&](double s, bool refine) {
-    FlexibleImpactResult fr = solve(s, refine);
+  auto impact = [&](double s, StingRun run) {
+    FlexibleImpactResult fr = solve(s, run);
     for (const auto& w : fr.summary.warnings) {
       if (std::find(warnings->begin(), warnings->end(), w) == warnings->end()) {
         warnings->push_back(w);
@@ -35,7 +35,7 @@ bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob
   double err_e = 0.0;
   for (int i = 0; i < n; ++i) {
     const double s = i + 1 == n ? hi : lo + (hi - lo) * i / (n - 1);
-    const FlexibleImpactResult fr = impact(s, true);
+    const FlexibleImpactResult fr = impact(s, StingRun::kSample);
     if (failed) return false;
     StingPoint p;
     p.position_from_knob_m = s;
@@ -58,32 +58,40 @@ bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob
   const std::size_t i_min =
       static_cast<std::size_t>(std::min_element(es.begin(), es.end()) - es.begin());
   out->max_hands_energy_j = *std::max_element(es.begin(), es.end());
-  // Refine the minimum between the neighbouring samples (Brent, ~1e-6 relative in s).
-  auto energy = [&](double s) { return impact(s, false).hands_vibration_energy_j; };
+  // Refine the minimum between the neighbouring samples (Brent to x_tolerance_m: boost's
+  // tolerance is relative to |x|, and 2 tol (|x| + 1/4) bounds its final half-bracket).
+  auto energy = [&](double s) { return impact(s, StingRun::kSearch).hands_vibration_energy_j; };
+  const double rel = x_tolerance_m / (2.0 * (std::max(std::abs(lo), std::abs(hi)) + 0.25));
+  const int bits = static_cast<int>(std::floor(1.0 - std::log2(rel)));
   const double a = xs[i_min == 0 ? 0 : i_min - 1];
   const double b = xs[std::min(i_min + 1, xs.size() - 1)];
   double x_min = xs[i_min], e_min = es[i_min];
   double err_x = 0.5 * (b - a);
   if (b > a) {
     boost::uintmax_t iters = 60;
-    const auto m = boost::math::tools::brent_find_minima(energy, a, b, 20, iters);
+    const auto m = boost::math::tools::brent_find_minima(energy, a, b, bits, iters);
     if (failed) return false;
     if (m.second <= e_min) {
       x_min = m.first;
       e_min = m.second;
     }
+  }
+  // The least-sting impact once more, with the refinement check: the exit speed there and the
+  // error of the hands' energy (integration + mode truncation) that the ends' estimates use.
+  const FlexibleImpactResult checked = impact(x_min, StingRun::kChecked);
+  if (failed) return false;
+  err_e = std::max(err_e, checked.error_estimate_hands_energy_j);
+  if (b > a) {
     // Brent's bracket, widened by how far the energy's own error moves a flat minimum.
     const double h = 0.5 * (b - a);
     const double curv = (es[std::min(i_min + 1, es.size() - 1)] + es[i_min == 0 ? 0 : i_min - 1] -
                          2.0 * es[i_min]) /
                         (h * h);
-    err_x = std::ldexp(std::abs(x_min), -19) +
-            (curv > 0.0 ? std::sqrt(2.0 * err_e / curv) : 0.5 * (b - a));
+    err_x = x_tolerance_m + (curv > 0.0 ? std::sqrt(2.0 * err_e / curv) : 0.5 * (b - a));
   }
   out->min_position_from_knob_m = x_min;
   out->min_hands_energy_j = e_min;
-  out->exit_speed_at_min_mps = impact(x_min, false).exit_speed_mps;
-  if (failed) return false;
+  out->exit_speed_at_min_mps = checked.exit_speed_mps;
   out->threshold_j = e_min + fraction * (out->max_hands_energy_j - e_min);
   auto g = [&](double s) { return energy(s) - out->threshold_j; };
   double err_edges = 0.0;
@@ -108,7 +116,7 @@ bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob
           const double x0 = std::min(inside, outside), x1 = std::max(inside, outside);
           const auto rr = boost::math::tools::toms748_solve(
               g, x0, x1, x0 == inside ? ga : gb, x0 == inside ? gb : ga,
-              boost::math::tools::eps_tolerance<double>(30), iters);
+              [&](double l, double r) { return r - l <= 2.0 * x_tolerance_m; }, iters);
           const double root = 0.5 * (rr.first + rr.second);
           const double slope = std::abs(gb - ga) / std::abs(outside - inside);
           err_edges =

@@ -1,11 +1,18 @@
 #include "core/sweet_spot/numeric.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <vector>
 
+#include <boost/math/tools/minima.hpp>
 #include <boost/math/tools/roots.hpp>
+
+#include "core/geometry_format.hpp"
+#include "core/refusal.hpp"
+#include "core/scene/timing_book.hpp"
 
 namespace sweetspot::core {
 
@@ -35,6 +42,123 @@ MaxExitSpeedResult SearchMaxExitSpeed(ExitSpeedFunction* model, double length_m,
                                                           : Placement::kOnBat;
   out.error_estimate_m = r.error_estimate_x;
   out.error_estimate_mps = r.error_estimate_value + model_err;
+  return out;
+}
+
+bool BracketSearchOptions::IsValid(std::string* why) const {
+  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
+}
+
+bool BracketSearchOptions::Validate(Refusal* why) const {
+  if (samples < 3 || samples > 1001)
+    return Refuse(why, IntegerRefusal("samples", samples, "must be in [3, 1001]"));
+  if (!(std::isfinite(x_tolerance_m) && x_tolerance_m >= 1e-9 && x_tolerance_m <= 0.01))
+    return Refuse(why, Number17Refusal("x_tolerance_m", x_tolerance_m, "must be in [1e-9, 0.01]"));
+  if (max_iterations < 5 || max_iterations > 1000)
+    return Refuse(why, IntegerRefusal("max_iterations", max_iterations, "must be in [5, 1000]"));
+  return true;
+}
+
+MaxExitSpeedResult BracketMaxExitSpeed(ExitSpeedFunction* model, double length_m,
+                                       const BracketSearchOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  MaxExitSpeedResult out;
+  out.model = model->name();
+  out.method = "bracket_brent";
+  Summary& sm = out.summary;
+  sm.backend = out.method;
+  sm.termination = Termination::kInvalidInput;
+  sm.evaluations = 0;
+  sm.iterations = 0;
+  CatchInternalError(&sm, [&] {
+    if (Refusal why; !options.Validate(&why)) {
+      sm.SetRefusal(std::move(why));
+      return;
+    }
+    if (!(std::isfinite(length_m) && length_m > 0.0)) {
+      sm.SetRefusal(Number17Refusal("length_m", length_m, "must be finite and > 0"));
+      return;
+    }
+    std::string error;
+    double noise = 0.0;
+    bool failed = false;
+    auto fast = [&](double s) {
+      double v = 0.0, e = 0.0;
+      ++sm.evaluations;
+      if (failed || !model->EvalFast(s, &v, &e, &error)) {
+        failed = true;
+        return -std::numeric_limits<double>::infinity();
+      }
+      noise = std::max(noise, e);
+      return v;
+    };
+    auto fail = [&] {
+      sm.termination = Termination::kFailure;
+      sm.message = error.empty() ? std::string("the exit-speed model failed") : error;
+    };
+    // 1. The samples: the best one and its neighbours bracket the maximum of a smooth curve.
+    const int n = options.samples;
+    std::vector<double> xs(static_cast<std::size_t>(n)), fs(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      const std::size_t is = static_cast<std::size_t>(i);
+      xs[is] = i + 1 == n ? length_m : length_m * i / (n - 1);
+      fs[is] = fast(xs[is]);
+      if (failed) return fail();
+    }
+    const std::size_t best =
+        static_cast<std::size_t>(std::max_element(fs.begin(), fs.end()) - fs.begin());
+    const std::size_t lo_i = best == 0 ? 0 : best - 1;
+    const std::size_t hi_i = std::min(best + 1, fs.size() - 1);
+    // 2. Brent between the neighbours (boost's tolerance is relative to |x|: 2 tol (|x| + 1/4)
+    // bounds the final bracket's half-width, so tol = x_tolerance / (2 (L + 1/4))).
+    const double rel = options.x_tolerance_m / (2.0 * (length_m + 0.25));
+    const int bits = static_cast<int>(std::floor(1.0 - std::log2(rel)));
+    boost::uintmax_t iters = static_cast<boost::uintmax_t>(options.max_iterations);
+    const auto m = boost::math::tools::brent_find_minima([&](double s) { return -fast(s); },
+                                                         xs[lo_i], xs[hi_i], bits, iters);
+    if (failed) return fail();
+    sm.iterations = static_cast<int>(iters);
+    double x = m.first, f = -m.second;
+    if (fs[best] >= f) {  // an end of the bat (or a sample) that the interior does not beat
+      x = xs[best];
+      f = fs[best];
+    }
+    const bool at_knob = x == 0.0, at_tip = x == length_m;
+    // 3. The error: the tolerance, plus how far noise moves a maximum of curvature f''
+    // (the samples' second difference around the best one; a flat or convex triple: half the
+    // bracket).
+    const std::size_t c = std::clamp<std::size_t>(best, 1, fs.size() - 2);
+    const double h = xs[c + 1] - xs[c];
+    const double curv = (fs[c + 1] + fs[c - 1] - 2.0 * fs[c]) / (h * h);
+    double err_x = options.x_tolerance_m +
+                   (curv < 0.0 ? std::sqrt(4.0 * noise / -curv) : 0.5 * (xs[hi_i] - xs[lo_i]));
+    if ((at_knob || at_tip) && curv < 0.0) {
+      // An end: the converged answer is that end too unless noise hides the slope there.
+      const std::size_t in = at_knob ? 1 : fs.size() - 2;
+      const double slope = std::abs(fs[best] - fs[in]) / std::abs(xs[best] - xs[in]);
+      if (slope * options.x_tolerance_m > 2.0 * noise) err_x = 0.0;
+    }
+    // 4. One full evaluation at the answer: the value and the model's own error estimate.
+    double v = 0.0, model_err = 0.0;
+    ++sm.evaluations;
+    if (!model->Eval(x, &v, nullptr, &model_err, &error)) return fail();
+    out.position_from_knob_m = x;
+    out.unconstrained_position_from_knob_m = x;
+    out.exit_speed_mps = v;
+    out.placement = at_tip    ? Placement::kBeyondTip
+                    : at_knob ? Placement::kBeforeKnob
+                              : Placement::kOnBat;
+    out.error_estimate_m = err_x;
+    out.error_estimate_mps = model_err + (curv < 0.0 ? 0.5 * -curv * err_x * err_x : noise);
+    const bool converged = iters < static_cast<boost::uintmax_t>(options.max_iterations);
+    sm.termination = converged ? Termination::kConverged : Termination::kNoConvergence;
+    sm.message = std::string(converged ? "converged" : "Brent's iteration budget reached") + ": " +
+                 std::to_string(n) + " samples, Brent between " + FormatNumber17(xs[lo_i]) +
+                 " and " + FormatNumber17(xs[hi_i]) + " m";
+    sm.objective = v;
+    sm.error_estimate = err_x;
+  });
+  sm.solve_time_s = SecondsSince(t0);
   return out;
 }
 
