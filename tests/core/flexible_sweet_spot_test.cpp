@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "core/bat.hpp"
+#include "core/material.hpp"
 #include "core/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/sweet_spot/numeric.hpp"
@@ -119,11 +120,17 @@ TEST(FlexibleSweetSpot, LowAndHighBallSpeedsStillAnswer) {
 }
 
 TEST(FlexibleSweetSpot, AnOptimumAtTheTipIsTheTipExactly) {
-  // A short, stiff club (0.4 m, 3 cm radius: the fundamental near 1.4 kHz, so the bat acts
-  // rigidly) and a slow ball: the rigid maximiser lies beyond the tip (~0.46 m), so the exit
-  // speed rises all the way to the tip.
+  // A short, heavy steel club (0.4 m, 3 cm radius, 8.8 kg: almost no recoil, a fundamental of
+  // several kHz) and a slow ball: the exit speed rises all the way to the tip, as the free
+  // rigid bat's closed form says (its maximiser is beyond the tip). An ash club of the same
+  // shape is too light: its optimum is at 0.32 m (the free bat's at 0.33 m).
+  Material steel = *FindMaterial("ash");
+  steel.name = "steel";
+  steel.density_kg_m3 = 7800.0;
+  steel.youngs_modulus_pa = 2e11;
+  steel.shear_modulus_pa = 2e11 / 2.6;
   Scene s;
-  s.bat = MakeThreeSegmentBat(ThreeSegmentShape{0.4, 0.03, 0.03, 0.1, 0.3}, *FindMaterial("ash"));
+  s.bat = MakeThreeSegmentBat(ThreeSegmentShape{0.4, 0.03, 0.03, 0.1, 0.3}, steel);
   s.outputs = {SceneOutput::kMaxExitSpeed};
   s.ball.speed_mps = 1.0;
   const SceneResult r = EvaluateScene(s, Flexible());
