@@ -8,11 +8,13 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "core/collision/collide.hpp"
 #include "core/collision/flexible_impact.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/flexible/modes.hpp"
+#include "core/flexible/modes_cache.hpp"
 #include "core/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
 
@@ -226,6 +228,106 @@ BENCHMARK_CAPTURE(BM_SceneFlexible, vibration_node, SceneOutput::kVibrationNode)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_SceneFlexible, least_sting_zone, SceneOutput::kLeastStingZone)
     ->Unit(benchmark::kMillisecond);
+
+// The flexible max-exit-speed sweet spot of wood-34-ash (issue 17), through EvaluateScene:
+// "paper" = the scene's default speeds (ball 27.7 m/s, 17.288 rad/s), "game" = a 40 m/s pitch
+// and a 45 rad/s swing (~32 m/s bat speed at 0.7 m). `nlopt` = SweetSpotMethod::kNlopt, the
+// NLopt search (LN_BOBYQA, every impact with the refinement check); `default` = the default
+// method. Fresh: no modes cache (the modes are computed in every iteration); cached: a
+// ModesCache warmed before the loop. Counters: evals = impacts of the search (summary
+// evaluations), pos_err_m = |position - reference| (the reference: a tight run, see
+// SweetSpotReference), est_m = the reported position error estimate.
+Scene AshScene(bool game, std::vector<SceneOutput> outputs) {
+  Scene scene;
+  scene.bat = FindPreset("wood-34-ash")->bat;
+  scene.outputs = std::move(outputs);
+  if (game) {
+    scene.ball.speed_mps = 40.0;
+    scene.swing.angular_speed_rad_s = 45.0;
+  }
+  return scene;
+}
+
+// The converged sweet spot: the NLopt search to 1e-12 m on impacts with 1e-11 integration
+// tolerance (the default modes and cutoff: the model the answer is an answer of).
+double TightSweetSpot(bool game) {
+  SceneOptions o;
+  o.model = CollisionModel::kFlexible;
+  o.method = SweetSpotMethod::kNlopt;
+  o.flexible.impact.relative_tolerance = 1e-11;
+  o.flexible.impact.refine_check = false;
+  const SceneResult r = EvaluateScene(AshScene(game, {SceneOutput::kMaxExitSpeed}), o);
+  return r.max_exit_speed ? r.max_exit_speed->position_from_knob_m : std::nan("");
+}
+double SweetSpotReference(bool game) {
+  static const double paper = TightSweetSpot(false);
+  static const double fast = TightSweetSpot(true);
+  return game ? fast : paper;
+}
+
+void BM_FlexibleSweetSpot(benchmark::State& state, bool game, bool nlopt, bool cached) {
+  const Scene scene = AshScene(game, {SceneOutput::kMaxExitSpeed});
+  ModesCache cache;
+  SceneOptions o;
+  o.model = CollisionModel::kFlexible;
+  if (nlopt) o.method = SweetSpotMethod::kNlopt;
+  if (cached) {
+    o.flexible.modes_cache = &cache;
+    Keep(EvaluateScene(scene, o).summary.solve_time_s);
+  }
+  SceneResult r;
+  for (auto _ : state) {
+    r = EvaluateScene(scene, o);
+    Keep(r.summary.solve_time_s);
+  }
+  state.SetLabel(TerminationName(r.summary.termination));
+  if (!r.max_exit_speed) return;
+  state.counters["evals"] = r.max_exit_speed->summary.evaluations;
+  state.counters["pos_err_m"] =
+      std::abs(r.max_exit_speed->position_from_knob_m - SweetSpotReference(game));
+  state.counters["est_m"] = r.max_exit_speed->error_estimate_m;
+}
+BENCHMARK_CAPTURE(BM_FlexibleSweetSpot, paper_nlopt_fresh, false, true, false)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FlexibleSweetSpot, paper_nlopt_cached, false, true, true)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FlexibleSweetSpot, paper_default_fresh, false, false, false)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FlexibleSweetSpot, paper_default_cached, false, false, true)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FlexibleSweetSpot, game_nlopt_cached, true, true, true)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FlexibleSweetSpot, game_default_fresh, true, false, false)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FlexibleSweetSpot, game_default_cached, true, false, true)
+    ->Unit(benchmark::kMillisecond);
+
+// least_sting_zone of wood-34-ash per design (default speeds), fresh and cached modes.
+void BM_LeastStingZone(benchmark::State& state, bool cached) {
+  const Scene scene = AshScene(false, {SceneOutput::kLeastStingZone});
+  ModesCache cache;
+  SceneOptions o;
+  if (cached) {
+    o.flexible.modes_cache = &cache;
+    Keep(EvaluateScene(scene, o).summary.solve_time_s);
+  }
+  SceneResult r;
+  for (auto _ : state) {
+    r = EvaluateScene(scene, o);
+    Keep(r.summary.solve_time_s);
+  }
+  state.SetLabel(TerminationName(r.summary.termination));
+  if (!r.least_sting_zone) return;
+  state.counters["min_m"] = r.least_sting_zone->min_position_from_knob_m;
+  state.counters["from_m"] = r.least_sting_zone->from_knob_m;
+  state.counters["to_m"] = r.least_sting_zone->to_knob_m;
+  state.counters["est_m"] = r.least_sting_zone->error_estimate_m;
+  for (const auto& t : r.timings) {
+    if (t.model == "flexible") state.counters["impacts"] = t.calls;
+  }
+}
+BENCHMARK_CAPTURE(BM_LeastStingZone, fresh, false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LeastStingZone, cached, true)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace bench_core_flexible
