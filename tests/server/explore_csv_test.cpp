@@ -11,9 +11,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -47,14 +49,29 @@ CliOutput RunSweetspot(const std::string& args) {
   return result;
 }
 
-// Writes `text` to a new file in a new temporary folder; returns its path.
-std::string WriteTemporary(const std::string& name, const std::string& text) {
-  char folder[] = "/tmp/sweetspot-csv-XXXXXX";
-  if (mkdtemp(folder) == nullptr) return "";
-  const std::string path = std::string(folder) + "/" + name;
-  std::ofstream(path) << text;
-  return path;
-}
+// A file holding `text` in a new temporary folder, removed with the folder when it goes.
+class TemporaryFile {
+ public:
+  TemporaryFile(const std::string& name, const std::string& text) {
+    char folder[] = "/tmp/sweetspot-csv-XXXXXX";
+    if (mkdtemp(folder) == nullptr) return;
+    folder_ = folder;
+    path_ = folder_ + "/" + name;
+    std::ofstream(path_) << text;
+  }
+  ~TemporaryFile() {
+    std::error_code ignored;
+    if (!folder_.empty()) std::filesystem::remove_all(folder_, ignored);
+  }
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  /// The file's path ("" when the folder could not be made).
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string folder_;
+  std::string path_;
+};
 
 std::vector<std::string> Lines(const std::string& text) {
   std::vector<std::string> lines;
@@ -103,7 +120,8 @@ TEST(ExploreCsvEndToEndTest, HttpCliAndJobGiveTheSameBytes) {
       << lines[0];
   EXPECT_EQ(lines[3].substr(lines[3].rfind(',')), ",InvalidValue");  // cor 1.2 is refused
 
-  const std::string file = WriteTemporary("sweep.json", sweep.dump());
+  const TemporaryFile request_file("sweep.json", sweep.dump());
+  const std::string& file = request_file.path();
   const CliOutput cli = RunSweetspot("explore " + file);
   EXPECT_EQ(cli.exit_code, 0);
   EXPECT_TRUE(cli.out == streamed) << "the CLI's output differs from the HTTP answer";
@@ -152,7 +170,8 @@ TEST(ExploreCsvEndToEndTest, TheCliRunsASweepLargerThanARequestMayBe) {
     EXPECT_EQ(body["message"],
               "parameters describe 150000 designs, over the limit max_samples = 100000");
   }
-  const std::string file = WriteTemporary("sweep.json", sweep.dump());
+  const TemporaryFile request_file("sweep.json", sweep.dump());
+  const std::string& file = request_file.path();
   const CliOutput cli = RunSweetspot("explore " + file);
   ASSERT_EQ(cli.exit_code, 0);
   const std::vector<std::string> lines = Lines(cli.out);
@@ -174,7 +193,8 @@ TEST(ExploreCsvEndToEndTest, TheCliRunsASweepLargerThanARequestMayBe) {
     single["bat"] = sweep["bat"];
     single["bat"]["three_segment"]["taper_start_m"] = 0.2;
     single["bat"]["three_segment"]["taper_end_m"] = taper_end_m;
-    const CliOutput one = RunSweetspot("sweet-spot " + WriteTemporary("one.json", single.dump()));
+    const TemporaryFile one_file("one.json", single.dump());
+    const CliOutput one = RunSweetspot("sweet-spot " + one_file.path());
     ASSERT_EQ(one.exit_code, 0) << one.out;
     const double expected = Json::parse(one.out)["max_exit_speed"]["exit_speed_mps"].get<double>();
     EXPECT_EQ(std::memcmp(&exit_speed_mps, &expected, sizeof expected), 0)
