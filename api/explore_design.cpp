@@ -1,6 +1,5 @@
 #include "api/explore_design.hpp"
 
-#include <chrono>
 #include <optional>
 #include <string>
 #include <utility>
@@ -13,69 +12,66 @@
 namespace sweetspot::api {
 namespace {
 using Json = nlohmann::json;
+
+Json DesignErrorJson(const ApiError& e) {
+  return Json{{"code", ErrorCodeName(e.code.value_or(ErrorCode::kInternalError))},
+              {"message", e.message},
+              {"field", e.field}};
+}
 }  // namespace
 
-DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
-                         const core::SceneOptions& options, const ApiLimits& limits) {
-  DesignRow out;
-  const auto refused = [&out](Json error) {
-    out.row = {{"feasible", false}, {"error", std::move(error)}};
-    return out;
-  };
-  ApiError error;
-  ObjectReader reader(design_json, "", &error);
-  core::Scene scene;
-  std::optional<BatSpec> spec;
-  // The bat's mass properties are left to the single computation below.
-  if (const Json* bat = reader.Get("bat")) spec = ParseBatGeometry(*bat, "bat", limits, &error);
-  if (spec) {
-    scene.bat = spec->bat;
-    ReadSceneCommon(reader, &scene);
-  }
-  scene.outputs = outputs.scene;
-  if (!error.code) {
-    // A row of properties only names no scene output; the scene (bat, ball,
-    // swing, cor) must still be valid, so it is checked as if it named one.
+bool ValidateDesignScene(const core::Scene& scene, ApiError* error) {
+  // A row of properties only names no scene output; the scene (bat, ball,
+  // swing, cor) must still be valid, so it is checked as if it named one.
+  core::Refusal refusal;
+  if (scene.outputs.empty()) {
     core::Scene check = scene;
-    if (check.outputs.empty()) check.outputs = {core::SceneOutput::kMaxExitSpeed};
-    if (core::Refusal refusal; !check.Validate(&refusal)) CoreRefusal(refusal, "", &error);
+    check.outputs = {core::SceneOutput::kMaxExitSpeed};
+    if (check.Validate(&refusal)) return true;
+  } else if (scene.Validate(&refusal)) {
+    return true;
   }
-  const auto error_json = [](const ApiError& e) {
-    return Json{{"code", ErrorCodeName(e.code.value_or(ErrorCode::kInternalError))},
-                {"message", e.message},
-                {"field", e.field}};
+  CoreRefusal(refusal, "", error);
+  return false;
+}
+
+DesignOutcome ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
+                            const core::SceneOptions& options,
+                            std::vector<core::ModelTiming>* timings) {
+  DesignOutcome out;
+  core::SceneResult& result = out.result;
+  core::TimingBook book(options.time_models);
+  const auto done = [&] {
+    if (timings != nullptr) *timings = book.TakeTimings();
+    return std::move(out);
   };
-  if (error.code) return refused(error_json(error));
-  Json row{{"feasible", true}};
-  core::TimingBook book;
-  core::SceneResult result;
   if (!scene.outputs.empty()) {
     result = core::EvaluateScene(scene, options);
-    for (const auto& t : result.timings) book.Add(t.model, t.time_s, t.calls);
-    out.timings = book.timings();
+    if (timings != nullptr) {
+      for (const auto& t : result.timings) book.Add(t.model, t.time_s, t.calls);
+    }
     if (!result.summary.IsSolutionUsable()) {
       // The same code and field /v1/sweet-spot would answer for this design.
       const Response failure =
           SceneFailure(result.summary, result.missing_model, result.mass_properties, "bat",
                        result.refused_field.empty() ? "outputs" : result.refused_field,
                        /*options_object=*/true);
-      return refused(failure.body);
-    }
-    Json rendered = SceneResultToJson(result);
-    for (const core::SceneOutput output : scene.outputs) {
-      const char* name = core::SceneOutputName(output);
-      if (rendered.contains(name)) row[name] = std::move(rendered[name]);
+      out.error = failure.body;
+      return done();
     }
   } else {
-    const auto start = std::chrono::steady_clock::now();
-    result.mass_properties = core::ComputeMassProperties(spec->bat, scene.inertia_model);
-    book.Add("mass_properties", core::SecondsSince(start), 1);
-    out.timings = book.timings();
-    if (!CheckComputable(result.mass_properties, "bat", &error)) return refused(error_json(error));
-    result.length_m = spec->bat.LengthM();
-  }
-  if (outputs.properties) {
-    row["properties"] = PropertiesToJson(result.mass_properties, result.length_m);
+    if (scene.mass_properties) {
+      result.mass_properties = *scene.mass_properties;
+    } else {
+      const auto start = book.Now();
+      result.mass_properties = core::ComputeMassProperties(*scene.bat, scene.inertia_model);
+      book.Add("mass_properties", book.Since(start), 1);
+    }
+    if (ApiError error; !CheckComputable(result.mass_properties, "bat", &error)) {
+      out.error = DesignErrorJson(error);
+      return done();
+    }
+    result.length_m = scene.bat->LengthM();
   }
   if (outputs.collision_efficiency && result.max_exit_speed) {
     // The impact at the sweet spot, with the mass properties the scene already computed.
@@ -83,11 +79,53 @@ DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
     resolved.mass_properties = result.mass_properties;
     const core::CollisionResult hit = core::Collide(
         resolved, result.max_exit_speed->position_from_knob_m, core::CollisionModel::kRigidPivot);
-    for (const auto& t : hit.timings) book.Add(t.model, t.time_s, t.calls);
-    out.timings = book.timings();
-    if (hit.rigid_pivot) row["collision_efficiency"] = hit.rigid_pivot->collision_efficiency;
+    if (timings != nullptr) {
+      for (const auto& t : hit.timings) book.Add(t.model, t.time_s, t.calls);
+    }
+    if (hit.rigid_pivot) out.collision_efficiency = hit.rigid_pivot->collision_efficiency;
   }
-  out.row = std::move(row);
+  out.feasible = true;
+  return done();
+}
+
+Json RenderDesignRow(const DesignOutcome& outcome, const RowOutputs& outputs) {
+  if (!outcome.feasible) return {{"feasible", false}, {"error", outcome.error}};
+  Json row{{"feasible", true}};
+  if (!outputs.scene.empty()) {
+    Json rendered = SceneResultToJson(outcome.result);
+    for (const core::SceneOutput output : outputs.scene) {
+      const char* name = core::SceneOutputName(output);
+      if (rendered.contains(name)) row[name] = std::move(rendered[name]);
+    }
+  }
+  if (outputs.properties) {
+    row["properties"] = PropertiesToJson(outcome.result.mass_properties, outcome.result.length_m);
+  }
+  if (outcome.collision_efficiency) row["collision_efficiency"] = *outcome.collision_efficiency;
+  return row;
+}
+
+DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
+                         const core::SceneOptions& options, const ApiLimits& limits) {
+  DesignRow out;
+  ApiError error;
+  ObjectReader reader(design_json, "", &error);
+  core::Scene scene;
+  // The bat's mass properties are left to the single computation in ComputeDesign.
+  if (const Json* bat = reader.Get("bat")) {
+    if (auto spec = ParseBatGeometry(*bat, "bat", limits, &error)) {
+      scene.bat = std::move(spec->bat);
+      ReadSceneCommon(reader, &scene);
+    }
+  }
+  scene.outputs = outputs.scene;
+  if (!error.code) ValidateDesignScene(scene, &error);
+  if (error.code) {
+    out.row = {{"feasible", false}, {"error", DesignErrorJson(error)}};
+    return out;
+  }
+  const DesignOutcome outcome = ComputeDesign(scene, outputs, options, &out.timings);
+  out.row = RenderDesignRow(outcome, outputs);
   return out;
 }
 

@@ -1,11 +1,16 @@
 // One design of a /v1/explore sweep: its row (the outputs asked for, or the error the
-// single endpoint would answer for that design) and the time its models took.
+// single endpoint would answer for that design). A design is
+// evaluated in two steps that the sweep engine (api/explore_engine.hpp) shares with the
+// JSON path: a scene (parsed from the design's JSON here, or bound from a resolved template
+// there), then ComputeDesign and RenderDesignRow.
 #pragma once
 
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <vector>
 
+#include "api/json_reader.hpp"
 #include "api/limits.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/scene/timing_book.hpp"
@@ -24,6 +29,28 @@ struct DesignRow {
   nlohmann::json row;  ///< {"feasible": true, outputs...} or {"feasible": false, "error": {...}}.
   std::vector<core::ModelTiming> timings;  ///< Per model over the scene and the collision.
 };
+
+/// What a design's models computed: the values a row is rendered from.
+struct DesignOutcome {
+  bool feasible = false;     ///< False: `error` is the row's error object.
+  nlohmann::json error;      ///< {"code", "message", "field"} when not feasible.
+  core::SceneResult result;  ///< The scene outputs, mass_properties and length_m (feasible).
+  std::optional<double> collision_efficiency;  ///< q at the sweet spot, when asked for.
+};
+
+/// True when `scene` (a design's, its outputs set) is a valid scene; a row of properties only
+/// is checked as if it named max_exit_speed. Otherwise false with the error in *error.
+bool ValidateDesignScene(const core::Scene& scene, ApiError* error);
+
+/// Runs the models of a valid design scene (`scene.outputs` = outputs.scene; its
+/// mass_properties may be preset when they are known to be the bat's); the time and calls
+/// per model in *timings when non-null. Never throws.
+DesignOutcome ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
+                            const core::SceneOptions& options,
+                            std::vector<core::ModelTiming>* timings = nullptr);
+
+/// The row of an outcome: {"feasible": false, "error"} or {"feasible": true, outputs...}.
+nlohmann::json RenderDesignRow(const DesignOutcome& outcome, const RowOutputs& outputs);
 
 /// Evaluates `design` (a bat and scene fields, as a request writes them): the mass properties
 /// are computed once per design, whatever the outputs. Never throws.

@@ -12,6 +12,7 @@
 #include "api/endpoint.hpp"
 #include "api/explore_columns.hpp"
 #include "api/explore_design.hpp"
+#include "api/explore_engine.hpp"
 #include "api/explore_shards.hpp"
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
@@ -26,12 +27,6 @@ using Json = nlohmann::json;
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
-
-// A swept parameter: its path as written, its steps from the template root.
-struct Parameter {
-  std::string path;
-  std::vector<PathStep> steps;
-};
 
 // The error a swept field gives because the design's parser does not know it (a misspelt
 // last key, "profile.knots[3].radius"): every design would fail alike, so the sweep is
@@ -49,110 +44,6 @@ bool IsKnownField(const Json& probe, const ApiLimits& limits, ApiError* unknown)
   *unknown = std::move(error);
   return false;
 }
-
-// A Pareto objective: an output path of a row and its sense.
-// A validated sweep: everything needed to evaluate its designs, owned, so a
-// streamed answer can run it after the handler has returned.
-struct Sweep {
-  Json base;                               // the design template (bat + scene fields)
-  std::vector<Parameter> parameters;       // the swept fields
-  core::SweepPlan plan;                    // sampling, dimensions, seed
-  std::vector<std::vector<double>> drawn;  // LHS / Sobol points (grids are enumerated)
-  RowOutputs outputs;
-  core::SceneOptions options;
-  ApiLimits limits;
-  std::vector<ParetoObjective> objectives;  // Pareto objectives (may be empty)
-  core::Shard shard;
-  std::uint64_t total = 0;  // designs in the whole sweep
-  Json provenance;
-  std::chrono::steady_clock::time_point start;
-};
-
-// How a sweep ended.
-struct SweepOutcome {
-  bool cancelled = false;  // Progress::Cancel() (message says after how many designs)
-  bool stopped = false;    // the row sink refused a row (a streaming client went away)
-  std::string message;
-  Json summary;  // set when neither
-};
-
-// Evaluates the shard's designs in index order, handing each row to `emit`
-// (false from it stops the sweep), and returns the summary.
-SweepOutcome RunSweep(const Sweep& sweep, core::Progress* progress,
-                      const std::function<bool(Json)>& emit) {
-  SweepOutcome outcome;
-  std::vector<std::vector<double>> objective_values;
-  std::vector<std::uint64_t> indices;
-  std::uint64_t evaluated = 0, failed = 0;
-  const core::Shard& shard = sweep.shard;
-  const std::uint64_t total = sweep.total;
-  const std::uint64_t in_shard = total / shard.count + (shard.index < total % shard.count ? 1 : 0);
-  for (std::uint64_t i = shard.index; i < total; i += shard.count) {
-    if (core::IsCancelled(progress)) {
-      outcome.cancelled = true;
-      outcome.message = "the sweep was cancelled after " + std::to_string(evaluated) + " designs";
-      return outcome;
-    }
-    const std::vector<double> point = sweep.plan.method == core::SamplingMethod::kGrid
-                                          ? core::GridDesign(sweep.plan, i)
-                                          : sweep.drawn[static_cast<std::size_t>(i)];
-    Json design = sweep.base;
-    Json values = Json::object();
-    for (std::size_t k = 0; k < sweep.parameters.size(); ++k) {
-      SetNumberAtPath(&design, sweep.parameters[k].steps, point[k], nullptr);
-      values[sweep.parameters[k].path] = point[k];
-    }
-    Json row = EvaluateDesign(design, sweep.outputs, sweep.options, sweep.limits).row;
-    row["index"] = i;
-    row["parameters"] = std::move(values);
-    if (!row["feasible"].get<bool>()) ++failed;
-    if (!sweep.objectives.empty()) {
-      std::vector<double> v;
-      for (const auto& objective : sweep.objectives) {
-        const Json* value = FindAt(row, objective.tokens);
-        v.push_back(value != nullptr && value->is_number() ? value->get<double>() : std::nan(""));
-      }
-      objective_values.push_back(std::move(v));
-      indices.push_back(i);
-    }
-    if (!emit(std::move(row))) {
-      outcome.stopped = true;
-      return outcome;
-    }
-    ++evaluated;
-    if (progress != nullptr && in_shard > 0) {
-      progress->Report(static_cast<double>(evaluated) / static_cast<double>(in_shard));
-    }
-  }
-  Json summary{{"designs_total", total},
-               {"designs_in_shard", evaluated},
-               {"failed", failed},
-               {"sampling", core::SamplingMethodName(sweep.plan.method)},
-               {"seed", sweep.plan.seed},
-               {"shard", {{"index", shard.index}, {"count", shard.count}}},
-               {"timing_s", SecondsSince(sweep.start)}};
-  if (!sweep.objectives.empty()) {
-    std::vector<core::Sense> senses;
-    for (const auto& o : sweep.objectives) senses.push_back(o.sense);
-    Json front = Json::array();
-    for (const std::size_t k : core::ParetoFront(objective_values, senses)) {
-      front.push_back(indices[k]);
-    }
-    summary["pareto_front"] = std::move(front);
-    summary["pareto_objectives"] = ObjectivesToJson(sweep.objectives);  // for explore-merge
-    summary["pareto_scope"] = "the rows of this response (this shard)";
-  }
-  summary["provenance"] = sweep.provenance;
-  outcome.summary = std::move(summary);
-  return outcome;
-}
-
-// A parsed /v1/explore request: the sweep, ready to run, and the answer's format.
-struct ExploreRequest {
-  std::shared_ptr<Sweep> sweep;
-  std::string format;                  // "json", "ndjson" or "csv"
-  std::vector<ExploreColumn> columns;  // "columns" (csv: the default set when not given)
-};
 
 // "columns": 1 to kMaxColumns distinct dotted paths, each naming a part of `shape` (what a
 // row of this sweep can have). Returns false with the error naming columns[i].
@@ -190,8 +81,10 @@ bool ParseColumns(const Json& list, const Json& shape, std::vector<ExploreColumn
   return true;
 }
 
-std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& context,
-                                           ApiError* error) {
+}  // namespace
+
+std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Context& context,
+                                                  ApiError* error) {
   ObjectReader reader(body, "", error);
 
   // The design template: the bat and the scene fields, as written.
@@ -236,7 +129,7 @@ std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& cont
     reader.Missing("samples");
   }
 
-  std::vector<Parameter> parameters;
+  std::vector<SweepParameter> parameters;
   const Json* params = reader.Get("parameters");
   if (reader.ok() && params == nullptr) reader.Missing("parameters");
   if (!reader.ok()) return std::nullopt;
@@ -247,7 +140,7 @@ std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& cont
   for (std::size_t i = 0; i < params->size(); ++i) {
     const std::string where = "parameters[" + std::to_string(i) + "]";
     ObjectReader p((*params)[i], where, error);
-    Parameter parameter;
+    SweepParameter parameter;
     core::SweepDimension dimension;
     p.String("path", &parameter.path);
     p.Number("min", Between(-1e12, 1e12), &dimension.min);
@@ -316,6 +209,7 @@ std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& cont
   }
   core::SceneOptions options;
   if (!ReadSceneOptions(reader, context.limits, &options)) return std::nullopt;
+  options.time_models = false;  // a row reports no timings
 
   std::vector<ParetoObjective> objectives;
   if (const Json* pareto = reader.Get("pareto")) {
@@ -358,7 +252,7 @@ std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& cont
   if (!reader.Finish()) return std::nullopt;
   // The columns are checked against what a row of this sweep can have, before any design.
   std::vector<std::string> parameter_paths;
-  for (const Parameter& parameter : parameters) parameter_paths.push_back(parameter.path);
+  for (const SweepParameter& parameter : parameters) parameter_paths.push_back(parameter.path);
   std::vector<ExploreColumn> columns;
   if (column_list != nullptr || format == "csv") {
     const Json shape = RowShape(parameter_paths, outputs);
@@ -403,56 +297,52 @@ std::optional<ExploreRequest> ParseExplore(const Json& body, const Context& cont
   if (sweep->plan.method != core::SamplingMethod::kGrid) {
     sweep->drawn = core::GenerateDesigns(sweep->plan);
   }
+  // The sweep engine: the template resolved once, the swept values bound without JSON.
+  sweep->binder =
+      DesignBinder::Compile(sweep->base, sweep->parameters, sweep->outputs, sweep->limits);
+  sweep->threads = std::max(1, context.explore_threads);
+  sweep->budget = context.thread_budget;
 
   return ExploreRequest{std::move(sweep), std::move(format), std::move(columns)};
 }
 
-}  // namespace
-
 Response HandleExplore(const Request& request, const Context& context) {
   const auto start = std::chrono::steady_clock::now();
   Response failure;
-  const auto parsed = ParseRequest<ExploreRequest>(request, context, ParseExplore, &failure);
+  const auto parsed = ParseRequest<ExploreRequest>(request, context, ParseExploreRequest, &failure);
   if (!parsed) return failure;
   // The sweep's timing_s, in its summary, counts from the request's arrival.
   const std::shared_ptr<Sweep>& sweep = parsed->sweep;
   sweep->start = start;
+  const std::vector<ExploreColumn> columns = parsed->columns;
   if (parsed->format == "csv") {
-    // Streamed like NDJSON: the header row, then a row per design as soon as it is
+    // Streamed like NDJSON: the header row, then the rows block by block as they are
     // evaluated. Only rows: the summary is in the json and ndjson answers (docs/api.md).
     Response streamed = Response::Text(200, std::string(), "text/csv");
     core::Progress* progress = context.progress;
-    streamed.stream = [sweep, progress, columns = parsed->columns](const ChunkSink& sink) {
-      std::string text;
-      AppendCsvHeader(columns, &text);
-      if (!sink(text)) return false;
-      const SweepOutcome outcome = RunSweep(*sweep, progress, [&](Json row) {
-        text.clear();
-        AppendCsvRow(row, columns, &text);
-        return sink(text);
-      });
+    streamed.stream = [sweep, progress, columns](const ChunkSink& sink) {
+      std::string header;
+      AppendCsvHeader(columns, &header);
+      if (!sink(header)) return false;
+      const SweepOutcome outcome = RunSweep(*sweep, RowFormat::kCsv, columns, progress,
+                                            [&](BlockRows& rows) { return sink(rows.text); });
       return !outcome.stopped && !outcome.cancelled;
     };
     return streamed;
   }
-  // With "columns", a row is the flat object of those columns (ProjectRow).
-  // Owns its columns: the NDJSON stream runs after this handler returns.
-  const auto shaped = [columns = parsed->columns](Json row) {
-    if (columns.empty()) return row;
-    return ProjectRow(row, columns);
-  };
+  // With "columns", a row is the flat object of those columns.
   if (parsed->format == "ndjson") {
-    // Streamed: a line per design as soon as it is evaluated, then the summary
-    // line. The sweep runs while the server writes (after this returns), so it
-    // owns copies of everything; a client that goes away stops it.
+    // Streamed: the rows block by block as they are evaluated, then the summary line. The
+    // sweep runs while the server writes (after this returns), so it owns copies of
+    // everything; a client that goes away stops it.
     Response streamed = Response::Text(200, std::string(), "application/x-ndjson");
     core::Progress* progress = context.progress;
-    streamed.stream = [sweep, progress, shaped](const ChunkSink& sink) {
+    streamed.stream = [sweep, progress, columns](const ChunkSink& sink) {
       const auto line = [&sink](const Json& value) {
         return sink(value.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n");
       };
-      const SweepOutcome outcome =
-          RunSweep(*sweep, progress, [&](Json row) { return line(shaped(std::move(row))); });
+      const SweepOutcome outcome = RunSweep(*sweep, RowFormat::kNdjson, columns, progress,
+                                            [&](BlockRows& rows) { return sink(rows.text); });
       if (outcome.stopped) return false;
       if (outcome.cancelled) {
         return line({{"error",
@@ -465,10 +355,11 @@ Response HandleExplore(const Request& request, const Context& context) {
     return streamed;
   }
   Json rows = Json::array();
-  const SweepOutcome outcome = RunSweep(*sweep, context.progress, [&](Json row) {
-    rows.push_back(shaped(std::move(row)));
-    return true;
-  });
+  const SweepOutcome outcome =
+      RunSweep(*sweep, RowFormat::kJson, columns, context.progress, [&](BlockRows& block) {
+        for (Json& row : block.rows) rows.push_back(std::move(row));
+        return true;
+      });
   if (outcome.cancelled) return ErrorResponse(409, ErrorCode::kCancelled, outcome.message);
   return {200, {{"rows", std::move(rows)}, {"summary", outcome.summary}}};
 }

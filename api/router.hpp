@@ -19,6 +19,7 @@ class ModesCache;
 namespace sweetspot::api {
 
 class JobService;
+class ThreadBudget;
 
 /// A request as the handlers see it.
 struct Request {
@@ -38,6 +39,12 @@ struct Context {
   /// True when the answer goes to a job's result or the CLI's output rather than to a waiting
   /// HTTP client: /v1/explore then allows limits.max_batch_samples designs, not max_samples.
   bool batch = false;
+  /// Threads one /v1/explore sweep may evaluate its designs on (>= 1; the rows' order and
+  /// bytes do not depend on it): the server's and the CLI's --explore-threads.
+  int explore_threads = 1;
+  /// Where a sweep's threads beyond its first come from, without waiting (null: no bound).
+  /// The server's is its compute pool's (server/connection_loop.hpp).
+  ThreadBudget* thread_budget = nullptr;
 };
 
 /// What answering a request costs, for the server's choice of worker pool.

@@ -211,8 +211,9 @@ bool Bat::Validate(Refusal* why) const {
   return true;
 }
 
-bool Bat::ValidateSize(Refusal* why) const {
-  if (!Validate(why)) return false;
+bool Bat::ValidateSize(Refusal* why) const { return Validate(why) && ValidateCaps(why); }
+
+bool Bat::ValidateCaps(Refusal* why) const {
   for (std::size_t i = 0; i < knots.size(); ++i) {
     if (knots[i].x_m > kMaxBatLengthM) {
       return why == nullptr ? false

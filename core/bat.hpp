@@ -120,6 +120,9 @@ struct Bat {
   /// Material::ValidateSize ("knots[1].x_m = 150: must be in [0, 100]"); for a bat given from
   /// outside.
   bool ValidateSize(Refusal* refusal) const;
+  /// The caps of ValidateSize alone (ValidateSize = Validate, then this): for a bat that
+  /// Validate checks elsewhere.
+  bool ValidateCaps(Refusal* refusal) const;
   /// L, m (the last knot's x; 0 without knots).
   double LengthM() const;
   /// Outer radius at x (from the knob), m; 0 outside [0, L].

@@ -11,6 +11,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "api/explore_shards.hpp"
@@ -22,7 +23,8 @@ namespace {
 
 std::string Usage() {
   std::ostringstream text;
-  text << "Usage: sweetspot [-X METHOD] [--max-batch-samples N|none] PATH [FILE|-]\n"
+  text << "Usage: sweetspot [-X METHOD] [--max-batch-samples N|none] [--explore-threads N]\n"
+       << "                 PATH [FILE|-]\n"
        << "       sweetspot explore --shard I/N [FILE|-]\n"
        << "       sweetspot explore-merge FILE...\n"
        << "       sweetspot serve [SERVER OPTIONS]   (as sweetspot-server; see its --help)\n"
@@ -35,6 +37,9 @@ std::string Usage() {
        << "  --max-batch-samples N|none  explore only: the most designs a sweep may have\n"
        << "        (also SWEETSPOT_MAX_BATCH_SAMPLES; default none: no limit, the rows are\n"
        << "        streamed to stdout)\n"
+       << "  --explore-threads N  explore only: threads to evaluate the designs on, 1 to\n"
+       << "        1024 (also SWEETSPOT_EXPLORE_THREADS; default: one per core); the rows\n"
+       << "        and their order are the same whatever N\n"
        << "  --shard I/N  explore only: run shard I (0-based) of N of the sweep, as\n"
        << "        NDJSON (the request's shard and format are set); design i is in\n"
        << "        shard i mod N\n"
@@ -124,6 +129,18 @@ bool ParseBatchLimit(const std::string& text, std::size_t* limit) {
   return true;
 }
 
+// "N" in [1, 1024] into *threads.
+bool ParseThreads(const std::string& text, int* threads) {
+  if (text.empty() || text.size() > 4 ||
+      text.find_first_not_of("0123456789") != std::string::npos) {
+    return false;
+  }
+  const int n = std::stoi(text);
+  if (n < 1 || n > 1024) return false;
+  *threads = n;
+  return true;
+}
+
 int ExitCode(int status) {
   if (status >= 200 && status < 300) return 0;
   if (status >= 400 && status < 500) return 2;
@@ -155,10 +172,15 @@ int main(int argc, char** argv) {
   context.limits.max_batch_samples = std::numeric_limits<std::size_t>::max();
   std::string batch_limit;
   if (const char* env = std::getenv("SWEETSPOT_MAX_BATCH_SAMPLES")) batch_limit = env;
-  std::string shard;
+  std::string shard, explore_threads;
+  if (const char* env = std::getenv("SWEETSPOT_EXPLORE_THREADS")) explore_threads = env;
   for (std::size_t i = 0; i < args.size();) {
-    if ((args[i] == "--shard" || args[i] == "--max-batch-samples") && i + 1 < args.size()) {
-      (args[i] == "--shard" ? shard : batch_limit) = args[i + 1];
+    if ((args[i] == "--shard" || args[i] == "--max-batch-samples" ||
+         args[i] == "--explore-threads") &&
+        i + 1 < args.size()) {
+      (args[i] == "--shard"             ? shard
+       : args[i] == "--explore-threads" ? explore_threads
+                                        : batch_limit) = args[i + 1];
       args.erase(args.begin() + static_cast<std::ptrdiff_t>(i),
                  args.begin() + static_cast<std::ptrdiff_t>(i) + 2);
     } else {
@@ -168,6 +190,13 @@ int main(int argc, char** argv) {
   if (!batch_limit.empty() && !ParseBatchLimit(batch_limit, &context.limits.max_batch_samples)) {
     std::cerr << "sweetspot: --max-batch-samples (or SWEETSPOT_MAX_BATCH_SAMPLES) \"" << batch_limit
               << "\": must be an integer in [1, 10^15] or none\n";
+    return 2;
+  }
+  const unsigned cores = std::thread::hardware_concurrency();
+  context.explore_threads = cores == 0 ? 1 : static_cast<int>(cores);
+  if (!explore_threads.empty() && !ParseThreads(explore_threads, &context.explore_threads)) {
+    std::cerr << "sweetspot: --explore-threads (or SWEETSPOT_EXPLORE_THREADS) \"" << explore_threads
+              << "\": must be an integer in [1, 1024]\n";
     return 2;
   }
   if (args.empty() || args.size() > 2) {

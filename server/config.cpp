@@ -103,6 +103,17 @@ const std::vector<Option>& Options() {
          c->compute_threads = static_cast<int>(n);
          return true;
        }},
+      {"--explore-threads", "SWEETSPOT_EXPLORE_THREADS",
+       "threads one /v1/explore sweep evaluates its designs on (the rows' order and bytes do "
+       "not depend on it); those beyond the sweep's own come from the compute pool's idle "
+       "workers; 0 = one per core (default 0)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 0, 1024, &n, rule)) return false;
+         c->explore_threads = static_cast<int>(n);
+         return true;
+       }},
       {"--max-connections", "SWEETSPOT_MAX_CONNECTIONS",
        "open connections (reading, answered or idle keep-alive); beyond: 503 TooBusy at once, "
        "then closed (default 256)",
@@ -386,6 +397,10 @@ bool ServerConfig::IsValid(std::string* why) const {
   }
   if (compute_threads < 0 || compute_threads > 1024) {
     return fail("compute_threads = " + std::to_string(compute_threads) +
+                ": must be in [0, 1024] (0 = one per core)");
+  }
+  if (explore_threads < 0 || explore_threads > 1024) {
+    return fail("explore_threads = " + std::to_string(explore_threads) +
                 ": must be in [0, 1024] (0 = one per core)");
   }
   if (max_head_bytes < 256) {

@@ -19,6 +19,7 @@ struct ServerConfig {
   int port = 8080;                       ///< TCP port, 0 = ephemeral (--port, SWEETSPOT_PORT).
   int threads = 8;                       ///< Worker threads for cheap requests (--threads, SWEETSPOT_THREADS), 1..1024. A connection holds one only while a request of it is being answered.
   int compute_threads = 0;               ///< Worker threads for requests that run models (explore, optimize, fit, modes, hertz and flexible scenes); 0 = one per core (--compute-threads, SWEETSPOT_COMPUTE_THREADS), 0..1024.
+  int explore_threads = 0;               ///< Threads one /v1/explore sweep evaluates on (beyond its own: idle compute workers); 0 = one per core (--explore-threads, SWEETSPOT_EXPLORE_THREADS), 0..1024.
   int max_connections = 256;             ///< Open connections (reading, answered, idle keep-alive); beyond: 503 TooBusy at once, then closed (--max-connections, SWEETSPOT_MAX_CONNECTIONS).
   std::string auth_token;                ///< If set, every path but /health needs "Authorization: Bearer <token>" (SWEETSPOT_AUTH_TOKEN, --auth-token-file).
   std::string cors_origin;               ///< CORS: the allowed Origin, or "*"; empty = no CORS headers (--cors-origin, SWEETSPOT_CORS_ORIGIN).

@@ -20,6 +20,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "api/thread_budget.hpp"
 #include "server/request_head.hpp"
 
 namespace sweetspot::server {
@@ -618,6 +619,15 @@ struct ConnectionLoop::Impl {
   }
 
   void ComputeWorker(ConnectionPtr c) {
+    // One of the pool's threads, unless a sweep has borrowed it (then this waits for it).
+    api::ThreadBudget* budget = options.compute_budget;
+    if (budget != nullptr) budget->TakeOne();
+    struct GiveBack {
+      api::ThreadBudget* budget;
+      ~GiveBack() {
+        if (budget != nullptr) budget->Give(1);
+      }
+    } give_back{budget};
     std::unique_lock<std::mutex> lock(c->mutex);
     if (c->closed) return;
     Answer(*c, compute_busy);

@@ -34,6 +34,10 @@
 #include "api/error_code.hpp"
 #include "server/request_stream.hpp"
 
+namespace sweetspot::api {
+class ThreadBudget;
+}  // namespace sweetspot::api
+
 namespace sweetspot::server {
 
 /// The loop's limits and pool sizes (ServerConfig supplies them).
@@ -60,6 +64,9 @@ struct ConnectionLoopOptions {
   int light_workers = 8;
   /// Threads for requests that run models.
   int compute_workers = 2;
+  /// The compute pool's threads as a budget (null: none): a compute worker takes one while it
+  /// answers, waiting when sweeps have borrowed them all (api/explore_engine.hpp).
+  api::ThreadBudget* compute_budget = nullptr;
   /// How long a closed connection is drained, s.
   double linger_s = 1.0;
 };

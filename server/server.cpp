@@ -1,6 +1,7 @@
 #include "server/server.hpp"
 
 // Before httplib.h: it pulls in <resolv.h>, whose `_res` macro breaks Eigen.
+#include "api/thread_budget.hpp"
 #include "core/flexible/modes_cache.hpp"
 
 #include <httplib.h>
@@ -256,6 +257,10 @@ struct Server::Impl {
   api::Context context;
   Metrics metrics;
   core::ModesCache modes_cache;               // bending modes kept across requests (bounded LRU)
+  // The compute pool's threads: a compute worker holds one while it answers, a sweep takes
+  // idle ones for its extra threads (--explore-threads), so model work never runs on more
+  // threads than the pool has.
+  std::unique_ptr<api::ThreadBudget> compute_budget;
   std::unique_ptr<SqliteJobStore> job_store;  // A SQLite --jobs-db only; outlives `jobs`.
   std::unique_ptr<ServerJobService> jobs;     // Never null after the constructor.
   std::unique_ptr<StaticFiles> static_files;  // The explorer's files (web root); never null.
@@ -328,6 +333,10 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
       std::make_unique<StaticFiles>(config_.web_root.empty() ? DefaultWebRoot() : config_.web_root);
   impl_->context.limits = config_.limits;
   impl_->context.modes_cache = &impl_->modes_cache;
+  impl_->compute_budget =
+      std::make_unique<api::ThreadBudget>(ComputeWorkers(config_.compute_threads));
+  impl_->context.thread_budget = impl_->compute_budget.get();
+  impl_->context.explore_threads = ComputeWorkers(config_.explore_threads);
   // Jobs run the same router with the job's cancel flag and progress, on a
   // copy of the context taken now: loaded jobs may start before this
   // constructor returns, and jobbable requests need neither jobs nor metrics.
@@ -514,6 +523,7 @@ bool Server::Bind(std::string* error) {
   options.keep_alive_max_requests = config_.keep_alive_max_requests;
   options.light_workers = config_.threads;
   options.compute_workers = ComputeWorkers(config_.compute_threads);
+  options.compute_budget = impl_->compute_budget.get();
   ConnectionLoopHooks hooks;
   hooks.serve = [impl = impl_.get()](RequestStream& stream, bool close_connection, bool* closed) {
     return impl->http.ServeOne(stream, close_connection, closed);

@@ -103,7 +103,8 @@ std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model
 }
 
 SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
-  return TimedRequest<SceneResult>("scene", [&](SceneResult& out, TimingBook& book) {
+  const bool timed = options.time_models;
+  return TimedRequest<SceneResult>("scene", timed, [&](SceneResult& out, TimingBook& book) {
     Summary& s = out.summary;
     if (Refusal refusal; !options.Validate(&refusal)) {
       s.SetRefusal(std::move(refusal));
@@ -197,10 +198,10 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
     if (need_max) {
       MaxExitSpeedResult mx;
       if (closed) {
-        const auto tm = std::chrono::steady_clock::now();
+        const auto tm = book.Now();
         mx = ClosedFormMaxExitSpeed(*exit_model->profile(), r.length_m);
         mx.model = exit_model->name();
-        mx.summary.solve_time_s = SecondsSince(tm);
+        mx.summary.solve_time_s = book.Since(tm);
         mx.summary.models_used = {exit_model->name()};
         book.Add(exit_model->name(), mx.summary.solve_time_s, 1);
       } else if (model == CollisionModel::kFlexible &&
@@ -215,10 +216,13 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
       note(mx.summary.termination,
            mx.summary.IsSolutionUsable() ? std::string() : "max_exit_speed: " + mx.summary.message);
       const bool usable = mx.summary.IsSolutionUsable();
-      if (std::find(wanted.begin(), wanted.end(), SceneOutput::kMaxExitSpeed) != wanted.end()) {
-        out.max_exit_speed = mx;
-      }
-      if (std::find(wanted.begin(), wanted.end(), SceneOutput::kSweetZone) != wanted.end()) {
+      const bool want_max =
+          std::find(wanted.begin(), wanted.end(), SceneOutput::kMaxExitSpeed) != wanted.end();
+      const bool want_zone =
+          std::find(wanted.begin(), wanted.end(), SceneOutput::kSweetZone) != wanted.end();
+      if (want_max && !want_zone) out.max_exit_speed = std::move(mx);  // the zone reads mx
+      if (want_max && want_zone) out.max_exit_speed = mx;
+      if (want_zone) {
         if (!usable) {
           note(Termination::kFailure, "sweet_zone: needs max_exit_speed, which failed");
         } else {
@@ -227,9 +231,9 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
                   ? options.sweet_zone_tolerance / 100.0 * std::abs(mx.exit_speed_mps)
                   : options.sweet_zone_tolerance;
           if (closed) {
-            const auto tz = std::chrono::steady_clock::now();
+            const auto tz = book.Now();
             out.sweet_zone = ClosedFormSweetZone(*exit_model->profile(), r.length_m, mx, tol);
-            book.Add(exit_model->name(), SecondsSince(tz), 1);
+            book.Add(exit_model->name(), book.Since(tz), 1);
           } else {
             std::string error;
             out.sweet_zone = RootFindSweetZone(&*exit_model, r.length_m, mx, tol, &error);

@@ -36,7 +36,7 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
   if (scene.mass_properties.has_value()) {
     r->mass_properties = *scene.mass_properties;
   } else {
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = book->Now();
     try {
       r->mass_properties = ComputeMassProperties(*scene.bat, scene.inertia_model);
     } catch (const std::exception& e) {
@@ -44,7 +44,7 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
       s->message = std::string("mass properties failed: ") + e.what();
       return false;
     }
-    book->Add("mass_properties", SecondsSince(t0), 1);
+    book->Add("mass_properties", book->Since(t0), 1);
   }
   const MassProperties& mp = r->mass_properties;
   if (!(std::isfinite(mp.mass_kg) && mp.mass_kg > 0.0 && std::isfinite(mp.balance_point_m) &&

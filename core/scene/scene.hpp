@@ -168,6 +168,10 @@ struct SceneOptions {
   int max_curve_points = 10000;
   HertzOptions hertz;        ///< Contact-model settings (model = kHertz).
   FlexibleOptions flexible;  ///< Flexible-beam settings (vibration_node, flexible, sting).
+  /// True (the default): the result's timings and solve_time_s are measured. False: the
+  /// closed forms and the mass properties read no clock (their timings are 0 s; the models
+  /// and calls are still listed): /v1/explore's sweeps, whose rows report no timings.
+  bool time_models = true;
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;

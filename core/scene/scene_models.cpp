@@ -67,7 +67,7 @@ ExitSpeedModel::ExitSpeedModel(CollisionModel model, const Scene& scene,
 }
 
 bool ExitSpeedModel::Eval(double s, double* v, double* grad, double* err, std::string* why) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = book_->Now();
   bool ok = true;
   if (profile_.has_value()) {
     const double x = s - profile_->origin_from_knob_m;
@@ -107,7 +107,7 @@ bool ExitSpeedModel::Eval(double s, double* v, double* grad, double* err, std::s
       }
     }
   }
-  book_->Add(name(), SecondsSince(t0), 1);
+  book_->Add(name(), book_->Since(t0), 1);
   return ok;
 }
 

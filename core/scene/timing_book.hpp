@@ -26,6 +26,20 @@ struct ModelTiming {
 /// Time and calls per model, in first-use order; one per request (not shared across threads).
 class TimingBook {
  public:
+  /// A book that reads the clock (`timed`, the default) or one that lists the models and their
+  /// calls with 0 s and never reads it (a sweep that reports no timings: the clock is a tenth of
+  /// a closed-form design's time).
+  explicit TimingBook(bool timed = true) : timed_(timed) {}
+  /// Now, or the epoch when not timed.
+  std::chrono::steady_clock::time_point Now() const {
+    return timed_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
+  }
+  /// Seconds since `start` (from Now()), or 0 when not timed.
+  double Since(std::chrono::steady_clock::time_point start) const {
+    return timed_ ? SecondsSince(start) : 0.0;
+  }
+  /// True when the book reads the clock.
+  bool timed() const { return timed_; }
   /// Adds `time_s` seconds and `calls` evaluations to `model` (listed on first use).
   void Add(const std::string& model, double time_s, int calls) {
     for (auto& t : timings_) {
@@ -39,6 +53,8 @@ class TimingBook {
   }
   /// The timings, in first-use order.
   const std::vector<ModelTiming>& timings() const { return timings_; }
+  /// The timings, moved out (the book is left empty).
+  std::vector<ModelTiming> TakeTimings() { return std::move(timings_); }
   /// The models used, in first-use order (a result's models_used).
   std::vector<std::string> Models() const {
     std::vector<std::string> out;
@@ -48,34 +64,42 @@ class TimingBook {
 
  private:
   std::vector<ModelTiming> timings_;
+  bool timed_ = true;
 };
 
 /// Runs one solve: `body(out)` fills a fresh `Result` (a struct with a `Summary summary`),
 /// whose termination starts as invalid input; what `body` throws becomes an internal error
-/// (CatchInternalError); summary.solve_time_s is the wall time of it all, s.
+/// (CatchInternalError); summary.solve_time_s is the wall time of it all, s (0 and no clock
+/// read when not `timed`).
 template <class Result, class Body>
-Result TimedSolve(Body&& body) {
-  const auto t0 = std::chrono::steady_clock::now();
+Result TimedSolve(Body&& body, bool timed = true) {
+  const auto t0 =
+      timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
   Result out;
   out.summary.termination = Termination::kInvalidInput;
   CatchInternalError(&out.summary, [&] { body(out); });
-  out.summary.solve_time_s = SecondsSince(t0);
+  if (timed) out.summary.solve_time_s = SecondsSince(t0);
   return out;
 }
 
-/// Runs one request as TimedSolve does, with `backend` as the summary's backend and a fresh
-/// TimingBook for `body(out, book)`: the result's `timings` and summary.models_used are the
-/// book's, however the request ended.
+template <class Result, class Body>
+Result TimedRequest(const char* backend, bool timed, Body&& body) {
+  TimingBook book(timed);
+  Result out = TimedSolve<Result>(
+      [&](Result& r) {
+        r.summary.backend = backend;
+        body(r, book);
+      },
+      timed);
+  out.summary.models_used = book.Models();
+  out.timings = book.TakeTimings();
+  return out;
+}
+
+/// TimedRequest with the clock read (timed = true).
 template <class Result, class Body>
 Result TimedRequest(const char* backend, Body&& body) {
-  TimingBook book;
-  Result out = TimedSolve<Result>([&](Result& r) {
-    r.summary.backend = backend;
-    body(r, book);
-  });
-  out.timings = book.timings();
-  out.summary.models_used = book.Models();
-  return out;
+  return TimedRequest<Result>(backend, true, std::forward<Body>(body));
 }
 
 }  // namespace sweetspot::core

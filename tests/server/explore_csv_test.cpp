@@ -33,10 +33,12 @@ struct CliOutput {
   std::string out;
 };
 
-// Runs the CLI with `args` (stderr dropped) and collects its stdout.
-CliOutput RunSweetspot(const std::string& args) {
-  const std::string command =
-      std::string(SWEETSPOT_BINARY_DIR) + "/server/sweetspot " + args + " 2>/dev/null";
+// Runs the CLI with `args` (stderr dropped; `env`, e.g. "NAME=value", set for it) and
+// collects its stdout.
+CliOutput RunSweetspot(const std::string& args, const std::string& env = "") {
+  const std::string command = (env.empty() ? "" : "env " + env + " ") +
+                              std::string(SWEETSPOT_BINARY_DIR) + "/server/sweetspot " + args +
+                              " 2>/dev/null";
   CliOutput result;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return result;
@@ -204,6 +206,49 @@ TEST(ExploreCsvEndToEndTest, TheCliRunsASweepLargerThanARequestMayBe) {
   EXPECT_EQ(limited.exit_code, 2);
   EXPECT_EQ(Json::parse(limited.out)["message"],
             "parameters describe 150000 designs, over the limit max_batch_samples = 149999");
+}
+
+// --explore-threads (flag or environment, CLI and server) changes the threads, never the
+// bytes: row i is design i whatever the count; a count out of range is refused (exit 2).
+TEST(ExploreCsvEndToEndTest, ExploreThreadsChangeNothingButTheThreads) {
+  // 2000 designs: at least eight blocks (of at most 256), so that three threads interleave; some infeasible
+  // (taper_start past taper_end), whose error rows must sit in their place too.
+  const Json sweep = Json::parse(R"({"bat": {"three_segment": {"length_m": 0.8636,
+        "handle_radius_m": 0.0125, "barrel_radius_m": 0.033, "taper_start_m": 0.30,
+        "taper_end_m": 0.55}, "material": "ash"},
+    "parameters": [{"path": "three_segment.taper_start_m", "min": 0.2, "max": 0.6, "count": 40},
+                   {"path": "three_segment.taper_end_m", "min": 0.45, "max": 0.7, "count": 50}],
+    "outputs": ["max_exit_speed", "properties"], "format": "csv",
+    "columns": ["index", "max_exit_speed.exit_speed_mps", "properties.mass_kg", "error.code"]})");
+  const TemporaryFile request_file("sweep.json", sweep.dump());
+  const std::string& file = request_file.path();
+  const CliOutput one = RunSweetspot("--explore-threads 1 explore " + file);
+  ASSERT_EQ(one.exit_code, 0);
+  ASSERT_EQ(Lines(one.out).size(), 2001u);
+  EXPECT_NE(one.out.find(",InvalidValue\n"), std::string::npos);  // infeasible rows are in it
+  EXPECT_EQ(RunSweetspot("--explore-threads 3 explore " + file).out, one.out);
+  EXPECT_EQ(RunSweetspot("explore " + file).out, one.out);  // one per core
+  EXPECT_EQ(RunSweetspot("explore " + file, "SWEETSPOT_EXPLORE_THREADS=2").out, one.out);
+  EXPECT_EQ(RunSweetspot("explore " + file, "SWEETSPOT_EXPLORE_THREADS=0").exit_code, 2);
+  EXPECT_EQ(RunSweetspot("--explore-threads 0 explore " + file).exit_code, 2);
+  EXPECT_EQ(RunSweetspot("--explore-threads many explore " + file).exit_code, 2);
+  // The server with three explore threads and one compute worker to borrow from: the same
+  // bytes over HTTP.
+  ServerConfig config;
+  config.explore_threads = 3;
+  config.compute_threads = 2;
+  RunningServer server(config);
+  ASSERT_TRUE(server.bound());
+  const auto answer = server.Client().Post("/v1/explore", sweep.dump(), "application/json");
+  ASSERT_TRUE(answer);
+  EXPECT_EQ(answer->status, 200);
+  EXPECT_EQ(answer->body, one.out);
+  // Out of range in the server's configuration: refused with the rule.
+  ServerConfig bad;
+  bad.explore_threads = 2000;
+  std::string why;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_EQ(why, "explore_threads = 2000: must be in [0, 1024] (0 = one per core)");
 }
 
 // A job runs a sweep as a batch: over --max-samples but within --max-batch-samples, it is

@@ -1,0 +1,860 @@
+#include "api/explore_engine.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <string_view>
+#include <thread>
+#include <utility>
+
+#include "api/bat_json.hpp"
+#include "api/json_reader.hpp"
+#include "api/scene_json.hpp"
+#include "core/scene/timing_book.hpp"
+
+namespace sweetspot::api {
+
+using Json = nlohmann::json;
+
+// ---- DesignBinder ---------------------------------------------------------------------------
+
+enum class DesignBinder::Target {
+  kBallMass,
+  kBallRadius,
+  kBallSpeed,
+  kBallStiffness,
+  kBallExponent,
+  kSwingOmega,
+  kSwingPivot,
+  kSwingHands,
+  kCor,
+  kShapeLength,
+  kShapeHandle,
+  kShapeBarrel,
+  kShapeTaperStart,
+  kShapeTaperEnd,
+  kKnotX,
+  kKnotRadius,
+  kDensity,
+  kYoungs,
+  kShear,
+  kPoisson,
+  kMaterialCor,
+  kWall,
+  kFillDiameter,
+  kFillDepth,
+};
+
+namespace {
+
+// The steps of a path as "bat.profile.knots[].x_m" (indices left out) and its indices.
+std::string StepPattern(const std::vector<PathStep>& steps, std::vector<std::size_t>* indices) {
+  std::string pattern;
+  for (const PathStep& step : steps) {
+    if (const auto* key = std::get_if<std::string>(&step)) {
+      if (!pattern.empty()) pattern += '.';
+      pattern += *key;
+    } else {
+      pattern += "[]";
+      indices->push_back(std::get<std::size_t>(step));
+    }
+  }
+  return pattern;
+}
+
+bool IsObjectAt(const Json& root, std::initializer_list<const char*> keys) {
+  const Json* node = &root;
+  for (const char* key : keys) {
+    if (!node->is_object()) return false;
+    const auto it = node->find(key);
+    if (it == node->end()) return false;
+    node = &*it;
+  }
+  return node->is_object();
+}
+
+}  // namespace
+
+std::optional<DesignBinder> DesignBinder::Compile(const Json& base,
+                                                  const std::vector<SweepParameter>& parameters,
+                                                  const RowOutputs& outputs,
+                                                  const ApiLimits& limits) {
+  DesignBinder binder;
+  ApiError error;
+  if (!base.is_object() || !base.contains("bat")) return std::nullopt;
+  const auto spec = ParseBatGeometry(base["bat"], "bat", limits, &error);
+  if (!spec) return std::nullopt;
+  ObjectReader reader(base, "", &error);
+  binder.scene_.bat = spec->bat;
+  if (!ReadSceneCommon(reader, &binder.scene_)) return std::nullopt;
+  binder.scene_.outputs = outputs.scene;
+  const Json& bat = base["bat"];
+  using T = Target;
+  static const std::map<std::string_view, T> kScene = {
+      {"ball.mass_kg", T::kBallMass},
+      {"ball.radius_m", T::kBallRadius},
+      {"ball.speed_mps", T::kBallSpeed},
+      {"ball.stiffness_n_m_p", T::kBallStiffness},
+      {"ball.stiffness_exponent", T::kBallExponent},
+      {"swing.angular_speed_rad_s", T::kSwingOmega},
+      {"swing.pivot_from_knob_m", T::kSwingPivot},
+      {"swing.hands_from_knob_m", T::kSwingHands},
+      {"cor", T::kCor},
+      {"bat.wall_thickness_m", T::kWall}};
+  static const std::map<std::string_view, T> kShape = {
+      {"bat.three_segment.length_m", T::kShapeLength},
+      {"bat.three_segment.handle_radius_m", T::kShapeHandle},
+      {"bat.three_segment.barrel_radius_m", T::kShapeBarrel},
+      {"bat.three_segment.taper_start_m", T::kShapeTaperStart},
+      {"bat.three_segment.taper_end_m", T::kShapeTaperEnd}};
+  static const std::map<std::string_view, T> kKnot = {
+      {"bat.profile.knots[].x_m", T::kKnotX}, {"bat.profile.knots[].radius_m", T::kKnotRadius}};
+  static const std::map<std::string_view, T> kMaterial = {
+      {"bat.material.density_kg_m3", T::kDensity},
+      {"bat.material.youngs_modulus_pa", T::kYoungs},
+      {"bat.material.shear_modulus_pa", T::kShear},
+      {"bat.material.poissons_ratio", T::kPoisson},
+      {"bat.material.cor", T::kMaterialCor}};
+  static const std::map<std::string_view, T> kFill = {{"bat.fill.diameter_m", T::kFillDiameter},
+                                                      {"bat.fill.depth_m", T::kFillDepth}};
+  for (const SweepParameter& parameter : parameters) {
+    std::vector<std::size_t> indices;
+    const std::string pattern = StepPattern(parameter.steps, &indices);
+    Binding binding{};
+    if (const auto it = kScene.find(pattern); it != kScene.end()) {
+      binding.target = it->second;
+    } else if (const auto shape = kShape.find(pattern);
+               shape != kShape.end() && spec->three_segment) {
+      binding.target = shape->second;
+      binder.shape_ = spec->three_segment;
+    } else if (const auto knot = kKnot.find(pattern);
+               knot != kKnot.end() && spec->shape_form == "profile" && indices.size() == 1 &&
+               indices[0] < spec->bat.knots.size()) {
+      binding.target = knot->second;
+      binding.index = indices[0];
+    } else if (const auto material = kMaterial.find(pattern);
+               material != kMaterial.end() && IsObjectAt(bat, {"material"})) {
+      binding.target = material->second;
+    } else if (const auto fill = kFill.find(pattern);
+               fill != kFill.end() && IsObjectAt(bat, {"fill"}) && spec->bat.fill) {
+      binding.target = fill->second;
+    } else {
+      return std::nullopt;  // not bound here: the JSON path
+    }
+    if (pattern.rfind("bat.", 0) == 0) binder.bat_swept_ = true;
+    binder.bindings_.push_back(binding);
+  }
+  if (!binder.bat_swept_) {
+    // The bat is the template's in every design: its mass properties are computed once
+    // (a bat the JSON path would refuse as too small leaves them to each design).
+    const core::MassProperties p =
+        core::ComputeMassProperties(*binder.scene_.bat, binder.scene_.inertia_model);
+    if (ApiError e; CheckComputable(p, "bat", &e)) binder.scene_.mass_properties = p;
+  }
+  return binder;
+}
+
+bool DesignBinder::Bind(const std::vector<double>& values, core::Scene* scene) const {
+  core::Bat& bat = *scene->bat;
+  std::optional<core::ThreeSegmentShape> shape = shape_;
+  for (std::size_t k = 0; k < bindings_.size(); ++k) {
+    const double v = values[k];
+    switch (bindings_[k].target) {
+      case Target::kBallMass:
+        scene->ball.mass_kg = v;
+        break;
+      case Target::kBallRadius:
+        scene->ball.radius_m = v;
+        break;
+      case Target::kBallSpeed:
+        scene->ball.speed_mps = v;
+        break;
+      case Target::kBallStiffness:
+        scene->ball.stiffness = v;
+        break;
+      case Target::kBallExponent:
+        scene->ball.stiffness_exponent = v;
+        break;
+      case Target::kSwingOmega:
+        scene->swing.angular_speed_rad_s = v;
+        break;
+      case Target::kSwingPivot:
+        scene->swing.pivot_from_knob_m = v;
+        break;
+      case Target::kSwingHands:
+        scene->swing.hands_from_knob_m = v;
+        break;
+      case Target::kCor:
+        scene->cor = v;
+        break;
+      case Target::kShapeLength:
+        shape->length_m = v;
+        break;
+      case Target::kShapeHandle:
+        shape->handle_radius_m = v;
+        break;
+      case Target::kShapeBarrel:
+        shape->barrel_radius_m = v;
+        break;
+      case Target::kShapeTaperStart:
+        shape->taper_start_m = v;
+        break;
+      case Target::kShapeTaperEnd:
+        shape->taper_end_m = v;
+        break;
+      case Target::kKnotX:
+        bat.knots[bindings_[k].index].x_m = v;
+        break;
+      case Target::kKnotRadius:
+        bat.knots[bindings_[k].index].radius_m = v;
+        break;
+      case Target::kDensity:
+        bat.material.density_kg_m3 = v;
+        break;
+      case Target::kYoungs:
+        bat.material.youngs_modulus_pa = v;
+        break;
+      case Target::kShear:
+        bat.material.shear_modulus_pa = v;
+        break;
+      case Target::kPoisson:
+        bat.material.poissons_ratio = v;
+        break;
+      case Target::kMaterialCor:
+        bat.material.cor = v;
+        break;
+      case Target::kWall:
+        bat.wall_thickness_m = v;
+        break;
+      case Target::kFillDiameter:
+        bat.fill->diameter_m = v;
+        break;
+      case Target::kFillDepth:
+        bat.fill->depth_m = v;
+        break;
+    }
+  }
+  // The JSON path's checks, in its order (ParseBatGeometry, then the scene's).
+  if (shape) {
+    if (!shape->ValidateSize(nullptr)) return false;
+    bat.knots = shape->Knots();
+  }
+  // A scene output validates the scene itself (EvaluateScene, Bat::Validate among it); a
+  // design it refuses is not feasible, and the engine gives it the JSON path's row.
+  if (!scene->outputs.empty()) return !bat_swept_ || bat.ValidateCaps(nullptr);
+  if (bat_swept_ && !bat.ValidateSize(nullptr)) return false;
+  core::Scene check = *scene;
+  check.outputs = {core::SceneOutput::kMaxExitSpeed};
+  return check.Validate(nullptr);
+}
+
+// ---- Direct columns -------------------------------------------------------------------------
+
+namespace {
+
+// A value a column reads from a design's outcome without a JSON row.
+struct DirectValue {
+  enum Kind { kMissing, kNumber, kUnsigned, kBool, kString } kind = kMissing;
+  double number = 0.0;
+  std::uint64_t count = 0;
+  bool flag = false;
+  std::string_view text;
+};
+
+// Where a direct column's value comes from.
+enum class Source {
+  kIndex,
+  kFeasible,
+  kParameter,
+  kMissing,
+  kCollisionEfficiency,
+  kMaxPosition,
+  kMaxSpeed,
+  kMaxUnconstrained,
+  kMaxPlacement,
+  kMaxModel,
+  kMaxMethod,
+  kCopPosition,
+  kCopHands,
+  kCopMoiHands,
+  kCopPlacement,
+  kMass,
+  kBalance,
+  kMoiKnob,
+  kMoiSixInch,
+  kMoiCentroid,
+  kVolume,
+  kLength,
+  kInertiaModel,
+  kLengthIn,
+  kWeightOz,
+  kDrop,
+  kBalanceIn,
+  kMoiKnobOzIn2,
+  kMoiSixInchOzIn2,
+  kMoiCentroidOzIn2,
+};
+
+struct DirectAccessor {
+  Source source = Source::kMissing;
+  std::size_t parameter = 0;
+};
+
+// The accessor of `tokens` in a feasible row of this sweep, or nullopt when the engine does
+// not read it directly (the row is then rendered as JSON). The names are those
+// RenderDesignRow renders (SceneResultToJson, PropertiesToJson): explore_engine_test checks
+// every one of them against the JSON row.
+std::optional<DirectAccessor> CompileAccessor(const std::vector<std::string>& tokens,
+                                              const std::vector<SweepParameter>& parameters,
+                                              const RowOutputs& outputs) {
+  using S = Source;
+  const auto has = [&outputs](core::SceneOutput o) {
+    return std::find(outputs.scene.begin(), outputs.scene.end(), o) != outputs.scene.end();
+  };
+  const auto field = [&tokens](const std::map<std::string_view, S>& table) -> std::optional<S> {
+    if (tokens.size() != 2) return std::nullopt;
+    const auto it = table.find(tokens[1]);
+    if (it == table.end()) return std::nullopt;
+    return it->second;
+  };
+  if (tokens.empty()) return std::nullopt;
+  const std::string& head = tokens[0];
+  std::optional<S> source;
+  if (tokens.size() == 1 && head == "index") {
+    source = S::kIndex;
+  } else if (tokens.size() == 1 && head == "feasible") {
+    source = S::kFeasible;
+  } else if (tokens.size() == 2 && head == "parameters") {
+    for (std::size_t k = 0; k < parameters.size(); ++k) {
+      if (parameters[k].path == tokens[1]) return DirectAccessor{S::kParameter, k};
+    }
+  } else if (head == "error") {
+    source = S::kMissing;  // a feasible row has no error
+  } else if (tokens.size() == 1 && head == "collision_efficiency" && outputs.collision_efficiency) {
+    source = S::kCollisionEfficiency;
+  } else if (head == "max_exit_speed" && has(core::SceneOutput::kMaxExitSpeed)) {
+    source = field({{"position_from_knob_m", S::kMaxPosition},
+                    {"exit_speed_mps", S::kMaxSpeed},
+                    {"unconstrained_position_from_knob_m", S::kMaxUnconstrained},
+                    {"placement", S::kMaxPlacement},
+                    {"model", S::kMaxModel},
+                    {"method", S::kMaxMethod}});
+  } else if (head == "center_of_percussion" && has(core::SceneOutput::kCenterOfPercussion)) {
+    source = field({{"position_from_knob_m", S::kCopPosition},
+                    {"hands_from_knob_m", S::kCopHands},
+                    {"moi_hands_kg_m2", S::kCopMoiHands},
+                    {"placement", S::kCopPlacement}});
+  } else if (head == "properties" && outputs.properties) {
+    if (tokens.size() == 3 && tokens[1] == "imperial") {
+      static const std::map<std::string_view, S> kImperial = {
+          {"length_in", S::kLengthIn},
+          {"weight_oz", S::kWeightOz},
+          {"drop", S::kDrop},
+          {"balance_point_in", S::kBalanceIn},
+          {"moi_knob_oz_in2", S::kMoiKnobOzIn2},
+          {"moi_six_inch_oz_in2", S::kMoiSixInchOzIn2},
+          {"moi_centroid_oz_in2", S::kMoiCentroidOzIn2}};
+      if (const auto it = kImperial.find(tokens[2]); it != kImperial.end()) source = it->second;
+    } else {
+      source = field({{"mass_kg", S::kMass},
+                      {"balance_point_m", S::kBalance},
+                      {"moi_knob_kg_m2", S::kMoiKnob},
+                      {"moi_six_inch_kg_m2", S::kMoiSixInch},
+                      {"moi_centroid_kg_m2", S::kMoiCentroid},
+                      {"volume_m3", S::kVolume},
+                      {"length_m", S::kLength},
+                      {"inertia_model", S::kInertiaModel}});
+    }
+  }
+  if (!source) return std::nullopt;
+  return DirectAccessor{*source, 0};
+}
+
+DirectValue Number(double v) {
+  DirectValue d;
+  d.kind = DirectValue::kNumber;
+  d.number = v;
+  return d;
+}
+
+DirectValue Text(std::string_view v) {
+  DirectValue d;
+  d.kind = DirectValue::kString;
+  d.text = v;
+  return d;
+}
+
+// The value of `a` in the feasible row of design `index`.
+DirectValue ReadDirect(const DirectAccessor& a, std::uint64_t index,
+                       const std::vector<double>& values, const DesignOutcome& o,
+                       const core::ImperialProperties& imperial) {
+  using S = Source;
+  const core::SceneResult& r = o.result;
+  const core::MassProperties& p = r.mass_properties;
+  const auto* m = r.max_exit_speed ? &*r.max_exit_speed : nullptr;
+  const auto* c = r.center_of_percussion ? &*r.center_of_percussion : nullptr;
+  switch (a.source) {
+    case S::kIndex: {
+      DirectValue d;
+      d.kind = DirectValue::kUnsigned;
+      d.count = index;
+      return d;
+    }
+    case S::kFeasible: {
+      DirectValue d;
+      d.kind = DirectValue::kBool;
+      d.flag = true;
+      return d;
+    }
+    case S::kParameter:
+      return Number(values[a.parameter]);
+    case S::kMissing:
+      return {};
+    case S::kCollisionEfficiency:
+      return o.collision_efficiency ? Number(*o.collision_efficiency) : DirectValue{};
+    case S::kMaxPosition:
+      return m ? Number(m->position_from_knob_m) : DirectValue{};
+    case S::kMaxSpeed:
+      return m ? Number(m->exit_speed_mps) : DirectValue{};
+    case S::kMaxUnconstrained:
+      return m ? Number(m->unconstrained_position_from_knob_m) : DirectValue{};
+    case S::kMaxPlacement:
+      return m ? Text(core::PlacementName(m->placement)) : DirectValue{};
+    case S::kMaxModel:
+      return m ? Text(m->model) : DirectValue{};
+    case S::kMaxMethod:
+      return m ? Text(m->method) : DirectValue{};
+    case S::kCopPosition:
+      return c ? Number(c->position_from_knob_m) : DirectValue{};
+    case S::kCopHands:
+      return c ? Number(c->hands_from_knob_m) : DirectValue{};
+    case S::kCopMoiHands:
+      return c ? Number(c->moi_hands_kg_m2) : DirectValue{};
+    case S::kCopPlacement:
+      return c ? Text(core::PlacementName(c->placement)) : DirectValue{};
+    case S::kMass:
+      return Number(p.mass_kg);
+    case S::kBalance:
+      return Number(p.balance_point_m);
+    case S::kMoiKnob:
+      return Number(p.moi_knob_kg_m2);
+    case S::kMoiSixInch:
+      return Number(p.MoiSixInchKgM2());
+    case S::kMoiCentroid:
+      return Number(p.moi_centroid_kg_m2);
+    case S::kVolume:
+      return Number(p.volume_m3);
+    case S::kLength:
+      return Number(r.length_m);
+    case S::kInertiaModel:
+      return Text(InertiaModelName(p.inertia_model));
+    case S::kLengthIn:
+      return Number(imperial.length_in);
+    case S::kWeightOz:
+      return Number(imperial.weight_oz);
+    case S::kDrop:
+      return Number(imperial.drop);
+    case S::kBalanceIn:
+      return Number(imperial.balance_point_in);
+    case S::kMoiKnobOzIn2:
+      return Number(imperial.moi_knob_oz_in2);
+    case S::kMoiSixInchOzIn2:
+      return Number(imperial.moi_six_inch_oz_in2);
+    case S::kMoiCentroidOzIn2:
+      return Number(imperial.moi_centroid_oz_in2);
+  }
+  return {};
+}
+
+bool NeedsImperial(const std::vector<DirectAccessor>& accessors) {
+  return std::any_of(accessors.begin(), accessors.end(), [](const DirectAccessor& a) {
+    return a.source >= Source::kLengthIn && a.source <= Source::kMoiCentroidOzIn2;
+  });
+}
+
+Json ToJson(const DirectValue& v) {
+  switch (v.kind) {
+    case DirectValue::kMissing:
+      return nullptr;
+    case DirectValue::kNumber:
+      return v.number;
+    case DirectValue::kUnsigned:
+      return v.count;
+    case DirectValue::kBool:
+      return v.flag;
+    case DirectValue::kString:
+      return std::string(v.text);
+  }
+  return nullptr;
+}
+
+double ToObjective(const DirectValue& v) {
+  if (v.kind == DirectValue::kNumber) return v.number;
+  if (v.kind == DirectValue::kUnsigned) return static_cast<double>(v.count);
+  return std::nan("");
+}
+
+void WriteCsv(const DirectValue& v, CsvRowWriter* writer) {
+  switch (v.kind) {
+    case DirectValue::kMissing:
+      writer->Empty();
+      break;
+    case DirectValue::kNumber:
+      writer->Number(v.number);
+      break;
+    case DirectValue::kUnsigned:
+      writer->Unsigned(v.count);
+      break;
+    case DirectValue::kBool:
+      writer->Bool(v.flag);
+      break;
+    case DirectValue::kString:
+      writer->String(v.text);
+      break;
+  }
+}
+
+std::string DumpRow(const Json& value) {
+  return value.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+// What one run of a sweep shares between its threads: the format, the compiled columns and
+// objectives, the designs.
+struct RunPlan {
+  const Sweep* sweep = nullptr;
+  RowFormat format = RowFormat::kJson;
+  const std::vector<ExploreColumn>* columns = nullptr;
+  std::vector<DirectAccessor> column_accessors;     // when `direct`
+  std::vector<DirectAccessor> objective_accessors;  // when `direct`
+  bool direct = false;    // feasible bound rows are written without a JSON row
+  bool imperial = false;  // some direct column reads the imperial properties
+  std::uint64_t in_shard = 0;
+
+  // The design index of the shard's k-th design.
+  std::uint64_t DesignIndex(std::uint64_t k) const {
+    return sweep->shard.index + k * sweep->shard.count;
+  }
+};
+
+// One block's rows and what the summary needs from them.
+struct BlockResult {
+  BlockRows rows;
+  std::uint64_t failed = 0;
+  std::vector<std::vector<double>> objective_values;
+  std::vector<std::uint64_t> indices;
+  bool cancelled = false;  // stopped early: Progress::Cancel()
+};
+
+// A worker's reusable state.
+struct Worker {
+  std::optional<core::Scene> scene;  // the binder's scene, bound design after design
+  std::vector<double> point;
+};
+
+// The row of design `i` from its JSON row (the JSON path, or a bound design whose columns are
+// not all direct): index and parameters added, objectives read, then written in the format.
+void AddJsonRow(const RunPlan& plan, std::uint64_t i, const std::vector<double>& point, Json row,
+                BlockResult* out) {
+  const Sweep& sweep = *plan.sweep;
+  Json values = Json::object();
+  for (std::size_t k = 0; k < sweep.parameters.size(); ++k)
+    values[sweep.parameters[k].path] = point[k];
+  row["index"] = i;
+  row["parameters"] = std::move(values);
+  if (!row["feasible"].get<bool>()) ++out->failed;
+  if (!sweep.objectives.empty()) {
+    std::vector<double> v;
+    for (const auto& objective : sweep.objectives) {
+      const Json* value = FindAt(row, objective.tokens);
+      v.push_back(value != nullptr && value->is_number() ? value->get<double>() : std::nan(""));
+    }
+    out->objective_values.push_back(std::move(v));
+    out->indices.push_back(i);
+  }
+  const std::vector<ExploreColumn>& columns = *plan.columns;
+  switch (plan.format) {
+    case RowFormat::kCsv:
+      AppendCsvRow(row, columns, &out->rows.text);
+      break;
+    case RowFormat::kNdjson:
+      out->rows.text += DumpRow(columns.empty() ? row : ProjectRow(row, columns));
+      out->rows.text += '\n';
+      break;
+    case RowFormat::kJson:
+      out->rows.rows.push_back(columns.empty() ? std::move(row) : ProjectRow(row, columns));
+      break;
+  }
+}
+
+// Design `i` (the JSON path, or bound) into *out.
+void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResult* out) {
+  const Sweep& sweep = *plan.sweep;
+  std::vector<double>& point = worker->point;
+  if (sweep.plan.method == core::SamplingMethod::kGrid) {
+    point = core::GridDesign(sweep.plan, i);
+  } else {
+    point = sweep.drawn[static_cast<std::size_t>(i)];
+  }
+  if (sweep.binder) {
+    if (!worker->scene) worker->scene = sweep.binder->base_scene();
+    if (sweep.binder->Bind(point, &*worker->scene)) {
+      const DesignOutcome outcome = ComputeDesign(*worker->scene, sweep.outputs, sweep.options);
+      if (outcome.feasible && !plan.direct) {
+        AddJsonRow(plan, i, point, RenderDesignRow(outcome, sweep.outputs), out);
+        return;
+      }
+      if (outcome.feasible) {
+        const core::ImperialProperties imperial =
+            plan.imperial
+                ? core::ToImperial(outcome.result.mass_properties, outcome.result.length_m)
+                : core::ImperialProperties{};
+        if (!sweep.objectives.empty()) {
+          std::vector<double> v;
+          for (const DirectAccessor& a : plan.objective_accessors) {
+            v.push_back(ToObjective(ReadDirect(a, i, point, outcome, imperial)));
+          }
+          out->objective_values.push_back(std::move(v));
+          out->indices.push_back(i);
+        }
+        const std::vector<ExploreColumn>& columns = *plan.columns;
+        if (plan.format == RowFormat::kCsv) {
+          CsvRowWriter writer(&out->rows.text);
+          for (const DirectAccessor& a : plan.column_accessors) {
+            WriteCsv(ReadDirect(a, i, point, outcome, imperial), &writer);
+          }
+          writer.EndRow();
+          return;
+        }
+        Json flat = Json::object();
+        for (std::size_t c = 0; c < columns.size(); ++c) {
+          flat[columns[c].path] =
+              ToJson(ReadDirect(plan.column_accessors[c], i, point, outcome, imperial));
+        }
+        if (plan.format == RowFormat::kNdjson) {
+          out->rows.text += DumpRow(flat);
+          out->rows.text += '\n';
+        } else {
+          out->rows.rows.push_back(std::move(flat));
+        }
+        return;
+      }
+    }
+    // A bound design that fails a check or a model: the JSON path says why, as a single
+    // request would.
+  }
+  Json design = sweep.base;
+  for (std::size_t k = 0; k < sweep.parameters.size(); ++k) {
+    SetNumberAtPath(&design, sweep.parameters[k].steps, point[k], nullptr);
+  }
+  AddJsonRow(plan, i, point, EvaluateDesign(design, sweep.outputs, sweep.options, sweep.limits).row,
+             out);
+}
+
+// The most designs in a block, and the time a block aims at: blocks of fast designs are
+// large (few hand-overs), those of slow ones short, so a streamed answer gets its first rows
+// within about kBlockTargetS whatever a design costs.
+constexpr std::uint64_t kMaxBlockDesigns = 256;
+constexpr double kBlockTargetS = 0.01;
+
+// How many designs the next block takes, from the time a design took in the last block
+// (negative: none measured yet, one design).
+std::uint64_t BlockDesigns(double seconds_per_design) {
+  if (!(seconds_per_design >= 0.0)) return 1;
+  if (seconds_per_design * kMaxBlockDesigns <= kBlockTargetS) return kMaxBlockDesigns;
+  return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(kBlockTargetS / seconds_per_design));
+}
+
+// The shard's designs [first, first + count) into *out; the time per design in
+// *seconds_per_design.
+void EvaluateBlock(const RunPlan& plan, std::uint64_t first, std::uint64_t count,
+                   core::Progress* progress, Worker* worker, BlockResult* out,
+                   double* seconds_per_design) {
+  const auto start = std::chrono::steady_clock::now();
+  for (std::uint64_t k = first; k < first + count; ++k) {
+    if (core::IsCancelled(progress)) {
+      out->cancelled = true;
+      return;
+    }
+    EvaluateOne(plan, plan.DesignIndex(k), worker, out);
+    ++out->rows.count;
+  }
+  *seconds_per_design = core::SecondsSince(start) / static_cast<double>(count);
+}
+
+}  // namespace
+
+// ---- RunSweep --------------------------------------------------------------------------------
+
+SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
+                      const std::vector<ExploreColumn>& columns, core::Progress* progress,
+                      const std::function<bool(BlockRows&)>& emit) {
+  SweepOutcome outcome;
+  RunPlan plan;
+  plan.sweep = &sweep;
+  plan.format = format;
+  plan.columns = &columns;
+  const core::Shard& shard = sweep.shard;
+  const std::uint64_t total = sweep.total;
+  plan.in_shard = total / shard.count + (shard.index < total % shard.count ? 1 : 0);
+  // Direct rows: every column and objective is read from the outcome (a full row is JSON).
+  if (sweep.binder && !columns.empty()) {
+    plan.direct = true;
+    for (const ExploreColumn& column : columns) {
+      const auto a = CompileAccessor(column.tokens, sweep.parameters, sweep.outputs);
+      if (!a) plan.direct = false;
+      if (a) plan.column_accessors.push_back(*a);
+    }
+    for (const ParetoObjective& objective : sweep.objectives) {
+      const auto a = CompileAccessor(objective.tokens, sweep.parameters, sweep.outputs);
+      if (!a) plan.direct = false;
+      if (a) plan.objective_accessors.push_back(*a);
+    }
+    plan.imperial = NeedsImperial(plan.column_accessors) || NeedsImperial(plan.objective_accessors);
+  }
+
+  std::vector<std::vector<double>> objective_values;
+  std::vector<std::uint64_t> indices;
+  std::uint64_t evaluated = 0, failed = 0;
+  // Takes a finished block: false when the sweep ends here (cancelled or stopped).
+  const auto take = [&](BlockResult& block) {
+    if (block.cancelled || core::IsCancelled(progress)) {
+      outcome.cancelled = true;
+      outcome.message = "the sweep was cancelled after " + std::to_string(evaluated) + " designs";
+      return false;
+    }
+    failed += block.failed;
+    for (auto& v : block.objective_values) objective_values.push_back(std::move(v));
+    indices.insert(indices.end(), block.indices.begin(), block.indices.end());
+    if (!emit(block.rows)) {
+      outcome.stopped = true;
+      return false;
+    }
+    evaluated += block.rows.count;
+    if (progress != nullptr && plan.in_shard > 0) {
+      progress->Report(static_cast<double>(evaluated) / static_cast<double>(plan.in_shard));
+    }
+    return true;
+  };
+
+  // Threads beyond this one come from the budget, without waiting for it.
+  const std::uint64_t n = plan.in_shard;
+  int helpers = static_cast<int>(std::min<std::uint64_t>(
+      static_cast<std::uint64_t>(std::max(1, sweep.threads) - 1), n > 0 ? n - 1 : 0));
+  if (helpers > 0 && sweep.budget != nullptr) helpers = sweep.budget->TryTake(helpers);
+  if (helpers <= 0) {
+    Worker worker;
+    double per_design = -1.0;
+    for (std::uint64_t k = 0; k < n;) {
+      BlockResult block;
+      const std::uint64_t count = std::min(n - k, BlockDesigns(per_design));
+      EvaluateBlock(plan, k, count, progress, &worker, &block, &per_design);
+      k += count;
+      if (!take(block)) return outcome;
+    }
+  } else {
+    // Workers (this thread among them) take the next designs as a block; this thread hands
+    // the blocks on in design order. At most `window` blocks are finished or being evaluated
+    // beyond the one handed on next.
+    std::mutex mutex;
+    std::condition_variable ready, room;
+    std::map<std::uint64_t, BlockResult> done;  // by first design
+    std::uint64_t next = 0;                     // the first design not taken yet
+    std::uint64_t in_flight = 0;                // blocks being evaluated
+    double per_design = -1.0;                   // the last block's time per design, s
+    bool stop = false;
+    const std::uint64_t window = 4 * static_cast<std::uint64_t>(helpers + 1);
+    const auto has_room = [&] { return next < n && done.size() + in_flight < window; };
+    // Takes the next block under the lock: [*first, *first + *count).
+    const auto claim = [&](std::uint64_t* first, std::uint64_t* count) {
+      *first = next;
+      *count = std::min(n - next, BlockDesigns(per_design));
+      next += *count;
+      ++in_flight;
+    };
+    // Evaluates a claimed block outside the lock, then files it under the lock.
+    const auto evaluate = [&](std::unique_lock<std::mutex>& lock, std::uint64_t first,
+                              std::uint64_t count, Worker* worker) {
+      lock.unlock();
+      BlockResult block;
+      double seconds = -1.0;
+      EvaluateBlock(plan, first, count, progress, worker, &block, &seconds);
+      lock.lock();
+      if (seconds >= 0.0) per_design = seconds;
+      done.emplace(first, std::move(block));
+      --in_flight;
+    };
+    const auto work = [&]() {
+      Worker worker;
+      std::unique_lock<std::mutex> lock(mutex);
+      for (;;) {
+        room.wait(lock, [&] { return stop || next >= n || has_room(); });
+        if (stop || next >= n) return;
+        std::uint64_t first = 0, count = 0;
+        claim(&first, &count);
+        evaluate(lock, first, count, &worker);
+        ready.notify_all();
+      }
+    };
+    std::vector<std::thread> threads;
+    threads.reserve(static_cast<std::size_t>(helpers));
+    for (int t = 0; t < helpers; ++t) threads.emplace_back(work);
+    Worker own_worker;
+    bool ok = true;
+    std::uint64_t handed = 0;  // the first design not handed on yet
+    while (ok && handed < n) {
+      BlockResult block;
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        ready.wait(lock, [&] { return done.count(handed) > 0 || has_room(); });
+        if (done.count(handed) == 0) {
+          // The next block is not finished and there is room: this thread evaluates one too.
+          std::uint64_t first = 0, count = 0;
+          claim(&first, &count);
+          evaluate(lock, first, count, &own_worker);
+          continue;
+        }
+        block = std::move(done[handed]);
+        done.erase(handed);
+        // A cancelled block is short: what follows it is never handed on.
+        handed += block.cancelled ? n : block.rows.count;
+      }
+      room.notify_all();
+      ok = take(block);
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      stop = true;
+    }
+    room.notify_all();
+    for (std::thread& t : threads) t.join();
+    if (sweep.budget != nullptr) sweep.budget->Give(helpers);
+    if (!ok) return outcome;
+  }
+
+  Json summary{{"designs_total", total},
+               {"designs_in_shard", evaluated},
+               {"failed", failed},
+               {"sampling", core::SamplingMethodName(sweep.plan.method)},
+               {"seed", sweep.plan.seed},
+               {"shard", {{"index", shard.index}, {"count", shard.count}}},
+               {"timing_s", core::SecondsSince(sweep.start)}};
+  if (!sweep.objectives.empty()) {
+    std::vector<core::Sense> senses;
+    for (const auto& o : sweep.objectives) senses.push_back(o.sense);
+    Json front = Json::array();
+    for (const std::size_t k : core::ParetoFront(objective_values, senses)) {
+      front.push_back(indices[k]);
+    }
+    summary["pareto_front"] = std::move(front);
+    summary["pareto_objectives"] = ObjectivesToJson(sweep.objectives);  // for explore-merge
+    summary["pareto_scope"] = "the rows of this response (this shard)";
+  }
+  summary["provenance"] = sweep.provenance;
+  outcome.summary = std::move(summary);
+  return outcome;
+}
+
+}  // namespace sweetspot::api

@@ -1,0 +1,213 @@
+// The sweep engine (api/explore_engine.hpp): its rows are the JSON path's, byte for byte, in
+// every format, for every path it binds and every column it reads directly, for feasible and
+// failing designs alike; and they do not depend on the number of threads.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "api/explore_engine.hpp"
+#include "api/router.hpp"
+#include "api/thread_budget.hpp"
+
+namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace explore_engine_test {
+namespace {
+
+using Json = nlohmann::json;
+
+ExploreRequest Parse(const Json& body) {
+  ApiError error;
+  Context context;
+  auto request = ParseExploreRequest(body, context, &error);
+  EXPECT_TRUE(request.has_value()) << error.message;
+  return request ? std::move(*request) : ExploreRequest{};
+}
+
+// The whole answer of a run as text: the rows (ndjson or csv lines, or each JSON row dumped
+// on a line) and the summary without its timing.
+std::string RunText(const Sweep& sweep, RowFormat format,
+                    const std::vector<ExploreColumn>& columns) {
+  std::string text;
+  const SweepOutcome outcome = RunSweep(sweep, format, columns, nullptr, [&](BlockRows& rows) {
+    text += rows.text;
+    for (const Json& row : rows.rows) text += row.dump() + "\n";
+    return true;
+  });
+  Json summary = outcome.summary;
+  summary.erase("timing_s");
+  return text + summary.dump() + "\n";
+}
+
+// Runs `body` through the engine (bound, 1 and 3 threads) and through the JSON path (the
+// binder dropped) in json, ndjson and csv, with and without `columns`; all must agree.
+// Returns the engine's ndjson rows. `expect_bound`: the engine binds every swept path.
+std::string ExpectSameRows(Json body, bool expect_bound, const Json& columns = nullptr) {
+  std::string ndjson;
+  for (const char* format : {"json", "ndjson", "csv"}) {
+    for (const bool with_columns : {false, true}) {
+      if (with_columns && columns.is_null()) continue;
+      body["format"] = format;
+      if (with_columns) {
+        body["columns"] = columns;
+      } else {
+        body.erase("columns");
+      }
+      const ExploreRequest request = Parse(body);
+      if (request.sweep == nullptr) return "";
+      EXPECT_EQ(request.sweep->binder.has_value(), expect_bound) << body.dump();
+      const RowFormat f = request.format == "csv"      ? RowFormat::kCsv
+                          : request.format == "ndjson" ? RowFormat::kNdjson
+                                                       : RowFormat::kJson;
+      Sweep engine = *request.sweep;
+      engine.threads = 1;
+      const std::string one = RunText(engine, f, request.columns);
+      engine.threads = 3;
+      ThreadBudget budget(8);
+      engine.budget = &budget;
+      const std::string three = RunText(engine, f, request.columns);
+      EXPECT_EQ(budget.taken(), 0);  // every borrowed thread given back
+      Sweep json_path = *request.sweep;
+      json_path.binder.reset();
+      const std::string reference = RunText(json_path, f, request.columns);
+      EXPECT_EQ(one, reference) << format << (with_columns ? " with columns" : "");
+      EXPECT_EQ(three, one) << format << (with_columns ? " with columns" : "");
+      if (request.format == "ndjson" && !with_columns) ndjson = one;
+    }
+  }
+  return ndjson;
+}
+
+TEST(ExploreEngineTest, ThreeSegmentSweepWithInfeasibleDesignsMatchesTheJsonPath) {
+  // taper_start past taper_end in part of the grid: those designs fail the shape's check, and
+  // their error rows must be the JSON path's. 600 designs: at least three blocks (of at
+  // most 256), so threads interleave.
+  const Json body = Json::parse(R"({
+    "bat": {"three_segment": {"length_m": 0.8636, "handle_radius_m": 0.0125,
+            "barrel_radius_m": 0.033, "taper_start_m": 0.30, "taper_end_m": 0.55},
+            "material": "ash"},
+    "cor": 0.5,
+    "parameters": [{"path": "three_segment.taper_start_m", "min": 0.2, "max": 0.6, "count": 30},
+                   {"path": "three_segment.taper_end_m", "min": 0.45, "max": 0.7, "count": 20}],
+    "outputs": ["max_exit_speed", "properties", "center_of_percussion", "collision_efficiency"],
+    "pareto": {"objectives": [{"output": "max_exit_speed.exit_speed_mps", "sense": "max"},
+                              {"output": "properties.mass_kg", "sense": "min"}]}})");
+  const Json columns = {"index",
+                        "feasible",
+                        "parameters.three_segment.taper_start_m",
+                        "max_exit_speed.exit_speed_mps",
+                        "max_exit_speed.position_from_knob_m",
+                        "max_exit_speed.unconstrained_position_from_knob_m",
+                        "max_exit_speed.placement",
+                        "max_exit_speed.model",
+                        "max_exit_speed.method",
+                        "center_of_percussion.position_from_knob_m",
+                        "center_of_percussion.hands_from_knob_m",
+                        "center_of_percussion.moi_hands_kg_m2",
+                        "center_of_percussion.placement",
+                        "properties.mass_kg",
+                        "properties.balance_point_m",
+                        "properties.moi_knob_kg_m2",
+                        "properties.moi_six_inch_kg_m2",
+                        "properties.moi_centroid_kg_m2",
+                        "properties.volume_m3",
+                        "properties.length_m",
+                        "properties.inertia_model",
+                        "properties.imperial.length_in",
+                        "properties.imperial.weight_oz",
+                        "properties.imperial.drop",
+                        "properties.imperial.balance_point_in",
+                        "properties.imperial.moi_knob_oz_in2",
+                        "properties.imperial.moi_six_inch_oz_in2",
+                        "properties.imperial.moi_centroid_oz_in2",
+                        "collision_efficiency",
+                        "error.code",
+                        "error.field"};
+  const std::string rows = ExpectSameRows(body, /*expect_bound=*/true, columns);
+  // The sweep holds both kinds of row (else the comparison proves less than it says).
+  EXPECT_NE(rows.find("\"feasible\":false"), std::string::npos);
+  EXPECT_NE(rows.find("\"feasible\":true"), std::string::npos);
+}
+
+TEST(ExploreEngineTest, SceneAndMaterialAndFillPathsMatchTheJsonPath) {
+  // The bat unswept (its mass properties computed once) with ball, swing and cor swept, some
+  // designs out of range (a cor above 1, hands past the tip); then material, wall and fill.
+  Json scene = Json::parse(R"({
+    "bat": {"preset": "paper-wood"},
+    "parameters": [{"path": "ball.speed_mps", "min": 20, "max": 40, "count": 3},
+                   {"path": "swing.hands_from_knob_m", "min": 0.1, "max": 0.9, "count": 3},
+                   {"path": "cor", "min": 0.4, "max": 1.2, "count": 5}],
+    "outputs": ["max_exit_speed", "center_of_percussion", "properties"]})");
+  ExpectSameRows(scene, true, {"index", "max_exit_speed.exit_speed_mps", "error.code"});
+  Json bat = Json::parse(R"({
+    "bat": {"three_segment": {"length_m": 0.84, "handle_radius_m": 0.0125,
+            "barrel_radius_m": 0.033, "taper_start_m": 0.30, "taper_end_m": 0.55},
+            "material": {"density_kg_m3": 700, "youngs_modulus_pa": 1.2e10, "cor": 0.5},
+            "fill": {"material": "cork", "diameter_m": 0.02, "depth_m": 0.2}},
+    "parameters": [{"path": "material.density_kg_m3", "min": -100, "max": 900, "count": 3},
+                   {"path": "fill.depth_m", "min": 0.0, "max": 0.3, "count": 3},
+                   {"path": "fill.diameter_m", "min": 0.01, "max": 0.07, "count": 2},
+                   {"path": "material.cor", "min": 0.4, "max": 0.6, "count": 2}],
+    "outputs": ["max_exit_speed", "properties"]})");
+  ExpectSameRows(bat, true, {"parameters.fill.depth_m", "properties.mass_kg", "error.message"});
+  // A hollow profile bat: knots and the wall swept, a properties-only row.
+  Json profile = Json::parse(R"({
+    "bat": {"profile": {"knots": [{"x_m": 0, "radius_m": 0.012}, {"x_m": 0.3, "radius_m": 0.013},
+                                  {"x_m": 0.55, "radius_m": 0.03}, {"x_m": 0.8, "radius_m": 0.032}]},
+            "material": "aluminium-7046", "wall_thickness_m": 0.003},
+    "parameters": [{"path": "profile.knots[2].x_m", "min": 0.2, "max": 0.6, "count": 3},
+                   {"path": "profile.knots[1].radius_m", "min": 0.01, "max": 0.02, "count": 2},
+                   {"path": "wall_thickness_m", "min": 0.001, "max": 0.02, "count": 2}],
+    "outputs": ["properties"]})");
+  ExpectSameRows(profile, true, {"properties.mass_kg", "feasible"});
+}
+
+TEST(ExploreEngineTest, OutputsAndPathsTheEngineDoesNotReadDirectlyMatchTheJsonPath) {
+  // A sweet zone and a curve are rendered from the JSON row (not direct columns); the swept
+  // path is bound.
+  Json body = Json::parse(R"({
+    "bat": {"preset": "paper-wood"},
+    "parameters": [{"path": "ball.mass_kg", "min": 0.1, "max": 0.2, "count": 4}],
+    "outputs": ["sweet_zone", "exit_speed_curve"], "options": {"curve_samples": 5}})");
+  ExpectSameRows(body, true, {"sweet_zone.from_knob_m", "exit_speed_curve.2.exit_speed_mps"});
+  // A fill's own material is not a path the engine binds: the whole sweep takes the JSON path.
+  body["bat"]["fill"] = {{"material", {{"density_kg_m3", 100}, {"youngs_modulus_pa", 1e7}}},
+                         {"diameter_m", 0.02},
+                         {"depth_m", 0.2}};
+  body["parameters"] = {
+      {{"path", "fill.material.density_kg_m3"}, {"min", 50}, {"max", 400}, {"count", 3}}};
+  body["outputs"] = {"max_exit_speed"};
+  ExpectSameRows(body, false, {"max_exit_speed.exit_speed_mps"});
+}
+
+TEST(ExploreEngineTest, ThreadsBeyondTheSweepsOwnComeFromTheBudget) {
+  ThreadBudget budget(2);
+  EXPECT_EQ(budget.TryTake(5), 2);  // no more than there are
+  EXPECT_EQ(budget.TryTake(1), 0);  // never waits
+  budget.Give(1);
+  EXPECT_EQ(budget.taken(), 1);
+  budget.TakeOne();
+  EXPECT_EQ(budget.taken(), 2);
+  budget.Give(2);
+  EXPECT_EQ(budget.taken(), 0);
+  // A sweep with no thread free runs on its own thread alone, with the same rows.
+  const Json body = Json::parse(R"({
+    "bat": {"preset": "paper-wood"},
+    "parameters": [{"path": "ball.speed_mps", "min": 20, "max": 40, "count": 700}],
+    "outputs": ["max_exit_speed"], "format": "ndjson"})");
+  const ExploreRequest request = Parse(body);
+  ASSERT_NE(request.sweep, nullptr);
+  Sweep sweep = *request.sweep;
+  sweep.threads = 4;
+  const std::string free_threads = RunText(sweep, RowFormat::kNdjson, {});
+  EXPECT_EQ(budget.TryTake(2), 2);
+  sweep.budget = &budget;
+  const std::string none_free = RunText(sweep, RowFormat::kNdjson, {});
+  EXPECT_EQ(budget.taken(), 2);  // the sweep took none and gave none back
+  EXPECT_EQ(none_free, free_threads);
+}
+
+}  // namespace
+}  // namespace explore_engine_test
+}  // namespace sweetspot::api
