@@ -35,15 +35,17 @@ bool ValidateDesignScene(const core::Scene& scene, ApiError* error) {
   return false;
 }
 
-DesignOutcome ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
-                            const core::SceneOptions& options,
-                            std::vector<core::ModelTiming>* timings) {
-  DesignOutcome out;
+void ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
+                   const core::SceneOptions& options, DesignOutcome* out_ptr,
+                   std::vector<core::ModelTiming>* timings) {
+  DesignOutcome& out = *out_ptr;
+  out.feasible = false;
+  out.error = nullptr;
+  out.collision_efficiency.reset();
   core::SceneResult& result = out.result;
   core::TimingBook book(options.time_models);
   const auto done = [&] {
     if (timings != nullptr) *timings = book.TakeTimings();
-    return std::move(out);
   };
   if (!scene.outputs.empty()) {
     result = core::EvaluateScene(scene, options);
@@ -57,9 +59,11 @@ DesignOutcome ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
                        result.refused_field.empty() ? "outputs" : result.refused_field,
                        /*options_object=*/true);
       out.error = failure.body;
-      return done();
+      done();
+      return;
     }
   } else {
+    result = core::SceneResult{};
     if (scene.mass_properties) {
       result.mass_properties = *scene.mass_properties;
     } else {
@@ -69,7 +73,8 @@ DesignOutcome ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
     }
     if (ApiError error; !CheckComputable(result.mass_properties, "bat", &error)) {
       out.error = DesignErrorJson(error);
-      return done();
+      done();
+      return;
     }
     result.length_m = scene.bat->LengthM();
   }
@@ -85,7 +90,7 @@ DesignOutcome ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
     if (hit.rigid_pivot) out.collision_efficiency = hit.rigid_pivot->collision_efficiency;
   }
   out.feasible = true;
-  return done();
+  done();
 }
 
 Json RenderDesignRow(const DesignOutcome& outcome, const RowOutputs& outputs) {
@@ -124,7 +129,8 @@ DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
     out.row = {{"feasible", false}, {"error", DesignErrorJson(error)}};
     return out;
   }
-  const DesignOutcome outcome = ComputeDesign(scene, outputs, options, &out.timings);
+  DesignOutcome outcome;
+  ComputeDesign(scene, outputs, options, &outcome, &out.timings);
   out.row = RenderDesignRow(outcome, outputs);
   return out;
 }

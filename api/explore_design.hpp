@@ -43,11 +43,12 @@ struct DesignOutcome {
 bool ValidateDesignScene(const core::Scene& scene, ApiError* error);
 
 /// Runs the models of a valid design scene (`scene.outputs` = outputs.scene; its
-/// mass_properties may be preset when they are known to be the bat's); the time and calls
+/// mass_properties may be preset when they are known to be the bat's) into *out (a fresh
+/// outcome, or one a previous design filled: every field is set again); the time and calls
 /// per model in *timings when non-null. Never throws.
-DesignOutcome ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
-                            const core::SceneOptions& options,
-                            std::vector<core::ModelTiming>* timings = nullptr);
+void ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
+                   const core::SceneOptions& options, DesignOutcome* out,
+                   std::vector<core::ModelTiming>* timings = nullptr);
 
 /// The row of an outcome: {"feasible": false, "error"} or {"feasible": true, outputs...}.
 nlohmann::json RenderDesignRow(const DesignOutcome& outcome, const RowOutputs& outputs);

@@ -552,7 +552,60 @@ struct BlockResult {
 struct Worker {
   std::optional<core::Scene> scene;  // the binder's scene, bound design after design
   std::vector<double> point;
+  DesignOutcome outcome;  // the last bound design's, refilled design after design
+  // Full rows of bound designs: the first feasible row, kept as a template whose leaves are
+  // overwritten design after design (no JSON tree built per row), when every leaf is a value
+  // the engine reads directly.
+  bool template_tried = false;
+  std::optional<Json> row_template;
+  std::vector<std::pair<Json*, DirectAccessor>> leaves;
 };
+
+// The leaves of `node` (at `tokens`) with their accessors into *leaves; false when one is not
+// read directly (or is an array).
+bool CollectLeaves(Json* node, std::vector<std::string>* tokens, const Sweep& sweep,
+                   std::vector<std::pair<Json*, DirectAccessor>>* leaves) {
+  if (node->is_array()) return false;
+  if (node->is_object()) {
+    for (auto it = node->begin(); it != node->end(); ++it) {
+      tokens->push_back(it.key());
+      const bool ok = CollectLeaves(&it.value(), tokens, sweep, leaves);
+      tokens->pop_back();
+      if (!ok) return false;
+    }
+    return true;
+  }
+  const auto accessor = CompileAccessor(*tokens, sweep.parameters, sweep.outputs);
+  if (!accessor || accessor->source == Source::kMissing) return false;
+  leaves->emplace_back(node, *accessor);
+  return true;
+}
+
+// Sets `value` on the template's leaf `node` when it is of the leaf's own kind (so the dump is
+// the one of a freshly rendered row); false otherwise.
+bool SetLeaf(const DirectValue& value, Json* node) {
+  switch (value.kind) {
+    case DirectValue::kNumber:
+      if (!node->is_number_float()) return false;
+      *node->get_ptr<double*>() = value.number;
+      return true;
+    case DirectValue::kUnsigned:
+      if (!node->is_number_unsigned()) return false;
+      *node->get_ptr<std::uint64_t*>() = value.count;
+      return true;
+    case DirectValue::kBool:
+      if (!node->is_boolean()) return false;
+      *node->get_ptr<bool*>() = value.flag;
+      return true;
+    case DirectValue::kString:
+      if (!node->is_string()) return false;
+      node->get_ptr<std::string*>()->assign(value.text);
+      return true;
+    case DirectValue::kMissing:
+      return false;
+  }
+  return false;
+}
 
 // The row of design `i` from its JSON row (the JSON path, or a bound design whose columns are
 // not all direct): index and parameters added, objectives read, then written in the format.
@@ -589,6 +642,39 @@ void AddJsonRow(const RunPlan& plan, std::uint64_t i, const std::vector<double>&
   }
 }
 
+// The full row of feasible bound design `i` from the worker's template, its leaves set from
+// `outcome`: the bytes of RenderDesignRow's row (explore_engine_test checks it). False, with
+// nothing written, when a leaf's value is not of the template's kind (render it instead).
+bool FillTemplate(const RunPlan& plan, std::uint64_t i, const std::vector<double>& point,
+                  const DesignOutcome& outcome, Worker* worker, BlockResult* out) {
+  const Sweep& sweep = *plan.sweep;
+  const core::ImperialProperties imperial =
+      core::ToImperial(outcome.result.mass_properties, outcome.result.length_m);
+  for (auto& [node, accessor] : worker->leaves) {
+    if (!SetLeaf(ReadDirect(accessor, i, point, outcome, imperial), node)) {
+      // The template is left part-filled: the next design overwrites every leaf again.
+      return false;
+    }
+  }
+  const Json& row = *worker->row_template;
+  if (!sweep.objectives.empty()) {
+    std::vector<double> v;
+    for (const auto& objective : sweep.objectives) {
+      const Json* value = FindAt(row, objective.tokens);
+      v.push_back(value != nullptr && value->is_number() ? value->get<double>() : std::nan(""));
+    }
+    out->objective_values.push_back(std::move(v));
+    out->indices.push_back(i);
+  }
+  if (plan.format == RowFormat::kNdjson) {
+    out->rows.text += DumpRow(row);
+    out->rows.text += '\n';
+  } else {
+    out->rows.rows.push_back(row);
+  }
+  return true;
+}
+
 // Design `i` (the JSON path, or bound) into *out.
 void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResult* out) {
   const Sweep& sweep = *plan.sweep;
@@ -601,7 +687,31 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
   if (sweep.binder) {
     if (!worker->scene) worker->scene = sweep.binder->base_scene();
     if (sweep.binder->Bind(point, &*worker->scene)) {
-      const DesignOutcome outcome = ComputeDesign(*worker->scene, sweep.outputs, sweep.options);
+      DesignOutcome& outcome = worker->outcome;
+      ComputeDesign(*worker->scene, sweep.outputs, sweep.options, &outcome);
+      if (outcome.feasible && !plan.direct && plan.columns->empty() &&
+          plan.format != RowFormat::kCsv) {
+        if (worker->row_template && FillTemplate(plan, i, point, outcome, worker, out)) return;
+        if (!worker->template_tried) {
+          // The first feasible row: rendered, and kept as the template when it can be.
+          worker->template_tried = true;
+          Json row = RenderDesignRow(outcome, sweep.outputs);
+          Json values = Json::object();
+          for (std::size_t k = 0; k < sweep.parameters.size(); ++k) {
+            values[sweep.parameters[k].path] = point[k];
+          }
+          row["index"] = i;
+          row["parameters"] = std::move(values);
+          std::vector<std::string> tokens;
+          worker->row_template = row;
+          if (!CollectLeaves(&*worker->row_template, &tokens, sweep, &worker->leaves)) {
+            worker->row_template.reset();
+            worker->leaves.clear();
+          }
+          AddJsonRow(plan, i, point, std::move(row), out);
+          return;
+        }
+      }
       if (outcome.feasible && !plan.direct) {
         AddJsonRow(plan, i, point, RenderDesignRow(outcome, sweep.outputs), out);
         return;
@@ -658,21 +768,32 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
 // within about kBlockTargetS whatever a design costs.
 constexpr std::uint64_t kMaxBlockDesigns = 256;
 constexpr double kBlockTargetS = 0.01;
+// A block's text stays under malloc's mmap threshold (128 KiB), so that its buffer is reused
+// from the heap rather than mapped and faulted in anew each time.
+constexpr double kBlockTargetBytes = 64 * 1024;
 
-// How many designs the next block takes, from the time a design took in the last block
-// (negative: none measured yet, one design).
-std::uint64_t BlockDesigns(double seconds_per_design) {
-  if (!(seconds_per_design >= 0.0)) return 1;
-  if (seconds_per_design * kMaxBlockDesigns <= kBlockTargetS) return kMaxBlockDesigns;
-  return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(kBlockTargetS / seconds_per_design));
+// What the last block measured per design (negative: nothing measured yet).
+struct BlockCost {
+  double seconds = -1.0;
+  double bytes = -1.0;
+};
+
+// How many designs the next block takes (one before anything is measured).
+std::uint64_t BlockDesigns(const BlockCost& cost) {
+  if (!(cost.seconds >= 0.0)) return 1;
+  double n = static_cast<double>(kMaxBlockDesigns);
+  if (cost.seconds > 0.0) n = std::min(n, kBlockTargetS / cost.seconds);
+  if (cost.bytes > 0.0) n = std::min(n, kBlockTargetBytes / cost.bytes);
+  return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(n));
 }
 
-// The shard's designs [first, first + count) into *out; the time per design in
-// *seconds_per_design.
+// The shard's designs [first, first + count) into *out; what a design cost in *cost.
 void EvaluateBlock(const RunPlan& plan, std::uint64_t first, std::uint64_t count,
-                   core::Progress* progress, Worker* worker, BlockResult* out,
-                   double* seconds_per_design) {
+                   core::Progress* progress, Worker* worker, BlockResult* out, BlockCost* cost) {
   const auto start = std::chrono::steady_clock::now();
+  if (plan.format != RowFormat::kJson && cost->bytes > 0.0) {
+    out->rows.text.reserve(static_cast<std::size_t>(cost->bytes * static_cast<double>(count) * 1.25));
+  }
   for (std::uint64_t k = first; k < first + count; ++k) {
     if (core::IsCancelled(progress)) {
       out->cancelled = true;
@@ -681,7 +802,8 @@ void EvaluateBlock(const RunPlan& plan, std::uint64_t first, std::uint64_t count
     EvaluateOne(plan, plan.DesignIndex(k), worker, out);
     ++out->rows.count;
   }
-  *seconds_per_design = core::SecondsSince(start) / static_cast<double>(count);
+  cost->seconds = core::SecondsSince(start) / static_cast<double>(count);
+  cost->bytes = static_cast<double>(out->rows.text.size()) / static_cast<double>(count);
 }
 
 }  // namespace
@@ -746,11 +868,11 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
   if (helpers > 0 && sweep.budget != nullptr) helpers = sweep.budget->TryTake(helpers);
   if (helpers <= 0) {
     Worker worker;
-    double per_design = -1.0;
+    BlockCost cost;
     for (std::uint64_t k = 0; k < n;) {
       BlockResult block;
-      const std::uint64_t count = std::min(n - k, BlockDesigns(per_design));
-      EvaluateBlock(plan, k, count, progress, &worker, &block, &per_design);
+      const std::uint64_t count = std::min(n - k, BlockDesigns(cost));
+      EvaluateBlock(plan, k, count, progress, &worker, &block, &cost);
       k += count;
       if (!take(block)) return outcome;
     }
@@ -763,26 +885,26 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
     std::map<std::uint64_t, BlockResult> done;  // by first design
     std::uint64_t next = 0;                     // the first design not taken yet
     std::uint64_t in_flight = 0;                // blocks being evaluated
-    double per_design = -1.0;                   // the last block's time per design, s
+    BlockCost cost;                             // what a design of the last block cost
     bool stop = false;
     const std::uint64_t window = 4 * static_cast<std::uint64_t>(helpers + 1);
     const auto has_room = [&] { return next < n && done.size() + in_flight < window; };
     // Takes the next block under the lock: [*first, *first + *count).
     const auto claim = [&](std::uint64_t* first, std::uint64_t* count) {
       *first = next;
-      *count = std::min(n - next, BlockDesigns(per_design));
+      *count = std::min(n - next, BlockDesigns(cost));
       next += *count;
       ++in_flight;
     };
     // Evaluates a claimed block outside the lock, then files it under the lock.
     const auto evaluate = [&](std::unique_lock<std::mutex>& lock, std::uint64_t first,
                               std::uint64_t count, Worker* worker) {
-      lock.unlock();
       BlockResult block;
-      double seconds = -1.0;
-      EvaluateBlock(plan, first, count, progress, worker, &block, &seconds);
+      BlockCost measured = cost;
+      lock.unlock();
+      EvaluateBlock(plan, first, count, progress, worker, &block, &measured);
       lock.lock();
-      if (seconds >= 0.0) per_design = seconds;
+      cost = measured;
       done.emplace(first, std::move(block));
       --in_flight;
     };

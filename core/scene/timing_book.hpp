@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -41,7 +42,7 @@ class TimingBook {
   /// True when the book reads the clock.
   bool timed() const { return timed_; }
   /// Adds `time_s` seconds and `calls` evaluations to `model` (listed on first use).
-  void Add(const std::string& model, double time_s, int calls) {
+  void Add(std::string_view model, double time_s, int calls) {
     for (auto& t : timings_) {
       if (t.model == model) {
         t.time_s += time_s;
@@ -49,7 +50,7 @@ class TimingBook {
         return;
       }
     }
-    timings_.push_back({model, time_s, calls});
+    timings_.push_back({std::string(model), time_s, calls});
   }
   /// The timings, in first-use order.
   const std::vector<ModelTiming>& timings() const { return timings_; }
