@@ -15,6 +15,7 @@
 #include <Eigen/Dense>
 
 #include "core/collision/rigid_pivot.hpp"
+#include "core/flexible/modes.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/limits.hpp"
 #include "core/optimize/design_backends.hpp"
@@ -148,9 +149,28 @@ double PublicConstraintValue(const DesignModel& model, const DesignConstraintSpe
       return ToImperial(e.properties, bat.LengthM()).drop;
     case DesignFunction::kLinear:
     case DesignFunction::kObjective:
+    case DesignFunction::kFirstFrequency:  // the fixed mesh the constraint is defined on
       break;
   }
   return model.Value(c.f, x);
+}
+
+// The answer's first bending mode: the modes code on its own adaptive mesh, and the fixed mesh's
+// value that the constraint holds.
+DesignFrequency FirstBendingModeOf(const DesignProblem& problem, const DesignModel& model,
+                                   const Bat& bat, const std::vector<double>& x) {
+  DesignFrequency out;
+  const BatModes modes = ComputeBatModes(bat, problem.flexible.VibrationModes());
+  out.frequency_hz = kNaN;
+  out.error_estimate_hz = kNaN;
+  if (modes.summary.IsSolutionUsable() && !modes.modes.empty()) {
+    out.frequency_hz = modes.modes.front().frequency_hz;
+    out.error_estimate_hz = modes.modes.front().error_estimate_hz;
+    out.elements = modes.Elements();
+  }
+  out.model_frequency_hz = model.FirstFrequencyAt(x.data());
+  out.model_elements = model.frequency_elements();
+  return out;
 }
 
 void FillBase(const DesignProblem& problem, DesignResult* result) {
@@ -389,10 +409,10 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
   summary.models_used = {"mass_properties"};
   if (problem.objective != DesignObjective::kMinMoi) summary.models_used.push_back("rigid_pivot");
   const bool sting = problem.objective == DesignObjective::kMinSting;
-  if (sting) {
+  if (sting || problem.constraints.min_frequency_hz.has_value()) {
     summary.models_used.push_back(kFlexibleBeamModel);
-    summary.models_used.push_back("flexible");
   }
+  if (sting) summary.models_used.push_back("flexible");
   summary.iterations = 0;
   summary.evaluations = 0;
   result.objective_unit = ObjectiveUnit(problem.objective);
@@ -455,6 +475,9 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     result.max_exit_speed_mps = pub.max_exit_speed_mps;
     result.angular_speed_rad_s = pub.omega_rad_s;
     summary.objective = pub.objective;
+    if (problem.constraints.min_frequency_hz.has_value()) {
+      result.first_bending_mode = FirstBendingModeOf(problem, model, result.bat, x);
+    }
 
     // Independent re-check of every constraint (public mass properties).
     double worst = 0.0, worst_relative = 0.0;

@@ -11,6 +11,7 @@
 #include "core/collision/collide.hpp"
 #include "core/collision/exit_speed_algebra.hpp"
 #include "core/collision/rigid_pivot.hpp"
+#include "core/flexible/beam_frequency.hpp"
 #include "core/geometry_format.hpp"
 #include "core/geometry_integrals.hpp"
 #include "core/numerics/jet.hpp"
@@ -335,6 +336,7 @@ T DesignModel::FunctionOf(DesignFunction f, const T* p) const {
     case DesignFunction::kObjective:
       return ObjectiveOf(p);
     case DesignFunction::kLinear:
+    case DesignFunction::kFirstFrequency:  // not a function of P (FrequencyOf)
       break;
   }
   return T(kNaN);
@@ -356,10 +358,41 @@ std::vector<double> DesignModel::BaseX() const {
   return x;
 }
 
+bool DesignModel::FrequencyOf(const std::vector<double>& t, double* value, double* gradient_row,
+                              int stride) const {
+  *value = kNaN;
+  if (frequency_beam_ == nullptr) return false;
+  const FirstBendingMode mode =
+      ComputeFirstBendingMode(*frequency_beam_, t, gradient_row != nullptr);
+  if (!mode.ok || !(mode.frequency_hz > 0.0)) return false;
+  *value = mode.frequency_hz;
+  if (gradient_row != nullptr) {
+    // f = sqrt(lambda) / (2 pi): df/dlambda = 1 / (4 pi sqrt(lambda)) = 1 / (8 pi^2 f).
+    const double df_dlambda = 1.0 / (8.0 * kPi * kPi * mode.frequency_hz);
+    for (std::size_t idx = 0; idx < parameter_variable_.size(); ++idx) {
+      const int j = parameter_variable_[idx];
+      if (j < 0) continue;
+      gradient_row[j * stride] += df_dlambda * mode.lambda_gradient[static_cast<Eigen::Index>(idx)];
+    }
+  }
+  return std::isfinite(*value);
+}
+
+double DesignModel::FirstFrequencyAt(const double* x) const {
+  double f = kNaN;
+  if (!FrequencyOf(ParametersAt(x), &f, nullptr, 1)) return kNaN;
+  return f;
+}
+
+int DesignModel::frequency_elements() const {
+  return frequency_beam_ == nullptr ? 0 : frequency_beam_->Elements();
+}
+
 double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
   if (f.function == DesignFunction::kObjective && objective_kind_ == DesignObjective::kMinSting) {
     return StingOf(BatAt(x), false).sting_j;  // NaN when it cannot be computed
   }
+  if (f.function == DesignFunction::kFirstFrequency) return FirstFrequencyAt(x);
   const std::vector<double> t = ParametersAt(x);
   if (f.function == DesignFunction::kLinear) {
     double v = f.constant;
@@ -399,6 +432,9 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
       }
       *value = v;
       return std::isfinite(v);
+    }
+    if (f.function == DesignFunction::kFirstFrequency) {
+      return FrequencyOf(t, value, gradient_row, stride);
     }
     if (gradient_row == nullptr) {
       *value = FunctionOf<double>(f.function, p);
@@ -456,8 +492,13 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   if (!(in.p[0] > 0.0)) return false;
   Eigen::Matrix4d big_w = Eigen::Matrix4d::Zero();
   std::array<double, 4> w{};
+  bool available = true;
   auto add = [&](const DesignFunctionSpec& f, double weight) {
     if (f.function == DesignFunction::kLinear || weight == 0.0) return;
+    if (f.function == DesignFunction::kFirstFrequency) {
+      available = false;  // no second derivatives of the eigenvalue (Build refuses kExact)
+      return;
+    }
     using J = jet::Jet<4, true>;
     std::array<J, 4> pj;
     for (int c = 0; c < 4; ++c)
@@ -472,6 +513,7 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   add(objective_, objective_weight);
   for (int k = 0; k < m(); ++k)
     add(constraints_[static_cast<std::size_t>(k)].f, constraint_weights[k]);
+  if (!available) return false;
   *out = in.dp.transpose() * big_w * in.dp;
   // L is linear in x: only M, S1 and S2 have second derivatives.
   design_detail::AddIntegralHessian(context, {w[0], w[1], w[2]}, out);

@@ -31,6 +31,8 @@
 
 namespace sweetspot::core {
 
+struct FixedMeshBeam;  // core/flexible/beam_frequency.hpp
+
 namespace design_detail {
 struct ModelBuilder;  // DesignModel::Build's steps (design_model_build.cpp)
 }  // namespace design_detail
@@ -42,6 +44,8 @@ enum class DesignFunction {
   kBalancePoint,  ///< C, m from the knob.
   kMoiSixInch,    ///< I about 0.1524 m, kg·m².
   kDrop,          ///< length_in - weight_oz (dimensionless).
+  /// The first free-free bending frequency on the fixed mesh, Hz (core/flexible/beam_frequency).
+  kFirstFrequency,
   kObjective,     ///< The problem's objective, in its unit.
 };
 
@@ -165,6 +169,11 @@ class DesignModel {
     return objective_kind_ == DesignObjective::kMinSting &&
            objective_.function == DesignFunction::kObjective;
   }
+  /// The first bending frequency at x on the model's fixed mesh, Hz (NaN without the
+  /// min_frequency_hz constraint or when it cannot be computed).
+  double FirstFrequencyAt(const double* x) const;
+  /// Elements of the fixed mesh of the frequency constraint (0 without it).
+  int frequency_elements() const;
   /// The sting of `bat` in this problem's scene (EvaluateSting with the model's modes cache).
   StingEvaluation StingOf(const Bat& bat, bool refine_check) const;
 
@@ -182,6 +191,10 @@ class DesignModel {
   template <typename Scalar>
   Scalar FunctionOf(DesignFunction f, const Scalar* p) const;
   std::vector<double> ParametersAt(const double* x) const;
+  // The frequency at parameters t, Hz, and (when gradient_row) df/dx added into
+  // gradient_row[j * stride]; false when it cannot be computed.
+  bool FrequencyOf(const std::vector<double>& t, double* value, double* gradient_row,
+                   int stride) const;
 
   std::vector<DesignVariableSpec> variables_;
   std::vector<DesignConstraintSpec> constraints_;
@@ -215,6 +228,8 @@ class DesignModel {
   // model's copies; thread-safe), so repeated points do not recompute them.
   StingScene sting_scene_;
   std::shared_ptr<ModesCache> sting_modes_;
+  // min_frequency_hz: the beam on its fixed mesh (immutable, shared by the model's copies).
+  std::shared_ptr<const FixedMeshBeam> frequency_beam_;
 };
 
 /// The model as the solvers see it: variables scaled to s in [0, 1] (x = lower + (upper -

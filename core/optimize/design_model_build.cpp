@@ -25,6 +25,17 @@ bool ModelBuilder::CheckScene() {
     return Refuse(why, "swing_weight_exponent", problem.swing_weight_exponent,
                   "must be in [0, 0.5]");
   }
+  if (problem.swing_weight_reference_kg_m2.has_value()) {
+    if (problem.objective != DesignObjective::kMaxExitSpeedSwingWeight) {
+      return Refuse(why, "swing_weight_reference_kg_m2", *problem.swing_weight_reference_kg_m2,
+                    "applies only to objective max_exit_speed_swing_weight (objective is " +
+                        std::string(DesignObjectiveName(problem.objective)) + ")");
+    }
+    if (!CheckInRange(why, "swing_weight_reference_kg_m2", *problem.swing_weight_reference_kg_m2,
+                      0.0, kMaxDesignMoiKgM2, /*lo_open=*/true)) {
+      return false;
+    }
+  }
   if (!CheckInRange(why, "sweet_zone_tolerance_mps", problem.sweet_zone_tolerance_mps, 0.0,
                     kMaxDesignZoneToleranceMps, /*lo_open=*/true)) {
     return false;
@@ -41,7 +52,9 @@ bool ModelBuilder::CheckScene() {
       problem.inertia_model != InertiaModel::kSlenderRod) {
     return Refuse(why, TextRefusal("inertia_model", "not a known inertia model"));
   }
-  if (problem.objective == DesignObjective::kMinSting && !problem.flexible.Validate(why)) {
+  if ((problem.objective == DesignObjective::kMinSting ||
+       problem.constraints.min_frequency_hz.has_value()) &&
+      !problem.flexible.Validate(why)) {
     return false;
   }
 
@@ -260,10 +273,11 @@ bool ModelBuilder::SceneNumbers() {
   }
   const MassProperties base_properties = ComputeMassProperties(base, problem.inertia_model);
   model.c0_ = base_properties.balance_point_m;
-  model.i6_ref_ = base_properties.MoiSixInchKgM2();
-  if (!(std::isfinite(model.c0_) && model.i6_ref_ > 0.0)) {
+  if (!(std::isfinite(model.c0_) && base_properties.MoiSixInchKgM2() > 0.0)) {
     return Refuse(why, TextRefusal("bat", "its mass properties are not finite"));
   }
+  model.i6_ref_ =
+      problem.swing_weight_reference_kg_m2.value_or(base_properties.MoiSixInchKgM2());
 
   return true;
 }
@@ -318,6 +332,7 @@ bool ModelBuilder::Run() {
   if (!DiameterConstraints() || !TaperConstraints()) return false;
   CupConstraints();
   ValidityConstraints();
+  if (!FrequencyConstraint()) return false;
   return Objective();
 }
 

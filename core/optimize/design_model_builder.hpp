@@ -138,6 +138,11 @@ struct ModelBuilder {
   void RadiusKnots();
   // Diameters: the tightest of the request and the rules.
   bool DiameterConstraints();
+  // The knots (indices into radius_knots) the minimum diameter bounds: all, or those whose
+  // neighbouring segments can reach into the handle region.
+  bool HandleRegionKnots(std::vector<std::size_t>* out);
+  // The first bending frequency (min_frequency_hz) on its fixed mesh.
+  bool FrequencyConstraint();
   // Taper: the knot pairs it bounds (refused when the request's knots are not in the profile).
   bool TaperPairs(std::vector<std::pair<int, int>>* pairs_out,
                   std::vector<std::string>* suffix_out);

@@ -7,7 +7,10 @@
 #include <utility>
 #include <vector>
 
+#include "core/flexible/beam_frequency.hpp"
+#include "core/flexible/modes.hpp"
 #include "core/optimize/design_model_builder.hpp"
+#include "core/units.hpp"
 
 namespace sweetspot::core::design_detail {
 
@@ -219,12 +222,120 @@ bool ModelBuilder::DiameterConstraints() {
                       kMaxDesignDiameterM, /*lo_open=*/true)) {
       return false;
     }
-    for (std::size_t q = 0; q < radius_knots.size(); ++q) {
+    std::vector<std::size_t> knots;
+    if (!HandleRegionKnots(&knots)) return false;
+    for (std::size_t q : knots) {
       const std::string n = "min_handle_diameter_m" + knot_suffix[q];
       AddLinear(n, n, n, "m", {{lay.KnotRadius(radius_knots[q]), 2.0}}, 0.0,
                 *cons.min_handle_diameter_m, kInf, false, false);
     }
+  } else if (cons.handle_region_from_knob_m.has_value()) {
+    return Refuse(why, TextRefusal("constraints.handle_region_from_knob_m",
+                                   "needs constraints.min_handle_diameter_m"));
   }
+  return true;
+}
+
+// The knots (indices into radius_knots) the minimum diameter bounds.
+bool ModelBuilder::HandleRegionKnots(std::vector<std::size_t>* out) {
+  out->clear();
+  if (!cons.handle_region_from_knob_m.has_value()) {
+    for (std::size_t q = 0; q < radius_knots.size(); ++q) out->push_back(q);
+    return true;
+  }
+  const auto [from, to] = *cons.handle_region_from_knob_m;
+  if (!CheckInRange(why, "constraints.handle_region_from_knob_m[0]", from, 0.0, kMaxBatLengthM)) {
+    return false;
+  }
+  if (!CheckInRange(why, "constraints.handle_region_from_knob_m[1]", to, 0.0, kMaxBatLengthM,
+                    /*lo_open=*/true)) {
+    return false;
+  }
+  if (!(to > from)) {
+    return Refuse(why, "constraints.handle_region_from_knob_m[1]", to,
+                  "must be greater than constraints.handle_region_from_knob_m[0] = " + Num(from));
+  }
+  // The least and largest position a knot can take within the variables' bounds.
+  auto lower_of = [&](int k) {
+    const int idx = lay.KnotPosition(k);
+    const int j = model.parameter_variable_[static_cast<std::size_t>(idx)];
+    return j >= 0 ? model.variables_[static_cast<std::size_t>(j)].lower : Param(idx);
+  };
+  auto upper_of = [&](int k) {
+    const int idx = lay.KnotPosition(k);
+    const int j = model.parameter_variable_[static_cast<std::size_t>(idx)];
+    return j >= 0 ? model.variables_[static_cast<std::size_t>(j)].upper : Param(idx);
+  };
+  const int last = model.num_knots_ - 1;
+  if (problem.three_segment.has_value()) {
+    // r1 sets the radius on [0, x2) (the handle and the taper), r2 on (x1, L].
+    if (from < upper_of(2)) out->push_back(0);
+    if (to > lower_of(1)) out->push_back(1);
+    return true;
+  }
+  // Knot k sets the radius on (x(k-1), x(k+1)) (from the knob for k = 0, to the tip for the
+  // last): constrained when that interval can meet [from, to].
+  for (std::size_t q = 0; q < radius_knots.size(); ++q) {
+    const int k = radius_knots[q];
+    const bool starts_before_end = k == 0 || lower_of(k - 1) < to;
+    const bool ends_after_start = k == last || upper_of(k + 1) > from;
+    if (starts_before_end && ends_after_start) out->push_back(q);
+  }
+  return true;
+}
+
+// The first bending frequency (min_frequency_hz) on its fixed mesh.
+bool ModelBuilder::FrequencyConstraint() {
+  if (!cons.min_frequency_hz.has_value()) return true;
+  const double bound = *cons.min_frequency_hz;
+  if (!CheckInRange(why, "constraints.min_frequency_hz", bound, 0.0, kMaxDesignFrequencyHz,
+                    /*lo_open=*/true)) {
+    return false;
+  }
+  if (options.hessian == HessianMode::kExact) {
+    return Refuse(why, TextRefusal("options.hessian",
+                                   "exact is not available with constraints.min_frequency_hz "
+                                   "(the frequency has an exact gradient but no second "
+                                   "derivatives): use limited_memory"));
+  }
+  // The mesh: the modes code's final mesh for the start design at vibration_node's settings,
+  // its nodes kept as fractions of the length for the whole optimisation.
+  const std::vector<double> x0 = model.BaseX();
+  const Bat start = model.BatAt(x0.data());
+  const BeamModesOptions mo = problem.flexible.VibrationModes();
+  const BatModes modes = ComputeBatModes(start, mo);
+  if (!modes.summary.IsSolutionUsable() || modes.modes.size() < 2) {
+    return Refuse(why, "constraints.min_frequency_hz", bound,
+                  "the bending modes of the start (the base design clamped into the "
+                  "variables' bounds) cannot be computed: " +
+                      modes.summary.message);
+  }
+  FixedMeshBeam beam = MakeFixedMeshBeam(start, modes.nodes_m, model.num_knots_, model.hollow_,
+                                         model.has_fill_, mo.theory, mo.rotary_inertia);
+  const Eigen::Index ndof = modes.modes.front().vector.size();
+  beam.start_basis.resize(ndof, 4);
+  beam.start_basis.col(0) = modes.TranslationMode();
+  beam.start_basis.col(1) = modes.RotationMode();
+  beam.start_basis.col(2) = modes.modes[0].vector;
+  beam.start_basis.col(3) = modes.modes[1].vector;
+  const double omega = 2.0 * kPi * modes.modes[0].frequency_hz;
+  beam.shift = omega * omega;
+  const std::vector<double> t0 = model.ParametersAt(x0.data());
+  const FirstBendingMode check = ComputeFirstBendingMode(beam, t0, false);
+  if (!check.ok) {
+    return Refuse(why, "constraints.min_frequency_hz", bound,
+                  "the first bending mode of the start cannot be computed on its mesh: " +
+                      check.message);
+  }
+  model.frequency_beam_ = std::make_shared<const FixedMeshBeam>(std::move(beam));
+  DesignConstraintSpec c;
+  c.name = c.min_name = c.max_name = "min_frequency_hz";
+  c.unit = "hz";
+  c.f.function = DesignFunction::kFirstFrequency;
+  c.lower = bound;
+  c.upper = kInf;
+  c.property = true;  // analysed for conflicts (its reach within the bounds)
+  model.constraints_.push_back(std::move(c));
   return true;
 }
 

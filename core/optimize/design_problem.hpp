@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/bat.hpp"
@@ -32,6 +33,8 @@ inline constexpr double kMaxDesignMassKg = 1e4;
 inline constexpr double kMaxDesignMoiKgM2 = 1e4;
 /// Largest diameter a design constraint names (max_barrel_diameter_m, min_handle_diameter_m), m.
 inline constexpr double kMaxDesignDiameterM = 10.0;
+/// Largest first bending frequency a design constraint names (constraints.min_frequency_hz), Hz.
+inline constexpr double kMaxDesignFrequencyHz = 1e5;
 /// Largest taper slope a design constraint allows (constraints.max_taper_slope), m per m.
 inline constexpr double kMaxTaperSlope = 100.0;
 /// Largest sweet-zone tolerance of the widest_sweet_zone objective, m/s.
@@ -108,9 +111,23 @@ struct DesignConstraints {
   /// "max_barrel_diameter_m.knots[i]": every knot's diameter at most this, m, in
   /// (0, kMaxDesignDiameterM].
   std::optional<double> max_barrel_diameter_m;
-  /// "min_handle_diameter_m.knots[i]": every knot's diameter at least this, m, in
-  /// (0, kMaxDesignDiameterM].
+  /// "min_handle_diameter_m.knots[i]": the diameter at least this, m, in
+  /// (0, kMaxDesignDiameterM], over the whole bat or over handle_region_from_knob_m.
   std::optional<double> min_handle_diameter_m;
+  /// Where min_handle_diameter_m applies: [from, to] m from the knob, 0 <= from < to <=
+  /// kMaxBatLengthM (the grip). The profile is linear between knots, so the diameter over the
+  /// region is at least the limit when every knot whose neighbouring segments can reach into
+  /// the region (given the variables' bounds) is: those knots are constrained (a three-segment
+  /// design: r1 when the region can start before x2, r2 when it can end after x1). Unset = every
+  /// knot (the whole bat).
+  std::optional<std::pair<double, double>> handle_region_from_knob_m;
+  /// "min_frequency_hz": the first free-free bending frequency at least this, Hz, in
+  /// (0, kMaxDesignFrequencyHz]. Computed by the flexible beam (problem.flexible's theory) on
+  /// a mesh fixed for the whole optimisation: the final mesh of the modes code (vibration_node's
+  /// settings, problem.flexible.frequency_tolerance) for the start design, its nodes kept as
+  /// fractions of the length. Exact gradient (phi' (dK - lambda dM) phi); with it the exact
+  /// Hessian is not available (options.hessian must be limited_memory).
+  std::optional<double> min_frequency_hz;
   TaperRule taper = TaperRule::kNone;  ///< "taper.knots[i]" / "max_slope.knots[i]" (i to i+1).
   /// kMaxSlope: largest |dr/dx|, m per m, in (0, kMaxTaperSlope].
   double max_taper_slope = 0.0;
@@ -152,9 +169,14 @@ struct DesignProblem {
   std::vector<DesignVariable> variables;                       ///< 1 to 200 distinct variables.
   DesignConstraints constraints;                               ///< What must hold.
   DesignObjective objective = DesignObjective::kMaxExitSpeed;  ///< What to improve.
-  /// kMaxExitSpeedSwingWeight: n in omega = omega0 (I6 / I6_ref)^-n, in [0, 0.5]; I6_ref is the
-  /// base design's MOI about the 6-in point, so the base design swings at omega0.
+  /// kMaxExitSpeedSwingWeight: n in omega = omega0 (I6 / I6_ref)^-n, in [0, 0.5]; I6_ref is
+  /// swing_weight_reference_kg_m2 when set, else the base design's MOI about the 6-in point (so
+  /// the base design swings at omega0).
   double swing_weight_exponent = 0.27;
+  /// kMaxExitSpeedSwingWeight: I6_ref, the MOI about the 6-in point that swings at omega0,
+  /// kg·m², in (0, kMaxDesignMoiKgM2]; unset = the base design's. Refused with any other
+  /// objective (it would have no effect).
+  std::optional<double> swing_weight_reference_kg_m2;
   /// kWidestSweetZone: the zone is where the exit speed is within this of the max, m/s, in
   /// (0, kMaxDesignZoneToleranceMps].
   double sweet_zone_tolerance_mps = 1.0;
@@ -306,6 +328,17 @@ struct DesignSting {
   FlexibleImpactResult impact;  ///< Everything the flexible model knows about that impact.
 };
 
+/// The first bending mode of the answer (constraints.min_frequency_hz), recomputed by the modes
+/// code (ComputeBatModes with problem.flexible's vibration_node settings) on its own adaptive
+/// mesh, beside the optimisation's fixed-mesh value that the constraint holds.
+struct DesignFrequency {
+  double frequency_hz = 0.0;        ///< The modes code's first bending frequency, Hz.
+  double error_estimate_hz = 0.0;   ///< Its error estimate, Hz.
+  int elements = 0;                 ///< Elements of its final mesh.
+  double model_frequency_hz = 0.0;  ///< The fixed mesh's value (the constrained one), Hz.
+  int model_elements = 0;           ///< Elements of the fixed mesh.
+};
+
 /// The answer of OptimizeDesign. The summary is always filled:
 /// - termination: converged (Ipopt converged and the design meets every constraint when
 ///   re-checked through ComputeMassProperties), no_convergence (stopped by iterations, time,
@@ -337,6 +370,8 @@ struct DesignResult {
   std::vector<DesignConflict> conflicts;                   ///< For an infeasible request: why.
   DesignSpread spread;                                     ///< Over the starts.
   std::optional<DesignSting> sting;  ///< min_sting: the answer's impact (else empty).
+  /// constraints.min_frequency_hz: the answer's first bending mode (else empty).
+  std::optional<DesignFrequency> first_bending_mode;
   /// Errors reported by Ipopt's derivative checker (-1 = not run).
   int derivative_check_errors = -1;
   std::string derivative_check_report;  ///< The checker's output (empty if not run).
