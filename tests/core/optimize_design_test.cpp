@@ -7,9 +7,11 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/mass_properties.hpp"
+#include "core/optimize/design_model.hpp"
 #include "core/material.hpp"
 #include "core/presets.hpp"
 #include "core/units.hpp"
@@ -478,6 +480,36 @@ TEST(OptimizeInvalid, IllPosedRequestsAreRefusedByName) {
       "handle 0", [](DesignProblem& p) { p.constraints.min_handle_diameter_m = 0.0; },
       "constraints.min_handle_diameter_m = 0: must be in (0, 10]");
   with(
+      "grip order",
+      [](DesignProblem& p) {
+        p.constraints.min_handle_diameter_m = 0.02;
+        p.constraints.handle_region_from_knob_m = std::pair{0.3, 0.1};
+      },
+      "constraints.handle_region_from_knob_m[1] = 0.1: must be greater than "
+      "constraints.handle_region_from_knob_m[0] = 0.3");
+  with(
+      "grip start",
+      [](DesignProblem& p) {
+        p.constraints.min_handle_diameter_m = 0.02;
+        p.constraints.handle_region_from_knob_m = std::pair{-0.1, 0.3};
+      },
+      "constraints.handle_region_from_knob_m[0] = -0.1: must be in [0, 100]");
+  with(
+      "grip alone",
+      [](DesignProblem& p) { p.constraints.handle_region_from_knob_m = std::pair{0.0, 0.3}; },
+      "constraints.handle_region_from_knob_m: needs constraints.min_handle_diameter_m");
+  with(
+      "reference 0",
+      [](DesignProblem& p) {
+        p.objective = DesignObjective::kMaxExitSpeedSwingWeight;
+        p.swing_weight_reference_kg_m2 = 0.0;
+      },
+      "swing_weight_reference_kg_m2 = 0: must be in (0, 10000]");
+  with(
+      "reference elsewhere", [](DesignProblem& p) { p.swing_weight_reference_kg_m2 = 0.2; },
+      "swing_weight_reference_kg_m2 = 0.2: applies only to objective max_exit_speed_swing_weight "
+      "(objective is max_exit_speed)");
+  with(
       "slope cap",
       [](DesignProblem& p) {
         p.constraints.taper = TaperRule::kMaxSlope;
@@ -615,6 +647,18 @@ TEST(OptimizeObjectives, SwingWeightAndSweetZoneObjectivesAreReportedThroughTheP
   EXPECT_NEAR(r.angular_speed_rad_s, omega, 1e-12);
   EXPECT_EQ(r.objective_value, r.max_exit_speed_mps);
 
+  // A reference of one's own: omega0 belongs to that swing weight instead of the base design's.
+  // The reference 0.20 kg m^2 is the contract's MOI limit; the same optimum design family.
+  p.swing_weight_reference_kg_m2 = 0.20;
+  r = OptimizeDesign(p);
+  ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.FullReport();
+  const double omega_own =
+      Swing{}.angular_speed_rad_s * std::pow(r.properties.MoiSixInchKgM2() / 0.20, -0.27);
+  // 1e-12 rad/s: the answer's omega is this closed form of the returned bat's I6 (round-off).
+  EXPECT_NEAR(r.angular_speed_rad_s, omega_own, 1e-12);
+  EXPECT_EQ(r.objective_value, r.max_exit_speed_mps);
+  p.swing_weight_reference_kg_m2.reset();
+
   p.objective = DesignObjective::kWidestSweetZone;
   p.sweet_zone_tolerance_mps = 1.0;
   r = OptimizeDesign(p);
@@ -622,6 +666,60 @@ TEST(OptimizeObjectives, SwingWeightAndSweetZoneObjectivesAreReportedThroughTheP
   EXPECT_EQ(r.objective_unit, "m");
   EXPECT_GT(r.objective_value, 0.3);
   EXPECT_LE(r.objective_value, r.bat.LengthM());
+}
+
+TEST(OptimizeConstraints, HandleRegionBoundsOnlyTheKnotsThatReachTheGrip) {
+  // The sixteen-knot profile (knots every 0.0573 m) with the handle limit over the grip [0,
+  // 0.2 m] only: knots 0 to 4 (knot 4 at 0.229 m sets the radius on (0.172, 0.287)) carry the
+  // constraint, the others not.
+  DesignProblem p = SixteenKnotProblem();
+  p.constraints.min_handle_diameter_m = InchesToMetres(0.95);
+  p.constraints.handle_region_from_knob_m = std::pair{0.0, 0.2};
+  DesignModel model;
+  std::string why;
+  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why;
+  std::vector<std::string> names;
+  for (const auto& c : model.constraints()) {
+    if (c.name.rfind("min_handle_diameter_m", 0) == 0) names.push_back(c.name);
+  }
+  // Knot 0 is fixed (not a variable) and meets the limit (its diameter 0.985 in), so it is
+  // checked at build time and not added.
+  EXPECT_EQ(names, (std::vector<std::string>{"min_handle_diameter_m.knots[1]",
+                                             "min_handle_diameter_m.knots[2]",
+                                             "min_handle_diameter_m.knots[3]",
+                                             "min_handle_diameter_m.knots[4]"}));
+  const DesignResult r = OptimizeDesign(p);
+  ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.FullReport();
+  // The profile is linear between knots: over the grip the diameter is at least 0.95 in (1e-8
+  // m, the re-check tolerance of the other constraints), sampled every mm.
+  for (double x = 0.0; x <= 0.2; x += 0.001) {
+    EXPECT_GE(2.0 * r.bat.RadiusAtM(x), InchesToMetres(0.95) - 1e-8) << x;
+  }
+  // Without the region the same limit binds at every knot (the whole bat), a different design.
+  DesignProblem whole = p;
+  whole.constraints.handle_region_from_knob_m.reset();
+  ASSERT_TRUE(DesignModel::Build(whole, DesignOptions{}, &model, &why)) << why;
+  int count = 0;
+  for (const auto& c : model.constraints()) count += c.name.rfind("min_handle", 0) == 0 ? 1 : 0;
+  EXPECT_EQ(count, 14);  // the 14 variable knots
+
+  // Three segments: r2 sets the radius on (x1, L], x1 in [0.1, 0.5] here. A grip ending before
+  // x1 can start leaves the barrel radius free; one reaching past 0.1 m bounds it too (r1 is
+  // not a variable in this problem and meets the limit, so it is checked at build time).
+  DesignProblem three = ContractExample();
+  three.constraints.min_handle_diameter_m = InchesToMetres(0.95);
+  auto handle_names = [&](double to) {
+    three.constraints.handle_region_from_knob_m = std::pair{0.0, to};
+    std::vector<std::string> out;
+    EXPECT_TRUE(DesignModel::Build(three, DesignOptions{}, &model, &why)) << why;
+    for (const auto& c : model.constraints()) {
+      if (c.name.rfind("min_handle", 0) == 0) out.push_back(c.name);
+    }
+    return out;
+  };
+  EXPECT_TRUE(handle_names(0.08).empty());
+  EXPECT_EQ(handle_names(0.2), (std::vector<std::string>{
+                                   "min_handle_diameter_m.three_segment.barrel_radius_m"}));
 }
 
 TEST(OptimizeMultiStart, CancellationAndTheTimeBudgetKeepTheBestDesign) {
