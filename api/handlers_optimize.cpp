@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <utility>
 
 #include "api/bat_json.hpp"
 #include "api/endpoint.hpp"
@@ -58,6 +59,17 @@ bool ReadConstraints(ObjectReader& top, core::DesignConstraints* c) {
   ReadRange(reader, "moi_six_inch_kg_m2", &c->moi_six_inch_kg_m2);
   c->max_barrel_diameter_m = reader.MaybeNumber("max_barrel_diameter_m", AnyNumber());
   c->min_handle_diameter_m = reader.MaybeNumber("min_handle_diameter_m", AnyNumber());
+  if (const Json* region = reader.Get("handle_region_from_knob_m")) {
+    // [from, to], m from the knob; the numbers' ranges and order are core's.
+    if (!region->is_array() || region->size() != 2 || !(*region)[0].is_number() ||
+        !(*region)[1].is_number()) {
+      return reader.Fail("handle_region_from_knob_m",
+                         "must be [from, to]: two numbers, m from the knob");
+    }
+    c->handle_region_from_knob_m =
+        std::pair{(*region)[0].get<double>(), (*region)[1].get<double>()};
+  }
+  c->min_frequency_hz = reader.MaybeNumber("min_frequency_hz", AnyNumber());
   if (const Json* taper = reader.Get("taper")) {
     if (taper->is_string() && taper->get<std::string>() == "non_decreasing") {
       c->taper = core::TaperRule::kNonDecreasing;
@@ -238,6 +250,14 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
              {"angular_speed_rad_s", Finite(r.angular_speed_rad_s)}}},
            {"summary", std::move(summary)}};
   if (!conflicts.empty()) out["conflicts"] = std::move(conflicts);
+  if (r.first_bending_mode) {
+    const core::DesignFrequency& f = *r.first_bending_mode;
+    out["first_bending_mode"] = {{"frequency_hz", Finite(f.frequency_hz)},
+                                 {"error_estimate_hz", Finite(f.error_estimate_hz)},
+                                 {"elements", f.elements},
+                                 {"model_frequency_hz", Finite(f.model_frequency_hz)},
+                                 {"model_elements", f.model_elements}};
+  }
   if (r.sting) {
     out["sting"] = {{"position_from_knob_m", r.sting->impact_from_knob_m},
                     {"hands_vibration_energy_j", r.sting->hands_vibration_energy_j},
@@ -350,6 +370,8 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
                          "min_moi", "min_sting"});
   problem.objective = *core::ParseDesignObjective(request.objective);
   reader.OptionalNumber("swing_weight_exponent", AnyNumber(), &problem.swing_weight_exponent);
+  problem.swing_weight_reference_kg_m2 =
+      reader.MaybeNumber("swing_weight_reference_kg_m2", AnyNumber());  // range: core's
   reader.OptionalNumber("sweet_zone_tolerance_mps", AnyNumber(), &problem.sweet_zone_tolerance_mps);
   if (!ReadOptions(reader, context.limits, problem.objective, &request.options,
                    &problem.flexible) ||

@@ -477,6 +477,16 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     summary.objective = pub.objective;
     if (problem.constraints.min_frequency_hz.has_value()) {
       result.first_bending_mode = FirstBendingModeOf(problem, model, result.bat, x);
+      const DesignFrequency& f = *result.first_bending_mode;
+      const double gap = std::abs(f.frequency_hz - f.model_frequency_hz);
+      if (!(gap <= problem.flexible.frequency_tolerance * f.frequency_hz)) {
+        summary.warnings.push_back(
+            "min_frequency_hz: the fixed mesh's first frequency " +
+            FormatNumber(f.model_frequency_hz) + " Hz differs from the modes code's " +
+            FormatNumber(f.frequency_hz) + " Hz by more than frequency_tolerance = " +
+            FormatNumber(problem.flexible.frequency_tolerance) +
+            " (the start's mesh no longer resolves this design: start from it again)");
+      }
     }
 
     // Independent re-check of every constraint (public mass properties).

@@ -167,10 +167,15 @@ TEST(OptimizeFrequency, MlbDesignMeetsAMinimumFrequency) {
     // constraint's scale, ~150 Hz; 1e-6 Hz leaves room for the re-check's round-off).
     EXPECT_NEAR(fm.model_frequency_hz, bound, 1e-6);
     // The modes code, on its own adaptive mesh for the optimum, gives the same frequency within
-    // its error estimate (both approximate the beam's exact frequency; the fixed mesh's knots
-    // have moved off its nodes, which costs it some accuracy): 2 x the estimate.
-    EXPECT_NEAR(fm.frequency_hz, bound, 2.0 * fm.error_estimate_hz + 1e-6);
-    EXPECT_LT(fm.error_estimate_hz, 1e-4 * bound);  // the modes code's tolerance
+    // the tolerance the fixed mesh was chosen for (frequency_tolerance, 1e-4 relative): both
+    // approximate the beam's exact frequency, and the fixed mesh loses some accuracy as the
+    // knots move off its nodes (measured: 149.99927 Hz, 4.9e-6 relative, beside the modes
+    // code's own estimate 7.5e-4 Hz). No warning says otherwise.
+    EXPECT_NEAR(fm.frequency_hz, bound, p.flexible.frequency_tolerance * bound);
+    EXPECT_LT(fm.error_estimate_hz, p.flexible.frequency_tolerance * bound);
+    for (const std::string& w : r.summary.warnings) {
+      EXPECT_EQ(w.find("fixed mesh"), std::string::npos) << w;
+    }
     EXPECT_LE(r.summary.constraint_violation, 1e-6);
   }
 }
