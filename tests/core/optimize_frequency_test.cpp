@@ -180,6 +180,19 @@ TEST(OptimizeFrequency, MlbDesignMeetsAMinimumFrequency) {
   }
 }
 
+TEST(OptimizeFrequency, AnUnreachableFrequencyIsExplained) {
+  DesignProblem p = MlbProblem();
+  p.constraints.min_frequency_hz = 400.0;
+  const DesignResult r = OptimizeDesign(p);
+  EXPECT_EQ(r.summary.termination, Termination::kInfeasible) << r.summary.FullReport();
+  // 400 Hz needs a thick bat: the conflict found is the mass range against the frequency
+  // ("mass_kg in [0.8788, 0.9072 kg] is below the lightest bat with min_frequency_hz = 400 hz
+  // ...: 1.36 kg").
+  ASSERT_FALSE(r.conflicts.empty());
+  EXPECT_NE(r.conflicts.front().message.find("min_frequency_hz = 400 hz"), std::string::npos)
+      << r.conflicts.front().message;
+}
+
 TEST(OptimizeFrequency, RefusesBadBoundsAndTheExactHessian) {
   DesignProblem p = MlbProblem();
   p.constraints.min_frequency_hz = 0.0;
