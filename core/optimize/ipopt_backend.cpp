@@ -262,6 +262,10 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
                                          settings.derivative_check == DerivativeCheck::kSecondOrder
                                              ? "second-order"
                                              : "first-order");
+      if (settings.derivative_test_perturbation > 0.0) {
+        ok = ok && options->SetNumericValue("derivative_test_perturbation",
+                                            settings.derivative_test_perturbation);
+      }
       // The checker prints to the journals only: capture its lines in a string (the console
       // journal stays at print_level 0).
       Ipopt::SmartPtr<Ipopt::StreamJournal> journal =
