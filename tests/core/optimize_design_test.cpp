@@ -647,18 +647,6 @@ TEST(OptimizeObjectives, SwingWeightAndSweetZoneObjectivesAreReportedThroughTheP
   EXPECT_NEAR(r.angular_speed_rad_s, omega, 1e-12);
   EXPECT_EQ(r.objective_value, r.max_exit_speed_mps);
 
-  // A reference of one's own: omega0 belongs to that swing weight instead of the base design's.
-  // The reference 0.20 kg m^2 is the contract's MOI limit; the same optimum design family.
-  p.swing_weight_reference_kg_m2 = 0.20;
-  r = OptimizeDesign(p);
-  ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.FullReport();
-  const double omega_own =
-      Swing{}.angular_speed_rad_s * std::pow(r.properties.MoiSixInchKgM2() / 0.20, -0.27);
-  // 1e-12 rad/s: the answer's omega is this closed form of the returned bat's I6 (round-off).
-  EXPECT_NEAR(r.angular_speed_rad_s, omega_own, 1e-12);
-  EXPECT_EQ(r.objective_value, r.max_exit_speed_mps);
-  p.swing_weight_reference_kg_m2.reset();
-
   p.objective = DesignObjective::kWidestSweetZone;
   p.sweet_zone_tolerance_mps = 1.0;
   r = OptimizeDesign(p);
@@ -666,6 +654,28 @@ TEST(OptimizeObjectives, SwingWeightAndSweetZoneObjectivesAreReportedThroughTheP
   EXPECT_EQ(r.objective_unit, "m");
   EXPECT_GT(r.objective_value, 0.3);
   EXPECT_LE(r.objective_value, r.bat.LengthM());
+}
+
+TEST(OptimizeObjectives, SwingWeightReferenceIsTheOneThatSwingsAtOmega0) {
+  // A reference of one's own: omega0 belongs to that swing weight instead of the base design's.
+  // The reference 0.20 kg m^2 is the contract's MOI limit.
+  DesignProblem p = ContractExample();
+  p.objective = DesignObjective::kMaxExitSpeedSwingWeight;
+  p.swing_weight_reference_kg_m2 = 0.20;
+  const DesignResult r = OptimizeDesign(p);
+  ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.FullReport();
+  const double omega_own =
+      Swing{}.angular_speed_rad_s * std::pow(r.properties.MoiSixInchKgM2() / 0.20, -0.27);
+  // 1e-12 rad/s: the answer's omega is this closed form of the returned bat's I6 (round-off).
+  EXPECT_NEAR(r.angular_speed_rad_s, omega_own, 1e-12);
+  EXPECT_EQ(r.objective_value, r.max_exit_speed_mps);
+  // With the base design's reference (its I6 is not 0.20) omega0 belongs to another swing
+  // weight, so the same request answers another exit speed: the field is used.
+  DesignProblem base_ref = p;
+  base_ref.swing_weight_reference_kg_m2.reset();
+  const DesignResult b = OptimizeDesign(base_ref);
+  ASSERT_EQ(b.summary.termination, Termination::kConverged) << b.summary.FullReport();
+  EXPECT_NE(r.objective_value, b.objective_value);
 }
 
 TEST(OptimizeConstraints, HandleRegionBoundsOnlyTheKnotsThatReachTheGrip) {
