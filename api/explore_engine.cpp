@@ -680,7 +680,7 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
   const Sweep& sweep = *plan.sweep;
   std::vector<double>& point = worker->point;
   if (sweep.plan.method == core::SamplingMethod::kGrid) {
-    point = core::GridDesign(sweep.plan, i);
+    core::GridDesignInto(sweep.plan, i, &point);
   } else {
     point = sweep.drawn[static_cast<std::size_t>(i)];
   }

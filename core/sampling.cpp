@@ -112,7 +112,14 @@ bool Shard::Validate(Refusal* why) const {
 }
 
 std::vector<double> GridDesign(const SweepPlan& plan, std::uint64_t i) {
-  std::vector<double> point(plan.dimensions.size());
+  std::vector<double> point;
+  GridDesignInto(plan, i, &point);
+  return point;
+}
+
+void GridDesignInto(const SweepPlan& plan, std::uint64_t i, std::vector<double>* out) {
+  std::vector<double>& point = *out;
+  point.resize(plan.dimensions.size());
   for (std::size_t k = plan.dimensions.size(); k-- > 0;) {
     const SweepDimension& d = plan.dimensions[k];
     const auto c = static_cast<std::uint64_t>(std::max(d.count, 1));
@@ -120,7 +127,6 @@ std::vector<double> GridDesign(const SweepPlan& plan, std::uint64_t i) {
     i /= c;
     point[k] = c == 1 ? d.min : Lerp(d, static_cast<double>(j) / static_cast<double>(c - 1));
   }
-  return point;
 }
 
 std::vector<std::vector<double>> GenerateDesigns(const SweepPlan& plan) {

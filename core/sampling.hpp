@@ -68,6 +68,8 @@ std::vector<std::vector<double>> GenerateDesigns(const SweepPlan& plan);
 /// Design `i` of a grid plan without generating the others (row-major: the
 /// last dimension varies fastest). Precondition: i < plan.DesignCount().
 std::vector<double> GridDesign(const SweepPlan& plan, std::uint64_t i);
+/// GridDesign into *point (resized; its storage reused design after design).
+void GridDesignInto(const SweepPlan& plan, std::uint64_t i, std::vector<double>* point);
 
 /// Whether an objective is maximised or minimised.
 enum class Sense { kMaximize, kMinimize };
