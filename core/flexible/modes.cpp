@@ -37,8 +37,19 @@ struct Level {
   // The largest eigenvalue (dense fallback) or max K_ii / M_ii over the w_b DOFs, its order of
   // magnitude: sets the round-off floor of the frequencies.
   double lambda_max = 0.0;
-  int iterations = 0;  // subspace iterations (0 = dense)
+  int iterations = 0;  // Lanczos steps or subspace iterations (0 = dense)
 };
+
+// a <- (a + a') / 2 without a temporary.
+void SymmetrizeInPlace(Eigen::MatrixXd* a) {
+  for (Eigen::Index j = 0; j < a->cols(); ++j) {
+    for (Eigen::Index i = j + 1; i < a->rows(); ++i) {
+      const double v = 0.5 * ((*a)(i, j) + (*a)(j, i));
+      (*a)(i, j) = v;
+      (*a)(j, i) = v;
+    }
+  }
+}
 
 // Lowest eigenpairs of (K, M) by shift-invert subspace iteration from the basis X (n x p).
 bool SubspaceIteration(const SparseMatrix& k, const SparseMatrix& m, int wanted, double sigma,
@@ -50,12 +61,19 @@ bool SubspaceIteration(const SparseMatrix& k, const SparseMatrix& m, int wanted,
     *why = "the factorisation of K + sigma M failed (sigma = " + FormatNumber17(sigma) + ")";
     return false;
   }
+  // Every buffer is allocated once, before the loop: the products below assign into them
+  // (noalias), so an iteration allocates nothing. (Allocating them per iteration cost ~20 times
+  // the arithmetic: buffers of ~60 kB each, freed together at the heap's top, made glibc hand
+  // the pages back to the kernel every iteration and fault them in again.)
+  const Eigen::Index n = x.rows(), p = x.cols();
+  Eigen::MatrixXd mx(n, p), y(n, p), ky(n, p), my(n, p), kr(p, p), mr(p, p);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(p);
   Eigen::VectorXd lambda;
   double best = std::numeric_limits<double>::infinity();
   int stalled = 0;
+  mx.noalias() = m * x;
   for (int it = 1; it <= kMaxSubspaceIterations; ++it) {
-    const Eigen::MatrixXd mx = m * x;
-    const Eigen::MatrixXd y = ldlt.solve(mx);
+    y = ldlt.solve(mx);  // evaluated into y (copy, then the triangular solves in place)
     // Residual of the (well-conditioned) shift-invert operator for the current Ritz pairs:
     // |(lambda_i + sigma) (K + sigma M)^-1 M x_i - x_i| / |x_i|.
     double worst = lambda.size() == 0 ? std::numeric_limits<double>::infinity() : 0.0;
@@ -73,19 +91,18 @@ bool SubspaceIteration(const SparseMatrix& k, const SparseMatrix& m, int wanted,
       ++stalled;
     }
     const bool done = worst <= kResidualTolerance || (best <= 1e-6 && stalled >= 3);
-    const Eigen::MatrixXd ky = k * y;
-    const Eigen::MatrixXd my = m * y;
-    Eigen::MatrixXd kr = y.transpose() * ky;
-    Eigen::MatrixXd mr = y.transpose() * my;
-    kr = 0.5 * (kr + kr.transpose()).eval();
-    mr = 0.5 * (mr + mr.transpose()).eval();
-    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(
-        kr, mr, Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
+    ky.noalias() = k * y;
+    my.noalias() = m * y;
+    kr.noalias() = y.transpose() * ky;
+    mr.noalias() = y.transpose() * my;
+    SymmetrizeInPlace(&kr);
+    SymmetrizeInPlace(&mr);
+    es.compute(kr, mr, Eigen::ComputeEigenvectors | Eigen::Ax_lBx);
     if (es.info() != Eigen::Success) {
       *why = "the Rayleigh-Ritz step failed (the basis lost independence)";
       return false;
     }
-    x = y * es.eigenvectors();
+    x.noalias() = y * es.eigenvectors();
     lambda = es.eigenvalues();
     if (done) {
       *values = lambda;
@@ -93,9 +110,127 @@ bool SubspaceIteration(const SparseMatrix& k, const SparseMatrix& m, int wanted,
       *iterations = it;
       return true;
     }
+    // M x for the next iteration from M y: x = y V, so M x = (M y) V (no sparse product).
+    mx.noalias() = my * es.eigenvectors();
   }
   *why = "the subspace iteration did not converge in " + std::to_string(kMaxSubspaceIterations) +
          " iterations";
+  return false;
+}
+
+// The number of eigenvalues of (K, M) below mu (Sylvester's law of inertia: the negative
+// pivots of the LDL' factorisation of K - mu M, the Sturm sequence check of structural
+// codes); -1 when the factorisation meets a zero pivot.
+int ModesBelowCount(const SparseMatrix& k, const SparseMatrix& m, double mu) {
+  const SparseMatrix shifted = k - mu * m;
+  const Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(
+      shifted);
+  if (ldlt.info() != Eigen::Success) return -1;
+  const Eigen::VectorXd d = ldlt.vectorD();
+  int below = 0;
+  for (Eigen::Index i = 0; i < d.size(); ++i) {
+    if (!std::isfinite(d[i])) return -1;
+    if (d[i] < 0.0) ++below;
+  }
+  return below;
+}
+
+// The lowest `flexible` flexible eigenpairs of (K, M) by shift-invert Lanczos: the Krylov
+// space of A = (K + sigma M)^-1 M from `start`, kept M-orthogonal to the rigid modes (`rigid`,
+// M-orthonormal, K rigid = 0: A's largest eigenvalue 1/sigma, double, which one Krylov vector
+// could not resolve) and fully reorthogonalised (classical Gram-Schmidt twice in the M inner
+// product). Every few steps the tridiagonal T = Q' M A Q gives Ritz values theta = 1/(lambda +
+// sigma); once the Lanczos estimates say the wanted ones converged, their residuals are
+// checked explicitly with the subspace iteration's criterion and tolerance. Returns the
+// flexible Ritz pairs (ascending lambda; the wanted ones first, then up to `extra` more, not
+// converged: seeds for the next mesh), mass-normalised. False when it did not converge
+// within its step budget or broke down: the caller falls back to the subspace iteration.
+// Cost: one sparse solve and O(n j) for the reorthogonalisation per step j, instead of p
+// solves and O(n p^2) dense work per subspace iteration.
+bool ShiftInvertLanczos(const SparseMatrix& k, const SparseMatrix& m, const Eigen::MatrixXd& rigid,
+                        int flexible, int extra, double sigma, const Eigen::VectorXd& start,
+                        Eigen::VectorXd* values, Eigen::MatrixXd* vectors, int* steps) {
+  const Eigen::Index n = k.rows();
+  const Eigen::Index max_steps = std::min<Eigen::Index>(n - rigid.cols(), 4 * flexible + 40);
+  if (max_steps < flexible + 1) return false;
+  const SparseMatrix shifted = k + sigma * m;
+  const Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> ldlt(
+      shifted);
+  if (ldlt.info() != Eigen::Success) return false;
+  const Eigen::MatrixXd m_rigid = m * rigid;
+  Eigen::MatrixXd q(n, max_steps + 1), mq(n, max_steps + 1);
+  Eigen::VectorXd alpha(max_steps), beta(max_steps), w(n), mw(n), h(max_steps);
+  w = start - rigid * (m_rigid.transpose() * start);
+  mw.noalias() = m * w;
+  double norm = std::sqrt(std::max(w.dot(mw), 0.0));
+  if (!(norm > 0.0 && std::isfinite(norm))) return false;
+  q.col(0) = w / norm;
+  mq.col(0) = mw / norm;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> tri;
+  Eigen::MatrixXd x, mx, y;
+  double previous_worst = std::numeric_limits<double>::infinity();
+  for (Eigen::Index j = 0; j < max_steps; ++j) {
+    w = ldlt.solve(mq.col(j));
+    w -= rigid * (m_rigid.transpose() * w);
+    const Eigen::Index cols = j + 1;
+    for (int pass = 0; pass < 2; ++pass) {
+      h.head(cols).noalias() = mq.leftCols(cols).transpose() * w;
+      if (pass == 0) alpha[j] = h[j];
+      w.noalias() -= q.leftCols(cols) * h.head(cols);
+    }
+    w -= rigid * (m_rigid.transpose() * w);
+    mw.noalias() = m * w;
+    beta[j] = std::sqrt(std::max(w.dot(mw), 0.0));
+    if (!std::isfinite(beta[j]) || !std::isfinite(alpha[j])) return false;
+    // An invariant subspace: its Ritz pairs are exact (beta = 0 in the estimates below).
+    const bool breakdown = beta[j] <= 1e-14 * std::abs(alpha[0]);
+    const bool check = cols >= flexible + 2 && (cols % 4 == 0 || breakdown || j + 1 == max_steps);
+    if (check) {
+      tri.computeFromTridiagonal(alpha.head(cols), beta.head(cols - 1), Eigen::ComputeEigenvectors);
+      if (tri.info() != Eigen::Success) return false;
+      // Ascending theta: the wanted (lowest lambda) are the last `flexible` ones.
+      bool estimated = true;
+      for (int i = 0; i < flexible; ++i) {
+        const Eigen::Index c = cols - 1 - i;
+        const double theta = tri.eigenvalues()[c];
+        if (!(theta > 0.0)) return false;
+        const double r = std::abs(beta[j] * tri.eigenvectors()(cols - 1, c)) / theta;
+        if (!breakdown && !(r <= 0.1 * kResidualTolerance)) estimated = false;
+      }
+      if (estimated || breakdown) {
+        const Eigen::Index keep = std::min<Eigen::Index>(cols, flexible + extra);
+        const Eigen::MatrixXd s = tri.eigenvectors().rightCols(keep).rowwise().reverse();
+        x.noalias() = q.leftCols(cols) * s;
+        mx.noalias() = m * x.leftCols(flexible);
+        y = ldlt.solve(mx);
+        Eigen::VectorXd lambda(keep);
+        for (Eigen::Index i = 0; i < keep; ++i) {
+          lambda[i] = 1.0 / tri.eigenvalues()[cols - 1 - i] - sigma;
+        }
+        double worst = 0.0;
+        for (int i = 0; i < flexible; ++i) {
+          const double r = ((lambda[i] + sigma) * y.col(i) - x.col(i)).norm() / x.col(i).norm();
+          worst = std::max(worst, std::isfinite(r) ? r : std::numeric_limits<double>::infinity());
+        }
+        // Converged, or at round-off: the Lanczos estimates are below the tolerance but the
+        // explicit residual, which carries the rounding of the solve (K + sigma M has a
+        // condition number ~lambda_max / sigma), no longer halves (the subspace iteration's
+        // rule: fine meshes stall near 1e-8, accepted below 1e-6).
+        const bool converged =
+            worst <= kResidualTolerance || (worst <= 1e-6 && worst > 0.5 * previous_worst);
+        previous_worst = worst;
+        if (converged) {
+          *values = std::move(lambda);
+          *vectors = std::move(x);
+          *steps = static_cast<int>(cols);
+          return true;
+        }
+      }
+    }
+    if (breakdown) return false;
+    q.col(j + 1) = w / beta[j];
+    mq.col(j + 1) = mw / beta[j];
+  }
   return false;
 }
 
@@ -113,34 +248,40 @@ bool SolveLevel(const Bat& bat, const BeamModesOptions& o, BeamMesh mesh, const 
   // must hold only well-resolved low modes for its dense solve to be accurate).
   const int p = std::max(wanted + 2, std::min(ndof / 2, std::max(2 * wanted, wanted + 8)));
   Eigen::MatrixXd seed = Eigen::MatrixXd::Zero(ndof, p);
+  // Columns seeded from the coarser mesh (its Ritz basis prolonged exactly); the others start
+  // as the first mesh's do.
+  const Eigen::Index prolonged =
+      previous == nullptr ? 0 : std::min<Eigen::Index>(p, previous->basis.cols());
+  for (Eigen::Index j = 0; j < prolonged; ++j) {
+    seed.col(j) =
+        ProlongField(o.theory, previous->mesh.nodes_m, previous->basis.col(j), mesh.nodes_m);
+  }
+  // Rigid translation and rotation, then cosines cos(j pi x / L) as w_b.
+  const double length = mesh.nodes_m.back();
+  for (int e = 0; e < mesh.Elements(); ++e) {
+    int idx[kElementDofs];
+    ElementDofIndices(o.theory, e, idx);
+    for (int side = 0; side < 2; ++side) {
+      const double x = mesh.nodes_m[static_cast<std::size_t>(e + side)];
+      const int iw = idx[side == 0 ? 0 : 4], it = idx[side == 0 ? 1 : 5];
+      if (prolonged <= 0) seed(iw, 0) = 1.0;
+      if (prolonged <= 1) {
+        seed(iw, 1) = x - 0.5 * length;
+        seed(it, 1) = 1.0;
+      }
+      for (Eigen::Index j = std::max<Eigen::Index>(prolonged, 2); j < p; ++j) {
+        const double kj = static_cast<double>(j - 1) * kPi / length;
+        seed(iw, j) = std::cos(kj * x);
+        seed(it, j) = -kj * std::sin(kj * x);
+      }
+    }
+  }
   double sigma = 0.0;
   if (previous != nullptr) {
-    for (Eigen::Index j = 0; j < std::min<Eigen::Index>(p, previous->basis.cols()); ++j) {
-      seed.col(j) =
-          ProlongField(o.theory, previous->mesh.nodes_m, previous->basis.col(j), mesh.nodes_m);
-    }
     // Shift near the first bending mode: K + sigma M is positive definite and the wanted modes
     // converge at the rate (lambda_i + sigma) / (lambda_p + sigma).
     sigma = previous->basis_values[2];
   } else {
-    // First mesh: rigid translation and rotation, then cosines cos(j pi x / L) as w_b.
-    const double length = mesh.nodes_m.back();
-    for (int e = 0; e < mesh.Elements(); ++e) {
-      int idx[kElementDofs];
-      ElementDofIndices(o.theory, e, idx);
-      for (int side = 0; side < 2; ++side) {
-        const double x = mesh.nodes_m[static_cast<std::size_t>(e + side)];
-        const int iw = idx[side == 0 ? 0 : 4], it = idx[side == 0 ? 1 : 5];
-        seed(iw, 0) = 1.0;
-        seed(iw, 1) = x - 0.5 * length;
-        seed(it, 1) = 1.0;
-        for (int j = 2; j < p; ++j) {
-          const double kj = (j - 1) * kPi / length;
-          seed(iw, j) = std::cos(kj * x);
-          seed(it, j) = -kj * std::sin(kj * x);
-        }
-      }
-    }
     // The shift: a uniform beam's first free-free mode with the bat's mean section.
     double ei = 0.0, rho_a = 0.0;
     constexpr int kProbes = 64;
@@ -160,12 +301,55 @@ bool SolveLevel(const Bat& bat, const BeamModesOptions& o, BeamMesh mesh, const 
       if (mii > 0.0) out->lambda_max = std::max(out->lambda_max, mats.stiffness.coeff(i, i) / mii);
     }
   }
+  // The rigid modes, M-orthonormal: translation (w_b = 1) and rotation about the centroid
+  // (w_b = x - C, theta = 1), both in K's null space.
+  Eigen::MatrixXd rigid = Eigen::MatrixXd::Zero(ndof, 2);
+  for (int e = 0; e < mesh.Elements(); ++e) {
+    int idx[kElementDofs];
+    ElementDofIndices(o.theory, e, idx);
+    rigid(idx[0], 0) = rigid(idx[4], 0) = 1.0;
+    rigid(idx[0], 1) = mesh.nodes_m[static_cast<std::size_t>(e)];
+    rigid(idx[4], 1) = mesh.nodes_m[static_cast<std::size_t>(e) + 1];
+    rigid(idx[1], 1) = rigid(idx[5], 1) = 1.0;
+  }
+  {
+    const Eigen::VectorXd mt = mats.mass * rigid.col(0);
+    const double mass = rigid.col(0).dot(mt);
+    rigid.col(1) -= (rigid.col(1).dot(mt) / mass) * rigid.col(0);
+    rigid.col(0) /= std::sqrt(mass);
+    rigid.col(1) /= std::sqrt(rigid.col(1).dot(mats.mass * rigid.col(1)));
+  }
   Eigen::VectorXd lambda;
   Eigen::MatrixXd vectors;
   std::string iteration_error;
-  if (!(std::isfinite(sigma) && sigma > 0.0) ||
-      !SubspaceIteration(mats.stiffness, mats.mass, wanted, sigma, seed, &lambda, &vectors,
-                         &out->iterations, &iteration_error)) {
+  // The fast path: shift-invert Lanczos from the sum of the seed's flexible columns, accepted
+  // when the Sturm count confirms that no mode below the last wanted one was missed.
+  bool solved = false;
+  if (std::isfinite(sigma) && sigma > 0.0) {
+    const Eigen::VectorXd start = seed.rightCols(p - 2).rowwise().sum();
+    Eigen::VectorXd flex_values;
+    Eigen::MatrixXd flex_vectors;
+    int steps = 0;
+    if (ShiftInvertLanczos(mats.stiffness, mats.mass, rigid, o.num_modes, p - wanted, sigma,
+                           start, &flex_values, &flex_vectors, &steps)) {
+      const double last = flex_values[o.num_modes - 1];
+      // Between the last wanted eigenvalue and the next Ritz value (an upper bound of the next
+      // eigenvalue), at most 5 % above the last: a missed mode below it changes the count.
+      const double next = flex_values.size() > o.num_modes ? flex_values[o.num_modes] : 2.0 * last;
+      const double mu = last + 0.5 * std::min(next - last, 0.1 * last);
+      if (next > last && ModesBelowCount(mats.stiffness, mats.mass, mu) == wanted) {
+        lambda.resize(flex_values.size() + 2);
+        lambda << 0.0, 0.0, flex_values;
+        vectors.resize(ndof, lambda.size());
+        vectors << rigid, flex_vectors;
+        out->iterations = steps;
+        solved = true;
+      }
+    }
+  }
+  if (!solved && (!(std::isfinite(sigma) && sigma > 0.0) ||
+                  !SubspaceIteration(mats.stiffness, mats.mass, wanted, sigma, seed, &lambda,
+                                     &vectors, &out->iterations, &iteration_error))) {
     if (ndof > kDenseMaxDofs) {
       *why =
           iteration_error.empty() ? "no usable shift for the subspace iteration" : iteration_error;
@@ -490,7 +674,8 @@ BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
       out.modes.push_back(std::move(mode));
     }
     s.iterations = static_cast<int>(levels.size());
-    // evaluations: eigen solves = 1 dense + the subspace iterations of the finer meshes.
+    // evaluations: the shift-invert steps of every mesh (Lanczos steps or subspace iterations; a
+    // dense solve counts 1).
     s.evaluations = 0;
     for (const Level& l : levels) s.evaluations += std::max(l.iterations, 1);
     s.error_estimate = out.max_relative_error;
