@@ -60,14 +60,19 @@ struct FlexibleSystem {
     out->peak_shear_n = std::max(out->peak_shear_n, std::abs(v));
     out->peak_moment_n_m = std::max(out->peak_moment_n_m, std::abs(mo));
   }
-  // The hands' loads at the quarter points and the end of each step.
+  // The hands' loads at the end and the quarter points of each step, backwards: the end first,
+  // where the step's last right-hand side left the force's warm start (one Newton iteration),
+  // then each point from its neighbour a quarter step away. The warm start is put back for the
+  // next step's stages, which start at the end.
   void OnStep(const DenseStep<State>& step) {
     if (!hands_loads) return;
-    for (int j = 1; j < 4; ++j) {
+    SampleHands(*step.y_end);
+    const double force_at_end = rhs->last_force;
+    for (int j = 3; j >= 1; --j) {
       step.StateAt(step.t_start + (step.t_end - step.t_start) * j / 4.0, &sample);
       SampleHands(sample);
     }
-    SampleHands(*step.y_end);
+    rhs->last_force = force_at_end;
   }
   EventAction OnEvent(int id, double /*t*/, const State& ye) {
     if (id == kEnd) return EventAction::kStop;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <utility>
 
 #include <boost/math/tools/minima.hpp>
 #include <boost/math/tools/roots.hpp>
@@ -10,6 +11,83 @@
 #include "core/geometry_format.hpp"
 
 namespace sweetspot::core {
+
+namespace {
+
+// Brent's minimisation (parabolic steps safeguarded by golden sections; R. P. Brent,
+// "Algorithms for Minimization without Derivatives", 1973, ch. 5) of f on [a, b], started from
+// three points already evaluated: x (the lowest, inside), w and v (the other two, lowest
+// first). The first step is the parabola through them, not a golden section: the sweep's
+// samples around its minimum are such a triple. Stops when the bracket's half-width around x
+// is below x_tolerance_m (then the minimiser of a unimodal f is within x_tolerance_m of x) or
+// after max_evaluations; returns x and f(x) with the evaluations made in *evaluations.
+template <class F>
+std::pair<double, double> StingBrentFromTriple(F&& f, double a, double b, double x, double fx,
+                                               double w, double fw, double v, double fv,
+                                               double x_tolerance_m, int max_evaluations,
+                                               int* evaluations) {
+  constexpr double kGolden = 0.3819660112501051;  // (3 - sqrt(5)) / 2
+  const double tol1 = 0.5 * x_tolerance_m;
+  // The last two steps (Brent's e and d), as if both were the whole bracket: the first two
+  // steps may then be parabolic (a zero d would force a golden section on the second).
+  double d = b - a, e = b - a;
+  *evaluations = 0;
+  while (*evaluations < max_evaluations) {
+    const double mid = 0.5 * (a + b);
+    if (std::abs(x - mid) <= 2.0 * tol1 - 0.5 * (b - a)) break;
+    bool golden = true;
+    if (std::abs(e) > tol1) {
+      // The parabola through (v, w, x); its vertex x + p / q.
+      double r = (x - w) * (fx - fv);
+      double q = (x - v) * (fx - fw);
+      double p = (x - v) * q - (x - w) * r;
+      q = 2.0 * (q - r);
+      if (q > 0.0) p = -p;
+      q = std::abs(q);
+      const double e_prev = e;
+      e = d;
+      // Accept it when it falls inside the bracket and moves less than half the step before
+      // last (otherwise it may not converge).
+      if (std::abs(p) < std::abs(0.5 * q * e_prev) && p > q * (a - x) && p < q * (b - x)) {
+        d = p / q;
+        const double u = x + d;
+        if (u - a < 2.0 * tol1 || b - u < 2.0 * tol1) d = mid >= x ? tol1 : -tol1;
+        golden = false;
+      }
+    }
+    if (golden) {
+      e = x >= mid ? a - x : b - x;
+      d = kGolden * e;
+    }
+    // Never a step below tol1: two evaluations closer than that tell nothing apart.
+    const double u = std::abs(d) >= tol1 ? x + d : x + (d > 0.0 ? tol1 : -tol1);
+    const double fu = f(u);
+    ++*evaluations;
+    if (fu <= fx) {
+      (u >= x ? a : b) = x;
+      v = w;
+      fv = fw;
+      w = x;
+      fw = fx;
+      x = u;
+      fx = fu;
+    } else {
+      (u < x ? a : b) = u;
+      if (fu <= fw || w == x) {
+        v = w;
+        fv = fw;
+        w = u;
+        fw = fu;
+      } else if (fu <= fv || v == x || v == w) {
+        v = u;
+        fv = fu;
+      }
+    }
+  }
+  return {x, fx};
+}
+
+}  // namespace
 
 bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob_m, int samples,
                     double fraction, double x_tolerance_m, std::vector<std::string>* warnings,
@@ -58,16 +136,28 @@ bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob
   const std::size_t i_min =
       static_cast<std::size_t>(std::min_element(es.begin(), es.end()) - es.begin());
   out->max_hands_energy_j = *std::max_element(es.begin(), es.end());
-  // Refine the minimum between the neighbouring samples (Brent to x_tolerance_m: boost's
-  // tolerance is relative to |x|, and 2 tol (|x| + 1/4) bounds its final half-bracket).
+  // Refine the minimum between the neighbouring samples by Brent's method to x_tolerance_m,
+  // started from the three samples around it (their parabola is the first step). At an end
+  // of the sweep there is no such triple: boost's Brent on [end, neighbour] (its tolerance is
+  // relative to |x|, and 2 tol (|x| + 1/4) bounds its final half-bracket).
   auto energy = [&](double s) { return impact(s, StingRun::kSearch).hands_vibration_energy_j; };
-  const double rel = x_tolerance_m / (2.0 * (std::max(std::abs(lo), std::abs(hi)) + 0.25));
-  const int bits = static_cast<int>(std::floor(1.0 - std::log2(rel)));
   const double a = xs[i_min == 0 ? 0 : i_min - 1];
   const double b = xs[std::min(i_min + 1, xs.size() - 1)];
   double x_min = xs[i_min], e_min = es[i_min];
   double err_x = 0.5 * (b - a);
-  if (b > a) {
+  if (i_min > 0 && i_min + 1 < xs.size()) {
+    const std::size_t lo_i = i_min - 1, hi_i = i_min + 1;
+    const std::size_t w_i = es[lo_i] <= es[hi_i] ? lo_i : hi_i;
+    const std::size_t v_i = w_i == lo_i ? hi_i : lo_i;
+    int evaluations = 0;
+    const auto m = StingBrentFromTriple(energy, a, b, x_min, e_min, xs[w_i], es[w_i], xs[v_i],
+                                        es[v_i], x_tolerance_m, 60, &evaluations);
+    if (failed) return false;
+    x_min = m.first;
+    e_min = m.second;
+  } else if (b > a) {
+    const double rel = x_tolerance_m / (2.0 * (std::max(std::abs(lo), std::abs(hi)) + 0.25));
+    const int bits = static_cast<int>(std::floor(1.0 - std::log2(rel)));
     boost::uintmax_t iters = 60;
     const auto m = boost::math::tools::brent_find_minima(energy, a, b, bits, iters);
     if (failed) return false;
@@ -108,7 +198,10 @@ bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob
         const double inside =
             j == static_cast<long>(i_min) ? x_min : xs[static_cast<std::size_t>(j)];
         const double outside = xs[static_cast<std::size_t>(next)];
-        const double ga = g(inside);
+        // The energy inside is known: the minimum's, or a sample's (the same impact; the
+        // samples compute the hands' loads besides, which do not change the energy).
+        const double ga = (j == static_cast<long>(i_min) ? e_min : es[static_cast<std::size_t>(j)]) -
+                          out->threshold_j;
         const double gb = es[static_cast<std::size_t>(next)] - out->threshold_j;
         if (failed || !(ga <= 0.0)) return inside;
         boost::uintmax_t iters = 60;
