@@ -50,34 +50,45 @@ void FreeHandsPeaks(const Rhs& rhs, const State& y, double window, double dtau, 
   if (!(window > 0.0) || !(dtau > 0.0)) return;
   // Clamp in double before the cast (no overflow for any ratio).
   const long samples = static_cast<long>(std::min(std::ceil(window / dtau), 2e6));
-  std::vector<double> c(static_cast<std::size_t>(n), 1.0), s(static_cast<std::size_t>(n), 0.0),
-      cd(static_cast<std::size_t>(n)), sd(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) {
-    const double om = md.omega_hat[static_cast<std::size_t>(k)];
-    cd[static_cast<std::size_t>(k)] = std::cos(om * dtau);
-    sd[static_cast<std::size_t>(k)] = std::sin(om * dtau);
-  }
+  // In free motion q_k = q0 cos(om t) + qd0 / om sin(om t) and the hands' loads are sums of
+  // -scale om^2 q_k weighted by S_k and T_k: per flexible mode, shear = a_k c_k + b_k s_k and
+  // moment = am_k c_k + bm_k s_k with (c_k, s_k) = (cos, sin)(om_k t) by rotation recurrences
+  // (the rigid modes do not accelerate in free motion and are left out).
   const double scale = rhs.delta_s * std::sqrt(rhs.m) / (rhs.t_s * rhs.t_s);
+  std::vector<double> c, s, cd, sd, a, b, am, bm;
+  for (int k = 0; k < n; ++k) {
+    const std::size_t ks = static_cast<std::size_t>(k);
+    const double om = md.omega_hat[ks];
+    if (om == 0.0) continue;
+    const double q0 = y[static_cast<std::size_t>(rhs.Q(k))];
+    const double qd0 = y[static_cast<std::size_t>(rhs.QD(k))];
+    const double acc_c = -scale * om * om * q0, acc_s = -scale * om * qd0;
+    c.push_back(1.0);
+    s.push_back(0.0);
+    cd.push_back(std::cos(om * dtau));
+    sd.push_back(std::sin(om * dtau));
+    a.push_back(md.shear[ks] * acc_c);
+    b.push_back(md.shear[ks] * acc_s);
+    am.push_back(md.moment[ks] * acc_c);
+    bm.push_back(md.moment[ks] * acc_s);
+  }
+  const std::size_t nf = c.size();
+  double peak_v = run->peak_shear_n, peak_mo = run->peak_moment_n_m;
   for (long i = 1; i <= samples; ++i) {
     double v = 0.0, mo = 0.0;
-    for (int k = 0; k < n; ++k) {
-      const std::size_t ks = static_cast<std::size_t>(k);
-      const double cn = c[ks] * cd[ks] - s[ks] * sd[ks];
-      const double sn = s[ks] * cd[ks] + c[ks] * sd[ks];
-      c[ks] = cn;
-      s[ks] = sn;
-      const double om = md.omega_hat[ks];
-      if (om == 0.0) continue;  // rigid modes do not accelerate in free motion
-      const double q0 = y[static_cast<std::size_t>(rhs.Q(k))];
-      const double qd0 = y[static_cast<std::size_t>(rhs.QD(k))];
-      const double q = q0 * cn + qd0 / om * sn;
-      const double acc = -scale * om * om * q;
-      v += md.shear[ks] * acc;
-      mo += md.moment[ks] * acc;
+    for (std::size_t k = 0; k < nf; ++k) {
+      const double cn = c[k] * cd[k] - s[k] * sd[k];
+      const double sn = s[k] * cd[k] + c[k] * sd[k];
+      c[k] = cn;
+      s[k] = sn;
+      v += a[k] * cn + b[k] * sn;
+      mo += am[k] * cn + bm[k] * sn;
     }
-    run->peak_shear_n = std::max(run->peak_shear_n, std::abs(v));
-    run->peak_moment_n_m = std::max(run->peak_moment_n_m, std::abs(mo));
+    peak_v = std::max(peak_v, std::abs(v));
+    peak_mo = std::max(peak_mo, std::abs(mo));
   }
+  run->peak_shear_n = peak_v;
+  run->peak_moment_n_m = peak_mo;
 }
 
 // The first time (scaled, > 0) the free motion from y closes the gap again, or a negative value.

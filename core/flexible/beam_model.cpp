@@ -195,8 +195,15 @@ int BeamDofCount(BeamTheory theory, int elements) {
   return theory == BeamTheory::kEulerBernoulli ? 2 * elements + 2 : 4 * elements + 2;
 }
 
-BeamMatrices AssembleBeam(const Bat& bat, const BeamMesh& mesh, BeamTheory theory,
-                          bool rotary_inertia) {
+namespace {
+
+// AssembleBeam's loop. With `mass` null, M is not assembled; instead *mass_t and *mass_r0 (if
+// non-null) get M t and M r0 for the rigid translation t (w = 1) and rotation about the knob
+// r0 (w = x, theta = 1): the consistent loads of the mass distribution, integrated directly.
+void AssembleBeamParts(const Bat& bat, const BeamMesh& mesh, BeamTheory theory,
+                       bool rotary_inertia, Eigen::SparseMatrix<double>* stiffness,
+                       Eigen::SparseMatrix<double>* mass, Eigen::VectorXd* mass_t,
+                       Eigen::VectorXd* mass_r0) {
   const int ne = mesh.Elements();
   const int ndof = BeamDofCount(theory, ne);
   const bool timoshenko = theory == BeamTheory::kTimoshenko;
@@ -205,13 +212,16 @@ BeamMatrices AssembleBeam(const Bat& bat, const BeamMesh& mesh, BeamTheory theor
   using Vector7 = Eigen::Matrix<double, kElementDofs, 1>;
   std::vector<Eigen::Triplet<double>> kt, mt;
   kt.reserve(static_cast<std::size_t>(ne) * 49);
-  mt.reserve(static_cast<std::size_t>(ne) * 49);
+  if (mass != nullptr) mt.reserve(static_cast<std::size_t>(ne) * 49);
+  if (mass_t != nullptr) *mass_t = Eigen::VectorXd::Zero(ndof);
+  if (mass_r0 != nullptr) *mass_r0 = Eigen::VectorXd::Zero(ndof);
   for (int e = 0; e < ne; ++e) {
     const double a = mesh.nodes_m[static_cast<std::size_t>(e)];
     const double b = mesh.nodes_m[static_cast<std::size_t>(e) + 1];
     const double h = b - a;
     Matrix7 ke = Matrix7::Zero();
     Matrix7 me = Matrix7::Zero();
+    Vector7 te = Vector7::Zero(), re = Vector7::Zero();
     IntegratePiecewise(a, b, mesh.breakpoints_m, [&](double x, double wgt) {
       const BeamSection s = SectionAt(bat, x);
       ElementShape n = EvaluateElementShape(h, (x - a) / h);
@@ -221,25 +231,51 @@ BeamMatrices AssembleBeam(const Bat& bat, const BeamMesh& mesh, BeamTheory theor
       const Eigen::Map<const Vector7> nw(n.w), nt(n.theta), cv(n.curvature), sh(n.shear);
       ke.noalias() += (wgt * s.bending_stiffness_n_m2) * (cv * cv.transpose());
       if (timoshenko) ke.noalias() += (wgt * s.shear_stiffness_n) * (sh * sh.transpose());
-      me.noalias() += (wgt * s.mass_per_length_kg_m) * (nw * nw.transpose());
-      if (rotary) me.noalias() += (wgt * s.rotary_inertia_kg_m) * (nt * nt.transpose());
+      if (mass != nullptr) {
+        me.noalias() += (wgt * s.mass_per_length_kg_m) * (nw * nw.transpose());
+        if (rotary) me.noalias() += (wgt * s.rotary_inertia_kg_m) * (nt * nt.transpose());
+      } else {
+        te.noalias() += (wgt * s.mass_per_length_kg_m) * nw;
+        re.noalias() += (wgt * s.mass_per_length_kg_m * x) * nw;
+        if (rotary) re.noalias() += (wgt * s.rotary_inertia_kg_m) * nt;
+      }
     });
     int idx[kElementDofs];
     ElementDofIndices(theory, e, idx);
     for (int i = 0; i < kElementDofs; ++i) {
       if (idx[i] < 0) continue;
+      if (mass_t != nullptr) (*mass_t)[idx[i]] += te[i];
+      if (mass_r0 != nullptr) (*mass_r0)[idx[i]] += re[i];
       for (int j = 0; j < kElementDofs; ++j) {
         if (idx[j] < 0) continue;
         if (ke(i, j) != 0.0) kt.emplace_back(idx[i], idx[j], ke(i, j));
-        if (me(i, j) != 0.0) mt.emplace_back(idx[i], idx[j], me(i, j));
+        if (mass != nullptr && me(i, j) != 0.0) mt.emplace_back(idx[i], idx[j], me(i, j));
       }
     }
   }
+  stiffness->resize(ndof, ndof);
+  stiffness->setFromTriplets(kt.begin(), kt.end());
+  if (mass != nullptr) {
+    mass->resize(ndof, ndof);
+    mass->setFromTriplets(mt.begin(), mt.end());
+  }
+}
+
+}  // namespace
+
+BeamMatrices AssembleBeam(const Bat& bat, const BeamMesh& mesh, BeamTheory theory,
+                          bool rotary_inertia) {
   BeamMatrices out;
-  out.stiffness.resize(ndof, ndof);
-  out.mass.resize(ndof, ndof);
-  out.stiffness.setFromTriplets(kt.begin(), kt.end());
-  out.mass.setFromTriplets(mt.begin(), mt.end());
+  AssembleBeamParts(bat, mesh, theory, rotary_inertia, &out.stiffness, &out.mass, nullptr,
+                    nullptr);
+  return out;
+}
+
+BeamStiffnessAndInertia AssembleBeamStiffnessAndInertia(const Bat& bat, const BeamMesh& mesh,
+                                                        BeamTheory theory, bool rotary_inertia) {
+  BeamStiffnessAndInertia out;
+  AssembleBeamParts(bat, mesh, theory, rotary_inertia, &out.stiffness, nullptr,
+                    &out.mass_times_translation, &out.mass_times_rotation);
   return out;
 }
 

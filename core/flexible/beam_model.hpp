@@ -114,6 +114,19 @@ struct BeamMatrices {
 BeamMatrices AssembleBeam(const Bat& bat, const BeamMesh& mesh, BeamTheory theory,
                           bool rotary_inertia);
 
+/// K and, instead of M, its products with the two rigid motions: what a static solve under
+/// inertia relief needs of M (core/flexible/static_flexibility.hpp), without assembling it.
+struct BeamStiffnessAndInertia {
+  Eigen::SparseMatrix<double> stiffness;   ///< K, as AssembleBeam's.
+  Eigen::VectorXd mass_times_translation;  ///< M t, t the translation w = 1 (kg per DOF unit).
+  /// M r0, r0 the rotation about the knob w = x, theta = 1 (kg m per DOF unit).
+  Eigen::VectorXd mass_times_rotation;
+};
+
+/// K of `bat` on `mesh` with M t and M r0 (see BeamStiffnessAndInertia), integrated directly.
+BeamStiffnessAndInertia AssembleBeamStiffnessAndInertia(const Bat& bat, const BeamMesh& mesh,
+                                                        BeamTheory theory, bool rotary_inertia);
+
 /// Shape functions of one element of length h at xi in [0, 1], per local DOF.
 struct ElementShape {
   double w[kElementDofs];          ///< Total displacement w = w_b + w_s.

@@ -2,6 +2,7 @@
 #include "core/flexible/static_flexibility.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <limits>
 #include <vector>
@@ -43,7 +44,9 @@ double InertiaReliefFlexibility(const Bat& bat, const BatModes& modes, double x_
   on_mesh.mass_kg = modes.mass_kg;
   on_mesh.balance_point_m = modes.balance_point_m;
   on_mesh.moi_centroid_kg_m2 = modes.moi_centroid_kg_m2;
-  const BeamMatrices mats = AssembleBeam(bat, mesh, modes.theory, modes.rotary_inertia);
+  // K and the products of M with the rigid modes (M itself is not needed).
+  const BeamStiffnessAndInertia mats =
+      AssembleBeamStiffnessAndInertia(bat, mesh, modes.theory, modes.rotary_inertia);
   const int ne = mesh.Elements();
   const Eigen::Index n = mats.stiffness.rows();
   // The load: a unit force at x, as consistent nodal loads (the displacement shape functions).
@@ -63,8 +66,13 @@ double InertiaReliefFlexibility(const Bat& bat, const BatModes& modes, double x_
   }
   const Eigen::VectorXd t = on_mesh.TranslationMode();
   const Eigen::VectorXd r = on_mesh.RotationMode();
+  // M t and M r: t = t0 / sqrt(mass), r = (r0 - C t0) / sqrt(I_cm).
+  const Eigen::VectorXd mt = mats.mass_times_translation / std::sqrt(modes.mass_kg);
+  const Eigen::VectorXd mr =
+      (mats.mass_times_rotation - modes.balance_point_m * mats.mass_times_translation) /
+      std::sqrt(modes.moi_centroid_kg_m2);
   // Inertia relief: the rigid body's inertia forces balance the load.
-  const Eigen::VectorXd f_bal = f - mats.mass * t * t.dot(f) - mats.mass * r * r.dot(f);
+  const Eigen::VectorXd f_bal = f - mt * t.dot(f) - mr * r.dot(f);
   // Hold w_b at both ends (the balanced load has no reactions there), then remove the
   // rigid-body part of the deflection.
   const Eigen::Index first = 0;
@@ -85,7 +93,7 @@ double InertiaReliefFlexibility(const Bat& bat, const BatModes& modes, double x_
       ldlt(k);
   if (ldlt.info() != Eigen::Success) return std::numeric_limits<double>::quiet_NaN();
   Eigen::VectorXd u = ldlt.solve(rhs);
-  u -= t * t.dot(mats.mass * u) + r * r.dot(mats.mass * u);
+  u -= t * mt.dot(u) + r * mr.dot(u);
   return f.dot(u);
 }
 

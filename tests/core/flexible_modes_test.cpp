@@ -429,6 +429,30 @@ TEST(FlexibleModes, LanczosMatchesTheFormerSubspaceIteration) {
   }
 }
 
+TEST(FlexibleModes, StiffnessAndInertiaAreAssembleBeamsKAndMTimesTheRigidMotions) {
+  for (BeamTheory theory : {BeamTheory::kEulerBernoulli, BeamTheory::kTimoshenko}) {
+    const Bat bat = FindPreset("wood-34-ash")->bat;
+    const BeamMesh mesh = MakeBeamMesh(bat, 20, 0);
+    const BeamMatrices full = AssembleBeam(bat, mesh, theory, true);
+    const BeamStiffnessAndInertia part = AssembleBeamStiffnessAndInertia(bat, mesh, theory, true);
+    EXPECT_EQ((Eigen::MatrixXd(full.stiffness) - Eigen::MatrixXd(part.stiffness)).norm(), 0.0);
+    // t: w_b = 1; r0: w_b = x, theta = 1 (the shear DOFs 0).
+    Eigen::VectorXd t = Eigen::VectorXd::Zero(full.mass.rows()), r0 = t;
+    for (int e = 0; e < mesh.Elements(); ++e) {
+      int idx[kElementDofs];
+      ElementDofIndices(theory, e, idx);
+      t[idx[0]] = t[idx[4]] = 1.0;
+      r0[idx[0]] = mesh.nodes_m[static_cast<std::size_t>(e)];
+      r0[idx[4]] = mesh.nodes_m[static_cast<std::size_t>(e) + 1];
+      r0[idx[1]] = r0[idx[5]] = 1.0;
+    }
+    // The same integrals summed in another order: rounding only (1e-14 of the norm).
+    const Eigen::VectorXd mt = full.mass * t, mr = full.mass * r0;
+    EXPECT_LE((part.mass_times_translation - mt).norm(), 1e-14 * mt.norm());
+    EXPECT_LE((part.mass_times_rotation - mr).norm(), 1e-14 * mr.norm());
+  }
+}
+
 TEST(FlexibleModes, MeshHasNodesAtKnotsAndTheFillAndMergesATinyStep) {
   Bat bat = FindPreset("paper-wood")->bat;
   bat.fill = Fill{*FindMaterial("cork"), 0.0254, 0.254};
