@@ -359,12 +359,15 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     out.residual_compliance_m_n = full.residual_compliance;
     const bool rotary = modes.rotary_inertia;
     // The knob-side segment's inertia: only the hands' loads need it.
+    // Every mode's field at a quadrature point, the element's shapes evaluated once.
+    std::vector<BeamField> fields(static_cast<std::size_t>(n_all));
     if (o.hands_loads)
       IntegrateAlong(modes, 0.0, h, [&](double x, double wgt) {
         const BeamSection sec = SectionAt(bat, x);
+        EvaluateFields(modes.theory, modes.nodes_m, vecs, x, fields.data());
         for (int k = 0; k < n_all; ++k) {
           const std::size_t ks = static_cast<std::size_t>(k);
-          const BeamField f = EvaluateField(modes.theory, modes.nodes_m, vecs[ks], x);
+          const BeamField& f = fields[ks];
           const double w = f.bending_m + f.shear_m;
           full.shear[ks] += wgt * sec.mass_per_length_kg_m * w;
           full.moment[ks] += wgt * (sec.mass_per_length_kg_m * w * (x - h) +
@@ -375,9 +378,10 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     const double g_hi = std::min(length, h + 0.5 * o.hands_grip_length_m);
     IntegrateAlong(modes, g_lo, g_hi, [&](double x, double wgt) {
       const BeamSection sec = SectionAt(bat, x);
+      EvaluateFields(modes.theory, modes.nodes_m, vecs, x, fields.data());
       for (int k = 2; k < n_all; ++k) {
         const std::size_t ks = static_cast<std::size_t>(k);
-        const BeamField f = EvaluateField(modes.theory, modes.nodes_m, vecs[ks], x);
+        const BeamField& f = fields[ks];
         const double w = f.bending_m + f.shear_m;
         full.grip[ks] += wgt * (sec.mass_per_length_kg_m * w * w +
                                 (rotary ? sec.rotary_inertia_kg_m * f.rotation * f.rotation : 0.0));

@@ -316,6 +316,30 @@ BeamField EvaluateField(BeamTheory theory, const std::vector<double>& nodes_m,
   return f;
 }
 
+void EvaluateFields(BeamTheory theory, const std::vector<double>& nodes_m,
+                    const std::vector<Eigen::VectorXd>& vs, double x_m, BeamField* out) {
+  int e = 0;
+  double xi = 0.0;
+  LocateInMesh(nodes_m, x_m, &e, &xi);
+  const double h = nodes_m[static_cast<std::size_t>(e) + 1] - nodes_m[static_cast<std::size_t>(e)];
+  const ElementShape s = EvaluateElementShape(h, xi);
+  int idx[kElementDofs];
+  ElementDofIndices(theory, e, idx);
+  for (std::size_t k = 0; k < vs.size(); ++k) {
+    const Eigen::VectorXd& v = vs[k];
+    BeamField f;
+    for (int i : {0, 1, 4, 5}) {
+      const double d = v[idx[i]];
+      f.bending_m += s.w[i] * d;
+      f.rotation += s.theta[i] * d;
+    }
+    for (int i : {2, 3, 6}) {
+      if (idx[i] >= 0) f.shear_m += s.w[i] * v[idx[i]];
+    }
+    out[k] = f;
+  }
+}
+
 Eigen::VectorXd ProlongField(BeamTheory theory, const std::vector<double>& coarse_nodes_m,
                              const Eigen::VectorXd& coarse,
                              const std::vector<double>& fine_nodes_m) {

@@ -149,6 +149,11 @@ struct BeamField {
 BeamField EvaluateField(BeamTheory theory, const std::vector<double>& nodes_m,
                         const Eigen::VectorXd& v, double x_m);
 
+/// EvaluateField of every vector of `vs` at x into out[0..vs.size()) (the same values; the
+/// element is located and its shape functions evaluated once for all of them).
+void EvaluateFields(BeamTheory theory, const std::vector<double>& nodes_m,
+                    const std::vector<Eigen::VectorXd>& vs, double x_m, BeamField* out);
+
 /// The DOF vector on the nested fine mesh `fine_nodes_m` that represents exactly the field of
 /// `coarse` on `coarse_nodes_m` (every coarse element is a union of fine ones).
 Eigen::VectorXd ProlongField(BeamTheory theory, const std::vector<double>& coarse_nodes_m,

@@ -453,6 +453,26 @@ TEST(FlexibleModes, StiffnessAndInertiaAreAssembleBeamsKAndMTimesTheRigidMotions
   }
 }
 
+TEST(FlexibleModes, EvaluateFieldsIsEvaluateFieldForEveryVector) {
+  const Bat bat = FindPreset("wood-34-ash")->bat;
+  BeamModesOptions o;
+  o.num_modes = 4;
+  const BatModes m = ComputeBatModes(bat, o);
+  std::vector<Eigen::VectorXd> vs;
+  for (const BeamMode& mode : m.modes) vs.push_back(mode.vector);
+  std::vector<BeamField> fields(vs.size());
+  for (double x : {0.0, 0.1234, m.nodes_m[5], 0.7, m.length_m}) {
+    EvaluateFields(m.theory, m.nodes_m, vs, x, fields.data());
+    for (std::size_t k = 0; k < vs.size(); ++k) {
+      const BeamField f = EvaluateField(m.theory, m.nodes_m, vs[k], x);
+      // The same operations in the same order: equal, not just close.
+      EXPECT_EQ(fields[k].bending_m, f.bending_m) << x << " " << k;
+      EXPECT_EQ(fields[k].rotation, f.rotation) << x << " " << k;
+      EXPECT_EQ(fields[k].shear_m, f.shear_m) << x << " " << k;
+    }
+  }
+}
+
 TEST(FlexibleModes, MeshHasNodesAtKnotsAndTheFillAndMergesATinyStep) {
   Bat bat = FindPreset("paper-wood")->bat;
   bat.fill = Fill{*FindMaterial("cork"), 0.0254, 0.254};
