@@ -145,6 +145,9 @@ std::optional<DesignBinder> DesignBinder::Compile(const Json& base,
       return std::nullopt;  // not bound here: the JSON path
     }
     if (pattern.rfind("bat.", 0) == 0) binder.bat_swept_ = true;
+    if (pattern.rfind("bat.material.", 0) == 0 || pattern.rfind("bat.fill.", 0) == 0) {
+      binder.materials_swept_ = true;
+    }
     binder.bindings_.push_back(binding);
   }
   if (!binder.bat_swept_) {
@@ -244,7 +247,11 @@ bool DesignBinder::Bind(const std::vector<double>& values, core::Scene* scene) c
   }
   // A scene output validates the scene itself (EvaluateScene, Bat::Validate among it); a
   // design it refuses is not feasible, and the engine gives it the JSON path's row.
-  if (!scene->outputs.empty()) return !bat_swept_ || bat.ValidateCaps(nullptr);
+  // The caps of the template's materials and fill hold unless one of their numbers is swept.
+  if (!scene->outputs.empty()) {
+    return !bat_swept_ ||
+           (materials_swept_ ? bat.ValidateCaps(nullptr) : bat.ValidateKnotCaps(nullptr));
+  }
   if (bat_swept_ && !bat.ValidateSize(nullptr)) return false;
   core::Scene check = *scene;
   check.outputs = {core::SceneOutput::kMaxExitSpeed};

@@ -67,7 +67,8 @@ class DesignBinder {
   std::vector<Binding> bindings_;
   core::Scene scene_;
   std::optional<core::ThreeSegmentShape> shape_;  // the template's, when one is swept
-  bool bat_swept_ = false;
+  bool bat_swept_ = false;        // some parameter changes the bat
+  bool materials_swept_ = false;  // some parameter is a number of the material or the fill
 };
 
 /// A validated sweep: everything needed to evaluate its designs, owned, so a streamed answer

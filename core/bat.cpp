@@ -213,7 +213,7 @@ bool Bat::Validate(Refusal* why) const {
 
 bool Bat::ValidateSize(Refusal* why) const { return Validate(why) && ValidateCaps(why); }
 
-bool Bat::ValidateCaps(Refusal* why) const {
+bool Bat::ValidateKnotCaps(Refusal* why) const {
   for (std::size_t i = 0; i < knots.size(); ++i) {
     if (knots[i].x_m > kMaxBatLengthM) {
       return why == nullptr ? false
@@ -227,6 +227,11 @@ bool Bat::ValidateCaps(Refusal* why) const {
                                 kMaxBatRadiusM, /*lo_open=*/true);
     }
   }
+  return true;
+}
+
+bool Bat::ValidateCaps(Refusal* why) const {
+  if (!ValidateKnotCaps(why)) return false;
   // Validate holds the wall below the smallest radius and the fill no deeper than the bat: the
   // caps on the radii and the length hold them too.
   if (!CheckMaterialSize(material, "material.", why)) return false;

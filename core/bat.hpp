@@ -123,6 +123,9 @@ struct Bat {
   /// The caps of ValidateSize alone (ValidateSize = Validate, then this): for a bat that
   /// Validate checks elsewhere.
   bool ValidateCaps(Refusal* refusal) const;
+  /// The caps on the knots alone (x and radius), the first check of ValidateCaps: for a bat
+  /// whose material, wall and fill are known to pass theirs.
+  bool ValidateKnotCaps(Refusal* refusal) const;
   /// L, m (the last knot's x; 0 without knots).
   double LengthM() const;
   /// Outer radius at x (from the knob), m; 0 outside [0, L].

@@ -339,7 +339,7 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
     }
     if (messages.empty()) {
       s.message = "computed";
-      for (SceneOutput o : wanted) s.message += std::string(" ") + SceneOutputName(o);
+      for (SceneOutput o : wanted) s.message.append(" ").append(SceneOutputName(o));
     } else {
       for (size_t i = 0; i < messages.size(); ++i) s.message += (i ? "; " : "") + messages[i];
     }

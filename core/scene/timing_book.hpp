@@ -30,7 +30,7 @@ class TimingBook {
   /// A book that reads the clock (`timed`, the default) or one that lists the models and their
   /// calls with 0 s and never reads it (a sweep that reports no timings: the clock is a tenth of
   /// a closed-form design's time).
-  explicit TimingBook(bool timed = true) : timed_(timed) {}
+  explicit TimingBook(bool timed = true) : timed_(timed) { timings_.reserve(4); }
   /// Now, or the epoch when not timed.
   std::chrono::steady_clock::time_point Now() const {
     return timed_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
@@ -59,6 +59,7 @@ class TimingBook {
   /// The models used, in first-use order (a result's models_used).
   std::vector<std::string> Models() const {
     std::vector<std::string> out;
+    out.reserve(timings_.size());
     for (const auto& t : timings_) out.push_back(t.model);
     return out;
   }
