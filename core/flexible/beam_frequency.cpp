@@ -14,6 +14,7 @@
 #include <Eigen/SparseCore>
 
 #include "core/mass_properties.hpp"
+#include "core/numerics/gauss_legendre.hpp"
 #include "core/numerics/jet.hpp"
 #include "core/units.hpp"
 
@@ -21,13 +22,6 @@ namespace sweetspot::core {
 namespace beam_frequency_detail {
 namespace {
 
-// 5-point Gauss-Legendre on [-1, 1] (as beam_model.cpp: exact to degree 9).
-constexpr std::array<double, 5> kQuadX = {
-    -0.9061798459386639927976269, -0.5384693101056830910363144, 0.0, 0.5384693101056830910363144,
-    0.9061798459386639927976269};
-constexpr std::array<double, 5> kQuadW = {0.2369268850561890875142640, 0.4786286704993664680412915,
-                                          0.5688888888888888888888889, 0.4786286704993664680412915,
-                                          0.2369268850561890875142640};
 
 // The local parameters of one knot segment: its two knot positions and radii, L, the wall, the
 // density, the fill's diameter, depth and density.
@@ -216,14 +210,14 @@ void VisitQuadrature(const FixedMeshBeam& b, const std::vector<double>& t, Visit
                     p.length;
       const T half = 0.5 * (hi.x - lo.x);
       const T ds = hi.s - lo.s;
-      for (std::size_t g = 0; g < kQuadX.size(); ++g) {
-        const double u = 0.5 * (1.0 + kQuadX[g]);
+      for (std::size_t g = 0; g < kGauss5X.size(); ++g) {
+        const double u = 0.5 * (1.0 + kGauss5X[g]);
         const T x = lo.x + (2.0 * u) * half;
         const T s = lo.s + u * ds;
         const T r = p.ra + (p.rb - p.ra) * s;
         const Section<T> sec = SectionOf(b, r, in_fill, p, fill_density_v);
         const Shape<T> shape = ShapeOf(h_e, (x - a_e) / h_e);
-        visit(i, e, shape, sec, half * kQuadW[g]);
+        visit(i, e, shape, sec, half * kGauss5W[g]);
       }
     }
   }

@@ -5,18 +5,12 @@
 #include <array>
 #include <cmath>
 
+#include "core/numerics/gauss_legendre.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
 namespace {
 
-// 5-point Gauss-Legendre on [-1, 1]: exact for polynomials of degree <= 9.
-constexpr std::array<double, 5> kGaussX = {
-    -0.9061798459386639927976269, -0.5384693101056830910363144, 0.0, 0.5384693101056830910363144,
-    0.9061798459386639927976269};
-constexpr std::array<double, 5> kGaussW = {0.2369268850561890875142640, 0.4786286704993664680412915,
-                                           0.5688888888888888888888889, 0.4786286704993664680412915,
-                                           0.2369268850561890875142640};
 
 // The pieces of [a, b] between the breakpoints strictly inside it.
 std::vector<double> PiecesOf(double a, double b, const std::vector<double>& breakpoints) {
@@ -38,7 +32,9 @@ void IntegratePiecewise(double a, double b, const std::vector<double>& breakpoin
     const double half = 0.5 * (hi - lo);
     const double mid = 0.5 * (hi + lo);
     if (!(half > 0.0)) continue;
-    for (std::size_t g = 0; g < kGaussX.size(); ++g) f(mid + half * kGaussX[g], half * kGaussW[g]);
+    for (std::size_t g = 0; g < kGauss5X.size(); ++g) {
+      f(mid + half * kGauss5X[g], half * kGauss5W[g]);
+    }
   }
 }
 
@@ -295,15 +291,9 @@ void LocateInMesh(const std::vector<double>& nodes, double x, int* element, doub
 
 }  // namespace
 
-BeamField EvaluateField(BeamTheory theory, const std::vector<double>& nodes_m,
-                        const Eigen::VectorXd& v, double x_m) {
-  int e = 0;
-  double xi = 0.0;
-  LocateInMesh(nodes_m, x_m, &e, &xi);
-  const double h = nodes_m[static_cast<std::size_t>(e) + 1] - nodes_m[static_cast<std::size_t>(e)];
-  const ElementShape s = EvaluateElementShape(h, xi);
-  int idx[kElementDofs];
-  ElementDofIndices(theory, e, idx);
+namespace {
+// The field of nodal vector `v` at a point of element `idx` with shape values `s`.
+BeamField FieldAt(const ElementShape& s, const int (&idx)[kElementDofs], const Eigen::VectorXd& v) {
   BeamField f;
   for (int i : {0, 1, 4, 5}) {
     const double d = v[idx[i]];
@@ -315,6 +305,19 @@ BeamField EvaluateField(BeamTheory theory, const std::vector<double>& nodes_m,
   }
   return f;
 }
+}  // namespace
+
+BeamField EvaluateField(BeamTheory theory, const std::vector<double>& nodes_m,
+                        const Eigen::VectorXd& v, double x_m) {
+  int e = 0;
+  double xi = 0.0;
+  LocateInMesh(nodes_m, x_m, &e, &xi);
+  const double h = nodes_m[static_cast<std::size_t>(e) + 1] - nodes_m[static_cast<std::size_t>(e)];
+  const ElementShape s = EvaluateElementShape(h, xi);
+  int idx[kElementDofs];
+  ElementDofIndices(theory, e, idx);
+  return FieldAt(s, idx, v);
+}
 
 void EvaluateFields(BeamTheory theory, const std::vector<double>& nodes_m,
                     const std::vector<Eigen::VectorXd>& vs, double x_m, BeamField* out) {
@@ -325,19 +328,7 @@ void EvaluateFields(BeamTheory theory, const std::vector<double>& nodes_m,
   const ElementShape s = EvaluateElementShape(h, xi);
   int idx[kElementDofs];
   ElementDofIndices(theory, e, idx);
-  for (std::size_t k = 0; k < vs.size(); ++k) {
-    const Eigen::VectorXd& v = vs[k];
-    BeamField f;
-    for (int i : {0, 1, 4, 5}) {
-      const double d = v[idx[i]];
-      f.bending_m += s.w[i] * d;
-      f.rotation += s.theta[i] * d;
-    }
-    for (int i : {2, 3, 6}) {
-      if (idx[i] >= 0) f.shear_m += s.w[i] * v[idx[i]];
-    }
-    out[k] = f;
-  }
+  for (std::size_t k = 0; k < vs.size(); ++k) out[k] = FieldAt(s, idx, vs[k]);
 }
 
 Eigen::VectorXd ProlongField(BeamTheory theory, const std::vector<double>& coarse_nodes_m,
