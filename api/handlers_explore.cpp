@@ -24,10 +24,6 @@ namespace {
 
 using Json = nlohmann::json;
 
-double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 // The error a swept field gives because the design's parser does not know it (a misspelt
 // last key, "profile.knots[3].radius"): every design would fail alike, so the sweep is
 // refused before its first design. `probe` is the valid template with only that field set;
