@@ -36,8 +36,16 @@ bool ValidateDesignScene(const core::Scene& scene, ApiError* error) {
 }
 
 void ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
-                   const core::SceneOptions& options, DesignOutcome* out_ptr,
+                   const core::SceneOptions& options, DesignOutcome* out,
                    std::vector<core::ModelTiming>* timings) {
+  core::SceneEvaluator evaluator(options);
+  ComputeDesign(scene, outputs, &evaluator, out, timings);
+}
+
+void ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
+                   core::SceneEvaluator* evaluator, DesignOutcome* out_ptr,
+                   std::vector<core::ModelTiming>* timings) {
+  const core::SceneOptions& options = evaluator->options();
   DesignOutcome& out = *out_ptr;
   out.feasible = false;
   out.error = nullptr;
@@ -48,7 +56,7 @@ void ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
     if (timings != nullptr) *timings = book.TakeTimings();
   };
   if (!scene.outputs.empty()) {
-    result = core::EvaluateScene(scene, options);
+    evaluator->Evaluate(scene, &result);
     if (timings != nullptr) {
       for (const auto& t : result.timings) book.Add(t.model, t.time_s, t.calls);
     }
@@ -63,7 +71,7 @@ void ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
       return;
     }
   } else {
-    result = core::SceneResult{};
+    result.Reset();
     if (scene.mass_properties) {
       result.mass_properties = *scene.mass_properties;
     } else {

@@ -49,6 +49,11 @@ bool ValidateDesignScene(const core::Scene& scene, ApiError* error);
 void ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
                    const core::SceneOptions& options, DesignOutcome* out,
                    std::vector<core::ModelTiming>* timings = nullptr);
+/// ComputeDesign with `evaluator`'s options, its scene results written over *out's (a sweep's
+/// worker: the options validated once, the result's buffers reused design after design).
+void ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
+                   core::SceneEvaluator* evaluator, DesignOutcome* out,
+                   std::vector<core::ModelTiming>* timings = nullptr);
 
 /// The row of an outcome: {"feasible": false, "error"} or {"feasible": true, outputs...}.
 nlohmann::json RenderDesignRow(const DesignOutcome& outcome, const RowOutputs& outputs);

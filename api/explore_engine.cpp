@@ -243,7 +243,7 @@ bool DesignBinder::Bind(const std::vector<double>& values, core::Scene* scene) c
   // The JSON path's checks, in its order (ParseBatGeometry, then the scene's).
   if (shape) {
     if (!shape->ValidateSize(nullptr)) return false;
-    bat.knots = shape->Knots();
+    shape->KnotsInto(&bat.knots);
   }
   // A scene output validates the scene itself (EvaluateScene, Bat::Validate among it); a
   // design it refuses is not feasible, and the engine gives it the JSON path's row.
@@ -560,6 +560,7 @@ struct Worker {
   std::optional<core::Scene> scene;  // the binder's scene, bound design after design
   std::vector<double> point;
   DesignOutcome outcome;  // the last bound design's, refilled design after design
+  std::optional<core::SceneEvaluator> evaluator;  // the sweep's options, validated once
   // Full rows of bound designs: the first feasible row, kept as a template whose leaves are
   // overwritten design after design (no JSON tree built per row), when every leaf is a value
   // the engine reads directly.
@@ -695,7 +696,8 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
     if (!worker->scene) worker->scene = sweep.binder->base_scene();
     if (sweep.binder->Bind(point, &*worker->scene)) {
       DesignOutcome& outcome = worker->outcome;
-      ComputeDesign(*worker->scene, sweep.outputs, sweep.options, &outcome);
+      if (!worker->evaluator) worker->evaluator.emplace(sweep.options);
+      ComputeDesign(*worker->scene, sweep.outputs, &*worker->evaluator, &outcome);
       if (outcome.feasible && !plan.direct && plan.columns->empty() &&
           plan.format != RowFormat::kCsv) {
         if (worker->row_template && FillTemplate(plan, i, point, outcome, worker, out)) return;

@@ -87,17 +87,33 @@ bool ThreeSegmentShape::ValidateSize(Refusal* why) const {
 }
 
 std::vector<ProfileKnot> ThreeSegmentShape::Knots() const {
+  std::vector<ProfileKnot> out;
+  out.reserve(4);
+  KnotsInto(&out);
+  return out;
+}
+
+void ThreeSegmentShape::KnotsInto(std::vector<ProfileKnot>* knots) const {
+  std::vector<ProfileKnot>& out = *knots;
+  out.clear();
   const double length = length_m;
   const double r1 = handle_radius_m;
   const double r2 = barrel_radius_m;
   double x1 = taper_start_m;
   double x2 = taper_end_m;
-  std::vector<ProfileKnot> out;
-  out.reserve(4);
   if (x1 == x2) {
-    if (x1 <= 0.0) return {{0.0, r2}, {length, r2}};     // all barrel
-    if (x1 >= length) return {{0.0, r1}, {length, r1}};  // all handle
-    if (r1 == r2) return {{0.0, r1}, {x1, r1}, {length, r1}};
+    if (x1 <= 0.0) {  // all barrel
+      out.assign({{0.0, r2}, {length, r2}});
+      return;
+    }
+    if (x1 >= length) {  // all handle
+      out.assign({{0.0, r1}, {length, r1}});
+      return;
+    }
+    if (r1 == r2) {
+      out.assign({{0.0, r1}, {x1, r1}, {length, r1}});
+      return;
+    }
     // A zero-length taper is a step: two knots a tiny distance apart.
     const double half_width = 0.5 * kStepWidth * length;
     x1 = std::max(x1 - half_width, 0.0);
@@ -107,7 +123,6 @@ std::vector<ProfileKnot> ThreeSegmentShape::Knots() const {
   if (x1 > 0.0) out.push_back({x1, r1});
   out.push_back({x2, r2});
   if (x2 < length) out.push_back({length, r2});
-  return out;
 }
 
 bool Bat::IsValid(std::string* why) const {

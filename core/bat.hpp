@@ -76,6 +76,8 @@ struct ThreeSegmentShape {
   /// x1 = x2 = L: the bat is all barrel or all handle; 0 < x1 = x2 < L with
   /// r1 != r2: a step of width L * kStepWidth). 2 to 4 knots.
   std::vector<ProfileKnot> Knots() const;
+  /// Knots() into *knots (its buffer reused: a sweep's designs).
+  void KnotsInto(std::vector<ProfileKnot>* knots) const;
 };
 
 /// A cylinder bored from the barrel end along the axis and filled.

@@ -28,6 +28,27 @@ void Summary::SetRefusal(Refusal why) {
   refusal = std::move(why);
 }
 
+void Summary::Reset() {
+  // A field added to Summary must be reset here too: on x86-64 (the size this list was
+  // written for) the size check says so.
+#if defined(__x86_64__)
+  static_assert(sizeof(Summary) == 280, "Summary gained a field: reset it in Summary::Reset");
+#endif
+  termination = Termination::kInvalidInput;
+  message.clear();
+  backend.clear();
+  raw_status = 0;
+  iterations = -1;
+  evaluations = -1;
+  objective = 0.0;
+  constraint_violation = 0.0;
+  error_estimate = 0.0;
+  solve_time_s = -1.0;
+  models_used.clear();
+  warnings.clear();
+  refusal.reset();
+}
+
 std::string InternalErrorMessage() {
   try {
     throw;

@@ -47,6 +47,10 @@ struct Summary {
   /// refusal kept as data.
   void SetRefusal(Refusal why);
 
+  /// Every field as a default-constructed summary has it, the strings and vectors keeping
+  /// their buffers.
+  void Reset();
+
   /// True when the result may be used (converged, or no_convergence with a kept point).
   bool IsSolutionUsable() const {
     return termination == Termination::kConverged || termination == Termination::kNoConvergence;

@@ -102,15 +102,60 @@ std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model
   return {};
 }
 
+void SceneResult::Reset() {
+  // A field added to SceneResult must be reset here too: on x86-64 (the size this list was
+  // written for) the size check says so.
+#if defined(__x86_64__)
+  static_assert(sizeof(SceneResult) == 1744, "SceneResult gained a field: reset it in Reset");
+#endif
+  summary.Reset();
+  missing_model.clear();
+  refused_field.clear();
+  cor.reset();
+  cor_source.clear();
+  mass_properties = MassProperties{};
+  length_m = 0.0;
+  exit_speed_model.clear();
+  model_reason.clear();
+  max_exit_speed.reset();
+  center_of_percussion.reset();
+  sweet_zone.reset();
+  exit_speed_curve.reset();
+  vibration_node.reset();
+  least_sting_zone.reset();
+  timings.clear();
+}
+
+SceneEvaluator::SceneEvaluator(SceneOptions options) : options_(std::move(options)) {
+  if (Refusal refusal; !options_.Validate(&refusal)) options_refusal_ = std::move(refusal);
+  wanted_.reserve(8);
+}
+
 SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
+  SceneResult out;
+  SceneEvaluator(options).Evaluate(scene, &out);
+  return out;
+}
+
+void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
+  // TimedRequest's frame ("scene"), over the previous result's buffers.
+  const SceneOptions& options = options_;
   const bool timed = options.time_models;
-  return TimedRequest<SceneResult>("scene", timed, [&](SceneResult& out, TimingBook& book) {
-    Summary& s = out.summary;
-    if (Refusal refusal; !options.Validate(&refusal)) {
-      s.SetRefusal(std::move(refusal));
+  const auto t0 =
+      timed ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
+  SceneResult& out = *out_ptr;
+  out.Reset();
+  book_.Reset(timed);
+  TimingBook& book = book_;
+  Summary& s = out.summary;
+  s.backend = "scene";
+  CatchInternalError(&s, [&] {
+    if (options_refusal_.has_value()) {
+      s.SetRefusal(*options_refusal_);
       return;
     }
-    std::vector<SceneOutput> wanted;
+    std::vector<SceneOutput>& wanted = wanted_;
+    wanted.clear();
     for (SceneOutput o : scene.outputs) {
       if (std::find(wanted.begin(), wanted.end(), o) == wanted.end()) wanted.push_back(o);
     }
@@ -352,6 +397,9 @@ SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options) {
     }
     s.error_estimate = worst_err;
   });
+  if (timed) s.solve_time_s = SecondsSince(t0);
+  book.ModelsInto(&s.models_used);
+  out.timings.assign(book.timings().begin(), book.timings().end());
 }
 
 }  // namespace sweetspot::core

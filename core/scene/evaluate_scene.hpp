@@ -40,9 +40,33 @@ struct SceneResult {
   std::optional<VibrationNodeResult> vibration_node;             ///< vibration_node.
   std::optional<LeastStingZoneResult> least_sting_zone;          ///< least_sting_zone.
   std::vector<ModelTiming> timings;  ///< Time per model, in first-use order.
+
+  /// Every field as a default-constructed result has it, the strings and vectors keeping their
+  /// buffers (a sweep writes each design's result over the previous one's).
+  void Reset();
 };
 
-/// Computes the requested outputs. Never throws.
+/// Evaluates scenes with one set of options, validated once: a sweep's designs. Each result is
+/// written over the previous one, reusing its buffers, so a closed-form design allocates
+/// little. Not thread-safe: one per thread.
+class SceneEvaluator {
+ public:
+  /// An evaluator of scenes under `options` (validated here, once).
+  explicit SceneEvaluator(SceneOptions options);
+  /// What EvaluateScene(scene, options()) returns, into *out (every field set again; what a
+  /// previous call left there is reused as buffers only). Never throws.
+  void Evaluate(const Scene& scene, SceneResult* out);
+  /// The options every evaluation uses.
+  const SceneOptions& options() const { return options_; }
+
+ private:
+  SceneOptions options_;
+  std::optional<Refusal> options_refusal_;  // set when the options are invalid
+  TimingBook book_;
+  std::vector<SceneOutput> wanted_;  // the scene's outputs without duplicates (scratch)
+};
+
+/// Computes the requested outputs (SceneEvaluator(options).Evaluate). Never throws.
 SceneResult EvaluateScene(const Scene& scene, const SceneOptions& options);
 
 }  // namespace sweetspot::core

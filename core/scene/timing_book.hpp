@@ -30,7 +30,7 @@ class TimingBook {
   /// A book that reads the clock (`timed`, the default) or one that lists the models and their
   /// calls with 0 s and never reads it (a sweep that reports no timings: the clock is a tenth of
   /// a closed-form design's time).
-  explicit TimingBook(bool timed = true) : timed_(timed) { timings_.reserve(4); }
+  explicit TimingBook(bool timed = true) : timed_(timed) {}
   /// Now, or the epoch when not timed.
   std::chrono::steady_clock::time_point Now() const {
     return timed_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
@@ -56,6 +56,16 @@ class TimingBook {
   const std::vector<ModelTiming>& timings() const { return timings_; }
   /// The timings, moved out (the book is left empty).
   std::vector<ModelTiming> TakeTimings() { return std::move(timings_); }
+  /// Forgets every model, keeping the buffers; `timed` as the constructor's.
+  void Reset(bool timed) {
+    timings_.clear();
+    timed_ = timed;
+  }
+  /// The models used, in first-use order, into *out (its buffers reused).
+  void ModelsInto(std::vector<std::string>* out) const {
+    out->resize(timings_.size());
+    for (std::size_t i = 0; i < timings_.size(); ++i) (*out)[i] = timings_[i].model;
+  }
   /// The models used, in first-use order (a result's models_used).
   std::vector<std::string> Models() const {
     std::vector<std::string> out;

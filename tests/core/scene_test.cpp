@@ -4,6 +4,7 @@
 #include "core/scene/evaluate_scene.hpp"
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -364,6 +365,79 @@ TEST(SceneThreads, ManySolvesOnManyThreadsGiveIdenticalResults) {
   }
   for (auto& th : threads) th.join();
   for (int m : mismatches) EXPECT_EQ(m, 0);
+}
+
+// What a result says, field by field (its numbers to the bit): a reused result must say exactly
+// what a fresh one does.
+std::string Describe(const SceneResult& r) {
+  std::ostringstream o;
+  o.precision(17);
+  const Summary& s = r.summary;
+  o << TerminationName(s.termination) << '|' << s.message << '|' << s.backend << '|'
+    << s.raw_status << '|' << s.iterations << '|' << s.evaluations << '|' << s.objective << '|'
+    << s.constraint_violation << '|' << s.error_estimate << '|' << s.refusal.has_value() << '|';
+  for (const auto& m : s.models_used) o << m << ',';
+  for (const auto& w : s.warnings) o << w << ',';
+  o << '|' << r.missing_model << '|' << r.refused_field << '|' << r.cor.value_or(-1) << '|'
+    << r.cor_source << '|' << r.mass_properties.mass_kg << '|' << r.mass_properties.balance_point_m
+    << '|' << r.length_m << '|' << r.exit_speed_model << '|' << r.model_reason << '|';
+  if (r.max_exit_speed) {
+    o << "max " << r.max_exit_speed->position_from_knob_m << ' '
+      << r.max_exit_speed->exit_speed_mps << ' ' << r.max_exit_speed->model << ' '
+      << r.max_exit_speed->method << ' ' << r.max_exit_speed->summary.message;
+  }
+  if (r.center_of_percussion) o << "|cop " << r.center_of_percussion->position_from_knob_m;
+  if (r.sweet_zone) o << "|zone " << r.sweet_zone->to_knob_m;
+  if (r.exit_speed_curve) o << "|curve " << r.exit_speed_curve->points.size();
+  if (r.vibration_node) o << "|node";
+  if (r.least_sting_zone) o << "|sting";
+  for (const auto& t : r.timings) o << '|' << t.model << ' ' << t.calls;
+  return o.str();
+}
+
+TEST(SceneEvaluatorReuse, EachResultEqualsAFreshEvaluation) {
+  // One evaluator, one result written over again and again, through scenes that fill
+  // different fields (every output, a refusal, a missing bat, an exit speed only): each
+  // must equal EvaluateScene's fresh result, so nothing of a previous design survives.
+  SceneOptions o;
+  o.time_models = false;  // timings are 0 s and comparable
+  SceneEvaluator evaluator(o);
+  SceneResult reused;
+  Scene all = PaperWood({SceneOutput::kMaxExitSpeed, SceneOutput::kSweetZone,
+                         SceneOutput::kCenterOfPercussion, SceneOutput::kExitSpeedCurve});
+  Scene refused = PaperWood();
+  refused.ball.speed_mps = -3;
+  Scene no_bat = PaperWood({SceneOutput::kCenterOfPercussion});
+  no_bat.mass_properties = ComputeMassProperties(*no_bat.bat);
+  no_bat.bat.reset();
+  Scene cop_beyond = PaperWood({SceneOutput::kCenterOfPercussion});
+  cop_beyond.swing.hands_from_knob_m = 0.5;  // a warning, and cop beyond the tip
+  Scene given_cor = PaperWood();
+  given_cor.cor = 0.45;
+  int compared = 0;
+  for (const Scene* scene : {&all, &refused, &all, &no_bat, &cop_beyond, &given_cor, &all,
+                             &refused, &given_cor}) {
+    evaluator.Evaluate(*scene, &reused);
+    EXPECT_EQ(Describe(reused), Describe(EvaluateScene(*scene, o))) << "scene " << compared;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 9);
+  // The scenes did differ: a refusal, a result with every output.
+  EXPECT_EQ(EvaluateScene(refused, o).summary.termination, Termination::kInvalidInput);
+  EXPECT_TRUE(EvaluateScene(all, o).sweet_zone.has_value());
+}
+
+TEST(SceneEvaluatorReuse, InvalidOptionsRefuseEveryScene) {
+  SceneOptions o;
+  o.curve_samples = 0;  // out of range
+  SceneEvaluator evaluator(o);
+  SceneResult r;
+  for (int i = 0; i < 2; ++i) {
+    evaluator.Evaluate(PaperWood(), &r);
+    EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
+    EXPECT_EQ(r.summary.message, EvaluateScene(PaperWood(), o).summary.message);
+    EXPECT_FALSE(r.max_exit_speed.has_value());
+  }
 }
 
 }  // namespace
