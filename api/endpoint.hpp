@@ -79,6 +79,10 @@ Response Answer(nlohmann::json out, const core::Summary* summary,
 
 }  // namespace endpoint_detail
 
+/// The answer of a request that passed validation under Context::validate_only:
+/// 200 {"valid": true}.
+inline Response ValidRequest() { return {200, nlohmann::json{{"valid", true}}}; }
+
 /// Parses `request`'s body as a JSON object and then with `parse` (the Endpoint::parse
 /// signature); on a refusal nullopt with the error's response in *failure. For handlers
 /// that keep their own flow after parsing (the streamed /v1/explore, /v1/jobs).
@@ -106,6 +110,7 @@ Response ServeEndpoint(const Endpoint<Req, Result>& endpoint, const Request& req
   ApiError error;
   const std::optional<Req> parsed = endpoint.parse(*body, context, &error);
   if (!parsed) return ToResponse(error);
+  if (context.validate_only) return ValidRequest();
   const Result result = endpoint.run(*parsed, context);
   if (endpoint.failure) {
     if (std::optional<Response> failed = endpoint.failure(*parsed, result)) {

@@ -41,11 +41,12 @@ Response HandleCompare(const Request& request, const Context& context);
 Response HandleOptimize(const Request& request, const Context& context);
 /// POST /v1/explore: design sweeps (501 until the optimisation issue lands).
 Response HandleExplore(const Request& request, const Context& context);
-/// POST /v1/jobs: run a long request as a job.
+/// POST /v1/jobs: run a long request as a job, once its endpoint's parser accepted it.
 Response HandleJobSubmit(const Request& request, const Context& context);
 /// GET /v1/jobs/{id}: a job's state and progress.
 Response HandleJobStatus(const Request& request, const Context& context);
-/// GET /v1/jobs: {"jobs": [...]}, every job the server keeps, oldest submitted first.
+/// GET /v1/jobs?state=&limit=&offset=: {"jobs": [...], "total", "next_offset"}, the jobs the
+/// server keeps, newest submitted first (api/job_service.hpp's JobListQuery); 400 for a bad query.
 Response HandleJobList(const Request& request, const Context& context);
 /// GET /v1/jobs/{id}/result: a finished job's result.
 Response HandleJobResult(const Request& request, const Context& context);

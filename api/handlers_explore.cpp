@@ -307,6 +307,7 @@ Response HandleExplore(const Request& request, const Context& context) {
   Response failure;
   const auto parsed = ParseRequest<ExploreRequest>(request, context, ParseExploreRequest, &failure);
   if (!parsed) return failure;
+  if (context.validate_only) return ValidRequest();
   // The sweep's timing_s, in its summary, counts from the request's arrival.
   const std::shared_ptr<Sweep>& sweep = parsed->sweep;
   sweep->start = start;

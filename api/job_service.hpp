@@ -16,8 +16,11 @@
 //                   are durations; negative for events before it started,
 //                   converted through the wall clock); null until the event happened,
 //    "created_at":  wall-clock submit time, ISO-8601 UTC ("2024-05-01T12:00:00.123Z"),
-//    "status":      the inner HTTP status once done or failed, else null,
-//    "error":       the failure's message once failed, else null,
+//    "status":      the inner HTTP status once done or failed (or cancelled
+//                   with a kept result), else null,
+//    "error":       once failed, the error object the inner request answered
+//                   ({"code", "message", "field"}, as the synchronous endpoint
+//                   returns it), else null,
 //    "cancel_requested": true once DELETE (or a shutdown without a store) asked
 //                   the job to stop,
 //    "resumes":     times the job was run again because the server running it died,
@@ -25,8 +28,10 @@
 //                   count eviction may drop it sooner), null while unfinished}
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "api/response.hpp"
@@ -37,10 +42,25 @@ namespace sweetspot::api {
 
 /// Runs one inner request. Called on a worker thread, concurrently with other
 /// calls (must be thread-safe). Long work polls progress->Cancelled() and
-/// returns soon after it turns true (its result is then discarded), and may
+/// returns soon after it turns true (a 2xx result is then kept with the
+/// cancelled job, anything else discarded), and may
 /// call progress->Report(fraction). A 2xx response makes the job done, any
 /// other status failed; an exception makes it failed with "internal error".
 using JobRunner = std::function<Response(const Request& inner, core::Progress* progress)>;
+
+/// GET /v1/jobs's query, validated by the handler (HandleJobList).
+struct JobListQuery {
+  std::optional<std::string> state;  ///< Only jobs in this state (one of the five); all if empty.
+  std::size_t limit = 100;           ///< Most jobs on the page (1..ApiLimits::max_jobs_page).
+  std::size_t offset = 0;            ///< Jobs skipped first, in the list's order (newest first).
+};
+
+/// A job's failure as the error object {"code", "message", "field"} of the
+/// contract's envelope: `body`'s code, message and field when it is one (the
+/// inner request's error answer), else {"code": InternalError for a status
+/// >= 500 or without one, else InvalidValue; "message": `message`; "field": null}
+/// (jobs stored before errors were objects kept only the message).
+nlohmann::json JobErrorObject(int status, const nlohmann::json& body, const std::string& message);
 
 /// Accepts, shows, lists, cancels and returns the results of jobs. Every call
 /// answers with a Response in the contract's envelope and never throws;
@@ -57,12 +77,17 @@ class JobService {
   /// 200 with the job's JSON; 404 "NotFound" for an unknown (or dropped) id.
   virtual Response Status(const std::string& id) const = 0;
 
-  /// GET /v1/jobs: 200 with {"jobs": [job JSON, ...]}, oldest submitted first.
-  virtual Response List() const = 0;
+  /// GET /v1/jobs: 200 with {"jobs": [job JSON, ...], "total": jobs matching the
+  /// filter, "next_offset": the offset of the next page, or null on the last}:
+  /// newest submitted first, `query.state` only if set, `query.limit` jobs from
+  /// `query.offset`.
+  virtual Response List(const JobListQuery& query) const = 0;
 
   /// The job's result. done or failed: the inner response verbatim (status,
   /// body, text, content type); a runner that threw gives 500 "InternalError".
-  /// queued or running: 409 "NotReady"; cancelled: 409 "Cancelled"; unknown: 404.
+  /// cancelled: the inner 2xx response when the runner still gave one (an
+  /// optimisation keeps its best design so far, termination no_convergence),
+  /// else 409 "Cancelled". queued or running: 409 "NotReady"; unknown: 404.
   virtual Response Result(const std::string& id) const = 0;
 
   /// DELETE. queued: cancelled at once, 200 with the job (state "cancelled").

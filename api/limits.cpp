@@ -19,7 +19,8 @@ bool ApiLimits::IsValid(std::string* why) const {
       {"max_knots", max_knots},                 {"max_variants", max_variants},
       {"max_curve_samples", max_curve_samples}, {"max_samples", max_samples},
       {"max_batch_samples", max_batch_samples},
-      {"max_design_variables", max_design_variables}};
+      {"max_design_variables", max_design_variables},
+      {"max_jobs_page", max_jobs_page}};
   for (const auto& [name, value] : sizes) {
     if (value < 1) return fail(std::string(name) + " = 0: must be at least 1");
   }

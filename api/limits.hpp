@@ -25,6 +25,8 @@ struct ApiLimits {
   int max_iterations = 10000;                  ///< Solver iterations a request may ask for.
   double max_time_s = 60.0;                    ///< Solver wall time a request may ask for, s.
   long long max_integration_steps = 10000000;  ///< ODE steps of one impact (hertz, flexible).
+  /// Jobs on one page of GET /v1/jobs (the largest `limit` a client may ask for).
+  std::size_t max_jobs_page = 1000;
 
   /// True when every limit is positive and sane; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;

@@ -74,7 +74,9 @@ const std::vector<Route>& Routes() {
        HandleExplore, true, RouteWorkload::kCompute},
       {"POST", "/v1/jobs", "Run a long request as a job: {\"path\", \"body\"} -> 202 with its id.",
        HandleJobSubmit},
-      {"GET", "/v1/jobs", "Every job the server keeps: {\"jobs\": [...]}, oldest first.",
+      {"GET", "/v1/jobs",
+       "The jobs the server keeps, newest first: {\"jobs\": [...], \"total\", \"next_offset\"} "
+       "(?state=, ?limit=, ?offset=).",
        HandleJobList},
       {"GET", "/v1/jobs/{id}", "A job's state and progress (0-1).", HandleJobStatus},
       {"GET", "/v1/jobs/{id}/result", "A finished job's result.", HandleJobResult},

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,6 +27,8 @@ struct Request {
   std::string method;  ///< "GET", "POST", "DELETE".
   std::string path;    ///< Path without query, e.g. "/v1/bat/properties".
   std::string body;    ///< Raw body (JSON for POST).
+  /// The query string's parameters, decoded (GET /v1/jobs?state=running); empty for most routes.
+  std::multimap<std::string, std::string> query{};
 };
 
 /// What handlers may use besides the request: limits, and what only a
@@ -45,6 +48,10 @@ struct Context {
   /// Where a sweep's threads beyond its first come from, without waiting (null: no bound).
   /// The server's is its compute pool's (server/connection_loop.hpp).
   ThreadBudget* thread_budget = nullptr;
+  /// True when only the request's validation runs (POST /v1/jobs checks a job's inner request
+  /// before queueing it): a typed endpoint answers its 4xx, or 200 {"valid": true} once its
+  /// body parsed, without calling core.
+  bool validate_only = false;
 };
 
 /// What answering a request costs, for the server's choice of worker pool.

@@ -238,6 +238,11 @@ const std::vector<Option>& Options() {
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->limits.max_variants, v, rule);
        }},
+      {"--max-jobs-page", "SWEETSPOT_MAX_JOBS_PAGE",
+       "jobs on one page of GET /v1/jobs: the largest `limit` (default 1000)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_jobs_page, v, rule);
+       }},
       {"--max-curve-samples", "SWEETSPOT_MAX_CURVE_SAMPLES",
        "points of an exit-speed curve (default 10000)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {

@@ -397,8 +397,8 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
       route = kStaticRoute;
       WriteStaticResponse(req, *impl_->static_files, res);
     } else {
-      api::Response response = api::Dispatch({req.method, req.path, req.body}, impl_->context,
-                                             &route, /*allow_stream=*/true);
+      api::Response response = api::Dispatch({req.method, req.path, req.body, req.params},
+                                             impl_->context, &route, /*allow_stream=*/true);
       internal_error = std::move(response.internal_error);
       WriteApiResponse(response, res);
     }

@@ -76,7 +76,7 @@ nlohmann::json JobJson(const JobView& job) {
       {"finished_s", OptionalSeconds(job.finished_s)},
       {"created_at", job.created_at},
       {"status", job.status ? nlohmann::json(*job.status) : nlohmann::json()},
-      {"error", job.error ? nlohmann::json(*job.error) : nlohmann::json()},
+      {"error", job.error ? *job.error : nlohmann::json()},
       {"cancel_requested", job.cancel_requested},
       {"resumes", job.resumes},
       {"expires_in_s", job.expires_in_s ? nlohmann::json(RoundedSeconds(std::max(0.0, *job.expires_in_s)))
@@ -137,6 +137,21 @@ std::string FailureMessage(const api::Response& response) {
     if (it != response.body.end() && it->is_string()) return it->get<std::string>();
   }
   return "the request failed with HTTP status " + std::to_string(response.status);
+}
+
+nlohmann::json FailureObject(const api::Response& response) {
+  return api::JobErrorObject(response.status, response.body, FailureMessage(response));
+}
+
+std::string StoredJobError(const nlohmann::json& error) { return SerializeJobBody(error); }
+
+nlohmann::json ReadStoredJobError(const std::string& stored, int status,
+                                  const nlohmann::json& body) {
+  if (!stored.empty() && stored.front() == '{') {
+    nlohmann::json parsed = nlohmann::json::parse(stored, nullptr, false);
+    if (parsed.is_object() && parsed.contains("code")) return parsed;
+  }
+  return api::JobErrorObject(status, body, stored);
 }
 
 std::mt19937_64 SeededEngine() {

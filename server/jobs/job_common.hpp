@@ -60,7 +60,7 @@ struct JobView {
   std::optional<double> finished_s;      ///< Finish, s since this process started.
   std::string created_at;                ///< Submit time, ISO-8601 UTC.
   std::optional<int> status;             ///< Inner status once done or failed.
-  std::optional<std::string> error;      ///< Failure message once failed.
+  std::optional<nlohmann::json> error;   ///< The error object once failed.
   bool cancel_requested = false;         ///< DELETE asked it to stop.
   int resumes = 0;                       ///< Times it was run again after its server died.
   std::optional<double> expires_in_s;    ///< Until a finished job is dropped, s.
@@ -89,6 +89,17 @@ std::string IsoUtc(std::chrono::system_clock::time_point time);
 std::string SerializeJobBody(const nlohmann::json& body);
 /// The failure's message of an inner response: its "message", else its status.
 std::string FailureMessage(const api::Response& response);
+/// The error object of a failed job whose inner response is `response`
+/// (api::JobErrorObject of its status, body and FailureMessage).
+nlohmann::json FailureObject(const api::Response& response);
+/// A failed job's error object as a store keeps it (compact JSON text).
+std::string StoredJobError(const nlohmann::json& error);
+/// A failed job's error object read back from a store: `stored` when it is an
+/// error object's JSON (rows written since errors are objects), else the bare
+/// message of an older row wrapped by api::JobErrorObject(status, body, stored)
+/// (`body`: the stored inner answer if at hand, else null).
+nlohmann::json ReadStoredJobError(const std::string& stored, int status,
+                                  const nlohmann::json& body = nullptr);
 /// An engine seeded from std::random_device with 256 bits.
 std::mt19937_64 SeededEngine();
 /// A new id: 32 lowercase hex digits (128 random bits).

@@ -21,6 +21,7 @@ using api::ToResponse;
 
 struct JobManager::Job {
   std::string id;                             // 32 hex digits.
+  std::uint64_t seq = 0;                      // Submit order (for the list's ties).
   std::string path;                           // The inner request's path.
   Request inner;                              // Cleared once the job is finished.
   State state = State::kQueued;               // Current state.
@@ -32,8 +33,9 @@ struct JobManager::Job {
   std::optional<Clock::time_point> started;   // When a worker took it.
   std::optional<Clock::time_point> finished;  // When it reached a final state.
   std::string created_at;                     // Submit time, ISO-8601 UTC.
-  Response result;                            // The inner response (done or failed).
-  std::string error;                          // The failure's message (failed).
+  Response result;                            // The inner response (done, failed, kept).
+  bool kept_result = false;                   // Cancelled, with the runner's 2xx in result.
+  nlohmann::json error;                       // The failure's error object (failed), else null.
 };
 
 JobManager::JobManager(JobConfig config, JobRunner runner, JobPersistence persistence)
@@ -100,6 +102,7 @@ Response JobManager::Submit(const Request& inner) {
                                  ""});
     }
     job->id = NewIdLocked();
+    job->seq = next_seq_++;
     job->created = now;
     // Saved before it is visible: a 202 means the job survives a restart. The
     // store's own message goes to the log, never to the client.
@@ -125,19 +128,27 @@ Response JobManager::Status(const std::string& id) const {
   return {200, ToJsonLocked(*job, now)};
 }
 
-Response JobManager::List() const {
+Response JobManager::List(const api::JobListQuery& query) const {
   std::lock_guard lock(mutex_);
   const Clock::time_point now = Clock::now();
   EvictLocked(now);
   std::vector<const Job*> all;
   all.reserve(jobs_.size());
-  for (const auto& [id, job] : jobs_) all.push_back(job.get());
-  std::stable_sort(all.begin(), all.end(), [](const Job* a, const Job* b) {
-    return a->created != b->created ? a->created < b->created : a->id < b->id;
+  for (const auto& [id, job] : jobs_) {
+    if (!query.state || *query.state == StateName(job->state)) all.push_back(job.get());
+  }
+  // Newest first; the submit order (seq) breaks ties of the clock.
+  std::sort(all.begin(), all.end(), [](const Job* a, const Job* b) {
+    return a->created != b->created ? a->created > b->created : a->seq > b->seq;
   });
   nlohmann::json list = nlohmann::json::array();
-  for (const Job* job : all) list.push_back(ToJsonLocked(*job, now));
-  return {200, nlohmann::json{{"jobs", std::move(list)}}};
+  const std::size_t from = std::min(query.offset, all.size());
+  const std::size_t to = from + std::min(query.limit, all.size() - from);
+  for (std::size_t i = from; i < to; ++i) list.push_back(ToJsonLocked(*all[i], now));
+  nlohmann::json next_offset = to < all.size() ? nlohmann::json(to) : nlohmann::json();
+  return {200, nlohmann::json{{"jobs", std::move(list)},
+                              {"total", all.size()},
+                              {"next_offset", std::move(next_offset)}}};
 }
 
 Response JobManager::Result(const std::string& id) const {
@@ -150,7 +161,7 @@ Response JobManager::Result(const std::string& id) const {
     case State::kFailed:
       return job->result;
     case State::kCancelled:
-      return JobWasCancelled(id);
+      return job->kept_result ? job->result : JobWasCancelled(id);
     case State::kQueued:
     case State::kRunning:
       break;
@@ -287,7 +298,12 @@ void JobManager::WorkerLoop() {
     idle_cv_.notify_all();
     const Clock::time_point now = Clock::now();
     if (job->cancel_requested) {
-      FinishLocked(*job, State::kCancelled, now);  // A cancelled job's result is discarded.
+      // A 2xx answer is kept (an optimisation's best design so far); anything else is dropped.
+      if (!threw && response.status >= 200 && response.status < 300) {
+        job->result = std::move(response);
+        job->kept_result = true;
+      }
+      FinishLocked(*job, State::kCancelled, now);
     } else if (job->interrupted) {
       // Shutdown cut it short: its result (if any) is discarded, and it is
       // queued again, saved for the next start, which runs it from the start.
@@ -297,14 +313,14 @@ void JobManager::WorkerLoop() {
       SaveLocked(*job);
       continue;
     } else if (threw) {
-      job->error = "internal error";
-      job->result = ToResponse(ApiError{500, api::ErrorCode::kInternalError, job->error, ""});
+      job->result = ToResponse(ApiError{500, api::ErrorCode::kInternalError, "internal error", ""});
+      job->error = FailureObject(job->result);
       FinishLocked(*job, State::kFailed, now);
     } else if (response.status >= 200 && response.status < 300) {
       job->result = std::move(response);
       FinishLocked(*job, State::kDone, now);
     } else {
-      job->error = FailureMessage(response);
+      job->error = FailureObject(response);
       job->result = std::move(response);
       FinishLocked(*job, State::kFailed, now);
     }
@@ -371,7 +387,9 @@ nlohmann::json JobManager::ToJsonLocked(const Job& job, Clock::time_point now) c
         config_.keep_results_s - std::chrono::duration<double>(now - *job.finished).count();
   }
   view.created_at = job.created_at;
-  if (job.state == State::kDone || job.state == State::kFailed) view.status = job.result.status;
+  if (job.state == State::kDone || job.state == State::kFailed || job.kept_result) {
+    view.status = job.result.status;
+  }
   if (job.state == State::kFailed) view.error = job.error;
   view.cancel_requested = job.cancel_requested;
   view.resumes = job.resumes;
@@ -403,7 +421,7 @@ JobRecord JobManager::RecordLocked(const Job& job) const {
   record.created_unix_s = ToUnixSeconds(job.created);
   if (job.started) record.started_unix_s = ToUnixSeconds(*job.started);
   if (job.finished) record.finished_unix_s = ToUnixSeconds(*job.finished);
-  if (job.state == State::kDone || job.state == State::kFailed) {
+  if (job.state == State::kDone || job.state == State::kFailed || job.kept_result) {
     record.status = job.result.status;
     if (job.result.content_type.empty()) {
       record.response_json = SerializeJobBody(job.result.body);
@@ -411,7 +429,7 @@ JobRecord JobManager::RecordLocked(const Job& job) const {
       record.response_text = job.result.text;
       record.content_type = job.result.content_type;
     }
-    record.error = job.error;
+    if (job.state == State::kFailed) record.error = StoredJobError(job.error);
   }
   return record;
 }
@@ -448,6 +466,7 @@ void JobManager::LoadFromStore() {
     bool changed = false;  // Its stored state must be rewritten.
     auto job = std::make_shared<Job>();
     job->id = record.id;
+    job->seq = next_seq_++;  // Records come oldest created first.
     job->path = record.path;
     job->inner = Request{record.method, record.path, std::move(record.body)};
     job->cancel_requested = record.cancel_requested;
@@ -456,10 +475,15 @@ void JobManager::LoadFromStore() {
     job->created_at = record.created_at;
     if (record.started_unix_s) job->started = FromUnixSeconds(*record.started_unix_s);
     if (record.finished_unix_s) job->finished = FromUnixSeconds(*record.finished_unix_s);
-    if (record.state == "done" || record.state == "failed") {
-      job->state = record.state == "done" ? State::kDone : State::kFailed;
+    // A cancelled job keeps the runner's 2xx answer when it gave one (status != 0).
+    const bool kept = record.state == "cancelled" && record.status != 0;
+    if (record.state == "done" || record.state == "failed" || kept) {
+      job->state = record.state == "done"     ? State::kDone
+                   : record.state == "failed" ? State::kFailed
+                                              : State::kCancelled;
+      job->kept_result = kept;
       job->progress.Report(record.progress);
-      job->error = record.error;
+      if (kept) job->progress.Cancel();
       if (!record.content_type.empty()) {
         job->result = Response::Text(record.status, std::move(record.response_text),
                                      std::move(record.content_type));
@@ -467,11 +491,17 @@ void JobManager::LoadFromStore() {
         nlohmann::json body = nlohmann::json::parse(record.response_json, nullptr, false);
         if (body.is_discarded()) {  // Only a damaged database gets here.
           job->state = State::kFailed;
-          job->error = "the stored result of this job could not be read";
-          body = ToResponse(ApiError{500, api::ErrorCode::kInternalError, job->error, ""}).body;
+          job->kept_result = false;
+          body = ToResponse(ApiError{500, api::ErrorCode::kInternalError,
+                                     "the stored result of this job could not be read", ""})
+                     .body;
           record.status = 500;
+          record.error.clear();
         }
         job->result = Response(record.status, std::move(body));
+      }
+      if (job->state == State::kFailed) {
+        job->error = ReadStoredJobError(record.error, record.status, job->result.body);
       }
     } else if (record.state == "cancelled") {
       job->state = State::kCancelled;
@@ -495,7 +525,9 @@ void JobManager::LoadFromStore() {
         job->state = State::kFailed;
         job->progress.Report(record.progress);
         job->finished = now;
-        job->result = JobInterrupted(job->resumes, config_.max_resumes, &job->error);
+        std::string message;
+        job->result = JobInterrupted(job->resumes, config_.max_resumes, &message);
+        job->error = FailureObject(job->result);
       }
       changed = true;
     } else {

@@ -19,6 +19,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <cstddef>
 #include <deque>
 #include <functional>
@@ -74,12 +75,16 @@ class JobManager final : public ServerJobService {
   /// 200 with the job's JSON; 404 "NotFound" for an unknown (or dropped) id.
   api::Response Status(const std::string& id) const override;
 
-  /// 200 with {"jobs": [...]}: every kept job, oldest submitted first.
-  api::Response List() const override;
+  /// 200 with {"jobs": [...], "total", "next_offset"}: the kept jobs in
+  /// query.state (all if unset), newest submitted first, query.limit of them
+  /// from query.offset (api::JobService::List).
+  api::Response List(const api::JobListQuery& query) const override;
 
   /// The job's result. done or failed: the inner response verbatim (status,
   /// body, text, content type); a runner that threw gives 500 "InternalError".
-  /// queued or running: 409 "NotReady"; cancelled: 409 "Cancelled"; unknown: 404.
+  /// cancelled: the runner's 2xx answer when it gave one after the cancel (an
+  /// optimisation's best design so far), else 409 "Cancelled".
+  /// queued or running: 409 "NotReady"; unknown: 404.
   api::Response Result(const std::string& id) const override;
 
   /// DELETE. queued: cancelled at once, 200 with the job (state "cancelled").
@@ -148,6 +153,7 @@ class JobManager final : public ServerJobService {
   bool stopping_ = false;                     // Set by Shutdown().
   bool grace_ended_ = false;                  // Set by EndGrace().
   std::mt19937_64 random_;                    // Id source, seeded from std::random_device.
+  std::uint64_t next_seq_ = 0;                // The next job's Job::seq.
 
   std::once_flag shutdown_once_;
   std::vector<std::thread> workers_;

@@ -398,8 +398,13 @@ JobView PostgresJobService::Impl::ViewOf(const PGresult* result, int row) const 
     view.finished_s = *finished - wall_start_unix_s;
     view.expires_in_s = config.keep_results_s - (db_now - *finished);
   }
-  if (view.state == "done" || view.state == "failed") view.status = std::atoi(PQgetvalue(result, row, 8));
-  if (view.state == "failed") view.error = Text(result, row, 9);
+  const int status = std::atoi(PQgetvalue(result, row, 8));
+  // A cancelled job shows its status when it kept the runner's 2xx answer.
+  if (view.state == "done" || view.state == "failed" ||
+      (view.state == "cancelled" && status >= 200 && status < 300)) {
+    view.status = status;
+  }
+  if (view.state == "failed") view.error = ReadStoredJobError(Text(result, row, 9), status);
   view.cancel_requested = Text(result, row, 10) == "t";
   view.resumes = std::atoi(PQgetvalue(result, row, 11));
   return view;
@@ -525,10 +530,31 @@ bool PostgresJobService::Impl::ClaimAndRun() {
   if (job->lost) {
     // Another replica runs it now: nothing of this run is kept.
   } else if (job->cancel_requested) {
+    // The runner's 2xx answer is kept (an optimisation's best design so far), unless it is
+    // over max_result_bytes; anything else is dropped (status 0).
+    std::string status = "0", json, text, content_type;
+    if (!threw && response.status >= 200 && response.status < 300) {
+      if (response.content_type.empty()) {
+        json = SerializeJobBody(response.body);
+      } else {
+        text = std::move(response.text);
+        content_type = response.content_type;
+      }
+      if (json.size() + text.size() <= config.max_result_bytes) {
+        status = std::to_string(response.status);
+      } else {
+        json.clear();
+        text.clear();
+        content_type.clear();
+      }
+    }
     finish.emplace("UPDATE sweetspot_jobs SET state = 'cancelled', progress = $3, body = '', "
+                   "status = $4, response_json = $5, response_text = $6, content_type = $7, "
                    "finished_unix_s = " SWEETSPOT_NOW
                    ", lease_owner = NULL, lease_expires_unix_s = NULL" + where,
-                   std::vector<Param>{job->id, owner, Decimal(job->progress.Fraction())});
+                   std::vector<Param>{job->id, owner, Decimal(job->progress.Fraction()),
+                                      std::move(status), std::move(json), std::move(text),
+                                      std::move(content_type)});
   } else if (job->interrupted) {
     // Back to the queue for another replica or the next start (no resume counted),
     // unless a DELETE arrived meanwhile.
@@ -547,11 +573,12 @@ bool PostgresJobService::Impl::ClaimAndRun() {
     std::string content_type;
     if (threw) {
       state = "failed";
-      error = "internal error";
-      response = api::ToResponse(api::ApiError{500, api::ErrorCode::kInternalError, error, ""});
+      response =
+          api::ToResponse(api::ApiError{500, api::ErrorCode::kInternalError, "internal error", ""});
+      error = StoredJobError(FailureObject(response));
     } else if (response.status < 200 || response.status >= 300) {
       state = "failed";
-      error = FailureMessage(response);
+      error = StoredJobError(FailureObject(response));
     }
     if (response.content_type.empty()) {
       json = SerializeJobBody(response.body);
@@ -562,11 +589,13 @@ bool PostgresJobService::Impl::ClaimAndRun() {
     const std::size_t size = json.size() + text.size();
     if (size > config.max_result_bytes) {
       state = "failed";
-      error = "the job's result is " + std::to_string(size) +
-              " bytes, more than the jobs database keeps (max_result_bytes = " +
-              std::to_string(config.max_result_bytes) +
-              "): ask for fewer rows or outputs, or raise --job-max-result-bytes";
-      response = api::ToResponse(api::ApiError{413, api::ErrorCode::kTooBig, error, ""});
+      const std::string message =
+          "the job's result is " + std::to_string(size) +
+          " bytes, more than the jobs database keeps (max_result_bytes = " +
+          std::to_string(config.max_result_bytes) +
+          "): ask for fewer rows or outputs, or raise --job-max-result-bytes";
+      response = api::ToResponse(api::ApiError{413, api::ErrorCode::kTooBig, message, ""});
+      error = StoredJobError(FailureObject(response));
       json = SerializeJobBody(response.body);
       text.clear();
       content_type.clear();
@@ -638,7 +667,8 @@ void PostgresJobService::Impl::Sweep() {
         " AND (cancel_requested OR resumes >= $1) FOR UPDATE SKIP LOCKED) "
         "UPDATE sweetspot_jobs j SET state = CASE WHEN j.cancel_requested THEN 'cancelled' ELSE "
         "'failed' END, status = CASE WHEN j.cancel_requested THEN 0 ELSE 503 END, error = CASE "
-        "WHEN j.cancel_requested THEN '' ELSE format($2, j.resumes) END, response_json = CASE "
+        "WHEN j.cancel_requested THEN '' ELSE json_build_object('code', 'Interrupted', "
+        "'message', format($2, j.resumes), 'field', NULL)::text END, response_json = CASE "
         "WHEN j.cancel_requested THEN '' ELSE json_build_object('code', 'Interrupted', "
         "'message', format($2, j.resumes), 'field', NULL)::text END, body = '', "
         "finished_unix_s = " SWEETSPOT_NOW
@@ -777,20 +807,37 @@ api::Response PostgresJobService::Status(const std::string& id) const {
   return {200, JobJson(self.ViewOf(found.get(), 0))};
 }
 
-api::Response PostgresJobService::List() const {
+api::Response PostgresJobService::List(const api::JobListQuery& query) const {
   const Impl& self = *impl_;
+  // The kept jobs ($1: keep_results_s) in state $2 (NULL: any), newest submitted first.
+  const std::string where =
+      " FROM sweetspot_jobs WHERE (finished_unix_s IS NULL OR finished_unix_s > " SWEETSPOT_NOW
+      " - $1) AND ($2::text IS NULL OR state = $2)";
+  const Param state = query.state ? Param(*query.state) : Param();
   PgResult found(nullptr, &PQclear);
-  if (!self.Query(std::string("SELECT ") + kViewColumns +
-                      " FROM sweetspot_jobs WHERE finished_unix_s IS NULL OR finished_unix_s > " SWEETSPOT_NOW
-                      " - $1 ORDER BY seq",
-                  {Decimal(self.config.keep_results_s)}, &found)) {
+  PgResult counted(nullptr, &PQclear);
+  if (!self.Query(std::string("SELECT ") + kViewColumns + where +
+                      " ORDER BY seq DESC LIMIT $3 OFFSET $4",
+                  {Decimal(self.config.keep_results_s), state, std::to_string(query.limit),
+                   std::to_string(query.offset)},
+                  &found) ||
+      !self.Query("SELECT count(*)" + where, {Decimal(self.config.keep_results_s), state},
+                  &counted)) {
     return Unavailable();
   }
   nlohmann::json jobs = nlohmann::json::array();
   for (int row = 0; row < PQntuples(found.get()); ++row) {
     jobs.push_back(JobJson(self.ViewOf(found.get(), row)));
   }
-  return {200, nlohmann::json{{"jobs", std::move(jobs)}}};
+  // The count runs after the page: jobs submitted in between only raise it.
+  const std::size_t total = std::max<std::size_t>(
+      std::strtoull(PQgetvalue(counted.get(), 0, 0), nullptr, 10), query.offset + jobs.size());
+  const std::size_t next = query.offset + jobs.size();
+  nlohmann::json next_offset =
+      next < total && !jobs.empty() ? nlohmann::json(next) : nlohmann::json();
+  return {200, nlohmann::json{{"jobs", std::move(jobs)},
+                              {"total", total},
+                              {"next_offset", std::move(next_offset)}}};
 }
 
 api::Response PostgresJobService::Result(const std::string& id) const {
@@ -804,9 +851,10 @@ api::Response PostgresJobService::Result(const std::string& id) const {
   }
   if (PQntuples(found.get()) == 0) return JobNotFound(id);
   const std::string state = Text(found.get(), 0, 0);
-  if (state == "cancelled") return JobWasCancelled(id);
-  if (state != "done" && state != "failed") return JobNotReady(id, state);
   const int status = std::atoi(PQgetvalue(found.get(), 0, 1));
+  // A cancelled job has a result only when it kept the runner's 2xx answer.
+  if (state == "cancelled" && (status < 200 || status >= 300)) return JobWasCancelled(id);
+  if (state != "done" && state != "failed" && state != "cancelled") return JobNotReady(id, state);
   const std::string content_type = Text(found.get(), 0, 4);
   if (!content_type.empty()) {
     return api::Response::Text(status, Text(found.get(), 0, 3), content_type);

@@ -69,7 +69,8 @@ class PostgresJobService final : public ServerJobService {
   /// See api::JobService; 503 Unavailable when the database cannot be reached.
   api::Response Submit(const api::Request& inner) override;
   api::Response Status(const std::string& id) const override;
-  api::Response List() const override;
+  /// Newest submitted first (by the database's submit order), filtered and paged in SQL.
+  api::Response List(const api::JobListQuery& query) const override;
   api::Response Result(const std::string& id) const override;
   api::Response Cancel(const std::string& id) override;
   std::map<std::string, int> CountsByState() const override;

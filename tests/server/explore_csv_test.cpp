@@ -252,7 +252,8 @@ TEST(ExploreCsvEndToEndTest, ExploreThreadsChangeNothingButTheThreads) {
 }
 
 // A job runs a sweep as a batch: over --max-samples but within --max-batch-samples, it is
-// done while the same request is refused; over --max-batch-samples, the job fails with 413.
+// done while the same request is refused; over --max-batch-samples, POST /v1/jobs answers
+// 413 at once and makes no job.
 TEST(ExploreCsvEndToEndTest, AJobHasTheBatchLimit) {
   ServerConfig config;
   config.limits.max_samples = 10;
@@ -291,11 +292,16 @@ TEST(ExploreCsvEndToEndTest, AJobHasTheBatchLimit) {
   const Json done = run_job(sweep(15));
   EXPECT_EQ(done["state"], "done") << done.dump();
   EXPECT_EQ(Lines(done.value("result", "")).size(), 16u);
-  const Json failed = run_job(sweep(25));
-  EXPECT_EQ(failed["state"], "failed") << failed.dump();
-  EXPECT_EQ(failed["status"], 413);
-  EXPECT_EQ(failed["error"],
+  // Over the batch limit: refused at submit, as the endpoint refuses it, and no job is made.
+  const auto refused_job = client.Post(
+      "/v1/jobs", Json{{"path", "/v1/explore"}, {"body", sweep(25)}}.dump(), "application/json");
+  ASSERT_TRUE(refused_job);
+  EXPECT_EQ(refused_job->status, 413);
+  const Json refusal = Json::parse(refused_job->body);
+  EXPECT_EQ(refusal["code"], "TooBig");
+  EXPECT_EQ(refusal["message"],
             "parameters describe 25 designs, over the limit max_batch_samples = 20");
+  EXPECT_EQ(Json::parse(client.Get("/v1/jobs")->body)["total"], 1);  // Only the first job.
 }
 
 }  // namespace

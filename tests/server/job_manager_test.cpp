@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -286,7 +287,7 @@ TEST(JobManagerTest, FailedOnClientErrorKeepsTheInnerErrorBody) {
   const std::string id = IdOf(jobs.Submit(Post("/v1/bat/fit")));
   const Json failed = WaitForState(jobs, id, "failed");
   EXPECT_EQ(failed["status"], 422);
-  EXPECT_EQ(failed["error"], "targets.mass_kg = 5: no bat of this shape reaches it");
+  EXPECT_EQ(failed["error"], inner_error);  // The error object, as the endpoint answered it.
   EXPECT_EQ(failed["progress"], 0.25);  // Frozen at the last report.
   EXPECT_TRUE(failed["finished_s"].is_number());
   const Response result = jobs.Result(id);
@@ -301,7 +302,10 @@ TEST(JobManagerTest, FailedOnServerErrorWithoutMessageNamesTheStatus) {
   const std::string id = IdOf(jobs.Submit(Post("/v1/optimize")));
   const Json failed = WaitForState(jobs, id, "failed");
   EXPECT_EQ(failed["status"], 501);
-  EXPECT_EQ(failed["error"], "the request failed with HTTP status 501");
+  // Not an error envelope: wrapped, the status named in the message.
+  EXPECT_EQ(failed["error"], (Json{{"code", "InternalError"},
+                                   {"message", "the request failed with HTTP status 501"},
+                                   {"field", nullptr}}));
   EXPECT_EQ(jobs.Result(id).status, 501);
   EXPECT_EQ(jobs.Result(id).body, Json::array());
 }
@@ -320,7 +324,9 @@ TEST(JobManagerTest, ThrowingRunnerFailsWithInternalErrorAndWorkersSurvive) {
     const std::string id = IdOf(jobs.Submit(Post("/v1/collision", body)));
     const Json failed = WaitForState(jobs, id, "failed");
     EXPECT_EQ(failed["status"], 500);
-    EXPECT_EQ(failed["error"], "internal error");
+    EXPECT_EQ(failed["error"], (Json{{"code", "InternalError"},
+                                     {"message", "internal error"},
+                                     {"field", nullptr}}));
     ExpectError(jobs.Result(id), 500, "InternalError", "internal error");
   }
   const std::string ok = IdOf(jobs.Submit(Post("/v1/collision", "fine")));
@@ -351,7 +357,9 @@ TEST(JobManagerTest, CancelRunningJobStopsItPromptly) {
     while (!progress->Cancelled()) std::this_thread::sleep_for(milliseconds(1));
     saw_cancel = true;
     asked.WaitForOpen();
-    return Echo(inner, progress);  // Discarded: the job was cancelled.
+    // What a cancelled sweep answers (an error, dropped); a 2xx would be kept
+    // (RunnerThatFinishesAfterCancelIsStillCancelled).
+    return Response{409, Json{{"code", "Cancelled"}, {"message", inner.path}, {"field", nullptr}}};
   });
   OpenOnExit open_asked{asked};
   const std::string id = IdOf(jobs.Submit(Post("/v1/optimize")));
@@ -389,8 +397,88 @@ TEST(JobManagerTest, RunnerThatFinishesAfterCancelIsStillCancelled) {
   EXPECT_EQ(jobs.Cancel(id).status, 202);
   EXPECT_EQ(jobs.Status(id).body["state"], "running");  // Until the runner returns.
   release.Open();
-  WaitForState(jobs, id, "cancelled");
-  EXPECT_EQ(jobs.Result(id).status, 409);
+  const Json cancelled = WaitForState(jobs, id, "cancelled");
+  // Its 2xx answer is kept (an optimisation's best design so far): the result and its status.
+  EXPECT_EQ(cancelled["status"], 200);
+  EXPECT_TRUE(cancelled["error"].is_null());
+  const Response result = jobs.Result(id);
+  EXPECT_EQ(result.status, 200);
+  EXPECT_EQ(result.body, Echo(Post("/v1/explore"), nullptr).body);
+}
+
+TEST(JobManagerTest, ACancelledRunnersErrorAnswerIsDroppedAndTheResultIs409) {
+  Gate started;
+  JobManager jobs(JobConfig{}, [&](const Request&, core::Progress* progress) {
+    started.Open();
+    while (!progress->Cancelled()) std::this_thread::sleep_for(milliseconds(1));
+    return Response{409, Json{{"code", "Cancelled"}, {"message", "the sweep was cancelled"},
+                              {"field", nullptr}}};
+  });
+  const std::string id = IdOf(jobs.Submit(Post("/v1/explore")));
+  ASSERT_TRUE(started.WaitForOpen());
+  EXPECT_EQ(jobs.Cancel(id).status, 202);
+  const Json cancelled = WaitForState(jobs, id, "cancelled");
+  EXPECT_TRUE(cancelled["status"].is_null());
+  ExpectError(jobs.Result(id), 409, "Cancelled",
+              "job \"" + id + "\" was cancelled: it has no result");
+}
+
+// GET /v1/jobs: newest submitted first, filtered by state, paged with limit and offset.
+TEST(JobManagerTest, ListIsNewestFirstFilteredByStateAndPaged) {
+  Gate started, release;
+  JobConfig config;
+  config.workers = 1;
+  JobManager jobs(config, Blocking(&started, &release));
+  OpenOnExit open_release{release};
+  std::vector<std::string> ids;  // oldest first
+  ids.push_back(IdOf(jobs.Submit(Post("/v1/explore"))));
+  ASSERT_TRUE(started.WaitForOpen());  // ids[0] runs; the next four wait behind it
+  for (int i = 0; i < 4; ++i) ids.push_back(IdOf(jobs.Submit(Post("/v1/compare"))));
+  auto list = [&](std::optional<std::string> state, std::size_t limit, std::size_t offset) {
+    const Response r = jobs.List(api::JobListQuery{std::move(state), limit, offset});
+    EXPECT_EQ(r.status, 200);
+    return r.body;
+  };
+  auto ids_of = [](const Json& page) {
+    std::vector<std::string> out;
+    for (const Json& job : page["jobs"]) out.push_back(job["id"]);
+    return out;
+  };
+  const Json all = list(std::nullopt, 100, 0);
+  EXPECT_EQ(ids_of(all), (std::vector<std::string>{ids[4], ids[3], ids[2], ids[1], ids[0]}));
+  EXPECT_EQ(all["total"], 5);
+  EXPECT_TRUE(all["next_offset"].is_null());
+  // Each entry is the job's JSON, as GET /v1/jobs/{id} gives it.
+  EXPECT_EQ(all["jobs"][4], jobs.Status(ids[0]).body);
+  EXPECT_EQ(all["jobs"][4]["path"], "/v1/explore");
+
+  const Json running = list("running", 100, 0);
+  EXPECT_EQ(ids_of(running), (std::vector<std::string>{ids[0]}));
+  EXPECT_EQ(running["total"], 1);
+  const Json queued = list("queued", 100, 0);
+  EXPECT_EQ(ids_of(queued), (std::vector<std::string>{ids[4], ids[3], ids[2], ids[1]}));
+  EXPECT_EQ(list("done", 100, 0)["jobs"], Json::array());
+  EXPECT_EQ(list("done", 100, 0)["total"], 0);
+
+  // Pages of two: [4 3] next 2, [2 1] next 4, [0] last.
+  const Json first = list(std::nullopt, 2, 0);
+  EXPECT_EQ(ids_of(first), (std::vector<std::string>{ids[4], ids[3]}));
+  EXPECT_EQ(first["next_offset"], 2);
+  const Json second = list(std::nullopt, 2, 2);
+  EXPECT_EQ(ids_of(second), (std::vector<std::string>{ids[2], ids[1]}));
+  EXPECT_EQ(second["next_offset"], 4);
+  const Json last = list(std::nullopt, 2, 4);
+  EXPECT_EQ(ids_of(last), (std::vector<std::string>{ids[0]}));
+  EXPECT_TRUE(last["next_offset"].is_null());
+  const Json beyond = list(std::nullopt, 2, 9);
+  EXPECT_EQ(beyond["jobs"], Json::array());
+  EXPECT_EQ(beyond["total"], 5);
+  EXPECT_TRUE(beyond["next_offset"].is_null());
+
+  // A cancelled queued job moves to its state's list.
+  EXPECT_EQ(jobs.Cancel(ids[2]).status, 200);
+  EXPECT_EQ(ids_of(list("cancelled", 100, 0)), (std::vector<std::string>{ids[2]}));
+  EXPECT_EQ(list("queued", 100, 0)["total"], 3);
 }
 
 TEST(JobManagerTest, CancelQueuedJobAtOnceItNeverRunsAndFreesItsSlot) {

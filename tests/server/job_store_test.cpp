@@ -324,7 +324,8 @@ TEST(JobStoreTest, CancelsAndFailuresAreSaved) {
   WaitForState(jobs, failed, "failed");
   const JobRecord failed_record = WaitForStoredState(store, failed, "failed");
   EXPECT_EQ(failed_record.status, 422);
-  EXPECT_EQ(failed_record.error, "no bat");
+  // The error object, as JSON text (old rows hold a bare message: SqliteJobStoreTest).
+  EXPECT_EQ(failed_record.error, R"({"code":"Infeasible","field":null,"message":"no bat"})");
   EXPECT_EQ(failed_record.progress, 0.5);
   EXPECT_EQ(failed_record.response_json, R"({"code":"Infeasible","message":"no bat"})");
 
@@ -343,7 +344,11 @@ TEST(JobStoreTest, CancelsAndFailuresAreSaved) {
   const std::optional<JobRecord> asked = store.Get(running);
   ASSERT_TRUE(asked.has_value());
   EXPECT_TRUE(asked->cancel_requested);
-  WaitForStoredState(store, running, "cancelled");
+  // Its runner answered 200 after the cancel: that answer is saved with it.
+  const JobRecord kept = WaitForStoredState(store, running, "cancelled");
+  EXPECT_EQ(kept.status, 200);
+  EXPECT_EQ(kept.response_json, Echo(Post("/v1/explore", "run"), nullptr).body.dump());
+  EXPECT_EQ(kept.error, "");
 }
 
 TEST(JobStoreTest, TextResultsAreSavedAndLoadedAsText) {
@@ -506,7 +511,8 @@ TEST(JobStoreTest, JobRunningWhenTheProcessDiedTooOftenIsFailedWithItsReason) {
     const Response status = jobs.Status(Hex('d'));
     ASSERT_EQ(status.status, 200);
     EXPECT_EQ(status.body["state"], "failed");
-    EXPECT_EQ(status.body["error"], reason);
+    EXPECT_EQ(status.body["error"],
+              (Json{{"code", "Interrupted"}, {"message", reason}, {"field", nullptr}}));
     EXPECT_EQ(status.body["status"], 503);
     EXPECT_EQ(status.body["resumes"], max_resumes);
     EXPECT_LE(status.body["started_s"].get<double>(), -8.0);  // The start that was cut.
@@ -518,7 +524,8 @@ TEST(JobStoreTest, JobRunningWhenTheProcessDiedTooOftenIsFailedWithItsReason) {
     const std::optional<JobRecord> saved = store.Get(Hex('d'));
     ASSERT_TRUE(saved.has_value());
     EXPECT_EQ(saved->state, "failed");
-    EXPECT_EQ(saved->error, reason);
+    EXPECT_EQ(Json::parse(saved->error),
+              (Json{{"code", "Interrupted"}, {"message", reason}, {"field", nullptr}}));
     EXPECT_EQ(saved->status, 503);
     EXPECT_EQ(saved->body, "");
     EXPECT_EQ(calls.load(), 0);
@@ -583,7 +590,9 @@ TEST(JobStoreTest, AnUnreadableStoredResultFailsThatJobOnly) {
   JobManager jobs(JobConfig{}, Echo, On(&store, &errors));
   const Json status = jobs.Status(Hex('5')).body;
   EXPECT_EQ(status["state"], "failed");
-  EXPECT_EQ(status["error"], "the stored result of this job could not be read");
+  EXPECT_EQ(status["error"], (Json{{"code", "InternalError"},
+                                   {"message", "the stored result of this job could not be read"},
+                                   {"field", nullptr}}));
   EXPECT_EQ(jobs.Result(Hex('5')).status, 500);
   EXPECT_EQ(jobs.Status(Hex('6')).status, 404);
   EXPECT_EQ(errors, (std::vector<std::string>{"job " + Hex('6') +

@@ -119,7 +119,8 @@ TEST(JobsRestartTest, SigkillMidJobBeyondMaxResumesMarksItFailedWithTheReason) {
   const Answer status = Get(second, "/v1/jobs/" + id);
   ASSERT_EQ(status.status, 200);
   EXPECT_EQ(status.body["state"], "failed");
-  EXPECT_EQ(status.body["error"], reason);
+  EXPECT_EQ(status.body["error"],
+            (Json{{"code", "Interrupted"}, {"message", reason}, {"field", nullptr}}));
   EXPECT_EQ(status.body["status"], 503);
   const Answer result = Get(second, "/v1/jobs/" + id + "/result");
   EXPECT_EQ(result.status, 503);

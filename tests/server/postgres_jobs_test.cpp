@@ -114,13 +114,13 @@ TEST_F(PostgresJobsTest, EveryJobIsVisibleFromEveryReplicaAndTheQueueIsShared) {
   }
   EXPECT_EQ(most_running, 3) << "the replicas did not share the queue";
 
-  // The list is the same from every replica: the four jobs, oldest first.
+  // The list is the same from every replica: the four jobs, newest first.
   for (auto& replica : replicas) {
     const Answer list = Get(*replica, "/v1/jobs");
     ASSERT_EQ(list.status, 200);
     ASSERT_EQ(list.body["jobs"].size(), 4u) << list.body.dump();
-    EXPECT_EQ(list.body["jobs"][0]["id"], quick);
-    EXPECT_EQ(list.body["jobs"][3]["id"], slow[2]);
+    EXPECT_EQ(list.body["jobs"][0]["id"], slow[2]);
+    EXPECT_EQ(list.body["jobs"][3]["id"], quick);
   }
   for (const std::string& id : slow) {
     WaitForState(*replicas[1], id, "done");
@@ -149,6 +149,71 @@ TEST_F(PostgresJobsTest, JobOfAReplicaKilledWithSigkillIsFinishedByAnother) {
   EXPECT_EQ(WithoutTimings(result.body["rows"]), WithoutTimings(direct.body["rows"]));
 }
 
+// Ids of a GET /v1/jobs page, in order.
+std::vector<std::string> IdsOf(const Answer& page) {
+  std::vector<std::string> ids;
+  for (const Json& job : page.body["jobs"]) ids.push_back(job["id"]);
+  return ids;
+}
+
+// GET /v1/jobs from the database: newest first, a state filter and pages, the same order from
+// another replica; a failed job's error is the error object its endpoint answered; a row an
+// older server wrote (error a bare message) reads back wrapped.
+TEST_F(PostgresJobsTest, TheListIsNewestFirstFilteredAndPagedAndErrorsAreObjects) {
+  auto replica = Replica({"--job-workers", "1"});
+  const std::string slow = SubmitJob(*replica, "/v1/explore", kLongSweep);
+  WaitForState(*replica, slow, "running");
+  const std::string q1 = SubmitJob(*replica, "/v1/bat/properties", kQuick);
+  const std::string q2 = SubmitJob(*replica, "/v1/bat/properties", kQuick);
+  // One worker: the quick jobs wait behind the sweep (~2.5 s in Release).
+  const Answer running = Get(*replica, "/v1/jobs?state=running");
+  ASSERT_EQ(running.status, 200) << running.body.dump();
+  EXPECT_EQ(IdsOf(running), (std::vector<std::string>{slow}));
+  EXPECT_EQ(running.body["total"], 1);
+  EXPECT_EQ(IdsOf(Get(*replica, "/v1/jobs?state=queued")), (std::vector<std::string>{q2, q1}));
+  const Answer first = Get(*replica, "/v1/jobs?limit=2");
+  EXPECT_EQ(IdsOf(first), (std::vector<std::string>{q2, q1}));
+  EXPECT_EQ(first.body["total"], 3);
+  EXPECT_EQ(first.body["next_offset"], 2);
+  const Answer second = Get(*replica, "/v1/jobs?limit=2&offset=2");
+  EXPECT_EQ(IdsOf(second), (std::vector<std::string>{slow}));
+  EXPECT_TRUE(second.body["next_offset"].is_null());
+  EXPECT_EQ(second.body["jobs"][0]["path"], "/v1/explore");
+  EXPECT_EQ(Delete(*replica, "/v1/jobs/" + slow).status, 202);
+  WaitForState(*replica, slow, "cancelled");
+  WaitForState(*replica, q2, "done");
+
+  // Refused by core while it runs (no bat of the family meets the targets): a failed job.
+  const std::string failed = SubmitJob(
+      *replica, "/v1/bat/fit",
+      R"({"bat": {"preset": "paper-wood"},
+          "targets": {"mass_kg": 0.885, "balance_point_m": 0.564}})");
+  const Json status = WaitForState(*replica, failed, "failed");
+  EXPECT_EQ(status["status"], 422);
+  EXPECT_EQ(status["error"]["code"], "Infeasible") << status.dump();
+  EXPECT_EQ(status["error"]["field"], "targets") << status.dump();
+  EXPECT_EQ(status["error"].size(), 3u) << status.dump();  // no "closest": that is the result's
+  const Answer result = Get(*replica, "/v1/jobs/" + failed + "/result");
+  EXPECT_EQ(result.status, 422);
+  EXPECT_EQ(status["error"]["message"], result.body["message"]);
+  EXPECT_EQ(IdsOf(Get(*replica, "/v1/jobs?state=failed")), (std::vector<std::string>{failed}));
+  EXPECT_EQ(IdsOf(Get(*replica, "/v1/jobs?state=cancelled")), (std::vector<std::string>{slow}));
+
+  ASSERT_EQ(cluster_.Psql("UPDATE sweetspot_jobs SET error = 'an older server''s message' "
+                          "WHERE id = '" + failed + "'"),
+            "");
+  EXPECT_EQ(Get(*replica, "/v1/jobs/" + failed).body["error"],
+            (Json{{"code", "Infeasible"},
+                  {"message", "an older server's message"},
+                  {"field", nullptr}}));
+
+  auto other = Replica();
+  EXPECT_EQ(IdsOf(Get(*other, "/v1/jobs")), (std::vector<std::string>{failed, q2, q1, slow}));
+  const Answer bad = Get(*other, "/v1/jobs?state=sleeping");
+  EXPECT_EQ(bad.status, 400);
+  EXPECT_EQ(bad.body["field"], "state");
+}
+
 TEST_F(PostgresJobsTest, AJobWhoseReplicasKeepDyingFailsWithTheReasonAfterMaxResumes) {
   auto first = Replica({"--job-lease-s", "1", "--job-max-resumes", "0"});
   const std::string id = SubmitJob(*first, "/v1/explore", kSlowSweep);
@@ -157,7 +222,10 @@ TEST_F(PostgresJobsTest, AJobWhoseReplicasKeepDyingFailsWithTheReasonAfterMaxRes
   first->Stop(SIGKILL);
   const Json failed = WaitForState(*second, id, "failed");
   EXPECT_EQ(failed["status"], 503);
-  EXPECT_NE(failed["error"].get<std::string>().find("limit max_resumes = 0"), std::string::npos)
+  EXPECT_EQ(failed["error"]["code"], "Interrupted") << failed.dump();
+  EXPECT_TRUE(failed["error"]["field"].is_null()) << failed.dump();
+  EXPECT_NE(failed["error"]["message"].get<std::string>().find("limit max_resumes = 0"),
+            std::string::npos)
       << failed.dump();
   const Answer result = Get(*second, "/v1/jobs/" + id + "/result");
   EXPECT_EQ(result.status, 503);
@@ -340,7 +408,8 @@ TEST_F(PostgresJobsTest, AResultOverTheLimitFailsTheJobWholeNeverTruncated) {
   const std::string big = SubmitJob(*replica, "/v1/explore", kSlowSweep);
   const Json failed = WaitForState(*replica, big, "failed");
   EXPECT_EQ(failed["status"], 413);
-  const std::string error = failed["error"];
+  EXPECT_EQ(failed["error"]["code"], "TooBig");
+  const std::string error = failed["error"]["message"];
   EXPECT_NE(error.find("more than the jobs database keeps (max_result_bytes = 4096)"),
             std::string::npos)
       << error;

@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "tests/server/running_server.hpp"
 
@@ -38,6 +41,62 @@ TEST(SecurityTest, BearerTokenGuardsEverythingButHealth) {
   const auto allowed = client.Get("/v1/materials");
   ASSERT_TRUE(allowed);
   EXPECT_EQ(allowed->status, 200);
+}
+
+// GET /v1/jobs over real HTTP: the token guards it like every job route, the query string
+// reaches the handler (filter, paging, a bad state named), and POST /v1/jobs refuses an invalid
+// inner request at once without making a job.
+TEST(SecurityTest, JobListIsGuardedAndTakesItsQueryOverHttp) {
+  ServerConfig config;
+  config.auth_token = "0123456789abcdef-secret";
+  config.jobs_db = kNoJobsDb;  // in memory: a shared default file would couple tests
+  RunningServer server(config);
+  ASSERT_TRUE(server.bound());
+  auto client = server.Client();
+  const auto anonymous = client.Get("/v1/jobs?state=running");
+  ASSERT_TRUE(anonymous);
+  EXPECT_EQ(anonymous->status, 401);
+  client.set_bearer_token_auth("0123456789abcdef-secret");
+
+  const auto refused = client.Post(
+      "/v1/jobs",
+      R"({"path": "/v1/optimize", "body": {"bat": {"preset": "paper-wood"},
+          "variables": [{"path": "three_segment.taper_start_m", "min": 0.1, "max": 0.5}],
+          "options": {"starts": 500}}})",
+      "application/json");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 400);
+  EXPECT_EQ(nlohmann::json::parse(refused->body)["field"], "options.starts") << refused->body;
+
+  std::vector<std::string> ids;
+  for (int i = 0; i < 3; ++i) {
+    const auto submitted = client.Post(
+        "/v1/jobs", R"({"path": "/v1/bat/properties", "body": {"bat": {"preset": "paper-wood"}}})",
+        "application/json");
+    ASSERT_TRUE(submitted);
+    ASSERT_EQ(submitted->status, 202) << submitted->body;
+    ids.push_back(nlohmann::json::parse(submitted->body)["id"]);
+  }
+  // Every job done (quick ones; bounded wait: 2000 x 5 ms).
+  for (int i = 0; i < 2000; ++i) {
+    const auto done = client.Get("/v1/jobs?state=done");
+    ASSERT_TRUE(done);
+    if (nlohmann::json::parse(done->body)["total"] == 3) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const auto page = client.Get("/v1/jobs?state=done&limit=2&offset=1");
+  ASSERT_TRUE(page);
+  ASSERT_EQ(page->status, 200) << page->body;
+  const auto body = nlohmann::json::parse(page->body);
+  EXPECT_EQ(body["total"], 3);  // the refused request made no job
+  ASSERT_EQ(body["jobs"].size(), 2u) << page->body;
+  EXPECT_EQ(body["jobs"][0]["id"], ids[1]);  // newest first, one skipped
+  EXPECT_EQ(body["jobs"][1]["id"], ids[0]);
+  EXPECT_TRUE(body["next_offset"].is_null());
+  const auto bad = client.Get("/v1/jobs?state=sleeping");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_EQ(nlohmann::json::parse(bad->body)["field"], "state");
 }
 
 TEST(SecurityTest, NoCorsHeadersUnlessConfigured) {

@@ -277,6 +277,96 @@ TEST(SqliteJobStoreTest, AJobManagerRestartedOnTheSameFileGetsItsJobsBack) {
   EXPECT_EQ(result.body, (nlohmann::json{{"body", "payload"}}));
 }
 
+// Errors are objects and a cancelled job keeps its runner's 2xx answer, across a restart on
+// the same file; rows written before errors were objects (a bare message) read back wrapped.
+TEST(SqliteJobStoreTest, ErrorObjectsAndKeptResultsSurviveARestartAndOldErrorsAreWrapped) {
+  TempDir dir;
+  const std::string path = dir.File("jobs.db");
+  const nlohmann::json infeasible{{"code", "Infeasible"},
+                                  {"message", "no design meets the constraints"},
+                                  {"field", "constraints"}};
+  const nlohmann::json best{{"summary", {{"termination", "no_convergence"}}}, {"objective", 1.5}};
+  const auto runner = [&](const api::Request& inner, core::Progress* progress) {
+    if (inner.body == "fail") return api::Response{422, infeasible};
+    while (!progress->Cancelled()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    return api::Response{200, best};  // as a cancelled optimisation answers
+  };
+  auto wait_for = [](const JobManager& jobs, const std::string& id, const std::string& state) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (jobs.Status(id).body["state"] != state && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    EXPECT_EQ(jobs.Status(id).body["state"], state);
+  };
+  std::string failed, cancelled;
+  {
+    auto store = OpenOrFail(path);
+    ASSERT_NE(store, nullptr);
+    JobPersistence persistence;
+    persistence.store = store.get();
+    JobManager jobs(JobConfig{}, runner, persistence);
+    failed = jobs.Submit({"POST", "/v1/optimize", "fail"}).body["id"];
+    cancelled = jobs.Submit({"POST", "/v1/optimize", "run"}).body["id"];
+    wait_for(jobs, failed, "failed");
+    wait_for(jobs, cancelled, "running");
+    EXPECT_EQ(jobs.Cancel(cancelled).status, 202);
+    wait_for(jobs, cancelled, "cancelled");
+    // Two rows as an older server wrote them: the error a bare message, with and without an
+    // error envelope in the stored answer.
+    JobRecord old;
+    old.id = std::string(32, 'a');
+    old.state = "failed";
+    old.method = "POST";
+    old.path = "/v1/explore";
+    old.created_at = "2024-05-01T12:00:00.123Z";
+    old.created_unix_s = old.finished_unix_s.emplace(
+        std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+            .count());
+    old.status = 413;
+    old.error = "parameters describe 25 designs, over the limit max_batch_samples = 20";
+    old.response_json = nlohmann::json{{"code", "TooBig"},
+                                       {"message", old.error},
+                                       {"field", "parameters"}}
+                            .dump();
+    std::string why;
+    ASSERT_TRUE(store->Save(old, &why)) << why;
+    old.id = std::string(32, 'b');
+    old.status = 500;
+    old.error = "internal error";
+    old.response_json = "[]";
+    ASSERT_TRUE(store->Save(old, &why)) << why;
+  }
+  auto store = OpenOrFail(path);
+  ASSERT_NE(store, nullptr);
+  JobPersistence persistence;
+  persistence.store = store.get();
+  JobManager jobs(JobConfig{}, runner, persistence);
+
+  const nlohmann::json failed_status = jobs.Status(failed).body;
+  EXPECT_EQ(failed_status["state"], "failed");
+  EXPECT_EQ(failed_status["status"], 422);
+  EXPECT_EQ(failed_status["error"], infeasible);
+  EXPECT_EQ(jobs.Result(failed).body, infeasible);
+
+  const nlohmann::json cancelled_status = jobs.Status(cancelled).body;
+  EXPECT_EQ(cancelled_status["state"], "cancelled");
+  EXPECT_EQ(cancelled_status["status"], 200);
+  EXPECT_TRUE(cancelled_status["error"].is_null());
+  const api::Response kept = jobs.Result(cancelled);
+  EXPECT_EQ(kept.status, 200);
+  EXPECT_EQ(kept.body, best);
+
+  EXPECT_EQ(jobs.Status(std::string(32, 'a')).body["error"],
+            (nlohmann::json{{"code", "TooBig"},
+                            {"message", "parameters describe 25 designs, over the limit "
+                                        "max_batch_samples = 20"},
+                            {"field", "parameters"}}));
+  EXPECT_EQ(jobs.Status(std::string(32, 'b')).body["error"],
+            (nlohmann::json{{"code", "InternalError"},
+                            {"message", "internal error"},
+                            {"field", nullptr}}));
+}
+
 }  // namespace
 }  // namespace sqlite_job_store_test
 }  // namespace sweetspot::server
