@@ -233,7 +233,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   if (const Json* s = reader.Get("shard")) {
     ObjectReader sr(*s, "shard", error);
     long long index = 0, count = 1;
-    sr.OptionalInteger("index", 0, 1LL << 40, &index);
+    sr.OptionalInteger("index", 0, (1LL << 40) - 1, &index);  // below count (<= 2^40)
     sr.OptionalInteger("count", 1, 1LL << 40, &count);
     if (!sr.Finish()) return std::nullopt;
     shard = {static_cast<std::uint64_t>(index), static_cast<std::uint64_t>(count)};

@@ -324,6 +324,23 @@ bool ObjectReader::OptionalInteger(std::string_view key, long long min, long lon
   const NumberRule rule = IntegerBetween(static_cast<double>(min), static_cast<double>(max));
   // 2.0 is accepted as 2; 2.7 and -1 for an unsigned field are refused (pitfalls.md).
   if (!value->is_number()) return Fail(key, "must be an integer");
+  // An integer literal is compared exactly: through a double, 2^53 + 1 would pass a maximum
+  // of 2^53 and be read as 2^53.
+  if (value->is_number_unsigned()) {
+    const auto number = value->get<unsigned long long>();
+    if (max < 0 || number > static_cast<unsigned long long>(max) ||
+        (min > 0 && number < static_cast<unsigned long long>(min))) {
+      return Fail(key, rule.Describe());
+    }
+    *out = static_cast<long long>(number);
+    return true;
+  }
+  if (value->is_number_integer()) {
+    const auto number = value->get<long long>();
+    if (number < min || number > max) return Fail(key, rule.Describe());
+    *out = number;
+    return true;
+  }
   const double number = value->get<double>();
   if (!rule.Accepts(number)) return Fail(key, rule.Describe());
   *out = static_cast<long long>(number);
