@@ -399,6 +399,24 @@ void ClassifyFeasibility(const DesignModel& model, const DesignOptions& options,
   }
 }
 
+// A multi-start cut short by Progress::Cancel() (a start stopped mid-solve, or starts not begun)
+// is no_convergence even when its chosen start converged: the starts not run might have found a
+// better design. Infeasible, failure and invalid_input stand; a chosen start that was itself cut
+// is no_convergence already, its message "cancelled (...)".
+void MarkCancelledMultiStart(const DesignOptions& options, const std::vector<Run>& runs,
+                             const Progress* progress, DesignResult* result) {
+  const bool cut =
+      !runs.empty() && (runs.back().outcome.cancelled ||
+                        (IsCancelled(progress) && static_cast<int>(runs.size()) < options.starts));
+  Summary& summary = result->summary;
+  if (!cut || summary.termination != Termination::kConverged) return;
+  summary.termination = Termination::kNoConvergence;
+  summary.message = "cancelled after " + std::to_string(runs.size()) + " of " +
+                    std::to_string(options.starts) + " starts (the chosen start " +
+                    std::to_string(result->spread.best_start) + ": " + summary.message +
+                    "); the best design so far is kept";
+}
+
 // The optimisation, with the progress it reports mapped into [progress_from, progress_to]
 // and an overall deadline (OptimizeOverMaterials shares one budget between materials).
 DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options,
@@ -517,6 +535,7 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     ClassifyChosen(options, backend, chosen, pub, result.bat, &result);
     ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, &result);
     ReportActiveConstraints(model, x, chosen.outcome, &result);
+    MarkCancelledMultiStart(options, runs, progress, &result);
   } catch (const std::bad_alloc&) {
     summary.termination = Termination::kFailure;
     summary.message = "out of memory";

@@ -379,7 +379,7 @@ struct DesignResult {
 
 /// Optimises the design. Never throws. `progress` (may be null) receives the fraction of
 /// starts done and is polled for cancellation (a cancelled solve ends no_convergence with a
-/// message saying so).
+/// message saying so, also when its chosen start converged but later starts were not run).
 DesignResult OptimizeDesign(const DesignProblem& problem, const DesignOptions& options = {},
                             Progress* progress = nullptr);
 

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "api/handlers.hpp"
@@ -279,6 +280,40 @@ TEST(CancelledOptimisationTest, AnswersTheBestDesignSoFarWithNoConvergence) {
   EXPECT_TRUE(r.body["objective_value"].is_number());
   // Later starts are not begun: one start ran.
   EXPECT_EQ(r.body["summary"]["spread"]["starts"], 1) << r.body["summary"].dump();
+}
+
+// A cancel between starts (or during one) leaves the multi-start unfinished: no_convergence even
+// though the chosen start converged (without this the answer said "converged" after 3 of 64
+// starts), with how many starts ran in the message.
+TEST(CancelledOptimisationTest, ACancelAfterTheFirstStartIsNoConvergenceWithTheStartsRun) {
+  core::Progress progress;
+  std::thread canceller([&progress] {
+    // The first start reports 1/64; bounded wait (10 s) in case the solve never reports.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (progress.Fraction() <= 0.0 && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    progress.Cancel();
+  });
+  Context context;
+  context.progress = &progress;
+  const Response r = Dispatch(
+      {"POST", "/v1/optimize", Optimisation({{"starts", 64}, {"seed", 1}}).dump()}, context);
+  canceller.join();
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const Json& summary = r.body["summary"];
+  EXPECT_EQ(summary["termination"], "no_convergence") << summary.dump();
+  const int ran = summary["spread"]["starts"];
+  EXPECT_GE(ran, 1);
+  EXPECT_LT(ran, 64);  // the cancel came after the first of 64 starts, each tens of ms
+  const std::string message = summary["message"];
+  EXPECT_EQ(message.rfind("cancelled", 0), 0u) << message;
+  EXPECT_NE(message.find("the best design so far is kept"), std::string::npos) << message;
+  // The design is the chosen start's: inside the bounds, with its objective.
+  const double taper_start = r.body["bat"]["three_segment"]["taper_start_m"];
+  EXPECT_GE(taper_start, 0.1);
+  EXPECT_LE(taper_start, 0.5);
+  EXPECT_TRUE(r.body["objective_value"].is_number());
 }
 
 }  // namespace
