@@ -42,6 +42,8 @@ id=$(echo "$submitted" | sed -n 's/.*"id":"\([0-9a-f]*\)".*/\1/p')
 sleep 0.2
 run curl -s "$base/v1/jobs/$id"
 run curl -s "$base/v1/jobs/$id/result"
+run curl -s "$base/v1/jobs?state=done&limit=1"
+post /v1/jobs '{"path": "/v1/optimize", "body": {"bat": {"preset": "paper-wood"}, "variables": [{"path": "three_segment.taper_start_m", "min": 0.1, "max": 0.5}], "options": {"starts": 500}}}'
 run curl -s -X DELETE "$base/v1/jobs/$id"
 run curl -s "$base/metrics"
 post /v1/sweet-spot '{"bat": {"preset": "paper-wood"}, "ball": {"mass_kg": -1}}'
