@@ -214,6 +214,48 @@ TEST_F(PostgresJobsTest, TheListIsNewestFirstFilteredAndPagedAndErrorsAreObjects
   EXPECT_EQ(bad.body["field"], "state");
 }
 
+// A cancelled optimisation keeps its best design so far in the database: the job is
+// cancelled with status 200, and its result is the design with termination no_convergence,
+// read through another replica.
+TEST_F(PostgresJobsTest, ACancelledOptimisationKeepsItsBestDesignSoFar) {
+  auto replica = Replica();
+  // 64 COBYLA starts of min_sting: ~0.2 s each in Release, ~13 s in all; cancelled after one.
+  const std::string id = SubmitJob(*replica, "/v1/optimize", R"({
+    "bat": {"three_segment": {"length_m": 0.8636, "handle_radius_m": 0.0125,
+            "barrel_radius_m": 0.033, "taper_start_m": 0.30, "taper_end_m": 0.55},
+            "material": "ash"},
+    "variables": [{"path": "three_segment.taper_start_m", "min": 0.1, "max": 0.5},
+                  {"path": "three_segment.barrel_radius_m", "min": 0.028, "max": 0.0331}],
+    "constraints": {"mass_kg": 0.88, "balance_point_m": {"min": 0.56, "max": 0.60}},
+    "objective": "min_sting", "cor": 0.5,
+    "options": {"max_time_s": 60, "starts": 64, "seed": 1}})");
+  const auto deadline = Clock::now() + kMustHappen;
+  Json status = Get(*replica, "/v1/jobs/" + id).body;
+  while (!(status["progress"].get<double>() > 0.0) && Clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    status = Get(*replica, "/v1/jobs/" + id).body;
+  }
+  ASSERT_EQ(status["state"], "running") << status.dump();
+  EXPECT_EQ(Delete(*replica, "/v1/jobs/" + id).status, 202);
+  const Json cancelled = WaitForState(*replica, id, "cancelled");
+  EXPECT_EQ(cancelled["status"], 200);
+  EXPECT_TRUE(cancelled["error"].is_null());
+
+  auto other = Replica();
+  const Answer result = Get(*other, "/v1/jobs/" + id + "/result");
+  ASSERT_EQ(result.status, 200) << result.body.dump();
+  EXPECT_EQ(result.body["summary"]["termination"], "no_convergence");
+  const std::string message = result.body["summary"]["message"];
+  EXPECT_EQ(message.rfind("cancelled", 0), 0u) << message;
+  const int ran = result.body["summary"]["spread"]["starts"];
+  EXPECT_GE(ran, 1);
+  EXPECT_LT(ran, 64);
+  // The kept design meets the mass equality: the chosen start is a feasible one, within
+  // kFeasibleRelative = 1e-6 of the constraint's scale (0.88 kg), 8.8e-7 kg < 1e-6 kg.
+  EXPECT_NEAR(result.body["properties"]["mass_kg"].get<double>(), 0.88, 1e-6);
+  EXPECT_EQ(IdsOf(Get(*other, "/v1/jobs?state=cancelled")), (std::vector<std::string>{id}));
+}
+
 TEST_F(PostgresJobsTest, AJobWhoseReplicasKeepDyingFailsWithTheReasonAfterMaxResumes) {
   auto first = Replica({"--job-lease-s", "1", "--job-max-resumes", "0"});
   const std::string id = SubmitJob(*first, "/v1/explore", kSlowSweep);
