@@ -5,6 +5,8 @@
 // solve or sweep runs. The maxima tied to a configured limit are the defaults (ApiLimits{}).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -154,6 +156,57 @@ TEST(OpenApiRangesTest, JobListParametersAreTheHandlersRange) {
     ++checked;
   }
   EXPECT_EQ(checked, 2);  // limit and offset
+}
+
+// The ranged numbers of the same parsers: the document's bounds, exclusive or not, against the
+// parser's, to the last double (std::nextafter on each side of each bound).
+TEST(OpenApiRangesTest, EveryRangedNumberIsDocumentedAndIsTheParsersRange) {
+  const Json document = OpenApi();
+  const std::string optimize_options =
+      "/paths/~1v1~1optimize/post/requestBody/content/application~1json/schema/properties/"
+      "options/properties/";
+  const std::string nlopt =
+      "/paths/~1v1~1explore/post/requestBody/content/application~1json/schema/properties/"
+      "options/properties/nlopt/properties/";
+  const std::vector<RangedField> fields = {
+      {"/v1/optimize", optimize_options + "max_time_s", "/options/max_time_s",
+       "options.max_time_s"},
+      {"/v1/optimize", optimize_options + "max_cpu_time_s", "/options/max_cpu_time_s",
+       "options.max_cpu_time_s"},
+      {"/v1/optimize", optimize_options + "tolerance", "/options/tolerance", "options.tolerance"},
+      {"/v1/optimize", optimize_options + "constraint_tolerance", "/options/constraint_tolerance",
+       "options.constraint_tolerance"},
+      {"/v1/explore", nlopt + "x_tolerance_m", "/options/nlopt/x_tolerance_m",
+       "options.nlopt.x_tolerance_m"},
+      {"/v1/explore", nlopt + "max_time_s", "/options/nlopt/max_time_s",
+       "options.nlopt.max_time_s"},
+  };
+  for (const RangedField& f : fields) {
+    SCOPED_TRACE(f.field);
+    const Json& schema = document[Json::json_pointer(f.schema_pointer)];
+    ASSERT_EQ(schema.value("type", ""), "number") << schema.dump();
+    ASSERT_TRUE(schema.contains("minimum") && schema.contains("maximum")) << schema.dump();
+    const double min = schema["minimum"];
+    const double max = schema["maximum"];
+    const bool min_exclusive = schema.value("exclusiveMinimum", false);
+    const bool max_exclusive = schema.value("exclusiveMaximum", false);
+    const double inf = std::numeric_limits<double>::infinity();
+    auto check = [&](double value, bool accepted) {
+      Json body = f.route == "/v1/optimize" ? Optimisation() : Sweep();
+      body[Json::json_pointer(f.body_pointer)] = value;
+      Context context;
+      context.validate_only = true;
+      const Response r = Dispatch({"POST", f.route, body.dump()}, context);
+      EXPECT_EQ(r.status, accepted ? 200 : 400) << value << ": " << r.body.dump();
+      if (!accepted) EXPECT_EQ(r.body.value("field", Json()), f.field) << value;
+    };
+    check(min, !min_exclusive);
+    check(std::nextafter(min, inf), true);
+    check(std::nextafter(min, -inf), false);
+    check(max, !max_exclusive);
+    check(std::nextafter(max, -inf), true);
+    check(std::nextafter(max, inf), false);
+  }
 }
 
 }  // namespace
