@@ -165,9 +165,9 @@ TEST(OpenApiRangesTest, EveryRangedNumberIsDocumentedAndIsTheParsersRange) {
   const std::string optimize_options =
       "/paths/~1v1~1optimize/post/requestBody/content/application~1json/schema/properties/"
       "options/properties/";
-  const std::string nlopt =
-      "/paths/~1v1~1explore/post/requestBody/content/application~1json/schema/properties/"
-      "options/properties/nlopt/properties/";
+  const std::string explore =
+      "/paths/~1v1~1explore/post/requestBody/content/application~1json/schema/properties/";
+  const std::string nlopt = explore + "options/properties/nlopt/properties/";
   const std::vector<RangedField> fields = {
       {"/v1/optimize", optimize_options + "max_time_s", "/options/max_time_s",
        "options.max_time_s"},
@@ -180,6 +180,11 @@ TEST(OpenApiRangesTest, EveryRangedNumberIsDocumentedAndIsTheParsersRange) {
        "options.nlopt.x_tolerance_m"},
       {"/v1/explore", nlopt + "max_time_s", "/options/nlopt/max_time_s",
        "options.nlopt.max_time_s"},
+      // The swept range's ends.
+      {"/v1/explore", explore + "parameters/items/properties/min", "/parameters/0/min",
+       "parameters[0].min"},
+      {"/v1/explore", explore + "parameters/items/properties/max", "/parameters/0/max",
+       "parameters[0].max"},
   };
   for (const RangedField& f : fields) {
     SCOPED_TRACE(f.field);
@@ -194,6 +199,9 @@ TEST(OpenApiRangesTest, EveryRangedNumberIsDocumentedAndIsTheParsersRange) {
     auto check = [&](double value, bool accepted) {
       Json body = f.route == "/v1/optimize" ? Optimisation() : Sweep();
       body[Json::json_pointer(f.body_pointer)] = value;
+      // The other end of a swept range at its own bound, so that min <= max holds.
+      if (f.body_pointer == "/parameters/0/min") body["parameters"][0]["max"] = max;
+      if (f.body_pointer == "/parameters/0/max") body["parameters"][0]["min"] = min;
       Context context;
       context.validate_only = true;
       const Response r = Dispatch({"POST", f.route, body.dump()}, context);
