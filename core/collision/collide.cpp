@@ -36,11 +36,15 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
       return;
     }
     ResolvedScene r;
-    const bool resolved = ResolveScene(scene, /*needs_cor=*/true, &book, &r, &s);
+    // A ball's COR law is evaluated at this impact's own normal speed.
+    const bool resolved =
+        ResolveScene(scene, /*needs_cor=*/true, &book, &r, &s, impact_from_knob_m);
     // Also when refused: the caller can then tell properties that are not usable (the bat's).
     out.mass_properties = r.mass_properties;
     if (!resolved) return;
     out.cor = *r.cor;
+    out.cor_source = r.cor_source;
+    out.cor_impact_speed_mps = r.cor_impact_speed_mps;
     if (!(std::isfinite(impact_from_knob_m) && impact_from_knob_m >= 0.0 &&
           impact_from_knob_m <= r.length_m)) {
       s.SetRefusal(

@@ -42,6 +42,9 @@ struct CollisionResult {
   double exit_speed_mps = 0.0;                         ///< m/s, positive away from the bat.
   double error_estimate_mps = 0.0;                     ///< Estimated error of the exit speed, m/s.
   double cor = 0.0;                                    ///< The COR used.
+  std::string cor_source;  ///< "scene", "ball:<preset>" or "material:<name>" (ResolvedScene).
+  /// With cor_source "ball:...": this impact's normal speed the ball's law was evaluated at, m/s.
+  std::optional<double> cor_impact_speed_mps;
   MassProperties mass_properties;  ///< The properties used (when refused: as computed, or zero).
   std::optional<RigidPivotImpact> rigid_pivot;         ///< Details when model = rigid_pivot.
   std::optional<FreeBatImpact> free_bat;               ///< Details when model = free_bat.

@@ -187,6 +187,7 @@ void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
     if (!resolved) return;
     out.cor = r.cor;
     out.cor_source = r.cor_source;
+    out.cor_impact_speed_mps = r.cor_impact_speed_mps;
     out.length_m = r.length_m;
     for (size_t i = 0; i < options.curve_positions_from_knob_m.size(); ++i) {
       const double x = options.curve_positions_from_knob_m[i];

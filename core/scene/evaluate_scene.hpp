@@ -24,11 +24,14 @@ std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model
 
 /// The answer of EvaluateScene. Outputs not requested (or not computed) are empty.
 struct SceneResult {
-  Summary summary;                 ///< Overall: termination, message, models_used, total time.
-  std::string missing_model;       ///< Set (e.g. "flexible_beam") when refused for a missing model.
-  std::string refused_field;       ///< The request field the refusal is about (e.g. "outputs").
-  std::optional<double> cor;       ///< The COR used; unset when no wanted output needs one.
-  std::string cor_source;          ///< "scene" or "material:<name>"; "" when `cor` is unset.
+  Summary summary;            ///< Overall: termination, message, models_used, total time.
+  std::string missing_model;  ///< Set (e.g. "flexible_beam") when refused for a missing model.
+  std::string refused_field;  ///< The request field the refusal is about (e.g. "outputs").
+  std::optional<double> cor;  ///< The COR used; unset when no wanted output needs one.
+  /// "scene", "ball:<preset>" or "material:<name>" (ResolvedScene); "" when `cor` is unset.
+  std::string cor_source;
+  /// With cor_source "ball:...": the impact speed the ball's COR law was evaluated at, m/s.
+  std::optional<double> cor_impact_speed_mps;
   MassProperties mass_properties;  ///< The properties used (when refused: as computed, or zero).
   double length_m = 0.0;           ///< The bat length used, m.
   std::string exit_speed_model;    ///< The exit-speed model used ("" when none was needed).

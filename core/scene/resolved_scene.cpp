@@ -1,5 +1,6 @@
 #include "core/scene/resolved_scene.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -9,20 +10,35 @@
 
 namespace sweetspot::core {
 
+bool BallCorApplies(const Scene& scene) {
+  if (!scene.ball.cor_law.has_value()) return false;
+  if (!scene.bat.has_value()) return true;
+  return scene.bat->wall_thickness_m <= 0.0 || !scene.bat->material.cor.has_value();
+}
+
 bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, ResolvedScene* r,
-                  Summary* s) {
+                  Summary* s, std::optional<double> cor_impact_from_knob_m) {
   if (Refusal refusal; !scene.Validate(&refusal)) {
     s->SetRefusal(std::move(refusal));
     return false;
   }
-  if (!needs_cor) {
-    // Nothing wanted uses a COR: none is resolved, so none is required.
+  // The ball's law needs the bat's length: evaluated below, once the length is known.
+  const bool ball_cor = needs_cor && !scene.cor.has_value() && BallCorApplies(scene);
+  if (!needs_cor || ball_cor) {
+    // Nothing wanted uses a COR (none is resolved, so none is required), or the ball's law.
   } else if (scene.cor.has_value()) {
     r->cor = *scene.cor;
     r->cor_source = "scene";
   } else if (scene.bat.has_value() && scene.bat->material.cor.has_value()) {
     r->cor = *scene.bat->material.cor;
     r->cor_source = "material:" + scene.bat->material.name;
+    if (scene.ball.cor_law.has_value()) {
+      s->warnings.push_back(
+          "hollow bat: the COR is the material's (" + FormatNumber(*r->cor) +
+          "), not the law of ball '" + scene.ball.preset +
+          "' against solid wood (a hollow barrel's compliance changes the ball-bat COR; give "
+          "cor to set it)");
+    }
   } else {
     // About the scene's COR and the bat's material together, so no one field: the api names
     // the part of the request it was evaluating (the bat, a compared variant).
@@ -61,6 +77,16 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
         Number17Refusal("swing.hands_from_knob_m", h,
                         "must be within the bat [0, " + FormatNumber17(r->length_m) + "]"));
     return false;
+  }
+  if (ball_cor) {
+    const double x = cor_impact_from_knob_m.has_value() && std::isfinite(*cor_impact_from_knob_m)
+                         ? std::clamp(*cor_impact_from_knob_m, 0.0, r->length_m)
+                         : std::max(0.0, r->length_m - kCorReferenceFromTipM);
+    const double v = scene.ball.speed_mps +
+                     scene.swing.angular_speed_rad_s * (x - scene.swing.pivot_from_knob_m);
+    r->cor = scene.ball.cor_law->CorAt(v);
+    r->cor_source = "ball:" + (scene.ball.preset.empty() ? "custom" : scene.ball.preset);
+    r->cor_impact_speed_mps = v;
   }
   return true;
 }

@@ -23,14 +23,26 @@ struct ResolvedScene {
   MassProperties mass_properties;  ///< The bat's (computed from `bat`, or the scene's own).
   double length_m = 0.0;           ///< The bat length, m.
   std::optional<double> cor;       ///< The COR; unset when nothing wanted needs one.
-  std::string cor_source;          ///< "scene" or "material:<name>"; "" when `cor` is unset.
+  /// "scene" (the request's `cor`), "ball:<preset>" (the ball's COR law) or "material:<name>";
+  /// "" when `cor` is unset.
+  std::string cor_source;
+  /// With cor_source "ball:...": the normal impact speed the ball's law was evaluated at, m/s.
+  std::optional<double> cor_impact_speed_mps;
 };
+
+/// True when a scene without `cor` takes its COR from the ball's law (the ball has one, and the
+/// bat is solid, absent, or has no material COR); false: the bat material's COR, as before.
+bool BallCorApplies(const Scene& scene);
 
 /// Validates `scene`, resolves its COR when `needs_cor`, computes (or takes) its mass properties
 /// once (timed as "mass_properties" in *book when computed) and checks the hands are on the bat.
-/// False with the termination and message in *summary otherwise. Never throws.
+/// The COR: the scene's `cor`; else, when BallCorApplies, the ball's law at the normal impact
+/// speed ball.speed_mps + omega (x - pivot) at x = `cor_impact_from_knob_m` (clamped to the bat)
+/// or, without it, kCorReferenceFromTipM from the tip; else the bat material's. A hollow bat
+/// with a ball law keeps its material's COR with a warning in *summary. False with the
+/// termination and message in *summary otherwise. Never throws.
 bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, ResolvedScene* resolved,
-                  Summary* summary);
+                  Summary* summary, std::optional<double> cor_impact_from_knob_m = std::nullopt);
 
 /// The rigid-pivot inputs of a bat with `mass_properties` hit by `ball` in `swing` with `cor`.
 RigidPivotInputs RigidPivotInputsFor(const MassProperties& mass_properties, const Ball& ball,

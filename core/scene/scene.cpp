@@ -39,7 +39,16 @@ bool Ball::Validate(Refusal* why) const {
   if (!(std::isfinite(stiffness_exponent) && stiffness_exponent >= 1.0 &&
         stiffness_exponent <= 3.0))
     return Refuse17(why, "ball.stiffness_exponent", stiffness_exponent, "must be in [1, 3]");
-  return true;
+  return !cor_law.has_value() || cor_law->Validate(why);
+}
+
+void ApplyBallPreset(const BallPreset& preset, Ball* ball) {
+  ball->mass_kg = preset.mass_kg;
+  ball->radius_m = preset.radius_m;
+  ball->stiffness = preset.stiffness;
+  ball->stiffness_exponent = preset.stiffness_exponent;
+  ball->preset = preset.name;
+  ball->cor_law = preset.cor_law;
 }
 
 bool Swing::IsValid(std::string* why) const {

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/ball_catalogue.hpp"
 #include "core/bat.hpp"
 #include "core/collision/flexible_impact.hpp"
 #include "core/collision/hertz_contact.hpp"
@@ -53,12 +54,26 @@ struct Ball {
   /// Contact models: k in F = k delta^p, N/m^p, in (0, kMaxBallStiffness].
   double stiffness = kDefaultBallStiffness;
   double stiffness_exponent = kDefaultBallStiffnessExponent;  ///< Contact models: p, in [1, 3].
+  /// The catalogue entry this ball came from ("" = none: today's default ball).
+  std::string preset;
+  /// The ball's COR against solid wood by impact speed (set by a preset). When set and the scene
+  /// gives no `cor`, a solid bat's COR is this law at the scene's impact speed
+  /// (ResolveScene); unset = the bat material's COR, as before.
+  std::optional<BallCorLaw> cor_law;
 
   /// True when every field is in range; otherwise "ball.field = value: rule" in *why.
   bool IsValid(std::string* why) const;
   /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
   bool Validate(Refusal* refusal) const;
 };
+
+/// `ball` with the catalogue entry's mass, radius, contact law and COR law (its speed kept):
+/// the values a request's explicit ball fields then override.
+void ApplyBallPreset(const BallPreset& preset, Ball* ball);
+
+/// Where a scene's ball COR law is evaluated when no impact point is given: 0.1524 m (6 in)
+/// from the tip, the standard bat-speed point, near every model's sweet spot.
+inline constexpr double kCorReferenceFromTipM = 0.1524;
 
 /// The swing just before impact. Defaults: the paper's Table 3 and the standard grip.
 struct Swing {
@@ -83,7 +98,9 @@ struct Scene {
   InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< When computing from `bat`.
   Ball ball;                                              ///< The ball.
   Swing swing;                                            ///< The swing.
-  std::optional<double> cor;  ///< COR in [0, 1]; unset = the bat material's default.
+  /// COR in [0, 1]; unset = the ball's COR law (a preset's) for a solid bat, else the bat
+  /// material's default (ResolveScene).
+  std::optional<double> cor;
   std::vector<SceneOutput> outputs = {
       SceneOutput::kMaxExitSpeed};  ///< What to compute (duplicates ignored).
 
