@@ -27,6 +27,8 @@ nlohmann::json SpeedVsErrorGenerated();
 Response HandleMaterials(const Request& request, const Context& context);
 /// GET /v1/presets: the preset bats with their properties and sources.
 Response HandlePresets(const Request& request, const Context& context);
+/// GET /v1/balls: the ball catalogue (mass, radius, COR law, contact law) with sources.
+Response HandleBalls(const Request& request, const Context& context);
 /// POST /v1/bat/properties: exact mass properties of a bat.
 Response HandleBatProperties(const Request& request, const Context& context);
 /// POST /v1/bat/fit: unknown dimensions from target mass and balance point.

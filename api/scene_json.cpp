@@ -14,8 +14,19 @@ using Json = nlohmann::json;
 
 // The ball's and the swing's numbers: their ranges are core's (core::Ball::Validate,
 // core::Swing::Validate), checked with the assembled scene.
+// "preset" first (a catalogue ball), then the explicit fields, which override the preset's.
 bool ReadBall(const Json& value, const std::string& path, core::Ball* ball, ApiError* error) {
   ObjectReader reader(value, path, error);
+  std::string preset;
+  reader.OptionalString("preset", &preset);
+  if (reader.ok() && reader.Has("preset")) {
+    const auto found = core::FindBallPreset(preset);
+    if (!found) {
+      reader.Fail("preset", "is not a ball (GET /v1/balls lists: " + core::BallPresetNames() + ")");
+      return false;
+    }
+    core::ApplyBallPreset(*found, ball);
+  }
   reader.OptionalNumber("mass_kg", AnyNumber(), &ball->mass_kg);
   reader.OptionalNumber("radius_m", AnyNumber(), &ball->radius_m);
   reader.OptionalNumber("speed_mps", AnyNumber(), &ball->speed_mps);
@@ -371,6 +382,7 @@ Json SceneResultToJson(const core::SceneResult& r) {
   if (r.cor.has_value()) {  // absent when no requested output uses a COR
     out["cor"] = *r.cor;
     out["cor_source"] = r.cor_source;
+    if (r.cor_impact_speed_mps) out["cor_impact_speed_mps"] = *r.cor_impact_speed_mps;
   }
   Json timings = Json::array();
   for (const auto& t : r.timings) {
@@ -389,7 +401,9 @@ Json CollisionResultToJson(const core::CollisionResult& r) {
            {"exit_speed_mps", r.exit_speed_mps},
            {"error_estimate", {{"exit_speed_mps", r.error_estimate_mps}}},
            {"cor", r.cor},
+           {"cor_source", r.cor_source},
            {"models_used", r.summary.models_used}};
+  if (r.cor_impact_speed_mps) out["cor_impact_speed_mps"] = *r.cor_impact_speed_mps;
   if (r.rigid_pivot) {
     const auto& p = *r.rigid_pivot;
     out["rigid_pivot"] = {{"x_from_pivot_m", p.x_from_pivot_m},

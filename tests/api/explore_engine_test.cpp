@@ -163,6 +163,18 @@ TEST(ExploreEngineTest, SceneAndMaterialAndFillPathsMatchTheJsonPath) {
   ExpectSameRows(profile, true, {"properties.mass_kg", "feasible"});
 }
 
+TEST(ExploreEngineTest, APresetBallsSweptFieldsMatchTheJsonPath) {
+  // ball.preset in the template: each design's ball is the preset's with the swept fields
+  // over it, and its COR the preset's law at the design's own speeds, in both paths.
+  Json scene = Json::parse(R"({
+    "bat": {"preset": "paper-wood"}, "ball": {"preset": "mlb"},
+    "parameters": [{"path": "ball.speed_mps", "min": 20, "max": 40, "count": 3},
+                   {"path": "ball.mass_kg", "min": 0.14, "max": 0.15, "count": 2},
+                   {"path": "swing.angular_speed_rad_s", "min": 10, "max": 50, "count": 2}],
+    "outputs": ["max_exit_speed", "center_of_percussion"]})");
+  ExpectSameRows(scene, true, {"index", "max_exit_speed.exit_speed_mps", "error.code"});
+}
+
 TEST(ExploreEngineTest, OutputsAndPathsTheEngineDoesNotReadDirectlyMatchTheJsonPath) {
   // A sweet zone and a curve are rendered from the JSON row (not direct columns); the swept
   // path is bound.
