@@ -155,6 +155,14 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
     // A scene object the request left to its defaults can still be swept.
     if ((head == "ball" || head == "swing") && !base.contains(head)) base[head] = Json::object();
     std::string why;
+    // A preset (bat.preset, ball.preset) is a catalogue name: every design would fail alike.
+    if (path.size() >= 7 && path.compare(path.size() - 7, 7, ".preset") == 0) {
+      SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
+               path +
+                   " names a catalogue entry, not a number: sweep the preset's numeric "
+                   "fields (they override it) instead");
+      return std::nullopt;
+    }
     auto steps = ParseJsonPath(path, &why);
     Json probe = base;
     if (!steps || !SetNumberAtPath(&probe, *steps, dimension.min, &why)) {

@@ -138,6 +138,15 @@ TEST(BallPresetTest, ASweepOverAPresetBallMatchesTheJsonPath) {
               single.body["max_exit_speed"]["exit_speed_mps"])
         << row.dump();
   }
+  // A preset itself cannot be swept (a name): a 400 before the first design, with or without
+  // one in the template.
+  for (const char* ball : {R"({})", R"({"preset": "mlb"})"}) {
+    const Response r = Post("/v1/explore", std::string(R"({"bat": {"preset": "paper-wood"},
+        "ball": )") + ball + R"(, "parameters": [{"path": "ball.preset", "min": 0, "max": 1,
+        "count": 2}], "outputs": ["max_exit_speed"]})");
+    EXPECT_EQ(r.status, 400) << r.body.dump();
+    EXPECT_EQ(r.body["field"], "parameters[0].path") << r.body.dump();
+  }
   // Faster pitches, lower COR, so the exit speed rises by less than e * du per du.
   EXPECT_NE(rows[0]["max_exit_speed"]["exit_speed_mps"],
             rows[2]["max_exit_speed"]["exit_speed_mps"]);

@@ -266,7 +266,7 @@ TEST(ExploreTest, AnUnknownLastKeyIsRefusedBeforeTheFirstDesign) {
        "depth_m, diameter_m, material)"},
       {CorkSweep()["bat"], "ball.speed",
        "parameters[0].path = \"ball.speed\": ball.speed is not a known field (known: mass_kg, "
-       "radius_m, speed_mps, stiffness_exponent, stiffness_n_m_p)"},
+       "preset, radius_m, speed_mps, stiffness_exponent, stiffness_n_m_p)"},
   };
   for (const Case& c : cases) {
     Json body = CorkSweep();
