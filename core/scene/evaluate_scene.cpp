@@ -106,13 +106,14 @@ void SceneResult::Reset() {
   // A field added to SceneResult must be reset here too: on x86-64 (the size this list was
   // written for) the size check says so.
 #if defined(__x86_64__)
-  static_assert(sizeof(SceneResult) == 1744, "SceneResult gained a field: reset it in Reset");
+  static_assert(sizeof(SceneResult) == 1760, "SceneResult gained a field: reset it in Reset");
 #endif
   summary.Reset();
   missing_model.clear();
   refused_field.clear();
   cor.reset();
   cor_source.clear();
+  cor_impact_speed_mps.reset();
   mass_properties = MassProperties{};
   length_m = 0.0;
   exit_speed_model.clear();
