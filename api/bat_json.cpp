@@ -141,6 +141,7 @@ std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& pa
     }
     spec.bat = preset->bat;
     spec.shape_form = "preset";
+    spec.paper = preset->name.rfind("paper-", 0) == 0;
   }
   const bool has_three = reader.Has("three_segment");
   const bool has_profile = reader.Has("profile");

@@ -23,6 +23,9 @@ struct BatSpec {
   nlohmann::json request_form;  ///< The bat object as the request wrote it.
   std::string shape_form;       ///< "preset", "three_segment" or "profile": where the shape came from.
   std::optional<core::ThreeSegmentShape> three_segment;  ///< Set for the three_segment form.
+  /// From one of the paper's presets ("paper-wood", "paper-wood-m885"): a scene's model auto
+  /// is then the paper's rigid_pivot (core::Scene::paper_bat).
+  bool paper = false;
 };
 
 /// Parses the bat object at `path` (e.g. "bat"). On error returns nullopt with

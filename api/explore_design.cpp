@@ -128,6 +128,7 @@ DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
   if (const Json* bat = reader.Get("bat")) {
     if (auto spec = ParseBatGeometry(*bat, "bat", limits, &error)) {
       scene.bat = std::move(spec->bat);
+      scene.paper_bat = spec->paper;
       ReadSceneCommon(reader, &scene);
     }
   }

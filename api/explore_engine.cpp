@@ -89,6 +89,7 @@ std::optional<DesignBinder> DesignBinder::Compile(const Json& base,
   if (!spec) return std::nullopt;
   ObjectReader reader(base, "", &error);
   binder.scene_.bat = spec->bat;
+  binder.scene_.paper_bat = spec->paper;
   if (!ReadSceneCommon(reader, &binder.scene_)) return std::nullopt;
   binder.scene_.outputs = outputs.scene;
   const Json& bat = base["bat"];
@@ -550,6 +551,8 @@ struct RunPlan {
 struct BlockResult {
   BlockRows rows;
   std::uint64_t failed = 0;
+  // Feasible designs whose max_exit_speed lies beyond the tip / before the knob (clamped).
+  std::uint64_t beyond_tip = 0, before_knob = 0;
   std::vector<std::vector<double>> objective_values;
   std::vector<std::uint64_t> indices;
   bool cancelled = false;  // stopped early: Progress::Cancel()
@@ -698,6 +701,11 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
       DesignOutcome& outcome = worker->outcome;
       if (!worker->evaluator) worker->evaluator.emplace(sweep.options);
       ComputeDesign(*worker->scene, sweep.outputs, &*worker->evaluator, &outcome);
+      if (outcome.feasible && outcome.result.max_exit_speed) {
+        const core::Placement at = outcome.result.max_exit_speed->placement;
+        out->beyond_tip += at == core::Placement::kBeyondTip;
+        out->before_knob += at == core::Placement::kBeforeKnob;
+      }
       if (outcome.feasible && !plan.direct && plan.columns->empty() &&
           plan.format != RowFormat::kCsv) {
         if (worker->row_template && FillTemplate(plan, i, point, outcome, worker, out)) return;
@@ -768,8 +776,12 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
   for (std::size_t k = 0; k < sweep.parameters.size(); ++k) {
     SetNumberAtPath(&design, sweep.parameters[k].steps, point[k], nullptr);
   }
-  AddJsonRow(plan, i, point, EvaluateDesign(design, sweep.outputs, sweep.options, sweep.limits).row,
-             out);
+  Json row = EvaluateDesign(design, sweep.outputs, sweep.options, sweep.limits).row;
+  if (const Json* at = FindAt(row, {"max_exit_speed", "placement"}); at != nullptr) {
+    out->beyond_tip += *at == core::PlacementName(core::Placement::kBeyondTip);
+    out->before_knob += *at == core::PlacementName(core::Placement::kBeforeKnob);
+  }
+  AddJsonRow(plan, i, point, std::move(row), out);
 }
 
 // The most designs in a block, and the time a block aims at: blocks of fast designs are
@@ -848,7 +860,7 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
 
   std::vector<std::vector<double>> objective_values;
   std::vector<std::uint64_t> indices;
-  std::uint64_t evaluated = 0, failed = 0;
+  std::uint64_t evaluated = 0, failed = 0, beyond_tip = 0, before_knob = 0;
   // Takes a finished block: false when the sweep ends here (cancelled or stopped).
   const auto take = [&](BlockResult& block) {
     if (block.cancelled || core::IsCancelled(progress)) {
@@ -857,6 +869,8 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
       return false;
     }
     failed += block.failed;
+    beyond_tip += block.beyond_tip;
+    before_knob += block.before_knob;
     for (auto& v : block.objective_values) objective_values.push_back(std::move(v));
     indices.insert(indices.end(), block.indices.begin(), block.indices.end());
     if (!emit(block.rows)) {
@@ -983,6 +997,7 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
     summary["pareto_objectives"] = ObjectivesToJson(sweep.objectives);  // for explore-merge
     summary["pareto_scope"] = "the rows of this response (this shard)";
   }
+  AddEndPlacements(beyond_tip, before_knob, &summary);
   summary["provenance"] = sweep.provenance;
   outcome.summary = std::move(summary);
   return outcome;

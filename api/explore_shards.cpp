@@ -72,6 +72,18 @@ Json ObjectivesToJson(const std::vector<ParetoObjective>& objectives) {
   return list;
 }
 
+void AddEndPlacements(std::uint64_t beyond_tip, std::uint64_t before_knob, Json* summary) {
+  if (beyond_tip + before_knob == 0) return;
+  (*summary)["max_exit_speed_at_bat_end"] = {{"beyond_tip", beyond_tip},
+                                             {"before_knob", before_knob}};
+  // As /v1/sweet-spot warns for one design: the sweet spot reported is the bat's end.
+  (*summary)["warnings"] = Json::array(
+      {"max_exit_speed: the maximum of " + std::to_string(beyond_tip) +
+       " designs lies beyond the tip and of " + std::to_string(before_knob) +
+       " before the knob; their sweet spot is the bat's end (each row's "
+       "max_exit_speed.placement says which)"});
+}
+
 MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards) {
   MergedSweep out;
   const auto fail = [&out](const std::string& why) {
@@ -84,7 +96,7 @@ MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards) {
     std::map<std::uint64_t, Json> rows;  // by design index
     std::set<std::uint64_t> shard_indices;
     SweepIdentity first;
-    std::uint64_t failed = 0;
+    std::uint64_t failed = 0, beyond_tip = 0, before_knob = 0;
     double timing_s = 0.0;
     for (std::size_t f = 0; f < shards.size(); ++f) {
       const ShardOutput& shard = shards[f];
@@ -170,6 +182,10 @@ MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards) {
         }
       }
       failed += s.value("failed", std::uint64_t{0});
+      if (const auto at_end = s.find("max_exit_speed_at_bat_end"); at_end != s.end()) {
+        beyond_tip += at_end->value("beyond_tip", std::uint64_t{0});
+        before_knob += at_end->value("before_knob", std::uint64_t{0});
+      }
       timing_s += s.value("timing_s", 0.0);
     }
     if (shard_indices.size() != first.count) {
@@ -220,6 +236,7 @@ MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards) {
       summary["pareto_objectives"] = first.objectives;
       summary["pareto_scope"] = "the rows of this response (this shard)";
     }
+    AddEndPlacements(beyond_tip, before_knob, &summary);
     summary["provenance"] = first.provenance;
     std::string text;
     for (const auto& [i, row] : rows) text += Dump(row) + "\n";

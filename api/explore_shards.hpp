@@ -33,6 +33,12 @@ const nlohmann::json* FindAt(const nlohmann::json& row, const std::vector<std::s
 /// The objectives as a summary lists them: [{"output", "sense"}].
 nlohmann::json ObjectivesToJson(const std::vector<ParetoObjective>& objectives);
 
+/// Adds to a sweep's summary how many feasible designs have their max_exit_speed clamped to an
+/// end of the bat ("max_exit_speed_at_bat_end": {"beyond_tip", "before_knob"}) and a warning
+/// saying so, when any has; nothing otherwise. The merge of shards sums the counts.
+void AddEndPlacements(std::uint64_t beyond_tip, std::uint64_t before_knob,
+                      nlohmann::json* summary);
+
 /// One shard's NDJSON output and where it came from (for messages).
 struct ShardOutput {
   std::string name;  ///< A file name, or any label.

@@ -99,6 +99,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
     if (!spec || !ReadSceneCommon(check, &scene)) return std::nullopt;
     // The ranges (ball, swing, cor) are core's: checked as a design's row checks them.
     scene.bat = spec->bat;
+    scene.paper_bat = spec->paper;
     scene.outputs = {core::SceneOutput::kMaxExitSpeed};
     if (core::Refusal refusal; !scene.Validate(&refusal)) {
       CoreRefusal(refusal, "", error);

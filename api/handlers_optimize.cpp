@@ -107,7 +107,8 @@ bool ReadConstraints(ObjectReader& top, core::DesignConstraints* c) {
 // beam's settings, as for /v1/sweet-spot). Without "backend", min_sting runs
 // nlopt_cobyla (the only solver it can use) and the other objectives ipopt.
 bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjective objective,
-                 core::DesignOptions* o, core::FlexibleOptions* flexible) {
+                 core::DesignOptions* o, core::FlexibleOptions* flexible,
+                 core::CollisionModel* model) {
   // Defaults never exceed the configured limits.
   o->max_iterations = std::min(o->max_iterations, limits.max_iterations);
   o->max_time_s = std::min(o->max_time_s, limits.max_time_s);
@@ -125,6 +126,10 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
   reader.OptionalString("backend", &backend, {"ipopt", "nlopt_slsqp", "nlopt_cobyla"});
   reader.OptionalString("hessian", &hessian, {"limited_memory", "exact"});
   reader.OptionalString("derivative_check", &check, {"none", "first_order", "second_order"});
+  // The exit-speed model: the closed forms only (the design's derivatives are exact).
+  std::string model_name = "auto";
+  reader.OptionalString("model", &model_name, {"auto", "rigid_pivot", "free_bat"});
+  *model = *core::ParseCollisionModel(model_name);
   o->backend = backend == "ipopt"         ? core::DesignBackend::kIpopt
                : backend == "nlopt_slsqp" ? core::DesignBackend::kNloptSlsqp
                                           : core::DesignBackend::kNloptCobyla;
@@ -246,6 +251,7 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
            {"cor", r.cor},
            {"sweet_spot",
             {{"position_from_knob_m", Finite(r.sweet_spot_from_knob_m)},
+             {"placement", core::PlacementName(r.sweet_spot_placement)},
              {"exit_speed_mps", Finite(r.max_exit_speed_mps)},
              {"angular_speed_rad_s", Finite(r.angular_speed_rad_s)}}},
            {"summary", std::move(summary)}};
@@ -272,6 +278,7 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
 // is given back in its form).
 struct OptimizeRequest {
   core::DesignProblem problem;
+  std::string model_reason;  // why problem.model (core::ResolveExitModel)
   core::DesignOptions options;
   std::vector<core::Material> material_choices;
   std::string objective;
@@ -373,11 +380,15 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
   problem.swing_weight_reference_kg_m2 =
       reader.MaybeNumber("swing_weight_reference_kg_m2", AnyNumber());  // range: core's
   reader.OptionalNumber("sweet_zone_tolerance_mps", AnyNumber(), &problem.sweet_zone_tolerance_mps);
+  core::CollisionModel model = core::CollisionModel::kAuto;
   if (!ReadOptions(reader, context.limits, problem.objective, &request.options,
-                   &problem.flexible) ||
+                   &problem.flexible, &model) ||
       !reader.Finish()) {
     return std::nullopt;
   }
+  // "auto" as the scenes resolve it: the free bat, or the paper's rigid_pivot for its bats.
+  scene.paper_bat = spec->paper;
+  problem.model = core::ResolveExitModel(model, scene, &request.model_reason);
   if (problem.variables.empty()) {
     reader.Fail("variables", "needs at least one continuous variable besides a material choice");
     return std::nullopt;
@@ -430,6 +441,10 @@ Json RenderOptimize(const OptimizeRequest& request, const OptimizeResult& result
     out["materials"] = std::move(per_material);
   }
   out["objective"] = request.objective;
+  if (request.problem.objective != core::DesignObjective::kMinMoi) {
+    out["sweet_spot"]["model"] = core::CollisionModelName(request.problem.model);
+    out["sweet_spot"]["model_reason"] = request.model_reason;
+  }
   return out;
 }
 

@@ -21,7 +21,10 @@ std::optional<BatSpec> ReadBat(ObjectReader& reader, const char* key, const ApiL
     return std::nullopt;
   }
   auto spec = ParseBatGeometry(*value, reader.PathOf(key), limits, reader.error());
-  if (spec && scene != nullptr) scene->bat = spec->bat;
+  if (spec && scene != nullptr) {
+    scene->bat = spec->bat;
+    scene->paper_bat = spec->paper;
+  }
   return spec;
 }
 
@@ -222,6 +225,7 @@ CompareResult RunCompare(const CompareRequest& request, const Context& context) 
     }
     core::Scene bat_scene = request.scene;
     bat_scene.bat = request.bats[i].second.bat;
+    bat_scene.paper_bat = request.bats[i].second.paper;
     if (core::Refusal refusal; !bat_scene.Validate(&refusal)) {
       out.refusal = std::move(refusal);
       return out;

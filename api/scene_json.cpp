@@ -174,7 +174,7 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
   const Json* value = top.Get("options");
   if (value == nullptr || !top.ok()) return top.ok();
   ObjectReader reader(*value, top.PathOf("options"), top.error());
-  std::string model = "rigid_pivot";
+  std::string model = "auto";
   reader.OptionalString("model", &model, {"auto", "rigid_pivot", "free_bat", "hertz", "flexible"});
   options->model = *core::ParseCollisionModel(model);
   std::string method = "closed_form";

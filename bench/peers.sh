@@ -28,7 +28,7 @@ echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at 
 "$py" -c 'import json,sys; print(json.dumps(json.load(open(sys.argv[1]))["request"]))' \
   "$work/design16.json" >"$work/optimize.json"
 for h in limited_memory exact; do
-  "$py" -c 'import json,sys; r=json.load(open(sys.argv[1])); r["options"]={"hessian": sys.argv[2]}; print(json.dumps(r))' \
+  "$py" -c 'import json,sys; r=json.load(open(sys.argv[1])); r["options"]={"hessian": sys.argv[2], "model": "rigid_pivot"}; print(json.dumps(r))' \
     "$work/optimize.json" "$h" >"$work/optimize_$h.json"
   "$cli" optimize "$work/optimize_$h.json" >"$work/ours_$h.json"
 done

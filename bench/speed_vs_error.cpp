@@ -389,7 +389,8 @@ void RigidAndFreeSweetSpotRows(const TimingOptions& timing, bool quick, Report* 
        "the closed form (core::ClosedFormMaxExitSpeed): the rows' errors are against it",
        "method = closed_form: core::SceneOptions::method = SweetSpotMethod::kClosedForm "
        "(core/scene/scene.hpp), request default \"closed_form\" (api/scene_json.cpp); model = auto "
-       "and the request default are rigid_pivot. With method = nlopt the default algorithm is "
+       "(the default) is free_bat, and rigid_pivot for the paper's bats "
+       "(core::ResolveExitModel). With method = nlopt the default algorithm is "
        "LD_SLSQP and x_tolerance_m = " +
            Tol(default_search.x_tolerance_m) +
            " (core::ScalarSearchOptions, core/optimize/nlopt_search.hpp)"});
@@ -465,7 +466,7 @@ void HertzImpactRows(const TimingOptions& timing, bool quick, Report* report) {
            " with refine_check = true (a second solve at tolerance/16 for the error estimate): "
            "core::HertzSolverOptions (core/collision/hertz_contact.hpp). model = auto picks "
            "hertz only when contact details are asked for (core::CollisionOptions::"
-           "want_contact_details), rigid_pivot otherwise"});
+           "want_contact_details), free_bat otherwise (rigid_pivot for the paper's bats)"});
   const core::Scene scene = PaperScene();
   core::CollisionOptions ref_o;
   ref_o.hertz.solver.relative_tolerance = 1e-12;
@@ -1033,8 +1034,8 @@ std::string HowToChoose(const Report& report) {
      << "); at looser tolerances the step bound, not the tolerance, sets it (1e-2: " << ErrorOf(h_2)
      << "). The default's refine check (a second solve at tolerance/16) costs "
      << Ratio(h_auto, h_8) << " (" << TimeOf(h_auto) << " against " << TimeOf(h_8)
-     << ") and buys an error estimate, not accuracy. `model = auto` runs `rigid_pivot` unless "
-        "contact details are asked for.\n";
+     << ") and buys an error estimate, not accuracy. `model = auto` runs `free_bat` "
+        "(`rigid_pivot` for the paper's bats) unless contact details are asked for.\n";
   const Row* hs_auto = FindRow(report, "hertz_sweet_spot", "defaults");
   md << "* **Sweet spot with `hertz`**: NLopt over ODE solves, " << TimeOf(hs_auto)
      << " with the defaults; the exit speed is flat at the maximum, so the position is "

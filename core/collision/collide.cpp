@@ -58,10 +58,7 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
         out.model_reason =
             "auto: hertz, the only model that knows contact time, peak force and compression";
       } else {
-        model = CollisionModel::kRigidPivot;
-        out.model_reason =
-            "auto: rigid_pivot, the cheapest adequate model (closed form; the swing has a fixed "
-            "pivot; only the exit speed and impulses were asked for)";
+        model = ResolveExitModel(model, scene, &out.model_reason);
       }
     } else {
       out.model_reason = "requested";

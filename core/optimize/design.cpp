@@ -93,6 +93,7 @@ struct PublicEvaluation {
   double sweet_spot_m = kNaN;
   double max_exit_speed_mps = kNaN;
   double omega_rad_s = kNaN;
+  Placement placement = Placement::kOnBat;  // of the sweet spot
   std::optional<StingEvaluation> sting;  // min_sting
 };
 
@@ -108,9 +109,10 @@ PublicEvaluation EvaluatePublic(const DesignProblem& problem, const DesignModel&
     Swing swing = problem.swing;
     swing.angular_speed_rad_s = out.omega_rad_s;  // the design's own (from its swing weight)
     const ExitSpeedProfile profile =
-        RigidPivotProfile(RigidPivotInputsFor(p, problem.ball, swing, model.cor()));
+        ClosedFormProfileFor(problem.model, p, problem.ball, swing, model.cor());
     const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(profile, length);
     out.sweet_spot_m = max.position_from_knob_m;
+    out.placement = max.placement;
     out.max_exit_speed_mps = max.exit_speed_mps;
     const SweetZoneResult zone =
         ClosedFormSweetZone(profile, length, max, problem.sweet_zone_tolerance_mps);
@@ -431,7 +433,9 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
   const DesignBackend backend = MainBackend(problem, options);
   summary.backend = BackendName(backend);
   summary.models_used = {"mass_properties"};
-  if (problem.objective != DesignObjective::kMinMoi) summary.models_used.push_back("rigid_pivot");
+  if (problem.objective != DesignObjective::kMinMoi) {
+    summary.models_used.push_back(CollisionModelName(problem.model));
+  }
   const bool sting = problem.objective == DesignObjective::kMinSting;
   if (sting || problem.constraints.min_frequency_hz.has_value()) {
     summary.models_used.push_back(kFlexibleBeamModel);
@@ -498,6 +502,13 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     result.sweet_spot_from_knob_m = pub.sweet_spot_m;
     result.max_exit_speed_mps = pub.max_exit_speed_mps;
     result.angular_speed_rad_s = pub.omega_rad_s;
+    result.sweet_spot_placement = pub.placement;
+    if (pub.placement != Placement::kOnBat && std::isfinite(pub.sweet_spot_m)) {
+      summary.warnings.push_back(
+          std::string("sweet_spot: the exit speed's maximum lies ") +
+          (pub.placement == Placement::kBeyondTip ? "beyond the tip" : "before the knob") +
+          "; the sweet spot reported is the bat's end (" + PlacementName(pub.placement) + ")");
+    }
     summary.objective = pub.objective;
     if (problem.constraints.min_frequency_hz.has_value()) {
       result.first_bending_mode = FirstBendingModeOf(problem, model, result.bat, x);

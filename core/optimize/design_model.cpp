@@ -298,16 +298,27 @@ T DesignModel::ObjectiveOf(const T* p) const {
     omega = omega0_rad_s_ *
             jet::Pow(MoiAbout(p, c0_, kSixInchPivotM) * (1.0 / i6_ref_), -swing_weight_exponent_);
   }
-  const double lo = -pivot;   // the knob, in coordinates from the pivot
-  const T hi = p[3] - pivot;  // the tip
-  // The rigid-pivot closed forms (exit_speed_algebra.hpp, the code ExitSpeedProfile runs).
-  const exit_speed::Form<T> form = exit_speed::RigidPivotForm(j, m, u, omega, e);
+  // The closed forms (exit_speed_algebra.hpp, the code ExitSpeedProfile runs): x from the pivot
+  // (rigid_pivot, RigidPivotProfile) or from the balance point (free_bat, FreeBatProfile).
+  T origin(pivot);
+  exit_speed::Form<T> form;
+  if (free_bat_) {
+    // Moments about c0: S1 = M (C - c0), so C = c0 + S1/M and I_cm = S2 - S1^2/M.
+    origin = c0_ + p[1] / p[0];
+    const T i_cm = p[2] - p[1] * p[1] / p[0];
+    form = {T(u),         (1.0 + e) * i_cm, u + omega * (origin - pivot), i_cm * (1.0 + m / p[0]),
+            T(m),         omega};
+  } else {
+    form = exit_speed::RigidPivotForm(j, m, u, omega, e);
+  }
+  const T lo = -origin;        // the knob
+  const T hi = p[3] - origin;  // the tip
   const exit_speed::Maximum<T> mx = exit_speed::MaximumOf(form);
   const bool beyond_tip = jet::Value(mx.x_m) > jet::Value(hi);
-  const bool before_knob = jet::Value(mx.x_m) < lo;
+  const bool before_knob = jet::Value(mx.x_m) < jet::Value(lo);
   if (objective_kind_ != DesignObjective::kWidestSweetZone) {
     if (beyond_tip) return exit_speed::ExitSpeedAt(form, hi);
-    if (before_knob) return exit_speed::ExitSpeedAt(form, T(lo));
+    if (before_knob) return exit_speed::ExitSpeedAt(form, lo);
     return mx.peak_mps - u;
   }
   // The sweet zone (ClosedFormSweetZone's algebra): where f(x) >= f(x_c) - tolerance, x_c the
@@ -318,7 +329,7 @@ T DesignModel::ObjectiveOf(const T* p) const {
   }
   const exit_speed::Zone<T> zone = exit_speed::ZoneAround(form, mx, delta);
   const T top = (zone.hi_open || jet::Value(zone.hi_m) > jet::Value(hi)) ? hi : zone.hi_m;
-  const T bottom = (zone.lo_open || jet::Value(zone.lo_m) < lo) ? T(lo) : zone.lo_m;
+  const T bottom = (zone.lo_open || jet::Value(zone.lo_m) < jet::Value(lo)) ? lo : zone.lo_m;
   return top - bottom;
 }
 
@@ -557,8 +568,7 @@ StingEvaluation EvaluateSting(const Bat& bat, const StingScene& scene, bool refi
   try {
     const MassProperties p = ComputeMassProperties(bat, scene.inertia_model);
     const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(
-        RigidPivotProfile(RigidPivotInputsFor(p, scene.ball, scene.swing, scene.cor)),
-        bat.LengthM());
+        ClosedFormProfileFor(scene.model, p, scene.ball, scene.swing, scene.cor), bat.LengthM());
     out.sweet_spot_from_knob_m = max.position_from_knob_m;
     Scene s;
     s.bat = bat;

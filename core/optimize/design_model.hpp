@@ -98,6 +98,7 @@ struct StingScene {
   double cor = 0.5;                                       ///< The COR used.
   InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< For the mass properties.
   FlexibleOptions flexible;                               ///< The flexible beam's settings.
+  CollisionModel model = CollisionModel::kRigidPivot;  ///< The sweet spot's closed form.
 };
 
 /// One sting evaluation (internal).
@@ -221,6 +222,7 @@ class DesignModel {
   double omega0_rad_s_ = 17.288;
   double pivot_from_knob_m_ = 0.0;
   double cor_ = 0.5;
+  bool free_bat_ = false;  // the exit-speed model: free_bat (else rigid_pivot)
   double swing_weight_exponent_ = 0.27;
   double zone_tolerance_mps_ = 1.0;
   double i6_ref_ = 1.0;

@@ -259,6 +259,13 @@ bool ModelBuilder::SceneNumbers() {
   model.ball_speed_mps_ = problem.ball.speed_mps;
   model.omega0_rad_s_ = problem.swing.angular_speed_rad_s;
   model.pivot_from_knob_m_ = problem.swing.pivot_from_knob_m;
+  if (problem.model != CollisionModel::kRigidPivot && problem.model != CollisionModel::kFreeBat) {
+    return Refuse(why, Refusal{"model", std::numeric_limits<double>::quiet_NaN(),
+                               CollisionModelName(problem.model),
+                               "must be rigid_pivot or free_bat (the design's derivatives need a "
+                               "closed form)"});
+  }
+  model.free_bat_ = problem.model == CollisionModel::kFreeBat;
   model.swing_weight_exponent_ = problem.swing_weight_exponent;
   model.zone_tolerance_mps_ = problem.sweet_zone_tolerance_mps;
   model.objective_kind_ = problem.objective;
@@ -266,6 +273,7 @@ bool ModelBuilder::SceneNumbers() {
     model.sting_scene_.ball = problem.ball;
     model.sting_scene_.swing = problem.swing;
     model.sting_scene_.cor = model.cor_;
+    model.sting_scene_.model = problem.model;
     model.sting_scene_.inertia_model = problem.inertia_model;
     model.sting_scene_.flexible = problem.flexible;
     model.sting_scene_.flexible.modes_cache = nullptr;  // the model's own cache instead

@@ -185,6 +185,10 @@ struct DesignProblem {
   Swing swing;
   std::optional<double> cor;  ///< COR in [0, 1]; unset = the bat material's default.
   InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< How moments are computed.
+  /// The exit-speed model of the objectives, the reported sweet spot and min_sting's impact
+  /// point: kRigidPivot (the paper's pinned bat) or kFreeBat (the free bat in the swing's
+  /// velocity field); both closed forms. The api resolves "auto" as the scenes do.
+  CollisionModel model = CollisionModel::kRigidPivot;
   /// kMinSting: the flexible beam's settings (theory, modes, tolerances, grip length; defaults as
   /// for /v1/sweet-spot). flexible.modes_cache is not used: every design has new modes, so each
   /// solve keeps its own small cache (repeated points) instead of filling a shared one.
@@ -366,6 +370,9 @@ struct DesignResult {
   double sweet_spot_from_knob_m = 0.0;
   double max_exit_speed_mps = 0.0;   ///< Max exit speed there, m/s (NaN as above).
   double angular_speed_rad_s = 0.0;  ///< omega of the swing for the answer, rad/s.
+  /// Where the sweet spot's unconstrained maximum lies: kBeyondTip / kBeforeKnob when the
+  /// reported point is the bat's end it was clamped to.
+  Placement sweet_spot_placement = Placement::kOnBat;
   std::vector<DesignActiveConstraint> active_constraints;  ///< What holds the design back.
   std::vector<DesignConflict> conflicts;                   ///< For an infeasible request: why.
   DesignSpread spread;                                     ///< Over the starts.

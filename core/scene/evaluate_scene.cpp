@@ -83,7 +83,7 @@ bool StingZone(const Scene& scene, const ResolvedScene& r, const SceneOptions& o
 }  // namespace
 
 std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model) {
-  if (exit_model == CollisionModel::kAuto) exit_model = CollisionModel::kRigidPivot;
+  if (exit_model == CollisionModel::kAuto) exit_model = CollisionModel::kFreeBat;
   switch (output) {
     case SceneOutput::kCenterOfPercussion:
       return {"mass_properties"};
@@ -199,15 +199,7 @@ void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
         return;
       }
     }
-    CollisionModel model = options.model;
-    if (model == CollisionModel::kAuto) {
-      model = CollisionModel::kRigidPivot;
-      out.model_reason =
-          "auto: rigid_pivot, the cheapest adequate model (closed form; the swing has a fixed "
-          "pivot and these outputs need only the exit speed)";
-    } else {
-      out.model_reason = "requested";
-    }
+    const CollisionModel model = ResolveExitModel(options.model, scene, &out.model_reason);
     if (!needs_exit) out.model_reason.clear();
     s.termination = Termination::kConverged;
     std::vector<std::string> messages;

@@ -105,6 +105,24 @@ RigidPivotInputs RigidPivotInputsFor(const MassProperties& mass_properties, cons
   return in;
 }
 
+ExitSpeedProfile ClosedFormProfileFor(CollisionModel model, const MassProperties& mass_properties,
+                                      const Ball& ball, const Swing& swing, double cor) {
+  if (model != CollisionModel::kFreeBat) {
+    return RigidPivotProfile(RigidPivotInputsFor(mass_properties, ball, swing, cor));
+  }
+  FreeBatInputs in;
+  in.bat_mass_kg = mass_properties.mass_kg;
+  in.balance_point_m = mass_properties.balance_point_m;
+  in.moi_centroid_kg_m2 = mass_properties.moi_centroid_kg_m2;
+  in.pivot_from_knob_m = swing.pivot_from_knob_m;
+  in.hands_from_knob_m = swing.hands_from_knob_m;
+  in.ball_mass_kg = ball.mass_kg;
+  in.ball_speed_mps = ball.speed_mps;
+  in.angular_speed_rad_s = swing.angular_speed_rad_s;
+  in.cor = cor;
+  return FreeBatProfile(in);
+}
+
 RigidPivotInputs RigidPivotInputsFor(const Scene& scene, const ResolvedScene& r) {
   return RigidPivotInputsFor(r.mass_properties, scene.ball, scene.swing, *r.cor);
 }

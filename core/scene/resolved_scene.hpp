@@ -47,6 +47,10 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
 /// The rigid-pivot inputs of a bat with `mass_properties` hit by `ball` in `swing` with `cor`.
 RigidPivotInputs RigidPivotInputsFor(const MassProperties& mass_properties, const Ball& ball,
                                      const Swing& swing, double cor);
+/// The exit-speed profile of a closed-form model (kFreeBat; anything else: kRigidPivot) for a
+/// bat with `mass_properties` hit by `ball` in `swing` with `cor`.
+ExitSpeedProfile ClosedFormProfileFor(CollisionModel model, const MassProperties& mass_properties,
+                                      const Ball& ball, const Swing& swing, double cor);
 /// The rigid-pivot inputs of a resolved scene (its COR must be resolved).
 RigidPivotInputs RigidPivotInputsFor(const Scene& scene, const ResolvedScene& resolved);
 

@@ -192,6 +192,23 @@ const char* CollisionModelName(CollisionModel model) {
   return "auto";
 }
 
+CollisionModel ResolveExitModel(CollisionModel requested, const Scene& scene, std::string* reason) {
+  if (requested != CollisionModel::kAuto) {
+    *reason = "requested";
+    return requested;
+  }
+  if (scene.paper_bat) {
+    *reason =
+        "auto: rigid_pivot, the paper's model (the bat pinned at the pivot), for the paper's bat; "
+        "options.model = free_bat gives the free bat";
+    return CollisionModel::kRigidPivot;
+  }
+  *reason =
+      "auto: free_bat, the bat free during the ~1 ms contact and hit in the swing's velocity "
+      "field (closed form); rigid_pivot is the paper's pinned bat, flexible adds bending";
+  return CollisionModel::kFreeBat;
+}
+
 std::optional<CollisionModel> ParseCollisionModel(std::string_view name) {
   for (CollisionModel m :
        {CollisionModel::kAuto, CollisionModel::kRigidPivot, CollisionModel::kFreeBat,

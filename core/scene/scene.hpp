@@ -103,6 +103,9 @@ struct Scene {
   std::optional<double> cor;
   std::vector<SceneOutput> outputs = {
       SceneOutput::kMaxExitSpeed};  ///< What to compute (duplicates ignored).
+  /// The bat is one of the paper's presets ("paper-wood", "paper-wood-m885"): model auto picks
+  /// the paper's rigid_pivot for it, so the paper's numbers are reproduced.
+  bool paper_bat = false;
 
   /// True when the scene is well formed; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
@@ -112,7 +115,7 @@ struct Scene {
 
 /// A collision model.
 enum class CollisionModel {
-  kAuto,        ///< The cheapest adequate model; the result says which and why.
+  kAuto,        ///< free_bat (rigid_pivot for the paper's bats); the result says which and why.
   kRigidPivot,  ///< The paper's pivoted rigid bat (closed form).
   kFreeBat,     ///< The free rigid bat, collision efficiency (closed form).
   kHertz,       ///< The contact model (ODE).
@@ -123,6 +126,10 @@ enum class CollisionModel {
 const char* CollisionModelName(CollisionModel model);
 /// The model called `name`, or nullopt.
 std::optional<CollisionModel> ParseCollisionModel(std::string_view name);
+
+/// The exit-speed model `requested` resolves to for `scene` (kAuto: free_bat, or the paper's
+/// rigid_pivot for a paper bat), and why in *reason ("requested", or "auto: ..." saying why).
+CollisionModel ResolveExitModel(CollisionModel requested, const Scene& scene, std::string* reason);
 
 /// How the sweet spot is found.
 enum class SweetSpotMethod {
@@ -170,8 +177,9 @@ struct FlexibleOptions {
 
 /// Options of EvaluateScene.
 struct SceneOptions {
-  CollisionModel model =
-      CollisionModel::kRigidPivot;  ///< Exit-speed model for max/zone/curve (kAuto = rigid_pivot).
+  /// Exit-speed model for max/zone/curve: kAuto = free_bat (rigid_pivot for a paper bat);
+  /// ResolveExitModel says which and why.
+  CollisionModel model = CollisionModel::kAuto;
   SweetSpotMethod method = SweetSpotMethod::kClosedForm;  ///< Closed form or NLopt.
   ScalarSearchOptions nlopt;  ///< The NLopt search (algorithm, tolerances, budget).
   /// Sweet-zone tolerance in `sweet_zone_unit`: [0, 1000] m/s or [0, 100] percent.

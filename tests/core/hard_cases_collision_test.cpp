@@ -35,11 +35,13 @@ Scene BatByProperties(double mass, double balance, double moi_centroid, double l
 Scene PaperWood() {
   Scene s;
   s.bat = FindPreset("paper-wood")->bat;
+  s.paper_bat = true;  // as the api marks the paper's preset: model auto is the paper's rigid_pivot
   return s;
 }
 
 MaxExitSpeedResult Max(const Scene& s, SweetSpotMethod method = SweetSpotMethod::kClosedForm) {
   SceneOptions o;
+  o.model = CollisionModel::kRigidPivot;  // the hard cases of the paper's closed form
   o.method = method;
   const SceneResult r = EvaluateScene(s, o);
   EXPECT_TRUE(r.summary.IsSolutionUsable()) << r.summary.message;

@@ -15,6 +15,8 @@
 #include "core/material.hpp"
 #include "core/numerics/jet.hpp"
 #include "core/presets.hpp"
+#include "core/scene/resolved_scene.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -130,6 +132,47 @@ TEST(OptimizeModel, PropertiesMatchThePublicMassProperties) {
   }
 }
 
+// The model's exit-speed objectives equal the public closed forms of the design's bat, for
+// both models: the same algebra on moments about another point, so rounding only.
+TEST(OptimizeModel, ExitSpeedObjectivesMatchThePublicClosedForms) {
+  for (CollisionModel exit : {CollisionModel::kRigidPivot, CollisionModel::kFreeBat}) {
+    DesignProblem p = FilledThreeSegment(DesignObjective::kMaxExitSpeed);
+    p.model = exit;
+    const DesignModel model = Build(p);
+    std::mt19937_64 rng(5);
+    double spread = 0.0;  // how far the sweet spots of the designs are apart, m
+    double first = std::nan("");
+    for (int trial = 0; trial < 10; ++trial) {
+      const std::vector<double> x = RandomPoint(model, rng);
+      DesignPoint point;
+      ASSERT_TRUE(model.Evaluate(x.data(), false, &point));
+      const Bat bat = model.BatAt(x.data());
+      const MassProperties props = ComputeMassProperties(bat);
+      const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(
+          ClosedFormProfileFor(exit, props, p.ball, p.swing, model.cor()), bat.LengthM());
+      // Exit speeds of ~20 m/s from the same integrals: rounding, 1e-11 m/s.
+      EXPECT_NEAR(point.objective, max.exit_speed_mps, 1e-11) << CollisionModelName(exit);
+      if (std::isnan(first)) first = max.position_from_knob_m;
+      spread = std::max(spread, std::abs(max.position_from_knob_m - first));
+    }
+    EXPECT_GT(spread, 1e-3);  // the designs differ, so the comparison means something
+  }
+  // The free bat is not the pinned bat: their objectives differ at the base design.
+  DesignProblem rigid = FilledThreeSegment(DesignObjective::kMaxExitSpeed);
+  DesignProblem free = rigid;
+  free.model = CollisionModel::kFreeBat;
+  DesignPoint a, b;
+  ASSERT_TRUE(Build(rigid).Evaluate(Build(rigid).BaseX().data(), false, &a));
+  ASSERT_TRUE(Build(free).Evaluate(Build(free).BaseX().data(), false, &b));
+  EXPECT_GT(std::abs(a.objective - b.objective), 1e-3);  // 0.014 m/s here; rounding is 1e-11
+  // Only the closed forms can be optimised.
+  DesignProblem hertz = rigid;
+  hertz.model = CollisionModel::kHertz;
+  Refusal why;
+  EXPECT_FALSE(hertz.Validate(&why));
+  EXPECT_EQ(why.field, "model");
+}
+
 // Three-segment designs through x1 = 0 and x1 = x2, where ThreeSegmentShape::Knots() merges
 // knots: the model keeps 4 knots (coincident allowed), so it is smooth there, and equals the
 // merged bat's properties (the step of width 1e-12 L changes them by < 1e-12 relative).
@@ -218,7 +261,11 @@ TEST(OptimizeModel, GradientsMatchComputeMassPropertiesWithGradient) {
 TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
   std::mt19937_64 rng(11);
   for (DesignObjective objective : kObjectives) {
-    for (const DesignProblem& p : {HollowFilledProfile(objective), FilledThreeSegment(objective)}) {
+    for (int variant = 0; variant < 4; ++variant) {
+      // Both problems with both exit-speed models: rigid_pivot, then free_bat.
+      DesignProblem p =
+          variant % 2 == 0 ? HollowFilledProfile(objective) : FilledThreeSegment(objective);
+      p.model = variant < 2 ? CollisionModel::kRigidPivot : CollisionModel::kFreeBat;
       const DesignModel model = Build(p);
       ASSERT_GT(model.m(), 3);
       for (int trial = 0; trial < 3; ++trial) {

@@ -21,6 +21,7 @@ namespace {
 Scene PaperWood(std::vector<SceneOutput> outputs = {SceneOutput::kMaxExitSpeed}) {
   Scene s;
   s.bat = FindPreset("paper-wood")->bat;
+  s.paper_bat = true;  // as the api marks the paper's preset: model auto is the paper's rigid_pivot
   s.outputs = std::move(outputs);
   return s;
 }
@@ -147,8 +148,9 @@ TEST(SceneCor, OnlyOutputsThatRunAnImpactNeedOne) {
 TEST(SceneModels, EachOutputRunsOnlyWhatItNeeds) {
   EXPECT_EQ(ModelsFor(SceneOutput::kCenterOfPercussion, CollisionModel::kHertz),
             std::vector<std::string>{"mass_properties"});
+  // auto: the free bat (the paper's bats aside: rigid_pivot, also closed form).
   EXPECT_EQ(ModelsFor(SceneOutput::kMaxExitSpeed, CollisionModel::kAuto),
-            (std::vector<std::string>{"mass_properties", "rigid_pivot"}));
+            (std::vector<std::string>{"mass_properties", "free_bat"}));
   EXPECT_EQ(ModelsFor(SceneOutput::kVibrationNode, CollisionModel::kRigidPivot),
             std::vector<std::string>{"flexible_beam"});
   SceneResult r = EvaluateScene(PaperWood({SceneOutput::kCenterOfPercussion}), {});
@@ -235,12 +237,21 @@ TEST(SceneModels, FlexibleCollisionRunsTheBeamModel) {
   EXPECT_LT(c.exit_speed_mps, rigid.exit_speed_mps);
 }
 
-TEST(Collide, AutoPicksTheCheapestAdequateModelAndSaysWhy) {
+TEST(Collide, AutoPicksTheFreeBatOrThePapersModelAndSaysWhy) {
+  // The paper's bat: the paper's pinned bat.
   CollisionResult c = Collide(PaperWood(), 0.7, CollisionModel::kAuto);
   EXPECT_EQ(c.model, CollisionModel::kRigidPivot);
-  EXPECT_NE(c.model_reason.find("cheapest adequate"), std::string::npos);
+  EXPECT_NE(c.model_reason.find("the paper's model"), std::string::npos);
   EXPECT_TRUE(c.rigid_pivot.has_value());
   EXPECT_EQ(c.summary.models_used, (std::vector<std::string>{"mass_properties", "rigid_pivot"}));
+  // Any other bat: the free bat in the swing's velocity field.
+  Scene other = PaperWood();
+  other.paper_bat = false;
+  c = Collide(other, 0.7, CollisionModel::kAuto);
+  EXPECT_EQ(c.model, CollisionModel::kFreeBat);
+  EXPECT_NE(c.model_reason.find("auto: free_bat"), std::string::npos);
+  EXPECT_TRUE(c.free_bat.has_value());
+  EXPECT_EQ(c.summary.models_used, (std::vector<std::string>{"mass_properties", "free_bat"}));
   CollisionOptions o;
   o.want_contact_details = true;
   c = Collide(PaperWood(), 0.7, CollisionModel::kAuto, o);

@@ -18,6 +18,7 @@ namespace {
 Scene PaperWoodScene(std::vector<SceneOutput> outputs) {
   Scene s;
   s.bat = FindPreset("paper-wood")->bat;
+  s.paper_bat = true;  // as the api marks the paper's preset: model auto is the paper's rigid_pivot
   s.outputs = std::move(outputs);
   return s;
 }

@@ -354,6 +354,7 @@ INSTANTIATE_TEST_SUITE_P(Core, HardCaseHertz, testing::ValuesIn(HertzCases()), R
 core::Scene PaperWood() {
   core::Scene s;
   s.bat = core::FindPreset("paper-wood")->bat;
+  s.paper_bat = true;  // as the api marks the paper's preset: model auto is the paper's rigid_pivot
   return s;
 }
 
