@@ -21,6 +21,7 @@
 #include "api/json_reader.hpp"
 #include "api/response.hpp"
 #include "api/router.hpp"
+#include "api/trade_units.hpp"
 #include "core/summary.hpp"
 
 namespace sweetspot::api {
@@ -66,6 +67,9 @@ struct Endpoint {
   std::function<ProvenanceInputs(const Req& request, const nlohmann::json& body)> provenance;
   /// Whether a rendered result misses its targets (422 with it as "closest").
   std::function<std::optional<Unmet>(const Req& request, const Result& result)> unmet;
+  /// Notes on inputs no real bat, ball or swing has (SanityWarnings), appended to the
+  /// answer's "warnings"; empty = none.
+  std::function<std::vector<std::string>(const Req& request)> warnings;
 };
 
 namespace endpoint_detail {
@@ -89,9 +93,21 @@ inline Response ValidRequest() { return {200, nlohmann::json{{"valid", true}}}; 
 template <class Req, class Parse>
 std::optional<Req> ParseRequest(const Request& request, const Context& context, const Parse& parse,
                                 Response* failure) {
-  const std::optional<nlohmann::json> body = ParseObjectBody(request, context, failure);
+  std::optional<nlohmann::json> body = ParseObjectBody(request, context, failure);
   if (!body) return std::nullopt;
   ApiError error;
+  ReportUnits units = ReportUnits::kSi;
+  if (!TakeReportUnits(&*body, &units, &error)) {
+    *failure = ToResponse(error);
+    return std::nullopt;
+  }
+  if (units == ReportUnits::kImperial) {
+    SetError(&error, ErrorCode::kInvalidValue, "report_units", nullptr,
+             "\"imperial\" is not offered by " + request.path +
+                 " (its rows stay SI; properties.imperial.* gives inches and ounces)");
+    *failure = ToResponse(error);
+    return std::nullopt;
+  }
   std::optional<Req> parsed = parse(*body, context, &error);
   if (!parsed) *failure = ToResponse(error);
   return parsed;
@@ -105,9 +121,11 @@ Response ServeEndpoint(const Endpoint<Req, Result>& endpoint, const Request& req
                        const Context& context) {
   const auto start = std::chrono::steady_clock::now();
   Response refused;
-  const std::optional<nlohmann::json> body = ParseObjectBody(request, context, &refused);
+  std::optional<nlohmann::json> body = ParseObjectBody(request, context, &refused);
   if (!body) return refused;
   ApiError error;
+  ReportUnits units = ReportUnits::kSi;
+  if (!TakeReportUnits(&*body, &units, &error)) return ToResponse(error);
   const std::optional<Req> parsed = endpoint.parse(*body, context, &error);
   if (!parsed) return ToResponse(error);
   if (context.validate_only) return ValidRequest();
@@ -118,6 +136,8 @@ Response ServeEndpoint(const Endpoint<Req, Result>& endpoint, const Request& req
     }
   }
   nlohmann::json out = endpoint.render(*parsed, result);
+  if (endpoint.warnings) AppendWarnings(endpoint.warnings(*parsed), &out);
+  if (units == ReportUnits::kImperial) AddImperial(&out);
   const core::Summary* summary = endpoint.summary ? &endpoint.summary(result) : nullptr;
   std::optional<ProvenanceInputs> provenance;
   if (endpoint.provenance) provenance = endpoint.provenance(*parsed, *body);

@@ -4,6 +4,7 @@
 #include "api/bat_json.hpp"
 #include "api/endpoint.hpp"
 #include "api/handlers.hpp"
+#include "api/sanity.hpp"
 #include "core/presets.hpp"
 #include "core/shape_fit.hpp"
 
@@ -55,6 +56,9 @@ const Endpoint<PropertiesRequest, core::MassProperties>& PropertiesEndpoint() {
       out["models_used"] = {"mass_properties"};
       out["method"] = "closed_form";
       return out;
+    };
+    e.warnings = [](const PropertiesRequest& request) {
+      return SanityWarnings(&request.spec.bat, nullptr, nullptr);
     };
     return e;
   }();

@@ -13,6 +13,7 @@
 #include "api/endpoint.hpp"
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
+#include "api/sanity.hpp"
 #include "api/scene_json.hpp"
 #include "core/optimize/design_problem.hpp"
 
@@ -27,7 +28,10 @@ Json Finite(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 // are core's (DesignProblem::Validate).
 bool ReadRange(ObjectReader& reader, const char* key, std::optional<core::DesignRange>* out) {
   const NumberRule rule = AnyNumber();
-  const Json* value = reader.Get(key);
+  // The SI key or a trade spelling ("mass_oz": {"min": 30, "max": 31}), converted to SI.
+  std::string given_as;
+  double to_si = 1.0;
+  const Json* value = reader.GetInUnits(key, &given_as, &to_si);
   if (value == nullptr || !reader.ok()) return reader.ok();
   if (value->is_number()) {
     double v = 0;
@@ -35,10 +39,12 @@ bool ReadRange(ObjectReader& reader, const char* key, std::optional<core::Design
     *out = core::DesignRange::Equal(v);
     return true;
   }
-  ObjectReader range(*value, reader.PathOf(key), reader.error());
+  ObjectReader range(*value, reader.PathOf(given_as), reader.error());
   core::DesignRange r;
   r.min = range.MaybeNumber("min", rule);
   r.max = range.MaybeNumber("max", rule);
+  if (r.min) *r.min *= to_si;
+  if (r.max) *r.max *= to_si;
   if (!range.Finish()) return false;
   if (!r.min && !r.max) return range.Fail("min", "give min, max or both", ErrorCode::kMissingField);
   if (r.min && r.max && *r.min > *r.max) {
@@ -465,6 +471,11 @@ const Endpoint<OptimizeRequest, OptimizeResult>& OptimizeEndpoint() {
     e.run = RunOptimize;
     e.failure = OptimizeFailure;
     e.render = RenderOptimize;
+    e.warnings = [](const OptimizeRequest& request) {
+      // The base design's (the designs the solver finds are bounded by the variables).
+      const core::DesignProblem& p = request.problem;
+      return SanityWarnings(&p.bat, &p.ball, &p.swing);
+    };
     e.provenance = [](const OptimizeRequest& request, const Json& body) {
       return BodyOptions(body, request.options.seed);
     };

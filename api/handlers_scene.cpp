@@ -3,6 +3,7 @@
 // Each is a typed endpoint (api/endpoint.hpp): parse -> core call -> render.
 #include "api/endpoint.hpp"
 #include "api/handlers.hpp"
+#include "api/sanity.hpp"
 #include "api/scene_json.hpp"
 
 namespace sweetspot::api {
@@ -79,6 +80,7 @@ const Endpoint<SweetSpotRequest, core::SceneResult>& SweetSpotEndpoint() {
     e.summary = [](const core::SceneResult& result) -> const core::Summary& {
       return result.summary;
     };
+    e.warnings = [](const SweetSpotRequest& request) { return SceneSanityWarnings(request.scene); };
     e.provenance = [](const SweetSpotRequest& request, const Json& body) {
       return BodyOptions(body, request.options.method == core::SweetSpotMethod::kNlopt
                                    ? std::optional<unsigned long long>(request.options.nlopt.seed)
@@ -147,6 +149,7 @@ const Endpoint<CollisionRequest, core::CollisionResult>& CollisionEndpoint() {
     e.summary = [](const core::CollisionResult& result) -> const core::Summary& {
       return result.summary;
     };
+    e.warnings = [](const CollisionRequest& request) { return SceneSanityWarnings(request.scene); };
     e.provenance = [](const CollisionRequest&, const Json&) { return ProvenanceInputs{}; };
     return e;
   }();
@@ -305,6 +308,17 @@ const Endpoint<CompareRequest, CompareResult>& CompareEndpoint() {
     e.run = RunCompare;
     e.failure = CompareFailure;
     e.render = RenderCompare;
+    e.warnings = [](const CompareRequest& request) {
+      // The shared ball and swing once; each bat under its name.
+      std::vector<std::string> out =
+          SanityWarnings(nullptr, &request.scene.ball, nullptr);
+      for (const auto& [name, spec] : request.bats) {
+        for (const std::string& w : SanityWarnings(&spec.bat, nullptr, &request.scene.swing)) {
+          out.push_back(name + ": " + w);
+        }
+      }
+      return out;
+    };
     e.provenance = [](const CompareRequest&, const Json& body) { return BodyOptions(body); };
     return e;
   }();

@@ -1,5 +1,7 @@
 #include "api/json_reader.hpp"
 
+#include "api/trade_units.hpp"
+
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -291,28 +293,72 @@ bool ObjectReader::Missing(std::string_view key) {
   return SetError(error_, ErrorCode::kMissingField, PathOf(key), nullptr, "is required");
 }
 
+const nlohmann::json* ObjectReader::GetInUnits(std::string_view key, std::string* given_as,
+                                               double* to_si) {
+  *given_as = std::string(key);
+  *to_si = 1.0;
+  const nlohmann::json* found = Get(key);
+  if (!value_->is_object()) return found;
+  for (const TradeForm& form : TradeForms(key)) {
+    if (!value_->contains(form.key)) continue;
+    known_.insert(form.key);
+    if (found != nullptr) {
+      // Exactly one form per quantity: two could disagree.
+      Fail(form.key, "cannot be given together with " + PathOf(*given_as) +
+                         " (one quantity, give it in one form)");
+      return nullptr;
+    }
+    found = &(*value_)[form.key];
+    *given_as = form.key;
+    *to_si = form.to_si;
+  }
+  return found;
+}
+
+bool ObjectReader::HasInUnits(std::string_view key) const {
+  if (!value_->is_object()) return false;
+  if (value_->contains(key)) return true;
+  for (const TradeForm& form : TradeForms(key)) {
+    if (value_->contains(form.key)) return true;
+  }
+  return false;
+}
+
 bool ObjectReader::Number(std::string_view key, const NumberRule& rule, double* out) {
   if (!ok()) return false;
-  if (!Has(key)) return Missing(key);
+  if (!HasInUnits(key)) return Missing(key);
   return OptionalNumber(key, rule, out);
 }
 
 bool ObjectReader::OptionalNumber(std::string_view key, const NumberRule& rule, double* out) {
   if (!ok()) return false;
-  const nlohmann::json* value = Get(key);
+  std::string given_as;
+  double to_si = 1.0;
+  const nlohmann::json* value = GetInUnits(key, &given_as, &to_si);
+  if (!ok()) return false;
   if (value == nullptr) return true;
   if (!value->is_number()) {
-    return Fail(key, rule.integer ? "must be an integer" : "must be a number");
+    return Fail(given_as, rule.integer ? "must be an integer" : "must be a number");
   }
-  const double number = value->get<double>();
-  if (!rule.Accepts(number)) return Fail(key, rule.Describe());
+  const double number = value->get<double>() * to_si;
+  if (!rule.Accepts(number)) {
+    // The rule is the SI field's: say what the value is in it.
+    return Fail(given_as, given_as == key ? rule.Describe()
+                                          : rule.Describe() + " as " + std::string(key) + " (" +
+                                                core::FormatNumber(number) + ")");
+  }
   *out = number;
   return true;
 }
 
 std::optional<double> ObjectReader::MaybeNumber(std::string_view key, const NumberRule& rule) {
   double value = 0.0;
-  if (!Has(key) || !OptionalNumber(key, rule, &value)) return std::nullopt;
+  if (!ok()) return std::nullopt;
+  if (!HasInUnits(key)) {
+    Skip(key);
+    return std::nullopt;
+  }
+  if (!OptionalNumber(key, rule, &value)) return std::nullopt;
   return value;
 }
 

@@ -88,9 +88,18 @@ class ObjectReader {
   /// The raw value of `key` (marks it as known), or nullptr.
   const nlohmann::json* Get(std::string_view key);
 
-  /// A required number obeying `rule`.
+  /// The value of SI field `key` or of one of its trade spellings (TradeForms: "length_in",
+  /// "barrel_diameter_in", "mass_oz", ...; marks the one given as known), with the name it was
+  /// given as and the factor to SI; nullptr when none is given, or (recording the error) when
+  /// two forms are.
+  const nlohmann::json* GetInUnits(std::string_view key, std::string* given_as, double* to_si);
+  /// True when `key` or one of its trade spellings is given.
+  bool HasInUnits(std::string_view key) const;
+  /// A required number obeying `rule` (in SI; `key` may be given in a trade unit, see
+  /// GetInUnits).
   bool Number(std::string_view key, const NumberRule& rule, double* out);
-  /// An optional number obeying `rule`; `*out` untouched when absent.
+  /// An optional number obeying `rule` (in SI; `key` may be given in a trade unit, converted
+  /// here); `*out` untouched when absent.
   bool OptionalNumber(std::string_view key, const NumberRule& rule, double* out);
   /// An optional number; nullopt when absent or invalid (check ok()).
   std::optional<double> MaybeNumber(std::string_view key, const NumberRule& rule);

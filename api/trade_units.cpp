@@ -1,0 +1,130 @@
+#include "api/trade_units.hpp"
+
+#include <optional>
+#include <utility>
+
+#include "api/json_reader.hpp"
+#include "core/units.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr double kMetresPerSecondPerMph = 0.44704;  // exact: 1609.344 m / 3600 s
+constexpr double kKgM2PerOzIn2 =
+    core::kKilogramsPerOunce * core::kMetresPerInch * core::kMetresPerInch;
+
+bool EndsWith(std::string_view s, std::string_view suffix) {
+  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
+}
+
+// A unit suffix of an SI name and its trade form.
+struct UnitRule {
+  std::string_view si;     // "_kg_m2"
+  std::string_view trade;  // "_oz_in2"
+  double to_si;            // trade value * to_si = SI value
+};
+
+// Longest suffixes first: "_kg_m2" before "_m2"-like endings, "_mps" before "_s".
+constexpr UnitRule kRules[] = {
+    {"_kg_m2", "_oz_in2", kKgM2PerOzIn2},
+    {"_mps", "_mph", kMetresPerSecondPerMph},
+    {"_kg", "_oz", core::kKilogramsPerOunce},
+    {"_m", "_in", core::kMetresPerInch},
+};
+
+// The rule of `key`'s SI unit, or nullptr.
+const UnitRule* RuleOf(std::string_view key) {
+  // Stiffness (N/m) and damping (N·s/m) end in "_m" but are not lengths.
+  if (EndsWith(key, "_n_m") || EndsWith(key, "_s_m")) return nullptr;
+  for (const UnitRule& rule : kRules) {
+    if (EndsWith(key, rule.si) && key.size() > rule.si.size()) return &rule;
+  }
+  return nullptr;
+}
+
+// The bat length an object states: its own "length_m", or its "properties.length_m".
+std::optional<double> LengthOf(const Json& object) {
+  if (const auto it = object.find("length_m"); it != object.end() && it->is_number()) {
+    return it->get<double>();
+  }
+  if (const auto p = object.find("properties"); p != object.end() && p->is_object()) {
+    if (const auto it = p->find("length_m"); it != p->end() && it->is_number()) {
+      return it->get<double>();
+    }
+  }
+  return std::nullopt;
+}
+
+void AddImperialTo(Json* node, std::optional<double> length_m) {
+  if (node->is_array()) {
+    for (Json& item : *node) AddImperialTo(&item, length_m);
+    return;
+  }
+  if (!node->is_object()) return;
+  if (const auto own = LengthOf(*node)) length_m = own;
+  std::vector<std::pair<std::string, double>> added;
+  for (auto& [key, value] : node->items()) {
+    if (value.is_structured()) {
+      AddImperialTo(&value, length_m);
+      continue;
+    }
+    if (!value.is_number()) continue;
+    const UnitRule* rule = RuleOf(key);
+    if (rule == nullptr) continue;
+    const std::string base = key.substr(0, key.size() - rule->si.size());
+    const double si = value.get<double>();
+    added.emplace_back(base + std::string(rule->trade), si / rule->to_si);
+    if (rule->trade == "_in" && EndsWith(base, "_from_knob") && length_m) {
+      const std::string stem = base.substr(0, base.size() - std::string_view("_from_knob").size());
+      added.emplace_back(stem + "_from_tip_in", (*length_m - si) / core::kMetresPerInch);
+    }
+  }
+  for (auto& [key, value] : added) {
+    if (!node->contains(key)) (*node)[key] = value;
+  }
+}
+
+}  // namespace
+
+std::vector<TradeForm> TradeForms(std::string_view si_key) {
+  std::vector<TradeForm> out;
+  const UnitRule* rule = RuleOf(si_key);
+  if (rule == nullptr) return out;
+  const std::string_view base = si_key.substr(0, si_key.size() - rule->si.size());
+  out.push_back({std::string(base) + std::string(rule->trade), rule->to_si});
+  if (rule->si == "_m" && EndsWith(base, "radius")) {
+    // A radius may be given as a diameter, in metres or inches.
+    const std::string stem =
+        std::string(base.substr(0, base.size() - std::string_view("radius").size())) + "diameter";
+    out.push_back({stem + "_m", 0.5});
+    out.push_back({stem + "_in", 0.5 * core::kMetresPerInch});
+  }
+  return out;
+}
+
+void AddImperial(Json* answer) { AddImperialTo(answer, std::nullopt); }
+
+bool TakeReportUnits(Json* body, ReportUnits* units, ApiError* error) {
+  *units = ReportUnits::kSi;
+  if (!body->is_object()) return true;
+  const auto it = body->find("report_units");
+  if (it == body->end()) return true;
+  if (it->is_string() && (*it == "si" || *it == "imperial")) {
+    *units = *it == "imperial" ? ReportUnits::kImperial : ReportUnits::kSi;
+    body->erase(it);
+    return true;
+  }
+  return SetError(error, ErrorCode::kInvalidValue, "report_units", &*it,
+                  "must be \"si\" or \"imperial\"");
+}
+
+void AppendWarnings(const std::vector<std::string>& warnings, Json* answer) {
+  if (warnings.empty()) return;
+  Json& list = (*answer)["warnings"];
+  if (!list.is_array()) list = Json::array();
+  for (const std::string& w : warnings) list.push_back(w);
+}
+
+}  // namespace sweetspot::api

@@ -1,0 +1,51 @@
+// The trade's units at the API boundary (issue 19): every SI input field may be written in
+// inches, ounces, mph or oz·in² with the unit in its name, and radii as diameters; and
+// "report_units": "imperial" adds those units beside every SI number of an answer. Core stays
+// SI: these conversions happen only here.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sweetspot::api {
+
+/// Another spelling of an SI field: its name and the factor that turns its value into the SI
+/// field's (SI = value * to_si).
+struct TradeForm {
+  std::string key;     ///< e.g. "length_in", "barrel_diameter_in".
+  double to_si = 1.0;  ///< e.g. 0.0254 (in -> m), 0.0127 (diameter in -> radius m).
+};
+
+/// The trade spellings of SI field `si_key`: "*_m" -> "*_in" (a length; not "*_n_m" or
+/// "*_s_m", which are stiffness and damping); "*radius_m" also -> "*diameter_m", "*diameter_in";
+/// "*_kg" -> "*_oz"; "*_mps" -> "*_mph"; "*_kg_m2" -> "*_oz_in2". Empty for any other name.
+std::vector<TradeForm> TradeForms(std::string_view si_key);
+
+/// How an answer reports its numbers ("report_units").
+enum class ReportUnits {
+  kSi,        ///< SI only (the default).
+  kImperial,  ///< SI, and beside each SI number its inches / ounces / mph / oz·in² form.
+};
+
+/// Adds, beside every number of `answer` whose key has an SI unit (as TradeForms reads it; not
+/// "*_diameter_*"), the same quantity in the trade's unit ("length_m" -> "length_in",
+/// "mass_kg" -> "mass_oz", "exit_speed_mps" -> "exit_speed_mph", "*_kg_m2" -> "*_oz_in2"), and
+/// beside every position "*_from_knob_m" its distance from the barrel end in inches
+/// ("*_from_tip_in") where the bat's length is known (the object's own "length_m", its
+/// "properties.length_m", or the nearest enclosing one's). Keys already present are kept.
+void AddImperial(nlohmann::json* answer);
+
+struct ApiError;
+
+/// Reads and removes "report_units" ("si", the default, or "imperial") from a request body
+/// (an object), so the endpoint's own reader never sees it. False with the error (field
+/// report_units, the value, the rule) when it is not one of those.
+bool TakeReportUnits(nlohmann::json* body, ReportUnits* units, ApiError* error);
+
+/// Appends `warnings` to the answer's top-level "warnings" array (created when absent).
+void AppendWarnings(const std::vector<std::string>& warnings, nlohmann::json* answer);
+
+}  // namespace sweetspot::api
