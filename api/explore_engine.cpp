@@ -121,35 +121,40 @@ std::optional<DesignBinder> DesignBinder::Compile(const Json& base,
       {"bat.material.cor", T::kMaterialCor}};
   static const std::map<std::string_view, T> kFill = {{"bat.fill.diameter_m", T::kFillDiameter},
                                                       {"bat.fill.depth_m", T::kFillDepth}};
-  for (const SweepParameter& parameter : parameters) {
-    std::vector<std::size_t> indices;
-    const std::string pattern = StepPattern(parameter.steps, &indices);
-    Binding binding{};
-    if (const auto it = kScene.find(pattern); it != kScene.end()) {
-      binding.target = it->second;
-    } else if (const auto shape = kShape.find(pattern);
-               shape != kShape.end() && spec->three_segment) {
-      binding.target = shape->second;
-      binder.shape_ = spec->three_segment;
-    } else if (const auto knot = kKnot.find(pattern);
-               knot != kKnot.end() && spec->shape_form == "profile" && indices.size() == 1 &&
-               indices[0] < spec->bat.knots.size()) {
-      binding.target = knot->second;
-      binding.index = indices[0];
-    } else if (const auto material = kMaterial.find(pattern);
-               material != kMaterial.end() && IsObjectAt(bat, {"material"})) {
-      binding.target = material->second;
-    } else if (const auto fill = kFill.find(pattern);
-               fill != kFill.end() && IsObjectAt(bat, {"fill"}) && spec->bat.fill) {
-      binding.target = fill->second;
-    } else {
-      return std::nullopt;  // not bound here: the JSON path
+  binder.parameters_ = parameters;
+  for (std::size_t k = 0; k < parameters.size(); ++k) {
+    for (std::size_t t = 0; t < parameters[k].targets.size(); ++t) {
+      std::vector<std::size_t> indices;
+      const std::string pattern = StepPattern(parameters[k].targets[t], &indices);
+      Binding binding{};
+      binding.parameter = k;
+      binding.target_index = t;
+      if (const auto it = kScene.find(pattern); it != kScene.end()) {
+        binding.target = it->second;
+      } else if (const auto shape = kShape.find(pattern);
+                 shape != kShape.end() && spec->three_segment) {
+        binding.target = shape->second;
+        binder.shape_ = spec->three_segment;
+      } else if (const auto knot = kKnot.find(pattern);
+                 knot != kKnot.end() && spec->shape_form == "profile" && indices.size() == 1 &&
+                 indices[0] < spec->bat.knots.size()) {
+        binding.target = knot->second;
+        binding.index = indices[0];
+      } else if (const auto material = kMaterial.find(pattern);
+                 material != kMaterial.end() && IsObjectAt(bat, {"material"})) {
+        binding.target = material->second;
+      } else if (const auto fill = kFill.find(pattern);
+                 fill != kFill.end() && IsObjectAt(bat, {"fill"}) && spec->bat.fill) {
+        binding.target = fill->second;
+      } else {
+        return std::nullopt;  // not bound here: the JSON path
+      }
+      if (pattern.rfind("bat.", 0) == 0) binder.bat_swept_ = true;
+      if (pattern.rfind("bat.material.", 0) == 0 || pattern.rfind("bat.fill.", 0) == 0) {
+        binder.materials_swept_ = true;
+      }
+      binder.bindings_.push_back(binding);
     }
-    if (pattern.rfind("bat.", 0) == 0) binder.bat_swept_ = true;
-    if (pattern.rfind("bat.material.", 0) == 0 || pattern.rfind("bat.fill.", 0) == 0) {
-      binder.materials_swept_ = true;
-    }
-    binder.bindings_.push_back(binding);
   }
   if (!binder.bat_swept_) {
     // The bat is the template's in every design: its mass properties are computed once
@@ -165,7 +170,8 @@ bool DesignBinder::Bind(const std::vector<double>& values, core::Scene* scene) c
   core::Bat& bat = *scene->bat;
   std::optional<core::ThreeSegmentShape> shape = shape_;
   for (std::size_t k = 0; k < bindings_.size(); ++k) {
-    const double v = values[k];
+    const Binding& b = bindings_[k];
+    const double v = parameters_[b.parameter].TargetValue(b.target_index, values[b.parameter]);
     switch (bindings_[k].target) {
       case Target::kBallMass:
         scene->ball.mass_kg = v;
@@ -774,7 +780,10 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
   }
   Json design = sweep.base;
   for (std::size_t k = 0; k < sweep.parameters.size(); ++k) {
-    SetNumberAtPath(&design, sweep.parameters[k].steps, point[k], nullptr);
+    const SweepParameter& parameter = sweep.parameters[k];
+    for (std::size_t t = 0; t < parameter.targets.size(); ++t) {
+      SetNumberAtPath(&design, parameter.targets[t], parameter.TargetValue(t, point[k]), nullptr);
+    }
   }
   Json row = EvaluateDesign(design, sweep.outputs, sweep.options, sweep.limits).row;
   if (const Json* at = FindAt(row, {"max_exit_speed", "placement"}); at != nullptr) {

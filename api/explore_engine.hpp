@@ -38,8 +38,21 @@ namespace sweetspot::api {
 
 /// A swept parameter: its path as written, its steps from the template root.
 struct SweepParameter {
-  std::string path;             ///< As written ("three_segment.taper_start_m").
-  std::vector<PathStep> steps;  ///< From the template root ("bat", "three_segment", ...).
+  /// Its name in rows ("parameters.<name>"): "path" as written ("three_segment.taper_start_m"),
+  /// or for linked fields "name" (default: the paths joined with "+").
+  std::string path;
+  std::vector<PathStep> steps;  ///< The first field, from the template root ("bat", ...).
+  /// Every field the value sets ("paths": all set to the value; "scale_paths": each the
+  /// template's value times the swept value), in order; one for "path".
+  std::vector<std::vector<PathStep>> targets;
+  /// For "scale_paths": the template's value of each target (the value multiplies them).
+  std::vector<double> scale_bases;
+  bool scale = false;  ///< True for "scale_paths".
+
+  /// The value of target `t` in a design whose swept value is `value`.
+  double TargetValue(std::size_t t, double value) const {
+    return scale ? scale_bases[t] * value : value;
+  }
 };
 
 /// Sets a design's swept values on the template's scene without JSON. Made once per sweep.
@@ -62,8 +75,11 @@ class DesignBinder {
   enum class Target;
   struct Binding {
     Target target;
-    std::size_t index = 0;  // a knot's
+    std::size_t index = 0;      // a knot's
+    std::size_t parameter = 0;  // whose value it takes
+    std::size_t target_index = 0;  // which of that parameter's targets (SweepParameter)
   };
+  std::vector<SweepParameter> parameters_;  // the values' meaning (linked and scaled paths)
   std::vector<Binding> bindings_;
   core::Scene scene_;
   std::optional<core::ThreeSegmentShape> shape_;  // the template's, when one is swept

@@ -139,7 +139,42 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
     ObjectReader p((*params)[i], where, error);
     SweepParameter parameter;
     core::SweepDimension dimension;
-    p.String("path", &parameter.path);
+    // One field ("path"), or several linked ones: "paths" (all set to the value) or
+    // "scale_paths" (each the template's value times it).
+    const int forms = int{p.Has("path")} + int{p.Has("paths")} + int{p.Has("scale_paths")};
+    if (p.ok() && forms != 1) {
+      p.Fail(forms == 0 ? "path" : "paths",
+             "give exactly one of path, paths (several fields set to one value) and "
+             "scale_paths (several fields scaled by one value)",
+             forms == 0 ? ErrorCode::kMissingField : ErrorCode::kInvalidValue);
+      return std::nullopt;
+    }
+    std::string form = "path";
+    std::vector<std::pair<std::string, const Json*>> written;  // each path and its JSON value
+    if (p.Has("path")) {
+      p.String("path", &parameter.path);
+      if (p.ok()) written.emplace_back(parameter.path, p.Get("path"));
+    } else {
+      form = p.Has("paths") ? "paths" : "scale_paths";
+      parameter.scale = form == "scale_paths";
+      const Json* list = p.Get(form);
+      if (!list->is_array() || list->empty() || list->size() > 32) {
+        p.Fail(form, "must be an array of 1 to 32 paths");
+        return std::nullopt;
+      }
+      std::string joined;
+      for (std::size_t j = 0; j < list->size(); ++j) {
+        if (!(*list)[j].is_string()) {
+          SetError(error, ErrorCode::kInvalidValue, where + "." + form + "[" + std::to_string(j) +
+                   "]", &(*list)[j], "must be a path (a string)");
+          return std::nullopt;
+        }
+        written.emplace_back((*list)[j].get<std::string>(), &(*list)[j]);
+        joined += (j == 0 ? "" : "+") + written.back().first;
+      }
+      parameter.path = joined;
+      p.OptionalString("name", &parameter.path);
+    }
     p.Number("min", Between(-1e12, 1e12), &dimension.min);
     p.Number("max", Between(-1e12, 1e12), &dimension.max);
     long long count = plan.method == core::SamplingMethod::kGrid ? 2 : 1;
@@ -150,32 +185,45 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
       p.Fail("max", "must be >= min = " + Show(Json(dimension.min)));
       return std::nullopt;
     }
-    std::string path = parameter.path;
-    const std::string head = path.substr(0, path.find_first_of(".["));
-    if (head != "bat" && head != "ball" && head != "swing" && head != "cor") path = "bat." + path;
-    // A scene object the request left to its defaults can still be swept.
-    if ((head == "ball" || head == "swing") && !base.contains(head)) base[head] = Json::object();
-    std::string why;
-    // A preset (bat.preset, ball.preset) is a catalogue name: every design would fail alike.
-    if (path.size() >= 7 && path.compare(path.size() - 7, 7, ".preset") == 0) {
-      SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
-               path +
-                   " names a catalogue entry, not a number: sweep the preset's numeric "
-                   "fields (they override it) instead");
-      return std::nullopt;
+    for (std::size_t j = 0; j < written.size(); ++j) {
+      const std::string field =
+          where + "." + form + (form == "path" ? "" : "[" + std::to_string(j) + "]");
+      const Json* path_json = written[j].second;
+      std::string path = written[j].first;
+      const std::string head = path.substr(0, path.find_first_of(".["));
+      if (head != "bat" && head != "ball" && head != "swing" && head != "cor") path = "bat." + path;
+      // A scene object the request left to its defaults can still be swept.
+      if ((head == "ball" || head == "swing") && !base.contains(head)) base[head] = Json::object();
+      std::string why;
+      // A preset (bat.preset, ball.preset) is a catalogue name: every design would fail alike.
+      if (path.size() >= 7 && path.compare(path.size() - 7, 7, ".preset") == 0) {
+        SetError(error, ErrorCode::kInvalidValue, field, path_json,
+                 path +
+                     " names a catalogue entry, not a number: sweep the preset's numeric "
+                     "fields (they override it) instead");
+        return std::nullopt;
+      }
+      auto steps = ParseJsonPath(path, &why);
+      std::optional<double> scale_base;
+      if (steps && parameter.scale) {
+        // A scaled field multiplies the template's own value: it must be there.
+        scale_base = NumberAtPath(base, *steps, &why);
+        if (!scale_base) why = "scale_paths multiplies the template's value, and " + why;
+      }
+      Json probe = base;
+      if (!steps || (parameter.scale && !scale_base) ||
+          !SetNumberAtPath(&probe, *steps, dimension.min, &why)) {
+        SetError(error, ErrorCode::kInvalidValue, field, path_json, why);
+        return std::nullopt;
+      }
+      if (ApiError unknown; !IsKnownField(probe, context.limits, &unknown)) {
+        SetError(error, ErrorCode::kInvalidValue, field, path_json, unknown.message);
+        return std::nullopt;
+      }
+      if (j == 0) parameter.steps = *steps;
+      parameter.targets.push_back(std::move(*steps));
+      if (scale_base) parameter.scale_bases.push_back(*scale_base);
     }
-    auto steps = ParseJsonPath(path, &why);
-    Json probe = base;
-    if (!steps || !SetNumberAtPath(&probe, *steps, dimension.min, &why)) {
-      SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"], why);
-      return std::nullopt;
-    }
-    if (ApiError unknown; !IsKnownField(probe, context.limits, &unknown)) {
-      SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
-               unknown.message);
-      return std::nullopt;
-    }
-    parameter.steps = std::move(*steps);
     parameters.push_back(std::move(parameter));
     plan.dimensions.push_back(dimension);
   }

@@ -220,6 +220,65 @@ TEST(ExploreEngineTest, ThreadsBeyondTheSweepsOwnComeFromTheBudget) {
   EXPECT_EQ(none_free, free_threads);
 }
 
+// Issue 19: one parameter setting several fields ("paths": one barrel diameter is two knots)
+// or scaling a group ("scale_paths"): the engine's rows are the JSON path's, and each design
+// is the bat with those fields set, as a single request computes it.
+TEST(ExploreEngineTest, LinkedAndScaledPathsSetEveryFieldAndMatchTheJsonPath) {
+  const Json bat = Json::parse(R"({"profile": {"knots": [
+      {"x_m": 0.0, "radius_m": 0.0125}, {"x_m": 0.3, "radius_m": 0.0125},
+      {"x_m": 0.6, "radius_m": 0.032}, {"x_m": 0.8636, "radius_m": 0.032}]},
+      "material": "ash"})");
+  Json body{{"bat", bat},
+            {"cor", 0.5},
+            {"parameters",
+             {{{"paths", {"profile.knots[2].radius_m", "profile.knots[3].radius_m"}},
+               {"min", 0.030},
+               {"max", 0.034},
+               {"count", 3}},
+              {{"scale_paths", {"profile.knots[0].radius_m", "profile.knots[1].radius_m"}},
+               {"name", "handle_scale"},
+               {"min", 0.9},
+               {"max", 1.1},
+               {"count", 2}}}},
+            {"outputs", {"properties", "max_exit_speed"}}};
+  const std::string rows = ExpectSameRows(body, true,
+                                          Json{"parameters.handle_scale", "properties.mass_kg"});
+  ASSERT_FALSE(rows.empty());
+  // Design 0: barrel radius 0.030 m on both knots, the handle scaled by 0.9.
+  const Json row = Json::parse(rows.substr(0, rows.find('\n')));
+  EXPECT_EQ(row["parameters"]["profile.knots[2].radius_m+profile.knots[3].radius_m"], 0.030);
+  EXPECT_EQ(row["parameters"]["handle_scale"], 0.9);
+  Json single = bat;
+  single["profile"]["knots"][2]["radius_m"] = 0.030;
+  single["profile"]["knots"][3]["radius_m"] = 0.030;
+  single["profile"]["knots"][0]["radius_m"] = 0.0125 * 0.9;
+  single["profile"]["knots"][1]["radius_m"] = 0.0125 * 0.9;
+  const Response one = Dispatch({"POST", "/v1/bat/properties", Json{{"bat", single}}.dump()},
+                                Context{});
+  ASSERT_EQ(one.status, 200) << one.body.dump();
+  EXPECT_EQ(row["properties"]["mass_kg"], one.body["mass_kg"]);  // the same bat, bit for bit
+
+  // Refusals name the field: two forms, a scaled field the template lacks, a bad list.
+  Json both = body;
+  both["parameters"][0]["path"] = "profile.knots[2].radius_m";
+  ApiError error;
+  EXPECT_FALSE(ParseExploreRequest(both, Context{}, &error).has_value());
+  EXPECT_EQ(error.field, "parameters[0].paths") << error.message;
+  Json missing = body;
+  missing["bat"]["material"] = "ash";
+  missing["parameters"][1]["scale_paths"] = {"material.density_kg_m3"};
+  error = ApiError{};
+  EXPECT_FALSE(ParseExploreRequest(missing, Context{}, &error).has_value());
+  EXPECT_EQ(error.field, "parameters[1].scale_paths[0]") << error.message;
+  EXPECT_NE(error.message.find("multiplies the template's value"), std::string::npos)
+      << error.message;
+  Json empty = body;
+  empty["parameters"][0]["paths"] = Json::array();
+  error = ApiError{};
+  EXPECT_FALSE(ParseExploreRequest(empty, Context{}, &error).has_value());
+  EXPECT_EQ(error.field, "parameters[0].paths") << error.message;
+}
+
 }  // namespace
 }  // namespace explore_engine_test
 }  // namespace sweetspot::api
