@@ -322,7 +322,36 @@ bool ReadVariables(ObjectReader& reader, const ApiLimits& limits, core::DesignPr
     const std::string where = "variables[" + std::to_string(i) + "]";
     ObjectReader v((*variables)[i], where, error);
     core::DesignVariable variable;
-    v.String("path", &variable.path);
+    if (v.Has("scale_paths")) {
+      return v.Fail("scale_paths",
+                    "is offered by /v1/explore's parameters, not by /v1/optimize's variables "
+                    "(use paths: the fields set to one value)");
+    }
+    if (v.Has("paths") && v.Has("path")) {
+      return v.Fail("paths", "give path or paths, not both");
+    }
+    if (const Json* paths = v.Get("paths")) {
+      // Several fields set to one value: the first is the variable's path, the rest linked.
+      if (!paths->is_array() || paths->empty() || paths->size() > 32) {
+        return v.Fail("paths", "must be an array of 1 to 32 variable paths");
+      }
+      for (std::size_t k = 0; k < paths->size(); ++k) {
+        const Json& item = (*paths)[k];
+        const std::string field = where + ".paths[" + std::to_string(k) + "]";
+        if (!item.is_string() || !core::ParseDesignVariablePath(item.get<std::string>())) {
+          return SetError(error, ErrorCode::kInvalidValue, field, &item,
+                          "is not a design variable path (profile.knots[i].radius_m, ...; "
+                          "material choices cannot be linked)");
+        }
+        if (k == 0) {
+          variable.path = item.get<std::string>();
+        } else {
+          variable.linked_paths.push_back(item.get<std::string>());
+        }
+      }
+    } else {
+      v.String("path", &variable.path);
+    }
     if (v.ok() && variable.path == "material") {  // a discrete choice among materials
       const Json* choices = v.Get("choices");
       if (choices == nullptr || !choices->is_array() || choices->empty() || choices->size() > 16) {

@@ -494,8 +494,12 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     std::vector<double> x = best >= 0 ? runs[static_cast<std::size_t>(best)].x : model.BaseX();
     result.bat = model.BatAt(x.data());
     result.three_segment = model.ShapeAt(x.data());
-    for (std::size_t j = 0; j < x.size(); ++j)
+    for (std::size_t j = 0; j < x.size(); ++j) {
       result.variables.push_back({model.variables()[j].path, x[j]});
+      for (const std::string& linked : model.variables()[j].linked_paths) {
+        result.variables.push_back({linked, x[j]});  // set to the same value
+      }
+    }
     const PublicEvaluation pub = EvaluatePublic(problem, model, result.bat, cor_known);
     result.properties = pub.properties;
     result.objective_value = pub.objective;

@@ -76,7 +76,8 @@ struct DesignVariableSpec {
   double lower = 0.0;           ///< Bound, field unit.
   double upper = 0.0;           ///< Bound, field unit.
   double base = 0.0;            ///< The base design's value (not clamped).
-  std::vector<int> parameters;  ///< Parameter indices it sets.
+  std::vector<int> parameters;  ///< Parameter indices it sets (its own and the linked fields').
+  std::vector<std::string> linked_paths;  ///< The fields set to the same value.
 };
 
 /// Values (and gradients) of the objective and constraints at a point, in user units.

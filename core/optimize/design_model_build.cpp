@@ -190,6 +190,20 @@ bool ModelBuilder::AddVariable(std::size_t i, std::set<std::string>* seen) {
   spec.upper = v.max;
   spec.parameters = ParametersOf(*ref);
   spec.base = Param(spec.parameters.front());
+  for (const std::string& path : v.linked_paths) {
+    // Each linked field is checked as a variable of its own would be; it takes the value.
+    DesignVariable linked = v;
+    linked.path = path;
+    linked.linked_paths.clear();
+    const std::optional<DesignVariableRef> linked_ref = ParseDesignVariablePath(path);
+    if (!CheckVariable(i, linked, linked_ref, seen)) return false;
+    for (int idx : ParametersOf(*linked_ref)) {
+      if (std::find(spec.parameters.begin(), spec.parameters.end(), idx) == spec.parameters.end()) {
+        spec.parameters.push_back(idx);
+      }
+    }
+    spec.linked_paths.push_back(path);
+  }
   for (int idx : spec.parameters) {
     model.parameter_variable_[static_cast<std::size_t>(idx)] =
         static_cast<int>(model.variables_.size());

@@ -72,6 +72,9 @@ struct DesignVariable {
   std::string path;  ///< The field (see DesignVariableKind), e.g. "three_segment.taper_start_m".
   double min = 0.0;  ///< Lower bound, field unit, in [-kMaxDesignBound, kMaxDesignBound].
   double max = 0.0;  ///< Upper bound, field unit, in (min, kMaxDesignBound].
+  /// Further fields set to the same value (a request's "paths": one barrel diameter is two
+  /// knots' radii), each a variable path of the same design, none repeated.
+  std::vector<std::string> linked_paths = {};
 };
 
 /// A constraint's allowed values: equality when min == max; either side may be open.

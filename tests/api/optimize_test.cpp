@@ -403,6 +403,39 @@ TEST(OptimizeEndpointTest, MaterialChoiceSolvesEachAndPicksTheBest) {
   EXPECT_EQ(r.body["objective_value"].get<double>(), best);
 }
 
+// Issue 19: a variable may set several fields at once ("paths"); the answer lists each and the
+// bat comes back with all of them set.
+TEST(OptimizeEndpointTest, LinkedPathsSetEveryFieldToTheVariablesValue) {
+  Json body = Json::parse(R"({
+    "bat": {"profile": {"knots": [{"x_m": 0.0, "radius_m": 0.0125}, {"x_m": 0.3, "radius_m": 0.0125},
+            {"x_m": 0.6, "radius_m": 0.032}, {"x_m": 0.8636, "radius_m": 0.031}]}, "material": "ash"},
+    "variables": [{"paths": ["profile.knots[2].radius_m", "profile.knots[3].radius_m"],
+                   "min": 0.028, "max": 0.033}],
+    "constraints": {"mass_kg": {"min": 0.85, "max": 0.95}},
+    "objective": "max_exit_speed", "cor": 0.5})");
+  const Response r = Post("/v1/optimize", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const double a = r.body["variables"]["profile.knots[2].radius_m"].get<double>();
+  EXPECT_EQ(r.body["variables"]["profile.knots[3].radius_m"].get<double>(), a);
+  EXPECT_EQ(r.body["bat"]["profile"]["knots"][2]["radius_m"].get<double>(), a);
+  EXPECT_EQ(r.body["bat"]["profile"]["knots"][3]["radius_m"].get<double>(), a);
+  // The returned bat re-checks: its mass within the range (Ipopt's tolerance, 1e-8 kg).
+  const Response p = Post("/v1/bat/properties", Json{{"bat", r.body["bat"]}});
+  ASSERT_EQ(p.status, 200);
+  EXPECT_GE(p.body["mass_kg"].get<double>(), 0.85 - 1e-8);
+  EXPECT_LE(p.body["mass_kg"].get<double>(), 0.95 + 1e-8);
+  // scale_paths is explore's; path with paths is ambiguous: 400s naming the field.
+  body["variables"][0]["scale_paths"] = {"profile.knots[2].radius_m"};
+  Response bad = Post("/v1/optimize", body);
+  EXPECT_EQ(bad.status, 400);
+  EXPECT_EQ(bad.body["field"], "variables[0].scale_paths");
+  body["variables"][0].erase("scale_paths");
+  body["variables"][0]["path"] = "profile.knots[2].radius_m";
+  bad = Post("/v1/optimize", body);
+  EXPECT_EQ(bad.status, 400);
+  EXPECT_EQ(bad.body["field"], "variables[0].paths");
+}
+
 }  // namespace
 }  // namespace optimize_test
 }  // namespace sweetspot::api

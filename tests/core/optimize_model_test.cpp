@@ -173,6 +173,30 @@ TEST(OptimizeModel, ExitSpeedObjectivesMatchThePublicClosedForms) {
   EXPECT_EQ(why.field, "model");
 }
 
+// A linked variable ("paths"): both fields take the value, in the model and in the answer.
+TEST(OptimizeModel, LinkedFieldsTakeTheVariablesValue) {
+  DesignProblem p = HollowFilledProfile(DesignObjective::kMaxExitSpeed);
+  p.variables = {{"profile.knots[10].radius_m", 0.030, 0.0334}};
+  p.variables[0].linked_paths = {"profile.knots[11].radius_m", "profile.knots[12].radius_m"};
+  p.constraints = {};
+  const DesignResult r = OptimizeDesign(p, DesignOptions{});
+  ASSERT_TRUE(r.summary.IsSolutionUsable()) << r.summary.FullReport();
+  ASSERT_EQ(r.variables.size(), 3u);
+  EXPECT_EQ(r.variables[1].path, "profile.knots[11].radius_m");
+  EXPECT_EQ(r.variables[0].value, r.variables[1].value);
+  EXPECT_EQ(r.variables[0].value, r.variables[2].value);
+  EXPECT_EQ(r.bat.knots[10].radius_m, r.variables[0].value);
+  EXPECT_EQ(r.bat.knots[11].radius_m, r.variables[0].value);
+  EXPECT_EQ(r.bat.knots[12].radius_m, r.variables[0].value);
+  // A wider barrel hits harder here with no mass limit: the upper bound, to Ipopt's 1e-8.
+  EXPECT_NEAR(r.variables[0].value, 0.0334, 1e-8);
+  // A linked field is checked as a variable: a repeated one is refused, naming it.
+  p.variables[0].linked_paths = {"profile.knots[10].radius_m"};
+  Refusal why;
+  EXPECT_FALSE(p.Validate(&why));
+  EXPECT_NE(why.Message().find("appears more than once"), std::string::npos) << why.Message();
+}
+
 // Three-segment designs through x1 = 0 and x1 = x2, where ThreeSegmentShape::Knots() merges
 // knots: the model keeps 4 knots (coincident allowed), so it is smooth there, and equals the
 // merged bat's properties (the step of width 1e-12 L changes them by < 1e-12 relative).
@@ -261,11 +285,14 @@ TEST(OptimizeModel, GradientsMatchComputeMassPropertiesWithGradient) {
 TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
   std::mt19937_64 rng(11);
   for (DesignObjective objective : kObjectives) {
-    for (int variant = 0; variant < 4; ++variant) {
-      // Both problems with both exit-speed models: rigid_pivot, then free_bat.
+    for (int variant = 0; variant < 5; ++variant) {
+      // Both problems with both exit-speed models: rigid_pivot, then free_bat; then the
+      // profile with a linked variable (two knots' radii set to one value).
       DesignProblem p =
           variant % 2 == 0 ? HollowFilledProfile(objective) : FilledThreeSegment(objective);
-      p.model = variant < 2 ? CollisionModel::kRigidPivot : CollisionModel::kFreeBat;
+      p.model = variant == 2 || variant == 3 ? CollisionModel::kFreeBat
+                                             : CollisionModel::kRigidPivot;
+      if (variant == 4) p.variables[1].linked_paths = {"profile.knots[11].radius_m"};
       const DesignModel model = Build(p);
       ASSERT_GT(model.m(), 3);
       for (int trial = 0; trial < 3; ++trial) {
