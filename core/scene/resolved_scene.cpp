@@ -110,6 +110,15 @@ ExitSpeedProfile ClosedFormProfileFor(CollisionModel model, const MassProperties
   if (model != CollisionModel::kFreeBat) {
     return RigidPivotProfile(RigidPivotInputsFor(mass_properties, ball, swing, cor));
   }
+  return FreeBatProfile(FreeBatInputsFor(mass_properties, ball, swing, cor));
+}
+
+RigidPivotInputs RigidPivotInputsFor(const Scene& scene, const ResolvedScene& r) {
+  return RigidPivotInputsFor(r.mass_properties, scene.ball, scene.swing, *r.cor);
+}
+
+FreeBatInputs FreeBatInputsFor(const MassProperties& mass_properties, const Ball& ball,
+                               const Swing& swing, double cor) {
   FreeBatInputs in;
   in.bat_mass_kg = mass_properties.mass_kg;
   in.balance_point_m = mass_properties.balance_point_m;
@@ -120,25 +129,11 @@ ExitSpeedProfile ClosedFormProfileFor(CollisionModel model, const MassProperties
   in.ball_speed_mps = ball.speed_mps;
   in.angular_speed_rad_s = swing.angular_speed_rad_s;
   in.cor = cor;
-  return FreeBatProfile(in);
-}
-
-RigidPivotInputs RigidPivotInputsFor(const Scene& scene, const ResolvedScene& r) {
-  return RigidPivotInputsFor(r.mass_properties, scene.ball, scene.swing, *r.cor);
+  return in;
 }
 
 FreeBatInputs FreeBatInputsFor(const Scene& scene, const ResolvedScene& r) {
-  FreeBatInputs in;
-  in.bat_mass_kg = r.mass_properties.mass_kg;
-  in.balance_point_m = r.mass_properties.balance_point_m;
-  in.moi_centroid_kg_m2 = r.mass_properties.moi_centroid_kg_m2;
-  in.pivot_from_knob_m = scene.swing.pivot_from_knob_m;
-  in.hands_from_knob_m = scene.swing.hands_from_knob_m;
-  in.ball_mass_kg = scene.ball.mass_kg;
-  in.ball_speed_mps = scene.ball.speed_mps;
-  in.angular_speed_rad_s = scene.swing.angular_speed_rad_s;
-  in.cor = *r.cor;
-  return in;
+  return FreeBatInputsFor(r.mass_properties, scene.ball, scene.swing, *r.cor);
 }
 
 HertzProblem HertzProblemFor(const Scene& scene, const ResolvedScene& r, double impact_from_knob_m,

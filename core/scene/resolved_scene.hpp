@@ -54,6 +54,9 @@ ExitSpeedProfile ClosedFormProfileFor(CollisionModel model, const MassProperties
 /// The rigid-pivot inputs of a resolved scene (its COR must be resolved).
 RigidPivotInputs RigidPivotInputsFor(const Scene& scene, const ResolvedScene& resolved);
 
+/// The free-bat inputs of a bat with `mass_properties` hit by `ball` in `swing` with `cor`.
+FreeBatInputs FreeBatInputsFor(const MassProperties& mass_properties, const Ball& ball,
+                               const Swing& swing, double cor);
 /// The free-bat inputs of a resolved scene (its COR must be resolved).
 FreeBatInputs FreeBatInputsFor(const Scene& scene, const ResolvedScene& resolved);
 
