@@ -1006,6 +1006,13 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
     summary["pareto_objectives"] = ObjectivesToJson(sweep.objectives);  // for explore-merge
     summary["pareto_scope"] = "the rows of this response (this shard)";
   }
+  if (std::any_of(sweep.outputs.scene.begin(), sweep.outputs.scene.end(), [](auto o) {
+        return o == core::SceneOutput::kMaxExitSpeed || o == core::SceneOutput::kSweetZone ||
+               o == core::SceneOutput::kExitSpeedCurve;
+      })) {
+    summary["exit_speed_model"] = sweep.exit_speed_model;
+    summary["model_reason"] = sweep.model_reason;
+  }
   AddEndPlacements(beyond_tip, before_knob, &summary);
   summary["provenance"] = sweep.provenance;
   outcome.summary = std::move(summary);

@@ -96,6 +96,8 @@ struct Sweep {
   std::vector<std::vector<double>> drawn;       ///< LHS / Sobol points (grids are enumerated).
   RowOutputs outputs;                           ///< What each row reports.
   core::SceneOptions options;                   ///< The models' settings.
+  std::string exit_speed_model;  ///< The exit-speed model options.model resolves to (summary).
+  std::string model_reason;      ///< Why that model ("requested", or "auto: ...").
   ApiLimits limits;                             ///< The request limits (the JSON path's parser).
   std::vector<ParetoObjective> objectives;      ///< Pareto objectives (may be empty).
   core::Shard shard;                            ///< Which designs this run evaluates.

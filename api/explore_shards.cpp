@@ -21,6 +21,7 @@ struct SweepIdentity {
   std::uint64_t total = 0;
   std::uint64_t count = 0;
   Json sampling, seed, objectives;
+  Json exit_speed_model, model_reason;  // null when the sweep needs no exit-speed model
 };
 
 }  // namespace
@@ -146,6 +147,8 @@ MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards) {
       id.sampling = s.value("sampling", Json());
       id.seed = s.value("seed", Json());
       id.objectives = s.value("pareto_objectives", Json());
+      id.exit_speed_model = s.value("exit_speed_model", Json());
+      id.model_reason = s.value("model_reason", Json());
       const std::uint64_t index = s["shard"]["index"].get<std::uint64_t>();
       if (f == 0) {
         first = id;
@@ -235,6 +238,10 @@ MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards) {
       summary["pareto_front"] = std::move(front);
       summary["pareto_objectives"] = first.objectives;
       summary["pareto_scope"] = "the rows of this response (this shard)";
+    }
+    if (!first.exit_speed_model.is_null()) {
+      summary["exit_speed_model"] = first.exit_speed_model;
+      summary["model_reason"] = first.model_reason;
     }
     AddEndPlacements(beyond_tip, before_knob, &summary);
     summary["provenance"] = first.provenance;

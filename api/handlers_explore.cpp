@@ -92,6 +92,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
     reader.Missing("bat");
     return std::nullopt;
   }
+  bool paper_bat = false;  // the template's bat is one of the paper's (model auto: rigid_pivot)
   {  // The template itself must be a valid bat and scene.
     core::Scene scene;
     ObjectReader check(base, "", error);
@@ -100,6 +101,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
     // The ranges (ball, swing, cor) are core's: checked as a design's row checks them.
     scene.bat = spec->bat;
     scene.paper_bat = spec->paper;
+    paper_bat = spec->paper;
     scene.outputs = {core::SceneOutput::kMaxExitSpeed};
     if (core::Refusal refusal; !scene.Validate(&refusal)) {
       CoreRefusal(refusal, "", error);
@@ -333,6 +335,14 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   sweep->plan = std::move(plan);
   sweep->outputs = std::move(outputs);
   sweep->options = std::move(options);
+  {
+    // Which exit-speed model the rows' max_exit_speed comes from, and why (as a single
+    // request's model_reason): the same for every design of the sweep.
+    core::Scene resolved;
+    resolved.paper_bat = paper_bat;
+    sweep->exit_speed_model = core::CollisionModelName(
+        core::ResolveExitModel(sweep->options.model, resolved, &sweep->model_reason));
+  }
   sweep->limits = context.limits;
   sweep->objectives = std::move(objectives);
   sweep->shard = shard;

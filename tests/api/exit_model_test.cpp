@@ -100,6 +100,9 @@ TEST(ExitModelTest, ASweepCountsTheMaximaAtAnEndInItsSummary) {
   EXPECT_TRUE(AnyWarningContains(r.body["summary"]["warnings"],
                                  "the maximum of 3 designs lies beyond the tip and of 0 before"))
       << r.body["summary"].dump();
+  EXPECT_EQ(r.body["summary"]["max_exit_speed_at_bat_end"]["beyond_tip"], 3);
+  EXPECT_EQ(r.body["summary"]["exit_speed_model"], "rigid_pivot");
+  EXPECT_EQ(r.body["summary"]["model_reason"], "requested");
   // The free bat (the default): on the bat, no warning.
   body.erase("options");
   const Response f = Post("/v1/explore", body);
@@ -109,6 +112,8 @@ TEST(ExitModelTest, ASweepCountsTheMaximaAtAnEndInItsSummary) {
     EXPECT_EQ(row["max_exit_speed"]["placement"], "on_bat");
   }
   EXPECT_FALSE(f.body["summary"].contains("warnings"));
+  EXPECT_EQ(f.body["summary"]["exit_speed_model"], "free_bat");
+  EXPECT_EQ(f.body["summary"]["model_reason"].get<std::string>().rfind("auto: free_bat", 0), 0u);
 }
 
 Json OptimizeRequest() {
