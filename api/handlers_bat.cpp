@@ -1,10 +1,14 @@
 // POST /v1/bat/properties and POST /v1/bat/fit.
 #include <algorithm>
+#include <optional>
+#include <string>
+#include <utility>
 
 #include "api/bat_json.hpp"
 #include "api/endpoint.hpp"
 #include "api/handlers.hpp"
 #include "api/sanity.hpp"
+#include "api/trade_units.hpp"
 #include "core/presets.hpp"
 #include "core/shape_fit.hpp"
 
@@ -204,8 +208,9 @@ std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& co
   const auto shape = ThreeSegmentOf(*spec);
   if (!shape) {
     reader.Fail("bat",
-                "must be a three-segment bat (three_segment, or the paper-wood presets): the fit "
-                "solves three-segment dimensions");
+                "is not a three-segment bat (three_segment, or the paper-wood presets), whose "
+                "unknowns are named by name: for any bat, name the unknowns by design-variable "
+                "path ({\"path\": \"material.density_kg_m3\", \"min\", \"max\"})");
     return std::nullopt;
   }
   FitRequest request{std::move(*spec), {}, {}};
@@ -322,9 +327,113 @@ const Endpoint<FitRequest, core::ShapeFitResult>& FitEndpoint() {
   return endpoint;
 }
 
+// True when the fit's unknowns name design-variable paths ({"path"} or {"paths"}): the
+// general fit, of any bat, by the design optimiser.
+bool IsDesignFit(const nlohmann::json& body) {
+  const auto unknowns = body.find("unknowns");
+  if (unknowns == body.end() || !unknowns->is_array()) return false;
+  return std::any_of(unknowns->begin(), unknowns->end(), [](const nlohmann::json& u) {
+    return u.is_object() && (u.contains("path") || u.contains("paths"));
+  });
+}
+
+// The optimiser's names in a refusal, as the fit's request writes them.
+std::string FitNames(std::string text) {
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"variables[", "unknowns["},
+                                 {"constraints.", "targets."},
+                                 {"constraints", "targets"}}) {
+    for (std::size_t at = text.find(from); at != std::string::npos;
+         at = text.find(from, at + to.size())) {
+      text.replace(at, from.size(), to);
+    }
+  }
+  return text;
+}
+
+// An optimiser answer (or its "closest") as a fit's: the bat, the unknowns' values, the
+// properties, each target's residual (achieved - target, SI) and the summary.
+nlohmann::json DesignFitAnswer(const nlohmann::json& design, const nlohmann::json& targets) {
+  nlohmann::json residuals = nlohmann::json::object();
+  const nlohmann::json& properties = design.value("properties", nlohmann::json::object());
+  for (const char* si : {"mass_kg", "balance_point_m", "moi_six_inch_kg_m2", "length_m"}) {
+    std::optional<double> target;
+    if (targets.contains(si) && targets[si].is_number()) target = targets[si].get<double>();
+    for (const TradeForm& form : TradeForms(si)) {
+      if (targets.contains(form.key) && targets[form.key].is_number()) {
+        target = targets[form.key].get<double>() * form.to_si;
+      }
+    }
+    if (target && properties.contains(si)) residuals[si] = properties[si].get<double>() - *target;
+  }
+  nlohmann::json out{{"bat", design.value("bat", nlohmann::json())},
+                     {"unknowns", design.value("variables", nlohmann::json::object())},
+                     {"properties", properties},
+                     {"residuals", std::move(residuals)},
+                     {"method",
+                      "the design optimiser: every target an equality constraint, the unknowns "
+                      "its variables, and among the bats that meet the targets the one with the "
+                      "least MOI about the 6-in point (objective min_moi)"}};
+  for (const char* key : {"summary", "conflicts", "provenance", "timing_s", "warnings"}) {
+    if (design.contains(key)) out[key] = design[key];
+  }
+  return out;
+}
+
+// The general fit: the request rewritten as /v1/optimize's (targets -> constraints, unknowns
+// -> variables, objective min_moi) and its answer as a fit's.
+Response HandleDesignFit(const nlohmann::json& body, const Request& request,
+                         const Context& context) {
+  nlohmann::json optimize = nlohmann::json::object();
+  for (const auto& [key, value] : body.items()) {
+    if (key == "targets") {
+      optimize["constraints"] = value;
+    } else if (key == "unknowns") {
+      optimize["variables"] = value;
+    } else if (key == "objective" || key == "variables" || key == "constraints") {
+      return ErrorResponse(400, ErrorCode::kUnknownField,
+                           key + " is not a field of /v1/bat/fit (targets, unknowns, bat, "
+                                 "options)",
+                           key);
+    } else {
+      optimize[key] = value;
+    }
+  }
+  if (!optimize.contains("constraints")) {
+    return ErrorResponse(400, ErrorCode::kMissingField, "targets: is required", "targets");
+  }
+  optimize["objective"] = "min_moi";
+  Request inner = request;
+  inner.path = "/v1/optimize";
+  inner.body = optimize.dump();
+  Response answer = HandleOptimize(inner, context);
+  const nlohmann::json targets = body.value("targets", nlohmann::json::object());
+  if (answer.status == 200) {
+    answer.body = DesignFitAnswer(answer.body, targets);
+  } else if (answer.status == 422 && answer.body.contains("closest")) {
+    answer.body["closest"] = DesignFitAnswer(answer.body["closest"], targets);
+    answer.body["field"] = "targets";
+    answer.body["message"] = FitNames(answer.body.value("message", std::string()));
+  } else if (answer.body.is_object()) {
+    if (answer.body.contains("field") && answer.body["field"].is_string()) {
+      answer.body["field"] = FitNames(answer.body["field"].get<std::string>());
+    }
+    if (answer.body.contains("message") && answer.body["message"].is_string()) {
+      answer.body["message"] = FitNames(answer.body["message"].get<std::string>());
+    }
+  }
+  return answer;
+}
+
 }  // namespace
 
 Response HandleBatFit(const Request& request, const Context& context) {
+  // A body that names design-variable paths goes to the general fit; any other to the
+  // three-segment fit (whose refusal of a profile bat says how to ask the general one).
+  ApiError error;
+  if (const auto body = ParseBody(request.body, context.limits, &error);
+      body && body->is_object() && IsDesignFit(*body)) {
+    return HandleDesignFit(*body, request, context);
+  }
   return ServeEndpoint(FitEndpoint(), request, context);
 }
 
