@@ -61,6 +61,15 @@ core::SceneResult ProbeResult(const std::vector<core::SceneOutput>& outputs) {
         r.least_sting_zone.emplace();
         r.least_sting_zone->curve.emplace_back();
         break;
+      case core::SceneOutput::kBarrel:
+        r.barrel.emplace();
+        r.barrel->hollow = true;  // every field a number
+        r.barrel->effective_cor_curve.emplace_back();
+        break;
+      case core::SceneOutput::kBbcor:
+        r.bbcor.emplace();
+        r.bbcor->method = "trampoline_quasi_static";
+        break;
     }
   }
   return r;

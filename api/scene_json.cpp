@@ -77,7 +77,8 @@ bool ReadOutputs(ObjectReader& reader, core::Scene* scene) {
       return reader.Fail("outputs",
                          "outputs[" + std::to_string(i) + "] = " + Show(item) +
                              " is not one of max_exit_speed, center_of_percussion, "
-                             "vibration_node, sweet_zone, exit_speed_curve, least_sting_zone");
+                             "vibration_node, sweet_zone, exit_speed_curve, least_sting_zone, barrel, "
+                             "bbcor");
     }
     if (std::find(scene->outputs.begin(), scene->outputs.end(), *parsed) == scene->outputs.end()) {
       scene->outputs.push_back(*parsed);
@@ -312,6 +313,49 @@ Json SummaryToJson(const core::Summary& s) {
           {"warnings", s.warnings}};
 }
 
+Json BarrelOutputToJson(const core::BarrelOutput& b) {
+  // A solid bat has no hoop mode: those fields are null on purpose (not a failed number).
+  auto hollow_only = [&](double v) { return b.hollow ? Json(v) : Json(nullptr); };
+  Json curve = Json::array();
+  for (const auto& p : b.effective_cor_curve) {
+    curve.push_back({{"position_from_knob_m", p.position_from_knob_m},
+                     {"approach_speed_mps", p.approach_speed_mps},
+                     {"ball_cor", p.ball_cor},
+                     {"effective_cor", p.effective_cor}});
+  }
+  return {{"hollow", b.hollow},
+          {"method", b.method},
+          {"position_from_knob_m", b.position_from_knob_m},
+          {"hoop_frequency_hz", hollow_only(b.wall.hoop_frequency_hz)},
+          {"barrel_stiffness_n_m", hollow_only(b.wall.stiffness_n_m)},
+          {"ring_stiffness_n_m", hollow_only(b.wall.ring_stiffness_n_m)},
+          {"modal_mass_kg", hollow_only(b.wall.modal_mass_kg)},
+          {"effective_length_m", hollow_only(b.wall.effective_length_m)},
+          {"mid_radius_m", hollow_only(b.wall.mid_radius_m)},
+          {"wall_thickness_m", hollow_only(b.wall.thickness_m)},
+          {"shell_factor", hollow_only(b.shell_factor)},
+          {"barrel_loss", hollow_only(b.wall.barrel_loss)},
+          {"barrel_energy_fraction", b.barrel_energy_fraction},
+          {"effective_cor", b.effective_cor},
+          {"effective_cor_curve", std::move(curve)}};
+}
+
+Json BbcorToJson(const core::BbcorResult& b) {
+  const bool hollow = b.method != "rigid";
+  return {{"value", b.value},
+          {"ball", b.ball},
+          {"ball_speed_mps", b.ball_speed_mps},
+          {"ball_cor", b.ball_cor},
+          {"impact_from_knob_m", b.impact_from_knob_m},
+          {"pivot_from_knob_m", b.pivot_from_knob_m},
+          {"method", b.method},
+          {"hoop_frequency_hz", hollow ? Json(b.hoop_frequency_hz) : Json(nullptr)},
+          {"barrel_stiffness_n_m", hollow ? Json(b.barrel_stiffness_n_m) : Json(nullptr)},
+          {"protocol",
+           "NCAA BBCOR: the bat at rest on a pivot 6 in from the knob, the ball fired at 136 mph "
+           "at 6 in from the barrel end; BBCOR = e_A (1 + r) + r, r = m z^2 / I_pivot"}};
+}
+
 Json SceneResultToJson(const core::SceneResult& r) {
   Json out = Json::object();
   Json errors = Json::object();
@@ -375,6 +419,8 @@ Json SceneResultToJson(const core::SceneResult& r) {
                                   {"exit_speed_mps", speed_err},
                                   {"hands_energy_j", energy_err}};
   }
+  if (r.barrel) out["barrel"] = BarrelOutputToJson(*r.barrel);
+  if (r.bbcor) out["bbcor"] = BbcorToJson(*r.bbcor);
   out["error_estimate"] = std::move(errors);
   out["models_used"] = r.summary.models_used;
   out["exit_speed_model"] = r.exit_speed_model.empty() ? Json(nullptr) : Json(r.exit_speed_model);

@@ -67,6 +67,11 @@ nlohmann::json SummaryToJson(const core::Summary& summary);
 /// The outputs of a scene result, by output name, plus models_used,
 /// error_estimate, timings, cor and properties.
 nlohmann::json SceneResultToJson(const core::SceneResult& result);
+/// The `barrel` output (hoop mode, stiffness, effective COR along the barrel); null hoop fields
+/// for a solid bat.
+nlohmann::json BarrelOutputToJson(const core::BarrelOutput& barrel);
+/// The `bbcor` output: value and the protocol's ball, speed, impact point, pivot and method.
+nlohmann::json BbcorToJson(const core::BbcorResult& bbcor);
 
 /// One collision result: exit speed, model and what the model knows.
 nlohmann::json CollisionResultToJson(const core::CollisionResult& result);

@@ -317,7 +317,8 @@ double QuasiStaticTrampolineCor(const TrampolineProblem& p) {
   return QuasiStaticTrampoline(p).effective_cor;
 }
 
-TrampolineResult EffectiveCorAt(const Bat& bat, double x_m, double ball_mass_kg,
+TrampolineResult EffectiveCorAt(const Bat& bat, const MassProperties& mp, double x_m,
+                                double ball_mass_kg,
                                 double ball_radius_m, double ball_stiffness, double ball_exponent,
                                 double ball_cor, double approach_speed_mps,
                                 const BarrelOptions& options) {
@@ -327,7 +328,6 @@ TrampolineResult EffectiveCorAt(const Bat& bat, double x_m, double ball_mass_kg,
     out.effective_cor = ball_cor;
     return out;
   }
-  const MassProperties mp = ComputeMassProperties(bat);
   const double b = x_m - mp.balance_point_m;
   const double m_e = 1.0 / (1.0 / mp.mass_kg + b * b / mp.moi_centroid_kg_m2);
   return barrel_detail::HollowImpact(bat, x_m, m_e, ball_mass_kg, ball_radius_m, ball_stiffness,

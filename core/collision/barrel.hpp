@@ -42,6 +42,7 @@
 
 #include "core/bat.hpp"
 #include "core/collision/contact_law.hpp"
+#include "core/mass_properties.hpp"
 
 namespace sweetspot::core {
 
@@ -169,11 +170,37 @@ BbcorResult ComputeBbcor(const Bat& bat, const BbcorProtocol& protocol = {},
 
 /// The effective COR (quasi-static trampoline) of a hollow bat at `x_m` for a ball of
 /// `ball_mass_kg`, `ball_radius_m`, `ball_stiffness`, `ball_exponent`, COR `ball_cor`,
-/// approaching at approach_speed_mps, the bat free (M_e = 1/(1/M + b^2/I_cm)); `ball_cor` itself
+/// approaching at approach_speed_mps, the bat (of `mass_properties`) free
+/// (M_e = 1/(1/M + b^2/I_cm)); `ball_cor` itself
 /// (exactly) for a solid bat.
-TrampolineResult EffectiveCorAt(const Bat& bat, double x_m, double ball_mass_kg,
+TrampolineResult EffectiveCorAt(const Bat& bat, const MassProperties& mass_properties,
+                                double x_m, double ball_mass_kg,
                                 double ball_radius_m, double ball_stiffness, double ball_exponent,
                                 double ball_cor, double approach_speed_mps,
                                 const BarrelOptions& options = {});
+
+}  // namespace sweetspot::core
+
+namespace sweetspot::core {
+
+/// The effective COR at one point along the barrel.
+struct BarrelCorPoint {
+  double position_from_knob_m = 0.0;  ///< m from the knob.
+  double approach_speed_mps = 0.0;    ///< Normal impact speed there, m/s.
+  double ball_cor = 0.0;              ///< The ball's COR against a rigid surface there.
+  double effective_cor = 0.0;         ///< e_eff (the ball's COR for a solid bat).
+};
+
+/// The `barrel` output of a scene.
+struct BarrelOutput {
+  bool hollow = false;                ///< False: a solid bat (no hoop mode; COR unchanged).
+  double position_from_knob_m = 0.0;  ///< The reference point (6 in from the tip), m.
+  BarrelWall wall;                    ///< The wall there (hollow only).
+  double shell_factor = 0.0;          ///< c used (hollow only).
+  double effective_cor = 0.0;         ///< e_eff at the reference point.
+  double barrel_energy_fraction = 0.0;  ///< The barrel's share of the stored energy there.
+  std::vector<BarrelCorPoint> effective_cor_curve;  ///< e_eff every inch over the last 10 in.
+  std::string method;  ///< "trampoline_quasi_static" or "solid".
+};
 
 }  // namespace sweetspot::core

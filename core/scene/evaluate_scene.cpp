@@ -6,6 +6,7 @@
 
 #include "core/geometry_format.hpp"
 #include "core/scene/resolved_scene.hpp"
+#include "core/scene/scene_barrel.hpp"
 #include "core/scene/scene_models.hpp"
 #include "core/sweet_spot/least_sting.hpp"
 #include "core/sweet_spot/numeric.hpp"
@@ -40,7 +41,10 @@ bool NeedsExitModel(SceneOutput o) {
 
 // Outputs that run an impact (every impact model uses the COR): the exit-speed outputs and
 // least_sting_zone's flexible impacts. center_of_percussion and vibration_node do not.
-bool NeedsCor(SceneOutput o) { return NeedsExitModel(o) || o == SceneOutput::kLeastStingZone; }
+// barrel's effective COR starts from the ball's (the resolved COR when the ball has no law).
+bool NeedsCor(SceneOutput o) {
+  return NeedsExitModel(o) || o == SceneOutput::kLeastStingZone || o == SceneOutput::kBarrel;
+}
 
 bool Wants(const std::vector<SceneOutput>& wanted, SceneOutput o) {
   return std::find(wanted.begin(), wanted.end(), o) != wanted.end();
@@ -91,6 +95,9 @@ std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model
       return {kFlexibleBeamModel};
     case SceneOutput::kLeastStingZone:
       return {"mass_properties", kFlexibleBeamModel, "flexible"};
+    case SceneOutput::kBarrel:
+    case SceneOutput::kBbcor:
+      return {"mass_properties", kBarrelModel};
     case SceneOutput::kMaxExitSpeed:
     case SceneOutput::kSweetZone:
     case SceneOutput::kExitSpeedCurve:
@@ -106,7 +113,8 @@ void SceneResult::Reset() {
   // A field added to SceneResult must be reset here too: on x86-64 (the size this list was
   // written for) the size check says so.
 #if defined(__x86_64__)
-  static_assert(sizeof(SceneResult) == 1760, "SceneResult gained a field: reset it in Reset");
+  static_assert(sizeof(SceneResult) == 1760 + kBarrelFieldsSize,
+                "SceneResult gained a field: reset it in Reset");
 #endif
   summary.Reset();
   missing_model.clear();
@@ -124,6 +132,8 @@ void SceneResult::Reset() {
   exit_speed_curve.reset();
   vibration_node.reset();
   least_sting_zone.reset();
+  barrel.reset();
+  bbcor.reset();
   timings.clear();
 }
 
@@ -164,7 +174,8 @@ void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
     // The flexible beam needs the bat's geometry, not only its mass properties.
     const bool flexible_exit = needs_exit && options.model == CollisionModel::kFlexible;
     if (!scene.bat.has_value()) {
-      for (SceneOutput o : {SceneOutput::kVibrationNode, SceneOutput::kLeastStingZone}) {
+      for (SceneOutput o : {SceneOutput::kVibrationNode, SceneOutput::kLeastStingZone,
+                            SceneOutput::kBarrel, SceneOutput::kBbcor}) {
         if (Wants(wanted, o)) {
           s.SetRefusal(TextRefusal("bat", std::string(SceneOutputName(o)) +
                                               " needs the bat's geometry (a bat, not only "
@@ -346,6 +357,27 @@ void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
           note(Termination::kFailure, "least_sting_zone: " + error);
         }
       }
+    }
+    if (Wants(wanted, SceneOutput::kBarrel)) {
+      const auto tb = book.Now();
+      BarrelOutput barrel;
+      std::string error;
+      if (SceneBarrel(scene, r, options.barrel, &barrel, &error)) {
+        out.barrel = std::move(barrel);
+      } else {
+        note(Termination::kFailure, error);
+      }
+      book.Add(kBarrelModel, book.Since(tb), 1);
+    }
+    if (Wants(wanted, SceneOutput::kBbcor)) {
+      const auto tb = book.Now();
+      BbcorResult bbcor = ComputeBbcor(*scene.bat, BbcorProtocol{}, options.barrel);
+      if (bbcor.ok) {
+        out.bbcor = std::move(bbcor);
+      } else {
+        note(Termination::kFailure, bbcor.message);
+      }
+      book.Add(kBarrelModel, book.Since(tb), 1);
     }
     if (std::find(wanted.begin(), wanted.end(), SceneOutput::kExitSpeedCurve) != wanted.end()) {
       ExitSpeedCurveResult curve;

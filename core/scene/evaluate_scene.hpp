@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/collision/barrel.hpp"
 #include "core/mass_properties.hpp"
 #include "core/scene/scene.hpp"
 #include "core/scene/timing_book.hpp"
@@ -21,6 +22,12 @@ namespace sweetspot::core {
 /// least_sting_zone, or any exit output with model flexible: {"mass_properties",
 /// "flexible_beam", "flexible"}).
 std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model);
+
+/// The name of the barrel model (in models_used and timings).
+inline constexpr char kBarrelModel[] = "barrel";
+/// The size the barrel outputs added to SceneResult (Reset's size check).
+inline constexpr size_t kBarrelFieldsSize =
+    sizeof(std::optional<BarrelOutput>) + sizeof(std::optional<BbcorResult>);
 
 /// The answer of EvaluateScene. Outputs not requested (or not computed) are empty.
 struct SceneResult {
@@ -42,6 +49,8 @@ struct SceneResult {
   std::optional<ExitSpeedCurveResult> exit_speed_curve;          ///< exit_speed_curve.
   std::optional<VibrationNodeResult> vibration_node;             ///< vibration_node.
   std::optional<LeastStingZoneResult> least_sting_zone;          ///< least_sting_zone.
+  std::optional<BarrelOutput> barrel;                            ///< barrel.
+  std::optional<BbcorResult> bbcor;                              ///< bbcor.
   std::vector<ModelTiming> timings;  ///< Time per model, in first-use order.
 
   /// Every field as a default-constructed result has it, the strings and vectors keeping their

@@ -130,6 +130,8 @@ bool SceneOptions::Validate(Refusal* why) const {
                       curve_positions_from_knob_m[i], "must be finite");
   }
   if (!hertz.Validate(why)) return false;
+  if (std::string barrel_why; !barrel.IsValid(&barrel_why))
+    return Refuse(why, TextRefusal("barrel", barrel_why));
   return flexible.Validate(why);
 }
 

@@ -12,6 +12,7 @@
 
 #include "core/ball_catalogue.hpp"
 #include "core/bat.hpp"
+#include "core/collision/barrel.hpp"
 #include "core/collision/flexible_impact.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/flexible/beam_model.hpp"
@@ -193,6 +194,7 @@ struct SceneOptions {
   int max_curve_points = 10000;
   HertzOptions hertz;        ///< Contact-model settings (model = kHertz).
   FlexibleOptions flexible;  ///< Flexible-beam settings (vibration_node, flexible, sting).
+  BarrelOptions barrel;      ///< Barrel-model settings (barrel, bbcor).
   /// True (the default): the result's timings and solve_time_s are measured. False: the
   /// closed forms and the mass properties read no clock (their timings are 0 s; the models
   /// and calls are still listed): /v1/explore's sweeps, whose rows report no timings.

@@ -22,6 +22,8 @@ constexpr OutputName kOutputNames[] = {
     {SceneOutput::kSweetZone, "sweet_zone"},
     {SceneOutput::kExitSpeedCurve, "exit_speed_curve"},
     {SceneOutput::kLeastStingZone, "least_sting_zone"},
+    {SceneOutput::kBarrel, "barrel"},
+    {SceneOutput::kBbcor, "bbcor"},
 };
 
 // A position x in a profile's coordinate (origin o from the knob) as metres from the knob, for

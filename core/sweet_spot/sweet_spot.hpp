@@ -24,10 +24,12 @@ enum class SceneOutput {
   kSweetZone,       ///< Positions whose exit speed is within a tolerance of the maximum.
   kExitSpeedCurve,  ///< Exit speed along the bat.
   kLeastStingZone,  ///< Flexible impacts swept along the bat: where the hands get least vibration.
+  kBarrel,          ///< A hollow barrel's hoop mode, stiffness and effective COR (trampoline).
+  kBbcor,           ///< BBCOR by the NCAA protocol (core/collision/barrel.hpp).
 };
 
 /// Stable name: "max_exit_speed", "center_of_percussion", "vibration_node", "sweet_zone",
-/// "exit_speed_curve", "least_sting_zone".
+/// "exit_speed_curve", "least_sting_zone", "barrel", "bbcor".
 const char* SceneOutputName(SceneOutput output);
 /// The output called `name`, or nullopt.
 std::optional<SceneOutput> ParseSceneOutput(std::string_view name);

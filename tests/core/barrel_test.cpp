@@ -102,7 +102,7 @@ TEST(Barrel, SolidWoodIsUnchanged) {
     const double e = FindBallPreset("ncaa-nfhs")->cor_law.CorAt(136.0 * 0.44704);
     EXPECT_EQ(r.value, e);
     EXPECT_EQ(r.hoop_frequency_hz, 0.0);
-    const TrampolineResult t = EffectiveCorAt(bat, 0.7, 0.145, 0.0366, 4e7, 1.5, 0.5, 40.0);
+    const TrampolineResult t = EffectiveCorAt(bat, ComputeMassProperties(bat), 0.7, 0.145, 0.0366, 4e7, 1.5, 0.5, 40.0);
     EXPECT_TRUE(t.ok);
     EXPECT_EQ(t.effective_cor, 0.5);
   }

@@ -1,0 +1,21 @@
+// The scene outputs of the barrel model (core/collision/barrel.hpp): `barrel` (the hoop mode,
+// the barrel's stiffness and the effective COR along the barrel for the scene's ball and swing)
+// and `bbcor` (the NCAA protocol, independent of the scene's ball and swing).
+#pragma once
+
+#include <string>
+
+#include "core/collision/barrel.hpp"
+#include "core/scene/resolved_scene.hpp"
+#include "core/scene/scene.hpp"
+
+namespace sweetspot::core {
+
+/// The `barrel` output of `scene` (its bat required) resolved as `resolved` (COR resolved). The
+/// ball's COR at each point: the ball's COR law at the normal impact speed
+/// ball.speed_mps + omega (x - pivot) when the ball has one, else the resolved COR. False with
+/// *error when the model fails.
+bool SceneBarrel(const Scene& scene, const ResolvedScene& resolved, const BarrelOptions& options,
+                 BarrelOutput* out, std::string* error);
+
+}  // namespace sweetspot::core
