@@ -262,6 +262,7 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
              {"angular_speed_rad_s", Finite(r.angular_speed_rad_s)}}},
            {"summary", std::move(summary)}};
   if (!conflicts.empty()) out["conflicts"] = std::move(conflicts);
+  if (r.bbcor) out["bbcor"] = BbcorToJson(*r.bbcor);
   if (r.first_bending_mode) {
     const core::DesignFrequency& f = *r.first_bending_mode;
     out["first_bending_mode"] = {{"frequency_hz", Finite(f.frequency_hz)},

@@ -551,6 +551,15 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, &result);
     ReportActiveConstraints(model, x, chosen.outcome, &result);
     MarkCancelledMultiStart(options, runs, progress, &result);
+    const auto& rules = problem.constraints.rules;
+    if (result.bat.IsHollow() &&
+        std::find(rules.begin(), rules.end(), RuleSet::kBbcor) != rules.end()) {
+      std::string bbcor_why;
+      if (!BbcorRuleHolds(result.bat, &result.bbcor.emplace(), &bbcor_why)) {
+        summary.termination = Termination::kInfeasible;
+        summary.message = bbcor_why;
+      }
+    }
   } catch (const std::bad_alloc&) {
     summary.termination = Termination::kFailure;
     summary.message = "out of memory";

@@ -126,4 +126,23 @@ bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why) {
   return true;
 }
 
+bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why) {
+  *bbcor = ComputeBbcor(bat);
+  const double limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
+  if (!bbcor->ok) {
+    if (why != nullptr) *why = "rules.bbcor: the BBCOR could not be computed: " + bbcor->message;
+    return false;
+  }
+  if (bbcor->value > limit) {
+    if (why != nullptr) {
+      *why = "rules.bbcor: the design's BBCOR = " + FormatNumber(bbcor->value) +
+             " exceeds the limit " + FormatNumber(limit) +
+             " (NCAA protocol with the barrel model, checked after solving: the wall's effect on "
+             "the BBCOR is not a constraint of the design model; thicken the wall's lower bound)";
+    }
+    return false;
+  }
+  return true;
+}
+
 }  // namespace sweetspot::core

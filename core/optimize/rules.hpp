@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/bat.hpp"
+#include "core/collision/barrel.hpp"
 #include "core/material.hpp"
 #include "core/refusal.hpp"
 
@@ -67,5 +69,11 @@ bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, std::string* why);
 /// RuleAllowsDesign with the refusal as data in *why (if non-null): field "rules.<name>", the
 /// rule the broken part.
 bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why);
+
+/// The `bbcor` rule's check of a finished hollow design (after solving: the design model does not
+/// differentiate the barrel): *bbcor = ComputeBbcor(bat) (the NCAA protocol, default barrel
+/// options). False, with "rules.bbcor: ..." in *why, when the value exceeds the limit or the model
+/// fails.
+bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why);
 
 }  // namespace sweetspot::core
