@@ -6,6 +6,7 @@
 #include <exception>
 #include <utility>
 
+#include "core/collision/barrel.hpp"
 #include "core/geometry_format.hpp"
 
 namespace sweetspot::core {
@@ -23,7 +24,11 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
     return false;
   }
   // The ball's law needs the bat's length: evaluated below, once the length is known.
-  const bool ball_cor = needs_cor && !scene.cor.has_value() && BallCorApplies(scene);
+  // A hollow bat hit by a ball with a COR law: the trampoline's effective COR (barrel.hpp).
+  const bool barrel_cor = needs_cor && !scene.cor.has_value() && scene.ball.cor_law.has_value() &&
+                          scene.bat.has_value() && scene.bat->IsHollow();
+  const bool ball_cor =
+      needs_cor && !scene.cor.has_value() && (barrel_cor || BallCorApplies(scene));
   if (!needs_cor || ball_cor) {
     // Nothing wanted uses a COR (none is resolved, so none is required), or the ball's law.
   } else if (scene.cor.has_value()) {
@@ -32,13 +37,6 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
   } else if (scene.bat.has_value() && scene.bat->material.cor.has_value()) {
     r->cor = *scene.bat->material.cor;
     r->cor_source = "material:" + scene.bat->material.name;
-    if (scene.ball.cor_law.has_value()) {
-      s->warnings.push_back(
-          "hollow bat: the COR is the material's (" + FormatNumber(*r->cor) +
-          "), not the law of ball '" + scene.ball.preset +
-          "' against solid wood (a hollow barrel's compliance changes the ball-bat COR; give "
-          "cor to set it)");
-    }
   } else {
     // About the scene's COR and the bat's material together, so no one field: the api names
     // the part of the request it was evaluating (the bat, a compared variant).
@@ -85,8 +83,22 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
     const double v = scene.ball.speed_mps +
                      scene.swing.angular_speed_rad_s * (x - scene.swing.pivot_from_knob_m);
     r->cor = scene.ball.cor_law->CorAt(v);
-    r->cor_source = "ball:" + (scene.ball.preset.empty() ? "custom" : scene.ball.preset);
+    const std::string ball_name = scene.ball.preset.empty() ? "custom" : scene.ball.preset;
+    r->cor_source = "ball:" + ball_name;
     r->cor_impact_speed_mps = v;
+    if (barrel_cor && v > 0.0) {
+      const Ball& b = scene.ball;
+      const TrampolineResult t = EffectiveCorAt(*scene.bat, r->mass_properties, x, b.mass_kg,
+                                                b.radius_m, b.stiffness, b.stiffness_exponent,
+                                                *r->cor, v);
+      if (!t.ok) {
+        s->termination = Termination::kFailure;
+        s->message = "barrel: " + t.message;
+        return false;
+      }
+      r->cor = t.effective_cor;
+      r->cor_source = "barrel:" + ball_name;
+    }
   }
   return true;
 }

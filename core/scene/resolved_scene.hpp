@@ -23,7 +23,8 @@ struct ResolvedScene {
   MassProperties mass_properties;  ///< The bat's (computed from `bat`, or the scene's own).
   double length_m = 0.0;           ///< The bat length, m.
   std::optional<double> cor;       ///< The COR; unset when nothing wanted needs one.
-  /// "scene" (the request's `cor`), "ball:<preset>" (the ball's COR law) or "material:<name>";
+  /// "scene" (the request's `cor`), "ball:<preset>" (the ball's COR law), "barrel:<preset>" (a
+  /// hollow bat: the trampoline's effective COR from the ball's law) or "material:<name>";
   /// "" when `cor` is unset.
   std::string cor_source;
   /// With cor_source "ball:...": the normal impact speed the ball's law was evaluated at, m/s.
@@ -38,8 +39,9 @@ bool BallCorApplies(const Scene& scene);
 /// once (timed as "mass_properties" in *book when computed) and checks the hands are on the bat.
 /// The COR: the scene's `cor`; else, when BallCorApplies, the ball's law at the normal impact
 /// speed ball.speed_mps + omega (x - pivot) at x = `cor_impact_from_knob_m` (clamped to the bat)
-/// or, without it, kCorReferenceFromTipM from the tip; else the bat material's. A hollow bat
-/// with a ball law keeps its material's COR with a warning in *summary. False with the
+/// or, without it, kCorReferenceFromTipM from the tip; for a hollow bat that ball COR goes through
+/// the barrel model (EffectiveCorAt, default BarrelOptions) at the same point and speed
+/// ("barrel:<ball>"); else the bat material's. False with the
 /// termination and message in *summary otherwise. Never throws.
 bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, ResolvedScene* resolved,
                   Summary* summary, std::optional<double> cor_impact_from_knob_m = std::nullopt);

@@ -55,6 +55,25 @@ TEST(BarrelApiTest, SolidWoodIsUnchanged) {
   EXPECT_NEAR(with.body["bbcor"]["value"].get<double>(), 0.555 - 0.001 * 76, 1e-12);
 }
 
+TEST(BarrelApiTest, HollowBatWithABallPresetTakesTheTrampolineCor) {
+  // Without cor: the ball's law at the reference point's speed, through the barrel model.
+  const Response r = Post("/v1/sweet-spot", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "ball": {"preset": "ncaa-nfhs"}, "outputs": ["max_exit_speed", "barrel"]})");
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["cor_source"], "barrel:ncaa-nfhs");
+  EXPECT_EQ(r.body["cor"], r.body["barrel"]["effective_cor"]);
+  const double ball_at_speed =
+      0.555 - 0.001 * (r.body["cor_impact_speed_mps"].get<double>() / 0.44704 - 60.0);
+  EXPECT_GT(r.body["cor"].get<double>(), ball_at_speed);
+  // A scene's cor is kept; without a ball preset the material's COR is kept (as before).
+  const Response given = Post("/v1/sweet-spot", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "ball": {"preset": "ncaa-nfhs"}, "cor": 0.45, "outputs": ["max_exit_speed"]})");
+  EXPECT_EQ(given.body["cor_source"], "scene");
+  const Response plain = Post("/v1/sweet-spot", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "outputs": ["max_exit_speed"]})");
+  EXPECT_EQ(plain.body["cor_source"], "material:aluminium-7050");
+}
+
 }  // namespace
 }  // namespace barrel_api_test
 }  // namespace sweetspot::api
