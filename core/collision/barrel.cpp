@@ -138,8 +138,7 @@ double RingFe(double e_prime, double rho, double radius, double h, int n_el) {
       }
     }
   }
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(kk, mm,
-                                                                   Eigen::EigenvaluesOnly);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> solver(kk, mm, Eigen::EigenvaluesOnly);
   if (solver.info() != Eigen::Success) return 0.0;
   // Three rigid-body modes (two translations, one rotation) come first, then the n = 2 pair.
   return std::sqrt(std::max(0.0, solver.eigenvalues()(3))) / (2.0 * kPi);
@@ -181,9 +180,8 @@ double RingModeFrequencyHz(double youngs_modulus_pa, double poissons_ratio, doub
   return std::sqrt(omega2) / (2.0 * kPi);
 }
 
-double RingFeHoopFrequencyHz(double youngs_modulus_pa, double poissons_ratio,
-                             double density_kg_m3, double radius_m, double thickness_m,
-                             int elements) {
+double RingFeHoopFrequencyHz(double youngs_modulus_pa, double poissons_ratio, double density_kg_m3,
+                             double radius_m, double thickness_m, int elements) {
   const double e_prime = youngs_modulus_pa / (1.0 - poissons_ratio * poissons_ratio);
   return barrel_detail::RingFe(e_prime, density_kg_m3, radius_m, thickness_m,
                                std::max(8, elements));
@@ -194,8 +192,8 @@ bool BarrelOptions::IsValid(std::string* why) const {
     return RefuseMessage(why,
                          Number17Refusal("barrel.barrel_loss", barrel_loss, "must be in [0, 1)"));
   if (!(std::isfinite(shell_factor) && shell_factor > 0.0))
-    return RefuseMessage(why, Number17Refusal("barrel.shell_factor", shell_factor,
-                                              "must be finite and > 0"));
+    return RefuseMessage(
+        why, Number17Refusal("barrel.shell_factor", shell_factor, "must be finite and > 0"));
   if (!(std::isfinite(effective_length_m) && effective_length_m >= 0.0))
     return RefuseMessage(why, Number17Refusal("barrel.effective_length_m", effective_length_m,
                                               "must be finite and >= 0 (0 = the default)"));
@@ -239,8 +237,9 @@ TrampolineResult TrampolineImpact(const TrampolineProblem& p, const BarrelOption
   if (!(p.ball_mass_kg > 0.0 && p.barrel_modal_mass_kg > 0.0 && rest > 0.0 &&
         p.barrel_stiffness_n_m > 0.0 && p.approach_speed_mps > 0.0 && p.ball_cor > 0.0 &&
         p.ball_cor <= 1.0 && p.barrel_damping_ratio >= 0.0)) {
-    out.message = "trampoline: masses, stiffness, approach speed and ball COR must be > 0 and "
-                  "the wall's modal mass below the bat's effective mass";
+    out.message =
+        "trampoline: masses, stiffness, approach speed and ball COR must be > 0 and "
+        "the wall's modal mass below the bat's effective mass";
     return out;
   }
   barrel_detail::TrampolineSystem sys;
@@ -280,13 +279,14 @@ TrampolineResult QuasiStaticTrampoline(const TrampolineProblem& p) {
   if (!(p.ball_mass_kg > 0.0 && p.bat_effective_mass_kg > 0.0 && p.barrel_stiffness_n_m > 0.0 &&
         p.approach_speed_mps > 0.0 && p.ball_cor >= 0.0 && p.ball_cor <= 1.0 &&
         p.barrel_loss >= 0.0 && p.barrel_loss < 1.0 && p.ball_stiffness > 0.0)) {
-    out.message = "trampoline: masses, stiffnesses and the approach speed must be > 0, the ball's "
-                  "COR in [0, 1] and the barrel's loss in [0, 1)";
+    out.message =
+        "trampoline: masses, stiffnesses and the approach speed must be > 0, the ball's "
+        "COR in [0, 1] and the barrel's loss in [0, 1)";
     return out;
   }
   const BallPowerLaw law(p.ball_stiffness, p.ball_exponent, p.surface_stiffness);
-  const double mu = p.ball_mass_kg * p.bat_effective_mass_kg /
-                    (p.ball_mass_kg + p.bat_effective_mass_kg);
+  const double mu =
+      p.ball_mass_kg * p.bat_effective_mass_kg / (p.ball_mass_kg + p.bat_effective_mass_kg);
   const double energy = 0.5 * mu * p.approach_speed_mps * p.approach_speed_mps;
   auto works = [&](double f, double* wc, double* wb) {
     *wc = law.LoadingWork(f, law.LoadingCompression(f));
@@ -318,9 +318,8 @@ double QuasiStaticTrampolineCor(const TrampolineProblem& p) {
 }
 
 TrampolineResult EffectiveCorAt(const Bat& bat, const MassProperties& mp, double x_m,
-                                double ball_mass_kg,
-                                double ball_radius_m, double ball_stiffness, double ball_exponent,
-                                double ball_cor, double approach_speed_mps,
+                                double ball_mass_kg, double ball_radius_m, double ball_stiffness,
+                                double ball_exponent, double ball_cor, double approach_speed_mps,
                                 const BarrelOptions& options) {
   if (!BarrelWallAt(bat, x_m, options).hollow) {
     TrampolineResult out;
@@ -331,8 +330,7 @@ TrampolineResult EffectiveCorAt(const Bat& bat, const MassProperties& mp, double
   const double b = x_m - mp.balance_point_m;
   const double m_e = 1.0 / (1.0 / mp.mass_kg + b * b / mp.moi_centroid_kg_m2);
   return barrel_detail::HollowImpact(bat, x_m, m_e, ball_mass_kg, ball_radius_m, ball_stiffness,
-                                     ball_exponent, ball_cor, approach_speed_mps, options,
-                                     nullptr);
+                                     ball_exponent, ball_cor, approach_speed_mps, options, nullptr);
 }
 
 BbcorResult ComputeBbcor(const Bat& bat, const BbcorProtocol& protocol,

@@ -5,12 +5,14 @@
 // long cylinder). Its lowest ovaling ("hoop") mode n = 2 has the inextensional thin-ring
 // frequency (A. E. H. Love, A Treatise on the Mathematical Theory of Elasticity, 4th ed., sec.
 // 293; W. Soedel, Vibrations of Shells and Plates, ring modes)
-//   omega_n^2 = E' h^2 n^2 (n^2 - 1)^2 / (12 rho R^4 (n^2 + 1)),   n = 2: omega^2 = 3 E' h^2 / (5 rho R^4).
+//   omega_n^2 = E' h^2 n^2 (n^2 - 1)^2 / (12 rho R^4 (n^2 + 1)),
+//   n = 2: omega^2 = 3 E' h^2 / (5 rho R^4).
 // A slice of length l of that ring, loaded radially at one point, has for the n = 2 mode
 // (w = A cos 2 theta, v = -(A/2) sin 2 theta) the modal mass and stiffness referred to the
 // displacement A under the load
 //   m_eff  = pi rho h R l (1 + 1/n^2) = (5/4) pi rho h R l,
-//   k_ring = pi E' (h^3 / 12) l (n^2 - 1)^2 / R^3 = (3/4) pi E' h^3 l / R^3  (= m_eff omega^2, tested).
+//   k_ring = pi E' (h^3 / 12) l (n^2 - 1)^2 / R^3 = (3/4) pi E' h^3 l / R^3
+//          (= m_eff omega^2, tested).
 // l = 2 R sqrt(R/h), twice the axial decay length R sqrt(R/h) of an n = 2 load on a long cylinder
 // (the semi-membrane length of shell theory); with it k_ring = (3/2) pi E' h^(5/2) / R^(3/2), the
 // h^(5/2) R^(-3/2) scaling of a point-loaded long cylinder. A ring cannot carry load by membrane
@@ -54,9 +56,8 @@ double RingModeFrequencyHz(double youngs_modulus_pa, double poissons_ratio, doub
 /// The same ring's n = 2 frequency from a finite-element model: `elements` straight frame
 /// elements (axial + Euler-Bernoulli bending, consistent mass, plane strain) around the
 /// circle; the lowest elastic eigenvalue of the generalised problem K x = w^2 M x, Hz.
-double RingFeHoopFrequencyHz(double youngs_modulus_pa, double poissons_ratio,
-                             double density_kg_m3, double radius_m, double thickness_m,
-                             int elements = 64);
+double RingFeHoopFrequencyHz(double youngs_modulus_pa, double poissons_ratio, double density_kg_m3,
+                             double radius_m, double thickness_m, int elements = 64);
 
 /// The calibrated shell factor c (the file comment): 6.98 puts the `bbcor-33-aluminium` preset at
 /// BBCOR 0.500 exactly; rounded to 7 (BarrelTest re-derives it).
@@ -82,10 +83,10 @@ struct BarrelOptions {
 
 /// The wall at one point along a hollow bat.
 struct BarrelWall {
-  bool hollow = false;           ///< False for a solid bat (or outside it): nothing else is set.
-  double outer_radius_m = 0.0;   ///< Outer radius there, m.
-  double thickness_m = 0.0;      ///< h, m.
-  double mid_radius_m = 0.0;     ///< R = outer - h/2, m.
+  bool hollow = false;              ///< False for a solid bat (or outside it): nothing else is set.
+  double outer_radius_m = 0.0;      ///< Outer radius there, m.
+  double thickness_m = 0.0;         ///< h, m.
+  double mid_radius_m = 0.0;        ///< R = outer - h/2, m.
   double effective_length_m = 0.0;  ///< l, m.
   double hoop_frequency_hz = 0.0;   ///< n = 2 ring frequency, Hz.
   double modal_mass_kg = 0.0;       ///< m_eff = (5/4) pi rho h R l, kg.
@@ -100,30 +101,30 @@ BarrelWall BarrelWallAt(const Bat& bat, double x_m, const BarrelOptions& options
 
 /// One impact of the trampoline model.
 struct TrampolineProblem {
-  double ball_mass_kg = 0.145;        ///< m, kg (> 0).
-  double ball_stiffness = 4.0e7;      ///< k in F = k delta^p, N/m^p (> 0).
-  double ball_exponent = 1.5;         ///< p, in [1, 3].
-  double surface_stiffness = 0.0;     ///< Hertz K of the bat's surface, N/m^1.5 (0 = rigid).
-  double ball_cor = 0.5;              ///< e of the ball against a rigid surface, in (0, 1].
-  double bat_effective_mass_kg = 0.0; ///< M_e at the impact point, kg (> modal mass).
-  double approach_speed_mps = 0.0;    ///< v0, m/s (> 0).
-  double barrel_stiffness_n_m = 0.0;  ///< k_b, N/m (> 0).
-  double barrel_modal_mass_kg = 0.0;  ///< m_eff, kg (> 0).
-  double barrel_damping_ratio = 0.0;  ///< zeta (>= 0; dynamic model).
-  double barrel_loss = 0.0;           ///< Loss of the barrel's energy, [0, 1) (quasi-static model).
+  double ball_mass_kg = 0.145;         ///< m, kg (> 0).
+  double ball_stiffness = 4.0e7;       ///< k in F = k delta^p, N/m^p (> 0).
+  double ball_exponent = 1.5;          ///< p, in [1, 3].
+  double surface_stiffness = 0.0;      ///< Hertz K of the bat's surface, N/m^1.5 (0 = rigid).
+  double ball_cor = 0.5;               ///< e of the ball against a rigid surface, in (0, 1].
+  double bat_effective_mass_kg = 0.0;  ///< M_e at the impact point, kg (> modal mass).
+  double approach_speed_mps = 0.0;     ///< v0, m/s (> 0).
+  double barrel_stiffness_n_m = 0.0;   ///< k_b, N/m (> 0).
+  double barrel_modal_mass_kg = 0.0;   ///< m_eff, kg (> 0).
+  double barrel_damping_ratio = 0.0;   ///< zeta (>= 0; dynamic model).
+  double barrel_loss = 0.0;  ///< Loss of the barrel's energy, [0, 1) (quasi-static model).
 };
 
 /// What the trampoline impact gives.
 struct TrampolineResult {
-  bool ok = false;                 ///< False: the integration failed (message).
-  std::string message;             ///< Why it failed.
-  double effective_cor = 0.0;      ///< e_eff (dimensionless).
-  double ball_impulse_n_s = 0.0;   ///< P, N s.
-  double contact_time_s = 0.0;     ///< s.
-  double peak_force_n = 0.0;       ///< N.
+  bool ok = false;                       ///< False: the integration failed (message).
+  std::string message;                   ///< Why it failed.
+  double effective_cor = 0.0;            ///< e_eff (dimensionless).
+  double ball_impulse_n_s = 0.0;         ///< P, N s.
+  double contact_time_s = 0.0;           ///< s.
+  double peak_force_n = 0.0;             ///< N.
   double max_barrel_deflection_m = 0.0;  ///< Largest wall deflection, m.
   double barrel_energy_fraction = 0.0;   ///< Wall's share of the stored energy at peak force.
-  int steps = 0;                   ///< Accepted integrator steps.
+  int steps = 0;                         ///< Accepted integrator steps.
 };
 
 /// Integrates one trampoline impact (never throws; a failure is ok = false).
@@ -139,7 +140,7 @@ double QuasiStaticTrampolineCor(const TrampolineProblem& problem);
 
 /// The NCAA BBCOR protocol as this model runs it (docs/models.md, "BBCOR").
 struct BbcorProtocol {
-  std::string ball = "ncaa-nfhs";          ///< The catalogue ball fired.
+  std::string ball = "ncaa-nfhs";           ///< The catalogue ball fired.
   double ball_speed_mps = 136.0 * 0.44704;  ///< Ball speed onto the bat at rest, m/s (136 mph).
   double pivot_from_knob_m = 0.1524;        ///< The bat's pivot, m from the knob (6 in).
   /// The impact point, m from the barrel end (6 in; see docs/models.md, "BBCOR": the lab locates
@@ -149,16 +150,16 @@ struct BbcorProtocol {
 
 /// The BBCOR of a bat by the protocol.
 struct BbcorResult {
-  bool ok = false;               ///< False: a model failure or invalid input (message).
-  std::string message;           ///< Why not.
-  double value = 0.0;            ///< BBCOR at the protocol's impact point.
-  std::string ball;              ///< Ball used.
-  double ball_speed_mps = 0.0;   ///< m/s.
-  double ball_cor = 0.0;         ///< The ball's COR against solid wood at that speed.
-  double impact_from_knob_m = 0.0;  ///< The impact point, m from the knob.
-  double pivot_from_knob_m = 0.0;   ///< m.
-  std::string method;            ///< "rigid" (solid bat) or "trampoline_quasi_static".
-  double hoop_frequency_hz = 0.0;   ///< At the impact point (0 for a solid bat), Hz.
+  bool ok = false;                    ///< False: a model failure or invalid input (message).
+  std::string message;                ///< Why not.
+  double value = 0.0;                 ///< BBCOR at the protocol's impact point.
+  std::string ball;                   ///< Ball used.
+  double ball_speed_mps = 0.0;        ///< m/s.
+  double ball_cor = 0.0;              ///< The ball's COR against solid wood at that speed.
+  double impact_from_knob_m = 0.0;    ///< The impact point, m from the knob.
+  double pivot_from_knob_m = 0.0;     ///< m.
+  std::string method;                 ///< "rigid" (solid bat) or "trampoline_quasi_static".
+  double hoop_frequency_hz = 0.0;     ///< At the impact point (0 for a solid bat), Hz.
   double barrel_stiffness_n_m = 0.0;  ///< k_b at the impact point (0 for a solid bat), N/m.
 };
 
@@ -173,15 +174,10 @@ BbcorResult ComputeBbcor(const Bat& bat, const BbcorProtocol& protocol = {},
 /// approaching at approach_speed_mps, the bat (of `mass_properties`) free
 /// (M_e = 1/(1/M + b^2/I_cm)); `ball_cor` itself
 /// (exactly) for a solid bat.
-TrampolineResult EffectiveCorAt(const Bat& bat, const MassProperties& mass_properties,
-                                double x_m, double ball_mass_kg,
-                                double ball_radius_m, double ball_stiffness, double ball_exponent,
-                                double ball_cor, double approach_speed_mps,
+TrampolineResult EffectiveCorAt(const Bat& bat, const MassProperties& mass_properties, double x_m,
+                                double ball_mass_kg, double ball_radius_m, double ball_stiffness,
+                                double ball_exponent, double ball_cor, double approach_speed_mps,
                                 const BarrelOptions& options = {});
-
-}  // namespace sweetspot::core
-
-namespace sweetspot::core {
 
 /// The effective COR at one point along the barrel.
 struct BarrelCorPoint {
@@ -193,14 +189,14 @@ struct BarrelCorPoint {
 
 /// The `barrel` output of a scene.
 struct BarrelOutput {
-  bool hollow = false;                ///< False: a solid bat (no hoop mode; COR unchanged).
-  double position_from_knob_m = 0.0;  ///< The reference point (6 in from the tip), m.
-  BarrelWall wall;                    ///< The wall there (hollow only).
-  double shell_factor = 0.0;          ///< c used (hollow only).
-  double effective_cor = 0.0;         ///< e_eff at the reference point.
+  bool hollow = false;                  ///< False: a solid bat (no hoop mode; COR unchanged).
+  double position_from_knob_m = 0.0;    ///< The reference point (6 in from the tip), m.
+  BarrelWall wall;                      ///< The wall there (hollow only).
+  double shell_factor = 0.0;            ///< c used (hollow only).
+  double effective_cor = 0.0;           ///< e_eff at the reference point.
   double barrel_energy_fraction = 0.0;  ///< The barrel's share of the stored energy there.
   std::vector<BarrelCorPoint> effective_cor_curve;  ///< e_eff every inch over the last 10 in.
-  std::string method;  ///< "trampoline_quasi_static" or "solid".
+  std::string method;                               ///< "trampoline_quasi_static" or "solid".
 };
 
 }  // namespace sweetspot::core

@@ -54,8 +54,8 @@ TEST(Barrel, RingStiffnessFromTheEnergyMethodEqualsModalMassTimesOmegaSquared) {
   const double omega = 2.0 * kPi * w.hoop_frequency_hz;
   EXPECT_NEAR(w.ring_stiffness_n_m, w.modal_mass_kg * omega * omega, 1e-12 * w.ring_stiffness_n_m);
   EXPECT_NEAR(w.stiffness_n_m, kBarrelShellFactor * w.ring_stiffness_n_m, 1e-6);
-  EXPECT_NEAR(w.effective_length_m, 2.0 * w.mid_radius_m * std::sqrt(w.mid_radius_m / w.thickness_m),
-              1e-15);
+  EXPECT_NEAR(w.effective_length_m,
+              2.0 * w.mid_radius_m * std::sqrt(w.mid_radius_m / w.thickness_m), 1e-15);
 }
 
 TEST(Barrel, AluminiumPresetHoopFrequencyIsInThePublishedRange) {
@@ -102,7 +102,8 @@ TEST(Barrel, SolidWoodIsUnchanged) {
     const double e = FindBallPreset("ncaa-nfhs")->cor_law.CorAt(136.0 * 0.44704);
     EXPECT_EQ(r.value, e);
     EXPECT_EQ(r.hoop_frequency_hz, 0.0);
-    const TrampolineResult t = EffectiveCorAt(bat, ComputeMassProperties(bat), 0.7, 0.145, 0.0366, 4e7, 1.5, 0.5, 40.0);
+    const TrampolineResult t =
+        EffectiveCorAt(bat, ComputeMassProperties(bat), 0.7, 0.145, 0.0366, 4e7, 1.5, 0.5, 40.0);
     EXPECT_TRUE(t.ok);
     EXPECT_EQ(t.effective_cor, 0.5);
   }

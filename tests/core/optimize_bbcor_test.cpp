@@ -54,8 +54,7 @@ TEST(OptimizeBbcor, TheRuleIsCheckedOnTheAnswerAndTheThinnestLegalWallPassesIt) 
   ASSERT_TRUE(drop_only.bbcor.has_value()) << drop_only.summary.FullReport();
   EXPECT_GT(drop_only.bbcor->value, 0.5);
   EXPECT_EQ(drop_only.summary.termination, Termination::kInfeasible);
-  EXPECT_NE(drop_only.summary.message.find("rules.bbcor: the design's BBCOR = "),
-            std::string::npos)
+  EXPECT_NE(drop_only.summary.message.find("rules.bbcor: the design's BBCOR = "), std::string::npos)
       << drop_only.summary.message;
 
   // The thinnest legal wall (bisection) as the wall's lower bound: the optimiser goes there,
@@ -69,7 +68,7 @@ TEST(OptimizeBbcor, TheRuleIsCheckedOnTheAnswerAndTheThinnestLegalWallPassesIt) 
   EXPECT_LE(r.bbcor->value, 0.5);
   EXPECT_NEAR(r.bbcor->value, 0.5, 1e-4);
   EXPECT_EQ(ComputeBbcor(r.bat).value, r.bbcor->value);  // recomputed
-  EXPECT_GT(BbcorWithWall(bat, legal - 1e-6), 0.5);       // any thinner is illegal
+  EXPECT_GT(BbcorWithWall(bat, legal - 1e-6), 0.5);      // any thinner is illegal
 }
 
 }  // namespace
