@@ -9,6 +9,7 @@
 
 #include "core/ball_catalogue.hpp"
 #include "core/presets.hpp"
+#include "core/scene/evaluate_scene.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -189,6 +190,50 @@ TEST(Barrel, OptionsAreCheckedWithTheirField) {
   const BbcorResult r = ComputeBbcor(AluminiumPreset(), {}, o);
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.message, why);
+}
+
+}  // namespace
+}  // namespace barrel_test
+}  // namespace sweetspot::core
+
+namespace sweetspot::core {
+namespace barrel_test {
+namespace {
+
+TEST(BarrelScene, OutputsNeedTheBatsGeometryAndSolidBatsKeepTheirCor) {
+  Scene s;
+  s.bat = FindPreset("wood-34-ash")->bat;
+  s.length_m = s.bat->LengthM();
+  s.outputs = {SceneOutput::kMaxExitSpeed};
+  const SceneResult plain = EvaluateScene(s, {});
+  s.outputs = {SceneOutput::kMaxExitSpeed, SceneOutput::kBarrel, SceneOutput::kBbcor};
+  const SceneResult with = EvaluateScene(s, {});
+  ASSERT_EQ(with.summary.termination, Termination::kConverged) << with.summary.message;
+  EXPECT_EQ(with.cor, plain.cor);
+  EXPECT_EQ(with.max_exit_speed->exit_speed_mps, plain.max_exit_speed->exit_speed_mps);
+  ASSERT_TRUE(with.barrel.has_value());
+  EXPECT_FALSE(with.barrel->hollow);
+  EXPECT_EQ(with.barrel->effective_cor, *with.cor);
+  ASSERT_TRUE(with.bbcor.has_value());
+  EXPECT_EQ(with.bbcor->method, "rigid");
+  // Only mass properties: refused, naming the bat.
+  Scene no_bat = s;
+  no_bat.mass_properties = ComputeMassProperties(*s.bat);
+  no_bat.bat.reset();
+  for (SceneOutput o : {SceneOutput::kBarrel, SceneOutput::kBbcor}) {
+    no_bat.outputs = {o};
+    const SceneResult r = EvaluateScene(no_bat, {});
+    EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
+    EXPECT_EQ(r.refused_field, "bat");
+  }
+  // A reused evaluator resets the barrel outputs.
+  SceneEvaluator evaluator({});
+  SceneResult reused;
+  evaluator.Evaluate(s, &reused);
+  s.outputs = {SceneOutput::kMaxExitSpeed};
+  evaluator.Evaluate(s, &reused);
+  EXPECT_FALSE(reused.barrel.has_value());
+  EXPECT_FALSE(reused.bbcor.has_value());
 }
 
 }  // namespace
