@@ -75,6 +75,7 @@ const Endpoint<SweetSpotRequest, core::SceneResult>& SweetSpotEndpoint() {
     e.render = [](const SweetSpotRequest&, const core::SceneResult& result) {
       Json out = SceneResultToJson(result);
       out["properties"] = PropertiesToJson(result.mass_properties, result.length_m);
+      out["swing"] = SwingToJson(result.swing);
       return out;
     };
     e.summary = [](const core::SceneResult& result) -> const core::Summary& {
@@ -295,6 +296,7 @@ Json RenderCompare(const CompareRequest& request, const CompareResult& compare) 
     row["name"] = request.bats[i].first;
     row["bat"] = request.bats[i].second.request_form;
     row["properties"] = PropertiesToJson(result.mass_properties, result.length_m);
+    row["swing"] = SwingToJson(result.swing);  // per bat: a bat speed gives each its own omega
     if (i > 0) row["deltas"] = CompareDeltas(result, compare.results.front());
     rows.push_back(std::move(row));
   }

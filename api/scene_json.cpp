@@ -1,6 +1,7 @@
 #include "api/scene_json.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <limits>
 
@@ -35,17 +36,46 @@ bool ReadBall(const Json& value, const std::string& path, core::Ball* ball, ApiE
   return reader.Finish();
 }
 
+// Exactly one of angular_speed_rad_s and bat_speed_mps (which core turns into the angular speed
+// once the bat's length is known: core::ResolveSwing). NaN marks "not given": JSON has none.
 bool ReadSwing(const Json& value, const std::string& path, core::Swing* swing, ApiError* error) {
   ObjectReader reader(value, path, error);
-  reader.OptionalNumber("angular_speed_rad_s", AnyNumber(), &swing->angular_speed_rad_s);
+  constexpr double kNotGiven = std::numeric_limits<double>::quiet_NaN();
+  double angular_speed_rad_s = kNotGiven;
+  double bat_speed_mps = kNotGiven;
+  reader.OptionalNumber("angular_speed_rad_s", AnyNumber(), &angular_speed_rad_s);
+  reader.OptionalNumber("bat_speed_mps", AnyNumber(), &bat_speed_mps);
+  reader.OptionalNumber("bat_speed_from_tip_m", AnyNumber(), &swing->bat_speed_from_tip_m);
   reader.OptionalNumber("pivot_from_knob_m", AnyNumber(), &swing->pivot_from_knob_m);
   reader.OptionalNumber("hands_from_knob_m", AnyNumber(), &swing->hands_from_knob_m);
+  if (!reader.ok()) return false;
+  if (!std::isnan(angular_speed_rad_s) && !std::isnan(bat_speed_mps)) {
+    return reader.Fail("bat_speed_mps",
+                       "give exactly one of swing.bat_speed_mps and swing.angular_speed_rad_s "
+                       "(both are given; the bat speed sets the angular speed)");
+  }
+  if (!std::isnan(angular_speed_rad_s)) {
+    swing->angular_speed_rad_s = angular_speed_rad_s;
+    swing->bat_speed_mps.reset();
+  }
+  if (!std::isnan(bat_speed_mps)) swing->bat_speed_mps = bat_speed_mps;
   return reader.Finish();
 }
 
 Json PlacementJson(core::Placement placement) { return core::PlacementName(placement); }
 
 }  // namespace
+
+Json SwingToJson(const core::Swing& swing) {
+  Json out{{"angular_speed_rad_s", swing.angular_speed_rad_s},
+           {"pivot_from_knob_m", swing.pivot_from_knob_m},
+           {"hands_from_knob_m", swing.hands_from_knob_m}};
+  if (swing.bat_speed_mps.has_value()) {
+    out["bat_speed_mps"] = *swing.bat_speed_mps;
+    out["bat_speed_from_tip_m"] = swing.bat_speed_from_tip_m;
+  }
+  return out;
+}
 
 bool ReadSceneCommon(ObjectReader& reader, core::Scene* scene) {
   if (const Json* ball = reader.Get("ball")) {
@@ -450,6 +480,7 @@ Json CollisionResultToJson(const core::CollisionResult& r) {
            {"cor_source", r.cor_source},
            {"models_used", r.summary.models_used}};
   if (r.cor_impact_speed_mps) out["cor_impact_speed_mps"] = *r.cor_impact_speed_mps;
+  out["swing"] = SwingToJson(r.swing);
   if (r.rigid_pivot) {
     const auto& p = *r.rigid_pivot;
     out["rigid_pivot"] = {{"x_from_pivot_m", p.x_from_pivot_m},

@@ -20,6 +20,10 @@ namespace sweetspot::api {
 /// COR from the bat's material, pivot at the knob).
 bool ReadSceneCommon(ObjectReader& reader, core::Scene* scene);
 
+/// The resolved swing a scene answer echoes: {angular_speed_rad_s, pivot_from_knob_m,
+/// hands_from_knob_m} plus {bat_speed_mps, bat_speed_from_tip_m} when the bat speed set it.
+nlohmann::json SwingToJson(const core::Swing& swing);
+
 /// Reads "outputs" (an array of output names; default ["max_exit_speed"]).
 bool ReadOutputs(ObjectReader& reader, core::Scene* scene);
 

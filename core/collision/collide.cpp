@@ -42,6 +42,7 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
     // Also when refused: the caller can then tell properties that are not usable (the bat's).
     out.mass_properties = r.mass_properties;
     if (!resolved) return;
+    out.swing = r.swing;
     out.cor = *r.cor;
     out.cor_source = r.cor_source;
     out.cor_impact_speed_mps = r.cor_impact_speed_mps;

@@ -46,6 +46,8 @@ struct CollisionResult {
   /// With cor_source "ball:...": this impact's normal speed the ball's law was evaluated at, m/s.
   std::optional<double> cor_impact_speed_mps;
   MassProperties mass_properties;  ///< The properties used (when refused: as computed, or zero).
+  /// The swing used, its angular speed resolved (from bat_speed_mps when given).
+  Swing swing;
   std::optional<RigidPivotImpact> rigid_pivot;         ///< Details when model = rigid_pivot.
   std::optional<FreeBatImpact> free_bat;               ///< Details when model = free_bat.
   std::optional<HertzImpact> hertz;                    ///< Details when model = hertz.

@@ -20,6 +20,13 @@ bool ModelBuilder::CheckScene() {
     return Refuse(why, TextRefusal("objective", "not a known objective"));
   }
   if (!problem.ball.Validate(why) || !problem.swing.Validate(why)) return false;
+  if (problem.swing.bat_speed_mps.has_value()) {
+    // The bat speed fixes omega only once the length is known, and the length (and the
+    // swing-weight objective's omega) vary with the design: the angular speed is the input here.
+    return Refuse(why, "swing.bat_speed_mps", *problem.swing.bat_speed_mps,
+                  "is not accepted by a design problem (its bat length varies with the design): "
+                  "give swing.angular_speed_rad_s");
+  }
   if (!(std::isfinite(problem.swing_weight_exponent) && problem.swing_weight_exponent >= 0.0 &&
         problem.swing_weight_exponent <= 0.5)) {
     return Refuse(why, "swing_weight_exponent", problem.swing_weight_exponent,

@@ -113,7 +113,7 @@ void SceneResult::Reset() {
   // A field added to SceneResult must be reset here too: on x86-64 (the size this list was
   // written for) the size check says so.
 #if defined(__x86_64__)
-  static_assert(sizeof(SceneResult) == 1760 + kBarrelFieldsSize,
+  static_assert(sizeof(SceneResult) == 1808 + kBarrelFieldsSize,
                 "SceneResult gained a field: reset it in Reset");
 #endif
   summary.Reset();
@@ -124,6 +124,7 @@ void SceneResult::Reset() {
   cor_impact_speed_mps.reset();
   mass_properties = MassProperties{};
   length_m = 0.0;
+  swing = Swing{};
   exit_speed_model.clear();
   model_reason.clear();
   max_exit_speed.reset();
@@ -201,6 +202,7 @@ void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
     out.cor_source = r.cor_source;
     out.cor_impact_speed_mps = r.cor_impact_speed_mps;
     out.length_m = r.length_m;
+    out.swing = r.swing;
     for (size_t i = 0; i < options.curve_positions_from_knob_m.size(); ++i) {
       const double x = options.curve_positions_from_knob_m[i];
       if (!(x >= 0.0 && x <= r.length_m)) {

@@ -41,6 +41,9 @@ struct SceneResult {
   std::optional<double> cor_impact_speed_mps;
   MassProperties mass_properties;  ///< The properties used (when refused: as computed, or zero).
   double length_m = 0.0;           ///< The bat length used, m.
+  /// The swing used, its angular speed resolved (from bat_speed_mps when given); the default
+  /// swing when refused before it was resolved.
+  Swing swing;
   std::string exit_speed_model;    ///< The exit-speed model used ("" when none was needed).
   std::string model_reason;        ///< Why that model (auto).
   std::optional<MaxExitSpeedResult> max_exit_speed;              ///< max_exit_speed.

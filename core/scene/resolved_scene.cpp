@@ -76,12 +76,16 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
                         "must be within the bat [0, " + FormatNumber17(r->length_m) + "]"));
     return false;
   }
+  if (Refusal refusal; !ResolveSwing(scene.swing, r->length_m, &r->swing, &refusal)) {
+    s->SetRefusal(std::move(refusal));
+    return false;
+  }
   if (ball_cor) {
     const double x = cor_impact_from_knob_m.has_value() && std::isfinite(*cor_impact_from_knob_m)
                          ? std::clamp(*cor_impact_from_knob_m, 0.0, r->length_m)
                          : std::max(0.0, r->length_m - kCorReferenceFromTipM);
-    const double v = scene.ball.speed_mps +
-                     scene.swing.angular_speed_rad_s * (x - scene.swing.pivot_from_knob_m);
+    const double v =
+        scene.ball.speed_mps + r->swing.angular_speed_rad_s * (x - r->swing.pivot_from_knob_m);
     r->cor = scene.ball.cor_law->CorAt(v);
     const std::string ball_name = scene.ball.preset.empty() ? "custom" : scene.ball.preset;
     r->cor_source = "ball:" + ball_name;
@@ -126,7 +130,7 @@ ExitSpeedProfile ClosedFormProfileFor(CollisionModel model, const MassProperties
 }
 
 RigidPivotInputs RigidPivotInputsFor(const Scene& scene, const ResolvedScene& r) {
-  return RigidPivotInputsFor(r.mass_properties, scene.ball, scene.swing, *r.cor);
+  return RigidPivotInputsFor(r.mass_properties, scene.ball, r.swing, *r.cor);
 }
 
 FreeBatInputs FreeBatInputsFor(const MassProperties& mass_properties, const Ball& ball,
@@ -145,7 +149,7 @@ FreeBatInputs FreeBatInputsFor(const MassProperties& mass_properties, const Ball
 }
 
 FreeBatInputs FreeBatInputsFor(const Scene& scene, const ResolvedScene& r) {
-  return FreeBatInputsFor(r.mass_properties, scene.ball, scene.swing, *r.cor);
+  return FreeBatInputsFor(r.mass_properties, scene.ball, r.swing, *r.cor);
 }
 
 HertzProblem HertzProblemFor(const Scene& scene, const ResolvedScene& r, double impact_from_knob_m,
@@ -160,7 +164,7 @@ HertzProblem HertzProblemFor(const Scene& scene, const ResolvedScene& r, double 
   p.ball_speed_mps = scene.ball.speed_mps;
   p.approach_speed_mps =
       scene.ball.speed_mps +
-      scene.swing.angular_speed_rad_s * (impact_from_knob_m - scene.swing.pivot_from_knob_m);
+      r.swing.angular_speed_rad_s * (impact_from_knob_m - r.swing.pivot_from_knob_m);
   p.c11_per_kg = 1.0 / scene.ball.mass_kg + 1.0 / m_bat + b * b / i;
   p.c12_per_kg = 1.0 / m_bat + b * bh / i;
   p.c22_per_kg = 1.0 / m_bat + bh * bh / i;
@@ -201,7 +205,7 @@ FlexibleImpactInputs FlexibleImpactInputsFor(const Scene& scene, const ResolvedS
   in.ball_speed_mps = scene.ball.speed_mps;
   in.approach_speed_mps =
       scene.ball.speed_mps +
-      scene.swing.angular_speed_rad_s * (impact_from_knob_m - scene.swing.pivot_from_knob_m);
+      r.swing.angular_speed_rad_s * (impact_from_knob_m - r.swing.pivot_from_knob_m);
   in.ball_stiffness = scene.ball.stiffness;
   in.ball_exponent = scene.ball.stiffness_exponent;
   in.cor = *r.cor;

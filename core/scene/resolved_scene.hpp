@@ -22,6 +22,9 @@ namespace sweetspot::core {
 struct ResolvedScene {
   MassProperties mass_properties;  ///< The bat's (computed from `bat`, or the scene's own).
   double length_m = 0.0;           ///< The bat length, m.
+  /// The scene's swing with its angular speed resolved (from bat_speed_mps when given): what
+  /// every model adapter below uses.
+  Swing swing;
   std::optional<double> cor;       ///< The COR; unset when nothing wanted needs one.
   /// "scene" (the request's `cor`), "ball:<preset>" (the ball's COR law), "barrel:<preset>" (a
   /// hollow bat: the trampoline's effective COR from the ball's law) or "material:<name>";
@@ -36,7 +39,8 @@ struct ResolvedScene {
 bool BallCorApplies(const Scene& scene);
 
 /// Validates `scene`, resolves its COR when `needs_cor`, computes (or takes) its mass properties
-/// once (timed as "mass_properties" in *book when computed) and checks the hands are on the bat.
+/// once (timed as "mass_properties" in *book when computed), checks the hands are on the bat and
+/// resolves the swing (ResolveSwing: omega from a bat speed, now that the length is known).
 /// The COR: the scene's `cor`; else, when BallCorApplies, the ball's law at the normal impact
 /// speed ball.speed_mps + omega (x - pivot) at x = `cor_impact_from_knob_m` (clamped to the bat)
 /// or, without it, kCorReferenceFromTipM from the tip; for a hollow bat that ball COR goes through

@@ -61,7 +61,39 @@ bool Swing::Validate(Refusal* why) const {
          CheckRange(why, "swing.pivot_from_knob_m", pivot_from_knob_m, -kMaxSwingOffsetM,
                     kMaxSwingOffsetM) &&
          CheckRange(why, "swing.hands_from_knob_m", hands_from_knob_m, -kMaxSwingOffsetM,
+                    kMaxSwingOffsetM) &&
+         (!bat_speed_mps.has_value() ||
+          CheckRange(why, "swing.bat_speed_mps", *bat_speed_mps, 0.0, kMaxBatSpeedMps)) &&
+         CheckRange(why, "swing.bat_speed_from_tip_m", bat_speed_from_tip_m, 0.0,
                     kMaxSwingOffsetM);
+}
+
+bool ResolveSwing(const Swing& swing, double length_m, Swing* resolved, Refusal* refusal) {
+  *resolved = swing;
+  if (!swing.bat_speed_mps.has_value()) return true;
+  const double from_tip = swing.bat_speed_from_tip_m;
+  if (!(from_tip <= length_m)) {
+    return Refuse17(refusal, "swing.bat_speed_from_tip_m", from_tip,
+                    "the bat-speed point must be on the bat: at most its length " +
+                        FormatNumber17(length_m) + " m from the tip");
+  }
+  const double x = length_m - from_tip;  // the bat-speed point, m from the knob
+  const double arm = x - swing.pivot_from_knob_m;
+  if (!(arm > 0.0)) {
+    return Refuse17(refusal, "swing.bat_speed_from_tip_m", from_tip,
+                    "the bat-speed point (" + FormatNumber17(x) +
+                        " m from the knob) must lie beyond the pivot (swing.pivot_from_knob_m = " +
+                        FormatNumber17(swing.pivot_from_knob_m) + ")");
+  }
+  const double omega = *swing.bat_speed_mps / arm;
+  if (!(omega <= kMaxSwingAngularSpeedRadS)) {
+    return Refuse17(refusal, "swing.bat_speed_mps", *swing.bat_speed_mps,
+                    "gives angular_speed_rad_s = " + FormatNumber17(omega) + " over " +
+                        FormatNumber17(kMaxSwingAngularSpeedRadS) + " (the point is " +
+                        FormatNumber17(arm) + " m from the pivot)");
+  }
+  resolved->angular_speed_rad_s = omega;
+  return true;
 }
 
 bool Scene::IsValid(std::string* why) const {

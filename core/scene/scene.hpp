@@ -46,6 +46,8 @@ inline constexpr double kMaxBallStiffness = 1e15;
 inline constexpr double kMaxSwingAngularSpeedRadS = 1e4;
 /// Largest distance of the pivot or the hands from the knob a scene accepts, m (either side).
 inline constexpr double kMaxSwingOffsetM = 100.0;
+/// Largest bat speed (swing.bat_speed_mps) a scene accepts, m/s.
+inline constexpr double kMaxBatSpeedMps = 1e3;
 
 /// The ball. Defaults: a regulation baseball and the paper's Table 3 speed.
 struct Ball {
@@ -83,12 +85,25 @@ struct Swing {
   /// The pivot, m from the knob (negative = behind the knob), within ±kMaxSwingOffsetM.
   double pivot_from_knob_m = 0.0;
   double hands_from_knob_m = 0.1524;  ///< The hands, m from the knob (within the bat).
+  /// The bat's speed at the bat-speed point, m/s, in [0, kMaxBatSpeedMps]: when set, it sets
+  /// angular_speed_rad_s = bat_speed_mps / (L - bat_speed_from_tip_m - pivot_from_knob_m) once
+  /// the bat length L is known (ResolveSwing, called by ResolveScene).
+  std::optional<double> bat_speed_mps;
+  /// Where bat_speed_mps is measured, m from the tip (the barrel end), in [0, kMaxSwingOffsetM];
+  /// the default is 6 in, as swing sensors report.
+  double bat_speed_from_tip_m = kCorReferenceFromTipM;
 
   /// True when every field is finite and in range; otherwise "swing.field = value: rule".
   bool IsValid(std::string* why) const;
   /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
   bool Validate(Refusal* refusal) const;
 };
+
+/// `swing` for a bat `length_m` long, into *resolved: a copy, with angular_speed_rad_s set from
+/// bat_speed_mps when that is given (omega = v / (L - from_tip - pivot)). False, with the
+/// refusal in *refusal (if non-null), when the bat-speed point is off the bat or not beyond the
+/// pivot, or the omega it gives is over kMaxSwingAngularSpeedRadS. `swing` must be valid.
+bool ResolveSwing(const Swing& swing, double length_m, Swing* resolved, Refusal* refusal);
 
 /// A scene: what is hit, how, and what is wanted.
 struct Scene {

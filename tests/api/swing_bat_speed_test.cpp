@@ -1,0 +1,163 @@
+// Issue 19, "Swing by bat speed": swing.bat_speed_mps at swing.bat_speed_from_tip_m sets the
+// angular speed about the pivot; the answers echo the swing they resolved.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "api/router.hpp"
+
+namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace swing_bat_speed_test {
+namespace {
+
+using Json = nlohmann::json;
+
+Response Post(const std::string& path, const Json& body) {
+  return Dispatch({"POST", path, body.dump()}, Context{});
+}
+
+// paper-wood's length, m (api-contract.md).
+constexpr double kPaperLengthM = 0.855;
+
+TEST(SwingBatSpeedTest, OmegaFromBatSpeedAtTheDefaultPoint) {
+  // 70 mph = 31.2928 m/s at 6 in from the tip, pivot 0.05 m from the knob.
+  const double v = 31.2928, pivot = 0.05;
+  const Response r = Post("/v1/sweet-spot", {{"bat", {{"preset", "paper-wood"}}},
+                                             {"swing", {{"bat_speed_mps", v},
+                                                        {"pivot_from_knob_m", pivot}}}});
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const Json& swing = r.body["swing"];
+  const double expected = v / (kPaperLengthM - 0.1524 - pivot);
+  // One division and two subtractions: a few ulps; 1e-12 relative as the brief asks.
+  EXPECT_NEAR(swing["angular_speed_rad_s"].get<double>(), expected, 1e-12 * expected);
+  EXPECT_EQ(swing["bat_speed_mps"], v);
+  EXPECT_EQ(swing["bat_speed_from_tip_m"], 0.1524);
+  EXPECT_EQ(swing["pivot_from_knob_m"], pivot);
+  EXPECT_EQ(swing["hands_from_knob_m"], 0.1524);
+}
+
+TEST(SwingBatSpeedTest, ExplicitPointAndEchoWithoutBatSpeed) {
+  const double v = 30.0, from_tip = 0.2;
+  const Response r = Post("/v1/collision", {{"bat", {{"preset", "paper-wood"}}},
+                                            {"impact_from_knob_m", 0.7},
+                                            {"swing", {{"bat_speed_mps", v},
+                                                       {"bat_speed_from_tip_m", from_tip}}}});
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const double expected = v / (kPaperLengthM - from_tip);  // pivot at the knob (default)
+  EXPECT_NEAR(r.body["swing"]["angular_speed_rad_s"].get<double>(), expected, 1e-12 * expected);
+  EXPECT_EQ(r.body["swing"]["bat_speed_from_tip_m"], from_tip);
+  // Without a bat speed the echo is the swing as given, compact (no bat-speed fields).
+  const Response plain = Post("/v1/collision", {{"bat", {{"preset", "paper-wood"}}},
+                                                {"impact_from_knob_m", 0.7}});
+  ASSERT_EQ(plain.status, 200) << plain.body.dump();
+  EXPECT_EQ(plain.body["swing"], Json({{"angular_speed_rad_s", 17.288},
+                                       {"pivot_from_knob_m", 0.0},
+                                       {"hands_from_knob_m", 0.1524}}));
+}
+
+TEST(SwingBatSpeedTest, SameExitSpeedAsTheEquivalentOmega) {
+  const double v = 31.2928;
+  for (const char* model : {"rigid_pivot", "free_bat"}) {
+    const Response by_speed =
+        Post("/v1/sweet-spot", {{"bat", {{"preset", "wood-34-ash"}}},
+                                {"swing", {{"bat_speed_mps", v}}},
+                                {"options", {{"model", model}}}});
+    ASSERT_EQ(by_speed.status, 200) << by_speed.body.dump();
+    const double omega = by_speed.body["swing"]["angular_speed_rad_s"];
+    const Response by_omega =
+        Post("/v1/sweet-spot", {{"bat", {{"preset", "wood-34-ash"}}},
+                                {"swing", {{"angular_speed_rad_s", omega}}},
+                                {"options", {{"model", model}}}});
+    ASSERT_EQ(by_omega.status, 200) << by_omega.body.dump();
+    // The same omega reaches the same closed form: bit-identical.
+    EXPECT_EQ(by_speed.body["max_exit_speed"], by_omega.body["max_exit_speed"]) << model;
+  }
+}
+
+TEST(SwingBatSpeedTest, CompareRowsEachResolveTheirOwnOmega) {
+  const Response r = Post(
+      "/v1/compare",
+      {{"baseline", {{"preset", "paper-wood"}}},
+       {"variants", {{{"name", "ash"}, {"bat", {{"preset", "wood-34-ash"}}}}}},
+       {"swing", {{"bat_speed_mps", 30.0}}}});
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  for (const Json& row : r.body["rows"]) {
+    const double length = row["properties"]["length_m"];
+    const double expected = 30.0 / (length - 0.1524);
+    EXPECT_NEAR(row["swing"]["angular_speed_rad_s"].get<double>(), expected, 1e-12 * expected);
+  }
+}
+
+TEST(SwingBatSpeedTest, BothGivenIsRefused) {
+  const Response r = Post("/v1/sweet-spot", {{"bat", {{"preset", "paper-wood"}}},
+                                             {"swing", {{"bat_speed_mps", 30.0},
+                                                        {"angular_speed_rad_s", 17.0}}}});
+  EXPECT_EQ(r.status, 400);
+  EXPECT_EQ(r.body["code"], "InvalidValue");
+  EXPECT_EQ(r.body["field"], "swing.bat_speed_mps");
+  EXPECT_NE(r.body["message"].get<std::string>().find("exactly one"), std::string::npos)
+      << r.body.dump();
+}
+
+TEST(SwingBatSpeedTest, PointNotBeyondThePivotIsRefused) {
+  // 0.855 - 0.1524 = 0.7026 m from the knob, behind a pivot at 0.75 m.
+  const Response behind = Post("/v1/sweet-spot", {{"bat", {{"preset", "paper-wood"}}},
+                                                  {"swing", {{"bat_speed_mps", 30.0},
+                                                             {"pivot_from_knob_m", 0.75}}}});
+  EXPECT_EQ(behind.status, 400) << behind.body.dump();
+  EXPECT_EQ(behind.body["field"], "swing.bat_speed_from_tip_m");
+  EXPECT_NE(behind.body["message"].get<std::string>().find("must lie beyond the pivot"),
+            std::string::npos)
+      << behind.body.dump();
+  // Off the bat (more than its length from the tip).
+  const Response off = Post("/v1/collision", {{"bat", {{"preset", "paper-wood"}}},
+                                              {"impact_from_knob_m", 0.7},
+                                              {"swing", {{"bat_speed_mps", 30.0},
+                                                         {"bat_speed_from_tip_m", 0.9}}}});
+  EXPECT_EQ(off.status, 400) << off.body.dump();
+  EXPECT_EQ(off.body["field"], "swing.bat_speed_from_tip_m");
+}
+
+TEST(SwingBatSpeedTest, OptimizeRefusesBatSpeed) {
+  const Response r = Post(
+      "/v1/optimize",
+      {{"bat", {{"preset", "paper-wood"}}},
+       {"swing", {{"bat_speed_mps", 30.0}}},
+       {"variables", {{{"path", "three_segment.taper_start_m"}, {"min", 0.1}, {"max", 0.3}}}}});
+  EXPECT_EQ(r.status, 400) << r.body.dump();
+  EXPECT_EQ(r.body["field"], "swing.bat_speed_mps");
+}
+
+// docs/models.md, "Bat speed at the impact point": with V = omega x fixed at the impact point,
+// rigid_pivot's v2 = -u + (1+e)(u+V) J/(J + m x^2) still depends on the bat through J/x^2.
+TEST(SwingBatSpeedTest, FixedBatSpeedAtImpactExitSpeedDependsOnEffectiveMass) {
+  const double v = 31.2928, u = 27.7, m = 0.145, e = 0.5;
+  double exits[2];
+  int i = 0;
+  for (const char* preset : {"paper-wood", "paper-wood-m885"}) {
+    const Response props = Post("/v1/bat/properties", {{"bat", {{"preset", preset}}}});
+    ASSERT_EQ(props.status, 200) << props.body.dump();
+    const double length = props.body["length_m"];
+    const double x = length - 0.1524;  // impact at the bat-speed point, pivot at the knob
+    const Response r = Post("/v1/collision", {{"bat", {{"preset", preset}}},
+                                              {"model", "rigid_pivot"},
+                                              {"cor", e},
+                                              {"impact_from_knob_m", x},
+                                              {"swing", {{"bat_speed_mps", v}}}});
+    ASSERT_EQ(r.status, 200) << r.body.dump();
+    const double j = props.body["moi_knob_kg_m2"];
+    const double expected = -u + (1.0 + e) * (u + v) * j / (j + m * x * x);
+    // A handful of roundings on numbers of order 50 m/s.
+    EXPECT_NEAR(r.body["exit_speed_mps"].get<double>(), expected, 1e-12 * 50.0) << preset;
+    EXPECT_NEAR(r.body["rigid_pivot"]["bat_speed_at_impact_mps"].get<double>(), v, 1e-12 * v);
+    exits[i++] = r.body["exit_speed_mps"];
+  }
+  // The lighter bat (smaller J/x^2) gives less: by ~1.5 m/s here, far beyond rounding.
+  EXPECT_GT(exits[0] - exits[1], 0.5);
+}
+
+}  // namespace
+}  // namespace swing_bat_speed_test
+}  // namespace sweetspot::api
