@@ -90,29 +90,57 @@ std::optional<core::Fill> ParseFill(const Json& value, const std::string& path, 
 
 std::optional<core::Material> ParseMaterial(const Json& value, const std::string& path,
                                             bool allow_empty, ApiError* error) {
+  const auto names = [allow_empty] {
+    return core::MaterialNamesList() + (allow_empty ? ", empty" : "");
+  };
   if (value.is_string()) {
     const std::string name = value.get<std::string>();
     if (allow_empty && name == "empty") return core::EmptyFillMaterial();
     if (auto material = core::FindMaterial(name)) return material;
-    std::string names;
-    for (const auto& m : core::MaterialCatalogue()) names += (names.empty() ? "" : ", ") + m.name;
-    if (allow_empty) names += ", empty";
     SetError(error, ErrorCode::kInvalidValue, path, &value,
-             "is not a catalogue material (GET /v1/materials lists: " + names + ")");
+             "is not a catalogue material (GET /v1/materials lists: " + names() + ")");
     return std::nullopt;
   }
   ObjectReader reader(value, path, error);
   core::Material material;
   material.name = "custom";
   material.source = "given in the request";
+  // {"base": NAME, ...overrides}: the catalogue entry's numbers, kind and COR, each field
+  // given overriding its own; without a base, density and E are required.
+  std::string base;
+  reader.OptionalString("base", &base);
+  const bool has_base = reader.ok() && reader.Has("base");
+  if (has_base) {
+    const auto found = core::FindMaterial(base);
+    if (!found) {
+      reader.Fail("base", "is not a catalogue material (GET /v1/materials lists: " +
+                              core::MaterialNamesList() + ")");
+      return std::nullopt;
+    }
+    material = *found;
+    material.name = "custom";
+    material.source = "base " + found->name + " with the request's overrides; base source: " +
+                      found->source;
+    // A density range is the base's; given another density, it is not this material's.
+    material.density_min_kg_m3 = material.density_max_kg_m3 = 0.0;
+  }
   reader.OptionalString("name", &material.name);
   // Presence and types here; the ranges are core's (Material::ValidateSize, below).
-  reader.Number("density_kg_m3", AnyNumber(), &material.density_kg_m3);
-  reader.Number("youngs_modulus_pa", AnyNumber(), &material.youngs_modulus_pa);
+  if (has_base) {
+    reader.OptionalNumber("density_kg_m3", AnyNumber(), &material.density_kg_m3);
+    reader.OptionalNumber("youngs_modulus_pa", AnyNumber(), &material.youngs_modulus_pa);
+  } else {
+    reader.Number("density_kg_m3", AnyNumber(), &material.density_kg_m3);
+    reader.Number("youngs_modulus_pa", AnyNumber(), &material.youngs_modulus_pa);
+  }
+  const bool has_shear = reader.ok() && reader.Has("shear_modulus_pa");
+  const bool has_poisson = reader.ok() && reader.Has("poissons_ratio");
   reader.OptionalNumber("shear_modulus_pa", AnyNumber(), &material.shear_modulus_pa);
   reader.OptionalNumber("poissons_ratio", AnyNumber(), &material.poissons_ratio);
   if (auto cor = reader.MaybeNumber("cor", AnyNumber())) material.cor = *cor;
   if (!reader.Finish()) return std::nullopt;
+  // Without a base and without G or nu, nu = 0.3 (as before) but not silently: scenes warn.
+  material.poissons_ratio_assumed = !has_base && !has_shear && !has_poisson;
   if (core::Refusal refusal; !material.ValidateSize(&refusal)) {
     CoreRefusal(refusal, path, error);
     return std::nullopt;
@@ -232,6 +260,8 @@ Json MaterialToJson(const core::Material& material) {
            {"poissons_ratio", material.poissons_ratio},
            {"source", material.source}};
   out["cor"] = material.cor ? Json(*material.cor) : Json(nullptr);
+  out["kind"] = material.kind ? Json(core::MaterialKindName(*material.kind)) : Json(nullptr);
+  if (!material.base.empty() && material.base != material.name) out["base"] = material.base;
   if (material.density_min_kg_m3 > 0 || material.density_max_kg_m3 > 0) {
     out["density_range_kg_m3"] = {{"min", material.density_min_kg_m3},
                                   {"max", material.density_max_kg_m3}};
@@ -248,6 +278,7 @@ Json BatToJson(const core::Bat& bat) {
     out["material"].erase("source");
     out["material"].erase("density_range_kg_m3");
     if (out["material"]["cor"].is_null()) out["material"].erase("cor");
+    out["material"].erase("kind");  // the base carries it
   }
   if (bat.wall_thickness_m > 0) out["wall_thickness_m"] = bat.wall_thickness_m;
   if (bat.fill) {

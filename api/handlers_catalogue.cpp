@@ -9,7 +9,9 @@ namespace sweetspot::api {
 Response HandleMaterials(const Request&, const Context&) {
   nlohmann::json materials = nlohmann::json::array();
   for (const auto& material : core::MaterialCatalogue()) {
-    materials.push_back(MaterialToJson(material));
+    nlohmann::json entry = MaterialToJson(material);
+    entry["aliases"] = core::MaterialAliases(material.name);
+    materials.push_back(std::move(entry));
   }
   return {200, {{"materials", std::move(materials)}}};
 }

@@ -23,6 +23,8 @@ Material Wood(std::string name, double specific_gravity, double modulus_pa, doub
   m.shear_modulus_pa = g_lr_over_e_l * modulus_pa;
   m.poissons_ratio = nu_lr;
   m.cor = 0.5;
+  m.kind = MaterialKind::kWood;
+  m.base = m.name;
   m.source =
       "USDA Forest Products Laboratory, Wood Handbook: Wood as an Engineering Material, "
       "FPL-GTR-190 (2010), " +
@@ -48,6 +50,8 @@ std::vector<Material> BuildCatalogue() {
   paper.youngs_modulus_pa = 1.814e10;
   paper.poissons_ratio = 0.25;
   paper.cor = 0.5;
+  paper.kind = MaterialKind::kWood;
+  paper.base = paper.name;
   paper.source =
       "Seed paper (Mathematical model research of baseball sweet spot based on "
       "mechanical analysis and MATLAB simulation), Table 2: density 649 kg/m3, "
@@ -71,6 +75,8 @@ std::vector<Material> BuildCatalogue() {
       "values of the neighbouring Al-Zn-Mg alloys 7005 (2.78 g/cm3, 72 GPa) and 7075 "
       "(2.81 g/cm3, 71.7 GPa); nu = 0.33 as for the 7xxx series (ASM Handbook vol. 2)." +
       bbcor;
+  al7046.kind = MaterialKind::kMetal;
+  al7046.base = al7046.name;
   out.push_back(al7046);
 
   Material al7050;
@@ -85,6 +91,8 @@ std::vector<Material> BuildCatalogue() {
       "MatWeb datasheet; Alcoa 7050 alloy datasheet): density 2.83 g/cm3, "
       "E = 71.7 GPa, G = 26.9 GPa, nu = 0.33." +
       bbcor;
+  al7050.kind = MaterialKind::kMetal;
+  al7050.base = al7050.name;
   out.push_back(al7050);
 
   Material cork;
@@ -100,6 +108,8 @@ std::vector<Material> BuildCatalogue() {
       "M. F. Ashby, Cellular Solids: Structure and Properties, 2nd ed., Cambridge "
       "University Press (1997), ch. 12, after Gibson, Easterling and Ashby, "
       "Proc. R. Soc. Lond. A 377 (1981) 99-117. A fill material: no COR.";
+  cork.kind = MaterialKind::kFill;
+  cork.base = cork.name;
   out.push_back(cork);
 
   Material rubber;
@@ -115,11 +125,39 @@ std::vector<Material> BuildCatalogue() {
       "(nu = 0.499); density 930 kg/m3 (unfilled natural rubber) to about "
       "1250 kg/m3 (carbon-black filled). 1100 kg/m3 and 5 MPa are mid-range "
       "values. A fill material: no COR.";
+  rubber.kind = MaterialKind::kFill;
+  rubber.base = rubber.name;
   out.push_back(rubber);
   return out;
 }
 
+// Common names of catalogue entries (alias, entry): the trade's short names.
+struct MaterialAlias {
+  const char* alias;
+  const char* name;
+};
+constexpr MaterialAlias kMaterialAliases[] = {
+    {"maple", "hard-maple"},
+    {"sugar-maple", "hard-maple"},
+    {"birch", "yellow-birch"},
+    {"white-ash", "ash"},
+};
+
 }  // namespace
+
+const char* MaterialKindName(MaterialKind kind) {
+  switch (kind) {
+    case MaterialKind::kWood:
+      return "wood";
+    case MaterialKind::kMetal:
+      return "metal";
+    case MaterialKind::kComposite:
+      return "composite";
+    case MaterialKind::kFill:
+      return "fill";
+  }
+  return "wood";
+}
 
 bool Material::IsValid(std::string* why) const {
   return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
@@ -193,10 +231,33 @@ const std::vector<Material>& MaterialCatalogue() {
 }
 
 std::optional<Material> FindMaterial(std::string_view name) {
+  for (const MaterialAlias& a : kMaterialAliases) {
+    if (name == a.alias) name = a.name;
+  }
   for (const Material& m : MaterialCatalogue()) {
     if (m.name == name) return m;
   }
   return std::nullopt;
+}
+
+std::vector<std::string> MaterialAliases(std::string_view name) {
+  std::vector<std::string> out;
+  for (const MaterialAlias& a : kMaterialAliases) {
+    if (name == a.name) out.emplace_back(a.alias);
+  }
+  return out;
+}
+
+std::string MaterialNamesList() {
+  std::string out;
+  for (const Material& m : MaterialCatalogue()) {
+    out += (out.empty() ? "" : ", ") + m.name;
+    const auto aliases = MaterialAliases(m.name);
+    for (std::size_t i = 0; i < aliases.size(); ++i) {
+      out += (i == 0 ? " (" : ", ") + aliases[i] + (i + 1 == aliases.size() ? ")" : "");
+    }
+  }
+  return out;
 }
 
 Material EmptyFillMaterial() {

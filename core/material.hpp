@@ -17,10 +17,29 @@ inline constexpr double kMaxDensityKgM3 = 1e5;
 /// Largest Young's or shear modulus of a material, Pa (diamond's is about 1.2e12).
 inline constexpr double kMaxModulusPa = 1e13;
 
+/// What a material is, for league rules and the catalogue listing.
+enum class MaterialKind {
+  kWood,       ///< Solid wood of one species.
+  kMetal,      ///< A metal (an alloy shell).
+  kComposite,  ///< A fibre composite.
+  kFill,       ///< A fill (cork, rubber): inside a bat, never the bat itself.
+};
+
+/// Stable name: "wood", "metal", "composite", "fill".
+const char* MaterialKindName(MaterialKind kind);
+
 /// An isotropic material (for wood: the longitudinal modulus and the
 /// longitudinal-radial shear modulus and Poisson's ratio). All values SI.
 struct Material {
   std::string name;  ///< Catalogue name ("ash") or "custom".
+  /// What it is; unset for a custom material given without a base (its kind is not known).
+  std::optional<MaterialKind> kind;
+  /// The catalogue entry its properties start from: its own name for a catalogue entry, the
+  /// base of a request's {"base": NAME, ...overrides}; "" for a custom material without one.
+  std::string base;
+  /// True when neither shear_modulus_pa nor poissons_ratio was given (a custom material
+  /// without a base): poissons_ratio is the default 0.3, and G = E / 2.6 from it; scenes warn.
+  bool poissons_ratio_assumed = false;
   /// Density, kg/m³ (> 0; 0 only as a fill's material, meaning an empty bore).
   double density_kg_m3 = 0.0;
   double youngs_modulus_pa = 0.0;  ///< Young's modulus along the bat's axis, Pa (> 0).
@@ -54,8 +73,14 @@ struct Material {
 /// "hard-maple", "yellow-birch", "paper-wood", "aluminium-7046",
 /// "aluminium-7050", "cork", "rubber"; each with its source.
 const std::vector<Material>& MaterialCatalogue();
-/// The catalogue entry called `name`, or nullopt.
+/// The catalogue entry called `name` or one of its aliases (MaterialAliases), or nullopt.
 std::optional<Material> FindMaterial(std::string_view name);
+/// The common names accepted for catalogue entry `name` ("hard-maple": {"maple"}); empty when
+/// it has none.
+std::vector<std::string> MaterialAliases(std::string_view name);
+/// The catalogue names and aliases, comma-separated ("ash, hard-maple (maple), ..."): for
+/// messages.
+std::string MaterialNamesList();
 /// The "material" of an empty bore (name "empty", every number 0). It is not
 /// a valid Material on its own; Bat::IsValid accepts it as a fill's material.
 Material EmptyFillMaterial();

@@ -78,8 +78,9 @@ RuleSetLimits LimitsOf(RuleSet rule) {
 }
 
 bool IsWoodMaterial(const Material& material) {
+  if (material.kind != MaterialKind::kWood) return false;
   for (const char* w : kWoods) {
-    if (material.name == w) return true;
+    if (material.base == w) return true;
   }
   return false;
 }
@@ -95,10 +96,19 @@ bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why) {
   const std::string field = std::string("rules.") + RuleSetName(rule);
   if (limits.solid_wood_only) {
     if (!IsWoodMaterial(facts.material)) {
-      return Refuse(why,
-                    TextRefusal(field, "one piece of solid wood: material '" + facts.material.name +
-                                           "' is not a wood of the catalogue (ash, "
-                                           "hard-maple, yellow-birch, paper-wood)"));
+      // About the bat's material: the field is that, the rule set is named in the rule.
+      const Material& m = facts.material;
+      const std::string what =
+          !m.kind.has_value()
+              ? "a custom material without a base (its kind is not known; give \"base\")"
+          : *m.kind != MaterialKind::kWood
+              ? std::string("of kind ") + MaterialKindName(*m.kind) +
+                    (m.base.empty() ? "" : " (base " + m.base + ")")
+              : "wood of base '" + m.base + "', not an allowed species";
+      return Refuse(why, TextRefusal("bat.material",
+                                     field + ": one piece of solid wood of an allowed species "
+                                             "(base ash, hard-maple, yellow-birch or paper-wood): "
+                                             "material '" + m.name + "' is " + what));
     }
     if (facts.wall_thickness_m > 0.0 || facts.wall_variable) {
       return Refuse(why,

@@ -46,8 +46,9 @@ struct RuleSetLimits {
 /// The limits of `rule` (constant data).
 RuleSetLimits LimitsOf(RuleSet rule);
 
-/// True for the catalogue's woods ("ash", "hard-maple", "yellow-birch", "paper-wood"), matched
-/// by name; a "custom" material is not known to be wood.
+/// True for a material of kind wood whose base is an allowed species ("ash", "hard-maple",
+/// "yellow-birch", "paper-wood"): a catalogue wood, or a request's {"base": wood, ...overrides},
+/// whatever its name; a custom material without a base is not known to be wood.
 bool IsWoodMaterial(const Material& material);
 
 /// The discrete facts of a design that a rule set checks before solving.

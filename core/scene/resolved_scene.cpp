@@ -23,6 +23,19 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
     s->SetRefusal(std::move(refusal));
     return false;
   }
+  if (scene.bat.has_value()) {
+    // A custom material given without G, nu or a base: nu = 0.3 is an assumption, said so.
+    const auto note = [s](const char* field, const Material& m) {
+      if (!m.poissons_ratio_assumed) return;
+      s->warnings.push_back(std::string(field) +
+                            ": neither shear_modulus_pa nor poissons_ratio given (nor a base): "
+                            "poissons_ratio = 0.3 assumed, G = E / 2.6 = " +
+                            FormatNumber(m.EffectiveShearModulusPa()) +
+                            " Pa (wood's G is nearer E / 10; give G, nu or a base)");
+    };
+    note("bat.material", scene.bat->material);
+    if (scene.bat->fill.has_value()) note("bat.fill.material", scene.bat->fill->material);
+  }
   // The ball's law needs the bat's length: evaluated below, once the length is known.
   // A hollow bat hit by a ball with a COR law: the trampoline's effective COR (barrel.hpp).
   const bool barrel_cor = needs_cor && !scene.cor.has_value() && scene.ball.cor_law.has_value() &&

@@ -414,6 +414,17 @@ TEST(OptimizeNames, PathsObjectivesAndRuleSetsRoundTrip) {
   EXPECT_NEAR(*LimitsOf(RuleSet::kMlbWood).max_length_m, 1.0668, 1e-15);     // 42 in
   EXPECT_TRUE(IsWoodMaterial(*FindMaterial("hard-maple")));
   EXPECT_FALSE(IsWoodMaterial(*FindMaterial("aluminium-7046")));
+  // Issue 19: the kind and the base decide, not the name.
+  Material based = *FindMaterial("maple");  // an alias
+  based.name = "hard-maple-30oz";
+  based.density_kg_m3 = 650.0;
+  EXPECT_TRUE(IsWoodMaterial(based));
+  Material metal = *FindMaterial("aluminium-7050");
+  metal.name = "hard-maple";
+  EXPECT_FALSE(IsWoodMaterial(metal));
+  Material custom;  // no base, no kind
+  custom.name = "ash";
+  EXPECT_FALSE(IsWoodMaterial(custom));
 }
 
 }  // namespace
