@@ -260,7 +260,6 @@ Json MaterialToJson(const core::Material& material) {
            {"poissons_ratio", material.poissons_ratio},
            {"source", material.source}};
   out["cor"] = material.cor ? Json(*material.cor) : Json(nullptr);
-  out["kind"] = material.kind ? Json(core::MaterialKindName(*material.kind)) : Json(nullptr);
   if (!material.base.empty() && material.base != material.name) out["base"] = material.base;
   if (material.density_min_kg_m3 > 0 || material.density_max_kg_m3 > 0) {
     out["density_range_kg_m3"] = {{"min", material.density_min_kg_m3},
@@ -278,7 +277,6 @@ Json BatToJson(const core::Bat& bat) {
     out["material"].erase("source");
     out["material"].erase("density_range_kg_m3");
     if (out["material"]["cor"].is_null()) out["material"].erase("cor");
-    out["material"].erase("kind");  // the base carries it
   }
   if (bat.wall_thickness_m > 0) out["wall_thickness_m"] = bat.wall_thickness_m;
   if (bat.fill) {

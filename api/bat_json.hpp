@@ -51,7 +51,7 @@ bool CheckComputable(const core::MassProperties& properties, const std::string& 
 std::optional<core::Material> ParseMaterial(const nlohmann::json& value, const std::string& path,
                                             bool allow_empty, ApiError* error);
 
-/// A material with its properties and source.
+/// A material with its properties and source (and `base` when it has one other than itself).
 nlohmann::json MaterialToJson(const core::Material& material);
 
 /// The bat's shape and build as JSON (profile knots, material name, wall, fill).

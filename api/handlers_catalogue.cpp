@@ -10,6 +10,9 @@ Response HandleMaterials(const Request&, const Context&) {
   nlohmann::json materials = nlohmann::json::array();
   for (const auto& material : core::MaterialCatalogue()) {
     nlohmann::json entry = MaterialToJson(material);
+    // Catalogue-only fields (a request's material object takes neither: its base has a kind).
+    entry["kind"] = material.kind ? nlohmann::json(core::MaterialKindName(*material.kind))
+                                  : nlohmann::json(nullptr);
     entry["aliases"] = core::MaterialAliases(material.name);
     materials.push_back(std::move(entry));
   }

@@ -128,6 +128,24 @@ TEST(MaterialBaseTest, MlbWoodChecksKindAndSpeciesNotName) {
   EXPECT_EQ(named.body["field"], "bat.material");
 }
 
+TEST(MaterialBaseTest, OptimizedBasedMaterialEchoesAsARequestMaterial) {
+  // A density variable on a based material: the answer's bat carries the base and can be sent
+  // back as it is (no catalogue-only field such as kind).
+  Json body = Optimize({{"base", "maple"}});
+  body["variables"] = {{{"path", "material.density_kg_m3"}, {"min", 600}, {"max", 800}}};
+  body["constraints"]["mass_kg"] = 1.05;
+  const Response r = Post("/v1/optimize", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const Json& material = r.body["bat"]["material"];
+  EXPECT_EQ(material["base"], "maple");
+  EXPECT_FALSE(material.contains("kind")) << material.dump();
+  const Response again = Post("/v1/bat/properties", {{"bat", r.body["bat"]}});
+  ASSERT_EQ(again.status, 200) << again.body.dump();
+  // The optimiser meets the mass equality to its constraint tolerance (Ipopt's default 1e-8
+  // on the scaled problem; 1e-6 kg is far above it and far below any design change).
+  EXPECT_NEAR(again.body["mass_kg"].get<double>(), 1.05, 1e-6);
+}
+
 TEST(MaterialBaseTest, CustomWithoutBaseWorksAsBeforeAndWarnsOnAssumedPoisson) {
   const Json custom = {{"density_kg_m3", 650}, {"youngs_modulus_pa", 1.2e10}, {"cor", 0.5}};
   const Response r = Post("/v1/sweet-spot", {{"bat", ThreeSegment(custom)}});
