@@ -115,6 +115,9 @@ Json RenderDesignRow(const DesignOutcome& outcome, const RowOutputs& outputs) {
     row["properties"] = PropertiesToJson(outcome.result.mass_properties, outcome.result.length_m);
   }
   if (outcome.collision_efficiency) row["collision_efficiency"] = *outcome.collision_efficiency;
+  // A bat speed gives each design its own omega (its own length): the row says which. Without
+  // one every row's swing is the request's, so rows stay as they were.
+  if (outcome.result.swing.bat_speed_mps) row["swing"] = SwingToJson(outcome.result.swing);
   return row;
 }
 

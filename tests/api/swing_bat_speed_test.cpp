@@ -90,6 +90,31 @@ TEST(SwingBatSpeedTest, CompareRowsEachResolveTheirOwnOmega) {
   }
 }
 
+TEST(SwingBatSpeedTest, ExploreRowsResolveEachDesignsOmega) {
+  const Json body = {
+      {"bat", {{"three_segment", {{"length_m", 0.8636}, {"handle_radius_m", 0.0125},
+                                  {"barrel_radius_m", 0.033}, {"taper_start_m", 0.30},
+                                  {"taper_end_m", 0.55}}},
+               {"material", "ash"}}},
+      {"swing", {{"bat_speed_mps", 30.0}}},
+      {"parameters", {{{"path", "three_segment.length_m"}, {"min", 0.80}, {"max", 0.86},
+                       {"count", 2}}}}};
+  const Response r = Post("/v1/explore", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  ASSERT_EQ(r.body["rows"].size(), 2u);
+  for (const Json& row : r.body["rows"]) {
+    const double length = row["parameters"]["three_segment.length_m"];
+    const double expected = 30.0 / (length - 0.1524);  // one division: 1e-12 relative is ample
+    EXPECT_NEAR(row["swing"]["angular_speed_rad_s"].get<double>(), expected, 1e-12 * expected);
+  }
+  // Without a bat speed the rows are as before: no swing block.
+  Json plain = body;
+  plain["swing"] = {{"angular_speed_rad_s", 40.0}};
+  const Response p = Post("/v1/explore", plain);
+  ASSERT_EQ(p.status, 200) << p.body.dump();
+  EXPECT_FALSE(p.body["rows"][0].contains("swing"));
+}
+
 TEST(SwingBatSpeedTest, BothGivenIsRefused) {
   const Response r = Post("/v1/sweet-spot", {{"bat", {{"preset", "paper-wood"}}},
                                              {"swing", {{"bat_speed_mps", 30.0},
