@@ -229,9 +229,11 @@ bool DesignBinder::Bind(const std::vector<double>& values, core::Scene* scene) c
         break;
       case Target::kShear:
         bat.material.shear_modulus_pa = v;
+        bat.material.poissons_ratio_assumed = false;  // given now: no "nu assumed" warning
         break;
       case Target::kPoisson:
         bat.material.poissons_ratio = v;
+        bat.material.poissons_ratio_assumed = false;
         break;
       case Target::kMaterialCor:
         bat.material.cor = v;

@@ -218,6 +218,17 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
         SetError(error, ErrorCode::kInvalidValue, field, path_json, why);
         return std::nullopt;
       }
+      if (head == "swing") {
+        // The swept swing as a design sees it: e.g. swing.angular_speed_rad_s swept beside a
+        // bat_speed_mps would be overridden by it in every design (exactly one may be given).
+        ApiError swing_error;
+        ObjectReader swing_reader(probe, "", &swing_error);
+        core::Scene swing_scene;
+        if (!ReadSceneCommon(swing_reader, &swing_scene)) {
+          SetError(error, ErrorCode::kInvalidValue, field, path_json, swing_error.message);
+          return std::nullopt;
+        }
+      }
       if (ApiError unknown; !IsKnownField(probe, context.limits, &unknown)) {
         SetError(error, ErrorCode::kInvalidValue, field, path_json, unknown.message);
         return std::nullopt;

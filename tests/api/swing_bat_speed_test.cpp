@@ -107,6 +107,15 @@ TEST(SwingBatSpeedTest, ExploreRowsResolveEachDesignsOmega) {
     const double expected = 30.0 / (length - 0.1524);  // one division: 1e-12 relative is ample
     EXPECT_NEAR(row["swing"]["angular_speed_rad_s"].get<double>(), expected, 1e-12 * expected);
   }
+  // Sweeping the angular speed beside a bat speed would be overridden in every design: a 400.
+  Json both = body;
+  both["parameters"] = {{{"path", "swing.angular_speed_rad_s"}, {"min", 10}, {"max", 20},
+                         {"count", 2}}};
+  const Response refused = Post("/v1/explore", both);
+  EXPECT_EQ(refused.status, 400) << refused.body.dump();
+  EXPECT_EQ(refused.body["field"], "parameters[0].path");
+  EXPECT_NE(refused.body["message"].get<std::string>().find("exactly one"), std::string::npos)
+      << refused.body.dump();
   // Without a bat speed the rows are as before: no swing block.
   Json plain = body;
   plain["swing"] = {{"angular_speed_rad_s", 40.0}};
