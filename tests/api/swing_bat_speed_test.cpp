@@ -124,6 +124,22 @@ TEST(SwingBatSpeedTest, ExploreRowsResolveEachDesignsOmega) {
   EXPECT_FALSE(p.body["rows"][0].contains("swing"));
 }
 
+TEST(SwingBatSpeedTest, BatSpeedInMphThroughTheUnitsMechanism) {
+  // No swing code reads *_mph: api/json_reader's central units turn it into bat_speed_mps.
+  const Response r = Post("/v1/sweet-spot", {{"bat", {{"preset", "paper-wood"}}},
+                                             {"swing", {{"bat_speed_mph", 70.0}}}});
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const double v = 70.0 * 0.44704;  // mph -> m/s, exact by definition
+  EXPECT_NEAR(r.body["swing"]["bat_speed_mps"].get<double>(), v, 1e-15 * v);  // one product
+  const double expected = v / (kPaperLengthM - 0.1524);
+  EXPECT_NEAR(r.body["swing"]["angular_speed_rad_s"].get<double>(), expected, 1e-12 * expected);
+  const Response both = Post("/v1/sweet-spot", {{"bat", {{"preset", "paper-wood"}}},
+                                                {"swing", {{"bat_speed_mph", 70.0},
+                                                           {"angular_speed_rad_s", 17.0}}}});
+  EXPECT_EQ(both.status, 400);
+  EXPECT_EQ(both.body["field"], "swing.bat_speed_mps");
+}
+
 TEST(SwingBatSpeedTest, BothGivenIsRefused) {
   const Response r = Post("/v1/sweet-spot", {{"bat", {{"preset", "paper-wood"}}},
                                              {"swing", {{"bat_speed_mps", 30.0},
