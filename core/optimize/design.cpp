@@ -403,15 +403,24 @@ void ClassifyFeasibility(const DesignModel& model, const DesignOptions& options,
 
 // A multi-start cut short by Progress::Cancel() (a start stopped mid-solve, or starts not begun)
 // is no_convergence even when its chosen start converged: the starts not run might have found a
-// better design. Infeasible, failure and invalid_input stand; a chosen start that was itself cut
-// is no_convergence already, its message "cancelled (...)".
+// better design. Infeasible and failure stand (a start that failed, e.g. in Ipopt's restoration
+// phase, may be all that ran), their message saying the run was cut; invalid_input stands as it
+// is. A chosen start that was itself cut is no_convergence already, its message "cancelled (...)".
 void MarkCancelledMultiStart(const DesignOptions& options, const std::vector<Run>& runs,
                              const Progress* progress, DesignResult* result) {
   const bool cut =
       !runs.empty() && (runs.back().outcome.cancelled ||
                         (IsCancelled(progress) && static_cast<int>(runs.size()) < options.starts));
   Summary& summary = result->summary;
-  if (!cut || summary.termination != Termination::kConverged) return;
+  if (!cut || summary.termination == Termination::kInvalidInput) return;
+  if (summary.termination != Termination::kConverged) {
+    if (summary.message.rfind("cancelled", 0) == 0) return;  // the chosen start's own cut
+    summary.message = "cancelled after " + std::to_string(runs.size()) + " of " +
+                      std::to_string(options.starts) + " starts (the chosen start " +
+                      std::to_string(result->spread.best_start) + ": " + summary.message +
+                      "); the best design so far is kept";
+    return;
+  }
   summary.termination = Termination::kNoConvergence;
   summary.message = "cancelled after " + std::to_string(runs.size()) + " of " +
                     std::to_string(options.starts) + " starts (the chosen start " +
