@@ -79,6 +79,9 @@ class ServerProcess {
       int status = 0;
       if (waitpid(pid_, &status, WNOHANG) == pid_) {
         pid_ = -1;
+        // The server exited: its last words may still be in the pipe; the reader ends at the
+        // pipe's end (no other process holds it: close-on-exec), so log() has them all.
+        if (reader_.joinable()) reader_.join();
         return false;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
