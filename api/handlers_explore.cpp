@@ -143,8 +143,15 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
     core::SweepDimension dimension;
     // One field ("path"), or several linked ones: "paths" (all set to the value) or
     // "scale_paths" (each the template's value times it).
+    if (!(*params)[i].is_object()) {
+      SetError(error, ErrorCode::kInvalidValue, where, &(*params)[i],
+               "must be an object {\"path\" (or \"paths\", \"scale_paths\"), \"min\", "
+               "\"max\"}");
+      return std::nullopt;
+    }
     const int forms = int{p.Has("path")} + int{p.Has("paths")} + int{p.Has("scale_paths")};
-    if (p.ok() && forms != 1) {
+    if (!p.ok()) return std::nullopt;
+    if (forms != 1) {
       p.Fail(forms == 0 ? "path" : "paths",
              "give exactly one of path, paths (several fields set to one value) and "
              "scale_paths (several fields scaled by one value)",
