@@ -363,7 +363,9 @@ nlohmann::json DesignFitAnswer(const nlohmann::json& design, const nlohmann::jso
         target = targets[form.key].get<double>() * form.to_si;
       }
     }
-    if (target && properties.contains(si)) residuals[si] = properties[si].get<double>() - *target;
+    if (target && properties.contains(si) && properties[si].is_number()) {
+      residuals[si] = properties[si].get<double>() - *target;
+    }
   }
   nlohmann::json out{{"bat", design.value("bat", nlohmann::json())},
                      {"unknowns", design.value("variables", nlohmann::json::object())},
