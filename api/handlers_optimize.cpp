@@ -169,6 +169,16 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
   return true;
 }
 
+// A material written out whole, as a request gives one (no source or density range; no
+// null cor).
+Json MaterialInRequestForm(const core::Material& m) {
+  Json material = MaterialToJson(m);
+  material.erase("source");
+  material.erase("density_range_kg_m3");
+  if (material["cor"].is_null()) material.erase("cor");
+  return material;
+}
+
 // The answer's bat in the request's own form: each variable written back at
 // its path; where the request's form lacks the path's parent (a preset), the
 // shape or material block is written out whole.
@@ -188,11 +198,7 @@ Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r) {
     } else if (v.path.rfind("profile.", 0) == 0) {
       bat["profile"] = BatToJson(r.bat)["profile"];
     } else if (v.path.rfind("material.", 0) == 0) {
-      Json material = MaterialToJson(r.bat.material);
-      material.erase("source");
-      material.erase("density_range_kg_m3");
-      if (material["cor"].is_null()) material.erase("cor");
-      bat["material"] = std::move(material);
+      bat["material"] = MaterialInRequestForm(r.bat.material);
     } else if (v.path.rfind("fill.", 0) == 0 || v.path == "wall_thickness_m") {
       const Json built = BatToJson(r.bat);
       if (built.contains("fill")) bat["fill"] = built["fill"];
@@ -483,6 +489,18 @@ Json RenderOptimize(const OptimizeRequest& request, const OptimizeResult& result
                               {"objective_value", Finite(m.result.objective_value)}});
     }
     out["materials"] = std::move(per_material);
+    // The bat comes back in the chosen material: by name, or written out whole when a
+    // material field is also a variable (the request's own material object would be stale).
+    const core::DesignResult& chosen = *result.Chosen();
+    const bool material_field_varies =
+        std::any_of(chosen.variables.begin(), chosen.variables.end(),
+                    [](const core::DesignValue& v) { return v.path.rfind("material.", 0) == 0; });
+    if (material_field_varies) {
+      out["bat"]["material"] = MaterialInRequestForm(chosen.bat.material);
+    } else {
+      out["bat"]["material"] =
+          result.choice.per_material[static_cast<std::size_t>(result.choice.best)].material;
+    }
   }
   out["objective"] = request.objective;
   if (request.problem.objective != core::DesignObjective::kMinMoi) {

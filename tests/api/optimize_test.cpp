@@ -390,8 +390,9 @@ TEST(OptimizeEndpointTest, MinStingStopsAtTheTimeBudgetWithTheBestDesign) {
 
 TEST(OptimizeEndpointTest, MaterialChoiceSolvesEachAndPicksTheBest) {
   Json body = ContractExample();
+  body["bat"]["material"] = "yellow-birch";  // not among the choices: the answer must not echo it
   body["variables"].push_back(
-      {{"path", "material"}, {"choices", {"ash", "hard-maple", "yellow-birch"}}});
+      {{"path", "material"}, {"choices", {"ash", "hard-maple", "paper-wood"}}});
   body["options"]["starts"] = 1;
   const Response r = Post("/v1/optimize", body);
   ASSERT_EQ(r.status, 200) << r.body.dump();
@@ -401,6 +402,42 @@ TEST(OptimizeEndpointTest, MaterialChoiceSolvesEachAndPicksTheBest) {
     if (m["termination"] == "converged") best = std::max(best, m["objective_value"].get<double>());
   }
   EXPECT_EQ(r.body["objective_value"].get<double>(), best);
+  // The bat comes back in the winning material (it had come back in the request's), so the
+  // returned bat re-computes to the answer's properties (same bat, same code: 1e-12 relative).
+  std::string winner;
+  for (const auto& m : r.body["materials"]) {
+    if (m["objective_value"] == r.body["objective_value"]) winner = m["material"];
+  }
+  EXPECT_EQ(r.body["bat"]["material"], winner);
+  const Response p = Post("/v1/bat/properties", Json{{"bat", r.body["bat"]}});
+  ASSERT_EQ(p.status, 200) << p.body.dump();
+  EXPECT_NEAR(p.body["mass_kg"].get<double>(), r.body["properties"]["mass_kg"].get<double>(),
+              1e-12 * r.body["properties"]["mass_kg"].get<double>());
+}
+
+// With a material field also varied, the chosen material is written out whole with the
+// design's density (the request's material object would name the wrong wood).
+TEST(OptimizeEndpointTest, MaterialChoiceWithDensityVariableReturnsTheChosenMaterial) {
+  Json body = ContractExample();
+  body["bat"]["material"] = {{"base", "yellow-birch"}};  // an object, not among the choices
+  body["variables"].push_back(
+      {{"path", "material"}, {"choices", {"ash", "hard-maple"}}});
+  body["variables"].push_back({{"path", "material.density_kg_m3"}, {"min", 600}, {"max", 760}});
+  body["options"]["starts"] = 1;
+  const Response r = Post("/v1/optimize", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const Json& material = r.body["bat"]["material"];
+  ASSERT_TRUE(material.is_object()) << material.dump();
+  std::string winner;
+  for (const auto& m : r.body["materials"]) {
+    if (m["objective_value"] == r.body["objective_value"]) winner = m["material"];
+  }
+  EXPECT_EQ(material["name"], winner);
+  EXPECT_EQ(material["density_kg_m3"], r.body["variables"]["material.density_kg_m3"]);
+  const Response p = Post("/v1/bat/properties", Json{{"bat", r.body["bat"]}});
+  ASSERT_EQ(p.status, 200) << p.body.dump();
+  EXPECT_NEAR(p.body["mass_kg"].get<double>(), r.body["properties"]["mass_kg"].get<double>(),
+              1e-12 * r.body["properties"]["mass_kg"].get<double>());
 }
 
 // Issue 19: a variable may set several fields at once ("paths"); the answer lists each and the
