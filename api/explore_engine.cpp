@@ -570,6 +570,7 @@ struct BlockResult {
 struct Worker {
   std::optional<core::Scene> scene;  // the binder's scene, bound design after design
   std::vector<double> point;
+  std::optional<core::DesignSequence> designs;  // the sweep's, with this worker's position
   DesignOutcome outcome;  // the last bound design's, refilled design after design
   std::optional<core::SceneEvaluator> evaluator;  // the sweep's options, validated once
   // Full rows of bound designs: the first feasible row, kept as a template whose leaves are
@@ -698,11 +699,8 @@ bool FillTemplate(const RunPlan& plan, std::uint64_t i, const std::vector<double
 void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResult* out) {
   const Sweep& sweep = *plan.sweep;
   std::vector<double>& point = worker->point;
-  if (sweep.plan.method == core::SamplingMethod::kGrid) {
-    core::GridDesignInto(sweep.plan, i, &point);
-  } else {
-    point = sweep.drawn[static_cast<std::size_t>(i)];
-  }
+  if (!worker->designs) worker->designs.emplace(*sweep.designs);
+  worker->designs->DesignInto(i, &point);
   if (sweep.binder) {
     if (!worker->scene) worker->scene = sweep.binder->base_scene();
     if (sweep.binder->Bind(point, &*worker->scene)) {

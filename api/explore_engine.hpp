@@ -93,7 +93,8 @@ struct Sweep {
   nlohmann::json base;                          ///< The design template (bat + scene fields).
   std::vector<SweepParameter> parameters;       ///< The swept fields.
   core::SweepPlan plan;                         ///< Sampling, dimensions, seed.
-  std::vector<std::vector<double>> drawn;       ///< LHS / Sobol points (grids are enumerated).
+  /// The plan's designs on demand (each worker evaluates from its own copy).
+  std::optional<core::DesignSequence> designs;
   RowOutputs outputs;                           ///< What each row reports.
   core::SceneOptions options;                   ///< The models' settings.
   std::string exit_speed_model;  ///< The exit-speed model options.model resolves to (summary).

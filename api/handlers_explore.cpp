@@ -374,11 +374,9 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   identity.erase("format");
   identity.erase("columns");
   sweep->provenance = Provenance(identity, Json::object(), sweep->plan.seed);
-  // Designs: grids are enumerated by index; LHS and Sobol are drawn in full
-  // (every shard draws the same sequence) and then filtered by shard.
-  if (sweep->plan.method != core::SamplingMethod::kGrid) {
-    sweep->drawn = core::GenerateDesigns(sweep->plan);
-  }
+  // Designs by index: grids enumerated, Sobol by a jump of its generator, LHS from the table
+  // drawn here (every shard draws the same table and takes its designs from it).
+  sweep->designs.emplace(sweep->plan);
   // The sweep engine: the template resolved once, the swept values bound without JSON.
   sweep->binder =
       DesignBinder::Compile(sweep->base, sweep->parameters, sweep->outputs, sweep->limits);

@@ -129,48 +129,94 @@ void GridDesignInto(const SweepPlan& plan, std::uint64_t i, std::vector<double>*
   }
 }
 
-std::vector<std::vector<double>> GenerateDesigns(const SweepPlan& plan) {
+namespace {
+
+// The Latin hypercube table of `plan`: design i's values at [i * dims, (i + 1) * dims).
+// Dimension by dimension: a Fisher-Yates shuffle of the strata, then one jitter per design.
+std::vector<double> LatinHypercubeTable(const SweepPlan& plan) {
   const std::size_t dims = plan.dimensions.size();
-  const std::uint64_t n = plan.DesignCount();
-  std::vector<std::vector<double>> designs;
-  designs.reserve(static_cast<std::size_t>(n));
-  switch (plan.method) {
-    case SamplingMethod::kGrid:
-      for (std::uint64_t i = 0; i < n; ++i) designs.push_back(GridDesign(plan, i));
-      break;
-    case SamplingMethod::kLatinHypercube: {
-      std::mt19937_64 rng(plan.seed);
-      designs.assign(static_cast<std::size_t>(n), std::vector<double>(dims));
-      std::vector<std::uint64_t> strata(static_cast<std::size_t>(n));
-      for (std::size_t k = 0; k < dims; ++k) {
-        std::iota(strata.begin(), strata.end(), std::uint64_t{0});
-        for (std::uint64_t i = n; i > 1; --i) {  // Fisher-Yates
-          std::swap(strata[static_cast<std::size_t>(i - 1)],
-                    strata[static_cast<std::size_t>(Below(rng, i))]);
-        }
-        for (std::uint64_t i = 0; i < n; ++i) {
-          const double t = (static_cast<double>(strata[static_cast<std::size_t>(i)]) + Unit(rng)) /
-                           static_cast<double>(n);
-          designs[static_cast<std::size_t>(i)][k] = Lerp(plan.dimensions[k], t);
-        }
-      }
-      break;
+  const auto n = static_cast<std::size_t>(plan.DesignCount());
+  std::mt19937_64 rng(plan.seed);
+  std::vector<double> table(n * dims);
+  std::vector<std::uint64_t> strata(n);
+  for (std::size_t k = 0; k < dims; ++k) {
+    std::iota(strata.begin(), strata.end(), std::uint64_t{0});
+    for (std::uint64_t i = n; i > 1; --i) {  // Fisher-Yates
+      std::swap(strata[static_cast<std::size_t>(i - 1)],
+                strata[static_cast<std::size_t>(Below(rng, i))]);
     }
-    case SamplingMethod::kSobol: {
-      boost::random::sobol sobol(dims);
-      // Boost's sequence starts after the origin at (1/2, ..., 1/2); skip `seed` points.
-      if (plan.seed > 0) sobol.discard(static_cast<boost::uintmax_t>(plan.seed * dims));
-      const double scale = 1.0 / (static_cast<double>(boost::random::sobol::max()) + 1.0);
-      for (std::uint64_t i = 0; i < n; ++i) {
-        std::vector<double> point(dims);
-        for (std::size_t k = 0; k < dims; ++k) {
-          point[k] = Lerp(plan.dimensions[k], static_cast<double>(sobol()) * scale);
-        }
-        designs.push_back(std::move(point));
-      }
-      break;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double t = (static_cast<double>(strata[i]) + Unit(rng)) / static_cast<double>(n);
+      table[i * dims + k] = Lerp(plan.dimensions[k], t);
     }
   }
+  return table;
+}
+
+}  // namespace
+
+struct DesignSequence::SobolState {
+  explicit SobolState(std::size_t dims) : engine(dims) {}
+  boost::random::sobol engine;
+  std::uint64_t next = 0;  // the design index the engine gives next
+};
+
+DesignSequence::DesignSequence(const SweepPlan& plan) : plan_(plan) {
+  if (plan_.method == SamplingMethod::kLatinHypercube) {
+    table_ = std::make_shared<const std::vector<double>>(LatinHypercubeTable(plan_));
+  } else if (plan_.method == SamplingMethod::kSobol) {
+    sobol_ = std::make_unique<SobolState>(plan_.dimensions.size());
+    // Boost's sequence starts after the origin at (1/2, ..., 1/2); design 0 is point `seed`.
+    sobol_->engine.seed(static_cast<boost::uintmax_t>(plan_.seed));
+  }
+}
+
+DesignSequence::DesignSequence(const DesignSequence& other)
+    : plan_(other.plan_),
+      table_(other.table_),
+      sobol_(other.sobol_ ? std::make_unique<SobolState>(*other.sobol_) : nullptr) {}
+
+DesignSequence& DesignSequence::operator=(const DesignSequence& other) {
+  if (this != &other) *this = DesignSequence(other);
+  return *this;
+}
+
+DesignSequence::DesignSequence(DesignSequence&&) noexcept = default;
+DesignSequence& DesignSequence::operator=(DesignSequence&&) noexcept = default;
+DesignSequence::~DesignSequence() = default;
+
+void DesignSequence::DesignInto(std::uint64_t i, std::vector<double>* out) {
+  const std::size_t dims = plan_.dimensions.size();
+  std::vector<double>& point = *out;
+  switch (plan_.method) {
+    case SamplingMethod::kGrid:
+      GridDesignInto(plan_, i, out);
+      return;
+    case SamplingMethod::kLatinHypercube: {
+      const double* row = table_->data() + static_cast<std::size_t>(i) * dims;
+      point.assign(row, row + dims);
+      return;
+    }
+    case SamplingMethod::kSobol: {
+      SobolState& s = *sobol_;
+      // A jump costs one Gray-code update per bit of the index: only when not sequential.
+      if (s.next != i) s.engine.seed(static_cast<boost::uintmax_t>(plan_.seed + i));
+      const double scale = 1.0 / (static_cast<double>(boost::random::sobol::max()) + 1.0);
+      point.resize(dims);
+      for (std::size_t k = 0; k < dims; ++k) {
+        point[k] = Lerp(plan_.dimensions[k], static_cast<double>(s.engine()) * scale);
+      }
+      s.next = i + 1;
+      return;
+    }
+  }
+}
+
+std::vector<std::vector<double>> GenerateDesigns(const SweepPlan& plan) {
+  const std::uint64_t n = plan.DesignCount();
+  std::vector<std::vector<double>> designs(static_cast<std::size_t>(n));
+  DesignSequence sequence(plan);
+  for (std::uint64_t i = 0; i < n; ++i) sequence.DesignInto(i, &designs[static_cast<std::size_t>(i)]);
   return designs;
 }
 

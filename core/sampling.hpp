@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -70,6 +71,32 @@ std::vector<std::vector<double>> GenerateDesigns(const SweepPlan& plan);
 std::vector<double> GridDesign(const SweepPlan& plan, std::uint64_t i);
 /// GridDesign into *point (resized; its storage reused design after design).
 void GridDesignInto(const SweepPlan& plan, std::uint64_t i, std::vector<double>* point);
+
+/// A plan's designs one at a time, in any order (explore's workers take blocks of indices):
+/// a grid point by its index, a Sobol point by a jump of the generator to it (memory bounded
+/// whatever the sample count), a Latin hypercube point from the table drawn once at
+/// construction (n x dimensions doubles, shared by copies: its strata are a permutation of
+/// all n designs). Design i equals GenerateDesigns(plan)[i] bit for bit. Copies share the
+/// table and each has its own Sobol position, so give each thread its own copy.
+/// Precondition: plan.IsValid().
+class DesignSequence {
+ public:
+  explicit DesignSequence(const SweepPlan& plan);
+  DesignSequence(const DesignSequence& other);
+  DesignSequence& operator=(const DesignSequence& other);
+  DesignSequence(DesignSequence&&) noexcept;
+  DesignSequence& operator=(DesignSequence&&) noexcept;
+  ~DesignSequence();
+
+  /// Design `i` (< plan.DesignCount()) into *point (resized; its storage reused).
+  void DesignInto(std::uint64_t i, std::vector<double>* point);
+
+ private:
+  struct SobolState;  // Boost's generator and the index of the next point it gives
+  SweepPlan plan_;
+  std::shared_ptr<const std::vector<double>> table_;  // LHS: design i at [i * dims, (i+1) * dims)
+  std::unique_ptr<SobolState> sobol_;
+};
 
 /// Whether an objective is maximised or minimised.
 enum class Sense { kMaximize, kMinimize };

@@ -1,8 +1,10 @@
 #include "core/sampling.hpp"
 
+#include <boost/random/sobol.hpp>
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <random>
 #include <set>
 
@@ -61,6 +63,52 @@ TEST(SamplingTest, SobolMatchesTheKnownFirstPointsAndSkipsBySeed) {
   const auto b = GenerateDesigns(plan);
   EXPECT_EQ(b[0], expected[1]);
   EXPECT_EQ(b[1], expected[2]);
+}
+
+// Explore's workers take designs by index in blocks, each from its own copy: every access
+// order gives design i of the sequential sequence, bit for bit. Sobol is checked against
+// Boost's generator read sequentially after discarding `seed` points (the drawing this class
+// replaced), LHS against GenerateDesigns.
+TEST(SamplingTest, DesignSequenceGivesDesignIInAnyOrder) {
+  SweepPlan plan;
+  plan.method = SamplingMethod::kSobol;
+  plan.dimensions = {{0.0, 1.0, 1}, {-2.0, 3.0, 1}, {10.0, 11.0, 1}};
+  plan.samples = 3000;
+  plan.seed = 17;
+  boost::random::sobol engine(3);
+  engine.discard(static_cast<boost::uintmax_t>(plan.seed * 3));
+  const double scale = 1.0 / (static_cast<double>(boost::random::sobol::max()) + 1.0);
+  std::vector<std::vector<double>> reference(plan.samples, std::vector<double>(3));
+  for (auto& point : reference) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const SweepDimension& d = plan.dimensions[k];
+      point[k] = d.min + (d.max - d.min) * (static_cast<double>(engine()) * scale);
+    }
+  }
+  EXPECT_EQ(GenerateDesigns(plan), reference);
+  std::vector<std::uint64_t> order(plan.samples);
+  std::iota(order.begin(), order.end(), std::uint64_t{0});
+  std::shuffle(order.begin(), order.end(), std::mt19937_64(5));
+  const DesignSequence prototype(plan);
+  DesignSequence a = prototype;
+  DesignSequence b = prototype;
+  std::vector<double> point;
+  for (std::size_t j = 0; j < order.size(); ++j) {
+    (j % 2 == 0 ? a : b).DesignInto(order[j], &point);  // jumps, alternating copies
+    ASSERT_EQ(point, reference[order[j]]) << "design " << order[j];
+  }
+  for (std::uint64_t i = 1000; i < 1100; ++i) {  // a block in order: sequential draws
+    a.DesignInto(i, &point);
+    ASSERT_EQ(point, reference[i]) << "design " << i;
+  }
+
+  plan.method = SamplingMethod::kLatinHypercube;
+  const auto lhs = GenerateDesigns(plan);
+  DesignSequence c(plan);
+  for (std::uint64_t i = plan.samples; i-- > 0;) {
+    c.DesignInto(i, &point);
+    ASSERT_EQ(point, lhs[i]) << "design " << i;
+  }
 }
 
 TEST(SamplingTest, ShardsPartitionTheDesigns) {
