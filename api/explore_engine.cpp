@@ -869,6 +869,25 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
 
   std::vector<std::vector<double>> objective_values;
   std::vector<std::uint64_t> indices;
+  std::vector<core::Sense> senses;
+  for (const auto& o : sweep.objectives) senses.push_back(o.sense);
+  // The Pareto front kept as it grows: a design dominated by the designs so far is dominated
+  // in the whole sweep, and a design on the whole front is on the front of any set holding it,
+  // so the values are cut to their front whenever they have grown 8-fold since the last cut
+  // (memory of the order of the front, not of the sweep; the same front, in design order). A
+  // cut costs O(values x front), so cutting more often would cost more time than one cut at
+  // the end.
+  std::size_t cut_at = std::max<std::size_t>(1, sweep.pareto_cut_min);
+  const auto cut_to_front = [&] {
+    std::vector<std::vector<double>> kept_values;
+    std::vector<std::uint64_t> kept_indices;
+    for (const std::size_t k : core::ParetoFront(objective_values, senses)) {
+      kept_values.push_back(std::move(objective_values[k]));
+      kept_indices.push_back(indices[k]);
+    }
+    objective_values = std::move(kept_values);
+    indices = std::move(kept_indices);
+  };
   std::uint64_t evaluated = 0, failed = 0, beyond_tip = 0, before_knob = 0;
   // Takes a finished block: false when the sweep ends here (cancelled or stopped).
   const auto take = [&](BlockResult& block) {
@@ -882,6 +901,10 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
     before_knob += block.before_knob;
     for (auto& v : block.objective_values) objective_values.push_back(std::move(v));
     indices.insert(indices.end(), block.indices.begin(), block.indices.end());
+    if (!senses.empty() && objective_values.size() >= cut_at) {
+      cut_to_front();
+      cut_at = std::max(sweep.pareto_cut_min, 8 * objective_values.size());
+    }
     if (!emit(block.rows)) {
       outcome.stopped = true;
       return false;
@@ -996,12 +1019,8 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
                {"shard", {{"index", shard.index}, {"count", shard.count}}},
                {"timing_s", core::SecondsSince(sweep.start)}};
   if (!sweep.objectives.empty()) {
-    std::vector<core::Sense> senses;
-    for (const auto& o : sweep.objectives) senses.push_back(o.sense);
-    Json front = Json::array();
-    for (const std::size_t k : core::ParetoFront(objective_values, senses)) {
-      front.push_back(indices[k]);
-    }
+    cut_to_front();
+    Json front = indices;
     summary["pareto_front"] = std::move(front);
     summary["pareto_objectives"] = ObjectivesToJson(sweep.objectives);  // for explore-merge
     summary["pareto_scope"] = "the rows of this response (this shard)";

@@ -107,6 +107,9 @@ struct Sweep {
   std::chrono::steady_clock::time_point start;  ///< When the request arrived (timing_s).
   std::optional<DesignBinder> binder;           ///< Set when every swept path binds without JSON.
   int threads = 1;                              ///< Threads to evaluate designs on (>= 1).
+  /// Pareto objective values kept before they are first cut to their front (then at each
+  /// 8-fold growth); tests lower it to exercise the cuts on small sweeps.
+  std::size_t pareto_cut_min = 65536;
   ThreadBudget* budget = nullptr;  ///< Where threads beyond the first come from (or none).
 };
 
