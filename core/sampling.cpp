@@ -241,6 +241,25 @@ std::vector<std::size_t> ParetoFront(const std::vector<std::vector<double>>& poi
     return a < b;
   });
   std::vector<std::size_t> front;
+  if (senses.size() == 2) {
+    // Two objectives, O(n log n): in this order a point is dominated exactly when a point of a
+    // larger first value has a second value at least as large (best_before), or one of the same
+    // first value a larger second value (the group's first, sorted before it).
+    double best_before = -std::numeric_limits<double>::infinity();
+    for (std::size_t g = 0; g < order.size();) {
+      const double first = value(order[g], 0);
+      const double group_max = value(order[g], 1);
+      std::size_t h = g;
+      for (; h < order.size() && value(order[h], 0) == first; ++h) {
+        const double second = value(order[h], 1);
+        if (!(best_before >= second) && !(group_max > second)) front.push_back(order[h]);
+      }
+      best_before = std::max(best_before, group_max);
+      g = h;
+    }
+    std::sort(front.begin(), front.end());
+    return front;
+  }
   for (const std::size_t i : order) {
     bool dominated = false;
     for (const std::size_t j : front) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <random>
 #include <set>
@@ -156,6 +157,37 @@ TEST(SamplingTest, ParetoFrontAgreesWithBruteForceOnRandomSets) {
       if (!dominated) brute.push_back(i);
     }
     EXPECT_EQ(ParetoFront(points, senses), brute);
+  }
+}
+
+// Two objectives take the O(n log n) sweep: the same front as the definition, with ties in
+// either objective, duplicates, both senses and non-finite values.
+TEST(SamplingTest, TwoObjectiveParetoFrontAgreesWithBruteForce) {
+  std::mt19937_64 rng(11);
+  for (int trial = 0; trial < 40; ++trial) {
+    const std::size_t n = trial < 20 ? 200 : 3;
+    std::vector<std::vector<double>> points(n, std::vector<double>(2));
+    for (auto& p : points) {
+      for (double& v : p) v = static_cast<double>(rng() % (trial % 2 == 0 ? 6 : 1000));
+    }
+    if (trial % 5 == 0) points[0][1] = std::nan("");
+    const std::vector<Sense> senses = {trial % 3 == 0 ? Sense::kMinimize : Sense::kMaximize,
+                                       trial % 4 == 0 ? Sense::kMaximize : Sense::kMinimize};
+    const auto good = [&](std::size_t j, std::size_t k) {
+      return senses[k] == Sense::kMaximize ? points[j][k] : -points[j][k];
+    };
+    std::vector<std::size_t> brute;
+    for (std::size_t i = 0; i < n; ++i) {
+      bool dominated = !std::isfinite(points[i][0]) || !std::isfinite(points[i][1]);
+      for (std::size_t j = 0; j < n; ++j) {
+        if (!std::isfinite(points[j][0]) || !std::isfinite(points[j][1])) continue;
+        const bool ge = good(j, 0) >= good(i, 0) && good(j, 1) >= good(i, 1);
+        const bool gt = good(j, 0) > good(i, 0) || good(j, 1) > good(i, 1);
+        dominated = dominated || (ge && gt);
+      }
+      if (!dominated) brute.push_back(i);
+    }
+    EXPECT_EQ(ParetoFront(points, senses), brute) << "trial " << trial;
   }
 }
 
