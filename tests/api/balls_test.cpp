@@ -83,7 +83,7 @@ TEST(BallPresetTest, ExplicitFieldsOverrideThePresetAndCorSourceSaysWhichCor) {
   EXPECT_EQ(s.body["cor_source"], "ball:mlb");
   const double v = 27.7 + 17.288 * (0.855 - 0.1524);  // 6 in from the tip
   EXPECT_NEAR(s.body["cor_impact_speed_mps"].get<double>(), v, 1e-12);
-  EXPECT_NEAR(s.body["cor"].get<double>(), 0.546 - 0.001 / 0.44704 * (v - 25.908), 1e-12);
+  EXPECT_NEAR(s.body["cor"].get<double>(), 0.546 - 0.0005 / 0.44704 * (v - 25.908), 1e-12);
   s = Post("/v1/sweet-spot",
            R"({"bat": {"preset": "paper-wood"}, "ball": {"preset": "mlb"}, "cor": 0.5})");
   EXPECT_EQ(s.body["cor_source"], "scene");

@@ -71,25 +71,45 @@ TEST(BallCatalogue, BaseballsMatchTheRuleBooksAndTheCorSpecifications) {
   const BallCorLaw ncaa = Get("ncaa-nfhs").cor_law;
   EXPECT_EQ(ncaa.cor_at_reference, 0.555);
   EXPECT_NEAR(ncaa.reference_speed_mps, 60 * kMph, 1e-12);
-  // About 0.001 per mph for both (Nathan/Adair as quoted in the issue), 30 to 160 mph.
+  // MLB: 0.0005 per mph, fitted to issue 18's two points; NCAA/NFHS: 0.001 per mph, kept so a
+  // solid wood bat passes BBCOR (the catalogue's comments). Exact up to the mph conversion.
+  EXPECT_NEAR(mlb.slope_per_mps * kMph, 0.0005, 1e-15);
+  EXPECT_NEAR(ncaa.slope_per_mps * kMph, 0.001, 1e-15);
   for (const BallCorLaw& law : {mlb, ncaa}) {
-    EXPECT_NEAR(law.slope_per_mps * kMph, 0.001, 1e-15);
     EXPECT_NEAR(law.min_speed_mps, 30 * kMph, 1e-12);
     EXPECT_NEAR(law.max_speed_mps, 160 * kMph, 1e-12);
   }
 }
 
-TEST(BallCatalogue, MlbLawAgreesWithTheWoodLikeBbcorLimit) {
-  // At the NCAA BBCOR test speed (136 mph) the MLB ball on solid wood gives
-  // 0.546 - 0.001 (136 - 57.95) = 0.468; the NCAA set the non-wood limit at 0.500 to be
-  // wood-like, so a wood collision must come out at or just below it. The band [0.44, 0.50]
-  // is that statement with the spec's own +/- 0.032 spread below it.
-  const double e = Get("mlb").cor_law.CorAt(136 * kMph);
-  EXPECT_NEAR(e, 0.546 - 0.001 * (136 - 25.908 / kMph), 1e-12);
-  EXPECT_GE(e, 0.44);
-  EXPECT_LE(e, 0.50);
-  // The issue's figures: about 0.55 at 58 mph (0.546 is the spec's centre).
-  EXPECT_NEAR(Get("mlb").cor_law.CorAt(58 * kMph), 0.546, 1e-4);  // 0.05 mph off the 85 ft/s
+TEST(BallCatalogue, MlbLawMeetsTheIssuesTwoPoints) {
+  // Issue 18: "about 0.55 at 58 mph on ash, falling with speed to about 0.50 at game speeds".
+  // 58 mph: 0.546 (the spec's centre; 85 ft/s is 57.95 mph, so 0.05 mph of slope: 2.5e-5).
+  const BallCorLaw mlb = Get("mlb").cor_law;
+  EXPECT_NEAR(mlb.CorAt(58 * kMph), 0.546, 1e-4);
+  // Game speeds: a 90-100 mph pitch on a 60-70 mph bat is 150-170 mph relative; the law is
+  // held above 160 mph. 0.546 - 0.0005 (160 - 57.95) = 0.4950 exactly (1e-12: rounding);
+  // "about 0.50" read as +/- 0.01.
+  const double game = mlb.CorAt(160 * kMph);
+  EXPECT_NEAR(game, 0.546 - 0.0005 * (160 - 25.908 / kMph), 1e-12);
+  EXPECT_NEAR(game, 0.50, 0.01);
+  EXPECT_EQ(mlb.CorAt(170 * kMph), game);  // held above the range
+}
+
+TEST(BallCatalogue, BaseballLawsAgainstTheWoodLikeBbcorLimit) {
+  // At the NCAA BBCOR test speed (136 mph) a near-rigid wood bat's BBCOR is the ball's COR on
+  // wood; the NCAA set the non-wood limit at 0.500 from wood bats. The NCAA ball (the one the
+  // BBCOR protocol fires) gives 0.555 - 0.001 (136 - 60) = 0.479: under the limit.
+  const double ncaa = Get("ncaa-nfhs").cor_law.CorAt(136 * kMph);
+  EXPECT_NEAR(ncaa, 0.479, 1e-12);
+  EXPECT_LE(ncaa, 0.50);
+  // The MLB fit gives 0.507 there: 0.007 ABOVE the limit (documented in docs/validation.md:
+  // the fit to the issue's points and the limit disagree by that much, for a rigid bat).
+  const double mlb = Get("mlb").cor_law.CorAt(136 * kMph);
+  EXPECT_NEAR(mlb, 0.546 - 0.0005 * (136 - 25.908 / kMph), 1e-12);
+  EXPECT_NEAR(mlb - 0.50, 0.007, 0.0005);  // 0.00698, to the digit quoted
+  // The NCAA slope is the smallest that keeps its rule maximum under the limit, plus margin:
+  // 0.555 - s 76 <= 0.50 needs s >= 0.000724 per mph.
+  EXPECT_GE(Get("ncaa-nfhs").cor_law.slope_per_mps * kMph, (0.555 - 0.50) / 76);
 }
 
 TEST(BallCatalogue, SoftballsMatchTheRuleAndTheStaticCompression) {
@@ -137,10 +157,11 @@ TEST(BallCorLaw, IsMonotoneAndClampedToItsSpeedRange) {
     EXPECT_EQ(law.CorAt(0.0), law.CorAt(law.min_speed_mps)) << b.name;
     EXPECT_EQ(law.CorAt(500.0), law.CorAt(law.max_speed_mps)) << b.name;
   }
-  // The MLB law's ends: 0.546 + 0.001 (57.95 - 30) and 0.546 - 0.001 (160 - 57.95).
+  // The MLB law's ends: 0.546 + 0.0005 (57.95 - 30) = 0.5600 and 0.546 - 0.0005 (160 - 57.95)
+  // = 0.4950 (1e-12: the mph conversion's rounding).
   const BallCorLaw mlb = FindBallPreset("mlb")->cor_law;
-  EXPECT_NEAR(mlb.CorAt(0.0), 0.546 + 0.001 * (25.908 / kMph - 30), 1e-12);
-  EXPECT_NEAR(mlb.CorAt(1e3), 0.546 - 0.001 * (160 - 25.908 / kMph), 1e-12);
+  EXPECT_NEAR(mlb.CorAt(0.0), 0.546 + 0.0005 * (25.908 / kMph - 30), 1e-12);
+  EXPECT_NEAR(mlb.CorAt(1e3), 0.546 - 0.0005 * (160 - 25.908 / kMph), 1e-12);
   // A law whose line leaves [0, 1] inside its range is clamped to it.
   BallCorLaw steep{0.5, 20.0, 0.1, 0.0, 100.0};
   EXPECT_EQ(steep.CorAt(100.0), 0.0);
@@ -179,7 +200,7 @@ TEST(SceneBallCor, APresetGivesTheBallsCorAtTheScenesImpactSpeed) {
   const double v = 27.7 + 17.288 * (0.855 - 0.1524);
   ASSERT_TRUE(r.cor_impact_speed_mps.has_value());
   EXPECT_NEAR(*r.cor_impact_speed_mps, v, 1e-12);
-  EXPECT_NEAR(*r.cor, 0.546 - 0.001 / kMph * (v - 25.908), 1e-12);
+  EXPECT_NEAR(*r.cor, 0.546 - 0.0005 / kMph * (v - 25.908), 1e-12);
   // The preset's ball is used: its mass changes the sweet spot against the default ball's.
   EXPECT_EQ(Wood("mlb").ball.mass_kg, FindBallPreset("mlb")->mass_kg);
 }
