@@ -49,15 +49,9 @@ struct TrampolineSystem {
   }
 
   std::span<const EventSpec> ActiveEvents() const { return ContactEvents(branch.unloading); }
+  // The contact's events on the compression delta (ContactEventId).
   double EventFunction(int id, const TrampolineState& s) const {
-    switch (id) {
-      case kMaxCompression:
-        return s[1];
-      case kEnd:
-        return s[0];
-      default:
-        return branch.delta_max_m / delta_s - s[0];
-    }
+    return ContactEventValue(id, s[0], s[1], branch.delta_max_m / delta_s);
   }
   void OnStep(const DenseStep<TrampolineState>& step) {
     const TrampolineState& y = *step.y_end;

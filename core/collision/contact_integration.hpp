@@ -1,4 +1,4 @@
-// What the two contact models (hertz_contact.cpp and flexible_impact.cpp) share around the
+// What the contact models (hertz_contact.cpp, flexible_impact.cpp, barrel.cpp) share around the
 // event integrator: the events of one contact, the integrator's settings for a contact, and the
 // opening of a solve (backend, model, refusal of invalid input). Internal to core/collision/:
 // included by .cpp files only, not part of core's API.
@@ -28,6 +28,22 @@ inline std::span<const EventSpec> ContactEvents(bool unloading) {
   static constexpr EventSpec kUnloading[] = {{kEnd, false}, {kReload, true}};
   if (unloading) return kUnloading;
   return kLoading;
+}
+
+/// The value of contact event `id` (ContactEventId) for a compression `delta`, its rate
+/// `delta_rate` and the branch's maximum compression `delta_max`, all on one scale: the rate
+/// (maximum compression), the compression (separation), delta_max - delta (reload). For the
+/// models whose compression and rate are state entries (hertz, barrel); the flexible model
+/// computes them from modal sums only for the event asked.
+inline double ContactEventValue(int id, double delta, double delta_rate, double delta_max) {
+  switch (id) {
+    case kMaxCompression:
+      return delta_rate;
+    case kEnd:
+      return delta;
+    default:
+      return delta_max - delta;
+  }
 }
 
 /// The integrator's settings for one contact: relative and absolute tolerance `tolerance` (on

@@ -83,14 +83,7 @@ struct HertzSystem {
   std::span<const EventSpec> ActiveEvents() const { return ContactEvents(branch.unloading); }
   // The contact's events on the compression delta1 (ContactEventId).
   double EventFunction(int id, const HertzState& s) const {
-    switch (id) {
-      case kMaxCompression:
-        return s[1];
-      case kEnd:
-        return s[0];
-      default:
-        return branch.delta_max_m / delta_s - s[0];
-    }
+    return ContactEventValue(id, s[0], s[1], branch.delta_max_m / delta_s);
   }
   void OnStep(const DenseStep<HertzState>& step) { peak_d = std::max(peak_d, (*step.y_end)[0]); }
 
