@@ -38,6 +38,8 @@
 #include <sched.h>
 #include <time.h>
 
+#include "core/ball_catalogue.hpp"
+#include "core/collision/barrel.hpp"
 #include "core/collision/collide.hpp"
 #include "core/mass_properties.hpp"
 #include "core/material.hpp"
@@ -520,6 +522,154 @@ void HertzImpactRows(const TimingOptions& timing, bool quick, Report* report) {
   }
   run(core::CollisionOptions{},
       "defaults: relative_tolerance " + Tol(defaults.relative_tolerance) + " + refine check", true);
+}
+
+// ----------------------------------------------------------------------------------- barrel
+
+/// The hollow preset of the barrel rows and its BBCOR impact point (6 in from the tip), m.
+constexpr char kHollowPreset[] = "bbcor-33-aluminium";
+constexpr double kBbcorImpactFromTipM = 0.1524;
+
+void BarrelHoopRows(const TimingOptions& timing, bool quick, Report* report) {
+  const std::string model = "barrel_hoop";
+  const core::Bat bat = core::FindPreset(kHollowPreset)->bat;
+  const double x = bat.LengthM() - kBbcorImpactFromTipM;
+  const core::BarrelWall wall = core::BarrelWallAt(bat, x);
+  const core::Material& m = bat.material;
+  const int ref_elements = quick ? 128 : 512;
+  report->models.push_back(
+      {model, "Barrel (trampoline model): the hoop frequency",
+       "the n = 2 hoop frequency of " + std::string(kHollowPreset) + "'s wall " +
+           Fixed(kBbcorImpactFromTipM, 4) +
+           " m from the tip: the thin-ring closed form (core::BarrelWallAt, what the barrel "
+           "and bbcor outputs report) or the ring finite-element model "
+           "(core::RingFeHoopFrequencyHz, N frame elements, a dense generalised eigenproblem)",
+       "the ring FE model with " + std::to_string(ref_elements) +
+           " elements (converged in N; it keeps the ring's extensibility, which the "
+           "inextensional closed form drops: their gap at this wall's h/R = " +
+           Fixed(wall.thickness_m / wall.mid_radius_m, 3) + " is the closed form's error)",
+       "the closed form: core::BarrelWallAt (core/collision/barrel.hpp); the FE model is the "
+       "check, never run by a request"});
+  const double ref = core::RingFeHoopFrequencyHz(m.youngs_modulus_pa, m.poissons_ratio,
+                                                 m.density_kg_m3, wall.mid_radius_m,
+                                                 wall.thickness_m, ref_elements);
+  auto push = [&](Row row) {
+    report->rows.push_back(std::move(row));
+    Progress(*report);
+  };
+  {
+    core::BarrelWall w;
+    Row row;
+    row.model = model;
+    row.setting = "closed form (thin inextensional ring)";
+    row.timing = TimePerEvaluation([&] { w = core::BarrelWallAt(bat, x); }, timing);
+    row.quantities = {{"hoop_frequency_hz", "Hz", w.hoop_frequency_hz, ref}};
+    row.parameters = {{"method", "closed_form"}};
+    row.is_auto = true;
+    row.termination = "converged";
+    push(row);
+  }
+  std::vector<int> counts = {8, 16, 32, 64, 128, 256};
+  if (quick) counts = {16, 64};
+  for (const int n : counts) {
+    double f = 0.0;
+    Row row;
+    row.model = model;
+    row.setting = "ring FE, " + std::to_string(n) + " elements";
+    row.timing = TimePerEvaluation(
+        [&] {
+          f = core::RingFeHoopFrequencyHz(m.youngs_modulus_pa, m.poissons_ratio, m.density_kg_m3,
+                                          wall.mid_radius_m, wall.thickness_m, n);
+        },
+        timing);
+    row.quantities = {{"hoop_frequency_hz", "Hz", f, ref}};
+    row.parameters = {{"method", "ring_fe"}, {"elements", n}};
+    row.termination = "converged";
+    push(row);
+  }
+}
+
+void BarrelTrampolineRows(const TimingOptions& timing, bool quick, Report* report) {
+  const std::string model = "barrel_trampoline";
+  const core::BarrelOptions defaults;
+  const core::Bat bat = core::FindPreset(kHollowPreset)->bat;
+  const core::BbcorProtocol protocol;
+  const core::BallPreset ball = *core::FindBallPreset(protocol.ball);
+  const double x = bat.LengthM() - protocol.impact_from_tip_m;
+  const double z = x - protocol.pivot_from_knob_m;
+  const core::MassProperties mp = core::ComputeMassProperties(bat);
+  const core::BarrelWall wall = core::BarrelWallAt(bat, x);
+  // The BBCOR impact of the preset (core::ComputeBbcor's problem) with the wall's modal mass.
+  core::TrampolineProblem p;
+  p.ball_mass_kg = ball.mass_kg;
+  p.ball_stiffness = ball.stiffness;
+  p.ball_exponent = ball.stiffness_exponent;
+  p.surface_stiffness =
+      core::BatSurfaceHertzStiffness(bat.material.youngs_modulus_pa, bat.material.poissons_ratio,
+                                     ball.radius_m, wall.outer_radius_m);
+  p.ball_cor = ball.cor_law.CorAt(protocol.ball_speed_mps);
+  p.bat_effective_mass_kg = mp.MoiAboutKgM2(protocol.pivot_from_knob_m) / (z * z);
+  p.approach_speed_mps = protocol.ball_speed_mps;
+  p.barrel_stiffness_n_m = wall.stiffness_n_m;
+  p.barrel_modal_mass_kg = wall.modal_mass_kg;
+  p.barrel_damping_ratio = wall.damping_ratio;
+  p.barrel_loss = wall.barrel_loss;
+  report->models.push_back(
+      {model, "Barrel (trampoline model): the integrated wall",
+       "one core::TrampolineImpact: the BBCOR impact of " + std::string(kHollowPreset) +
+           " (the ncaa-nfhs ball at 136 mph, 6 in from the tip, the bat pivoted 6 in from the "
+           "knob) with the wall's modal mass on its spring, integrated by Dormand-Prince 5(4). "
+           "The dynamic model is core's check of the quasi-static closed form "
+           "(core::QuasiStaticTrampoline), which the barrel and bbcor outputs use",
+       "the same impact at relative tolerance 1e-12",
+       "relative_tolerance = " + Tol(defaults.relative_tolerance) +
+           ": core::BarrelOptions (core/collision/barrel.hpp), the dynamic model's default; "
+           "no request runs it (the outputs use the quasi-static closed form)"});
+  core::BarrelOptions ref_o;
+  ref_o.relative_tolerance = 1e-12;
+  const core::TrampolineResult ref = core::TrampolineImpact(p, ref_o);
+  if (!ref.ok) {
+    core::Summary failed;
+    failed.message = ref.message;
+    Skip(report, model, "reference", failed);
+    return;
+  }
+  {
+    // The closed form the outputs use, for scale (not a row: a different model).
+    const core::TrampolineResult qs = core::QuasiStaticTrampoline(p);
+    report->models.back().reference +=
+        "; the quasi-static closed form gives e_eff = " + Fixed(qs.effective_cor, 5) +
+        " against the integrated " + Fixed(ref.effective_cor, 5) +
+        " (a modelling difference: the wall's phase when the ball leaves, docs/models.md)";
+  }
+  auto run = [&](const core::BarrelOptions& o, const std::string& setting, bool is_auto) {
+    core::TrampolineResult r = core::TrampolineImpact(p, o);
+    if (!r.ok) {
+      core::Summary failed;
+      failed.message = r.message;
+      Skip(report, model, setting, failed);
+      return;
+    }
+    Row row;
+    row.model = model;
+    row.setting = setting;
+    row.timing = TimePerEvaluation([&] { r = core::TrampolineImpact(p, o); }, timing);
+    row.quantities = {{"effective_cor", "1", r.effective_cor, ref.effective_cor},
+                      {"contact_time_s", "s", r.contact_time_s, ref.contact_time_s}};
+    row.parameters = {{"barrel.relative_tolerance", o.relative_tolerance}, {"steps", r.steps}};
+    row.is_auto = is_auto;
+    row.termination = "converged";
+    report->rows.push_back(row);
+    Progress(*report);
+  };
+  std::vector<double> tols = {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-9, 1e-10};
+  if (quick) tols = {1e-4};
+  for (const double tol : tols) {
+    core::BarrelOptions o;
+    o.relative_tolerance = tol;
+    run(o, "relative_tolerance " + Tol(tol), false);
+  }
+  run(defaults, "defaults: relative_tolerance " + Tol(defaults.relative_tolerance), true);
 }
 
 // ----------------------------------------------------------------------------- flexible modes
@@ -1088,6 +1238,21 @@ std::string HowToChoose(const Report& report) {
      << " and the exact Hessian " << TimeOf(d_ex) << ", both within " << ErrorOf(d_lm) << " / "
      << ErrorOf(d_ex) << " of the reference objective; the NLopt SLSQP backend " << TimeOf(d_sl)
      << " (" << ErrorOf(d_sl) << "). One problem only: time your own design before switching.\n";
+  const Row* hoop = FindRow(report, "barrel_hoop", "closed form");
+  const Row* hoop_fe = FindRow(report, "barrel_hoop", "ring FE, 64 elements");
+  const Row* tr_auto = FindRow(report, "barrel_trampoline", "defaults");
+  const Row* tr_6 = FindRow(report, "barrel_trampoline", "relative_tolerance 1e-06");
+  md << "* **Barrel** (`barrel`, `bbcor` outputs of a hollow bat): the hoop frequency's closed "
+        "form takes "
+     << TimeOf(hoop) << " and differs from the converged ring FE model by " << ErrorOf(hoop)
+     << " (the inextensional ring's modelling error, not a numeric one); the FE model with 64 "
+        "elements takes "
+     << TimeOf(hoop_fe) << " (" << Ratio(hoop_fe, hoop)
+     << "), a check only. The integrated trampoline (core's check of the quasi-static closed "
+        "form the outputs use) at its default tolerance takes "
+     << TimeOf(tr_auto) << " within " << (tr_auto ? ErrorText(tr_auto->Error()) : "?")
+     << " of the reference COR; 1e-6: " << TimeOf(tr_6) << ", "
+     << (tr_6 ? ErrorText(tr_6->Error()) : "?") << ".\n";
   return md.str();
 }
 
@@ -1406,6 +1571,8 @@ int Main(int argc, char** argv) {
   FlexibleModesRows(core::BeamTheory::kEulerBernoulli, timing, quick, &report);
   FlexibleImpactRows(timing, quick, &report);
   DesignRows(timing, quick, &report);
+  BarrelHoopRows(timing, quick, &report);
+  BarrelTrampolineRows(timing, quick, &report);
   const Json metadata = Metadata(command, timing, quick, SecondsSince(t0), load_before);
   const Json json = ToJson(report, metadata);
   const std::string base = out_dir + "/speed-vs-error";
