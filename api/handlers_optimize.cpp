@@ -7,7 +7,10 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <set>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "api/bat_json.hpp"
 #include "api/endpoint.hpp"
@@ -185,6 +188,7 @@ Json MaterialInRequestForm(const core::Material& m) {
 Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r) {
   Json bat = request_bat;
   for (const core::DesignValue& v : r.variables) {
+    if (v.scale_factor) continue;  // a factor: its fields follow it in the list
     std::string why;
     const auto steps = ParseJsonPath(v.path, &why);
     if (steps && SetNumberAtPath(&bat, *steps, v.value, &why)) continue;
@@ -325,35 +329,73 @@ bool ReadVariables(ObjectReader& reader, const ApiLimits& limits, core::DesignPr
     return reader.Fail("variables", "must be an array of 1 to " + std::to_string(max_variables) +
                                         " {\"path\", \"min\", \"max\"}");
   }
+  std::set<std::string> scale_names;  // the scale variables' names, each once
   for (std::size_t i = 0; i < variables->size(); ++i) {
     const std::string where = "variables[" + std::to_string(i) + "]";
     ObjectReader v((*variables)[i], where, error);
     core::DesignVariable variable;
-    if (v.Has("scale_paths")) {
-      return v.Fail("scale_paths",
-                    "is offered by /v1/explore's parameters, not by /v1/optimize's variables "
-                    "(use paths: the fields set to one value)");
+    if (!v.ok()) return false;  // not an object
+    // One field ("path"), several set to the value ("paths"), or several each the base
+    // design's value times it ("scale_paths"): exactly one form, as /v1/explore's parameters.
+    const char* const kForms[] = {"path", "paths", "scale_paths"};
+    std::vector<const char*> given;
+    for (const char* form : kForms) {
+      if (v.Has(form)) given.push_back(form);
     }
-    if (v.Has("paths") && v.Has("path")) {
-      return v.Fail("paths", "give path or paths, not both");
+    if (!v.ok()) return false;
+    if (given.size() != 1) {
+      return v.Fail(given.empty() ? "path" : given[1],
+                    "give exactly one of path, paths (several fields set to one value) and "
+                    "scale_paths (several fields scaled by one value)",
+                    given.empty() ? ErrorCode::kMissingField : ErrorCode::kInvalidValue);
     }
-    if (const Json* paths = v.Get("paths")) {
-      // Several fields set to one value: the first is the variable's path, the rest linked.
+    const std::string form = given.front();
+    if (v.Has("name") && form != "scale_paths") {
+      return v.Fail("name",
+                    "names a scale variable: give it with scale_paths only (a path is "
+                    "its own name)");
+    }
+    if (form != "path") {
+      // paths: the first is the variable's path, the rest linked. scale_paths: the fields of a
+      // scale variable named by "name" (default "scale:" and the paths joined with "+").
+      const Json* paths = v.Get(form);
       if (!paths->is_array() || paths->empty() || paths->size() > 32) {
-        return v.Fail("paths", "must be an array of 1 to 32 variable paths");
+        return v.Fail(form, "must be an array of 1 to 32 variable paths");
       }
+      std::string joined;
       for (std::size_t k = 0; k < paths->size(); ++k) {
         const Json& item = (*paths)[k];
-        const std::string field = where + ".paths[" + std::to_string(k) + "]";
+        const std::string field = where + "." + form + "[" + std::to_string(k) + "]";
         if (!item.is_string() || !core::ParseDesignVariablePath(item.get<std::string>())) {
           return SetError(error, ErrorCode::kInvalidValue, field, &item,
                           "is not a design variable path (profile.knots[i].radius_m, ...; "
-                          "material choices cannot be linked)");
+                          "material choices cannot be linked or scaled)");
         }
-        if (k == 0) {
-          variable.path = item.get<std::string>();
+        const std::string path = item.get<std::string>();
+        if (form == "scale_paths") {
+          variable.scale_paths.push_back(path);
+          joined += (k == 0 ? "" : "+") + path;
+        } else if (k == 0) {
+          variable.path = path;
         } else {
-          variable.linked_paths.push_back(item.get<std::string>());
+          variable.linked_paths.push_back(path);
+        }
+      }
+      if (form == "scale_paths") {
+        variable.path = "scale:" + joined;
+        v.OptionalString("name", &variable.path);
+        if (!v.ok()) return false;
+        if (variable.path.empty() || variable.path == "material" ||
+            core::ParseDesignVariablePath(variable.path)) {
+          return v.Fail("name",
+                        "must be a non-empty name that is not a design variable path "
+                        "(the answer's variables list the scale under it beside its "
+                        "fields)");
+        }
+        if (!scale_names.insert(variable.path).second) {
+          return v.Fail(v.Has("name") ? "name" : "scale_paths",
+                        "names a scale variable \"" + variable.path +
+                            "\" already given: each needs its own name");
         }
       }
     } else {
@@ -376,7 +418,7 @@ bool ReadVariables(ObjectReader& reader, const ApiLimits& limits, core::DesignPr
     v.Number("min", AnyNumber(), &variable.min);  // the bounds' ranges: core's
     v.Number("max", AnyNumber(), &variable.max);
     if (!v.Finish()) return false;
-    if (!core::ParseDesignVariablePath(variable.path)) {
+    if (variable.scale_paths.empty() && !core::ParseDesignVariablePath(variable.path)) {
       return SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*variables)[i]["path"],
                       "is not a design variable (profile.knots[i].radius_m, profile.knots[i].x_m, "
                       "three_segment.<field>, material.density_kg_m3, wall_thickness_m, "

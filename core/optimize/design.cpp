@@ -58,6 +58,7 @@ std::vector<double> RandomStart(const DesignModel& model, std::mt19937_64& rng, 
   std::vector<std::pair<int, std::size_t>> positions;  // (knot, variable)
   int taper_start = -1, taper_end = -1, length = -1;
   for (std::size_t j = 0; j < vars.size(); ++j) {
+    if (vars[j].scale) continue;  // a factor of several fields, none ordered here
     if (vars[j].ref.kind == DesignVariableKind::kKnotPosition)
       positions.push_back({vars[j].ref.knot, j});
     if (vars[j].ref.kind == DesignVariableKind::kTaperStart) taper_start = static_cast<int>(j);
@@ -186,7 +187,9 @@ void FillBase(const DesignProblem& problem, DesignResult* result) {
   result->sweet_spot_from_knob_m = kNaN;
   result->max_exit_speed_mps = kNaN;
   result->angular_speed_rad_s = problem.swing.angular_speed_rad_s;
-  for (const DesignVariable& v : problem.variables) result->variables.push_back({v.path, kNaN});
+  for (const DesignVariable& v : problem.variables) {
+    result->variables.push_back({v.path, kNaN, !v.scale_paths.empty()});
+  }
   result->spread.objective_min = result->spread.objective_max = result->spread.objective_median =
       kNaN;
 }
@@ -504,9 +507,14 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     result.bat = model.BatAt(x.data());
     result.three_segment = model.ShapeAt(x.data());
     for (std::size_t j = 0; j < x.size(); ++j) {
-      result.variables.push_back({model.variables()[j].path, x[j]});
-      for (const std::string& linked : model.variables()[j].linked_paths) {
+      const DesignVariableSpec& v = model.variables()[j];
+      result.variables.push_back({v.path, x[j], v.scale});
+      for (const std::string& linked : v.linked_paths) {
         result.variables.push_back({linked, x[j]});  // set to the same value
+      }
+      for (std::size_t k = 0; k < v.scale_paths.size(); ++k) {
+        // The product the model's parameters hold (DesignModel::ParametersAt), so the bat's field.
+        result.variables.push_back({v.scale_paths[k], v.scale_bases[k] * x[j]});
       }
     }
     const PublicEvaluation pub = EvaluatePublic(problem, model, result.bat, cor_known);

@@ -4,8 +4,10 @@
 // Parameters: DesignParameterLayout order (core/mass_properties.hpp): the knots' radii and
 // positions, then density, wall, fill diameter, depth and density. A three-segment shape is
 // the 4 knots (0, r1), (x1, r1), (x2, r2), (L, r2); each design variable sets one or two of
-// these parameters (DesignParametersOf). The integrals P = (M, S1, S2, L) and dP/dx over the
-// variables x come from forward-mode AD (jet.hpp) of the closed forms per segment and fill.
+// these parameters (DesignParametersOf), each parameter its coefficient (parameter_scale: 1,
+// or a scaled field's base value) times the variable. The integrals P = (M, S1, S2, L) and
+// dP/dx over the variables x come from forward-mode AD (jet.hpp) of the closed forms per
+// segment and fill.
 // Included only by core's .cpp files.
 #pragma once
 
@@ -43,6 +45,7 @@ struct Integrals {
 struct IntegralContext {
   const std::vector<double>& t;                ///< Parameters (DesignParameterLayout order).
   const std::vector<int>& parameter_variable;  ///< Parameter -> variable index, or -1.
+  const std::vector<double>& parameter_scale;  ///< Parameter -> d parameter / d its variable.
   int num_knots;                               ///< Knots of the profile.
   bool hollow;                                 ///< A shell of wall t[WallThickness()].
   bool has_fill;                               ///< The fill entries apply.

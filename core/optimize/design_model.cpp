@@ -69,8 +69,10 @@ T MoiAbout(const T* p, double c0, double pivot) {
 
 std::vector<double> DesignModel::ParametersAt(const double* x) const {
   std::vector<double> t = base_parameters_;
-  for (std::size_t j = 0; j < variables_.size(); ++j) {
-    for (int idx : variables_[j].parameters) t[static_cast<std::size_t>(idx)] = x[j];
+  for (std::size_t idx = 0; idx < t.size(); ++idx) {
+    const int j = parameter_variable_[idx];
+    // A coefficient of 1 (path, paths) gives x[j] itself, bit for bit.
+    if (j >= 0) t[idx] = parameter_scale_[idx] * x[j];
   }
   return t;
 }
@@ -166,9 +168,9 @@ void ComputeIntegrals(const IntegralContext& c, int n, bool gradients, Integrals
   out->p = {0.0, 0.0, 0.0, c.t[static_cast<std::size_t>(lay.KnotPosition(c.num_knots - 1))]};
   if (gradients) {
     out->dp = Eigen::Matrix<double, 4, Eigen::Dynamic>::Zero(4, n);
-    const int l_var =
-        c.parameter_variable[static_cast<std::size_t>(lay.KnotPosition(c.num_knots - 1))];
-    if (l_var >= 0) out->dp(3, l_var) = 1.0;
+    const auto l_idx = static_cast<std::size_t>(lay.KnotPosition(c.num_knots - 1));
+    const int l_var = c.parameter_variable[l_idx];
+    if (l_var >= 0) out->dp(3, l_var) = c.parameter_scale[l_idx];
   }
   auto at = [&](int idx) { return c.t[static_cast<std::size_t>(idx)]; };
   for (int i = 0; i + 1 < c.num_knots; ++i) {
@@ -191,12 +193,13 @@ void ComputeIntegrals(const IntegralContext& c, int n, bool gradients, Integrals
     out->p[1] += s.s1.v;
     out->p[2] += s.s2.v;
     for (int a = 0; a < 6; ++a) {
-      const int j =
-          c.parameter_variable[static_cast<std::size_t>(map.index[static_cast<std::size_t>(a)])];
+      const auto idx = static_cast<std::size_t>(map.index[static_cast<std::size_t>(a)]);
+      const int j = c.parameter_variable[idx];
       if (j < 0) continue;
-      out->dp(0, j) += s.mass.g[static_cast<std::size_t>(a)];
-      out->dp(1, j) += s.s1.g[static_cast<std::size_t>(a)];
-      out->dp(2, j) += s.s2.g[static_cast<std::size_t>(a)];
+      const double k = c.parameter_scale[idx];
+      out->dp(0, j) += k * s.mass.g[static_cast<std::size_t>(a)];
+      out->dp(1, j) += k * s.s1.g[static_cast<std::size_t>(a)];
+      out->dp(2, j) += k * s.s2.g[static_cast<std::size_t>(a)];
     }
   }
   if (c.has_fill) {
@@ -222,10 +225,10 @@ void ComputeIntegrals(const IntegralContext& c, int n, bool gradients, Integrals
       out->p[1] += s.s1.v;
       out->p[2] += s.s2.v;
       for (int a = 0; a < 5; ++a) {
-        const int j =
-            c.parameter_variable[static_cast<std::size_t>(map.index[static_cast<std::size_t>(a)])];
+        const auto idx = static_cast<std::size_t>(map.index[static_cast<std::size_t>(a)]);
+        const int j = c.parameter_variable[idx];
         if (j < 0) continue;
-        const double k = map.coefficient[static_cast<std::size_t>(a)];
+        const double k = map.coefficient[static_cast<std::size_t>(a)] * c.parameter_scale[idx];
         out->dp(0, j) += k * s.mass.g[static_cast<std::size_t>(a)];
         out->dp(1, j) += k * s.s1.g[static_cast<std::size_t>(a)];
         out->dp(2, j) += k * s.s2.g[static_cast<std::size_t>(a)];
@@ -240,16 +243,18 @@ void AddIntegralHessian(const IntegralContext& c, const std::array<double, 3>& w
   const DesignParameterLayout lay{c.num_knots};
   auto at = [&](int idx) { return c.t[static_cast<std::size_t>(idx)]; };
   auto scatter = [&](const LocalMap& map, const auto& combined, int size) {
+    // Each local parameter is coefficient * parameter, each parameter scale * its variable:
+    // a term of the Hessian carries both factors of both.
     for (int a = 0; a < size; ++a) {
-      const int ja =
-          c.parameter_variable[static_cast<std::size_t>(map.index[static_cast<std::size_t>(a)])];
+      const auto ia = static_cast<std::size_t>(map.index[static_cast<std::size_t>(a)]);
+      const int ja = c.parameter_variable[ia];
       if (ja < 0) continue;
-      const double ka = map.coefficient[static_cast<std::size_t>(a)];
+      const double ka = map.coefficient[static_cast<std::size_t>(a)] * c.parameter_scale[ia];
       for (int b = 0; b < size; ++b) {
-        const int jb =
-            c.parameter_variable[static_cast<std::size_t>(map.index[static_cast<std::size_t>(b)])];
+        const auto ib = static_cast<std::size_t>(map.index[static_cast<std::size_t>(b)]);
+        const int jb = c.parameter_variable[ib];
         if (jb < 0) continue;
-        const double kb = map.coefficient[static_cast<std::size_t>(b)];
+        const double kb = map.coefficient[static_cast<std::size_t>(b)] * c.parameter_scale[ib];
         (*h)(ja, jb) += ka * kb * combined.h[static_cast<std::size_t>(a * size + b)];
       }
     }
@@ -383,7 +388,8 @@ bool DesignModel::FrequencyOf(const std::vector<double>& t, double* value, doubl
     for (std::size_t idx = 0; idx < parameter_variable_.size(); ++idx) {
       const int j = parameter_variable_[idx];
       if (j < 0) continue;
-      gradient_row[j * stride] += df_dlambda * mode.lambda_gradient[static_cast<Eigen::Index>(idx)];
+      gradient_row[j * stride] +=
+          df_dlambda * parameter_scale_[idx] * mode.lambda_gradient[static_cast<Eigen::Index>(idx)];
     }
   }
   return std::isfinite(*value);
@@ -412,7 +418,8 @@ double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
   }
   design_detail::Integrals in;
   design_detail::ComputeIntegrals(
-      {t, parameter_variable_, num_knots_, hollow_, has_fill_, rigid_, c0_}, n(), false, &in);
+      {t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, rigid_, c0_}, n(),
+      false, &in);
   if (!(in.p[0] > 0.0)) return kNaN;
   const double v = FunctionOf<double>(f.function, in.p.data());
   return std::isfinite(v) ? v : kNaN;
@@ -422,7 +429,7 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
   const std::vector<double> t = ParametersAt(x);
   design_detail::Integrals in;
   const design_detail::IntegralContext context{
-      t, parameter_variable_, num_knots_, hollow_, has_fill_, rigid_, c0_};
+      t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, rigid_, c0_};
   design_detail::ComputeIntegrals(context, n(), with_gradients, &in);
   if (!(in.p[0] > 0.0) || !std::isfinite(in.p[1]) || !std::isfinite(in.p[2])) return false;
   const double* p = in.p.data();
@@ -439,7 +446,9 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
       for (const auto& [idx, k] : f.terms) {
         v += k * t[static_cast<std::size_t>(idx)];
         const int j = parameter_variable_[static_cast<std::size_t>(idx)];
-        if (gradient_row != nullptr && j >= 0) gradient_row[j * stride] += k;
+        if (gradient_row != nullptr && j >= 0) {
+          gradient_row[j * stride] += k * parameter_scale_[static_cast<std::size_t>(idx)];
+        }
       }
       *value = v;
       return std::isfinite(v);
@@ -498,7 +507,7 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   const std::vector<double> t = ParametersAt(x);
   design_detail::Integrals in;
   const design_detail::IntegralContext context{
-      t, parameter_variable_, num_knots_, hollow_, has_fill_, rigid_, c0_};
+      t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, rigid_, c0_};
   design_detail::ComputeIntegrals(context, n(), true, &in);
   if (!(in.p[0] > 0.0)) return false;
   Eigen::Matrix4d big_w = Eigen::Matrix4d::Zero();

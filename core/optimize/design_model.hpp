@@ -6,7 +6,9 @@
 // segment's length, so the map from (L, r1, r2, x1, x2) to the mass properties is smooth
 // everywhere, including x1 = 0, x2 = L and x1 = x2 where ThreeSegmentShape::Knots() merges
 // knots), then density, wall, fill diameter, depth and density (DesignParameterLayout order).
-// Each variable sets one or two of these parameters.
+// Each variable sets one or more of these parameters, each parameter = its coefficient times
+// the variable (1; a scale variable's field: the field's base value), so every derivative
+// chained from parameters to variables carries the coefficient (a Hessian term: both).
 //
 // Mass integrals: P = (M, S1, S2, L) with S1, S2 the first and second moments about a fixed
 // reference point c0 (the base design's balance point; S2 includes the cross-sections' own
@@ -75,9 +77,14 @@ struct DesignVariableSpec {
   DesignVariableRef ref;        ///< Parsed path.
   double lower = 0.0;           ///< Bound, field unit.
   double upper = 0.0;           ///< Bound, field unit.
-  double base = 0.0;            ///< The base design's value (not clamped).
+  double base = 0.0;            ///< The base design's value (not clamped); 1 for a scale.
   std::vector<int> parameters;  ///< Parameter indices it sets (its own and the linked fields').
   std::vector<std::string> linked_paths;  ///< The fields set to the same value.
+  /// A scale variable (path is its name, ref unused): the fields it scales, and their base
+  /// design's values (each field = its base value times the variable).
+  bool scale = false;
+  std::vector<std::string> scale_paths;  ///< The scaled fields (scale only).
+  std::vector<double> scale_bases;       ///< Their base values, field unit (scale only).
 };
 
 /// Values (and gradients) of the objective and constraints at a point, in user units.
@@ -211,6 +218,9 @@ class DesignModel {
   std::optional<ThreeSegmentShape> base_shape_;  // three-segment designs
   std::vector<double> base_parameters_;          // DesignParameterLayout order
   std::vector<int> parameter_variable_;          // parameter -> variable index or -1
+  // parameter -> d parameter / d its variable: 1, or a scaled field's base value (the
+  // parameter is parameter_scale_[idx] * x[parameter_variable_[idx]]).
+  std::vector<double> parameter_scale_;
   int num_knots_ = 0;
   bool hollow_ = false;
   bool has_fill_ = false;

@@ -112,6 +112,7 @@ void ModelBuilder::Parameters() {
   }
   lay = DesignParameterLayout{model.num_knots_};
   model.parameter_variable_.assign(static_cast<std::size_t>(lay.Size()), -1);
+  model.parameter_scale_.assign(static_cast<std::size_t>(lay.Size()), 1.0);
 }
 
 // The parameters a variable moves, with the flags the rules need.
@@ -122,14 +123,14 @@ std::vector<int> ModelBuilder::ParametersOf(const DesignVariableRef& ref) {
   return DesignParametersOf(ref, lay);
 }
 
-// Variable i checked against the design (refused with the reason in *why).
-bool ModelBuilder::CheckVariable(std::size_t i, const DesignVariable& v,
-                                 const std::optional<DesignVariableRef>& ref,
-                                 std::set<std::string>* seen) {
-  const std::string field = IndexedField("variables", i, "");
-  // "variables[i].path = <path>: rule".
+// The field `path` (named `field` in a refusal) checked against the design: a variable path
+// that applies to it, not named before.
+bool ModelBuilder::CheckVariablePath(const std::string& field, const std::string& path,
+                                     const std::optional<DesignVariableRef>& ref,
+                                     std::set<std::string>* seen) {
+  // "<field> = <path>: rule".
   auto refuse_path = [&](const std::string& rule) {
-    return Refuse(why, QuotedRefusal(field + "path", v.path, rule));
+    return Refuse(why, QuotedRefusal(field, path, rule));
   };
   if (!ref.has_value()) {
     return refuse_path(
@@ -140,7 +141,7 @@ bool ModelBuilder::CheckVariable(std::size_t i, const DesignVariable& v,
         "material.density_kg_m3, wall_thickness_m, fill.diameter_m, "
         "fill.depth_m, fill.material.density_kg_m3)");
   }
-  if (!seen->insert(v.path).second) return refuse_path("appears more than once");
+  if (!seen->insert(path).second) return refuse_path("appears more than once");
   if (IsProfileKind(ref->kind) && problem.three_segment.has_value()) {
     return refuse_path("the design is a three_segment shape (use three_segment.*)");
   }
@@ -156,6 +157,12 @@ bool ModelBuilder::CheckVariable(std::size_t i, const DesignVariable& v,
   if (IsFillKind(ref->kind) && !base.fill.has_value()) {
     return refuse_path("the bat has no fill");
   }
+  return true;
+}
+
+// Variable i's bounds: finite, ordered, within kMaxDesignBound.
+bool ModelBuilder::CheckBounds(std::size_t i, const DesignVariable& v) {
+  const std::string field = IndexedField("variables", i, "");
   if (!std::isfinite(v.min)) {
     return Refuse(why, field + "min", v.min,
                   "must be finite (an optimisation needs bounded variables)");
@@ -172,6 +179,15 @@ bool ModelBuilder::CheckVariable(std::size_t i, const DesignVariable& v,
     return Refuse(why, field + "max", v.max,
                   "must be greater than " + field + "min = " + Num(v.min));
   }
+  return true;
+}
+
+// Variable i checked against the design (refused with the reason in *why).
+bool ModelBuilder::CheckVariable(std::size_t i, const DesignVariable& v,
+                                 const std::optional<DesignVariableRef>& ref,
+                                 std::set<std::string>* seen) {
+  const std::string field = IndexedField("variables", i, "");
+  if (!CheckVariablePath(field + "path", v.path, ref, seen) || !CheckBounds(i, v)) return false;
   if (NeedsPositive(ref->kind) && !(v.min > 0.0)) {
     return Refuse(why, field + "min", v.min,
                   "must be positive for " + v.path +
@@ -185,9 +201,78 @@ bool ModelBuilder::CheckVariable(std::size_t i, const DesignVariable& v,
   return true;
 }
 
+// Scale variable i: its name, bounds and fields checked, then added with its parameters, each
+// parameter's coefficient the field's base value.
+bool ModelBuilder::AddScaleVariable(std::size_t i, std::set<std::string>* seen) {
+  const DesignVariable& v = problem.variables[i];
+  const std::string field = IndexedField("variables", i, "");
+  if (!v.linked_paths.empty()) {
+    return Refuse(why, TextRefusal(field + "linked_paths",
+                                   "a scale variable (scale_paths) has no linked paths: give "
+                                   "paths or scale_paths, not both"));
+  }
+  if (v.path.empty() || ParseDesignVariablePath(v.path).has_value()) {
+    return Refuse(why, QuotedRefusal(field + "path", v.path,
+                                     "a scale variable's name must be given and must not be a "
+                                     "variable path (its fields are in scale_paths)"));
+  }
+  if (!seen->insert(v.path).second) {
+    return Refuse(why, QuotedRefusal(field + "path", v.path, "appears more than once"));
+  }
+  if (!CheckBounds(i, v)) return false;
+  DesignVariableSpec spec;
+  spec.path = v.path;
+  spec.scale = true;
+  spec.lower = v.min;
+  spec.upper = v.max;
+  spec.base = 1.0;  // the base design
+  const auto j = static_cast<int>(model.variables_.size());
+  for (std::size_t k = 0; k < v.scale_paths.size(); ++k) {
+    const std::string& path = v.scale_paths[k];
+    const std::string path_field = field + "scale_paths[" + std::to_string(k) + "]";
+    const std::optional<DesignVariableRef> ref = ParseDesignVariablePath(path);
+    if (!CheckVariablePath(path_field, path, ref, seen)) return false;
+    const std::vector<int> parameters = ParametersOf(*ref);
+    const double base_value = Param(parameters.front());
+    if (base_value == 0.0) {
+      return Refuse(why, QuotedRefusal(path_field, path,
+                                       "is 0 in the base design, so scaling it keeps it 0 "
+                                       "(give it as a path of its own)"));
+    }
+    // The field's own rules over the range the scale gives it.
+    const double lo = std::min(v.min * base_value, v.max * base_value);
+    const double hi = std::max(v.min * base_value, v.max * base_value);
+    const bool positive = NeedsPositive(ref->kind);
+    if (positive ? !(lo > 0.0) : lo < 0.0) {
+      const bool by_min = lo == v.min * base_value;
+      return Refuse(why, field + (by_min ? "min" : "max"), by_min ? v.min : v.max,
+                    "gives " + path + " = " + Num(lo) + " (" + Num(base_value) +
+                        " in the base design), which must be " +
+                        (positive ? "positive" : "non-negative"));
+    }
+    if (!(hi <= kMaxDesignBound)) {
+      return Refuse(why, field + "max", v.max,
+                    "gives " + path + " = " + Num(hi) + ", over " + Num(kMaxDesignBound));
+    }
+    for (int idx : parameters) {
+      spec.parameters.push_back(idx);
+      model.parameter_variable_[static_cast<std::size_t>(idx)] = j;
+      model.parameter_scale_[static_cast<std::size_t>(idx)] = Param(idx);
+    }
+    spec.scale_paths.push_back(path);
+    spec.scale_bases.push_back(base_value);
+  }
+  if (spec.scale_paths.empty()) {
+    return Refuse(why, TextRefusal(field + "scale_paths", "must name at least one field"));
+  }
+  model.variables_.push_back(spec);
+  return true;
+}
+
 // Variable i: checked, then added with its parameters.
 bool ModelBuilder::AddVariable(std::size_t i, std::set<std::string>* seen) {
   const DesignVariable& v = problem.variables[i];
+  if (!v.scale_paths.empty()) return AddScaleVariable(i, seen);
   const std::optional<DesignVariableRef> ref = ParseDesignVariablePath(v.path);
   if (!CheckVariable(i, v, ref, seen)) return false;
   DesignVariableSpec spec;
@@ -305,8 +390,7 @@ bool ModelBuilder::SceneNumbers() {
   if (!(std::isfinite(model.c0_) && base_properties.MoiSixInchKgM2() > 0.0)) {
     return Refuse(why, TextRefusal("bat", "its mass properties are not finite"));
   }
-  model.i6_ref_ =
-      problem.swing_weight_reference_kg_m2.value_or(base_properties.MoiSixInchKgM2());
+  model.i6_ref_ = problem.swing_weight_reference_kg_m2.value_or(base_properties.MoiSixInchKgM2());
 
   return true;
 }

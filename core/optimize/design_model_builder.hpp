@@ -106,11 +106,23 @@ struct ModelBuilder {
   void Parameters();
   // The parameters a variable moves, with the flags the rules need.
   std::vector<int> ParametersOf(const DesignVariableRef& ref);
+  // The field `path` (named `field` in a refusal) checked against the design: a variable path
+  // that applies to it, not named before.
+  bool CheckVariablePath(const std::string& field, const std::string& path,
+                         const std::optional<DesignVariableRef>& ref, std::set<std::string>* seen);
+  // Variable i's bounds: finite, ordered, within kMaxDesignBound.
+  bool CheckBounds(std::size_t i, const DesignVariable& v);
   // Variable i checked against the design (refused with the reason in *why).
   bool CheckVariable(std::size_t i, const DesignVariable& v,
                      const std::optional<DesignVariableRef>& ref, std::set<std::string>* seen);
+  // Scale variable i: its name, bounds and fields checked, then added with its parameters,
+  // each parameter's coefficient the field's base value.
+  bool AddScaleVariable(std::size_t i, std::set<std::string>* seen);
   // Variable i: checked, then added with its parameters.
   bool AddVariable(std::size_t i, std::set<std::string>* seen);
+  // The least and largest value parameter `idx` can take within the variables' bounds.
+  double ParamLower(int idx) const;
+  double ParamUpper(int idx) const;
   // Every variable.
   bool Variables();
   // Rules: the discrete limits.

@@ -22,6 +22,28 @@ bool ModelBuilder::Depends(const std::vector<std::pair<int, double>>& terms) con
   return false;
 }
 
+// The least value parameter `idx` can take within the variables' bounds (its coefficient times
+// a bound of its variable: a scaled field's base value is not 0, and the bounds' order is kept
+// or swapped by its sign).
+double ModelBuilder::ParamLower(int idx) const {
+  const auto i = static_cast<std::size_t>(idx);
+  const int j = model.parameter_variable_[i];
+  if (j < 0) return Param(idx);
+  const DesignVariableSpec& v = model.variables_[static_cast<std::size_t>(j)];
+  const double k = model.parameter_scale_[i];
+  return std::min(k * v.lower, k * v.upper);
+}
+
+// The largest value parameter `idx` can take within the variables' bounds.
+double ModelBuilder::ParamUpper(int idx) const {
+  const auto i = static_cast<std::size_t>(idx);
+  const int j = model.parameter_variable_[i];
+  if (j < 0) return Param(idx);
+  const DesignVariableSpec& v = model.variables_[static_cast<std::size_t>(j)];
+  const double k = model.parameter_scale_[i];
+  return std::max(k * v.lower, k * v.upper);
+}
+
 // The linear function's value at the base design.
 double ModelBuilder::LinearValue(const std::vector<std::pair<int, double>>& terms,
                                  double constant) const {
@@ -256,16 +278,8 @@ bool ModelBuilder::HandleRegionKnots(std::vector<std::size_t>* out) {
                   "must be greater than constraints.handle_region_from_knob_m[0] = " + Num(from));
   }
   // The least and largest position a knot can take within the variables' bounds.
-  auto lower_of = [&](int k) {
-    const int idx = lay.KnotPosition(k);
-    const int j = model.parameter_variable_[static_cast<std::size_t>(idx)];
-    return j >= 0 ? model.variables_[static_cast<std::size_t>(j)].lower : Param(idx);
-  };
-  auto upper_of = [&](int k) {
-    const int idx = lay.KnotPosition(k);
-    const int j = model.parameter_variable_[static_cast<std::size_t>(idx)];
-    return j >= 0 ? model.variables_[static_cast<std::size_t>(j)].upper : Param(idx);
-  };
+  auto lower_of = [&](int k) { return ParamLower(lay.KnotPosition(k)); };
+  auto upper_of = [&](int k) { return ParamUpper(lay.KnotPosition(k)); };
   const int last = model.num_knots_ - 1;
   if (problem.three_segment.has_value()) {
     // r1 sets the radius on [0, x2) (the handle and the taper), r2 on (x1, L].
@@ -476,14 +490,8 @@ void ModelBuilder::FillValidityConstraints(double keep) {
   // so its least radius over [L - d, L] is at a knot inside or at the bore's bottom, which
   // lies on the segment of the last knot at or before it: constrain every knot that can be
   // at or after the knot before the bottom (conservative when positions or depth vary).
-  auto upper_of = [&](int idx) {
-    const int j = model.parameter_variable_[static_cast<std::size_t>(idx)];
-    return j >= 0 ? model.variables_[static_cast<std::size_t>(j)].upper : Param(idx);
-  };
-  auto lower_of = [&](int idx) {
-    const int j = model.parameter_variable_[static_cast<std::size_t>(idx)];
-    return j >= 0 ? model.variables_[static_cast<std::size_t>(j)].lower : Param(idx);
-  };
+  auto upper_of = [&](int idx) { return ParamUpper(idx); };
+  auto lower_of = [&](int idx) { return ParamLower(idx); };
   const double bottom_min = lower_of(last) - upper_of(lay.FillDepth());
   int first = model.num_knots_ - 1;
   while (first > 0 && upper_of(lay.KnotPosition(first)) >= bottom_min) --first;

@@ -67,14 +67,25 @@ std::optional<DesignVariableRef> ParseDesignVariablePath(std::string_view path);
 /// The path of `ref` (inverse of ParseDesignVariablePath).
 std::string DesignVariablePath(const DesignVariableRef& ref);
 
-/// A field the optimiser may change, with its bounds in the field's unit.
+/// A field the optimiser may change, with its bounds in the field's unit; or a scale variable:
+/// a dimensionless factor s that sets several fields to the base design's value times s.
 struct DesignVariable {
-  std::string path;  ///< The field (see DesignVariableKind), e.g. "three_segment.taper_start_m".
-  double min = 0.0;  ///< Lower bound, field unit, in [-kMaxDesignBound, kMaxDesignBound].
-  double max = 0.0;  ///< Upper bound, field unit, in (min, kMaxDesignBound].
+  /// The field (see DesignVariableKind), e.g. "three_segment.taper_start_m"; for a scale
+  /// variable its name (not a variable path: the answer lists it beside its fields).
+  std::string path;
+  /// Lower bound, field unit (a scale variable: dimensionless), in
+  /// [-kMaxDesignBound, kMaxDesignBound].
+  double min = 0.0;
+  double max = 0.0;  ///< Upper bound, same unit, in (min, kMaxDesignBound].
   /// Further fields set to the same value (a request's "paths": one barrel diameter is two
   /// knots' radii), each a variable path of the same design, none repeated.
   std::vector<std::string> linked_paths = {};
+  /// When not empty, a scale variable (a request's "scale_paths"): each of these fields is the
+  /// base design's value times the variable's value (the base design is the value 1). Each a
+  /// variable path of the same design, none repeated, none 0 in the base design; every field
+  /// obeys its own rules over [min, max] times its base value (a radius stays positive).
+  /// linked_paths must then be empty.
+  std::vector<std::string> scale_paths = {};
 };
 
 /// A constraint's allowed values: equality when min == max; either side may be open.
@@ -270,10 +281,14 @@ struct DesignOptions {
 /// where the FE mesh changes, so a tighter one only spends evaluations on the model's own error.
 inline constexpr double kDerivativeFreeTolerance = 1e-6;
 
-/// A variable's value in the answer.
+/// A variable's value in the answer. DesignResult::variables lists the variables in request
+/// order, each followed by its linked fields (the same value) or, for a scale variable, by its
+/// fields (each its base value times the factor).
 struct DesignValue {
-  std::string path;    ///< The variable's path.
-  double value = 0.0;  ///< Its value, field unit.
+  std::string path;    ///< The variable's path (a scale variable: its name).
+  double value = 0.0;  ///< Its value, field unit (a scale variable: the dimensionless factor).
+  /// True for a scale variable's own value (a factor, not a field of the bat).
+  bool scale_factor = false;
 };
 
 /// A constraint or variable bound that holds the design back.
@@ -363,7 +378,7 @@ struct DesignResult {
   Summary summary;                                 ///< How it went (see above).
   Bat bat;                                         ///< The optimised bat.
   std::optional<ThreeSegmentShape> three_segment;  ///< Its shape, for three-segment designs.
-  std::vector<DesignValue> variables;              ///< The variables' values, in request order.
+  std::vector<DesignValue> variables;              ///< The variables' values (see DesignValue).
   MassProperties properties;                       ///< Its mass properties (problem.inertia_model).
   double objective_value = 0.0;                    ///< The objective, in objective_unit.
   std::string objective_unit;                      ///< "mps", "m", "kg_m2" or "j" (joules).

@@ -243,7 +243,7 @@ void ReportActiveConstraints(const DesignModel& model, const std::vector<double>
       const DesignVariableSpec& v = model.variables()[jj];
       const double width = v.upper - v.lower;
       DesignActiveConstraint a;
-      a.unit = v.path.ends_with("kg_m3") ? "kg_m3" : "m";
+      a.unit = v.scale ? "" : v.path.ends_with("kg_m3") ? "kg_m3" : "m";  // a scale: a factor
       a.value = x[jj];
       if (s[jj] <= kActiveRelative) {
         a.name = v.path + ".min";

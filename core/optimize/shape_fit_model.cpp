@@ -260,7 +260,8 @@ ShapeFitModel::ShapeFitModel(const ShapeFitProblem& problem, const ShapeFitOptio
     : base_(StartParameters(problem)),
       hollow_(HollowOf(problem)),
       has_fill_(problem.fill.has_value()),
-      parameter_variable_(static_cast<std::size_t>(kNumFitParameters), -1) {
+      parameter_variable_(static_cast<std::size_t>(kNumFitParameters), -1),
+      parameter_scale_(static_cast<std::size_t>(kNumFitParameters), 1.0) {
   for (const FitUnknown& u : problem.unknowns) {
     for (int p : ParametersOf(u.variable)) {
       parameter_variable_[static_cast<std::size_t>(p)] = static_cast<int>(variables_.size());
@@ -322,7 +323,7 @@ void ShapeFitModel::Residuals(const double* s, Eigen::VectorXd* r, Eigen::Matrix
   design_detail::Integrals in;
   // S1 about the knob (c0 = 0): C = S1 / M. S2 is not used (rigid = false skips the disks).
   const design_detail::IntegralContext context{
-      t, parameter_variable_, 4, hollow_, has_fill_, false, 0.0};
+      t, parameter_variable_, parameter_scale_, 4, hollow_, has_fill_, false, 0.0};
   design_detail::ComputeIntegrals(context, n(), jacobian != nullptr, &in);
   const double mass = in.p[0];
   const double balance = in.p[1] / mass;

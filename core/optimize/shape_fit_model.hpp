@@ -102,6 +102,7 @@ class ShapeFitModel {
   bool has_fill_ = false;
   std::vector<std::vector<int>> variables_;  // per unknown: the parameters it sets
   std::vector<int> parameter_variable_;      // parameter -> unknown index, or -1
+  std::vector<double> parameter_scale_;      // d parameter / d its unknown: all 1 here
   std::vector<double> lo_, hi_;
   std::vector<double> targets_, scales_;
   std::vector<int> kinds_;  // 0 = mass, 1 = balance point

@@ -461,7 +461,7 @@ TEST(OptimizeEndpointTest, LinkedPathsSetEveryFieldToTheVariablesValue) {
   ASSERT_EQ(p.status, 200);
   EXPECT_GE(p.body["mass_kg"].get<double>(), 0.85 - 1e-8);
   EXPECT_LE(p.body["mass_kg"].get<double>(), 0.95 + 1e-8);
-  // scale_paths is explore's; path with paths is ambiguous: 400s naming the field.
+  // Exactly one of path, paths and scale_paths: a second form is a 400 naming it.
   body["variables"][0]["scale_paths"] = {"profile.knots[2].radius_m"};
   Response bad = Post("/v1/optimize", body);
   EXPECT_EQ(bad.status, 400);
@@ -471,6 +471,112 @@ TEST(OptimizeEndpointTest, LinkedPathsSetEveryFieldToTheVariablesValue) {
   bad = Post("/v1/optimize", body);
   EXPECT_EQ(bad.status, 400);
   EXPECT_EQ(bad.body["field"], "variables[0].paths");
+}
+
+// Issue 19: a scale variable ("scale_paths") sets each field to the base design's value times
+// its value; the answer lists the factor under its name (default "scale:" and the paths joined
+// with "+"), then each field, and the bat comes back with the fields set (not the name).
+TEST(OptimizeEndpointTest, ScalePathsSetEachFieldToItsBaseValueTimesTheFactor) {
+  Json body = Json::parse(R"({
+    "bat": {"profile": {"knots": [{"x_m": 0.0, "radius_m": 0.0125}, {"x_m": 0.3, "radius_m": 0.0125},
+            {"x_m": 0.6, "radius_m": 0.032}, {"x_m": 0.8636, "radius_m": 0.031}]}, "material": "ash"},
+    "variables": [{"scale_paths": ["profile.knots[2].radius_m", "profile.knots[3].radius_m"],
+                   "min": 0.9, "max": 1.05}],
+    "constraints": {"mass_kg": {"min": 0.85, "max": 0.95}},
+    "objective": "max_exit_speed", "cor": 0.5})");
+  const Response r = Post("/v1/optimize", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["summary"]["termination"], "converged") << r.body.dump();
+  const std::string name = "scale:profile.knots[2].radius_m+profile.knots[3].radius_m";
+  ASSERT_TRUE(r.body["variables"].contains(name)) << r.body["variables"].dump();
+  const double s = r.body["variables"][name].get<double>();
+  EXPECT_GE(s, 0.9);
+  EXPECT_LE(s, 1.05);
+  // Each field is its base value times the factor, exactly (one product; JSON numbers
+  // round-trip), and the bat carries it.
+  EXPECT_EQ(r.body["variables"]["profile.knots[2].radius_m"].get<double>(), 0.032 * s);
+  EXPECT_EQ(r.body["variables"]["profile.knots[3].radius_m"].get<double>(), 0.031 * s);
+  EXPECT_EQ(r.body["bat"]["profile"]["knots"][2]["radius_m"].get<double>(), 0.032 * s);
+  EXPECT_EQ(r.body["bat"]["profile"]["knots"][3]["radius_m"].get<double>(), 0.031 * s);
+  EXPECT_EQ(r.body["bat"]["profile"]["knots"][1]["radius_m"].get<double>(), 0.0125);
+  // The returned bat is a bat (no name written into it) and meets the mass range to Ipopt's
+  // tolerance (1e-8 kg).
+  const Response p = Post("/v1/bat/properties", Json{{"bat", r.body["bat"]}});
+  ASSERT_EQ(p.status, 200) << p.body.dump();
+  EXPECT_GE(p.body["mass_kg"].get<double>(), 0.85 - 1e-8);
+  EXPECT_LE(p.body["mass_kg"].get<double>(), 0.95 + 1e-8);
+  // A name of the request's choosing.
+  body["variables"][0]["name"] = "barrel";
+  const Response named = Post("/v1/optimize", body);
+  ASSERT_EQ(named.status, 200) << named.body.dump();
+  EXPECT_EQ(named.body["variables"]["barrel"].get<double>(), s);  // same problem, same answer
+  EXPECT_FALSE(named.body["variables"].contains(name));
+}
+
+// The scale variable's refusals name the request's field.
+TEST(OptimizeEndpointTest, ScalePathsRefusalsNameTheField) {
+  const Json good = Json::parse(R"({
+    "bat": {"profile": {"knots": [{"x_m": 0.0, "radius_m": 0.0125}, {"x_m": 0.3, "radius_m": 0.0125},
+            {"x_m": 0.6, "radius_m": 0.032}, {"x_m": 0.8636, "radius_m": 0.031}]}, "material": "ash"},
+    "variables": [{"scale_paths": ["profile.knots[2].radius_m", "profile.knots[3].radius_m"],
+                   "min": 0.9, "max": 1.05}],
+    "objective": "max_exit_speed", "cor": 0.5})");
+  struct Case {
+    const char* what;
+    void (*edit)(Json&);
+    const char* field;
+    const char* message_part;
+  };
+  const Case cases[] = {
+      {"path and scale_paths",
+       [](Json& b) { b["variables"][0]["path"] = "profile.knots[1].radius_m"; },
+       "variables[0].scale_paths", "give exactly one of path, paths"},
+      {"no form", [](Json& b) { b["variables"][0].erase("scale_paths"); }, "variables[0].path",
+       "give exactly one of path, paths"},
+      {"not a path", [](Json& b) { b["variables"][0]["scale_paths"][1] = "profile.colour"; },
+       "variables[0].scale_paths[1]", "is not a design variable path"},
+      {"empty", [](Json& b) { b["variables"][0]["scale_paths"] = Json::array(); },
+       "variables[0].scale_paths", "must be an array of 1 to 32"},
+      {"a zero base value",
+       [](Json& b) { b["variables"][0]["scale_paths"][1] = "wall_thickness_m"; },
+       "variables[0].scale_paths[1]", "is 0 in the base design"},
+      {"a radius below 0", [](Json& b) { b["variables"][0]["min"] = -1.0; }, "variables[0].min",
+       "which must be positive"},
+      {"a name that is a path",
+       [](Json& b) { b["variables"][0]["name"] = "profile.knots[1].radius_m"; },
+       "variables[0].name", "not a design variable path"},
+      {"a name without scale_paths",
+       [](Json& b) {
+         b["variables"][0] = {
+             {"path", "profile.knots[2].radius_m"}, {"min", 0.03}, {"max", 0.033}, {"name", "x"}};
+       },
+       "variables[0].name", "scale_paths only"},
+      {"the same name twice",
+       [](Json& b) {
+         b["variables"].push_back({{"scale_paths", {"profile.knots[1].radius_m"}},
+                                   {"name", "s"},
+                                   {"min", 0.9},
+                                   {"max", 1.1}});
+         b["variables"][0]["name"] = "s";
+       },
+       "variables[1].name", "already given"},
+      {"a field set twice",
+       [](Json& b) {
+         b["variables"].push_back(
+             {{"path", "profile.knots[3].radius_m"}, {"min", 0.03}, {"max", 0.033}});
+       },
+       "variables[1].path", "appears more than once"},
+  };
+  ASSERT_EQ(Post("/v1/optimize", good).status, 200);
+  for (const Case& c : cases) {
+    Json body = good;
+    c.edit(body);
+    const Response r = Post("/v1/optimize", body);
+    EXPECT_EQ(r.status, 400) << c.what << ": " << r.body.dump();
+    EXPECT_EQ(r.body["field"], c.field) << c.what << ": " << r.body.dump();
+    EXPECT_NE(r.body["message"].get<std::string>().find(c.message_part), std::string::npos)
+        << c.what << ": " << r.body.dump();
+  }
 }
 
 }  // namespace

@@ -197,6 +197,81 @@ TEST(OptimizeModel, LinkedFieldsTakeTheVariablesValue) {
   EXPECT_NE(why.Message().find("appears more than once"), std::string::npos) << why.Message();
 }
 
+// A scale variable ("scale_paths") over every radius of a solid wooden bat, with the mass
+// fixed: the mass of a solid bat is the base mass times s^2 exactly (every cross-section's area
+// scales by s^2), so the only feasible factor is s = sqrt(M / M0), whatever the objective. The
+// answer lists the factor under its name, then each field = its base value times the factor,
+// exactly (the product the model's parameters hold), and the bat has those radii.
+TEST(OptimizeModel, ScaledFieldsAreTheBaseValueTimesTheFactor) {
+  DesignProblem p;
+  p.bat = FindPreset("wood-34-ash")->bat;
+  const double base_mass_kg = ComputeMassProperties(p.bat).mass_kg;
+  DesignVariable scale{"all_radii", 0.8, 1.2};
+  for (std::size_t k = 0; k < p.bat.knots.size(); ++k) {
+    scale.scale_paths.push_back("profile.knots[" + std::to_string(k) + "].radius_m");
+  }
+  p.variables = {scale};
+  p.constraints.mass_kg = DesignRange::Equal(0.85);
+  p.objective = DesignObjective::kMaxExitSpeed;
+  const DesignResult r = OptimizeDesign(p, DesignOptions{});
+  ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.FullReport();
+  ASSERT_EQ(r.variables.size(), p.bat.knots.size() + 1);
+  EXPECT_EQ(r.variables[0].path, "all_radii");
+  EXPECT_TRUE(r.variables[0].scale_factor);
+  const double s = r.variables[0].value;
+  // Ipopt holds the mass to constr_viol_tol = 1e-10 of its scale (0.85 kg), so |dM| <= 1e-10
+  // kg and |ds| = s |dM| / (2 M) <= 6e-11; 1e-9 leaves room for the integrals' rounding.
+  EXPECT_NEAR(s, std::sqrt(0.85 / base_mass_kg), 1e-9);
+  EXPECT_NEAR(r.properties.mass_kg, 0.85, 1e-9);  // the re-checked mass, same budget
+  for (std::size_t k = 0; k < p.bat.knots.size(); ++k) {
+    const DesignValue& v = r.variables[k + 1];
+    EXPECT_EQ(v.path, scale.scale_paths[k]);
+    EXPECT_FALSE(v.scale_factor);
+    EXPECT_EQ(v.value, p.bat.knots[k].radius_m * s) << v.path;  // exactly: one product
+    EXPECT_EQ(r.bat.knots[k].radius_m, v.value) << v.path;
+    EXPECT_EQ(r.bat.knots[k].x_m, p.bat.knots[k].x_m);  // positions untouched
+  }
+}
+
+// A scale variable is checked as its fields would be: each field's rules over [min, max] times
+// its base value, a field that is 0 in the base design, its name, and its fields' uniqueness.
+TEST(OptimizeModel, ScaleVariablesAreCheckedPerField) {
+  DesignProblem p;
+  p.bat = FindPreset("wood-34-ash")->bat;
+  p.variables = {
+      {"handle", 0.9, 1.1, {}, {"profile.knots[4].radius_m", "profile.knots[5].radius_m"}}};
+  Refusal why;
+  ASSERT_TRUE(p.Validate(&why)) << why.Message();
+  // A radius must stay positive: min = -0.1 gives knot 4 a negative radius.
+  p.variables[0].min = -0.1;
+  ASSERT_FALSE(p.Validate(&why));
+  EXPECT_EQ(why.field, "variables[0].min");
+  EXPECT_NE(why.Message().find("gives profile.knots[4].radius_m = "), std::string::npos)
+      << why.Message();
+  EXPECT_NE(why.Message().find("must be positive"), std::string::npos) << why.Message();
+  p.variables[0].min = 0.9;
+  // The wall of a solid bat is 0: a factor cannot move it.
+  p.variables[0].scale_paths.push_back("wall_thickness_m");
+  ASSERT_FALSE(p.Validate(&why));
+  EXPECT_EQ(why.field, "variables[0].scale_paths[2]");
+  EXPECT_NE(why.Message().find("is 0 in the base design"), std::string::npos) << why.Message();
+  p.variables[0].scale_paths.pop_back();
+  // A field set by two variables.
+  p.variables.push_back({"profile.knots[5].radius_m", 0.01, 0.02});
+  ASSERT_FALSE(p.Validate(&why));
+  EXPECT_EQ(why.field, "variables[1].path");
+  EXPECT_NE(why.Message().find("appears more than once"), std::string::npos) << why.Message();
+  p.variables.pop_back();
+  // The name is not a field, and a scale variable links nothing.
+  p.variables[0].path = "profile.knots[6].radius_m";
+  ASSERT_FALSE(p.Validate(&why));
+  EXPECT_EQ(why.field, "variables[0].path");
+  p.variables[0].path = "handle";
+  p.variables[0].linked_paths = {"profile.knots[6].radius_m"};
+  ASSERT_FALSE(p.Validate(&why));
+  EXPECT_EQ(why.field, "variables[0].linked_paths");
+}
+
 // Three-segment designs through x1 = 0 and x1 = x2, where ThreeSegmentShape::Knots() merges
 // knots: the model keeps 4 knots (coincident allowed), so it is smooth there, and equals the
 // merged bat's properties (the step of width 1e-12 L changes them by < 1e-12 relative).
@@ -285,14 +360,36 @@ TEST(OptimizeModel, GradientsMatchComputeMassPropertiesWithGradient) {
 TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
   std::mt19937_64 rng(11);
   for (DesignObjective objective : kObjectives) {
-    for (int variant = 0; variant < 5; ++variant) {
+    for (int variant = 0; variant < 7; ++variant) {
       // Both problems with both exit-speed models: rigid_pivot, then free_bat; then the
-      // profile with a linked variable (two knots' radii set to one value).
+      // profile with a linked variable (two knots' radii set to one value); then a scale
+      // variable ("scale_paths") in each problem.
       DesignProblem p =
           variant % 2 == 0 ? HollowFilledProfile(objective) : FilledThreeSegment(objective);
       p.model = variant == 2 || variant == 3 ? CollisionModel::kFreeBat
                                              : CollisionModel::kRigidPivot;
       if (variant == 4) p.variables[1].linked_paths = {"profile.knots[11].radius_m"};
+      if (variant == 6) {
+        // Two knots' radii (coefficients ~0.033 m) and a knot's position (~0.83 m) by one
+        // factor: the chain rule's coefficients differ by 25x, so a missing one shows.
+        p.variables.push_back({"barrel",
+                               0.95,
+                               1.003,
+                               {},
+                               {"profile.knots[11].radius_m", "profile.knots[12].radius_m",
+                                "profile.knots[11].x_m"}});
+      }
+      if (variant == 5) {
+        // The length (the integrals' L row), a radius that is two parameters (knots 0 and 1)
+        // and the fill's diameter (the fill's own factor 0.5 as well) by one factor.
+        p.variables[0] = {
+            "length_handle_bore",
+            0.97,
+            1.03,
+            {},
+            {"three_segment.length_m", "three_segment.handle_radius_m", "fill.diameter_m"}};
+        p.variables.erase(p.variables.begin() + 1);  // three_segment.handle_radius_m
+      }
       const DesignModel model = Build(p);
       ASSERT_GT(model.m(), 3);
       for (int trial = 0; trial < 3; ++trial) {
