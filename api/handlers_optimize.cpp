@@ -447,14 +447,8 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
   problem.three_segment = spec->three_segment;
   core::Scene scene;
   if (!ReadSceneCommon(reader, &scene)) return std::nullopt;
-  if (scene.swing.bat_speed_mps.has_value()) {
-    // Refused, not resolved: each design has its own length (core's CheckScene says the same).
-    ObjectReader swing(*reader.Get("swing"), reader.PathOf("swing"), error);
-    swing.Fail("bat_speed_mps",
-               "is not accepted by /v1/optimize (the bat length, and so the angular speed a bat "
-               "speed gives, varies with the design): give swing.angular_speed_rad_s");
-    return std::nullopt;
-  }
+  // A swing by its bat speed (swing.bat_speed_mps or _mph) is core's to resolve: omega per
+  // design from the design's length (DesignModel; the answer's sweet_spot.angular_speed_rad_s).
   problem.ball = scene.ball;
   problem.swing = scene.swing;
   problem.cor = scene.cor;

@@ -104,11 +104,13 @@ PublicEvaluation EvaluatePublic(const DesignProblem& problem, const DesignModel&
   out.properties = ComputeMassProperties(bat, problem.inertia_model);
   const MassProperties& p = out.properties;
   const double length = bat.LengthM();
-  out.omega_rad_s = model.AngularSpeedFor(p.MoiSixInchKgM2());
+  out.omega_rad_s = model.AngularSpeedFor(p.MoiSixInchKgM2(), length);
   double zone_width = kNaN;
   if (cor_known) {
     Swing swing = problem.swing;
-    swing.angular_speed_rad_s = out.omega_rad_s;  // the design's own (from its swing weight)
+    // The design's own (from its swing weight, and from its length for a bat speed).
+    swing.angular_speed_rad_s = out.omega_rad_s;
+    swing.bat_speed_mps.reset();  // resolved: omega is the design's
     const ExitSpeedProfile profile =
         ClosedFormProfileFor(problem.model, p, problem.ball, swing, model.cor());
     const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(profile, length);
@@ -187,6 +189,13 @@ void FillBase(const DesignProblem& problem, DesignResult* result) {
   result->sweet_spot_from_knob_m = kNaN;
   result->max_exit_speed_mps = kNaN;
   result->angular_speed_rad_s = problem.swing.angular_speed_rad_s;
+  if (problem.swing.bat_speed_mps.has_value()) {
+    // The base design's omega when its bat speed resolves (NaN when the request cannot say).
+    Swing resolved;
+    const bool known = problem.swing.Validate(nullptr) && result->bat.Validate(nullptr) &&
+                       ResolveSwing(problem.swing, result->bat.LengthM(), &resolved, nullptr);
+    result->angular_speed_rad_s = known ? resolved.angular_speed_rad_s : kNaN;
+  }
   for (const DesignVariable& v : problem.variables) {
     result->variables.push_back({v.path, kNaN, !v.scale_paths.empty()});
   }

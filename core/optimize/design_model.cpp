@@ -297,10 +297,14 @@ T DesignModel::ObjectiveOf(const T* p) const {
   const double e = cor_;
   const double pivot = pivot_from_knob_m_;
   const T j = MoiAbout(p, c0_, pivot);
-  T omega(omega0_rad_s_);
-  if (objective_kind_ == DesignObjective::kMaxExitSpeedSwingWeight && omega0_rad_s_ > 0.0 &&
+  // A swing given by its bat speed on a bat whose length varies: omega0 is a function of L =
+  // p[3], so its derivatives (d omega0/dL = -v / (L - d - pivot)^2, and the second) come with
+  // the jet's.
+  const T omega0 = SwingAngularSpeedAt(p[3]);
+  T omega = omega0;
+  if (objective_kind_ == DesignObjective::kMaxExitSpeedSwingWeight && jet::Value(omega0) > 0.0 &&
       swing_weight_exponent_ != 0.0) {
-    omega = omega0_rad_s_ *
+    omega = omega0 *
             jet::Pow(MoiAbout(p, c0_, kSixInchPivotM) * (1.0 / i6_ref_), -swing_weight_exponent_);
   }
   // The closed forms (exit_speed_algebra.hpp, the code ExitSpeedProfile runs): x from the pivot
@@ -358,12 +362,20 @@ T DesignModel::FunctionOf(DesignFunction f, const T* p) const {
   return T(kNaN);
 }
 
-double DesignModel::AngularSpeedFor(double i6_kg_m2) const {
-  if (objective_kind_ != DesignObjective::kMaxExitSpeedSwingWeight || omega0_rad_s_ == 0.0 ||
+template <typename T>
+T DesignModel::SwingAngularSpeedAt(const T& length_m) const {
+  if (!omega_from_length_) return T(omega0_rad_s_);
+  // ResolveSwing's arithmetic, so a design's omega is the one the scenes give its bat.
+  return bat_speed_mps_ / ((length_m - bat_speed_from_tip_m_) - pivot_from_knob_m_);
+}
+
+double DesignModel::AngularSpeedFor(double i6_kg_m2, double length_m) const {
+  const double omega0 = SwingAngularSpeedAt(length_m);
+  if (objective_kind_ != DesignObjective::kMaxExitSpeedSwingWeight || omega0 == 0.0 ||
       swing_weight_exponent_ == 0.0) {
-    return omega0_rad_s_;
+    return omega0;
   }
-  return omega0_rad_s_ * std::pow(i6_kg_m2 / i6_ref_, -swing_weight_exponent_);
+  return omega0 * std::pow(i6_kg_m2 / i6_ref_, -swing_weight_exponent_);
 }
 
 std::vector<double> DesignModel::BaseX() const {
@@ -575,16 +587,25 @@ StingEvaluation EvaluateSting(const Bat& bat, const StingScene& scene, bool refi
                               ModesCache* cache) {
   StingEvaluation out;
   try {
+    // A swing given by its bat speed: omega for this bat's length (the design's own).
+    Swing swing;
+    Refusal refusal;
+    if (!ResolveSwing(scene.swing, bat.LengthM(), &swing, &refusal)) {
+      out.termination = Termination::kInvalidInput;
+      out.message = refusal.Message();
+      out.sting_j = kNaN;
+      return out;
+    }
     const MassProperties p = ComputeMassProperties(bat, scene.inertia_model);
     const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(
-        ClosedFormProfileFor(scene.model, p, scene.ball, scene.swing, scene.cor), bat.LengthM());
+        ClosedFormProfileFor(scene.model, p, scene.ball, swing, scene.cor), bat.LengthM());
     out.sweet_spot_from_knob_m = max.position_from_knob_m;
     Scene s;
     s.bat = bat;
     s.mass_properties = p;
     s.inertia_model = scene.inertia_model;
     s.ball = scene.ball;
-    s.swing = scene.swing;
+    s.swing = swing;
     s.cor = scene.cor;
     CollisionOptions options;
     options.flexible = scene.flexible;

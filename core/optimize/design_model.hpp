@@ -153,8 +153,9 @@ class DesignModel {
   std::string objective_unit() const { return objective_unit_; }      ///< Unit of F.
   double cor() const { return cor_; }                                 ///< The COR used.
   double reference_moi_six_inch_kg_m2() const { return i6_ref_; }     ///< I6_ref.
-  /// omega of the swing for a design with MOI `i6` about the 6-in point, rad/s.
-  double AngularSpeedFor(double i6_kg_m2) const;
+  /// omega of the swing for a design with MOI `i6` about the 6-in point and length `length_m`,
+  /// rad/s (the length matters for a swing given by its bat speed, omega0 = v / (L - d - p)).
+  double AngularSpeedFor(double i6_kg_m2, double length_m) const;
   /// The start: the base design clamped into the bounds.
   std::vector<double> BaseX() const;
 
@@ -197,6 +198,10 @@ class DesignModel {
 
   template <typename Scalar>
   Scalar ObjectiveOf(const Scalar* p) const;
+  // omega0 of the swing for a bat of length L, rad/s: the scene's angular speed, or the bat
+  // speed over the arm, v / (L - from_tip - pivot), when the length varies with the design.
+  template <typename Scalar>
+  Scalar SwingAngularSpeedAt(const Scalar& length_m) const;
   template <typename Scalar>
   Scalar FunctionOf(DesignFunction f, const Scalar* p) const;
   std::vector<double> ParametersAt(const double* x) const;
@@ -230,7 +235,12 @@ class DesignModel {
   // Scene.
   double ball_mass_kg_ = 0.145;
   double ball_speed_mps_ = 27.7;
-  double omega0_rad_s_ = 17.288;
+  double omega0_rad_s_ = 17.288;  // a bat speed with a fixed length: resolved once
+  // swing.bat_speed_mps with a length that varies: omega0 = bat_speed_mps_ / (L -
+  // bat_speed_from_tip_m_ - pivot_from_knob_m_).
+  bool omega_from_length_ = false;
+  double bat_speed_mps_ = 0.0;
+  double bat_speed_from_tip_m_ = 0.0;
   double pivot_from_knob_m_ = 0.0;
   double cor_ = 0.5;
   bool free_bat_ = false;  // the exit-speed model: free_bat (else rigid_pivot)

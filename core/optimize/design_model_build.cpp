@@ -20,13 +20,6 @@ bool ModelBuilder::CheckScene() {
     return Refuse(why, TextRefusal("objective", "not a known objective"));
   }
   if (!problem.ball.Validate(why) || !problem.swing.Validate(why)) return false;
-  if (problem.swing.bat_speed_mps.has_value()) {
-    // The bat speed fixes omega only once the length is known, and the length (and the
-    // swing-weight objective's omega) vary with the design: the angular speed is the input here.
-    return Refuse(why, "swing.bat_speed_mps", *problem.swing.bat_speed_mps,
-                  "is not accepted by a design problem (its bat length varies with the design): "
-                  "give swing.angular_speed_rad_s");
-  }
   if (!(std::isfinite(problem.swing_weight_exponent) && problem.swing_weight_exponent >= 0.0 &&
         problem.swing_weight_exponent <= 0.5)) {
     return Refuse(why, "swing_weight_exponent", problem.swing_weight_exponent,
@@ -48,10 +41,13 @@ bool ModelBuilder::CheckScene() {
     return false;
   }
   exit_speed_objective = problem.objective != DesignObjective::kMinMoi;
+  const bool by_bat_speed = problem.swing.bat_speed_mps.has_value();
   if (exit_speed_objective && problem.ball.speed_mps == 0.0 &&
-      problem.swing.angular_speed_rad_s == 0.0) {
+      (by_bat_speed ? *problem.swing.bat_speed_mps : problem.swing.angular_speed_rad_s) == 0.0) {
     return Refuse(why,
-                  QuotedRefusal("ball.speed_mps", "0 and swing.angular_speed_rad_s = 0",
+                  QuotedRefusal("ball.speed_mps",
+                                by_bat_speed ? "0 and swing.bat_speed_mps = 0"
+                                             : "0 and swing.angular_speed_rad_s = 0",
                                 "nothing moves, the exit speed is 0 everywhere (objective " +
                                     std::string(DesignObjectiveName(problem.objective)) + ")"));
   }
@@ -365,6 +361,7 @@ bool ModelBuilder::SceneNumbers() {
   model.ball_speed_mps_ = problem.ball.speed_mps;
   model.omega0_rad_s_ = problem.swing.angular_speed_rad_s;
   model.pivot_from_knob_m_ = problem.swing.pivot_from_knob_m;
+  if (!SwingByBatSpeed()) return false;
   if (problem.model != CollisionModel::kRigidPivot && problem.model != CollisionModel::kFreeBat) {
     return Refuse(why, Refusal{"model", std::numeric_limits<double>::quiet_NaN(),
                                CollisionModelName(problem.model),
@@ -392,6 +389,35 @@ bool ModelBuilder::SceneNumbers() {
   }
   model.i6_ref_ = problem.swing_weight_reference_kg_m2.value_or(base_properties.MoiSixInchKgM2());
 
+  return true;
+}
+
+// A swing given by its bat speed (swing.bat_speed_mps at bat_speed_from_tip_m): omega0 =
+// v / (L - from_tip - pivot), resolved once when no variable moves the length L, else a
+// function of the design's L (the objective's derivatives include d omega0 / dL).
+bool ModelBuilder::SwingByBatSpeed() {
+  const Swing& swing = problem.swing;
+  if (!swing.bat_speed_mps.has_value()) return true;
+  const int length_idx = lay.KnotPosition(model.num_knots_ - 1);
+  const bool varies = model.parameter_variable_[static_cast<std::size_t>(length_idx)] >= 0;
+  // The shortest bat the variables allow has the shortest arm and the fastest omega0: if the
+  // bat-speed point lies beyond the pivot there, with omega0 in range, it does on every design.
+  const double shortest_m = ParamLower(length_idx);
+  Swing resolved;
+  Refusal refusal;
+  if (!ResolveSwing(swing, shortest_m, &resolved, why != nullptr ? &refusal : nullptr)) {
+    if (!varies) return Refuse(why, std::move(refusal));
+    return Refuse(why, Noted(std::move(refusal),
+                             " (for the shortest bat the variables allow, L = " + Num(shortest_m) +
+                                 " m: the bat length is a design variable)"));
+  }
+  if (!varies) {
+    model.omega0_rad_s_ = resolved.angular_speed_rad_s;  // the base design's length
+    return true;
+  }
+  model.omega_from_length_ = true;
+  model.bat_speed_mps_ = *swing.bat_speed_mps;
+  model.bat_speed_from_tip_m_ = swing.bat_speed_from_tip_m;
   return true;
 }
 

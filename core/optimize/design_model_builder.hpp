@@ -129,6 +129,8 @@ struct ModelBuilder {
   bool Rules();
   // Scene numbers and references.
   bool SceneNumbers();
+  // A swing given by its bat speed: omega0 resolved once, or a function of the length.
+  bool SwingByBatSpeed();
   // True when a variable changes the linear function `terms`.
   bool Depends(const std::vector<std::pair<int, double>>& terms) const;
   // The linear function's value at the base design.

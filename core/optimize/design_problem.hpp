@@ -195,7 +195,11 @@ struct DesignProblem {
   /// (0, kMaxDesignZoneToleranceMps].
   double sweet_zone_tolerance_mps = 1.0;
   Ball ball;  ///< The pitched ball.
-  /// The swing (pivot and omega0); the hands (hands_from_knob_m) only for min_sting.
+  /// The swing (pivot and omega0); the hands (hands_from_knob_m) only for min_sting. Given by
+  /// its bat speed (bat_speed_mps), omega0 = v / (L - bat_speed_from_tip_m - pivot) for each
+  /// design's own length L: resolved once when no variable moves L, else a function of L with
+  /// its exact derivatives; the shortest bat the bounds allow must keep the point beyond the
+  /// pivot (ResolveSwing's rules).
   Swing swing;
   std::optional<double> cor;  ///< COR in [0, 1]; unset = the bat material's default.
   InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< How moments are computed.
@@ -387,7 +391,9 @@ struct DesignResult {
   /// knob; NaN when no COR is known (min_moi without one).
   double sweet_spot_from_knob_m = 0.0;
   double max_exit_speed_mps = 0.0;   ///< Max exit speed there, m/s (NaN as above).
-  double angular_speed_rad_s = 0.0;  ///< omega of the swing for the answer, rad/s.
+  /// omega of the swing for the answer, rad/s (from its swing weight and, for a bat speed,
+  /// its length).
+  double angular_speed_rad_s = 0.0;
   /// Where the sweet spot's unconstrained maximum lies: kBeyondTip / kBeforeKnob when the
   /// reported point is the bat's end it was clamped to.
   Placement sweet_spot_placement = Placement::kOnBat;

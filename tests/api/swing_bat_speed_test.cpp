@@ -170,14 +170,49 @@ TEST(SwingBatSpeedTest, PointNotBeyondThePivotIsRefused) {
   EXPECT_EQ(off.body["field"], "swing.bat_speed_from_tip_m");
 }
 
-TEST(SwingBatSpeedTest, OptimizeRefusesBatSpeed) {
-  const Response r = Post(
-      "/v1/optimize",
-      {{"bat", {{"preset", "paper-wood"}}},
-       {"swing", {{"bat_speed_mps", 30.0}}},
-       {"variables", {{{"path", "three_segment.taper_start_m"}, {"min", 0.1}, {"max", 0.3}}}}});
-  EXPECT_EQ(r.status, 400) << r.body.dump();
-  EXPECT_EQ(r.body["field"], "swing.bat_speed_mps");
+// /v1/optimize resolves a bat speed per design: with the length fixed, once (the base bat's);
+// with the length a variable, from each design's own length. The answer's
+// sweet_spot.angular_speed_rad_s is the final design's omega: times its arm it is the bat speed.
+TEST(SwingBatSpeedTest, OptimizeResolvesBatSpeedForEachDesignsLength) {
+  const double v = 31.2928;  // 70 mph
+  // paper-wood's shape and wood in the three_segment form (its length a variable below).
+  const Json bat = {{"three_segment",
+                     {{"length_m", kPaperLengthM},
+                      {"handle_radius_m", 0.0125},
+                      {"barrel_radius_m", 0.035},
+                      {"taper_start_m", 0.3459},
+                      {"taper_end_m", 0.6423}}},
+                    {"material", "paper-wood"}};
+  Json body = {
+      {"bat", bat},
+      {"swing", {{"bat_speed_mps", v}, {"pivot_from_knob_m", 0.05}}},
+      {"cor", 0.5},
+      {"variables", {{{"path", "three_segment.taper_start_m"}, {"min", 0.1}, {"max", 0.3}}}}};
+  const Response fixed = Post("/v1/optimize", body);
+  ASSERT_EQ(fixed.status, 200) << fixed.body.dump();
+  const double fixed_omega = fixed.body["sweet_spot"]["angular_speed_rad_s"];
+  // The base bat's length: one division, as the scenes resolve it (1e-12 relative).
+  EXPECT_NEAR(fixed_omega, v / (kPaperLengthM - 0.1524 - 0.05), 1e-12 * fixed_omega);
+  // The length a variable, in mph as the scenes accept it: the longest bat has the longest arm.
+  body["swing"] = {{"bat_speed_mph", 70.0}, {"pivot_from_knob_m", 0.05}};
+  body["variables"].push_back({{"path", "three_segment.length_m"}, {"min", 0.80}, {"max", 0.90}});
+  body["constraints"] = {{"mass_kg", {{"max", 0.95}}}};
+  const Response varied = Post("/v1/optimize", body);
+  ASSERT_EQ(varied.status, 200) << varied.body.dump();
+  EXPECT_EQ(varied.body["summary"]["termination"], "converged") << varied.body.dump();
+  const double length = varied.body["bat"]["three_segment"]["length_m"];
+  EXPECT_GT(std::abs(length - kPaperLengthM), 1e-3);  // the length moved: omega0 is its own
+  const double omega = varied.body["sweet_spot"]["angular_speed_rad_s"];
+  // omega = v / (L - 0.1524 - 0.05): their product is v to a few ulps (1e-12 relative).
+  EXPECT_NEAR(omega * (length - 0.1524 - 0.05), v, 1e-12 * v) << varied.body.dump();
+  // A bat-speed point behind the pivot for the shortest bat the bounds allow: 400 naming it.
+  body["swing"]["pivot_from_knob_m"] = 0.7;  // 0.80 - 0.1524 = 0.6476 m from the knob
+  const Response behind = Post("/v1/optimize", body);
+  EXPECT_EQ(behind.status, 400) << behind.body.dump();
+  EXPECT_EQ(behind.body["field"], "swing.bat_speed_from_tip_m");
+  EXPECT_NE(behind.body["message"].get<std::string>().find("the shortest bat the variables allow"),
+            std::string::npos)
+      << behind.body.dump();
 }
 
 // docs/models.md, "Bat speed at the impact point": with V = omega x fixed at the impact point,

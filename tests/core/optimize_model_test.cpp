@@ -173,6 +173,85 @@ TEST(OptimizeModel, ExitSpeedObjectivesMatchThePublicClosedForms) {
   EXPECT_EQ(why.field, "model");
 }
 
+// A swing given by its bat speed on designs whose length varies: the model's exit-speed
+// objectives equal the public closed forms at the omega ResolveSwing gives each design's bat
+// (omega0 = v / (L - from_tip - pivot)), for both problems (three-segment: pivot 0.1 m).
+TEST(OptimizeModel, BatSpeedObjectivesUseEachDesignsOwnLength) {
+  for (const DesignObjective objective :
+       {DesignObjective::kMaxExitSpeed, DesignObjective::kMaxExitSpeedSwingWeight}) {
+    for (DesignProblem p : {HollowFilledProfile(objective), FilledThreeSegment(objective)}) {
+      p.swing.bat_speed_mps = 32.0;
+      p.model = CollisionModel::kRigidPivot;
+      const DesignModel model = Build(p);
+      std::mt19937_64 rng(7);
+      double lengths[2] = {1e9, 0.0};  // the least and largest length met, m
+      for (int trial = 0; trial < 10; ++trial) {
+        const std::vector<double> x = RandomPoint(model, rng);
+        DesignPoint point;
+        ASSERT_TRUE(model.Evaluate(x.data(), false, &point));
+        const Bat bat = model.BatAt(x.data());
+        const MassProperties props = ComputeMassProperties(bat);
+        Swing swing;
+        ASSERT_TRUE(ResolveSwing(p.swing, bat.LengthM(), &swing, nullptr));
+        if (objective == DesignObjective::kMaxExitSpeedSwingWeight) {
+          swing.angular_speed_rad_s *=
+              std::pow(props.MoiSixInchKgM2() / model.reference_moi_six_inch_kg_m2(),
+                       -p.swing_weight_exponent);
+        }
+        EXPECT_DOUBLE_EQ(model.AngularSpeedFor(props.MoiSixInchKgM2(), bat.LengthM()),
+                         swing.angular_speed_rad_s);
+        const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(
+            ClosedFormProfileFor(p.model, props, p.ball, swing, model.cor()), bat.LengthM());
+        // Exit speeds of ~30 m/s from the same integrals: rounding, 1e-11 m/s.
+        EXPECT_NEAR(point.objective, max.exit_speed_mps, 1e-11) << DesignObjectiveName(objective);
+        lengths[0] = std::min(lengths[0], bat.LengthM());
+        lengths[1] = std::max(lengths[1], bat.LengthM());
+      }
+      EXPECT_GT(lengths[1] - lengths[0], 1e-3);  // the lengths differ, so omega0 does
+    }
+  }
+}
+
+// An optimisation with the swing given by its bat speed and the length a variable: the answer
+// reports its own omega, v over its own arm; Ipopt's derivative checker (first and second
+// order, so the gradient's and the exact Hessian's d omega0 / dL terms) finds no errors, and
+// the exact Hessian converges to the limited-memory answer.
+TEST(OptimizeModel, BatSpeedDesignReportsItsOwnOmega) {
+  DesignProblem p = FilledThreeSegment(DesignObjective::kMaxExitSpeed);
+  const double v = 32.0;
+  p.swing.bat_speed_mps = v;
+  const DesignResult r = OptimizeDesign(p, DesignOptions{});
+  ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.FullReport();
+  const double arm = r.bat.LengthM() - p.swing.bat_speed_from_tip_m - p.swing.pivot_from_knob_m;
+  // The same division as ResolveSwing: a few ulps at most.
+  EXPECT_NEAR(r.angular_speed_rad_s * arm, v, 1e-12 * v);
+  DesignOptions exact;
+  exact.hessian = HessianMode::kExact;
+  const DesignResult e = OptimizeDesign(p, exact);
+  ASSERT_EQ(e.summary.termination, Termination::kConverged) << e.summary.FullReport();
+  // Two converged solves of the same problem (tol 1e-9 on the scaled problem): their objectives
+  // agree far within 1e-7 of ~30 m/s.
+  EXPECT_NEAR(e.objective_value, r.objective_value, 1e-7 * r.objective_value);
+  for (DerivativeCheck check : {DerivativeCheck::kFirstOrder, DerivativeCheck::kSecondOrder}) {
+    DesignOptions o;
+    o.derivative_check = check;
+    o.hessian =
+        check == DerivativeCheck::kSecondOrder ? HessianMode::kExact : HessianMode::kLimitedMemory;
+    o.max_iterations = 1;
+    o.explain_infeasibility = false;
+    const DesignResult c = OptimizeDesign(p, o);
+    EXPECT_EQ(c.derivative_check_errors, 0) << c.derivative_check_report;
+  }
+  // A bat-speed point behind the pivot for the shortest bat the bounds allow is refused there.
+  p.swing.pivot_from_knob_m = 0.69;  // 0.84 - 0.1524 = 0.6876 m from the knob
+  Refusal why;
+  ASSERT_FALSE(p.Validate(&why));
+  EXPECT_EQ(why.field, "swing.bat_speed_from_tip_m");
+  EXPECT_NE(why.Message().find("for the shortest bat the variables allow, L = 0.84 m"),
+            std::string::npos)
+      << why.Message();
+}
+
 // A linked variable ("paths"): both fields take the value, in the model and in the answer.
 TEST(OptimizeModel, LinkedFieldsTakeTheVariablesValue) {
   DesignProblem p = HollowFilledProfile(DesignObjective::kMaxExitSpeed);
@@ -360,10 +439,12 @@ TEST(OptimizeModel, GradientsMatchComputeMassPropertiesWithGradient) {
 TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
   std::mt19937_64 rng(11);
   for (DesignObjective objective : kObjectives) {
-    for (int variant = 0; variant < 7; ++variant) {
+    for (int variant = 0; variant < 9; ++variant) {
       // Both problems with both exit-speed models: rigid_pivot, then free_bat; then the
       // profile with a linked variable (two knots' radii set to one value); then a scale
-      // variable ("scale_paths") in each problem.
+      // variable ("scale_paths") in each problem; then a swing given by its bat speed with the
+      // length a variable (omega0 = v / (L - from_tip - pivot) moves with L): the scaled
+      // three-segment problem (L scaled) and the profile (the last knot's position).
       DesignProblem p =
           variant % 2 == 0 ? HollowFilledProfile(objective) : FilledThreeSegment(objective);
       p.model = variant == 2 || variant == 3 ? CollisionModel::kFreeBat
@@ -379,7 +460,7 @@ TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
                                {"profile.knots[11].radius_m", "profile.knots[12].radius_m",
                                 "profile.knots[11].x_m"}});
       }
-      if (variant == 5) {
+      if (variant == 5 || variant == 7) {
         // The length (the integrals' L row), a radius that is two parameters (knots 0 and 1)
         // and the fill's diameter (the fill's own factor 0.5 as well) by one factor.
         p.variables[0] = {
@@ -390,6 +471,7 @@ TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
             {"three_segment.length_m", "three_segment.handle_radius_m", "fill.diameter_m"}};
         p.variables.erase(p.variables.begin() + 1);  // three_segment.handle_radius_m
       }
+      if (variant >= 7) p.swing.bat_speed_mps = 32.0;  // 72 mph at 6 in from the tip
       const DesignModel model = Build(p);
       ASSERT_GT(model.m(), 3);
       for (int trial = 0; trial < 3; ++trial) {
