@@ -327,13 +327,14 @@ const Endpoint<FitRequest, core::ShapeFitResult>& FitEndpoint() {
   return endpoint;
 }
 
-// True when the fit's unknowns name design-variable paths ({"path"} or {"paths"}): the
-// general fit, of any bat, by the design optimiser.
+// True when the fit's unknowns name design-variable paths ({"path"}, {"paths"} or
+// {"scale_paths"}): the general fit, of any bat, by the design optimiser.
 bool IsDesignFit(const nlohmann::json& body) {
   const auto unknowns = body.find("unknowns");
   if (unknowns == body.end() || !unknowns->is_array()) return false;
   return std::any_of(unknowns->begin(), unknowns->end(), [](const nlohmann::json& u) {
-    return u.is_object() && (u.contains("path") || u.contains("paths"));
+    return u.is_object() &&
+           (u.contains("path") || u.contains("paths") || u.contains("scale_paths"));
   });
 }
 

@@ -41,6 +41,39 @@ TEST(DesignFitTest, AProfilesDensityScaledToThirtyOunces) {
   EXPECT_NEAR(again.body["mass_kg"].get<double>(), 30 * kOunce, 1e-9);
 }
 
+// Every radius of a solid bat scaled by one factor ("scale_paths") to a target mass: the mass
+// of a solid bat is its base mass times s^2, so s = sqrt(M / M0) exactly.
+TEST(DesignFitTest, EveryRadiusScaledToATargetMass) {
+  Json body = Json::parse(R"({"bat": {"preset": "wood-34-ash"}, "targets": {"mass_kg": 0.85},
+      "unknowns": [{"scale_paths": [], "name": "radii", "min": 0.8, "max": 1.2}]})");
+  // The preset's knots and mass, from the catalogue.
+  const Response presets = Dispatch({"GET", "/v1/presets", ""}, Context{});
+  ASSERT_EQ(presets.status, 200);
+  Json preset;
+  for (const Json& p : presets.body["presets"]) {
+    if (p["name"] == "wood-34-ash") preset = p;
+  }
+  ASSERT_TRUE(preset.is_object());
+  const Json& knots = preset["bat"]["profile"]["knots"];
+  for (std::size_t k = 0; k < knots.size(); ++k) {
+    body["unknowns"][0]["scale_paths"].push_back("profile.knots[" + std::to_string(k) +
+                                                 "].radius_m");
+  }
+  const Response r = Post("/v1/bat/fit", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["summary"]["termination"], "converged");
+  const double s = r.body["unknowns"]["radii"];
+  // The mass holds to Ipopt's 1e-10 relative constraint tolerance (< 1e-10 kg): s = sqrt(M /
+  // M0) to s |dM| / (2 M) < 6e-11; 1e-9 leaves room for rounding.
+  EXPECT_NEAR(s, std::sqrt(0.85 / preset["properties"]["mass_kg"].get<double>()), 1e-9);
+  for (std::size_t k = 0; k < knots.size(); ++k) {
+    const std::string path = "profile.knots[" + std::to_string(k) + "].radius_m";
+    // Each field is its base value times the factor, exactly, in the answer and in the bat.
+    EXPECT_EQ(r.body["unknowns"][path].get<double>(), knots[k]["radius_m"].get<double>() * s);
+    EXPECT_EQ(r.body["bat"]["profile"]["knots"][k]["radius_m"], r.body["unknowns"][path]);
+  }
+}
+
 TEST(DesignFitTest, TwoTargetsTwoUnknownsAndLinkedKnots) {
   // Mass and balance point from the density and the barrel's two knots linked (one diameter).
   const Json body = Json::parse(R"({"bat": {"profile": {"knots": [
