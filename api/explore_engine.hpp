@@ -47,11 +47,16 @@ struct SweepParameter {
   std::vector<std::vector<PathStep>> targets;
   /// For "scale_paths": the template's value of each target (the value multiplies them).
   std::vector<double> scale_bases;
+  /// Per target, the factor from the swept value to the target's SI field: 1, or for a path
+  /// written in a trade unit ("ball.speed_mph", whose target is "ball.speed_mps") its TradeForm's
+  /// (0.44704). Not used by "scale_paths" (the value is a ratio).
+  std::vector<double> to_si;
   bool scale = false;  ///< True for "scale_paths".
 
   /// The value of target `t` in a design whose swept value is `value`.
   double TargetValue(std::size_t t, double value) const {
-    return scale ? scale_bases[t] * value : value;
+    if (scale) return scale_bases[t] * value;
+    return t < to_si.size() ? value * to_si[t] : value;
   }
 };
 

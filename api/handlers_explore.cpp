@@ -17,6 +17,7 @@
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
 #include "api/scene_json.hpp"
+#include "api/trade_units.hpp"
 #include "core/sampling.hpp"
 
 namespace sweetspot::api {
@@ -39,6 +40,67 @@ bool IsKnownField(const Json& probe, const ApiLimits& limits, ApiError* unknown)
   if (error.code != ErrorCode::kUnknownField) return true;
   *unknown = std::move(error);
   return false;
+}
+
+// The object holding the last step of `steps` in *root (the swept field's parent), or nullptr
+// when the path does not lead to one.
+Json* SweptFieldParent(Json* root, const std::vector<PathStep>& steps) {
+  Json* node = root;
+  for (std::size_t k = 0; k + 1 < steps.size(); ++k) {
+    if (const auto* key = std::get_if<std::string>(&steps[k])) {
+      if (!node->is_object() || !node->contains(*key)) return nullptr;
+      node = &(*node)[*key];
+    } else {
+      const std::size_t index = std::get<std::size_t>(steps[k]);
+      if (!node->is_array() || index >= node->size()) return nullptr;
+      node = &(*node)[index];
+    }
+  }
+  return node->is_object() ? node : nullptr;
+}
+
+// Issue 19: a swept field is set in SI in every design, so the template gives it in SI too:
+// a trade form of it there ("speed_mph" beside a swept "ball.speed_mps", "barrel_diameter_in"
+// beside "three_segment.barrel_radius_m") is replaced by the SI field, its value converted as
+// a request's reader converts it. Otherwise each design would hold two forms of one quantity,
+// which the JSON path refuses while the engine binds the SI one.
+void SweptFieldToSi(Json* base, const std::vector<PathStep>& steps) {
+  if (steps.empty()) return;
+  const auto* leaf = std::get_if<std::string>(&steps.back());
+  Json* parent = leaf != nullptr ? SweptFieldParent(base, steps) : nullptr;
+  if (parent == nullptr || parent->contains(*leaf)) return;
+  for (const TradeForm& form : TradeForms(*leaf)) {
+    const auto it = parent->find(form.key);
+    if (it == parent->end() || !it->is_number()) continue;
+    const double si = it->get<double>() * form.to_si;
+    parent->erase(it);
+    (*parent)[*leaf] = si;
+    return;  // the template was checked: it has at most one form of the quantity
+  }
+}
+
+// A swept path written in a trade unit ("ball.speed_mph", "three_segment.barrel_diameter_in")
+// sweeps its SI field: *steps becomes that field's path and *to_si the factor from the swept
+// value to it. A path whose last key is no trade spelling, or whose SI field the design's
+// parser does not know (a fill's own "diameter_m" is not a "radius_m"), is left as written.
+void SweptPathToSi(const Json& base, double min, const ApiLimits& limits,
+                   std::vector<PathStep>* steps, double* to_si) {
+  *to_si = 1.0;
+  if (steps->empty()) return;
+  const auto* leaf = std::get_if<std::string>(&steps->back());
+  if (leaf == nullptr) return;
+  for (const TradeForm& si : SiFormsOf(*leaf)) {
+    std::vector<PathStep> candidate = *steps;
+    candidate.back() = si.key;
+    // The template as written with the SI field added: a parser that knows the field reads
+    // it (and may refuse two forms of it), one that does not calls it unknown.
+    Json probe = base;
+    if (!SetNumberAtPath(&probe, candidate, min * si.to_si, nullptr)) continue;
+    if (ApiError unknown; !IsKnownField(probe, limits, &unknown)) continue;
+    *steps = std::move(candidate);
+    *to_si = si.to_si;
+    return;
+  }
 }
 
 // "columns": 1 to kMaxColumns distinct dotted paths, each naming a part of `shape` (what a
@@ -213,6 +275,11 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
         return std::nullopt;
       }
       auto steps = ParseJsonPath(path, &why);
+      double to_si = 1.0;
+      if (steps) {
+        SweptPathToSi(base, dimension.min, context.limits, &*steps, &to_si);
+        SweptFieldToSi(&base, *steps);
+      }
       std::optional<double> scale_base;
       if (steps && parameter.scale) {
         // A scaled field multiplies the template's own value: it must be there.
@@ -221,7 +288,8 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
       }
       Json probe = base;
       if (!steps || (parameter.scale && !scale_base) ||
-          !SetNumberAtPath(&probe, *steps, dimension.min, &why)) {
+          !SetNumberAtPath(&probe, *steps, dimension.min * (parameter.scale ? 1.0 : to_si),
+                           &why)) {
         SetError(error, ErrorCode::kInvalidValue, field, path_json, why);
         return std::nullopt;
       }
@@ -242,6 +310,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
       }
       if (j == 0) parameter.steps = *steps;
       parameter.targets.push_back(std::move(*steps));
+      parameter.to_si.push_back(to_si);
       if (scale_base) parameter.scale_bases.push_back(*scale_base);
     }
     parameters.push_back(std::move(parameter));

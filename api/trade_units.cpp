@@ -104,6 +104,28 @@ std::vector<TradeForm> TradeForms(std::string_view si_key) {
   return out;
 }
 
+std::vector<TradeForm> SiFormsOf(std::string_view key) {
+  std::vector<std::string> candidates;
+  for (const std::string_view suffix : {std::string_view("diameter_m"), std::string_view("diameter_in")}) {
+    if (EndsWith(key, suffix)) {
+      candidates.push_back(std::string(key.substr(0, key.size() - suffix.size())) + "radius_m");
+    }
+  }
+  for (const UnitRule& rule : kRules) {
+    if (EndsWith(key, rule.trade) && key.size() > rule.trade.size()) {
+      candidates.push_back(std::string(key.substr(0, key.size() - rule.trade.size())) +
+                           std::string(rule.si));
+    }
+  }
+  std::vector<TradeForm> out;
+  for (const std::string& si : candidates) {
+    for (const TradeForm& form : TradeForms(si)) {
+      if (form.key == key) out.push_back({si, form.to_si});
+    }
+  }
+  return out;
+}
+
 void AddImperial(Json* answer) { AddImperialTo(answer, std::nullopt); }
 
 bool TakeReportUnits(Json* body, ReportUnits* units, ApiError* error) {

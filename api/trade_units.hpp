@@ -24,6 +24,14 @@ struct TradeForm {
 /// "*_kg" -> "*_oz"; "*_mps" -> "*_mph"; "*_kg_m2" -> "*_oz_in2". Empty for any other name.
 std::vector<TradeForm> TradeForms(std::string_view si_key);
 
+/// The inverse of TradeForms: the SI fields that `key` is a trade spelling of, each with the
+/// factor to it (its TradeForm's), a radius from a diameter first: "barrel_diameter_in" ->
+/// {"barrel_radius_m", 0.0127}, {"barrel_diameter_m", 0.0254}; "speed_mph" -> {"speed_mps",
+/// 0.44704}. Empty for a key that is no trade spelling ("length_m", "cor"). Which of several
+/// is the field a given object has (a fill has "diameter_m" of its own, a knot "radius_m") is
+/// the caller's to decide.
+std::vector<TradeForm> SiFormsOf(std::string_view key);
+
 /// How an answer reports its numbers ("report_units").
 enum class ReportUnits {
   kSi,        ///< SI only (the default).

@@ -337,6 +337,84 @@ TEST(ExploreEngineTest, LinkedAndScaledPathsSetEveryFieldAndMatchTheJsonPath) {
   EXPECT_EQ(error.field, "parameters[0].paths") << error.message;
 }
 
+// Issue 19: a swept field is set in SI; a template that gives the same quantity in a trade
+// unit (ball.speed_mph beside a swept ball.speed_mps) has it replaced, so the engine and the
+// JSON path give the same rows (the JSON path used to refuse every design: two forms). A path
+// may be written in a trade unit too: its values are in that unit, its field the SI one.
+TEST(ExploreEngineTest, TradeUnitsInTheTemplateAndInSweptPathsMatchTheJsonPath) {
+  Json body = Json::parse(R"({
+    "bat": {"three_segment": {"length_in": 34, "handle_diameter_in": 0.98,
+            "barrel_diameter_in": 2.6, "taper_start_in": 12, "taper_end_in": 21.6},
+            "material": "ash"},
+    "ball": {"speed_mph": 60, "mass_oz": 5.1},
+    "parameters": [{"path": "ball.speed_mps", "min": 20, "max": 40, "count": 3},
+                   {"path": "three_segment.barrel_radius_m", "min": 0.03, "max": 0.034,
+                    "count": 2}],
+    "outputs": ["max_exit_speed", "properties"]})");
+  const std::string rows = ExpectSameRows(body, /*expect_bound=*/true,
+                                          Json{"index", "max_exit_speed.exit_speed_mps"});
+  ASSERT_FALSE(rows.empty());
+  EXPECT_EQ(rows.find("\"feasible\":false"), std::string::npos) << rows;
+  // Design 5 (speed 40 m/s, barrel radius 0.034 m) is the single request with those SI
+  // fields in place of the template's trade forms, bit for bit.
+  const auto row_of = [](const std::string& ndjson, std::size_t index) {
+    std::size_t at = 0;
+    for (std::size_t k = 0; k < index; ++k) at = ndjson.find('\n', at) + 1;
+    return Json::parse(ndjson.substr(at, ndjson.find('\n', at) - at));
+  };
+  const Json row = row_of(rows, 5);
+  EXPECT_EQ(row["parameters"]["ball.speed_mps"], 40.0);
+  EXPECT_EQ(row["parameters"]["three_segment.barrel_radius_m"], 0.034);
+  Json single{{"bat", body["bat"]}, {"ball", body["ball"]}, {"outputs", {"max_exit_speed"}}};
+  single["ball"].erase("speed_mph");
+  single["ball"]["speed_mps"] = 40.0;
+  single["bat"]["three_segment"].erase("barrel_diameter_in");
+  single["bat"]["three_segment"]["barrel_radius_m"] = 0.034;
+  const Response one = Dispatch({"POST", "/v1/sweet-spot", single.dump()}, Context{});
+  ASSERT_EQ(one.status, 200) << one.body.dump();
+  EXPECT_EQ(row["max_exit_speed"]["exit_speed_mps"], one.body["max_exit_speed"]["exit_speed_mps"]);
+
+  // The same sweep with its paths in trade units: the values as written (mph, diameter in
+  // inches) in the rows, the designs those values make. Bound, and the JSON path's rows.
+  Json trade = body;
+  trade["parameters"] = Json::parse(R"([
+      {"path": "ball.speed_mph", "min": 50, "max": 90, "count": 3},
+      {"path": "three_segment.barrel_diameter_in", "min": 2.4, "max": 2.7, "count": 2}])");
+  const std::string trade_rows =
+      ExpectSameRows(trade, true, Json{"parameters.ball.speed_mph", "max_exit_speed.exit_speed_mps"});
+  ASSERT_FALSE(trade_rows.empty());
+  const Json trade_row = row_of(trade_rows, 5);
+  EXPECT_EQ(trade_row["parameters"]["ball.speed_mph"], 90.0);
+  EXPECT_EQ(trade_row["parameters"]["three_segment.barrel_diameter_in"], 2.7);
+  Json single_trade = single;
+  single_trade["ball"].erase("speed_mps");
+  single_trade["ball"]["speed_mph"] = 90.0;
+  single_trade["bat"]["three_segment"].erase("barrel_radius_m");
+  single_trade["bat"]["three_segment"]["barrel_diameter_in"] = 2.7;
+  const Response two = Dispatch({"POST", "/v1/sweet-spot", single_trade.dump()}, Context{});
+  ASSERT_EQ(two.status, 200) << two.body.dump();
+  EXPECT_EQ(trade_row["max_exit_speed"]["exit_speed_mps"],
+            two.body["max_exit_speed"]["exit_speed_mps"]);
+
+  // A scaled field the template gives in a trade unit scales its SI value.
+  Json scaled = body;
+  scaled["parameters"] = Json::parse(
+      R"([{"scale_paths": ["ball.speed_mps"], "name": "speed_scale", "min": 1, "max": 1.5,
+           "count": 2}])");
+  const std::string scaled_rows = ExpectSameRows(scaled, true, Json{"max_exit_speed.exit_speed_mps"});
+  ASSERT_FALSE(scaled_rows.empty());
+  EXPECT_EQ(scaled_rows.find("\"feasible\":false"), std::string::npos) << scaled_rows;
+
+  // A fill's own diameter_m stays the field it is (it is not a trade form of a radius there).
+  Json fill = Json::parse(R"({
+    "bat": {"preset": "paper-wood", "fill": {"material": "cork", "diameter_in": 1, "depth_m": 0.2}},
+    "parameters": [{"path": "fill.diameter_m", "min": 0.02, "max": 0.03, "count": 2}],
+    "outputs": ["properties"]})");
+  const std::string fill_rows = ExpectSameRows(fill, true, Json{"properties.mass_kg"});
+  EXPECT_NE(fill_rows.find("\"fill.diameter_m\":0.03"), std::string::npos) << fill_rows;
+  EXPECT_EQ(fill_rows.find("\"feasible\":false"), std::string::npos) << fill_rows;
+}
+
 }  // namespace
 }  // namespace explore_engine_test
 }  // namespace sweetspot::api
