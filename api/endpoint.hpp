@@ -89,7 +89,9 @@ inline Response ValidRequest() { return {200, nlohmann::json{{"valid", true}}}; 
 
 /// Parses `request`'s body as a JSON object and then with `parse` (the Endpoint::parse
 /// signature); on a refusal nullopt with the error's response in *failure. For handlers
-/// that keep their own flow after parsing (the streamed /v1/explore, /v1/jobs).
+/// that keep their own flow after parsing and whose answer has no quantity to report in
+/// other units (/v1/jobs: the job's own request takes "report_units"), so
+/// "report_units": "imperial" is refused.
 template <class Req, class Parse>
 std::optional<Req> ParseRequest(const Request& request, const Context& context, const Parse& parse,
                                 Response* failure) {
@@ -104,7 +106,8 @@ std::optional<Req> ParseRequest(const Request& request, const Context& context, 
   if (units == ReportUnits::kImperial) {
     SetError(&error, ErrorCode::kInvalidValue, "report_units", nullptr,
              "\"imperial\" is not offered by " + request.path +
-                 " (its rows stay SI; properties.imperial.* gives inches and ounces)");
+                 " (its answer has no quantity with a unit; give report_units in the request "
+                 "it runs)");
     *failure = ToResponse(error);
     return std::nullopt;
   }

@@ -7,6 +7,7 @@
 #include "api/bat_json.hpp"
 #include "api/json_reader.hpp"
 #include "api/scene_json.hpp"
+#include "api/trade_units.hpp"
 #include "core/collision/collide.hpp"
 
 namespace sweetspot::api {
@@ -121,6 +122,13 @@ Json RenderDesignRow(const DesignOutcome& outcome, const RowOutputs& outputs) {
   return row;
 }
 
+void AddImperialToRow(Json* row, double length_m) {
+  for (auto& [key, block] : row->items()) {
+    if (key == "parameters" || key == "error" || !block.is_structured()) continue;
+    AddImperial(&block, length_m);
+  }
+}
+
 DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
                          const core::SceneOptions& options, const ApiLimits& limits) {
   DesignRow out;
@@ -144,6 +152,7 @@ DesignRow EvaluateDesign(const Json& design_json, const RowOutputs& outputs,
   DesignOutcome outcome;
   ComputeDesign(scene, outputs, options, &outcome, &out.timings);
   out.row = RenderDesignRow(outcome, outputs);
+  if (outcome.feasible) out.length_m = outcome.result.length_m;
   return out;
 }
 

@@ -27,6 +27,7 @@ struct RowOutputs {
 /// A design's row and what computing it took.
 struct DesignRow {
   nlohmann::json row;  ///< {"feasible": true, outputs...} or {"feasible": false, "error": {...}}.
+  std::optional<double> length_m;          ///< The design's bat length (feasible rows).
   std::vector<core::ModelTiming> timings;  ///< Per model over the scene and the collision.
 };
 
@@ -57,6 +58,11 @@ void ComputeDesign(const core::Scene& scene, const RowOutputs& outputs,
 
 /// The row of an outcome: {"feasible": false, "error"} or {"feasible": true, outputs...}.
 nlohmann::json RenderDesignRow(const DesignOutcome& outcome, const RowOutputs& outputs);
+
+/// "report_units": "imperial" on a row: each output block (not "parameters", the swept values
+/// as written, nor "error") gets its trade-unit fields as AddImperial gives them in a single
+/// request's answer, the positions also from the tip of a bat of `length_m`.
+void AddImperialToRow(nlohmann::json* row, double length_m);
 
 /// Evaluates `design` (a bat and scene fields, as a request writes them): the mass properties
 /// are computed once per design, whatever the outputs. Never throws.

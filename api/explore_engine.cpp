@@ -13,6 +13,7 @@
 #include "api/bat_json.hpp"
 #include "api/json_reader.hpp"
 #include "api/scene_json.hpp"
+#include "api/trade_units.hpp"
 #include "core/scene/timing_book.hpp"
 
 namespace sweetspot::api {
@@ -314,18 +315,68 @@ enum class Source {
   kMoiCentroidOzIn2,
 };
 
+// How a direct value is turned into the trade-unit field a column names (ImperialSources).
+enum class DirectConvert {
+  kNone,     // the value as it is
+  kDivide,   // value / factor ("exit_speed_mph")
+  kFromTip,  // (bat length - value) / inch ("position_from_tip_in")
+};
+
 struct DirectAccessor {
   Source source = Source::kMissing;
   std::size_t parameter = 0;
+  DirectConvert convert = DirectConvert::kNone;
+  double factor = 1.0;  // kDivide's divisor
 };
 
+std::optional<DirectAccessor> CompileSiAccessor(const std::vector<std::string>& tokens,
+                                                const std::vector<SweepParameter>& parameters,
+                                                const RowOutputs& outputs);
+
+bool IsNumberSource(Source s) {
+  switch (s) {
+    case Source::kIndex:
+    case Source::kFeasible:
+    case Source::kParameter:
+    case Source::kMissing:
+    case Source::kMaxPlacement:
+    case Source::kMaxModel:
+    case Source::kMaxMethod:
+    case Source::kCopPlacement:
+    case Source::kInertiaModel:
+      return false;
+    default:
+      return true;
+  }
+}
+
 // The accessor of `tokens` in a feasible row of this sweep, or nullopt when the engine does
-// not read it directly (the row is then rendered as JSON). The names are those
-// RenderDesignRow renders (SceneResultToJson, PropertiesToJson): explore_engine_test checks
-// every one of them against the JSON row.
+// not read it directly (the row is then rendered as JSON). A field of an output block may be
+// named in a trade unit, as "report_units": "imperial" adds it (AddImperialToRow): its SI
+// field's accessor with the conversion AddImperial makes, so the number is the same bits.
 std::optional<DirectAccessor> CompileAccessor(const std::vector<std::string>& tokens,
                                               const std::vector<SweepParameter>& parameters,
                                               const RowOutputs& outputs) {
+  if (auto native = CompileSiAccessor(tokens, parameters, outputs)) return native;
+  if (tokens.size() < 2 || tokens[0] == "parameters" || tokens[0] == "error") return std::nullopt;
+  for (const ImperialSource& source : ImperialSources(tokens.back())) {
+    std::vector<std::string> si = tokens;
+    si.back() = source.si_key;
+    auto accessor = CompileSiAccessor(si, parameters, outputs);
+    if (!accessor || !IsNumberSource(accessor->source)) continue;
+    accessor->convert = source.from_tip ? DirectConvert::kFromTip : DirectConvert::kDivide;
+    accessor->factor = source.to_si;
+    return accessor;
+  }
+  return std::nullopt;
+}
+
+// The accessor of SI (or native) field `tokens` in a feasible row of this sweep, or nullopt.
+// The names are those RenderDesignRow renders (SceneResultToJson, PropertiesToJson):
+// explore_engine_test checks every one of them against the JSON row.
+std::optional<DirectAccessor> CompileSiAccessor(const std::vector<std::string>& tokens,
+                                                const std::vector<SweepParameter>& parameters,
+                                                const RowOutputs& outputs) {
   using S = Source;
   const auto has = [&outputs](core::SceneOutput o) {
     return std::find(outputs.scene.begin(), outputs.scene.end(), o) != outputs.scene.end();
@@ -403,10 +454,26 @@ DirectValue Text(std::string_view v) {
   return d;
 }
 
+DirectValue ReadSiDirect(const DirectAccessor& a, std::uint64_t index,
+                         const std::vector<double>& values, const DesignOutcome& o,
+                         const core::ImperialProperties& imperial);
+
 // The value of `a` in the feasible row of design `index`.
 DirectValue ReadDirect(const DirectAccessor& a, std::uint64_t index,
                        const std::vector<double>& values, const DesignOutcome& o,
                        const core::ImperialProperties& imperial) {
+  DirectValue d = ReadSiDirect(a, index, values, o, imperial);
+  if (a.convert == DirectConvert::kNone || d.kind != DirectValue::kNumber) return d;
+  // As AddImperial computes it (api/trade_units.cpp), operation for operation.
+  d.number = a.convert == DirectConvert::kDivide ? d.number / a.factor
+                                                 : (o.result.length_m - d.number) / a.factor;
+  return d;
+}
+
+// The value of `a`'s SI field in the feasible row of design `index`.
+DirectValue ReadSiDirect(const DirectAccessor& a, std::uint64_t index,
+                         const std::vector<double>& values, const DesignOutcome& o,
+                         const core::ImperialProperties& imperial) {
   using S = Source;
   const core::SceneResult& r = o.result;
   const core::MassProperties& p = r.mass_properties;
@@ -547,6 +614,8 @@ struct RunPlan {
   std::vector<DirectAccessor> objective_accessors;  // when `direct`
   bool direct = false;    // feasible bound rows are written without a JSON row
   bool imperial = false;  // some direct column reads the imperial properties
+  bool row_twins = false;   // full rows carry the trade-unit fields (report_units imperial)
+  bool json_twins = false;  // JSON rows get them before columns and objectives read them
   std::uint64_t in_shard = 0;
 
   // The design index of the shard's k-th design.
@@ -628,10 +697,13 @@ bool SetLeaf(const DirectValue& value, Json* node) {
 }
 
 // The row of design `i` from its JSON row (the JSON path, or a bound design whose columns are
-// not all direct): index and parameters added, objectives read, then written in the format.
+// not all direct): the trade-unit fields added when the plan wants them (for a feasible row,
+// `length_m` its bat's length; nullopt when they are there already), index and parameters
+// added, objectives read, then written in the format.
 void AddJsonRow(const RunPlan& plan, std::uint64_t i, const std::vector<double>& point, Json row,
-                BlockResult* out) {
+                std::optional<double> length_m, BlockResult* out) {
   const Sweep& sweep = *plan.sweep;
+  if (plan.json_twins && length_m) AddImperialToRow(&row, *length_m);
   Json values = Json::object();
   for (std::size_t k = 0; k < sweep.parameters.size(); ++k)
     values[sweep.parameters[k].path] = point[k];
@@ -719,6 +791,7 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
           // The first feasible row: rendered, and kept as the template when it can be.
           worker->template_tried = true;
           Json row = RenderDesignRow(outcome, sweep.outputs);
+          if (plan.json_twins) AddImperialToRow(&row, outcome.result.length_m);
           Json values = Json::object();
           for (std::size_t k = 0; k < sweep.parameters.size(); ++k) {
             values[sweep.parameters[k].path] = point[k];
@@ -731,12 +804,13 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
             worker->row_template.reset();
             worker->leaves.clear();
           }
-          AddJsonRow(plan, i, point, std::move(row), out);
+          AddJsonRow(plan, i, point, std::move(row), std::nullopt, out);
           return;
         }
       }
       if (outcome.feasible && !plan.direct) {
-        AddJsonRow(plan, i, point, RenderDesignRow(outcome, sweep.outputs), out);
+        AddJsonRow(plan, i, point, RenderDesignRow(outcome, sweep.outputs), outcome.result.length_m,
+                   out);
         return;
       }
       if (outcome.feasible) {
@@ -785,12 +859,13 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
       SetNumberAtPath(&design, parameter.targets[t], parameter.TargetValue(t, point[k]), nullptr);
     }
   }
-  Json row = EvaluateDesign(design, sweep.outputs, sweep.options, sweep.limits).row;
+  DesignRow evaluated = EvaluateDesign(design, sweep.outputs, sweep.options, sweep.limits);
+  const Json& row = evaluated.row;
   if (const Json* at = FindAt(row, {"max_exit_speed", "placement"}); at != nullptr) {
     out->beyond_tip += *at == core::PlacementName(core::Placement::kBeyondTip);
     out->before_knob += *at == core::PlacementName(core::Placement::kBeforeKnob);
   }
-  AddJsonRow(plan, i, point, std::move(row), out);
+  AddJsonRow(plan, i, point, std::move(evaluated.row), evaluated.length_m, out);
 }
 
 // The most designs in a block, and the time a block aims at: blocks of fast designs are
@@ -851,6 +926,22 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
   const core::Shard& shard = sweep.shard;
   const std::uint64_t total = sweep.total;
   plan.in_shard = total / shard.count + (shard.index < total % shard.count ? 1 : 0);
+  // The trade-unit fields: in full rows with report_units imperial; in the JSON rows that
+  // columns and objectives read when one of them names such a field (not in the SI row).
+  plan.row_twins = sweep.imperial && columns.empty();
+  plan.json_twins = plan.row_twins;
+  if (!columns.empty()) {
+    std::vector<std::string> parameter_paths;
+    for (const SweepParameter& parameter : sweep.parameters)
+      parameter_paths.push_back(parameter.path);
+    const Json si_shape = RowShape(parameter_paths, sweep.outputs);
+    for (const ExploreColumn& column : columns) {
+      plan.json_twins = plan.json_twins || FindAt(si_shape, column.tokens) == nullptr;
+    }
+    for (const ParetoObjective& objective : sweep.objectives) {
+      plan.json_twins = plan.json_twins || FindAt(si_shape, objective.tokens) == nullptr;
+    }
+  }
   // Direct rows: every column and objective is read from the outcome (a full row is JSON).
   if (sweep.binder && !columns.empty()) {
     plan.direct = true;
@@ -1033,6 +1124,7 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
     summary["model_reason"] = sweep.model_reason;
   }
   AddEndPlacements(beyond_tip, before_knob, &summary);
+  if (sweep.imperial) summary["report_units"] = "imperial";  // explore-merge keeps it
   summary["provenance"] = sweep.provenance;
   outcome.summary = std::move(summary);
   return outcome;

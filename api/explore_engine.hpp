@@ -111,6 +111,10 @@ struct Sweep {
   nlohmann::json provenance;                    ///< The summary's provenance.
   std::chrono::steady_clock::time_point start;  ///< When the request arrived (timing_s).
   std::optional<DesignBinder> binder;           ///< Set when every swept path binds without JSON.
+  /// "report_units": "imperial": a full row's output blocks carry their trade-unit fields
+  /// (AddImperialToRow), and the summary says "report_units": "imperial". Rows of "columns"
+  /// hold the columns named, whatever this says.
+  bool imperial = false;
   int threads = 1;                              ///< Threads to evaluate designs on (>= 1).
   /// Pareto objective values kept before they are first cut to their front (then at each
   /// 8-fold growth); tests lower it to exercise the cuts on small sweeps.

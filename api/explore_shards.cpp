@@ -22,6 +22,7 @@ struct SweepIdentity {
   std::uint64_t count = 0;
   Json sampling, seed, objectives;
   Json exit_speed_model, model_reason;  // null when the sweep needs no exit-speed model
+  Json report_units;                    // "imperial", or null (SI rows)
 };
 
 }  // namespace
@@ -149,6 +150,7 @@ MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards) {
       id.objectives = s.value("pareto_objectives", Json());
       id.exit_speed_model = s.value("exit_speed_model", Json());
       id.model_reason = s.value("model_reason", Json());
+      id.report_units = s.value("report_units", Json());
       const std::uint64_t index = s["shard"]["index"].get<std::uint64_t>();
       if (f == 0) {
         first = id;
@@ -163,6 +165,14 @@ MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards) {
         return fail(who + "has shard count " + std::to_string(id.count) + " and " +
                     std::to_string(id.total) + " designs, " + shards[0].name + " has " +
                     std::to_string(first.count) + " and " + std::to_string(first.total));
+      } else if (id.report_units != first.report_units) {
+        // One sweep's rows in one set of units: a merge of SI and imperial rows would have
+        // fields in some rows only.
+        const auto units = [](const Json& u) {
+          return u.is_null() ? std::string("\"si\"") : Dump(u);
+        };
+        return fail(who + "has report_units " + units(id.report_units) + ", " + shards[0].name +
+                    " has " + units(first.report_units) + ": run every shard with the same");
       }
       if (!shard_indices.insert(index).second) {
         return fail(who + "repeats shard " + std::to_string(index) + " of " +
@@ -244,6 +254,7 @@ MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards) {
       summary["model_reason"] = first.model_reason;
     }
     AddEndPlacements(beyond_tip, before_knob, &summary);
+    if (!first.report_units.is_null()) summary["report_units"] = first.report_units;
     summary["provenance"] = first.provenance;
     std::string text;
     for (const auto& [i, row] : rows) text += Dump(row) + "\n";

@@ -53,8 +53,9 @@ struct MergedSweep {
 };
 
 /// Merges the shards of one sweep. They must all carry the same provenance
-/// (the sweep's input hash: explore hashes the request without its shard and
-/// format), the same shard count and designs_total, and between them every
+/// (the sweep's input hash: explore hashes the request without its shard,
+/// format, columns and report_units), the same shard count, designs_total and
+/// report_units (the summary's, absent for SI), and between them every
 /// shard index exactly once, each with all its rows (indices i with
 /// i mod count = its index, each once) and no error line. The summary is the
 /// unsharded sweep's: totals and failures summed, shard {0, 1}, the Pareto

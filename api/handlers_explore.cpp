@@ -104,10 +104,11 @@ void SweptPathToSi(const Json& base, double min, const ApiLimits& limits,
 }
 
 // "columns": 1 to kMaxColumns distinct dotted paths, each naming a part of `shape` (what a
-// row of this sweep can have). Returns false with the error naming columns[i].
+// row of this sweep can have, its numbers also in the trade's units). Returns false with the
+// error naming columns[i] and, from `si_shape` (the row in SI), the fields known there.
 constexpr std::size_t kMaxColumns = 1024;
-bool ParseColumns(const Json& list, const Json& shape, std::vector<ExploreColumn>* columns,
-                  ApiError* error) {
+bool ParseColumns(const Json& list, const Json& shape, const Json& si_shape,
+                  std::vector<ExploreColumn>* columns, ApiError* error) {
   if (!list.is_array() || list.empty() || list.size() > kMaxColumns) {
     SetError(error, ErrorCode::kInvalidValue, "columns", &list,
              "must be an array of 1 to " + std::to_string(kMaxColumns) +
@@ -131,6 +132,7 @@ bool ParseColumns(const Json& list, const Json& shape, std::vector<ExploreColumn
       }
     }
     if (std::string why; !CheckColumn(column, shape, &why)) {
+      CheckColumn(column, si_shape, &why);  // the known fields without their trade forms
       SetError(error, ErrorCode::kInvalidValue, where, &item, why);
       return false;
     }
@@ -144,6 +146,12 @@ bool ParseColumns(const Json& list, const Json& shape, std::vector<ExploreColumn
 std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Context& context,
                                                   ApiError* error) {
   ObjectReader reader(body, "", error);
+  // "report_units", read as every endpoint reads it (TakeReportUnits).
+  ReportUnits units = ReportUnits::kSi;
+  if (reader.Has("report_units")) {
+    Json only{{"report_units", body["report_units"]}};
+    if (!TakeReportUnits(&only, &units, error)) return std::nullopt;
+  }
 
   // The design template: the bat and the scene fields, as written.
   Json base = Json::object();
@@ -288,8 +296,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
       }
       Json probe = base;
       if (!steps || (parameter.scale && !scale_base) ||
-          !SetNumberAtPath(&probe, *steps, dimension.min * (parameter.scale ? 1.0 : to_si),
-                           &why)) {
+          !SetNumberAtPath(&probe, *steps, dimension.min * (parameter.scale ? 1.0 : to_si), &why)) {
         SetError(error, ErrorCode::kInvalidValue, field, path_json, why);
         return std::nullopt;
       }
@@ -398,10 +405,16 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   for (const SweepParameter& parameter : parameters) parameter_paths.push_back(parameter.path);
   std::vector<ExploreColumn> columns;
   if (column_list != nullptr || format == "csv") {
-    const Json shape = RowShape(parameter_paths, outputs);
+    // A column may name a field in a trade unit ("max_exit_speed.exit_speed_mph",
+    // "max_exit_speed.position_from_tip_in"), whatever report_units says; the default CSV
+    // columns are those of the rows report_units gives.
+    const Json si_shape = RowShape(parameter_paths, outputs);
+    Json shape = si_shape;
+    AddImperialToRow(&shape, 0.0);
     if (column_list == nullptr) {
-      columns = DefaultCsvColumns(parameter_paths, shape);
-    } else if (!ParseColumns(*column_list, shape, &columns, error)) {
+      columns =
+          DefaultCsvColumns(parameter_paths, units == ReportUnits::kImperial ? shape : si_shape);
+    } else if (!ParseColumns(*column_list, shape, si_shape, &columns, error)) {
       return std::nullopt;
     }
   }
@@ -435,13 +448,14 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   sweep->objectives = std::move(objectives);
   sweep->shard = shard;
   sweep->total = total;
-  // The sweep's identity: the request without its shard, format and columns, so
-  // that every shard of one sweep carries the same provenance (explore-merge checks
+  // The sweep's identity: the request without its shard, format, columns and report_units,
+  // so that every shard of one sweep carries the same provenance (explore-merge checks
   // it), whatever form its rows take.
   Json identity = body;
   identity.erase("shard");
   identity.erase("format");
   identity.erase("columns");
+  identity.erase("report_units");
   sweep->provenance = Provenance(identity, Json::object(), sweep->plan.seed);
   // Designs by index: grids enumerated, Sobol by a jump of its generator, LHS from the table
   // drawn here (every shard draws the same table and takes its designs from it).
@@ -451,6 +465,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
       DesignBinder::Compile(sweep->base, sweep->parameters, sweep->outputs, sweep->limits);
   sweep->threads = std::max(1, context.explore_threads);
   sweep->budget = context.thread_budget;
+  sweep->imperial = units == ReportUnits::kImperial;
 
   return ExploreRequest{std::move(sweep), std::move(format), std::move(columns)};
 }
@@ -458,8 +473,12 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
 Response HandleExplore(const Request& request, const Context& context) {
   const auto start = std::chrono::steady_clock::now();
   Response failure;
-  const auto parsed = ParseRequest<ExploreRequest>(request, context, ParseExploreRequest, &failure);
-  if (!parsed) return failure;
+  // Not ParseRequest: "report_units" is this endpoint's own field (ParseExploreRequest).
+  const std::optional<Json> body = ParseObjectBody(request, context, &failure);
+  if (!body) return failure;
+  ApiError error;
+  const auto parsed = ParseExploreRequest(*body, context, &error);
+  if (!parsed) return ToResponse(error);
   if (context.validate_only) return ValidRequest();
   // The sweep's timing_s, in its summary, counts from the request's arrival.
   const std::shared_ptr<Sweep>& sweep = parsed->sweep;

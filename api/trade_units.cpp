@@ -106,7 +106,8 @@ std::vector<TradeForm> TradeForms(std::string_view si_key) {
 
 std::vector<TradeForm> SiFormsOf(std::string_view key) {
   std::vector<std::string> candidates;
-  for (const std::string_view suffix : {std::string_view("diameter_m"), std::string_view("diameter_in")}) {
+  for (const std::string_view suffix :
+       {std::string_view("diameter_m"), std::string_view("diameter_in")}) {
     if (EndsWith(key, suffix)) {
       candidates.push_back(std::string(key.substr(0, key.size() - suffix.size())) + "radius_m");
     }
@@ -127,6 +128,24 @@ std::vector<TradeForm> SiFormsOf(std::string_view key) {
 }
 
 void AddImperial(Json* answer) { AddImperialTo(answer, std::nullopt); }
+
+void AddImperial(Json* answer, std::optional<double> length_m) { AddImperialTo(answer, length_m); }
+
+std::vector<ImperialSource> ImperialSources(std::string_view key) {
+  std::vector<ImperialSource> out;
+  constexpr std::string_view kFromTip = "_from_tip_in";
+  if (EndsWith(key, kFromTip) && key.size() > kFromTip.size()) {
+    out.push_back({std::string(key.substr(0, key.size() - kFromTip.size())) + "_from_knob_m", true,
+                   core::kMetresPerInch});
+  }
+  for (const UnitRule& rule : kRules) {
+    if (!EndsWith(key, rule.trade) || key.size() <= rule.trade.size()) continue;
+    std::string si =
+        std::string(key.substr(0, key.size() - rule.trade.size())) + std::string(rule.si);
+    if (RuleOf(si) == &rule) out.push_back({std::move(si), false, rule.to_si});
+  }
+  return out;
+}
 
 bool TakeReportUnits(Json* body, ReportUnits* units, ApiError* error) {
   *units = ReportUnits::kSi;

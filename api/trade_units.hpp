@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -45,6 +46,24 @@ enum class ReportUnits {
 /// ("*_from_tip_in") where the bat's length is known (the object's own "length_m", its
 /// "properties.length_m", or the nearest enclosing one's). Keys already present are kept.
 void AddImperial(nlohmann::json* answer);
+/// AddImperial, with the bat's length `length_m` where `answer` states none (a /v1/explore
+/// row's output block: the row need not carry the bat's properties).
+void AddImperial(nlohmann::json* answer, std::optional<double> length_m);
+
+/// Where AddImperial takes a field it adds: `key` is `si_key`'s value divided by `to_si`
+/// ("exit_speed_mph" = "exit_speed_mps" / 0.44704), or, `from_tip`, the bat's length less
+/// `si_key`'s value, in inches ("position_from_tip_in" = (length_m - "position_from_knob_m") /
+/// 0.0254). So a reader of one number (a /v1/explore column) computes it as AddImperial does.
+struct ImperialSource {
+  std::string si_key;     ///< e.g. "exit_speed_mps", "position_from_knob_m".
+  bool from_tip = false;  ///< The distance from the barrel end, in inches.
+  double to_si = 1.0;     ///< The divisor when not from_tip.
+};
+
+/// The SI fields AddImperial could add `key` from, in the order it prefers them (a position
+/// "*_from_tip_in" from "*_from_knob_m" before a "*_from_tip_m" length); the first one an
+/// object has is the one. Empty when `key` is no name AddImperial adds.
+std::vector<ImperialSource> ImperialSources(std::string_view key);
 
 struct ApiError;
 

@@ -3,6 +3,7 @@
 // failing designs alike; and they do not depend on the number of threads.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -351,8 +352,8 @@ TEST(ExploreEngineTest, TradeUnitsInTheTemplateAndInSweptPathsMatchTheJsonPath) 
                    {"path": "three_segment.barrel_radius_m", "min": 0.03, "max": 0.034,
                     "count": 2}],
     "outputs": ["max_exit_speed", "properties"]})");
-  const std::string rows = ExpectSameRows(body, /*expect_bound=*/true,
-                                          Json{"index", "max_exit_speed.exit_speed_mps"});
+  const std::string rows =
+      ExpectSameRows(body, /*expect_bound=*/true, Json{"index", "max_exit_speed.exit_speed_mps"});
   ASSERT_FALSE(rows.empty());
   EXPECT_EQ(rows.find("\"feasible\":false"), std::string::npos) << rows;
   // Design 5 (speed 40 m/s, barrel radius 0.034 m) is the single request with those SI
@@ -380,8 +381,8 @@ TEST(ExploreEngineTest, TradeUnitsInTheTemplateAndInSweptPathsMatchTheJsonPath) 
   trade["parameters"] = Json::parse(R"([
       {"path": "ball.speed_mph", "min": 50, "max": 90, "count": 3},
       {"path": "three_segment.barrel_diameter_in", "min": 2.4, "max": 2.7, "count": 2}])");
-  const std::string trade_rows =
-      ExpectSameRows(trade, true, Json{"parameters.ball.speed_mph", "max_exit_speed.exit_speed_mps"});
+  const std::string trade_rows = ExpectSameRows(
+      trade, true, Json{"parameters.ball.speed_mph", "max_exit_speed.exit_speed_mps"});
   ASSERT_FALSE(trade_rows.empty());
   const Json trade_row = row_of(trade_rows, 5);
   EXPECT_EQ(trade_row["parameters"]["ball.speed_mph"], 90.0);
@@ -401,7 +402,8 @@ TEST(ExploreEngineTest, TradeUnitsInTheTemplateAndInSweptPathsMatchTheJsonPath) 
   scaled["parameters"] = Json::parse(
       R"([{"scale_paths": ["ball.speed_mps"], "name": "speed_scale", "min": 1, "max": 1.5,
            "count": 2}])");
-  const std::string scaled_rows = ExpectSameRows(scaled, true, Json{"max_exit_speed.exit_speed_mps"});
+  const std::string scaled_rows =
+      ExpectSameRows(scaled, true, Json{"max_exit_speed.exit_speed_mps"});
   ASSERT_FALSE(scaled_rows.empty());
   EXPECT_EQ(scaled_rows.find("\"feasible\":false"), std::string::npos) << scaled_rows;
 
@@ -413,6 +415,66 @@ TEST(ExploreEngineTest, TradeUnitsInTheTemplateAndInSweptPathsMatchTheJsonPath) 
   const std::string fill_rows = ExpectSameRows(fill, true, Json{"properties.mass_kg"});
   EXPECT_NE(fill_rows.find("\"fill.diameter_m\":0.03"), std::string::npos) << fill_rows;
   EXPECT_EQ(fill_rows.find("\"feasible\":false"), std::string::npos) << fill_rows;
+}
+
+// Issue 19: "report_units": "imperial" rows, and columns that name trade-unit fields (read by
+// the engine as the SI value and a conversion), are the JSON path's, byte for byte, for
+// feasible and failing designs; a column's value does not depend on report_units.
+TEST(ExploreEngineTest, ImperialRowsAndTradeUnitColumnsMatchTheJsonPath) {
+  Json body = Json::parse(R"({
+    "bat": {"three_segment": {"length_m": 0.8636, "handle_radius_m": 0.0125,
+            "barrel_radius_m": 0.033, "taper_start_m": 0.30, "taper_end_m": 0.55},
+            "material": "ash"},
+    "cor": 0.5, "report_units": "imperial",
+    "parameters": [{"path": "three_segment.taper_start_m", "min": 0.2, "max": 0.6, "count": 12},
+                   {"path": "three_segment.taper_end_in", "min": 18, "max": 27, "count": 25}],
+    "outputs": ["max_exit_speed", "properties", "center_of_percussion", "collision_efficiency"],
+    "pareto": {"objectives": [{"output": "max_exit_speed.exit_speed_mph", "sense": "max"},
+                              {"output": "properties.mass_oz", "sense": "min"}]}})");
+  const Json columns = {"index",
+                        "parameters.three_segment.taper_end_in",
+                        "max_exit_speed.exit_speed_mph",
+                        "max_exit_speed.position_from_knob_in",
+                        "max_exit_speed.position_from_tip_in",
+                        "max_exit_speed.unconstrained_position_from_tip_in",
+                        "center_of_percussion.position_from_tip_in",
+                        "center_of_percussion.hands_from_knob_in",
+                        "center_of_percussion.moi_hands_oz_in2",
+                        "properties.mass_oz",
+                        "properties.balance_point_in",
+                        "properties.moi_knob_oz_in2",
+                        "properties.moi_six_inch_oz_in2",
+                        "properties.moi_centroid_oz_in2",
+                        "properties.length_in",
+                        "properties.imperial.weight_oz",
+                        "max_exit_speed.exit_speed_mps",
+                        "error.code"};
+  const std::string rows = ExpectSameRows(body, /*expect_bound=*/true, columns);
+  EXPECT_NE(rows.find("\"feasible\":false"), std::string::npos);
+  EXPECT_NE(rows.find("\"exit_speed_mph\":"), std::string::npos);
+  EXPECT_NE(rows.find("\"position_from_tip_in\":"), std::string::npos);
+  EXPECT_NE(rows.find("\"report_units\":\"imperial\""), std::string::npos);  // the summary
+  // The named columns are the same values without report_units.
+  Json si = body;
+  si.erase("report_units");
+  si.erase("pareto");
+  body.erase("pareto");
+  for (Json* b : {&body, &si}) {
+    (*b)["format"] = "csv";
+    (*b)["columns"] = columns;
+  }
+  const ExploreRequest imperial_request = Parse(body), si_request = Parse(si);
+  ASSERT_NE(imperial_request.sweep, nullptr);
+  ASSERT_NE(si_request.sweep, nullptr);
+  // RunText's last line is the summary, which says report_units in the imperial sweep only.
+  const auto csv_rows = [](const ExploreRequest& request) {
+    std::string text = RunText(*request.sweep, RowFormat::kCsv, request.columns);
+    text.pop_back();
+    return text.substr(0, text.rfind('\n') + 1);
+  };
+  const std::string imperial_csv = csv_rows(imperial_request);
+  EXPECT_EQ(std::count(imperial_csv.begin(), imperial_csv.end(), '\n'), 300);
+  EXPECT_EQ(imperial_csv, csv_rows(si_request));
 }
 
 }  // namespace

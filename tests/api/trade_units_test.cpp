@@ -172,15 +172,18 @@ TEST(TradeUnitsTest, ImperialReportsEveryQuantityInTheTradesUnitsAndFromTheTip) 
   // SI only by default.
   const Response si = Post("/v1/sweet-spot", Json{{"bat", SiBat()}});
   EXPECT_FALSE(si.body["max_exit_speed"].contains("exit_speed_mph"));
-  // Bad values, and the endpoint that keeps SI rows, say so.
+  // Bad values say so, /v1/explore's too (its imperial rows: explore_imperial_test.cpp).
   body["report_units"] = "furlongs";
   EXPECT_EQ(Post("/v1/sweet-spot", body).body["field"], "report_units");
-  const Response e = Post("/v1/explore", Json{{"bat", SiBat()},
-                                             {"report_units", "imperial"},
-                                             {"parameters", {{{"path", "cor"}, {"min", 0.4},
-                                                              {"max", 0.5}, {"count", 2}}}}});
+  Json sweep{{"bat", SiBat()},
+             {"report_units", "furlongs"},
+             {"parameters", {{{"path", "cor"}, {"min", 0.4}, {"max", 0.5}, {"count", 2}}}}};
+  const Response e = Post("/v1/explore", sweep);
   EXPECT_EQ(e.status, 400);
   EXPECT_EQ(e.body["field"], "report_units");
+  EXPECT_EQ(e.body["message"], "report_units = \"furlongs\": must be \"si\" or \"imperial\"");
+  sweep["report_units"] = "imperial";
+  EXPECT_EQ(Post("/v1/explore", sweep).status, 200);
 }
 
 bool Mentions(const Json& warnings, const std::string& text) {

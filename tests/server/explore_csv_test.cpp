@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -302,6 +303,96 @@ TEST(ExploreCsvEndToEndTest, AJobHasTheBatchLimit) {
   EXPECT_EQ(refusal["message"],
             "parameters describe 25 designs, over the limit max_batch_samples = 20");
   EXPECT_EQ(Json::parse(client.Get("/v1/jobs")->body)["total"], 1);  // Only the first job.
+}
+
+// Issue 19: an imperial sweep ("report_units": "imperial") in CSV (the default columns, the
+// trade-unit fields among them) and in NDJSON is the same bytes over HTTP, from the CLI and as
+// a job's result (NDJSON but the summary's timing_s); and its shards, run by the CLI and
+// merged by explore-merge, are the unsharded sweep.
+TEST(ExploreCsvEndToEndTest, ImperialSweepsAreTheSameBytesOverHttpCliAndJob) {
+  Json sweep = Json::parse(R"({"bat": {"preset": "paper-wood",
+      "fill": {"material": "cork", "diameter_in": 1, "depth_in": 10}},
+    "parameters": [{"path": "fill.depth_in", "min": 0, "max": 12, "count": 40},
+                   {"path": "ball.speed_mph", "min": 60, "max": 95, "count": 3}],
+    "outputs": ["max_exit_speed", "center_of_percussion", "properties"],
+    "report_units": "imperial"})");
+  ServerConfig config;
+  config.threads = 4;
+  RunningServer server(config);
+  ASSERT_TRUE(server.bound());
+  httplib::Client client = server.Client();
+  client.set_read_timeout(std::chrono::seconds(120));
+  const auto without_timing = [](const std::string& ndjson) {
+    const std::size_t at = ndjson.rfind("\"timing_s\":");
+    if (at == std::string::npos) return ndjson;
+    const std::size_t end = ndjson.find_first_of(",}", at);
+    return ndjson.substr(0, at) + ndjson.substr(end);
+  };
+  for (const char* format : {"csv", "ndjson"}) {
+    sweep["format"] = format;
+    const auto http = client.Post("/v1/explore", sweep.dump(), "application/json");
+    ASSERT_TRUE(http);
+    ASSERT_EQ(http->status, 200) << http->body;
+    const std::vector<std::string> lines = Lines(http->body);
+    ASSERT_EQ(lines.size(), 121u) << format;  // 120 rows and the header or the summary
+    if (std::string(format) == "csv") {
+      EXPECT_NE(lines[0].find(",max_exit_speed.exit_speed_mph,"), std::string::npos) << lines[0];
+      EXPECT_NE(lines[0].find(",center_of_percussion.position_from_tip_in,"), std::string::npos);
+      EXPECT_NE(lines[0].find(",properties.mass_oz,"), std::string::npos);
+    } else {
+      EXPECT_EQ(Json::parse(lines.back())["summary"]["report_units"], "imperial");
+      EXPECT_TRUE(Json::parse(lines[0])["max_exit_speed"].contains("position_from_tip_in"));
+    }
+    const TemporaryFile request_file("sweep.json", sweep.dump());
+    const CliOutput cli = RunSweetspot("explore " + request_file.path());
+    EXPECT_EQ(cli.exit_code, 0);
+    EXPECT_TRUE(without_timing(cli.out) == without_timing(http->body))
+        << format << ": the CLI's output differs from the HTTP answer";
+
+    const auto submitted = client.Post(
+        "/v1/jobs", Json{{"path", "/v1/explore"}, {"body", sweep}}.dump(), "application/json");
+    ASSERT_TRUE(submitted);
+    ASSERT_EQ(submitted->status, 202) << submitted->body;
+    const std::string id = Json::parse(submitted->body)["id"].get<std::string>();
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    std::string state;
+    while (state != "done" && std::chrono::steady_clock::now() < deadline) {
+      const auto status = client.Get("/v1/jobs/" + id);
+      ASSERT_TRUE(status);
+      state = Json::parse(status->body)["state"].get<std::string>();
+      ASSERT_NE(state, "failed") << status->body;
+      if (state != "done") std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ASSERT_EQ(state, "done");
+    const auto result = client.Get("/v1/jobs/" + id + "/result");
+    ASSERT_TRUE(result);
+    EXPECT_EQ(result->status, 200);
+    EXPECT_TRUE(without_timing(result->body) == without_timing(http->body))
+        << format << ": the job's result differs from the HTTP answer";
+
+    if (std::string(format) != "ndjson") continue;
+    // Three shards by the CLI, merged: the unsharded sweep (the summary but timing_s).
+    std::vector<std::unique_ptr<TemporaryFile>> shard_files;
+    std::string names;
+    for (int i = 0; i < 3; ++i) {
+      const CliOutput shard =
+          RunSweetspot("explore --shard " + std::to_string(i) + "/3 " + request_file.path());
+      ASSERT_EQ(shard.exit_code, 0) << shard.out;
+      shard_files.push_back(
+          std::make_unique<TemporaryFile>("shard-" + std::to_string(i) + ".ndjson", shard.out));
+      names += " " + shard_files.back()->path();
+    }
+    const CliOutput merged = RunSweetspot("explore-merge" + names);
+    ASSERT_EQ(merged.exit_code, 0) << merged.out;
+    const std::vector<std::string> merged_lines = Lines(merged.out);
+    ASSERT_EQ(merged_lines.size(), lines.size());
+    for (std::size_t i = 0; i + 1 < lines.size(); ++i) EXPECT_EQ(merged_lines[i], lines[i]) << i;
+    Json merged_summary = Json::parse(merged_lines.back())["summary"];
+    Json whole_summary = Json::parse(lines.back())["summary"];
+    merged_summary.erase("timing_s");
+    whole_summary.erase("timing_s");
+    EXPECT_EQ(merged_summary, whole_summary);
+  }
 }
 
 }  // namespace
