@@ -50,6 +50,44 @@ TEST(TradeUnitsTest, EachSiNameHasItsTradeSpellings) {
   EXPECT_TRUE(TradeForms("cor").empty());
 }
 
+// The inverses /v1/explore uses: a swept path in a trade unit -> its SI field (SiFormsOf), and
+// a column naming a trade-unit field -> the SI field and conversion AddImperial uses.
+TEST(TradeUnitsTest, TradeSpellingsLeadBackToTheirSiFields) {
+  const auto diameter = SiFormsOf("barrel_diameter_in");
+  ASSERT_EQ(diameter.size(), 2u);  // a radius first; "barrel_diameter_m" is itself a trade form
+  EXPECT_EQ(diameter[0].key, "barrel_radius_m");
+  EXPECT_EQ(diameter[0].to_si, 0.5 * kInch);
+  EXPECT_EQ(diameter[1].key, "barrel_diameter_m");
+  EXPECT_EQ(diameter[1].to_si, kInch);
+  ASSERT_EQ(SiFormsOf("speed_mph").size(), 1u);
+  EXPECT_EQ(SiFormsOf("speed_mph")[0].key, "speed_mps");
+  EXPECT_EQ(SiFormsOf("speed_mph")[0].to_si, kMph);
+  EXPECT_EQ(SiFormsOf("moi_six_inch_oz_in2").at(0).key, "moi_six_inch_kg_m2");
+  EXPECT_EQ(SiFormsOf("mass_oz").at(0).to_si, kOunce);
+  EXPECT_TRUE(SiFormsOf("length_m").empty());              // SI already
+  EXPECT_TRUE(SiFormsOf("hands_stiffness_n_in").empty());  // N/m has no trade form
+  EXPECT_TRUE(SiFormsOf("cor").empty());
+
+  const auto tip = ImperialSources("position_from_tip_in");
+  ASSERT_EQ(tip.size(), 2u);
+  EXPECT_EQ(tip[0].si_key, "position_from_knob_m");
+  EXPECT_TRUE(tip[0].from_tip);
+  EXPECT_EQ(tip[1].si_key, "position_from_tip_m");  // a length named so (bat_speed_from_tip_m)
+  EXPECT_FALSE(tip[1].from_tip);
+  const auto mph = ImperialSources("exit_speed_mph");
+  ASSERT_EQ(mph.size(), 1u);
+  EXPECT_EQ(mph[0].si_key, "exit_speed_mps");
+  EXPECT_EQ(mph[0].to_si, kMph);
+  EXPECT_EQ(ImperialSources("moi_hands_oz_in2").at(0).si_key, "moi_hands_kg_m2");
+  EXPECT_TRUE(ImperialSources("stiffness_n_in").empty());
+  EXPECT_TRUE(ImperialSources("exit_speed_mps").empty());
+  // AddImperial with a length given for an object that states none.
+  Json block{{"position_from_knob_m", 0.7}, {"exit_speed_mps", 30.0}};
+  AddImperial(&block, 0.8636);
+  EXPECT_EQ(block["position_from_tip_in"].get<double>(), (0.8636 - 0.7) / kInch);
+  EXPECT_EQ(block["exit_speed_mph"].get<double>(), 30.0 / kMph);
+}
+
 // The contract's three-segment ash bat in SI and in inches with diameters.
 Json SiBat() {
   return Json::parse(R"({"three_segment": {"length_m": 0.8636, "handle_radius_m": 0.0125,
