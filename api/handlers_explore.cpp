@@ -42,43 +42,6 @@ bool IsKnownField(const Json& probe, const ApiLimits& limits, ApiError* unknown)
   return false;
 }
 
-// The object holding the last step of `steps` in *root (the swept field's parent), or nullptr
-// when the path does not lead to one.
-Json* SweptFieldParent(Json* root, const std::vector<PathStep>& steps) {
-  Json* node = root;
-  for (std::size_t k = 0; k + 1 < steps.size(); ++k) {
-    if (const auto* key = std::get_if<std::string>(&steps[k])) {
-      if (!node->is_object() || !node->contains(*key)) return nullptr;
-      node = &(*node)[*key];
-    } else {
-      const std::size_t index = std::get<std::size_t>(steps[k]);
-      if (!node->is_array() || index >= node->size()) return nullptr;
-      node = &(*node)[index];
-    }
-  }
-  return node->is_object() ? node : nullptr;
-}
-
-// Issue 19: a swept field is set in SI in every design, so the template gives it in SI too:
-// a trade form of it there ("speed_mph" beside a swept "ball.speed_mps", "barrel_diameter_in"
-// beside "three_segment.barrel_radius_m") is replaced by the SI field, its value converted as
-// a request's reader converts it. Otherwise each design would hold two forms of one quantity,
-// which the JSON path refuses while the engine binds the SI one.
-void SweptFieldToSi(Json* base, const std::vector<PathStep>& steps) {
-  if (steps.empty()) return;
-  const auto* leaf = std::get_if<std::string>(&steps.back());
-  Json* parent = leaf != nullptr ? SweptFieldParent(base, steps) : nullptr;
-  if (parent == nullptr || parent->contains(*leaf)) return;
-  for (const TradeForm& form : TradeForms(*leaf)) {
-    const auto it = parent->find(form.key);
-    if (it == parent->end() || !it->is_number()) continue;
-    const double si = it->get<double>() * form.to_si;
-    parent->erase(it);
-    (*parent)[*leaf] = si;
-    return;  // the template was checked: it has at most one form of the quantity
-  }
-}
-
 // A swept path written in a trade unit ("ball.speed_mph", "three_segment.barrel_diameter_in")
 // sweeps its SI field: *steps becomes that field's path and *to_si the factor from the swept
 // value to it. A path whose last key is no trade spelling, or whose SI field the design's
@@ -286,7 +249,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
       double to_si = 1.0;
       if (steps) {
         SweptPathToSi(base, dimension.min, context.limits, &*steps, &to_si);
-        SweptFieldToSi(&base, *steps);
+        TradeFormToSi(&base, *steps);
       }
       std::optional<double> scale_base;
       if (steps && parameter.scale) {

@@ -17,6 +17,7 @@
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
 #include "api/sanity.hpp"
+#include "api/trade_units.hpp"
 #include "api/scene_json.hpp"
 #include "core/optimize/design_problem.hpp"
 
@@ -191,6 +192,7 @@ Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r) {
     if (v.scale_factor) continue;  // a factor: its fields follow it in the list
     std::string why;
     const auto steps = ParseJsonPath(v.path, &why);
+    if (steps) TradeFormToSi(&bat, *steps);  // "taper_start_in" becomes "taper_start_m"
     if (steps && SetNumberAtPath(&bat, *steps, v.value, &why)) continue;
     if (v.path.rfind("three_segment.", 0) == 0 && r.three_segment) {
       const auto& s = *r.three_segment;

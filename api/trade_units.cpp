@@ -3,6 +3,7 @@
 #include <optional>
 #include <utility>
 
+#include "api/json_path.hpp"
 #include "api/json_reader.hpp"
 #include "core/units.hpp"
 
@@ -86,7 +87,39 @@ void AddImperialTo(Json* node, std::optional<double> length_m) {
   }
 }
 
+// The object holding the last step of `steps` in *root (the field's parent), or nullptr
+// when the path does not lead to one.
+Json* TradeFieldParent(Json* root, const std::vector<PathStep>& steps) {
+  Json* node = root;
+  for (std::size_t k = 0; k + 1 < steps.size(); ++k) {
+    if (const auto* key = std::get_if<std::string>(&steps[k])) {
+      if (!node->is_object() || !node->contains(*key)) return nullptr;
+      node = &(*node)[*key];
+    } else {
+      const std::size_t index = std::get<std::size_t>(steps[k]);
+      if (!node->is_array() || index >= node->size()) return nullptr;
+      node = &(*node)[index];
+    }
+  }
+  return node->is_object() ? node : nullptr;
+}
+
 }  // namespace
+
+void TradeFormToSi(nlohmann::json* root, const std::vector<PathStep>& steps) {
+  if (steps.empty()) return;
+  const auto* leaf = std::get_if<std::string>(&steps.back());
+  Json* parent = leaf != nullptr ? TradeFieldParent(root, steps) : nullptr;
+  if (parent == nullptr || parent->contains(*leaf)) return;
+  for (const TradeForm& form : TradeForms(*leaf)) {
+    const auto it = parent->find(form.key);
+    if (it == parent->end() || !it->is_number()) continue;
+    const double si = it->get<double>() * form.to_si;
+    parent->erase(it);
+    (*parent)[*leaf] = si;
+    return;  // the template was checked: it has at most one form of the quantity
+  }
+}
 
 std::vector<TradeForm> TradeForms(std::string_view si_key) {
   std::vector<TradeForm> out;

@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "api/json_path.hpp"
+
 namespace sweetspot::api {
 
 /// Another spelling of an SI field: its name and the factor that turns its value into the SI
@@ -32,6 +34,15 @@ std::vector<TradeForm> TradeForms(std::string_view si_key);
 /// is the field a given object has (a fill has "diameter_m" of its own, a knot "radius_m") is
 /// the caller's to decide.
 std::vector<TradeForm> SiFormsOf(std::string_view key);
+
+/// Where `steps` leads to an SI field that its object (in *root) gives in a trade form instead
+/// ("taper_start_in" for "three_segment.taper_start_m", "barrel_diameter_in" for
+/// ".barrel_radius_m", "speed_mph" for "ball.speed_mps"), replaces that form by the SI field,
+/// its value converted as a request's reader converts it; otherwise leaves *root as it is.
+/// Used where a path is then set in SI (a swept field of /v1/explore's template, a design
+/// variable written back into /v1/optimize's bat), so the object never holds two forms of one
+/// quantity, which a request's reader refuses.
+void TradeFormToSi(nlohmann::json* root, const std::vector<PathStep>& steps);
 
 /// How an answer reports its numbers ("report_units").
 enum class ReportUnits {

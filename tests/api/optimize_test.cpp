@@ -440,6 +440,24 @@ TEST(OptimizeEndpointTest, MaterialChoiceWithDensityVariableReturnsTheChosenMate
               1e-12 * r.body["properties"]["mass_kg"].get<double>());
 }
 
+// A bat given in inches whose field is a variable in SI: the answer's bat holds the SI field
+// only (it held "taper_start_in": 12 beside "taper_start_m"), so it goes back as a request.
+TEST(OptimizeEndpointTest, AVariableOfAFieldGivenInInchesComesBackInSiOnly) {
+  Json body = ContractExample();
+  body["bat"]["three_segment"].erase("taper_start_m");
+  body["bat"]["three_segment"]["taper_start_in"] = 12;
+  const Response r = Post("/v1/optimize", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const Json& shape = r.body["bat"]["three_segment"];
+  EXPECT_FALSE(shape.contains("taper_start_in")) << shape.dump();
+  EXPECT_EQ(shape["taper_start_m"], r.body["variables"]["three_segment.taper_start_m"]);
+  const Response p = Post("/v1/bat/properties", Json{{"bat", r.body["bat"]}});
+  ASSERT_EQ(p.status, 200) << p.body.dump();
+  // Same bat, same code: the answer's mass to 1e-12 relative.
+  EXPECT_NEAR(p.body["mass_kg"].get<double>(), r.body["properties"]["mass_kg"].get<double>(),
+              1e-12 * r.body["properties"]["mass_kg"].get<double>());
+}
+
 // Issue 19: a variable may set several fields at once ("paths"); the answer lists each and the
 // bat comes back with all of them set.
 TEST(OptimizeEndpointTest, LinkedPathsSetEveryFieldToTheVariablesValue) {
