@@ -17,9 +17,12 @@
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
 #include "api/sanity.hpp"
-#include "api/trade_units.hpp"
 #include "api/scene_json.hpp"
+#include "api/trade_units.hpp"
+#include "core/geometry_format.hpp"
 #include "core/optimize/design_problem.hpp"
+#include "core/scene/resolved_scene.hpp"
+#include "core/scene/timing_book.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -302,6 +305,7 @@ struct OptimizeRequest {
   std::vector<core::Material> material_choices;
   std::string objective;
   Json request_bat;
+  std::string cor_source;  // "scene", or the ball's law at the base design; empty: material's
 };
 
 // What the optimiser returned: one design, or one per material and the best of them.
@@ -455,6 +459,25 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
   problem.swing = scene.swing;
   problem.cor = scene.cor;
   problem.inertia_model = scene.inertia_model;
+  if (!scene.cor.has_value()) {
+    // The COR of the ball-bat pair as a scene resolves it (issue 18): a ball with a COR law
+    // (ball.preset) gives the law's value at the base design's impact speed (through the
+    // barrel for a hollow bat), held fixed while the design changes; otherwise the material's.
+    core::Scene base = scene;
+    base.bat = problem.bat;
+    core::TimingBook book(false);
+    core::ResolvedScene resolved;
+    core::Summary summary;
+    if (core::ResolveScene(base, true, &book, &resolved, &summary) &&
+        resolved.cor_source.rfind("material:", 0) != 0) {
+      problem.cor = resolved.cor;
+      request.cor_source = resolved.cor_source + " at the base design's impact speed (" +
+                           core::FormatNumber(resolved.cor_impact_speed_mps.value_or(0.0)) +
+                           " m/s), held fixed while the design changes";
+    }
+  } else {
+    request.cor_source = "scene";
+  }
   if (!ReadVariables(reader, context.limits, &problem, &request.material_choices) ||
       !ReadConstraints(reader, &problem.constraints)) {
     return std::nullopt;
@@ -540,6 +563,10 @@ Json RenderOptimize(const OptimizeRequest& request, const OptimizeResult& result
           result.choice.per_material[static_cast<std::size_t>(result.choice.best)].material;
     }
   }
+  // Where the COR came from: the request, the ball's law, or (empty here) the material's.
+  out["cor_source"] = !request.cor_source.empty()
+                          ? request.cor_source
+                          : "material:" + result.Chosen()->bat.material.name;
   out["objective"] = request.objective;
   if (request.problem.objective != core::DesignObjective::kMinMoi) {
     out["sweet_spot"]["model"] = core::CollisionModelName(request.problem.model);

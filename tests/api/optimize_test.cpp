@@ -458,6 +458,36 @@ TEST(OptimizeEndpointTest, AVariableOfAFieldGivenInInchesComesBackInSiOnly) {
               1e-12 * r.body["properties"]["mass_kg"].get<double>());
 }
 
+// Issue 18: without "cor", a ball with a COR law gives the COR as a scene resolves it for the
+// base design (held fixed while the design changes), and the answer says where it came from.
+TEST(OptimizeEndpointTest, TheCorComesFromTheBallLikeAScenesAndSaysSo) {
+  Json body = ContractExample();
+  body.erase("cor");
+  body["ball"] = {{"preset", "mlb"}, {"speed_mph", 90}};
+  body["swing"] = {{"bat_speed_mph", 70}};
+  body["options"]["starts"] = 1;
+  const Response r = Post("/v1/optimize", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  Json scene{{"bat", body["bat"]}, {"ball", body["ball"]}, {"swing", body["swing"]}};
+  const Response s = Post("/v1/sweet-spot", scene);
+  ASSERT_EQ(s.status, 200) << s.body.dump();
+  EXPECT_EQ(r.body["cor"], s.body["cor"]);  // the same resolver on the same bat: bit for bit
+  EXPECT_NE(r.body["cor"].get<double>(), 0.5);  // not the material's
+  EXPECT_EQ(r.body["cor_source"].get<std::string>().rfind("ball:mlb at the base design", 0), 0u)
+      << r.body["cor_source"];
+  // Without a ball law: the material's; with "cor": the request's.
+  body.erase("ball");
+  const Response m = Post("/v1/optimize", body);
+  ASSERT_EQ(m.status, 200) << m.body.dump();
+  EXPECT_EQ(m.body["cor_source"], "material:ash");
+  EXPECT_EQ(m.body["cor"], 0.5);
+  body["cor"] = 0.45;
+  const Response c = Post("/v1/optimize", body);
+  ASSERT_EQ(c.status, 200) << c.body.dump();
+  EXPECT_EQ(c.body["cor_source"], "scene");
+  EXPECT_EQ(c.body["cor"], 0.45);
+}
+
 // Issue 19: a variable may set several fields at once ("paths"); the answer lists each and the
 // bat comes back with all of them set.
 TEST(OptimizeEndpointTest, LinkedPathsSetEveryFieldToTheVariablesValue) {
