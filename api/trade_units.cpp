@@ -80,6 +80,9 @@ void AddImperialTo(Json* node, std::optional<double> length_m) {
     if (rule->trade == "_in" && EndsWith(base, "_from_knob") && length_m) {
       const std::string stem = base.substr(0, base.size() - std::string_view("_from_knob").size());
       added.emplace_back(stem + "_from_tip_in", (*length_m - si) / core::kMetresPerInch);
+    } else if (rule->trade == "_in" && EndsWith(base, "_knob") && length_m) {
+      // A zone's ends ("from_knob_m", "to_knob_m" of sweet_zone): each end from the tip too.
+      added.emplace_back(base + "_from_tip_in", (*length_m - si) / core::kMetresPerInch);
     }
   }
   for (auto& [key, value] : added) {
@@ -168,8 +171,12 @@ std::vector<ImperialSource> ImperialSources(std::string_view key) {
   std::vector<ImperialSource> out;
   constexpr std::string_view kFromTip = "_from_tip_in";
   if (EndsWith(key, kFromTip) && key.size() > kFromTip.size()) {
-    out.push_back({std::string(key.substr(0, key.size() - kFromTip.size())) + "_from_knob_m", true,
-                   core::kMetresPerInch});
+    const std::string stem(key.substr(0, key.size() - kFromTip.size()));
+    if (EndsWith(stem, "_knob") && !EndsWith(stem, "_from_knob")) {
+      out.push_back({stem + "_m", true, core::kMetresPerInch});  // a zone's end: "to_knob_m"
+    } else {
+      out.push_back({stem + "_from_knob_m", true, core::kMetresPerInch});
+    }
   }
   for (const UnitRule& rule : kRules) {
     if (!EndsWith(key, rule.trade) || key.size() <= rule.trade.size()) continue;

@@ -54,7 +54,8 @@ enum class ReportUnits {
 /// "*_diameter_*"), the same quantity in the trade's unit ("length_m" -> "length_in",
 /// "mass_kg" -> "mass_oz", "exit_speed_mps" -> "exit_speed_mph", "*_kg_m2" -> "*_oz_in2"), and
 /// beside every position "*_from_knob_m" its distance from the barrel end in inches
-/// ("*_from_tip_in") where the bat's length is known (the object's own "length_m", its
+/// ("*_from_tip_in"; a zone's ends "from_knob_m", "to_knob_m": "*_knob_from_tip_in") where the
+/// bat's length is known (the object's own "length_m", its
 /// "properties.length_m", or the nearest enclosing one's). Keys already present are kept.
 void AddImperial(nlohmann::json* answer);
 /// AddImperial, with the bat's length `length_m` where `answer` states none (a /v1/explore

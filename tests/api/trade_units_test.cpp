@@ -207,6 +207,16 @@ TEST(TradeUnitsTest, ImperialReportsEveryQuantityInTheTradesUnitsAndFromTheTip) 
             r.body["properties"]["mass_kg"].get<double>() / kOunce);
   EXPECT_EQ(r.body["properties"]["moi_six_inch_oz_in2"].get<double>(),
             r.body["properties"]["moi_six_inch_kg_m2"].get<double>() / (kOunce * kInch * kInch));
+  // A zone's two ends are positions too: each also from the tip.
+  Json zone = body;
+  zone["outputs"] = {"sweet_zone"};
+  const Response z = Post("/v1/sweet-spot", zone);
+  ASSERT_EQ(z.status, 200) << z.body.dump();
+  const Json& sz = z.body["sweet_zone"];
+  EXPECT_EQ(sz["from_knob_from_tip_in"].get<double>(),
+            (length - sz["from_knob_m"].get<double>()) / kInch);
+  EXPECT_EQ(sz["to_knob_from_tip_in"].get<double>(),
+            (length - sz["to_knob_m"].get<double>()) / kInch);
   // SI only by default.
   const Response si = Post("/v1/sweet-spot", Json{{"bat", SiBat()}});
   EXPECT_FALSE(si.body["max_exit_speed"].contains("exit_speed_mph"));
