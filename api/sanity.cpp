@@ -53,7 +53,15 @@ std::vector<std::string> SanityWarnings(const core::Bat* bat, const core::Ball* 
                     N(b.max_ball_radius_m) + " m; a diameter, or inches?");
     }
   }
-  if (swing != nullptr && length_m > 0.0) {
+  if (swing != nullptr && swing->bat_speed_mps.has_value()) {
+    // A swing given by its bat speed (omega follows from it): the speed itself is checked, at
+    // the point it is given for, against the fastest tip (a point nearer the knob is slower).
+    if (*swing->bat_speed_mps > b.max_bat_tip_speed_mps) {
+      out.push_back("swing.bat_speed_mps = " + N(*swing->bat_speed_mps) +
+                    ": no swing is faster than " + N(b.max_bat_tip_speed_mps) +
+                    " m/s (134 mph) at the tip; mph given as m/s?");
+    }
+  } else if (swing != nullptr && length_m > 0.0) {
     const double tip_speed = swing->angular_speed_rad_s * (length_m - swing->pivot_from_knob_m);
     if (tip_speed > b.max_bat_tip_speed_mps) {
       out.push_back("swing.angular_speed_rad_s = " + N(swing->angular_speed_rad_s) +

@@ -264,8 +264,22 @@ TEST(SanityWarningsTest, TheIssuesThreeSlipsAreComputedAndNamed) {
   ASSERT_EQ(r.status, 200);
   EXPECT_TRUE(Mentions(r.body["warnings"], "ball.speed_mps = 90")) << r.body["warnings"];
   EXPECT_TRUE(Mentions(r.body["warnings"], "mph given as m/s?"));
-  // A real bat, ball and swing: no such warning.
+  // A 100 m/s swing, as an angular speed (the tip at 100 m/s) and as a bat speed (which the
+  // tip check did not see: omega follows from it). The limit is 60 m/s at the tip.
+  r = Post("/v1/sweet-spot",
+           Json{{"bat", SiBat()}, {"swing", {{"angular_speed_rad_s", 116}}}});  // tip 100.2 m/s
+  ASSERT_EQ(r.status, 200);
+  EXPECT_TRUE(Mentions(r.body["warnings"], "swing.angular_speed_rad_s = 116: the tip moves at"))
+      << r.body["warnings"];
+  r = Post("/v1/sweet-spot", Json{{"bat", SiBat()}, {"swing", {{"bat_speed_mps", 100}}}});
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_TRUE(Mentions(r.body["warnings"], "swing.bat_speed_mps = 100: no swing is faster"))
+      << r.body["warnings"];
+  // A real bat, ball and swing: no such warning (70 mph of bat speed either way).
   r = Post("/v1/sweet-spot", Json{{"bat", SiBat()}, {"ball", {{"speed_mph", 90}}}});
+  ASSERT_EQ(r.status, 200);
+  EXPECT_FALSE(Mentions(r.body["warnings"], "?")) << r.body["warnings"];
+  r = Post("/v1/sweet-spot", Json{{"bat", SiBat()}, {"swing", {{"bat_speed_mph", 70}}}});
   ASSERT_EQ(r.status, 200);
   EXPECT_FALSE(Mentions(r.body["warnings"], "?")) << r.body["warnings"];
 }

@@ -85,6 +85,36 @@ std::vector<std::string> Lines(const std::string& text) {
 
 // The HTTP answer, the CLI's output and a job's result of one CSV sweep are the same bytes
 // (the CSV has no timing in it, so they are equal whole).
+
+// Runs `sweep` as a /v1/explore job and returns GET /v1/jobs/{id}/result once the job is done
+// (a null result when submitting fails, the job fails or is not done within 120 s; the
+// failures are reported).
+httplib::Result ExploreJobResult(httplib::Client* client, const Json& sweep) {
+  const auto submitted = client->Post(
+      "/v1/jobs", Json{{"path", "/v1/explore"}, {"body", sweep}}.dump(), "application/json");
+  if (!submitted || submitted->status != 202) {
+    ADD_FAILURE() << "submitting the job: " << (submitted ? submitted->body : "no answer");
+    return httplib::Result{nullptr, httplib::Error::Unknown};
+  }
+  const std::string id = Json::parse(submitted->body)["id"].get<std::string>();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  std::string state;
+  while (state != "done" && std::chrono::steady_clock::now() < deadline) {
+    const auto status = client->Get("/v1/jobs/" + id);
+    if (!status) break;
+    state = Json::parse(status->body)["state"].get<std::string>();
+    if (state == "failed") {
+      ADD_FAILURE() << "the job failed: " << status->body;
+      break;
+    }
+    if (state != "done") std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  if (state != "done") {
+    ADD_FAILURE() << "the job is " << state << ", not done";
+    return httplib::Result{nullptr, httplib::Error::Unknown};
+  }
+  return client->Get("/v1/jobs/" + id + "/result");
+}
 TEST(ExploreCsvEndToEndTest, HttpCliAndJobGiveTheSameBytes) {
   const Json sweep = Json::parse(R"({"bat": {"preset": "paper-wood",
       "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
@@ -129,22 +159,7 @@ TEST(ExploreCsvEndToEndTest, HttpCliAndJobGiveTheSameBytes) {
   EXPECT_EQ(cli.exit_code, 0);
   EXPECT_TRUE(cli.out == streamed) << "the CLI's output differs from the HTTP answer";
 
-  const auto submitted = client.Post(
-      "/v1/jobs", Json{{"path", "/v1/explore"}, {"body", sweep}}.dump(), "application/json");
-  ASSERT_TRUE(submitted);
-  ASSERT_EQ(submitted->status, 202) << submitted->body;
-  const std::string id = Json::parse(submitted->body)["id"].get<std::string>();
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  std::string state;
-  while (state != "done" && std::chrono::steady_clock::now() < deadline) {
-    const auto status = client.Get("/v1/jobs/" + id);
-    ASSERT_TRUE(status);
-    state = Json::parse(status->body)["state"].get<std::string>();
-    ASSERT_NE(state, "failed") << status->body;
-    if (state != "done") std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  ASSERT_EQ(state, "done");
-  const auto result = client.Get("/v1/jobs/" + id + "/result");
+  const auto result = ExploreJobResult(&client, sweep);
   ASSERT_TRUE(result);
   EXPECT_EQ(result->status, 200);
   EXPECT_EQ(result->get_header_value("Content-Type"), "text/csv");
@@ -349,22 +364,7 @@ TEST(ExploreCsvEndToEndTest, ImperialSweepsAreTheSameBytesOverHttpCliAndJob) {
     EXPECT_TRUE(without_timing(cli.out) == without_timing(http->body))
         << format << ": the CLI's output differs from the HTTP answer";
 
-    const auto submitted = client.Post(
-        "/v1/jobs", Json{{"path", "/v1/explore"}, {"body", sweep}}.dump(), "application/json");
-    ASSERT_TRUE(submitted);
-    ASSERT_EQ(submitted->status, 202) << submitted->body;
-    const std::string id = Json::parse(submitted->body)["id"].get<std::string>();
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    std::string state;
-    while (state != "done" && std::chrono::steady_clock::now() < deadline) {
-      const auto status = client.Get("/v1/jobs/" + id);
-      ASSERT_TRUE(status);
-      state = Json::parse(status->body)["state"].get<std::string>();
-      ASSERT_NE(state, "failed") << status->body;
-      if (state != "done") std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    ASSERT_EQ(state, "done");
-    const auto result = client.Get("/v1/jobs/" + id + "/result");
+    const auto result = ExploreJobResult(&client, sweep);
     ASSERT_TRUE(result);
     EXPECT_EQ(result->status, 200);
     EXPECT_TRUE(without_timing(result->body) == without_timing(http->body))
