@@ -104,6 +104,49 @@ bool ParseColumns(const Json& list, const Json& shape, const Json& si_shape,
   return true;
 }
 
+// Each Pareto objective names a number a row has, as a column must: a typo, or an output not
+// asked for, is a 400 on pareto.objectives[i].output before the first design (it used to give
+// every design NaN and an empty front). A field in a trade unit ("…exit_speed_mph") is in the
+// rows only when they carry those units: report_units "imperial", or columns.
+bool CheckObjectives(const std::vector<ParetoObjective>& objectives, const Json& shape,
+                     const Json& si_shape, bool rows_carry_trade_units, ApiError* error) {
+  for (std::size_t i = 0; i < objectives.size(); ++i) {
+    const std::string where = "pareto.objectives[" + std::to_string(i) + "].output";
+    const Json output = objectives[i].output;
+    const ExploreColumn column = MakeColumn(objectives[i].output);
+    std::string why;
+    if (!CheckColumn(column, si_shape, &why)) {
+      if (std::string unused; !CheckColumn(column, shape, &unused)) {
+        SetError(error, ErrorCode::kInvalidValue, where, &output, why);
+        return false;
+      }
+      if (!rows_carry_trade_units) {
+        SetError(error, ErrorCode::kInvalidValue, where, &output,
+                 "names a field in a trade unit, which the rows carry only with "
+                 "report_units \"imperial\" or with columns; or name its SI field");
+        return false;
+      }
+      continue;
+    }
+    // The leaf, an array's elements read through its first (as CheckColumn reads them).
+    const Json* leaf = &si_shape;
+    for (const std::string& token : column.tokens) {
+      if (leaf->is_array()) {
+        leaf = leaf->empty() ? nullptr : &leaf->front();
+      } else {
+        leaf = &(*leaf)[token];  // CheckColumn found it
+      }
+      if (leaf == nullptr) break;
+    }
+    if (leaf != nullptr && !leaf->is_number() && !leaf->is_null()) {
+      SetError(error, ErrorCode::kInvalidValue, where, &output,
+               "must name a number of a row (this is " + std::string(leaf->type_name()) + ")");
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Context& context,
@@ -367,13 +410,17 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   std::vector<std::string> parameter_paths;
   for (const SweepParameter& parameter : parameters) parameter_paths.push_back(parameter.path);
   std::vector<ExploreColumn> columns;
+  const Json si_shape = RowShape(parameter_paths, outputs);
+  Json shape = si_shape;
+  AddImperialToRow(&shape, 0.0);
+  if (!CheckObjectives(objectives, shape, si_shape,
+                       units == ReportUnits::kImperial || column_list != nullptr, error)) {
+    return std::nullopt;
+  }
   if (column_list != nullptr || format == "csv") {
     // A column may name a field in a trade unit ("max_exit_speed.exit_speed_mph",
     // "max_exit_speed.position_from_tip_in"), whatever report_units says; the default CSV
     // columns are those of the rows report_units gives.
-    const Json si_shape = RowShape(parameter_paths, outputs);
-    Json shape = si_shape;
-    AddImperialToRow(&shape, 0.0);
     if (column_list == nullptr) {
       columns =
           DefaultCsvColumns(parameter_paths, units == ReportUnits::kImperial ? shape : si_shape);

@@ -195,6 +195,37 @@ TEST(ExploreTest, ParetoFrontOverTwoObjectives) {
   EXPECT_FALSE(front.empty());
 }
 
+// An objective names a number a row has, as a column must: a typo used to give every design
+// NaN and an empty front with a 200.
+TEST(ExploreTest, AParetoObjectiveARowDoesNotHaveIsRefusedBeforeTheFirstDesign) {
+  Json body = CorkSweep();
+  body["pareto"] = {{"objectives",
+                     {{{"output", "max_exit_speed.exit_speed_mps"}, {"sense", "max"}},
+                      {{"output", "properties.mass_kgg"}, {"sense", "min"}}}}};
+  Response r = Explore(body);
+  EXPECT_EQ(r.status, 400);
+  EXPECT_EQ(r.body["field"], "pareto.objectives[1].output");
+  EXPECT_NE(r.body["message"].get<std::string>().find("has no field \"mass_kgg\""),
+            std::string::npos)
+      << r.body["message"];
+  for (const char* not_a_number : {"feasible", "max_exit_speed"}) {
+    body["pareto"]["objectives"][1]["output"] = not_a_number;
+    r = Explore(body);
+    EXPECT_EQ(r.status, 400) << not_a_number;
+    EXPECT_NE(r.body["message"].get<std::string>().find("must name a number"), std::string::npos)
+        << r.body["message"];
+  }
+  // A trade unit: only in rows that carry it.
+  body["pareto"]["objectives"][1]["output"] = "properties.mass_oz";
+  r = Explore(body);
+  EXPECT_EQ(r.status, 400);
+  EXPECT_NE(r.body["message"].get<std::string>().find("report_units"), std::string::npos);
+  body["report_units"] = "imperial";
+  r = Explore(body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_FALSE(r.body["summary"]["pareto_front"].empty());
+}
+
 TEST(ExploreTest, NdjsonHasOneLinePerRowAndASummary) {
   Json body = CorkSweep();
   body["format"] = "ndjson";
