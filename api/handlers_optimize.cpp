@@ -195,8 +195,8 @@ Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r) {
     if (v.scale_factor) continue;  // a factor: its fields follow it in the list
     std::string why;
     const auto steps = ParseJsonPath(v.path, &why);
-    if (steps) TradeFormToSi(&bat, *steps);  // "taper_start_in" becomes "taper_start_m"
-    if (steps && SetNumberAtPath(&bat, *steps, v.value, &why)) continue;
+    // In the request's own units: "taper_start_in" stays inches.
+    if (steps && SetNumberInRequestForm(&bat, *steps, v.value, &why)) continue;
     if (v.path.rfind("three_segment.", 0) == 0 && r.three_segment) {
       const auto& s = *r.three_segment;
       bat["three_segment"] = {{"length_m", s.length_m},

@@ -68,7 +68,9 @@ void AddImperialTo(Json* node, std::optional<double> length_m) {
   std::vector<std::pair<std::string, double>> added;
   for (auto& [key, value] : node->items()) {
     if (value.is_structured()) {
-      AddImperialTo(&value, length_m);
+      // A "bat" is the request's own form (optimize, fit): a request again as it stands, so
+      // one form per quantity, as the request gave it.
+      if (key != "bat") AddImperialTo(&value, length_m);
       continue;
     }
     if (!value.is_number()) continue;
@@ -108,6 +110,21 @@ Json* TradeFieldParent(Json* root, const std::vector<PathStep>& steps) {
 }
 
 }  // namespace
+
+bool SetNumberInRequestForm(nlohmann::json* root, const std::vector<PathStep>& steps,
+                            double value_si, std::string* why) {
+  const auto* leaf = steps.empty() ? nullptr : std::get_if<std::string>(&steps.back());
+  Json* parent = leaf != nullptr ? TradeFieldParent(root, steps) : nullptr;
+  if (parent != nullptr && !parent->contains(*leaf)) {
+    for (const TradeForm& form : TradeForms(*leaf)) {
+      const auto it = parent->find(form.key);
+      if (it == parent->end() || !it->is_number()) continue;
+      *it = value_si / form.to_si;  // the form the request gave, e.g. "taper_start_in"
+      return true;
+    }
+  }
+  return SetNumberAtPath(root, steps, value_si, why);
+}
 
 void TradeFormToSi(nlohmann::json* root, const std::vector<PathStep>& steps) {
   if (steps.empty()) return;

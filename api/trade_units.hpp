@@ -44,6 +44,14 @@ std::vector<TradeForm> SiFormsOf(std::string_view key);
 /// quantity, which a request's reader refuses.
 void TradeFormToSi(nlohmann::json* root, const std::vector<PathStep>& steps);
 
+/// Sets the SI field at `steps` in *root to `value_si`, in the form the object gives it: where
+/// the object has a trade form of it instead ("taper_start_in" for ".taper_start_m",
+/// "barrel_diameter_in" for ".barrel_radius_m"), that form gets the value converted
+/// (value_si / its to_si); otherwise SetNumberAtPath. So a bat written back into the request's
+/// own form (/v1/optimize's answer) stays in the request's units, one form per quantity.
+bool SetNumberInRequestForm(nlohmann::json* root, const std::vector<PathStep>& steps,
+                            double value_si, std::string* why);
+
 /// How an answer reports its numbers ("report_units").
 enum class ReportUnits {
   kSi,        ///< SI only (the default).
@@ -56,7 +64,9 @@ enum class ReportUnits {
 /// beside every position "*_from_knob_m" its distance from the barrel end in inches
 /// ("*_from_tip_in"; a zone's ends "from_knob_m", "to_knob_m": "*_knob_from_tip_in") where the
 /// bat's length is known (the object's own "length_m", its
-/// "properties.length_m", or the nearest enclosing one's). Keys already present are kept.
+/// "properties.length_m", or the nearest enclosing one's). Keys already present are kept. An
+/// object under the key "bat" is left as it is: it is a request's form (optimize's, fit's
+/// answer), in the units the request gave, and can be sent again as it stands.
 void AddImperial(nlohmann::json* answer);
 /// AddImperial, with the bat's length `length_m` where `answer` states none (a /v1/explore
 /// row's output block: the row need not carry the bat's properties).

@@ -440,22 +440,31 @@ TEST(OptimizeEndpointTest, MaterialChoiceWithDensityVariableReturnsTheChosenMate
               1e-12 * r.body["properties"]["mass_kg"].get<double>());
 }
 
-// A bat given in inches whose field is a variable in SI: the answer's bat holds the SI field
-// only (it held "taper_start_in": 12 beside "taper_start_m"), so it goes back as a request.
-TEST(OptimizeEndpointTest, AVariableOfAFieldGivenInInchesComesBackInSiOnly) {
+// A bat given in inches whose field is a variable in SI: the answer's bat gives it in inches,
+// as the request did, and only so (it held "taper_start_in": 12 beside "taper_start_m" and
+// was refused when sent back); with report_units "imperial" the bat still has one form per
+// quantity (no twins are added to it), so it goes back as a request either way.
+TEST(OptimizeEndpointTest, AVariableOfAFieldGivenInInchesComesBackInInchesOnly) {
   Json body = ContractExample();
   body["bat"]["three_segment"].erase("taper_start_m");
   body["bat"]["three_segment"]["taper_start_in"] = 12;
-  const Response r = Post("/v1/optimize", body);
-  ASSERT_EQ(r.status, 200) << r.body.dump();
-  const Json& shape = r.body["bat"]["three_segment"];
-  EXPECT_FALSE(shape.contains("taper_start_in")) << shape.dump();
-  EXPECT_EQ(shape["taper_start_m"], r.body["variables"]["three_segment.taper_start_m"]);
-  const Response p = Post("/v1/bat/properties", Json{{"bat", r.body["bat"]}});
-  ASSERT_EQ(p.status, 200) << p.body.dump();
-  // Same bat, same code: the answer's mass to 1e-12 relative.
-  EXPECT_NEAR(p.body["mass_kg"].get<double>(), r.body["properties"]["mass_kg"].get<double>(),
-              1e-12 * r.body["properties"]["mass_kg"].get<double>());
+  for (const char* units : {"si", "imperial"}) {
+    body["report_units"] = units;
+    const Response r = Post("/v1/optimize", body);
+    ASSERT_EQ(r.status, 200) << r.body.dump();
+    const Json& shape = r.body["bat"]["three_segment"];
+    EXPECT_FALSE(shape.contains("taper_start_m")) << shape.dump();
+    EXPECT_FALSE(shape.contains("barrel_radius_in")) << shape.dump();
+    // The design's value in inches (one division: the reader's product gives it back to an ulp).
+    EXPECT_EQ(shape["taper_start_in"].get<double>(),
+              r.body["variables"]["three_segment.taper_start_m"].get<double>() / 0.0254);
+    const Response p = Post("/v1/bat/properties", Json{{"bat", r.body["bat"]}});
+    ASSERT_EQ(p.status, 200) << units << ": " << p.body.dump();
+    // The same bat to the ulp of the inch conversion: the answer's mass to 1e-12 relative.
+    EXPECT_NEAR(p.body["mass_kg"].get<double>(), r.body["properties"]["mass_kg"].get<double>(),
+                1e-12 * r.body["properties"]["mass_kg"].get<double>())
+        << units;
+  }
 }
 
 // Issue 18: without "cor", a ball with a COR law gives the COR as a scene resolves it for the
