@@ -109,36 +109,47 @@ Json* TradeFieldParent(Json* root, const std::vector<PathStep>& steps) {
   return node->is_object() ? node : nullptr;
 }
 
+// Where an object gives the SI field at `steps` in a trade form instead: its parent, the form
+// and its number (value null when the path leads to no object, the object has the SI field,
+// or it has none of its trade forms as a number).
+struct TradeFieldAt {
+  Json* parent = nullptr;
+  TradeForm form;
+  Json* value = nullptr;
+};
+TradeFieldAt FindTradeField(Json* root, const std::vector<PathStep>& steps) {
+  TradeFieldAt at;
+  const auto* leaf = steps.empty() ? nullptr : std::get_if<std::string>(&steps.back());
+  at.parent = leaf != nullptr ? TradeFieldParent(root, steps) : nullptr;
+  if (at.parent == nullptr || at.parent->contains(*leaf)) return at;
+  for (const TradeForm& form : TradeForms(*leaf)) {
+    const auto it = at.parent->find(form.key);
+    if (it == at.parent->end() || !it->is_number()) continue;
+    at.form = form;
+    at.value = &*it;
+    return at;
+  }
+  return at;
+}
+
 }  // namespace
 
 bool SetNumberInRequestForm(nlohmann::json* root, const std::vector<PathStep>& steps,
                             double value_si, std::string* why) {
-  const auto* leaf = steps.empty() ? nullptr : std::get_if<std::string>(&steps.back());
-  Json* parent = leaf != nullptr ? TradeFieldParent(root, steps) : nullptr;
-  if (parent != nullptr && !parent->contains(*leaf)) {
-    for (const TradeForm& form : TradeForms(*leaf)) {
-      const auto it = parent->find(form.key);
-      if (it == parent->end() || !it->is_number()) continue;
-      *it = value_si / form.to_si;  // the form the request gave, e.g. "taper_start_in"
-      return true;
-    }
+  const TradeFieldAt at = FindTradeField(root, steps);
+  if (at.value != nullptr) {
+    *at.value = value_si / at.form.to_si;  // the form the request gave, e.g. "taper_start_in"
+    return true;
   }
   return SetNumberAtPath(root, steps, value_si, why);
 }
 
 void TradeFormToSi(nlohmann::json* root, const std::vector<PathStep>& steps) {
-  if (steps.empty()) return;
-  const auto* leaf = std::get_if<std::string>(&steps.back());
-  Json* parent = leaf != nullptr ? TradeFieldParent(root, steps) : nullptr;
-  if (parent == nullptr || parent->contains(*leaf)) return;
-  for (const TradeForm& form : TradeForms(*leaf)) {
-    const auto it = parent->find(form.key);
-    if (it == parent->end() || !it->is_number()) continue;
-    const double si = it->get<double>() * form.to_si;
-    parent->erase(it);
-    (*parent)[*leaf] = si;
-    return;  // the template was checked: it has at most one form of the quantity
-  }
+  const TradeFieldAt at = FindTradeField(root, steps);
+  if (at.value == nullptr) return;
+  const double si = at.value->get<double>() * at.form.to_si;
+  at.parent->erase(at.form.key);  // the object was checked: at most one form of the quantity
+  (*at.parent)[*std::get_if<std::string>(&steps.back())] = si;
 }
 
 std::vector<TradeForm> TradeForms(std::string_view si_key) {

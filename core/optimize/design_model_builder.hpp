@@ -121,6 +121,7 @@ struct ModelBuilder {
   // Variable i: checked, then added with its parameters.
   bool AddVariable(std::size_t i, std::set<std::string>* seen);
   // The least and largest value parameter `idx` can take within the variables' bounds.
+  std::pair<double, double> ParamRange(int idx) const;
   double ParamLower(int idx) const;
   double ParamUpper(int idx) const;
   // Every variable.

@@ -22,27 +22,23 @@ bool ModelBuilder::Depends(const std::vector<std::pair<int, double>>& terms) con
   return false;
 }
 
-// The least value parameter `idx` can take within the variables' bounds (its coefficient times
-// a bound of its variable: a scaled field's base value is not 0, and the bounds' order is kept
-// or swapped by its sign).
-double ModelBuilder::ParamLower(int idx) const {
+// The least and the largest value parameter `idx` can take within the variables' bounds (its
+// coefficient times the bounds of its variable: a scaled field's base value is not 0, and the
+// bounds' order is kept or swapped by its sign); the base value twice for a fixed parameter.
+std::pair<double, double> ModelBuilder::ParamRange(int idx) const {
   const auto i = static_cast<std::size_t>(idx);
   const int j = model.parameter_variable_[i];
-  if (j < 0) return Param(idx);
+  if (j < 0) return {Param(idx), Param(idx)};
   const DesignVariableSpec& v = model.variables_[static_cast<std::size_t>(j)];
   const double k = model.parameter_scale_[i];
-  return std::min(k * v.lower, k * v.upper);
+  const double a = k * v.lower;
+  const double b = k * v.upper;
+  return {std::min(a, b), std::max(a, b)};
 }
 
-// The largest value parameter `idx` can take within the variables' bounds.
-double ModelBuilder::ParamUpper(int idx) const {
-  const auto i = static_cast<std::size_t>(idx);
-  const int j = model.parameter_variable_[i];
-  if (j < 0) return Param(idx);
-  const DesignVariableSpec& v = model.variables_[static_cast<std::size_t>(j)];
-  const double k = model.parameter_scale_[i];
-  return std::max(k * v.lower, k * v.upper);
-}
+double ModelBuilder::ParamLower(int idx) const { return ParamRange(idx).first; }
+
+double ModelBuilder::ParamUpper(int idx) const { return ParamRange(idx).second; }
 
 // The linear function's value at the base design.
 double ModelBuilder::LinearValue(const std::vector<std::pair<int, double>>& terms,

@@ -95,13 +95,13 @@ std::optional<DesignObjective> ParseDesignObjective(std::string_view name) {
 }
 
 bool DesignProblem::IsValid(std::string* why) const {
-  DesignModel model;
-  return DesignModel::Build(*this, DesignOptions{}, &model, why);
+  DesignModel built;  // not "model": that is the problem's exit-speed model
+  return DesignModel::Build(*this, DesignOptions{}, &built, why);
 }
 
 bool DesignProblem::Validate(Refusal* refusal) const {
-  DesignModel model;
-  return DesignModel::Build(*this, DesignOptions{}, &model, refusal);
+  DesignModel built;
+  return DesignModel::Build(*this, DesignOptions{}, &built, refusal);
 }
 
 bool DesignOptions::IsValid(std::string* why) const {
