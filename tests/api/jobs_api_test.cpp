@@ -13,6 +13,7 @@
 #include "api/handlers.hpp"
 #include "api/job_service.hpp"
 #include "api/router.hpp"
+#include "tests/contract_example.hpp"
 
 namespace sweetspot::api {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -43,15 +44,7 @@ class RecordingJobs final : public JobService {
 
 // The contract's optimisation (tests/api/optimize_test.cpp) with `options` replaced.
 Json Optimisation(const Json& options) {
-  Json body = Json::parse(R"({
-    "bat": {"three_segment": {"length_m": 0.8636, "handle_radius_m": 0.0125,
-            "barrel_radius_m": 0.033, "taper_start_m": 0.30, "taper_end_m": 0.55},
-            "material": "ash"},
-    "variables": [{"path": "three_segment.taper_start_m", "min": 0.1, "max": 0.5},
-                  {"path": "three_segment.barrel_radius_m", "min": 0.028, "max": 0.0331}],
-    "constraints": {"mass_kg": 0.88, "balance_point_m": {"min": 0.56, "max": 0.60},
-                    "moi_six_inch_kg_m2": {"max": 0.20}, "rules": "mlb-wood"},
-    "objective": "max_exit_speed", "cor": 0.5})");
+  Json body = sweetspot::testing::ContractOptimisation();
   body["options"] = options;
   return body;
 }

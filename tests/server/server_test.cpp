@@ -11,6 +11,8 @@
 #include <thread>
 #include <vector>
 
+#include "tests/contract_example.hpp"
+
 namespace sweetspot::server {
 namespace {
 
@@ -285,16 +287,9 @@ TEST(ServerLimitsTest, ConcurrentOptimisationsAllAgree) {
   // The issue's contract example with one start. max_time_s 60 (the limit): the solves queue
   // behind the lock, so the last one waits for all the others, and under a sanitizer each
   // takes up to a second; the test asserts the answer, not the speed.
-  const std::string body = R"({
-    "bat": {"three_segment": {"length_m": 0.8636, "handle_radius_m": 0.0125,
-            "barrel_radius_m": 0.033, "taper_start_m": 0.30, "taper_end_m": 0.55},
-            "material": "ash"},
-    "variables": [{"path": "three_segment.taper_start_m", "min": 0.1, "max": 0.5},
-                  {"path": "three_segment.barrel_radius_m", "min": 0.028, "max": 0.0331}],
-    "constraints": {"mass_kg": 0.88, "balance_point_m": {"min": 0.56, "max": 0.60},
-                    "moi_six_inch_kg_m2": {"max": 0.20}, "rules": "mlb-wood"},
-    "objective": "max_exit_speed", "cor": 0.5,
-    "options": {"max_time_s": 60, "starts": 1, "seed": 1}})";
+  nlohmann::json example = sweetspot::testing::ContractOptimisation();
+  example["options"] = {{"max_time_s", 60}, {"starts", 1}, {"seed", 1}};
+  const std::string body = example.dump();
   httplib::Client first("127.0.0.1", server.port());
   first.set_read_timeout(120, 0);
   const auto reference = first.Post("/v1/optimize", body, "application/json");
