@@ -152,6 +152,11 @@ double PublicConstraintValue(const DesignModel& model, const DesignConstraintSpe
       return e.properties.MoiSixInchKgM2();
     case DesignFunction::kDrop:
       return ToImperial(e.properties, bat.LengthM()).drop;
+    case DesignFunction::kBbcor: {
+      // Recomputed through the public model (ComputeBbcor on the answer's bat).
+      const BbcorResult b = ComputeBbcor(bat);
+      return b.ok ? b.value : kNaN;
+    }
     case DesignFunction::kLinear:
     case DesignFunction::kObjective:
     case DesignFunction::kFirstFrequency:  // the fixed mesh the constraint is defined on
@@ -581,7 +586,10 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     if (result.bat.IsHollow() &&
         std::find(rules.begin(), rules.end(), RuleSet::kBbcor) != rules.end()) {
       std::string bbcor_why;
-      if (!BbcorRuleHolds(result.bat, &result.bbcor.emplace(), &bbcor_why)) {
+      // The constraint's own acceptance: kFeasibleRelative of the limit (the re-check above).
+      const double limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
+      if (!BbcorRuleHolds(result.bat, &result.bbcor.emplace(), &bbcor_why,
+                          kFeasibleRelative * limit)) {
         summary.termination = Termination::kInfeasible;
         summary.message = bbcor_why;
       }

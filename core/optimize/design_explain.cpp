@@ -35,6 +35,8 @@ RangeWords WordsFor(const DesignConstraintSpec& c) {
       return {"the least length_in - weight_oz", "the largest length_in - weight_oz"};
     case DesignFunction::kFirstFrequency:
       return {"the lowest first bending frequency", "the highest first bending frequency"};
+    case DesignFunction::kBbcor:
+      return {"the least BBCOR", "the largest BBCOR"};
     default:
       if (c.name.rfind("length_m", 0) == 0 || c.name.find(".length") != std::string::npos) {
         return {"the shortest bat", "the longest bat"};

@@ -16,6 +16,7 @@
 #include "core/geometry_integrals.hpp"
 #include "core/numerics/jet.hpp"
 #include "core/numerics/limits.hpp"
+#include "core/optimize/design_bbcor.hpp"
 #include "core/optimize/design_integrals.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
@@ -357,6 +358,7 @@ T DesignModel::FunctionOf(DesignFunction f, const T* p) const {
       return ObjectiveOf(p);
     case DesignFunction::kLinear:
     case DesignFunction::kFirstFrequency:  // not a function of P (FrequencyOf)
+    case DesignFunction::kBbcor:           // nor this (BbcorOf)
       break;
   }
   return T(kNaN);
@@ -417,11 +419,115 @@ int DesignModel::frequency_elements() const {
   return frequency_beam_ == nullptr ? 0 : frequency_beam_->Elements();
 }
 
+template <typename J>
+J DesignModel::BbcorJet(const std::vector<double>& t, const std::array<double, 3>& integrals,
+                        std::array<int, 9>* parameter_of) const {
+  const design_detail::BbcorConstants& c = *bbcor_;
+  const DesignParameterLayout lay{num_knots_};
+  auto at = [&](int idx) { return t[static_cast<std::size_t>(idx)]; };
+  const int length_idx = lay.KnotPosition(num_knots_ - 1);
+  const double x = at(length_idx) - c.impact_from_tip_m;
+  // The impact point's segment by Bat::RadiusAtM's rule: from the last knot at or before x to
+  // the first beyond it (a constant radius before the first knot or from the last one).
+  int b = 0;
+  while (b < num_knots_ && !(at(lay.KnotPosition(b)) > x)) ++b;
+  const bool inside = b > 0 && b < num_knots_;
+  const int knot_b = std::min(b, num_knots_ - 1);
+  const int knot_a = inside ? b - 1 : knot_b;
+  *parameter_of = {-1,
+                   -1,
+                   -1,
+                   length_idx,
+                   lay.WallThickness(),
+                   lay.KnotPosition(knot_a),
+                   lay.KnotPosition(knot_b),
+                   lay.KnotRadius(knot_a),
+                   lay.KnotRadius(knot_b)};
+  std::array<J, 9> v;
+  for (int i = 0; i < 9; ++i) {
+    const auto ii = static_cast<std::size_t>(i);
+    v[ii] = J::Variable(i < 3 ? integrals[ii] : at((*parameter_of)[ii]), i);
+  }
+  const J impact = v[3] - c.impact_from_tip_m;
+  const J z = impact - c.pivot_from_knob_m;
+  const J r_out = inside ? v[7] + (v[8] - v[7]) * ((impact - v[5]) / (v[6] - v[5])) : v[7];
+  const double d = c0_ - c.pivot_from_knob_m;
+  const J moi = v[2] + (2.0 * d) * v[1] + (d * d) * v[0];  // MoiAbout the pivot
+  return design_detail::BbcorOfWall<J>(c, moi, z, r_out, v[4], J::kHessianSize > 0 ? 2 : 1);
+}
+
+bool DesignModel::BbcorOf(const std::vector<double>& t, double* value, double* gradient_row,
+                          int stride) const {
+  *value = kNaN;
+  if (bbcor_ == nullptr) return false;
+  // ComputeBbcor's I_pivot is the rigid body's (the cross-sections' own moments included),
+  // whatever inertia model the objective uses.
+  design_detail::Integrals in;
+  const design_detail::IntegralContext context{
+      t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, true, c0_};
+  design_detail::ComputeIntegrals(context, n(), gradient_row != nullptr, &in);
+  if (!(in.p[0] > 0.0)) return false;
+  std::array<int, 9> parameter_of{};
+  const auto bj = BbcorJet<jet::Jet<9, false>>(t, {in.p[0], in.p[1], in.p[2]}, &parameter_of);
+  *value = bj.v;
+  if (!std::isfinite(bj.v)) return false;
+  if (gradient_row != nullptr) {
+    for (int j = 0; j < n(); ++j) {
+      double s = 0.0;
+      for (int q = 0; q < 3; ++q) s += bj.g[static_cast<std::size_t>(q)] * in.dp(q, j);
+      gradient_row[j * stride] += s;
+    }
+    for (std::size_t q = 3; q < 9; ++q) {
+      const auto idx = static_cast<std::size_t>(parameter_of[q]);
+      const int j = parameter_variable_[idx];
+      if (j >= 0) gradient_row[j * stride] += bj.g[q] * parameter_scale_[idx];
+    }
+  }
+  return true;
+}
+
+bool DesignModel::AddBbcorHessian(const std::vector<double>& t, double weight,
+                                  Eigen::MatrixXd* h) const {
+  if (bbcor_ == nullptr) return false;
+  design_detail::Integrals in;
+  const design_detail::IntegralContext context{
+      t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, true, c0_};
+  design_detail::ComputeIntegrals(context, n(), true, &in);
+  if (!(in.p[0] > 0.0)) return false;
+  std::array<int, 9> parameter_of{};
+  const auto bj = BbcorJet<jet::Jet<9, true>>(t, {in.p[0], in.p[1], in.p[2]}, &parameter_of);
+  if (!std::isfinite(bj.v)) return false;
+  // d(local inputs)/dx: the integrals' rows, then one coefficient per parameter (linear in x).
+  Eigen::MatrixXd local = Eigen::MatrixXd::Zero(9, n());
+  local.topRows(3) = in.dp.topRows(3);
+  for (int q = 3; q < 9; ++q) {
+    const auto idx = static_cast<std::size_t>(parameter_of[static_cast<std::size_t>(q)]);
+    const int j = parameter_variable_[idx];
+    if (j >= 0) local(q, j) += parameter_scale_[idx];
+  }
+  Eigen::Matrix<double, 9, 9> hb;
+  for (int a = 0; a < 9; ++a) {
+    for (int b = 0; b < 9; ++b) hb(a, b) = bj.h[static_cast<std::size_t>(a * 9 + b)];
+  }
+  *h += weight * (local.transpose() * hb * local);
+  // M, S1 and S2 are nonlinear in x: their own second derivatives, weighted by dB/dP.
+  design_detail::AddIntegralHessian(context, {weight * bj.g[0], weight * bj.g[1], weight * bj.g[2]},
+                                    h);
+  return h->allFinite();
+}
+
+double DesignModel::BbcorAt(const double* x) const {
+  double v = kNaN;
+  if (!BbcorOf(ParametersAt(x), &v, nullptr, 1)) return kNaN;
+  return v;
+}
+
 double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
   if (f.function == DesignFunction::kObjective && objective_kind_ == DesignObjective::kMinSting) {
     return StingOf(BatAt(x), false).sting_j;  // NaN when it cannot be computed
   }
   if (f.function == DesignFunction::kFirstFrequency) return FirstFrequencyAt(x);
+  if (f.function == DesignFunction::kBbcor) return BbcorAt(x);
   const std::vector<double> t = ParametersAt(x);
   if (f.function == DesignFunction::kLinear) {
     double v = f.constant;
@@ -468,6 +574,7 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
     if (f.function == DesignFunction::kFirstFrequency) {
       return FrequencyOf(t, value, gradient_row, stride);
     }
+    if (f.function == DesignFunction::kBbcor) return BbcorOf(t, value, gradient_row, stride);
     if (gradient_row == nullptr) {
       *value = FunctionOf<double>(f.function, p);
       return std::isfinite(*value);
@@ -525,10 +632,15 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   Eigen::Matrix4d big_w = Eigen::Matrix4d::Zero();
   std::array<double, 4> w{};
   bool available = true;
+  double bbcor_weight = 0.0;
   auto add = [&](const DesignFunctionSpec& f, double weight) {
     if (f.function == DesignFunction::kLinear || weight == 0.0) return;
     if (f.function == DesignFunction::kFirstFrequency) {
       available = false;  // no second derivatives of the eigenvalue (Build refuses kExact)
+      return;
+    }
+    if (f.function == DesignFunction::kBbcor) {
+      bbcor_weight += weight;  // its own local inputs (AddBbcorHessian)
       return;
     }
     using J = jet::Jet<4, true>;
@@ -549,6 +661,7 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   *out = in.dp.transpose() * big_w * in.dp;
   // L is linear in x: only M, S1 and S2 have second derivatives.
   design_detail::AddIntegralHessian(context, {w[0], w[1], w[2]}, out);
+  if (bbcor_weight != 0.0 && !AddBbcorHessian(t, bbcor_weight, out)) return false;
   return out->allFinite();
 }
 

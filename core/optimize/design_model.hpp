@@ -18,6 +18,7 @@
 // same code (jet.hpp): H = (dP/dx)^T W (dP/dx) + sum_c w_c d2P_c/dx2.
 #pragma once
 
+#include <array>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -36,7 +37,8 @@ namespace sweetspot::core {
 struct FixedMeshBeam;  // core/flexible/beam_frequency.hpp
 
 namespace design_detail {
-struct ModelBuilder;  // DesignModel::Build's steps (design_model_build.cpp)
+struct ModelBuilder;    // DesignModel::Build's steps (design_model_build.cpp)
+struct BbcorConstants;  // design_bbcor.hpp
 }  // namespace design_detail
 
 /// A smooth function of the design (internal).
@@ -48,7 +50,10 @@ enum class DesignFunction {
   kDrop,          ///< length_in - weight_oz (dimensionless).
   /// The first free-free bending frequency on the fixed mesh, Hz (core/flexible/beam_frequency).
   kFirstFrequency,
-  kObjective,     ///< The problem's objective, in its unit.
+  /// The BBCOR by the NCAA protocol (ComputeBbcor's quasi-static trampoline, design_bbcor.hpp):
+  /// the `bbcor` rule's constraint on a hollow design (dimensionless).
+  kBbcor,
+  kObjective,  ///< The problem's objective, in its unit.
 };
 
 /// A function of the design: what constraints and objectives are made of (internal).
@@ -184,6 +189,9 @@ class DesignModel {
   double FirstFrequencyAt(const double* x) const;
   /// Elements of the fixed mesh of the frequency constraint (0 without it).
   int frequency_elements() const;
+  /// The BBCOR at x by the model's closed form (NaN without the bbcor constraint or outside
+  /// its domain); equals ComputeBbcor(BatAt(x)).value to rounding.
+  double BbcorAt(const double* x) const;
   /// The sting of `bat` in this problem's scene (EvaluateSting with the model's modes cache).
   StingEvaluation StingOf(const Bat& bat, bool refine_check) const;
 
@@ -209,6 +217,16 @@ class DesignModel {
   // gradient_row[j * stride]; false when it cannot be computed.
   bool FrequencyOf(const std::vector<double>& t, double* value, double* gradient_row,
                    int stride) const;
+  // The BBCOR at parameters t and (when gradient_row) its gradient added into
+  // gradient_row[j * stride]; false when it cannot be computed.
+  bool BbcorOf(const std::vector<double>& t, double* value, double* gradient_row, int stride) const;
+  // Adds weight times the BBCOR's Hessian at parameters t into *h; false when not finite.
+  bool AddBbcorHessian(const std::vector<double>& t, double weight, Eigen::MatrixXd* h) const;
+  // The BBCOR as a jet over its 9 local inputs (M, S1, S2 of the rigid-body integrals, L, h,
+  // the impact segment's x_a, x_b, r_a, r_b) and the parameters each one is (-1 for M, S1, S2).
+  template <typename J>
+  J BbcorJet(const std::vector<double>& t, const std::array<double, 3>& integrals,
+             std::array<int, 9>* parameter_of) const;
 
   std::vector<DesignVariableSpec> variables_;
   std::vector<DesignConstraintSpec> constraints_;
@@ -253,6 +271,8 @@ class DesignModel {
   std::shared_ptr<ModesCache> sting_modes_;
   // min_frequency_hz: the beam on its fixed mesh (immutable, shared by the model's copies).
   std::shared_ptr<const FixedMeshBeam> frequency_beam_;
+  // rules bbcor on a hollow design: the protocol's constants (immutable, shared by the copies).
+  std::shared_ptr<const design_detail::BbcorConstants> bbcor_;
 };
 
 /// The model as the solvers see it: variables scaled to s in [0, 1] (x = lower + (upper -

@@ -471,7 +471,7 @@ bool ModelBuilder::Run() {
   if (!DiameterConstraints() || !TaperConstraints()) return false;
   CupConstraints();
   ValidityConstraints();
-  if (!FrequencyConstraint()) return false;
+  if (!FrequencyConstraint() || !BbcorConstraint()) return false;
   return Objective();
 }
 

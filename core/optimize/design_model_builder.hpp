@@ -158,6 +158,8 @@ struct ModelBuilder {
   bool HandleRegionKnots(std::vector<std::size_t>* out);
   // The first bending frequency (min_frequency_hz) on its fixed mesh.
   bool FrequencyConstraint();
+  // The `bbcor` rule's BBCOR <= 0.50 on a hollow design (a nonlinear constraint).
+  bool BbcorConstraint();
   // Taper: the knot pairs it bounds (refused when the request's knots are not in the profile).
   bool TaperPairs(std::vector<std::pair<int, int>>* pairs_out,
                   std::vector<std::string>* suffix_out);

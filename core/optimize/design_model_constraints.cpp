@@ -7,8 +7,11 @@
 #include <utility>
 #include <vector>
 
+#include "core/ball_catalogue.hpp"
+#include "core/collision/barrel.hpp"
 #include "core/flexible/beam_frequency.hpp"
 #include "core/flexible/modes.hpp"
+#include "core/optimize/design_bbcor.hpp"
 #include "core/optimize/design_model_builder.hpp"
 #include "core/units.hpp"
 
@@ -344,6 +347,62 @@ bool ModelBuilder::FrequencyConstraint() {
   c.f.function = DesignFunction::kFirstFrequency;
   c.lower = bound;
   c.upper = kInf;
+  c.property = true;  // analysed for conflicts (its reach within the bounds)
+  model.constraints_.push_back(std::move(c));
+  return true;
+}
+
+// The `bbcor` rule on a hollow design: BBCOR <= 0.50 by ComputeBbcor's model (the NCAA protocol,
+// the default barrel options) as a nonlinear constraint with exact derivatives (design_bbcor.hpp).
+// A solid design keeps the check of the scene's COR before solving (Rules()).
+bool ModelBuilder::BbcorConstraint() {
+  const auto& rules = cons.rules;
+  if (!model.hollow_ || std::find(rules.begin(), rules.end(), RuleSet::kBbcor) == rules.end()) {
+    return true;
+  }
+  const BbcorProtocol protocol;
+  const BarrelOptions barrel;
+  const std::optional<BallPreset> ball = FindBallPreset(protocol.ball);
+  if (!ball.has_value()) {
+    return Refuse(why, TextRefusal("rules.bbcor", "the protocol's ball '" + protocol.ball +
+                                                      "' is not in the catalogue"));
+  }
+  BbcorConstants k;
+  k.ball_mass_kg = ball->mass_kg;
+  k.ball_radius_m = ball->radius_m;
+  k.ball_stiffness = ball->stiffness;
+  k.ball_exponent = ball->stiffness_exponent;
+  k.ball_cor = ball->cor_law.CorAt(protocol.ball_speed_mps);
+  k.speed_mps = protocol.ball_speed_mps;
+  k.youngs_modulus_pa = base.material.youngs_modulus_pa;
+  k.poissons_ratio = base.material.poissons_ratio;
+  k.shell_factor = barrel.shell_factor;
+  k.barrel_loss = barrel.barrel_loss;
+  k.pivot_from_knob_m = protocol.pivot_from_knob_m;
+  k.impact_from_tip_m = protocol.impact_from_tip_m;
+  // The impact point must lie beyond the pivot on every design: on the shortest one.
+  const double shortest_m = ParamLower(lay.KnotPosition(model.num_knots_ - 1));
+  if (!(shortest_m - k.impact_from_tip_m > k.pivot_from_knob_m)) {
+    return Refuse(why,
+                  TextRefusal("rules.bbcor",
+                              "the shortest bat the variables allow, L = " + Num(shortest_m) +
+                                  " m, does not put the BBCOR protocol's impact point (" +
+                                  Num(k.impact_from_tip_m) + " m from the tip) beyond its pivot (" +
+                                  Num(k.pivot_from_knob_m) + " m from the knob)"));
+  }
+  model.bbcor_ = std::make_shared<const BbcorConstants>(k);
+  const std::vector<double> x0 = model.BaseX();
+  const double start = model.BbcorAt(x0.data());
+  if (!std::isfinite(start)) {
+    return Refuse(why, TextRefusal("rules.bbcor",
+                                   "the BBCOR of the start (the base design clamped into the "
+                                   "variables' bounds) cannot be computed"));
+  }
+  DesignConstraintSpec c;
+  c.name = c.min_name = c.max_name = "rules.bbcor.bbcor";
+  c.unit = "";
+  c.f.function = DesignFunction::kBbcor;
+  c.upper = *LimitsOf(RuleSet::kBbcor).max_bbcor;
   c.property = true;  // analysed for conflicts (its reach within the bounds)
   model.constraints_.push_back(std::move(c));
   return true;

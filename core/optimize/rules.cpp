@@ -136,19 +136,20 @@ bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why) {
   return true;
 }
 
-bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why) {
+bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why, double tolerance) {
   *bbcor = ComputeBbcor(bat);
   const double limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
   if (!bbcor->ok) {
     if (why != nullptr) *why = "rules.bbcor: the BBCOR could not be computed: " + bbcor->message;
     return false;
   }
-  if (bbcor->value > limit) {
+  if (!(bbcor->value <= limit + tolerance)) {
     if (why != nullptr) {
       *why = "rules.bbcor: the design's BBCOR = " + FormatNumber(bbcor->value) +
              " exceeds the limit " + FormatNumber(limit) +
-             " (NCAA protocol with the barrel model, checked after solving: the wall's effect on "
-             "the BBCOR is not a constraint of the design model; thicken the wall's lower bound)";
+             " (NCAA protocol with the barrel model, recomputed on the answer; no design within "
+             "the variables' bounds and the other constraints meets it: thicken the wall's upper "
+             "bound or free the variables that lower it)";
     }
     return false;
   }

@@ -71,10 +71,11 @@ bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, std::string* why);
 /// rule the broken part.
 bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why);
 
-/// The `bbcor` rule's check of a finished hollow design (after solving: the design model does not
-/// differentiate the barrel): *bbcor = ComputeBbcor(bat) (the NCAA protocol, default barrel
-/// options). False, with "rules.bbcor: ..." in *why, when the value exceeds the limit or the model
-/// fails.
-bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why);
+/// The `bbcor` rule's check of a finished hollow design, by recomputing: *bbcor = ComputeBbcor(bat)
+/// (the NCAA protocol, default barrel options). The design model holds BBCOR <= 0.50 as a
+/// constraint; this is the independent check of its answer. False, with "rules.bbcor: ..." in
+/// *why, when the value exceeds the limit by more than tolerance (>= 0; the optimiser passes its
+/// feasibility tolerance) or the model fails.
+bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why, double tolerance = 0.0);
 
 }  // namespace sweetspot::core

@@ -74,6 +74,45 @@ TEST(BarrelApiTest, HollowBatWithABallPresetTakesTheTrampolineCor) {
   EXPECT_EQ(plain.body["cor_source"], "material:aluminium-7050");
 }
 
+// Issue 18 item 2: the `bbcor` rule of /v1/optimize constrains the BBCOR, so the wall thickness
+// is a design variable. The aluminium preset, the least MOI about the 6-in point with the wall
+// and the handle's radius free: the wall thins until BBCOR = 0.50 (the handle keeps the drop
+// at 3), and the bat returned measures BBCOR <= 0.50 through /v1/sweet-spot's `bbcor` output.
+TEST(BarrelApiTest, OptimizeHoldsTheBbcorAtTheLimitWithTheWallAsAVariable) {
+  const Response r = Post("/v1/optimize", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "variables": [{"path": "wall_thickness_m", "min": 0.0015, "max": 0.004},
+                    {"paths": ["profile.knots[4].radius_m", "profile.knots[5].radius_m"],
+                     "min": 0.0105, "max": 0.0135}],
+      "objective": "min_moi", "constraints": {"rules": "bbcor"}})");
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["summary"]["termination"], "converged") << r.body.dump();
+  const auto& b = r.body["bbcor"];
+  ASSERT_TRUE(b.is_object()) << r.body.dump();
+  EXPECT_EQ(b["method"], "trampoline_quasi_static");
+  // At most 0.50 plus Ipopt's constraint tolerance (1e-10 of the constraint's scale 0.5).
+  EXPECT_LE(b["value"].get<double>(), 0.50 + 0.5e-10);
+  EXPECT_NEAR(b["value"].get<double>(), 0.50, 1e-9);
+  bool bbcor_active = false, drop_active = false;
+  for (const auto& a : r.body["summary"]["active_constraints"]) {
+    if (a["name"] == "rules.bbcor.bbcor") {
+      bbcor_active = true;
+      EXPECT_EQ(a["bound"].get<double>(), 0.5);
+      EXPECT_LT(a["multiplier"].get<double>(), 0.0);  // a looser limit: a lighter-swinging bat
+    }
+    drop_active = drop_active || a["name"] == "rules.bbcor.drop";
+  }
+  EXPECT_TRUE(bbcor_active) << r.body["summary"]["active_constraints"].dump();
+  EXPECT_TRUE(drop_active) << r.body["summary"]["active_constraints"].dump();
+  // Thinner than the preset's 30-oz wall (whose BBCOR is 0.49995).
+  const double wall = r.body["bat"]["wall_thickness_m"].get<double>();
+  EXPECT_LT(wall, 0.0027614431802374);
+  // Recomputed through the scene endpoint on the returned bat.
+  const Response s =
+      Post("/v1/sweet-spot", nlohmann::json{{"bat", r.body["bat"]}, {"outputs", {"bbcor"}}}.dump());
+  ASSERT_EQ(s.status, 200) << s.body.dump();
+  EXPECT_EQ(s.body["bbcor"]["value"], b["value"]);
+}
+
 }  // namespace
 }  // namespace barrel_api_test
 }  // namespace sweetspot::api

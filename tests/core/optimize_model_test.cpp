@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -474,6 +475,12 @@ TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
       if (variant >= 7) p.swing.bat_speed_mps = 32.0;  // 72 mph at 6 in from the tip
       const DesignModel model = Build(p);
       ASSERT_GT(model.m(), 3);
+      if (variant % 2 == 0) {
+        // The hollow profile's rules bbcor: its BBCOR constraint is among those checked here.
+        EXPECT_TRUE(std::any_of(
+            model.constraints().begin(), model.constraints().end(),
+            [](const DesignConstraintSpec& c) { return c.f.function == DesignFunction::kBbcor; }));
+      }
       for (int trial = 0; trial < 3; ++trial) {
         const std::vector<double> x = RandomPoint(model, rng);
         DesignPoint point;
