@@ -403,8 +403,9 @@ struct DesignResult {
   std::optional<DesignSting> sting;  ///< min_sting: the answer's impact (else empty).
   /// constraints.min_frequency_hz: the answer's first bending mode (else empty).
   std::optional<DesignFrequency> first_bending_mode;
-  /// rules bbcor on a hollow answer: its BBCOR by the NCAA protocol, checked after solving
-  /// (BbcorRuleHolds; above the limit the termination is infeasible).
+  /// rules bbcor on a hollow answer: its BBCOR by the NCAA protocol, a constraint of the design
+  /// problem (rules.bbcor.bbcor) recomputed on the answer by ComputeBbcor (BbcorRuleHolds; above
+  /// the limit by more than the feasibility tolerance the termination is infeasible).
   std::optional<BbcorResult> bbcor;
   /// Errors reported by Ipopt's derivative checker (-1 = not run).
   int derivative_check_errors = -1;
