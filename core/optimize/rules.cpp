@@ -147,9 +147,9 @@ bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why, double
     if (why != nullptr) {
       *why = "rules.bbcor: the design's BBCOR = " + FormatNumber(bbcor->value) +
              " exceeds the limit " + FormatNumber(limit) +
-             " (NCAA protocol with the barrel model, recomputed on the answer; no design within "
-             "the variables' bounds and the other constraints meets it: thicken the wall's upper "
-             "bound or free the variables that lower it)";
+             " (NCAA protocol with the barrel model, recomputed on the answer: the optimiser "
+             "found no design within the variables' bounds and the other constraints that meets "
+             "it; raise the wall's upper bound or free the variables that lower the BBCOR)";
     }
     return false;
   }
