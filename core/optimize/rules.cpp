@@ -126,7 +126,11 @@ bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why) {
                                       "is allowed)"));
     }
   }
-  if (limits.max_bbcor.has_value() && facts.cor > *limits.max_bbcor) {
+  // A solid bat's BBCOR is the COR its scene uses. A hollow one's is the barrel model's, a
+  // constraint of the design (rules.bbcor.bbcor): its scene COR, the trampoline's at the scene's
+  // own ball and speed, may be above 0.50 for a legal bat.
+  const bool hollow = facts.wall_thickness_m > 0.0 || facts.wall_variable;
+  if (limits.max_bbcor.has_value() && !hollow && facts.cor > *limits.max_bbcor) {
     return Refuse(
         why, TextRefusal(field, "cor = " + FormatNumber(facts.cor) + " exceeds the BBCOR limit " +
                                     FormatNumber(*limits.max_bbcor) +

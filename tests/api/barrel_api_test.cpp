@@ -113,6 +113,25 @@ TEST(BarrelApiTest, OptimizeHoldsTheBbcorAtTheLimitWithTheWallAsAVariable) {
   EXPECT_EQ(s.body["bbcor"]["value"], b["value"]);
 }
 
+// A hollow bat's scene COR is the trampoline's at the scene's ball and speed: 0.516 here (an MLB
+// ball at 90 mph, a 70 mph bat speed), above 0.50 for a legal bat. The bbcor rule constrains the
+// protocol's BBCOR instead; it used to refuse this request with "cor = 0.516 exceeds the BBCOR
+// limit".
+TEST(BarrelApiTest, BbcorRuleOnAHollowBatIgnoresTheScenesGameSpeedCor) {
+  const Response r = Post("/v1/optimize", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "ball": {"preset": "mlb", "speed_mph": 90}, "swing": {"bat_speed_mph": 70},
+      "variables": [{"path": "wall_thickness_m", "min": 0.0015, "max": 0.004},
+                    {"paths": ["profile.knots[4].radius_m", "profile.knots[5].radius_m"],
+                     "min": 0.0105, "max": 0.0135}],
+      "objective": "max_exit_speed",
+      "constraints": {"rules": "bbcor", "mass_oz": {"min": 29, "max": 31}}})");
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_GT(r.body["cor"].get<double>(), 0.5) << r.body.dump();
+  EXPECT_EQ(r.body["cor_source"].get<std::string>().rfind("barrel:", 0), 0u) << r.body.dump();
+  // At most 0.50 plus Ipopt's constraint tolerance (as above).
+  EXPECT_LE(r.body["bbcor"]["value"].get<double>(), 0.50 + 0.5e-10) << r.body.dump();
+}
+
 }  // namespace
 }  // namespace barrel_api_test
 }  // namespace sweetspot::api
