@@ -277,6 +277,12 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
              {"angular_speed_rad_s", Finite(r.angular_speed_rad_s)}}},
            {"summary", std::move(summary)}};
   if (!conflicts.empty()) out["conflicts"] = std::move(conflicts);
+  if (std::isfinite(r.cor_impact_from_knob_m)) {
+    // The design's own barrel COR (cor_from_barrel): where and at what speed it was taken.
+    out["cor_impact_from_knob_m"] = r.cor_impact_from_knob_m;
+    out["cor_impact_speed_mps"] = Finite(r.cor_impact_speed_mps);
+    out["cor_ball"] = Finite(r.cor_ball);
+  }
   if (r.bbcor) out["bbcor"] = BbcorToJson(*r.bbcor);
   if (r.first_bending_mode) {
     const core::DesignFrequency& f = *r.first_bending_mode;
@@ -305,7 +311,9 @@ struct OptimizeRequest {
   std::vector<core::Material> material_choices;
   std::string objective;
   Json request_bat;
-  std::string cor_source;  // "scene", or the ball's law at the base design; empty: material's
+  // "scene", the ball's law at the base design, the design's barrel ("barrel:<ball> recomputed
+  // for every design ..."); empty: the material's.
+  std::string cor_source;
 };
 
 // What the optimiser returned: one design, or one per material and the best of them.
@@ -436,6 +444,57 @@ bool ReadVariables(ObjectReader& reader, const ApiLimits& limits, core::DesignPr
   return true;
 }
 
+// True when the design is hollow: the base bat, or wall_thickness_m among the variables' fields.
+bool HollowDesign(const core::DesignProblem& problem) {
+  if (problem.bat.IsHollow()) return true;
+  for (const core::DesignVariable& v : problem.variables) {
+    std::vector<std::string> paths = {v.path};
+    paths.insert(paths.end(), v.linked_paths.begin(), v.linked_paths.end());
+    paths.insert(paths.end(), v.scale_paths.begin(), v.scale_paths.end());
+    if (std::find(paths.begin(), paths.end(), "wall_thickness_m") != paths.end()) return true;
+  }
+  return false;
+}
+
+// The COR of the ball-bat pair (issue 18). A request's `cor` is held fixed ("scene"). Without
+// one, a ball with a COR law (ball.preset):
+// - on a hollow design with an exit-speed objective, the design's own barrel's COR, recomputed
+//   for every design (DesignProblem::cor_from_barrel: the trampoline at 0.1524 m from the tip);
+// - otherwise the law's value at the base design's impact speed (through the barrel for a hollow
+//   base), held fixed while the design changes.
+// Otherwise the material's (core's); a scene the base cannot resolve is left to core's validation.
+void ResolveOptimizeCor(const core::Scene& scene, core::DesignProblem* problem,
+                        std::string* cor_source) {
+  if (scene.cor.has_value()) {
+    *cor_source = "scene";
+    return;
+  }
+  const bool exit_speed = problem->objective == core::DesignObjective::kMaxExitSpeed ||
+                          problem->objective == core::DesignObjective::kMaxExitSpeedSwingWeight ||
+                          problem->objective == core::DesignObjective::kWidestSweetZone;
+  if (exit_speed && scene.ball.cor_law.has_value() && HollowDesign(*problem)) {
+    problem->cor_from_barrel = true;
+    const std::string ball = scene.ball.preset.empty() ? "custom" : scene.ball.preset;
+    *cor_source = "barrel:" + ball + " recomputed for every design at " +
+                  core::FormatNumber(core::kCorReferenceFromTipM) +
+                  " m from its tip, at its normal impact speed there (cor_impact_from_knob_m, "
+                  "cor_impact_speed_mps: the answer's); treated as constant along the bat";
+    return;
+  }
+  core::Scene base = scene;
+  base.bat = problem->bat;
+  core::TimingBook book(false);
+  core::ResolvedScene resolved;
+  core::Summary summary;
+  if (core::ResolveScene(base, true, &book, &resolved, &summary) &&
+      resolved.cor_source.rfind("material:", 0) != 0) {
+    problem->cor = resolved.cor;
+    *cor_source = resolved.cor_source + " at the base design's impact speed (" +
+                  core::FormatNumber(resolved.cor_impact_speed_mps.value_or(0.0)) +
+                  " m/s), held fixed while the design changes";
+  }
+}
+
 std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& context,
                                              ApiError* error) {
   ObjectReader reader(body, "", error);
@@ -459,25 +518,6 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
   problem.swing = scene.swing;
   problem.cor = scene.cor;
   problem.inertia_model = scene.inertia_model;
-  if (!scene.cor.has_value()) {
-    // The COR of the ball-bat pair as a scene resolves it (issue 18): a ball with a COR law
-    // (ball.preset) gives the law's value at the base design's impact speed (through the
-    // barrel for a hollow bat), held fixed while the design changes; otherwise the material's.
-    core::Scene base = scene;
-    base.bat = problem.bat;
-    core::TimingBook book(false);
-    core::ResolvedScene resolved;
-    core::Summary summary;
-    if (core::ResolveScene(base, true, &book, &resolved, &summary) &&
-        resolved.cor_source.rfind("material:", 0) != 0) {
-      problem.cor = resolved.cor;
-      request.cor_source = resolved.cor_source + " at the base design's impact speed (" +
-                           core::FormatNumber(resolved.cor_impact_speed_mps.value_or(0.0)) +
-                           " m/s), held fixed while the design changes";
-    }
-  } else {
-    request.cor_source = "scene";
-  }
   if (!ReadVariables(reader, context.limits, &problem, &request.material_choices) ||
       !ReadConstraints(reader, &problem.constraints)) {
     return std::nullopt;
@@ -487,6 +527,7 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
                         {"max_exit_speed", "max_exit_speed_swing_weight", "widest_sweet_zone",
                          "min_moi", "min_sting"});
   problem.objective = *core::ParseDesignObjective(request.objective);
+  ResolveOptimizeCor(scene, &problem, &request.cor_source);
   reader.OptionalNumber("swing_weight_exponent", AnyNumber(), &problem.swing_weight_exponent);
   problem.swing_weight_reference_kg_m2 =
       reader.MaybeNumber("swing_weight_reference_kg_m2", AnyNumber());  // range: core's

@@ -96,7 +96,30 @@ struct PublicEvaluation {
   double omega_rad_s = kNaN;
   Placement placement = Placement::kOnBat;  // of the sweet spot
   std::optional<StingEvaluation> sting;  // min_sting
+  // The COR used: the model's fixed one, or (cor_from_barrel) the design's barrel's through
+  // EffectiveCorAt at the point and speed below.
+  double cor = kNaN;
+  double cor_impact_m = kNaN;   // cor_from_barrel: m from the knob
+  double cor_speed_mps = kNaN;  // cor_from_barrel: the normal impact speed there
+  double cor_ball = kNaN;       // cor_from_barrel: the ball's law at that speed
 };
+
+// The barrel COR of `bat` (mass properties p, swing omega) as ResolveScene gives it: the ball's
+// law at the normal impact speed kCorReferenceFromTipM from the tip, through EffectiveCorAt.
+void PublicBarrelCor(const DesignProblem& problem, const DesignModel& model, const Bat& bat,
+                     const MassProperties& p, double omega_rad_s, PublicEvaluation* out) {
+  const double length = bat.LengthM();
+  const double x = std::max(0.0, length - model.cor_impact_from_tip_m());
+  const double v = problem.ball.speed_mps + omega_rad_s * (x - problem.swing.pivot_from_knob_m);
+  out->cor_impact_m = x;
+  out->cor_speed_mps = v;
+  if (!(v > 0.0) || !problem.ball.cor_law.has_value()) return;
+  const Ball& b = problem.ball;
+  out->cor_ball = b.cor_law->CorAt(v);
+  const TrampolineResult t = EffectiveCorAt(bat, p, x, b.mass_kg, b.radius_m, b.stiffness,
+                                            b.stiffness_exponent, out->cor_ball, v);
+  if (t.ok) out->cor = t.effective_cor;
+}
 
 PublicEvaluation EvaluatePublic(const DesignProblem& problem, const DesignModel& model,
                                 const Bat& bat, bool cor_known) {
@@ -106,13 +129,15 @@ PublicEvaluation EvaluatePublic(const DesignProblem& problem, const DesignModel&
   const double length = bat.LengthM();
   out.omega_rad_s = model.AngularSpeedFor(p.MoiSixInchKgM2(), length);
   double zone_width = kNaN;
-  if (cor_known) {
+  out.cor = model.cor();
+  if (model.cor_from_barrel()) PublicBarrelCor(problem, model, bat, p, out.omega_rad_s, &out);
+  if (cor_known && std::isfinite(out.cor)) {
     Swing swing = problem.swing;
     // The design's own (from its swing weight, and from its length for a bat speed).
     swing.angular_speed_rad_s = out.omega_rad_s;
     swing.bat_speed_mps.reset();  // resolved: omega is the design's
     const ExitSpeedProfile profile =
-        ClosedFormProfileFor(problem.model, p, problem.ball, swing, model.cor());
+        ClosedFormProfileFor(problem.model, p, problem.ball, swing, out.cor);
     const MaxExitSpeedResult max = ClosedFormMaxExitSpeed(profile, length);
     out.sweet_spot_m = max.position_from_knob_m;
     out.placement = max.placement;
@@ -494,7 +519,8 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     summary.solve_time_s = elapsed_s();
     return result;
   }
-  const bool cor_known = problem.cor.has_value() || problem.bat.material.cor.has_value();
+  const bool cor_known =
+      problem.cor.has_value() || problem.bat.material.cor.has_value() || model.cor_from_barrel();
   result.cor = cor_known ? model.cor() : kNaN;
   if (sting && options.backend != DesignBackend::kNloptCobyla) {
     summary.warnings.push_back(
@@ -537,6 +563,12 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     result.sweet_spot_from_knob_m = pub.sweet_spot_m;
     result.max_exit_speed_mps = pub.max_exit_speed_mps;
     result.angular_speed_rad_s = pub.omega_rad_s;
+    if (model.cor_from_barrel()) {
+      result.cor = pub.cor;
+      result.cor_impact_from_knob_m = pub.cor_impact_m;
+      result.cor_impact_speed_mps = pub.cor_speed_mps;
+      result.cor_ball = pub.cor_ball;
+    }
     result.sweet_spot_placement = pub.placement;
     if (pub.placement != Placement::kOnBat && std::isfinite(pub.sweet_spot_m)) {
       summary.warnings.push_back(

@@ -291,23 +291,27 @@ void AddIntegralHessian(const IntegralContext& c, const std::array<double, 3>& w
 // Functions of P = (M, S1, S2, L).
 
 template <typename T>
-T DesignModel::ObjectiveOf(const T* p) const {
-  if (objective_kind_ == DesignObjective::kMinMoi) return MoiAbout(p, c0_, kSixInchPivotM);
-  const double m = ball_mass_kg_;
-  const double u = ball_speed_mps_;
-  const double e = cor_;
-  const double pivot = pivot_from_knob_m_;
-  const T j = MoiAbout(p, c0_, pivot);
+T DesignModel::AngularSpeedOf(const T* p) const {
   // A swing given by its bat speed on a bat whose length varies: omega0 is a function of L =
   // p[3], so its derivatives (d omega0/dL = -v / (L - d - pivot)^2, and the second) come with
   // the jet's.
   const T omega0 = SwingAngularSpeedAt(p[3]);
-  T omega = omega0;
   if (objective_kind_ == DesignObjective::kMaxExitSpeedSwingWeight && jet::Value(omega0) > 0.0 &&
       swing_weight_exponent_ != 0.0) {
-    omega = omega0 *
-            jet::Pow(MoiAbout(p, c0_, kSixInchPivotM) * (1.0 / i6_ref_), -swing_weight_exponent_);
+    return omega0 *
+           jet::Pow(MoiAbout(p, c0_, kSixInchPivotM) * (1.0 / i6_ref_), -swing_weight_exponent_);
   }
+  return omega0;
+}
+
+template <typename T, typename E>
+T DesignModel::ObjectiveOf(const T* p, const E& e) const {
+  if (objective_kind_ == DesignObjective::kMinMoi) return MoiAbout(p, c0_, kSixInchPivotM);
+  const double m = ball_mass_kg_;
+  const double u = ball_speed_mps_;
+  const double pivot = pivot_from_knob_m_;
+  const T j = MoiAbout(p, c0_, pivot);
+  const T omega = AngularSpeedOf(p);
   // The closed forms (exit_speed_algebra.hpp, the code ExitSpeedProfile runs): x from the pivot
   // (rigid_pivot, RigidPivotProfile) or from the balance point (free_bat, FreeBatProfile).
   T origin(pivot);
@@ -319,7 +323,8 @@ T DesignModel::ObjectiveOf(const T* p) const {
     form = {T(u),         (1.0 + e) * i_cm, u + omega * (origin - pivot), i_cm * (1.0 + m / p[0]),
             T(m),         omega};
   } else {
-    form = exit_speed::RigidPivotForm(j, m, u, omega, e);
+    // exit_speed::RigidPivotForm's fields, with e a double or a jet.
+    form = {T(u), (1.0 + e) * j, T(u), j, T(m), omega};
   }
   const T lo = -origin;        // the knob
   const T hi = p[3] - origin;  // the tip
@@ -354,8 +359,8 @@ T DesignModel::FunctionOf(DesignFunction f, const T* p) const {
       return MoiAbout(p, c0_, kSixInchPivotM);
     case DesignFunction::kDrop:
       return p[3] * (1.0 / kMetresPerInch) - p[0] * (1.0 / kKilogramsPerOunce);
-    case DesignFunction::kObjective:
-      return ObjectiveOf(p);
+    case DesignFunction::kObjective:  // with cor_from_barrel() a function of the wall instead
+      return barrel_cor_ ? T(kNaN) : ObjectiveOf(p, cor_);
     case DesignFunction::kLinear:
     case DesignFunction::kFirstFrequency:  // not a function of P (FrequencyOf)
     case DesignFunction::kBbcor:           // nor this (BbcorOf)
@@ -419,14 +424,27 @@ int DesignModel::frequency_elements() const {
   return frequency_beam_ == nullptr ? 0 : frequency_beam_->Elements();
 }
 
+// The local inputs of a function of the wall at one impact point: (M, S1, S2, L, h, x_a, x_b,
+// r_a, r_b), the impact point x = L - from_tip and the outer radius there.
+namespace design_detail {
 template <typename J>
-J DesignModel::BbcorJet(const std::vector<double>& t, const std::array<double, 3>& integrals,
-                        std::array<int, 9>* parameter_of) const {
-  const design_detail::BbcorConstants& c = *bbcor_;
+struct WallInputs {
+  std::array<J, 9> v;  // the local inputs (jet variables 0..8)
+  J impact;            // x, m from the knob
+  J r_out;             // the outer radius at x, m
+};
+}  // namespace design_detail
+
+using design_detail::WallInputs;
+
+template <typename J>
+WallInputs<J> DesignModel::WallInputsAt(const std::vector<double>& t,
+                                        const std::array<double, 3>& integrals, double from_tip_m,
+                                        std::array<int, 9>* parameter_of) const {
   const DesignParameterLayout lay{num_knots_};
   auto at = [&](int idx) { return t[static_cast<std::size_t>(idx)]; };
   const int length_idx = lay.KnotPosition(num_knots_ - 1);
-  const double x = at(length_idx) - c.impact_from_tip_m;
+  const double x = at(length_idx) - from_tip_m;
   // The impact point's segment by Bat::RadiusAtM's rule: from the last knot at or before x to
   // the first beyond it (a constant radius before the first knot or from the last one).
   int b = 0;
@@ -443,32 +461,69 @@ J DesignModel::BbcorJet(const std::vector<double>& t, const std::array<double, 3
                    lay.KnotPosition(knot_b),
                    lay.KnotRadius(knot_a),
                    lay.KnotRadius(knot_b)};
-  std::array<J, 9> v;
+  WallInputs<J> w;
   for (int i = 0; i < 9; ++i) {
     const auto ii = static_cast<std::size_t>(i);
-    v[ii] = J::Variable(i < 3 ? integrals[ii] : at((*parameter_of)[ii]), i);
+    w.v[ii] = J::Variable(i < 3 ? integrals[ii] : at((*parameter_of)[ii]), i);
   }
-  const J impact = v[3] - c.impact_from_tip_m;
-  const J z = impact - c.pivot_from_knob_m;
-  const J r_out = inside ? v[7] + (v[8] - v[7]) * ((impact - v[5]) / (v[6] - v[5])) : v[7];
-  const double d = c0_ - c.pivot_from_knob_m;
-  const J moi = v[2] + (2.0 * d) * v[1] + (d * d) * v[0];  // MoiAbout the pivot
-  return design_detail::BbcorOfWall<J>(c, moi, z, r_out, v[4], J::kHessianSize > 0 ? 2 : 1);
+  w.impact = w.v[3] - from_tip_m;
+  w.r_out =
+      inside ? w.v[7] + (w.v[8] - w.v[7]) * ((w.impact - w.v[5]) / (w.v[6] - w.v[5])) : w.v[7];
+  return w;
 }
 
-bool DesignModel::BbcorOf(const std::vector<double>& t, double* value, double* gradient_row,
-                          int stride) const {
+template <typename J>
+J DesignModel::BarrelCorOf(const WallInputs<J>& w) const {
+  const design_detail::BarrelCorConstants& c = *barrel_cor_;
+  // EffectiveCorAt's free bat: M_e = 1 / (1/M + b^2 / I_cm), b = x - C, with the objective's
+  // inertia model (the integrals are its), as ResolveScene's mass properties.
+  const J& mass = w.v[0];
+  const J balance = c0_ + w.v[1] / mass;
+  const J i_cm = w.v[2] - w.v[1] * w.v[1] / mass;
+  const J b = w.impact - balance;
+  const J m_e = 1.0 / (1.0 / mass + b * b / i_cm);
+  // ResolveScene's normal impact speed there: ball.speed + omega (x - pivot), the design's omega.
+  const J speed = ball_speed_mps_ + AngularSpeedOf(w.v.data()) * (w.impact - pivot_from_knob_m_);
+  const J ball_cor = design_detail::BallCorLawAt(c.cor_law, speed);
+  if (!(jet::Value(w.impact) >= 0.0 && jet::Value(i_cm) > 0.0)) return J(kNaN);
+  return design_detail::TrampolineCorOfWall<J>(c.trampoline, m_e, speed, ball_cor, w.r_out, w.v[4],
+                                               J::kHessianSize > 0 ? 2 : 1);
+}
+
+template <typename J>
+J DesignModel::WallJet(DesignFunction f, const std::vector<double>& t,
+                       const std::array<double, 3>& integrals,
+                       std::array<int, 9>* parameter_of) const {
+  if (f == DesignFunction::kBbcor) {
+    const design_detail::BbcorConstants& c = *bbcor_;
+    const WallInputs<J> w = WallInputsAt<J>(t, integrals, c.impact_from_tip_m, parameter_of);
+    const J z = w.impact - c.pivot_from_knob_m;
+    const double d = c0_ - c.pivot_from_knob_m;
+    const J moi = w.v[2] + (2.0 * d) * w.v[1] + (d * d) * w.v[0];  // MoiAbout the pivot
+    return design_detail::BbcorOfWall<J>(c, moi, z, w.r_out, w.v[4], J::kHessianSize > 0 ? 2 : 1);
+  }
+  // The objective with the design's barrel COR: P = (M, S1, S2, L) are the first four inputs.
+  const WallInputs<J> w =
+      WallInputsAt<J>(t, integrals, barrel_cor_->impact_from_tip_m, parameter_of);
+  const J e = BarrelCorOf(w);
+  if (!std::isfinite(jet::Value(e))) return J(kNaN);
+  return ObjectiveOf<J, J>(w.v.data(), e);
+}
+
+bool DesignModel::WallFunctionOf(DesignFunction f, const std::vector<double>& t, double* value,
+                                 double* gradient_row, int stride) const {
   *value = kNaN;
-  if (bbcor_ == nullptr) return false;
+  if (f == DesignFunction::kBbcor ? bbcor_ == nullptr : barrel_cor_ == nullptr) return false;
   // ComputeBbcor's I_pivot is the rigid body's (the cross-sections' own moments included),
-  // whatever inertia model the objective uses.
+  // whatever inertia model the objective uses; the objective's COR uses the objective's.
+  const bool rigid = f == DesignFunction::kBbcor ? true : rigid_;
   design_detail::Integrals in;
   const design_detail::IntegralContext context{
-      t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, true, c0_};
+      t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, rigid, c0_};
   design_detail::ComputeIntegrals(context, n(), gradient_row != nullptr, &in);
   if (!(in.p[0] > 0.0)) return false;
   std::array<int, 9> parameter_of{};
-  const auto bj = BbcorJet<jet::Jet<9, false>>(t, {in.p[0], in.p[1], in.p[2]}, &parameter_of);
+  const auto bj = WallJet<jet::Jet<9, false>>(f, t, {in.p[0], in.p[1], in.p[2]}, &parameter_of);
   *value = bj.v;
   if (!std::isfinite(bj.v)) return false;
   if (gradient_row != nullptr) {
@@ -486,16 +541,17 @@ bool DesignModel::BbcorOf(const std::vector<double>& t, double* value, double* g
   return true;
 }
 
-bool DesignModel::AddBbcorHessian(const std::vector<double>& t, double weight,
-                                  Eigen::MatrixXd* h) const {
-  if (bbcor_ == nullptr) return false;
+bool DesignModel::AddWallFunctionHessian(DesignFunction f, const std::vector<double>& t,
+                                         double weight, Eigen::MatrixXd* h) const {
+  if (f == DesignFunction::kBbcor ? bbcor_ == nullptr : barrel_cor_ == nullptr) return false;
+  const bool rigid = f == DesignFunction::kBbcor ? true : rigid_;
   design_detail::Integrals in;
   const design_detail::IntegralContext context{
-      t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, true, c0_};
+      t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, rigid, c0_};
   design_detail::ComputeIntegrals(context, n(), true, &in);
   if (!(in.p[0] > 0.0)) return false;
   std::array<int, 9> parameter_of{};
-  const auto bj = BbcorJet<jet::Jet<9, true>>(t, {in.p[0], in.p[1], in.p[2]}, &parameter_of);
+  const auto bj = WallJet<jet::Jet<9, true>>(f, t, {in.p[0], in.p[1], in.p[2]}, &parameter_of);
   if (!std::isfinite(bj.v)) return false;
   // d(local inputs)/dx: the integrals' rows, then one coefficient per parameter (linear in x).
   Eigen::MatrixXd local = Eigen::MatrixXd::Zero(9, n());
@@ -510,7 +566,7 @@ bool DesignModel::AddBbcorHessian(const std::vector<double>& t, double weight,
     for (int b = 0; b < 9; ++b) hb(a, b) = bj.h[static_cast<std::size_t>(a * 9 + b)];
   }
   *h += weight * (local.transpose() * hb * local);
-  // M, S1 and S2 are nonlinear in x: their own second derivatives, weighted by dB/dP.
+  // M, S1 and S2 are nonlinear in x: their own second derivatives, weighted by dF/dP.
   design_detail::AddIntegralHessian(context, {weight * bj.g[0], weight * bj.g[1], weight * bj.g[2]},
                                     h);
   return h->allFinite();
@@ -518,8 +574,27 @@ bool DesignModel::AddBbcorHessian(const std::vector<double>& t, double weight,
 
 double DesignModel::BbcorAt(const double* x) const {
   double v = kNaN;
-  if (!BbcorOf(ParametersAt(x), &v, nullptr, 1)) return kNaN;
+  if (!WallFunctionOf(DesignFunction::kBbcor, ParametersAt(x), &v, nullptr, 1)) return kNaN;
   return v;
+}
+
+double DesignModel::CorAt(const double* x) const {
+  if (barrel_cor_ == nullptr) return cor_;
+  const std::vector<double> t = ParametersAt(x);
+  design_detail::Integrals in;
+  design_detail::ComputeIntegrals(
+      {t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, rigid_, c0_}, n(),
+      false, &in);
+  if (!(in.p[0] > 0.0)) return kNaN;
+  std::array<int, 9> parameter_of{};
+  const auto w = WallInputsAt<jet::Jet<9, false>>(t, {in.p[0], in.p[1], in.p[2]},
+                                                  barrel_cor_->impact_from_tip_m, &parameter_of);
+  const double e = BarrelCorOf(w).v;
+  return std::isfinite(e) ? e : kNaN;
+}
+
+double DesignModel::cor_impact_from_tip_m() const {
+  return barrel_cor_ == nullptr ? kNaN : barrel_cor_->impact_from_tip_m;
 }
 
 double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
@@ -527,8 +602,12 @@ double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
     return StingOf(BatAt(x), false).sting_j;  // NaN when it cannot be computed
   }
   if (f.function == DesignFunction::kFirstFrequency) return FirstFrequencyAt(x);
-  if (f.function == DesignFunction::kBbcor) return BbcorAt(x);
   const std::vector<double> t = ParametersAt(x);
+  if (IsWallFunction(f.function)) {
+    double v = kNaN;
+    if (!WallFunctionOf(f.function, t, &v, nullptr, 1)) return kNaN;
+    return v;
+  }
   if (f.function == DesignFunction::kLinear) {
     double v = f.constant;
     for (const auto& [idx, k] : f.terms) v += k * t[static_cast<std::size_t>(idx)];
@@ -574,7 +653,9 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
     if (f.function == DesignFunction::kFirstFrequency) {
       return FrequencyOf(t, value, gradient_row, stride);
     }
-    if (f.function == DesignFunction::kBbcor) return BbcorOf(t, value, gradient_row, stride);
+    if (IsWallFunction(f.function)) {
+      return WallFunctionOf(f.function, t, value, gradient_row, stride);
+    }
     if (gradient_row == nullptr) {
       *value = FunctionOf<double>(f.function, p);
       return std::isfinite(*value);
@@ -633,6 +714,7 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   std::array<double, 4> w{};
   bool available = true;
   double bbcor_weight = 0.0;
+  double wall_objective_weight = 0.0;
   auto add = [&](const DesignFunctionSpec& f, double weight) {
     if (f.function == DesignFunction::kLinear || weight == 0.0) return;
     if (f.function == DesignFunction::kFirstFrequency) {
@@ -640,7 +722,11 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
       return;
     }
     if (f.function == DesignFunction::kBbcor) {
-      bbcor_weight += weight;  // its own local inputs (AddBbcorHessian)
+      bbcor_weight += weight;  // its own local inputs (AddWallFunctionHessian)
+      return;
+    }
+    if (IsWallFunction(f.function)) {
+      wall_objective_weight += weight;  // the objective with the barrel's COR: the same
       return;
     }
     using J = jet::Jet<4, true>;
@@ -661,7 +747,14 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   *out = in.dp.transpose() * big_w * in.dp;
   // L is linear in x: only M, S1 and S2 have second derivatives.
   design_detail::AddIntegralHessian(context, {w[0], w[1], w[2]}, out);
-  if (bbcor_weight != 0.0 && !AddBbcorHessian(t, bbcor_weight, out)) return false;
+  if (bbcor_weight != 0.0 &&
+      !AddWallFunctionHessian(DesignFunction::kBbcor, t, bbcor_weight, out)) {
+    return false;
+  }
+  if (wall_objective_weight != 0.0 &&
+      !AddWallFunctionHessian(DesignFunction::kObjective, t, wall_objective_weight, out)) {
+    return false;
+  }
   return out->allFinite();
 }
 

@@ -39,6 +39,9 @@ struct FixedMeshBeam;  // core/flexible/beam_frequency.hpp
 namespace design_detail {
 struct ModelBuilder;    // DesignModel::Build's steps (design_model_build.cpp)
 struct BbcorConstants;  // design_bbcor.hpp
+struct BarrelCorConstants;  // design_bbcor.hpp
+template <typename J>
+struct WallInputs;  // design_model.cpp
 }  // namespace design_detail
 
 /// A smooth function of the design (internal).
@@ -156,7 +159,15 @@ class DesignModel {
   bool maximize() const { return maximize_; }                         ///< Objective sense.
   double objective_scale() const { return objective_scale_; }         ///< Typical |F|.
   std::string objective_unit() const { return objective_unit_; }      ///< Unit of F.
-  double cor() const { return cor_; }                                 ///< The COR used.
+  /// The COR used: the fixed one, or with cor_from_barrel() the start's (BaseX) barrel COR.
+  double cor() const { return cor_; }
+  /// True when the objective's COR is the design's barrel's (DesignProblem::cor_from_barrel).
+  bool cor_from_barrel() const { return barrel_cor_ != nullptr; }
+  /// The COR the objective uses at x: cor(), or with cor_from_barrel() the barrel's at x (NaN
+  /// when it cannot be computed); equals EffectiveCorAt on BatAt(x) to rounding.
+  double CorAt(const double* x) const;
+  /// With cor_from_barrel(): where the barrel COR is taken, m from the tip (NaN otherwise).
+  double cor_impact_from_tip_m() const;
   double reference_moi_six_inch_kg_m2() const { return i6_ref_; }     ///< I6_ref.
   /// omega of the swing for a design with MOI `i6` about the 6-in point and length `length_m`,
   /// rad/s (the length matters for a swing given by its bat speed, omega0 = v / (L - d - p)).
@@ -204,8 +215,12 @@ class DesignModel {
  private:
   friend struct design_detail::ModelBuilder;
 
+  // The objective of P = (M, S1, S2, L) with the COR `e` (a double: fixed; a jet: the barrel's).
+  template <typename Scalar, typename Cor>
+  Scalar ObjectiveOf(const Scalar* p, const Cor& e) const;
+  // omega of the swing for the design P (the swing weight's and the length's), rad/s.
   template <typename Scalar>
-  Scalar ObjectiveOf(const Scalar* p) const;
+  Scalar AngularSpeedOf(const Scalar* p) const;
   // omega0 of the swing for a bat of length L, rad/s: the scene's angular speed, or the bat
   // speed over the arm, v / (L - from_tip - pivot), when the length varies with the design.
   template <typename Scalar>
@@ -217,16 +232,33 @@ class DesignModel {
   // gradient_row[j * stride]; false when it cannot be computed.
   bool FrequencyOf(const std::vector<double>& t, double* value, double* gradient_row,
                    int stride) const;
-  // The BBCOR at parameters t and (when gradient_row) its gradient added into
+  // Functions of the wall at an impact point (f = kBbcor, or kObjective with cor_from_barrel()):
+  // the value at parameters t and (when gradient_row) its gradient added into
   // gradient_row[j * stride]; false when it cannot be computed.
-  bool BbcorOf(const std::vector<double>& t, double* value, double* gradient_row, int stride) const;
-  // Adds weight times the BBCOR's Hessian at parameters t into *h; false when not finite.
-  bool AddBbcorHessian(const std::vector<double>& t, double weight, Eigen::MatrixXd* h) const;
-  // The BBCOR as a jet over its 9 local inputs (M, S1, S2 of the rigid-body integrals, L, h,
-  // the impact segment's x_a, x_b, r_a, r_b) and the parameters each one is (-1 for M, S1, S2).
+  bool WallFunctionOf(DesignFunction f, const std::vector<double>& t, double* value,
+                      double* gradient_row, int stride) const;
+  // Adds weight times such a function's Hessian at parameters t into *h; false when not finite.
+  bool AddWallFunctionHessian(DesignFunction f, const std::vector<double>& t, double weight,
+                              Eigen::MatrixXd* h) const;
+  // True when `f` is a function of the wall (WallFunctionOf), not of P alone.
+  bool IsWallFunction(DesignFunction f) const {
+    return f == DesignFunction::kBbcor || (f == DesignFunction::kObjective && barrel_cor_);
+  }
+  // Such a function as a jet over its 9 local inputs (M, S1, S2 of the integrals (the rigid
+  // body's for the BBCOR, the objective's inertia model's for the objective), L, h, the impact
+  // segment's x_a, x_b, r_a, r_b) and the parameters each one is (-1 for M, S1, S2).
   template <typename J>
-  J BbcorJet(const std::vector<double>& t, const std::array<double, 3>& integrals,
-             std::array<int, 9>* parameter_of) const;
+  J WallJet(DesignFunction f, const std::vector<double>& t, const std::array<double, 3>& integrals,
+            std::array<int, 9>* parameter_of) const;
+  // The 9 local inputs at the point from_tip_m from the tip of the design at t (WallJet's).
+  template <typename J>
+  design_detail::WallInputs<J> WallInputsAt(const std::vector<double>& t,
+                                            const std::array<double, 3>& integrals,
+                                            double from_tip_m,
+                                            std::array<int, 9>* parameter_of) const;
+  // The barrel COR (EffectiveCorAt's e_eff) from the local inputs.
+  template <typename J>
+  J BarrelCorOf(const design_detail::WallInputs<J>& w) const;
 
   std::vector<DesignVariableSpec> variables_;
   std::vector<DesignConstraintSpec> constraints_;
@@ -273,6 +305,8 @@ class DesignModel {
   std::shared_ptr<const FixedMeshBeam> frequency_beam_;
   // rules bbcor on a hollow design: the protocol's constants (immutable, shared by the copies).
   std::shared_ptr<const design_detail::BbcorConstants> bbcor_;
+  // cor_from_barrel on a hollow design: the scene ball's trampoline (immutable, shared).
+  std::shared_ptr<const design_detail::BarrelCorConstants> barrel_cor_;
 };
 
 /// The model as the solvers see it: variables scaled to s in [0, 1] (x = lower + (upper -

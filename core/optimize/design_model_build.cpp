@@ -79,6 +79,8 @@ bool ModelBuilder::BaseDesign() {
       return Refuse(why, "cor", *problem.cor, "must be in [0, 1]");
     }
     model.cor_ = *problem.cor;
+  } else if (problem.cor_from_barrel) {
+    model.cor_ = kNaN;  // the start's barrel COR, set by BarrelCor() (which checks the request)
   } else if (base.material.cor.has_value()) {
     model.cor_ = *base.material.cor;
   } else if (exit_speed_objective) {
@@ -465,7 +467,7 @@ bool ModelBuilder::Objective() {
 bool ModelBuilder::Run() {
   if (!CheckScene() || !BaseDesign()) return false;
   Parameters();
-  if (!Variables() || !Rules() || !SceneNumbers()) return false;
+  if (!Variables() || !Rules() || !SceneNumbers() || !BarrelCor()) return false;
   if (!LengthConstraint() || !PropertyConstraints()) return false;
   RadiusKnots();
   if (!DiameterConstraints() || !TaperConstraints()) return false;

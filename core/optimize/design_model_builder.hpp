@@ -160,6 +160,8 @@ struct ModelBuilder {
   bool FrequencyConstraint();
   // The `bbcor` rule's BBCOR <= 0.50 on a hollow design (a nonlinear constraint).
   bool BbcorConstraint();
+  // cor_from_barrel: the objective's COR from the design's barrel (design_bbcor.hpp).
+  bool BarrelCor();
   // Taper: the knot pairs it bounds (refused when the request's knots are not in the profile).
   bool TaperPairs(std::vector<std::pair<int, int>>* pairs_out,
                   std::vector<std::string>* suffix_out);

@@ -352,6 +352,55 @@ bool ModelBuilder::FrequencyConstraint() {
   return true;
 }
 
+// cor_from_barrel: the exit-speed objectives' COR is the design's own barrel's, EffectiveCorAt's
+// quasi-static trampoline for the scene's ball at kCorReferenceFromTipM from the tip (the point
+// ResolveScene evaluates a scene's COR at, so the answer's COR is the one /v1/sweet-spot gives
+// its bat), recomputed per design with exact derivatives (design_bbcor.hpp, DesignModel::WallJet).
+bool ModelBuilder::BarrelCor() {
+  if (!problem.cor_from_barrel) return true;
+  const std::string field = "cor_from_barrel";
+  if (problem.cor.has_value()) {
+    return Refuse(why, TextRefusal(field, "needs cor unset (a given cor is held fixed)"));
+  }
+  if (!problem.ball.cor_law.has_value()) {
+    return Refuse(why, TextRefusal(field, "needs a ball with a COR law (ball.preset)"));
+  }
+  if (!model.hollow_) {
+    return Refuse(why,
+                  TextRefusal(field,
+                              "needs a hollow design (bat.wall_thickness_m > 0 or "
+                              "wall_thickness_m a variable): a solid bat's COR is the ball's"));
+  }
+  if (problem.objective != DesignObjective::kMaxExitSpeed &&
+      problem.objective != DesignObjective::kMaxExitSpeedSwingWeight &&
+      problem.objective != DesignObjective::kWidestSweetZone) {
+    return Refuse(why, TextRefusal(field,
+                                   "applies to the exit-speed objectives (max_exit_speed, "
+                                   "max_exit_speed_swing_weight, widest_sweet_zone) only"));
+  }
+  const double shortest_m = ParamLower(lay.KnotPosition(model.num_knots_ - 1));
+  if (!(shortest_m > kCorReferenceFromTipM)) {
+    return Refuse(
+        why, TextRefusal(field, "the shortest bat the variables allow, L = " + Num(shortest_m) +
+                                    " m, is not longer than " + Num(kCorReferenceFromTipM) +
+                                    " m, the COR's impact point from the tip"));
+  }
+  BarrelCorConstants k;
+  k.trampoline = TrampolineConstantsOf(problem.ball, base.material, BarrelOptions{});
+  k.cor_law = *problem.ball.cor_law;
+  k.impact_from_tip_m = kCorReferenceFromTipM;
+  model.barrel_cor_ = std::make_shared<const BarrelCorConstants>(k);
+  const std::vector<double> x0 = model.BaseX();
+  model.cor_ = model.CorAt(x0.data());
+  if (!std::isfinite(model.cor_)) {
+    return Refuse(why, TextRefusal(field,
+                                   "the barrel COR of the start (the base design clamped into "
+                                   "the variables' bounds) cannot be computed (the ball must "
+                                   "approach the point 0.1524 m from the tip)"));
+  }
+  return true;
+}
+
 // The `bbcor` rule on a hollow design: BBCOR <= 0.50 by ComputeBbcor's model (the NCAA protocol,
 // the default barrel options) as a nonlinear constraint with exact derivatives (design_bbcor.hpp).
 // A solid design keeps the check of the scene's COR before solving (Rules()).
@@ -368,16 +417,9 @@ bool ModelBuilder::BbcorConstraint() {
                                                       "' is not in the catalogue"));
   }
   BbcorConstants k;
-  k.ball_mass_kg = ball->mass_kg;
-  k.ball_radius_m = ball->radius_m;
-  k.ball_stiffness = ball->stiffness;
-  k.ball_exponent = ball->stiffness_exponent;
+  k.trampoline = TrampolineConstantsOf(*ball, base.material, barrel);
   k.ball_cor = ball->cor_law.CorAt(protocol.ball_speed_mps);
   k.speed_mps = protocol.ball_speed_mps;
-  k.youngs_modulus_pa = base.material.youngs_modulus_pa;
-  k.poissons_ratio = base.material.poissons_ratio;
-  k.shell_factor = barrel.shell_factor;
-  k.barrel_loss = barrel.barrel_loss;
   k.pivot_from_knob_m = protocol.pivot_from_knob_m;
   k.impact_from_tip_m = protocol.impact_from_tip_m;
   // The impact point must lie beyond the pivot on every design: on the shortest one.

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -202,6 +203,18 @@ struct DesignProblem {
   /// pivot (ResolveSwing's rules).
   Swing swing;
   std::optional<double> cor;  ///< COR in [0, 1]; unset = the bat material's default.
+  /// The exit-speed objectives' COR from the design's own barrel (issue 18 item 2): when true,
+  /// the COR of each design is the quasi-static trampoline's e_eff of this ball against the
+  /// design's wall (EffectiveCorAt, default BarrelOptions) at kCorReferenceFromTipM from the
+  /// design's tip, for the normal impact speed there, ball.speed_mps + omega (x - pivot) with the
+  /// design's own omega, and the ball's COR law at that speed: what ResolveScene gives that bat,
+  /// recomputed for every design with exact first and second derivatives. The exit speed's
+  /// maximum over the impact point treats this e as constant along the bat, as every scene does.
+  /// Requires `cor` unset, ball.cor_law set, a hollow design (the base bat, or wall_thickness_m
+  /// a variable), objective max_exit_speed, max_exit_speed_swing_weight or widest_sweet_zone and
+  /// the shortest bat longer than kCorReferenceFromTipM. False: `cor` (or the material's) is
+  /// held fixed.
+  bool cor_from_barrel = false;
   InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< How moments are computed.
   /// The exit-speed model of the objectives, the reported sweet spot and min_sting's impact
   /// point: kRigidPivot (the paper's pinned bat) or kFreeBat (the free bat in the swing's
@@ -387,6 +400,13 @@ struct DesignResult {
   double objective_value = 0.0;                    ///< The objective, in objective_unit.
   std::string objective_unit;                      ///< "mps", "m", "kg_m2" or "j" (joules).
   double cor = 0.0;  ///< The COR used (NaN when none is known: min_moi without one).
+  /// problem.cor_from_barrel: the answer's COR is its own barrel's, recomputed through the public
+  /// path (EffectiveCorAt at cor_impact_from_knob_m and cor_impact_speed_mps); NaN otherwise.
+  double cor_impact_from_knob_m = std::numeric_limits<double>::quiet_NaN();
+  /// The normal impact speed the answer's barrel COR was evaluated at, m/s (NaN otherwise).
+  double cor_impact_speed_mps = std::numeric_limits<double>::quiet_NaN();
+  /// The ball's COR (its law) at cor_impact_speed_mps (NaN otherwise).
+  double cor_ball = std::numeric_limits<double>::quiet_NaN();
   /// Sweet spot of the answer (rigid pivot, closed form, at angular_speed_rad_s), m from the
   /// knob; NaN when no COR is known (min_moi without one).
   double sweet_spot_from_knob_m = 0.0;
