@@ -12,11 +12,13 @@
 #include <string>
 #include <vector>
 
+#include "core/ball_catalogue.hpp"
 #include "core/mass_properties.hpp"
 #include "core/material.hpp"
 #include "core/numerics/jet.hpp"
 #include "core/presets.hpp"
 #include "core/scene/resolved_scene.hpp"
+#include "core/scene/scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {
@@ -72,6 +74,20 @@ DesignProblem FilledThreeSegment(DesignObjective objective) {
   p.swing.pivot_from_knob_m = 0.1;
   p.objective = objective;
   return p;
+}
+
+// The hollow profile hit by an MLB ball (its COR law) at 90 mph with the COR of each design its
+// own barrel's (cor_from_barrel: the exit-speed objectives only).
+DesignProblem HollowProfileWithBarrelCor(DesignObjective objective) {
+  DesignProblem p = HollowFilledProfile(objective);
+  ApplyBallPreset(*FindBallPreset("mlb"), &p.ball);
+  p.ball.speed_mps = 40.0;
+  p.cor_from_barrel = true;
+  return p;
+}
+
+bool ExitSpeedObjective(DesignObjective objective) {
+  return objective != DesignObjective::kMinMoi && objective != DesignObjective::kMinSting;
 }
 
 const DesignObjective kObjectives[] = {DesignObjective::kMaxExitSpeed,
@@ -440,16 +456,20 @@ TEST(OptimizeModel, GradientsMatchComputeMassPropertiesWithGradient) {
 TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
   std::mt19937_64 rng(11);
   for (DesignObjective objective : kObjectives) {
-    for (int variant = 0; variant < 9; ++variant) {
+    for (int variant = 0; variant < 11; ++variant) {
       // Both problems with both exit-speed models: rigid_pivot, then free_bat; then the
       // profile with a linked variable (two knots' radii set to one value); then a scale
       // variable ("scale_paths") in each problem; then a swing given by its bat speed with the
       // length a variable (omega0 = v / (L - from_tip - pivot) moves with L): the scaled
-      // three-segment problem (L scaled) and the profile (the last knot's position).
-      DesignProblem p =
-          variant % 2 == 0 ? HollowFilledProfile(objective) : FilledThreeSegment(objective);
-      p.model = variant == 2 || variant == 3 ? CollisionModel::kFreeBat
-                                             : CollisionModel::kRigidPivot;
+      // three-segment problem (L scaled) and the profile (the last knot's position); then the
+      // profile with the COR of each design its barrel's (cor_from_barrel), with the rigid pivot
+      // and with the free bat and a bat speed (exit-speed objectives only).
+      if (variant >= 9 && !ExitSpeedObjective(objective)) continue;
+      DesignProblem p = variant >= 9       ? HollowProfileWithBarrelCor(objective)
+                        : variant % 2 == 0 ? HollowFilledProfile(objective)
+                                           : FilledThreeSegment(objective);
+      p.model = variant == 2 || variant == 3 || variant == 10 ? CollisionModel::kFreeBat
+                                                              : CollisionModel::kRigidPivot;
       if (variant == 4) p.variables[1].linked_paths = {"profile.knots[11].radius_m"};
       if (variant == 6) {
         // Two knots' radii (coefficients ~0.033 m) and a knot's position (~0.83 m) by one
@@ -472,9 +492,10 @@ TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
             {"three_segment.length_m", "three_segment.handle_radius_m", "fill.diameter_m"}};
         p.variables.erase(p.variables.begin() + 1);  // three_segment.handle_radius_m
       }
-      if (variant >= 7) p.swing.bat_speed_mps = 32.0;  // 72 mph at 6 in from the tip
+      if (variant >= 7 && variant != 9) p.swing.bat_speed_mps = 32.0;  // 72 mph, 6 in from the tip
       const DesignModel model = Build(p);
       ASSERT_GT(model.m(), 3);
+      EXPECT_EQ(model.cor_from_barrel(), variant >= 9);
       if (variant % 2 == 0) {
         // The hollow profile's rules bbcor: its BBCOR constraint is among those checked here.
         EXPECT_TRUE(std::any_of(
@@ -542,7 +563,10 @@ TEST(OptimizeModel, GradientsAndHessiansMatchFiniteDifferences) {
 // silent).
 TEST(OptimizeModel, IpoptDerivativeCheckerFindsNoErrors) {
   for (DesignObjective objective : kObjectives) {
-    for (const DesignProblem& p : {HollowFilledProfile(objective), FilledThreeSegment(objective)}) {
+    std::vector<DesignProblem> problems = {HollowFilledProfile(objective),
+                                           FilledThreeSegment(objective)};
+    if (ExitSpeedObjective(objective)) problems.push_back(HollowProfileWithBarrelCor(objective));
+    for (const DesignProblem& p : problems) {
       for (DerivativeCheck check : {DerivativeCheck::kFirstOrder, DerivativeCheck::kSecondOrder}) {
         DesignOptions o;
         o.derivative_check = check;
