@@ -142,8 +142,8 @@ TEST(OptimizeBarrelCor, ObjectiveGradientAndHessianMatchFiniteDifferencesAndTheS
       // scene at that omega.
       DesignProblem scene_problem = p;
       const MassProperties mp = ComputeMassProperties(bat, p.inertia_model);
-      scene_problem.swing.angular_speed_rad_s = model.AngularSpeedFor(mp.MoiSixInchKgM2(),
-                                                                      bat.LengthM());
+      scene_problem.swing.angular_speed_rad_s =
+          model.AngularSpeedFor(mp.MoiSixInchKgM2(), bat.LengthM());
       scene_problem.swing.bat_speed_mps.reset();
       const ResolvedScene scene = SceneOf(scene_problem, bat);
       // The same closed forms in another order and the same bisection for the peak force:
@@ -156,7 +156,8 @@ TEST(OptimizeBarrelCor, ObjectiveGradientAndHessianMatchFiniteDifferencesAndTheS
       DesignPoint point;
       ASSERT_TRUE(model.Evaluate(x.data(), true, &point));
       Eigen::MatrixXd h;
-      ASSERT_TRUE(model.Hessian(x.data(), 1.0, std::vector<double>(static_cast<std::size_t>(model.m()), 0.0).data(), &h));
+      ASSERT_TRUE(model.Hessian(
+          x.data(), 1.0, std::vector<double>(static_cast<std::size_t>(model.m()), 0.0).data(), &h));
       EXPECT_LE((h - h.transpose()).norm(), 1e-12 * h.norm());
       for (int j = 0; j < model.n(); ++j) {
         const DesignVariableSpec& v = model.variables()[static_cast<std::size_t>(j)];
@@ -164,9 +165,9 @@ TEST(OptimizeBarrelCor, ObjectiveGradientAndHessianMatchFiniteDifferencesAndTheS
         std::vector<double> xp = x, xm = x;
         xp[static_cast<std::size_t>(j)] += step;
         xm[static_cast<std::size_t>(j)] -= step;
-        const double fd =
-            (model.Value(model.objective(), xp.data()) - model.Value(model.objective(), xm.data())) /
-            (2.0 * step);
+        const double fd = (model.Value(model.objective(), xp.data()) -
+                           model.Value(model.objective(), xm.data())) /
+                          (2.0 * step);
         // Relative to F / width: central differences' truncation ~ (1e-5)^2 and rounding
         // ~ 1e-16 / 1e-5 (the peak force's bisection stops at 1e-15 relative: ~1e-10); 1e-7
         // bounds both with room (measured below); a wrong or missing term (the COR's share of
@@ -180,7 +181,8 @@ TEST(OptimizeBarrelCor, ObjectiveGradientAndHessianMatchFiniteDifferencesAndTheS
         ASSERT_TRUE(model.Evaluate(xp.data(), true, &pp));
         ASSERT_TRUE(model.Evaluate(xm.data(), true, &pm));
         for (int i = 0; i < model.n(); ++i) {
-          const double column = (pp.objective_gradient(i) - pm.objective_gradient(i)) / (2.0 * step);
+          const double column =
+              (pp.objective_gradient(i) - pm.objective_gradient(i)) / (2.0 * step);
           const double width_i = model.variables()[static_cast<std::size_t>(i)].upper -
                                  model.variables()[static_cast<std::size_t>(i)].lower;
           const double hscale = objective_range / ((v.upper - v.lower) * width_i);
@@ -273,19 +275,20 @@ TEST(OptimizeBarrelCor, TheIssuesRequestIsHeldByTheMassNotTheBbcor) {
     const double x = r.sweet_spot_from_knob_m;
     EXPECT_NEAR(r.cor_impact_from_knob_m - x, 1.55 * 0.0254, 0.001);
     const double v = p.ball.speed_mps + scene.swing.angular_speed_rad_s * x;
-    const TrampolineResult at_sweet_spot = EffectiveCorAt(
-        r.bat, scene.mass_properties, x, p.ball.mass_kg, p.ball.radius_m, p.ball.stiffness,
-        p.ball.stiffness_exponent, p.ball.cor_law->CorAt(v), v);
+    const TrampolineResult at_sweet_spot =
+        EffectiveCorAt(r.bat, scene.mass_properties, x, p.ball.mass_kg, p.ball.radius_m,
+                       p.ball.stiffness, p.ball.stiffness_exponent, p.ball.cor_law->CorAt(v), v);
     ASSERT_TRUE(at_sweet_spot.ok);
     EXPECT_NEAR(at_sweet_spot.effective_cor - r.cor, 0.0018, 0.0001);
     const ExitSpeedProfile profile =
-        ClosedFormProfileFor(CollisionModel::kFreeBat, scene.mass_properties, p.ball,
-                             scene.swing, at_sweet_spot.effective_cor);
+        ClosedFormProfileFor(CollisionModel::kFreeBat, scene.mass_properties, p.ball, scene.swing,
+                             at_sweet_spot.effective_cor);
     const double faster = ClosedFormMaxExitSpeed(profile, r.bat.LengthM()).exit_speed_mps;
     EXPECT_NEAR(faster - r.max_exit_speed_mps, 0.104, 0.002);
-    std::printf("e_eff at the sweet spot (%.4f m) %.6f vs %.6f at the COR's point: exit speed "
-                "+%.4f m/s\n",
-                x, at_sweet_spot.effective_cor, r.cor, faster - r.max_exit_speed_mps);
+    std::printf(
+        "e_eff at the sweet spot (%.4f m) %.6f vs %.6f at the COR's point: exit speed "
+        "+%.4f m/s\n",
+        x, at_sweet_spot.effective_cor, r.cor, faster - r.max_exit_speed_mps);
   }
   // With the COR held, the same bat was reported 0.126 m/s faster than the scene measures it.
   EXPECT_NEAR(f.max_exit_speed_mps - r.max_exit_speed_mps, 0.1262, 0.0005);
@@ -318,11 +321,12 @@ TEST(OptimizeBarrelCor, WithTheDensityFreeTheWallThinsToTheBbcorLimit) {
     EXPECT_LT(r.bat.wall_thickness_m, 0.0027614431802374);
     EXPECT_NEAR(r.bat.wall_thickness_m, 0.00276045, 1e-7);
     ExpectAnswerIsTheScenes(p, r);
-    std::printf("density free (%s): wall %.9g m, density %.6g, COR %.6f, BBCOR %.12f, exit speed "
-                "%.6f m/s, %d iterations\n",
-                hessian == HessianMode::kExact ? "exact Hessian" : "limited memory",
-                r.bat.wall_thickness_m, r.bat.material.density_kg_m3, r.cor, r.bbcor->value,
-                r.max_exit_speed_mps, r.summary.iterations);
+    std::printf(
+        "density free (%s): wall %.9g m, density %.6g, COR %.6f, BBCOR %.12f, exit speed "
+        "%.6f m/s, %d iterations\n",
+        hessian == HessianMode::kExact ? "exact Hessian" : "limited memory", r.bat.wall_thickness_m,
+        r.bat.material.density_kg_m3, r.cor, r.bbcor->value, r.max_exit_speed_mps,
+        r.summary.iterations);
   }
   DesignProblem fixed = p;
   fixed.cor_from_barrel = false;
@@ -334,10 +338,10 @@ TEST(OptimizeBarrelCor, WithTheDensityFreeTheWallThinsToTheBbcorLimit) {
   // That design's own COR is lower than the held one: its true exit speed is below the claim.
   const ResolvedScene truth = SceneOf(p, f.bat);
   EXPECT_LT(*truth.cor, *fixed.cor - 0.01);
-  std::printf("density free, COR held %.6f: wall %.9g m, BBCOR %.6f, claimed exit speed %.6f m/s, "
-              "its own COR %.6f\n",
-              *fixed.cor, f.bat.wall_thickness_m, f.bbcor->value, f.max_exit_speed_mps,
-              *truth.cor);
+  std::printf(
+      "density free, COR held %.6f: wall %.9g m, BBCOR %.6f, claimed exit speed %.6f m/s, "
+      "its own COR %.6f\n",
+      *fixed.cor, f.bat.wall_thickness_m, f.bbcor->value, f.max_exit_speed_mps, *truth.cor);
 }
 
 // The COR from the barrel needs what it is made of: refused, naming the field, otherwise; a
