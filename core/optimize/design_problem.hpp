@@ -452,7 +452,8 @@ struct MaterialChoiceResult {
 };
 
 /// A discrete choice of material: solves `problem` once per material (the base bat's
-/// material replaced, the COR from the material unless problem.cor is set; rule sets apply
+/// material replaced; the COR: problem.cor if set, else each design's own barrel's with
+/// problem.cor_from_barrel, else the material's; rule sets apply
 /// per material, so e.g. mlb-wood refuses aluminium as invalid_input for that material) and
 /// picks the best usable design: converged ones first, then by objective. options.max_time_s
 /// bounds the whole call (one budget for all materials); `progress` covers all materials and is

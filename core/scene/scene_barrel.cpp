@@ -16,7 +16,7 @@ bool SceneBarrel(const Scene& scene, const ResolvedScene& r, const BarrelOptions
   auto point = [&](double x, BarrelCorPoint* p, TrampolineResult* tr) {
     p->position_from_knob_m = x;
     p->approach_speed_mps =
-        ball.speed_mps + scene.swing.angular_speed_rad_s * (x - scene.swing.pivot_from_knob_m);
+        ball.speed_mps + r.swing.angular_speed_rad_s * (x - r.swing.pivot_from_knob_m);
     p->ball_cor = ball.cor_law ? ball.cor_law->CorAt(p->approach_speed_mps) : r.cor.value_or(0.5);
     if (!(p->approach_speed_mps > 0.0)) {
       *error = "barrel: the ball and the bat do not approach at " + std::to_string(x) +

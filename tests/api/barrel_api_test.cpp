@@ -74,6 +74,24 @@ TEST(BarrelApiTest, HollowBatWithABallPresetTakesTheTrampolineCor) {
   EXPECT_EQ(plain.body["cor_source"], "material:aluminium-7050");
 }
 
+// A swing given by its bat speed: the barrel output's points use the resolved angular speed, as
+// the scene's COR does (they used the default 17.288 rad/s: 52.09 m/s against 71.53 at 6 in).
+TEST(BarrelApiTest, BarrelCurveUsesTheSwingResolvedFromABatSpeed) {
+  const Response r = Post("/v1/sweet-spot", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "ball": {"preset": "mlb", "speed_mph": 90}, "swing": {"bat_speed_mph": 70},
+      "outputs": ["max_exit_speed", "barrel"]})");
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const auto& barrel = r.body["barrel"];
+  EXPECT_EQ(r.body["cor"], barrel["effective_cor"]);
+  // The curve's points are 10, 9, ..., 1 in from the tip: the 6-in one is the COR's point.
+  const auto& six = barrel["effective_cor_curve"][4];
+  EXPECT_NEAR(six["position_from_knob_m"].get<double>(),
+              barrel["position_from_knob_m"].get<double>(), 1e-12);  // 33 in - 6 in, rounding
+  EXPECT_DOUBLE_EQ(six["approach_speed_mps"].get<double>(),
+                   r.body["cor_impact_speed_mps"].get<double>());
+  EXPECT_DOUBLE_EQ(six["effective_cor"].get<double>(), r.body["cor"].get<double>());
+}
+
 // Issue 18 item 2: the `bbcor` rule of /v1/optimize constrains the BBCOR, so the wall thickness
 // is a design variable. The aluminium preset, the least MOI about the 6-in point with the wall
 // and the handle's radius free: the wall thins until BBCOR = 0.50 (the handle keeps the drop
