@@ -129,7 +129,11 @@ bool Bat::IsValid(std::string* why) const {
   return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
 }
 
-bool Bat::Validate(Refusal* why) const {
+bool Bat::Validate(Refusal* why) const { return ValidateChecks(why, /*materials=*/true); }
+
+bool Bat::ValidateGeometry(Refusal* why) const { return ValidateChecks(why, /*materials=*/false); }
+
+bool Bat::ValidateChecks(Refusal* why, bool materials) const {
   const std::size_t n = knots.size();
   if (n < 2) {
     return Refuse(why, "knots.size()", static_cast<double>(n), "must be at least 2");
@@ -165,7 +169,7 @@ bool Bat::Validate(Refusal* why) const {
                                      "must be positive");
     }
   }
-  if (!CheckMaterial(material, "material.", why)) return false;
+  if (materials && !CheckMaterial(material, "material.", why)) return false;
 
   if (!std::isfinite(wall_thickness_m)) {
     return Refuse(why, "wall_thickness_m", wall_thickness_m, "must be finite");
@@ -188,7 +192,9 @@ bool Bat::Validate(Refusal* why) const {
       return Refuse(why, "fill.material.density_kg_m3", f.material.density_kg_m3,
                     "must be non-negative (0 = empty bore)");
     }
-    if (!f.IsEmpty() && !CheckMaterial(f.material, "fill.material.", why)) return false;
+    if (materials && !f.IsEmpty() && !CheckMaterial(f.material, "fill.material.", why)) {
+      return false;
+    }
     if (!std::isfinite(f.diameter_m)) {
       return Refuse(why, "fill.diameter_m", f.diameter_m, "must be finite");
     }

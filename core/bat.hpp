@@ -122,6 +122,11 @@ struct Bat {
   /// Material::ValidateSize ("knots[1].x_m = 150: must be in [0, 100]"); for a bat given from
   /// outside.
   bool ValidateSize(Refusal* refusal) const;
+  /// Validate without the materials' own checks (the bat's material and a non-empty fill's):
+  /// for a bat whose materials are known to pass them, as a sweep's designs that change only
+  /// the geometry, the wall or the fill's size. Does not allocate when the bat is valid and
+  /// refusal is null.
+  bool ValidateGeometry(Refusal* refusal) const;
   /// The caps of ValidateSize alone (ValidateSize = Validate, then this): for a bat that
   /// Validate checks elsewhere.
   bool ValidateCaps(Refusal* refusal) const;
@@ -139,6 +144,10 @@ struct Bat {
   double InnerRadiusAtM(double x_m) const;
   /// Smallest outer radius over the bat, m (0 without knots).
   double MinRadiusM() const;
+
+ private:
+  // Validate's checks in its order; the materials' own only when `materials`.
+  bool ValidateChecks(Refusal* refusal, bool materials) const;
 };
 
 /// A bat of the paper's three-segment shape (knots from shape.Knots()),

@@ -96,6 +96,10 @@ double MassProperties::MoiAboutKgM2(double pivot_from_knob_m) const {
 
 MassProperties ComputeMassProperties(const Bat& bat, InertiaModel model) {
   if (!bat.IsValid(nullptr)) return NanProperties(model);
+  return ComputeMassPropertiesOfValidBat(bat, model);
+}
+
+MassProperties ComputeMassPropertiesOfValidBat(const Bat& bat, InertiaModel model) {
   const geometry::KnotListProfile profile(bat.knots);
   const geometry::BodyScalars<double> body = geometry::BodyOf(bat);
   const geometry::MassMoment<double> mm = geometry::ComputeMassMoment<double>(profile, body);

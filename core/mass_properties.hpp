@@ -52,6 +52,11 @@ bool ValidatePivotFromKnob(double pivot_from_knob_m, Refusal* refusal);
 /// Mass properties of `bat` (precondition: bat.IsValid(nullptr); for an
 /// invalid bat every field is NaN). Never throws, never allocates; O(knots).
 MassProperties ComputeMassProperties(const Bat& bat, InertiaModel model = InertiaModel::kRigidBody);
+/// ComputeMassProperties of a bat the caller has checked (Bat::Validate passed, or
+/// ValidateGeometry with its materials known valid): the same numbers, without checking the bat
+/// again (a sweep's designs, validated once each). Undefined for an invalid bat.
+MassProperties ComputeMassPropertiesOfValidBat(const Bat& bat,
+                                               InertiaModel model = InertiaModel::kRigidBody);
 
 /// Where each design parameter sits in a gradient vector, for a bat with
 /// num_knots knots. The layout is always 2 * num_knots + 5 long:

@@ -62,12 +62,8 @@ const char* PlacementName(Placement placement) {
   return "on_bat";
 }
 
-MaxExitSpeedResult ClosedFormMaxExitSpeed(const ExitSpeedProfile& profile, double length_m) {
-  MaxExitSpeedResult out;
-  out.method = "closed_form";
-  out.summary.backend = "closed_form";
-  out.summary.iterations = 0;
-  out.summary.evaluations = 1;
+ClosedFormMaximum ClosedFormMaximumOnBat(const ExitSpeedProfile& profile, double length_m) {
+  ClosedFormMaximum out;
   const ProfileMaximum mx = profile.Maximum();
   const double lo = -profile.origin_from_knob_m;            // the knob, profile coordinate
   const double hi = length_m - profile.origin_from_knob_m;  // the tip
@@ -86,11 +82,9 @@ MaxExitSpeedResult ClosedFormMaxExitSpeed(const ExitSpeedProfile& profile, doubl
   out.position_from_knob_m = FromProfile(best_x, profile.origin_from_knob_m, lo, hi, length_m);
   out.exit_speed_mps = best_f;
   out.unconstrained_position_from_knob_m = mx.x_m + profile.origin_from_knob_m;
+  out.flat = mx.flat;
   if (mx.flat) {
     out.placement = Placement::kOnBat;
-    out.summary.warnings.push_back(
-        "the exit speed is the same at every impact position (no swing, no incoming ball "
-        "speed); the pivot's position (clamped to the bat) is reported");
   } else if (best_x == hi && mx.x_m > hi) {
     out.placement = Placement::kBeyondTip;
   } else if (best_x == lo && mx.x_m < lo) {
@@ -104,6 +98,28 @@ MaxExitSpeedResult ClosedFormMaxExitSpeed(const ExitSpeedProfile& profile, doubl
   } else {
     out.error_estimate_m = 0.0;  // an end of the bat, exactly
     out.error_estimate_mps = 8.0 * kEps * (profile.ball_speed_mps + std::abs(best_f));
+  }
+  return out;
+}
+
+MaxExitSpeedResult ClosedFormMaxExitSpeed(const ExitSpeedProfile& profile, double length_m) {
+  MaxExitSpeedResult out;
+  out.method = "closed_form";
+  out.summary.backend = "closed_form";
+  out.summary.iterations = 0;
+  out.summary.evaluations = 1;
+  const ClosedFormMaximum mx = ClosedFormMaximumOnBat(profile, length_m);
+  out.position_from_knob_m = mx.position_from_knob_m;
+  out.exit_speed_mps = mx.exit_speed_mps;
+  out.unconstrained_position_from_knob_m = mx.unconstrained_position_from_knob_m;
+  out.placement = mx.placement;
+  out.error_estimate_m = mx.error_estimate_m;
+  out.error_estimate_mps = mx.error_estimate_mps;
+  if (mx.flat) {
+    out.summary.warnings.emplace_back(
+        "the exit speed is the same at every impact position (no swing, no incoming ball "
+        "speed); the pivot's position (clamped to the bat) is reported");
+  } else if (out.placement != Placement::kOnBat) {
     out.summary.warnings.push_back(
         std::string("the unconstrained maximiser (") +
         FormatNumber17(out.unconstrained_position_from_knob_m) + " m from the knob) is " +

@@ -156,8 +156,23 @@ struct LeastStingZoneResult {
   std::string theory;                     ///< The beam theory.
 };
 
+/// The numbers of the closed-form sweet spot over the bat, without the result's strings
+/// (ClosedFormMaxExitSpeed's, which it fills from these): a sweep's designs.
+struct ClosedFormMaximum {
+  double position_from_knob_m = 0.0;                ///< The sweet spot on the bat, m from the knob.
+  double exit_speed_mps = 0.0;                      ///< The exit speed there, m/s.
+  double unconstrained_position_from_knob_m = 0.0;  ///< The unconstrained maximiser, m.
+  Placement placement = Placement::kOnBat;          ///< Where the unconstrained one lies.
+  bool flat = false;                ///< The exit speed is the same everywhere (ProfileMaximum).
+  double error_estimate_m = 0.0;    ///< As MaxExitSpeedResult's.
+  double error_estimate_mps = 0.0;  ///< As MaxExitSpeedResult's.
+};
+
 /// The closed-form sweet spot of `profile` over the bat [0, length_m] (candidates: the clamped
 /// unconstrained maximiser and both ends, so it is the maximum over the bat in every case).
+ClosedFormMaximum ClosedFormMaximumOnBat(const ExitSpeedProfile& profile, double length_m);
+
+/// ClosedFormMaximumOnBat as a max_exit_speed result (method, summary, warnings).
 MaxExitSpeedResult ClosedFormMaxExitSpeed(const ExitSpeedProfile& profile, double length_m);
 
 /// The closed-form sweet zone: the connected interval around `max.position_from_knob_m` where

@@ -1,6 +1,7 @@
 // Scenes: validation, "model only what is needed", NLopt backend mapping and algorithms,
 // auto model choice, refusals, determinism across threads.
 #include "core/collision/collide.hpp"
+#include "core/scene/closed_form_designs.hpp"
 #include "core/scene/evaluate_scene.hpp"
 
 #include <cmath>
@@ -449,6 +450,87 @@ TEST(SceneEvaluatorReuse, InvalidOptionsRefuseEveryScene) {
     EXPECT_EQ(r.summary.message, EvaluateScene(PaperWood(), o).summary.message);
     EXPECT_FALSE(r.max_exit_speed.has_value());
   }
+}
+
+// The lean path of a sweep (ClosedFormDesigns): whenever it vouches for a design, its numbers
+// are EvaluateScene's, bit for bit; a design EvaluateScene refuses it never vouches for. The
+// designs change the geometry, the ball, the swing and the COR, some of them out of range.
+TEST(ClosedFormDesigns, VouchesOnlyForEvaluateScenesNumbers) {
+  for (const CollisionModel model : {CollisionModel::kRigidPivot, CollisionModel::kFreeBat}) {
+    SceneOptions o;
+    o.time_models = false;
+    o.model = model;
+    Scene scene;
+    ThreeSegmentShape shape{0.8636, 0.0125, 0.033, 0.30, 0.55};
+    scene.bat = MakeThreeSegmentBat(shape, FindMaterial("ash").value());
+    scene.cor = 0.5;
+    scene.outputs = {SceneOutput::kMaxExitSpeed};
+    ASSERT_TRUE(ClosedFormDesigns::Applies(o, scene));
+    SceneChanges changes;
+    changes.bat_geometry = changes.ball = changes.swing = changes.cor = true;
+    ClosedFormDesigns lean(o, scene, changes);
+    EXPECT_EQ(lean.model(), model);
+    int vouched = 0, refused = 0, off_bat = 0;
+    for (int k = 0; k < 240; ++k) {
+      Scene design = scene;
+      shape.taper_end_m = 0.45 + 0.01 * (k % 30);  // from 0.45 to 0.74
+      design.bat->knots = shape.Knots();
+      design.bat->wall_thickness_m = k % 7 == 3 ? 0.02 : 0.0;       // the wall above r1 in some
+      design.ball.mass_kg = k % 11 == 5 ? 0.0 : 0.145;              // out of range in some
+      design.swing.hands_from_knob_m = k % 13 == 7 ? 0.9 : 0.1524;  // past the tip in some
+      design.swing.pivot_from_knob_m = -1.0 + 0.02 * (k % 100);
+      // The maximum off the bat in some: no swing (rigid_pivot), or no ball speed (free_bat).
+      design.swing.angular_speed_rad_s = k % 5 == 2 ? 0.0 : 17.288;
+      design.ball.speed_mps = k % 3 == 1 ? 0.0 : 27.7;
+      design.cor = k % 17 == 9 ? 1.5 : 0.5;  // out of range in some
+      ClosedFormDesign d;
+      const bool ok = lean.Evaluate(design, &d);
+      const SceneResult full = EvaluateScene(design, o);
+      if (!ok) {
+        ++refused;
+        continue;
+      }
+      ++vouched;
+      ASSERT_TRUE(full.summary.IsSolutionUsable())
+          << "design " << k << ": " << full.summary.message;
+      ASSERT_TRUE(full.max_exit_speed.has_value());
+      const MaxExitSpeedResult& m = *full.max_exit_speed;
+      EXPECT_EQ(d.max_exit_speed.exit_speed_mps, m.exit_speed_mps) << k;
+      EXPECT_EQ(d.max_exit_speed.position_from_knob_m, m.position_from_knob_m) << k;
+      EXPECT_EQ(d.max_exit_speed.unconstrained_position_from_knob_m,
+                m.unconstrained_position_from_knob_m)
+          << k;
+      EXPECT_EQ(d.max_exit_speed.placement, m.placement) << k;
+      off_bat += m.placement != Placement::kOnBat;
+      EXPECT_EQ(d.max_exit_speed.error_estimate_m, m.error_estimate_m) << k;
+      EXPECT_EQ(d.max_exit_speed.error_estimate_mps, m.error_estimate_mps) << k;
+      EXPECT_EQ(CollisionModelName(lean.model()), m.model) << k;
+      EXPECT_EQ(d.length_m, full.length_m) << k;
+      EXPECT_EQ(d.mass_properties.mass_kg, full.mass_properties.mass_kg) << k;
+      EXPECT_EQ(d.mass_properties.balance_point_m, full.mass_properties.balance_point_m) << k;
+      EXPECT_EQ(d.mass_properties.moi_knob_kg_m2, full.mass_properties.moi_knob_kg_m2) << k;
+      EXPECT_EQ(d.mass_properties.moi_centroid_kg_m2, full.mass_properties.moi_centroid_kg_m2) << k;
+      EXPECT_EQ(d.mass_properties.volume_m3, full.mass_properties.volume_m3) << k;
+    }
+    // Both kinds of design, and a placement off the bat among the vouched ones.
+    EXPECT_GT(vouched, 100);
+    EXPECT_GT(refused, 40);
+    EXPECT_GT(off_bat, 0) << CollisionModelName(model);
+  }
+  // Not for what it does not take: another output, a bat speed, flexible, NLopt.
+  SceneOptions o;
+  Scene scene = PaperWood({SceneOutput::kMaxExitSpeed, SceneOutput::kCenterOfPercussion});
+  EXPECT_FALSE(ClosedFormDesigns::Applies(o, scene));
+  scene.outputs = {SceneOutput::kMaxExitSpeed};
+  EXPECT_TRUE(ClosedFormDesigns::Applies(o, scene));
+  scene.swing.bat_speed_mps = 30.0;
+  EXPECT_FALSE(ClosedFormDesigns::Applies(o, scene));
+  scene.swing.bat_speed_mps.reset();
+  o.model = CollisionModel::kFlexible;
+  EXPECT_FALSE(ClosedFormDesigns::Applies(o, scene));
+  o.model = CollisionModel::kAuto;
+  o.method = SweetSpotMethod::kNlopt;
+  EXPECT_FALSE(ClosedFormDesigns::Applies(o, scene));
 }
 
 }  // namespace
