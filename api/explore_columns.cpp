@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 
 #include "api/bat_json.hpp"
 #include "api/explore_shards.hpp"
@@ -186,6 +187,20 @@ void CsvRowWriter::Separate() {
 void CsvRowWriter::Number(double value) {
   Separate();
   AppendCsvNumber(value, out_);
+}
+
+void CsvRowWriter::Number(double value, CsvNumberMemo* memo) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &value, sizeof bits);
+  Separate();
+  if (!(memo->set && memo->bits == bits)) {
+    if (!std::isfinite(value)) return;  // AppendCsvNumber writes nothing: nothing to remember
+    const auto result = std::to_chars(memo->text, memo->text + sizeof(memo->text), value);
+    memo->size = static_cast<unsigned char>(result.ptr - memo->text);
+    memo->bits = bits;
+    memo->set = true;
+  }
+  out_->append(memo->text, memo->size);
 }
 
 void CsvRowWriter::Integer(std::int64_t value) {

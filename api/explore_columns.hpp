@@ -58,6 +58,15 @@ void AppendCsvField(std::string_view text, std::string* out);
 /// (std::to_chars); nothing for NaN or an infinity (rows never hold them).
 void AppendCsvNumber(double value, std::string* out);
 
+/// The text of the last number one column wrote (AppendCsvNumber's), reused while the column's
+/// value keeps its bits: a grid's slower parameters keep their value for many rows.
+struct CsvNumberMemo {
+  std::uint64_t bits = 0;  ///< The number's bits.
+  bool set = false;        ///< A number is remembered.
+  unsigned char size = 0;  ///< Characters of its text.
+  char text[32];           ///< Its text (`size` characters).
+};
+
 /// Writes CSV rows value by value into a string: fields separated by commas, each row ended
 /// by LF ("\n"). The caller writes exactly one value per column, in column order.
 class CsvRowWriter {
@@ -66,6 +75,9 @@ class CsvRowWriter {
   explicit CsvRowWriter(std::string* out) : out_(out) {}
   /// A number, shortest round-trip (AppendCsvNumber).
   void Number(double value);
+  /// Number(value), its text taken from *memo when `value` has the bits *memo remembers, and
+  /// remembered there otherwise (the same characters either way).
+  void Number(double value, CsvNumberMemo* memo);
   /// An integer, in decimal.
   void Integer(std::int64_t value);
   /// An unsigned integer, in decimal.

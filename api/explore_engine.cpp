@@ -1,9 +1,12 @@
 #include "api/explore_engine.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <charconv>
 #include <cmath>
 #include <condition_variable>
+#include <cstring>
 #include <map>
 #include <mutex>
 #include <string_view>
@@ -149,6 +152,42 @@ std::optional<DesignBinder> DesignBinder::Compile(const Json& base,
         binding.target = fill->second;
       } else {
         return std::nullopt;  // not bound here: the JSON path
+      }
+      switch (binding.target) {
+        case T::kBallMass:
+        case T::kBallRadius:
+        case T::kBallSpeed:
+        case T::kBallStiffness:
+        case T::kBallExponent:
+          binder.changes_.ball = true;
+          break;
+        case T::kSwingOmega:
+        case T::kSwingPivot:
+        case T::kSwingHands:
+          binder.changes_.swing = true;
+          break;
+        case T::kCor:
+          binder.changes_.cor = true;
+          break;
+        case T::kDensity:
+        case T::kYoungs:
+        case T::kShear:
+        case T::kPoisson:
+        case T::kMaterialCor:
+          binder.changes_.bat_materials = true;
+          break;
+        case T::kShapeLength:
+        case T::kShapeHandle:
+        case T::kShapeBarrel:
+        case T::kShapeTaperStart:
+        case T::kShapeTaperEnd:
+        case T::kKnotX:
+        case T::kKnotRadius:
+        case T::kWall:
+        case T::kFillDiameter:
+        case T::kFillDepth:
+          binder.changes_.bat_geometry = true;
+          break;
       }
       if (pattern.rfind("bat.", 0) == 0) binder.bat_swept_ = true;
       if (pattern.rfind("bat.material.", 0) == 0 || pattern.rfind("bat.fill.", 0) == 0) {
@@ -454,31 +493,78 @@ DirectValue Text(std::string_view v) {
   return d;
 }
 
+// What a direct column reads of a feasible design: a DesignOutcome's result, or the lean
+// path's numbers (core::ClosedFormDesign), the same fields under the same names.
+struct DirectView {
+  const core::MassProperties* properties = nullptr;
+  double length_m = 0.0;
+  const std::optional<double>* collision_efficiency = nullptr;  // null: none
+  bool has_max = false;                                         // max_exit_speed was computed
+  double max_position = 0.0, max_speed = 0.0, max_unconstrained = 0.0;
+  core::Placement max_placement = core::Placement::kOnBat;
+  std::string_view max_model, max_method;
+  const core::CenterOfPercussionResult* cop = nullptr;  // null: none
+};
+
+DirectView ViewOf(const DesignOutcome& o) {
+  const core::SceneResult& r = o.result;
+  DirectView v;
+  v.properties = &r.mass_properties;
+  v.length_m = r.length_m;
+  v.collision_efficiency = &o.collision_efficiency;
+  if (r.max_exit_speed) {
+    const core::MaxExitSpeedResult& m = *r.max_exit_speed;
+    v.has_max = true;
+    v.max_position = m.position_from_knob_m;
+    v.max_speed = m.exit_speed_mps;
+    v.max_unconstrained = m.unconstrained_position_from_knob_m;
+    v.max_placement = m.placement;
+    v.max_model = m.model;
+    v.max_method = m.method;
+  }
+  if (r.center_of_percussion) v.cop = &*r.center_of_percussion;
+  return v;
+}
+
+// The lean path's design: max_exit_speed by the closed form of `model`.
+DirectView ViewOf(const core::ClosedFormDesign& d, core::CollisionModel model) {
+  DirectView v;
+  v.properties = &d.mass_properties;
+  v.length_m = d.length_m;
+  v.has_max = true;
+  v.max_position = d.max_exit_speed.position_from_knob_m;
+  v.max_speed = d.max_exit_speed.exit_speed_mps;
+  v.max_unconstrained = d.max_exit_speed.unconstrained_position_from_knob_m;
+  v.max_placement = d.max_exit_speed.placement;
+  v.max_model = core::CollisionModelName(model);
+  v.max_method = "closed_form";  // ClosedFormMaxExitSpeed's
+  return v;
+}
+
 DirectValue ReadSiDirect(const DirectAccessor& a, std::uint64_t index,
-                         const std::vector<double>& values, const DesignOutcome& o,
+                         const std::vector<double>& values, const DirectView& o,
                          const core::ImperialProperties& imperial);
 
 // The value of `a` in the feasible row of design `index`.
 DirectValue ReadDirect(const DirectAccessor& a, std::uint64_t index,
-                       const std::vector<double>& values, const DesignOutcome& o,
+                       const std::vector<double>& values, const DirectView& o,
                        const core::ImperialProperties& imperial) {
   DirectValue d = ReadSiDirect(a, index, values, o, imperial);
   if (a.convert == DirectConvert::kNone || d.kind != DirectValue::kNumber) return d;
   // As AddImperial computes it (api/trade_units.cpp), operation for operation.
   d.number = a.convert == DirectConvert::kDivide ? d.number / a.factor
-                                                 : (o.result.length_m - d.number) / a.factor;
+                                                 : (o.length_m - d.number) / a.factor;
   return d;
 }
 
 // The value of `a`'s SI field in the feasible row of design `index`.
 DirectValue ReadSiDirect(const DirectAccessor& a, std::uint64_t index,
-                         const std::vector<double>& values, const DesignOutcome& o,
+                         const std::vector<double>& values, const DirectView& o,
                          const core::ImperialProperties& imperial) {
   using S = Source;
-  const core::SceneResult& r = o.result;
-  const core::MassProperties& p = r.mass_properties;
-  const auto* m = r.max_exit_speed ? &*r.max_exit_speed : nullptr;
-  const auto* c = r.center_of_percussion ? &*r.center_of_percussion : nullptr;
+  const core::MassProperties& p = *o.properties;
+  const bool m = o.has_max;
+  const core::CenterOfPercussionResult* c = o.cop;
   switch (a.source) {
     case S::kIndex: {
       DirectValue d;
@@ -497,19 +583,21 @@ DirectValue ReadSiDirect(const DirectAccessor& a, std::uint64_t index,
     case S::kMissing:
       return {};
     case S::kCollisionEfficiency:
-      return o.collision_efficiency ? Number(*o.collision_efficiency) : DirectValue{};
+      return o.collision_efficiency != nullptr && o.collision_efficiency->has_value()
+                 ? Number(**o.collision_efficiency)
+                 : DirectValue{};
     case S::kMaxPosition:
-      return m ? Number(m->position_from_knob_m) : DirectValue{};
+      return m ? Number(o.max_position) : DirectValue{};
     case S::kMaxSpeed:
-      return m ? Number(m->exit_speed_mps) : DirectValue{};
+      return m ? Number(o.max_speed) : DirectValue{};
     case S::kMaxUnconstrained:
-      return m ? Number(m->unconstrained_position_from_knob_m) : DirectValue{};
+      return m ? Number(o.max_unconstrained) : DirectValue{};
     case S::kMaxPlacement:
-      return m ? Text(core::PlacementName(m->placement)) : DirectValue{};
+      return m ? Text(core::PlacementName(o.max_placement)) : DirectValue{};
     case S::kMaxModel:
-      return m ? Text(m->model) : DirectValue{};
+      return m ? Text(o.max_model) : DirectValue{};
     case S::kMaxMethod:
-      return m ? Text(m->method) : DirectValue{};
+      return m ? Text(o.max_method) : DirectValue{};
     case S::kCopPosition:
       return c ? Number(c->position_from_knob_m) : DirectValue{};
     case S::kCopHands:
@@ -531,7 +619,7 @@ DirectValue ReadSiDirect(const DirectAccessor& a, std::uint64_t index,
     case S::kVolume:
       return Number(p.volume_m3);
     case S::kLength:
-      return Number(r.length_m);
+      return Number(o.length_m);
     case S::kInertiaModel:
       return Text(InertiaModelName(p.inertia_model));
     case S::kLengthIn:
@@ -604,6 +692,60 @@ std::string DumpRow(const Json& value) {
   return value.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
+// The JSON text of the last number or string one column wrote, reused while the value stays
+// the same: a grid's slower parameters keep their value for many rows.
+struct JsonValueMemo {
+  DirectValue::Kind kind = DirectValue::kMissing;  // kMissing: nothing remembered
+  std::uint64_t bits = 0;                          // kNumber: the number's bits
+  std::string source;                              // kString: the string
+  std::string text;                                // the JSON text
+};
+
+// Appends `v` as the serializer of DumpRow writes it (nlohmann's: its shortest round-trip text
+// of a double, null for a missing value or a non-finite number, the string escaped).
+void AppendJsonValue(const DirectValue& v, JsonValueMemo* memo, std::string* out) {
+  switch (v.kind) {
+    case DirectValue::kMissing:
+      out->append("null");
+      return;
+    case DirectValue::kUnsigned: {
+      char buffer[24];
+      out->append(buffer, std::to_chars(buffer, buffer + sizeof(buffer), v.count).ptr);
+      return;
+    }
+    case DirectValue::kBool:
+      out->append(v.flag ? "true" : "false");
+      return;
+    case DirectValue::kNumber: {
+      std::uint64_t bits = 0;
+      std::memcpy(&bits, &v.number, sizeof bits);
+      if (memo->kind != DirectValue::kNumber || memo->bits != bits) {
+        memo->kind = DirectValue::kNumber;
+        memo->bits = bits;
+        if (!std::isfinite(v.number)) {
+          memo->text = "null";
+        } else {
+          // What basic_json's serializer calls for a double (dump_float), in its buffer size.
+          std::array<char, 64> buffer;
+          const char* end =
+              nlohmann::detail::to_chars(buffer.data(), buffer.data() + buffer.size(), v.number);
+          memo->text.assign(buffer.data(), static_cast<std::size_t>(end - buffer.data()));
+        }
+      }
+      out->append(memo->text);
+      return;
+    }
+    case DirectValue::kString:
+      if (memo->kind != DirectValue::kString || memo->source != v.text) {
+        memo->kind = DirectValue::kString;
+        memo->source.assign(v.text);
+        memo->text = DumpRow(Json(memo->source));
+      }
+      out->append(memo->text);
+      return;
+  }
+}
+
 // What one run of a sweep shares between its threads: the format, the compiled columns and
 // objectives, the designs.
 struct RunPlan {
@@ -613,6 +755,12 @@ struct RunPlan {
   std::vector<DirectAccessor> column_accessors;     // when `direct`
   std::vector<DirectAccessor> objective_accessors;  // when `direct`
   bool direct = false;    // feasible bound rows are written without a JSON row
+  // Direct rows whose designs go the lean path first (core::ClosedFormDesigns): the scene
+  // outputs only max_exit_speed by a closed form, and no column needs more.
+  bool lean = false;
+  // kNdjson direct rows: the columns in the order of the JSON object's keys (sorted, each path
+  // once), each with its key's text ("\"path\":").
+  std::vector<std::pair<std::size_t, std::string>> ndjson_keys;
   bool imperial = false;  // some direct column reads the imperial properties
   bool row_twins = false;   // full rows carry the trade-unit fields (report_units imperial)
   bool json_twins = false;  // JSON rows get them before columns and objectives read them
@@ -648,6 +796,11 @@ struct Worker {
   bool template_tried = false;
   std::optional<Json> row_template;
   std::vector<std::pair<Json*, DirectAccessor>> leaves;
+  // The lean path (plan.lean): its evaluator and the last design's numbers.
+  std::optional<core::ClosedFormDesigns> lean;
+  core::ClosedFormDesign lean_design;
+  std::vector<CsvNumberMemo> csv_memos;   // per CSV column: the text of its last number
+  std::vector<JsonValueMemo> json_memos;  // per NDJSON column: the text of its last value
 };
 
 // The leaves of `node` (at `tokens`) with their accessors into *leaves; false when one is not
@@ -742,8 +895,9 @@ bool FillTemplate(const RunPlan& plan, std::uint64_t i, const std::vector<double
   const Sweep& sweep = *plan.sweep;
   const core::ImperialProperties imperial =
       core::ToImperial(outcome.result.mass_properties, outcome.result.length_m);
+  const DirectView view = ViewOf(outcome);
   for (auto& [node, accessor] : worker->leaves) {
-    if (!SetLeaf(ReadDirect(accessor, i, point, outcome, imperial), node)) {
+    if (!SetLeaf(ReadDirect(accessor, i, point, view, imperial), node)) {
       // The template is left part-filled: the next design overwrites every leaf again.
       return false;
     }
@@ -767,6 +921,59 @@ bool FillTemplate(const RunPlan& plan, std::uint64_t i, const std::vector<double
   return true;
 }
 
+// The row of feasible bound design `i` from its direct columns (plan.direct).
+void WriteDirectRow(const RunPlan& plan, std::uint64_t i, const std::vector<double>& point,
+                    const DirectView& view, Worker* worker, BlockResult* out) {
+  const Sweep& sweep = *plan.sweep;
+  const core::ImperialProperties imperial = plan.imperial
+                                                ? core::ToImperial(*view.properties, view.length_m)
+                                                : core::ImperialProperties{};
+  if (!sweep.objectives.empty()) {
+    std::vector<double> v;
+    for (const DirectAccessor& a : plan.objective_accessors) {
+      v.push_back(ToObjective(ReadDirect(a, i, point, view, imperial)));
+    }
+    out->objective_values.push_back(std::move(v));
+    out->indices.push_back(i);
+  }
+  const std::vector<ExploreColumn>& columns = *plan.columns;
+  if (plan.format == RowFormat::kCsv) {
+    CsvRowWriter writer(&out->rows.text);
+    worker->csv_memos.resize(plan.column_accessors.size());
+    for (std::size_t c = 0; c < plan.column_accessors.size(); ++c) {
+      const DirectValue value = ReadDirect(plan.column_accessors[c], i, point, view, imperial);
+      if (value.kind == DirectValue::kNumber) {
+        writer.Number(value.number, &worker->csv_memos[c]);
+      } else {
+        WriteCsv(value, &writer);
+      }
+    }
+    writer.EndRow();
+    return;
+  }
+  if (plan.format == RowFormat::kNdjson) {
+    // The text DumpRow gives the flat object below, written value by value.
+    std::string& text = out->rows.text;
+    worker->json_memos.resize(columns.size());
+    text.push_back('{');
+    bool first = true;
+    for (const auto& [c, key] : plan.ndjson_keys) {
+      if (!first) text.push_back(',');
+      first = false;
+      text.append(key);
+      AppendJsonValue(ReadDirect(plan.column_accessors[c], i, point, view, imperial),
+                      &worker->json_memos[c], &text);
+    }
+    text.append("}\n");
+    return;
+  }
+  Json flat = Json::object();
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    flat[columns[c].path] = ToJson(ReadDirect(plan.column_accessors[c], i, point, view, imperial));
+  }
+  out->rows.rows.push_back(std::move(flat));
+}
+
 // Design `i` (the JSON path, or bound) into *out.
 void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResult* out) {
   const Sweep& sweep = *plan.sweep;
@@ -776,6 +983,20 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
   if (sweep.binder) {
     if (!worker->scene) worker->scene = sweep.binder->base_scene();
     if (sweep.binder->Bind(point, &*worker->scene)) {
+      if (plan.lean) {
+        if (!worker->lean) {
+          worker->lean.emplace(sweep.options, *worker->scene, sweep.binder->changes());
+        }
+        core::ClosedFormDesign& design = worker->lean_design;
+        if (worker->lean->Evaluate(*worker->scene, &design)) {
+          const core::Placement at = design.max_exit_speed.placement;
+          out->beyond_tip += at == core::Placement::kBeyondTip;
+          out->before_knob += at == core::Placement::kBeforeKnob;
+          WriteDirectRow(plan, i, point, ViewOf(design, worker->lean->model()), worker, out);
+          return;
+        }
+        // Not vouched for by the lean path: evaluated in full below.
+      }
       DesignOutcome& outcome = worker->outcome;
       if (!worker->evaluator) worker->evaluator.emplace(sweep.options);
       ComputeDesign(*worker->scene, sweep.outputs, &*worker->evaluator, &outcome);
@@ -814,38 +1035,7 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
         return;
       }
       if (outcome.feasible) {
-        const core::ImperialProperties imperial =
-            plan.imperial
-                ? core::ToImperial(outcome.result.mass_properties, outcome.result.length_m)
-                : core::ImperialProperties{};
-        if (!sweep.objectives.empty()) {
-          std::vector<double> v;
-          for (const DirectAccessor& a : plan.objective_accessors) {
-            v.push_back(ToObjective(ReadDirect(a, i, point, outcome, imperial)));
-          }
-          out->objective_values.push_back(std::move(v));
-          out->indices.push_back(i);
-        }
-        const std::vector<ExploreColumn>& columns = *plan.columns;
-        if (plan.format == RowFormat::kCsv) {
-          CsvRowWriter writer(&out->rows.text);
-          for (const DirectAccessor& a : plan.column_accessors) {
-            WriteCsv(ReadDirect(a, i, point, outcome, imperial), &writer);
-          }
-          writer.EndRow();
-          return;
-        }
-        Json flat = Json::object();
-        for (std::size_t c = 0; c < columns.size(); ++c) {
-          flat[columns[c].path] =
-              ToJson(ReadDirect(plan.column_accessors[c], i, point, outcome, imperial));
-        }
-        if (plan.format == RowFormat::kNdjson) {
-          out->rows.text += DumpRow(flat);
-          out->rows.text += '\n';
-        } else {
-          out->rows.rows.push_back(std::move(flat));
-        }
+        WriteDirectRow(plan, i, point, ViewOf(outcome), worker, out);
         return;
       }
     }
@@ -957,6 +1147,26 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
     }
     plan.imperial = NeedsImperial(plan.column_accessors) || NeedsImperial(plan.objective_accessors);
   }
+  // The lean path reads no collision efficiency (the outputs do not ask for it) and no centre
+  // of percussion (an output it does not take).
+  if (plan.direct && format == RowFormat::kNdjson) {
+    // A JSON object's keys are in std::map order, each once (the last value set wins; a path's
+    // values are the same).
+    std::vector<std::size_t> order(columns.size());
+    for (std::size_t c = 0; c < order.size(); ++c) order[c] = c;
+    std::stable_sort(order.begin(), order.end(), [&columns](std::size_t a, std::size_t b) {
+      return columns[a].path < columns[b].path;
+    });
+    for (const std::size_t c : order) {
+      if (!plan.ndjson_keys.empty() &&
+          columns[plan.ndjson_keys.back().first].path == columns[c].path) {
+        continue;
+      }
+      plan.ndjson_keys.emplace_back(c, DumpRow(Json(columns[c].path)) + ":");
+    }
+  }
+  plan.lean = plan.direct && !sweep.outputs.collision_efficiency &&
+              core::ClosedFormDesigns::Applies(sweep.options, sweep.binder->base_scene());
 
   std::vector<std::vector<double>> objective_values;
   std::vector<std::uint64_t> indices;

@@ -32,6 +32,7 @@
 #include "api/thread_budget.hpp"
 #include "core/progress.hpp"
 #include "core/sampling.hpp"
+#include "core/scene/closed_form_designs.hpp"
 #include "core/scene/scene.hpp"
 
 namespace sweetspot::api {
@@ -75,6 +76,8 @@ class DesignBinder {
   /// before). True when the design passes every check the JSON path makes; false when it
   /// does not (its row is then the JSON path's).
   bool Bind(const std::vector<double>& values, core::Scene* scene) const;
+  /// The parts of the scene Bind changes (the checks the lean path runs again per design).
+  const core::SceneChanges& changes() const { return changes_; }
 
  private:
   enum class Target;
@@ -90,6 +93,7 @@ class DesignBinder {
   std::optional<core::ThreeSegmentShape> shape_;  // the template's, when one is swept
   bool bat_swept_ = false;        // some parameter changes the bat
   bool materials_swept_ = false;  // some parameter is a number of the material or the fill
+  core::SceneChanges changes_;    // which parts of the scene the bindings change
 };
 
 /// A validated sweep: everything needed to evaluate its designs, owned, so a streamed answer

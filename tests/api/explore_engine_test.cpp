@@ -477,6 +477,73 @@ TEST(ExploreEngineTest, ImperialRowsAndTradeUnitColumnsMatchTheJsonPath) {
   EXPECT_EQ(imperial_csv, csv_rows(si_request));
 }
 
+// The lean path (core::ClosedFormDesigns: max_exit_speed by a closed form, direct columns):
+// its rows are the JSON path's in every format, for designs that change the shape, the swing,
+// the COR, the ball, the wall and the material, the failing ones among them (each check the
+// lean path runs again per design is failed by some design).
+TEST(ExploreEngineTest, LeanPathRowsMatchTheJsonPath) {
+  const Json columns = {"index",
+                        "feasible",
+                        "max_exit_speed.exit_speed_mps",
+                        "max_exit_speed.position_from_knob_m",
+                        "max_exit_speed.unconstrained_position_from_knob_m",
+                        "max_exit_speed.placement",
+                        "max_exit_speed.model",
+                        "max_exit_speed.method",
+                        "max_exit_speed.exit_speed_mph",
+                        "max_exit_speed.position_from_tip_in",
+                        "properties.mass_kg",
+                        "properties.moi_six_inch_kg_m2",
+                        "properties.volume_m3",
+                        "properties.length_m",
+                        "properties.inertia_model",
+                        "properties.imperial.weight_oz",
+                        "error.code",
+                        "error.message"};
+  const Json bat = Json::parse(R"({"three_segment": {"length_m": 0.8636,
+      "handle_radius_m": 0.0125, "barrel_radius_m": 0.033, "taper_start_m": 0.30,
+      "taper_end_m": 0.55}, "material": {"density_kg_m3": 700, "youngs_modulus_pa": 1.2e10,
+      "cor": 0.5}})");
+  const std::vector<Json> sweeps = {
+      // The shape (taper_start past taper_end fails the shape's check).
+      Json::parse(R"([{"path": "three_segment.taper_start_m", "min": 0.2, "max": 0.6, "count": 9},
+                      {"path": "three_segment.taper_end_m", "min": 0.45, "max": 0.7, "count": 7}])"),
+      // The hands (past the tip), the pivot (the maximum off the bat), the COR (above 1).
+      Json::parse(R"([{"path": "swing.hands_from_knob_m", "min": 0.0, "max": 1.0, "count": 5},
+                      {"path": "swing.pivot_from_knob_m", "min": -1.0, "max": 2.0, "count": 7},
+                      {"path": "cor", "min": 0.2, "max": 1.2, "count": 3}])"),
+      // The ball (a zero mass) and the swing's speed (zero: a maximum at an end).
+      Json::parse(R"([{"path": "ball.mass_kg", "min": 0.0, "max": 0.3, "count": 4},
+                      {"path": "ball.speed_mps", "min": 0.0, "max": 40, "count": 3},
+                      {"path": "swing.angular_speed_rad_s", "min": 0, "max": 30, "count": 3}])"),
+      // The wall (at or above the handle's radius) and the handle's radius.
+      Json::parse(R"([{"path": "wall_thickness_m", "min": 0.0, "max": 0.02, "count": 5},
+                      {"path": "three_segment.handle_radius_m", "min": 0.005, "max": 0.02,
+                       "count": 4}])"),
+      // The material (a negative density, a COR above 1), the template's cor not given.
+      Json::parse(R"([{"path": "material.density_kg_m3", "min": -100, "max": 900, "count": 6},
+                      {"path": "material.cor", "min": 0.3, "max": 1.3, "count": 3}])")};
+  for (const char* model : {"rigid_pivot", "free_bat"}) {
+    for (std::size_t k = 0; k < sweeps.size(); ++k) {
+      Json body{{"bat", bat},
+                {"parameters", sweeps[k]},
+                {"outputs", {"max_exit_speed", "properties"}},
+                {"options", {{"model", model}}}};
+      if (k + 1 < sweeps.size()) body["cor"] = 0.5;
+      const ExploreRequest request = Parse(body);
+      ASSERT_NE(request.sweep, nullptr);
+      ASSERT_TRUE(request.sweep->binder.has_value());
+      // The lean path applies (else this test proves nothing about it).
+      EXPECT_TRUE(core::ClosedFormDesigns::Applies(request.sweep->options,
+                                                   request.sweep->binder->base_scene()))
+          << model << " sweep " << k;
+      const std::string rows = ExpectSameRows(body, /*expect_bound=*/true, columns);
+      EXPECT_NE(rows.find("\"feasible\":false"), std::string::npos) << model << " sweep " << k;
+      EXPECT_NE(rows.find("\"feasible\":true"), std::string::npos) << model << " sweep " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace explore_engine_test
 }  // namespace sweetspot::api
