@@ -80,8 +80,14 @@ bool ThreeSegmentShape::Validate(Refusal* why) const {
 
 bool ThreeSegmentShape::ValidateSize(Refusal* why) const {
   // Validate holds x1 <= x2 <= L: the positions are then within the length's cap too.
-  return Validate(why) &&
-         CheckInRange(why, "length_m", length_m, 0.0, kMaxBatLengthM, /*lo_open=*/true) &&
+  if (!Validate(why)) return false;
+  // Validate holds L, r1, r2 finite and positive: within the caps, the checks below all pass
+  // (a sweep's designs, one shape after another, take this way).
+  if (length_m <= kMaxBatLengthM && handle_radius_m <= kMaxBatRadiusM &&
+      barrel_radius_m <= kMaxBatRadiusM) {
+    return true;
+  }
+  return CheckInRange(why, "length_m", length_m, 0.0, kMaxBatLengthM, /*lo_open=*/true) &&
          CheckInRange(why, "handle_radius_m", handle_radius_m, 0.0, kMaxBatRadiusM, true) &&
          CheckInRange(why, "barrel_radius_m", barrel_radius_m, 0.0, kMaxBatRadiusM, true);
 }
