@@ -189,18 +189,24 @@ void CsvRowWriter::Number(double value) {
   AppendCsvNumber(value, out_);
 }
 
-void CsvRowWriter::Number(double value, CsvNumberMemo* memo) {
+std::string_view CsvNumberText(double value, CsvNumberMemo* memo) {
   std::uint64_t bits = 0;
   std::memcpy(&bits, &value, sizeof bits);
-  Separate();
   if (!(memo->set && memo->bits == bits)) {
-    if (!std::isfinite(value)) return;  // AppendCsvNumber writes nothing: nothing to remember
-    const auto result = std::to_chars(memo->text, memo->text + sizeof(memo->text), value);
-    memo->size = static_cast<unsigned char>(result.ptr - memo->text);
+    // AppendCsvNumber's text: nothing for NaN or an infinity.
+    const char* end = memo->text;
+    if (std::isfinite(value))
+      end = std::to_chars(memo->text, memo->text + sizeof(memo->text), value).ptr;
+    memo->size = static_cast<unsigned char>(end - memo->text);
     memo->bits = bits;
     memo->set = true;
   }
-  out_->append(memo->text, memo->size);
+  return {memo->text, memo->size};
+}
+
+void CsvRowWriter::Number(double value, CsvNumberMemo* memo) {
+  Separate();
+  out_->append(CsvNumberText(value, memo));
 }
 
 void CsvRowWriter::Integer(std::int64_t value) {

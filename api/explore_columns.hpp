@@ -67,6 +67,11 @@ struct CsvNumberMemo {
   char text[32];           ///< Its text (`size` characters).
 };
 
+/// The text AppendCsvNumber writes for `value` (empty for NaN or an infinity), from *memo when
+/// `value` has the bits *memo remembers, and remembered there otherwise. Valid until *memo
+/// changes.
+std::string_view CsvNumberText(double value, CsvNumberMemo* memo);
+
 /// Writes CSV rows value by value into a string: fields separated by commas, each row ended
 /// by LF ("\n"). The caller writes exactly one value per column, in column order.
 class CsvRowWriter {

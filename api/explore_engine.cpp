@@ -921,6 +921,9 @@ bool FillTemplate(const RunPlan& plan, std::uint64_t i, const std::vector<double
   return true;
 }
 
+// The most characters of a direct CSV row written in a local buffer (WriteDirectRow).
+constexpr std::size_t kCsvRowBytes = 512;
+
 // The row of feasible bound design `i` from its direct columns (plan.direct).
 void WriteDirectRow(const RunPlan& plan, std::uint64_t i, const std::vector<double>& point,
                     const DirectView& view, Worker* worker, BlockResult* out) {
@@ -938,9 +941,45 @@ void WriteDirectRow(const RunPlan& plan, std::uint64_t i, const std::vector<doub
   }
   const std::vector<ExploreColumn>& columns = *plan.columns;
   if (plan.format == RowFormat::kCsv) {
+    const std::size_t n = plan.column_accessors.size();
+    worker->csv_memos.resize(n);
+    // The row in a local buffer, appended at once, when it fits: a field takes at most 32
+    // characters and a separator unless it is a string (CsvRowWriter then writes the row).
+    char row[kCsvRowBytes];
+    std::size_t size = 0;
+    bool local = n * 33 <= sizeof(row);
+    for (std::size_t c = 0; local && c < n; ++c) {
+      const DirectValue value = ReadDirect(plan.column_accessors[c], i, point, view, imperial);
+      if (c > 0) row[size++] = ',';
+      switch (value.kind) {
+        case DirectValue::kMissing:
+          break;
+        case DirectValue::kNumber: {
+          const std::string_view text = CsvNumberText(value.number, &worker->csv_memos[c]);
+          std::memcpy(row + size, text.data(), text.size());
+          size += text.size();
+          break;
+        }
+        case DirectValue::kUnsigned:
+          size = static_cast<std::size_t>(
+              std::to_chars(row + size, row + size + 32, value.count).ptr - row);
+          break;
+        case DirectValue::kBool:
+          std::memcpy(row + size, value.flag ? "true" : "false", value.flag ? 4 : 5);
+          size += value.flag ? 4 : 5;
+          break;
+        case DirectValue::kString:
+          local = false;
+          break;
+      }
+    }
+    if (local) {
+      row[size++] = '\n';
+      out->rows.text.append(row, size);
+      return;
+    }
     CsvRowWriter writer(&out->rows.text);
-    worker->csv_memos.resize(plan.column_accessors.size());
-    for (std::size_t c = 0; c < plan.column_accessors.size(); ++c) {
+    for (std::size_t c = 0; c < n; ++c) {
       const DirectValue value = ReadDirect(plan.column_accessors[c], i, point, view, imperial);
       if (value.kind == DirectValue::kNumber) {
         writer.Number(value.number, &worker->csv_memos[c]);
