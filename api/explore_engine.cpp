@@ -755,8 +755,9 @@ struct RunPlan {
   std::vector<DirectAccessor> column_accessors;     // when `direct`
   std::vector<DirectAccessor> objective_accessors;  // when `direct`
   bool direct = false;    // feasible bound rows are written without a JSON row
-  // Direct rows whose designs go the lean path first (core::ClosedFormDesigns): the scene
-  // outputs only max_exit_speed by a closed form, and no column needs more.
+  // Direct rows, and full rows filled in a worker's template, whose designs go the lean path
+  // first (core::ClosedFormDesigns): the scene outputs only max_exit_speed by a closed form,
+  // and no collision efficiency.
   bool lean = false;
   // kNdjson direct rows: the columns in the order of the JSON object's keys (sorted, each path
   // once), each with its key's text ("\"path\":").
@@ -801,7 +802,42 @@ struct Worker {
   core::ClosedFormDesign lean_design;
   std::vector<CsvNumberMemo> csv_memos;   // per CSV column: the text of its last number
   std::vector<JsonValueMemo> json_memos;  // per NDJSON column: the text of its last value
+  // The template's NDJSON text cut at its leaves (CompileTemplateText): the text before each
+  // leaf with the leaf's index in `leaves`, in the order DumpRow writes them, then the tail.
+  std::vector<std::pair<std::string, std::size_t>> template_pieces;
+  std::string template_tail;
+  std::vector<JsonValueMemo> template_memos;  // per leaf: the text of its last value
 };
+
+// The text DumpRow gives `node` (part of a row template: objects and leaves), cut at each
+// leaf: the text before the leaf and its index in `leaves` into *pieces; what follows the last
+// leaf so far in *pending. False when a leaf is not one of `leaves`.
+bool CompileTemplateText(const Json& node,
+                         const std::vector<std::pair<Json*, DirectAccessor>>& leaves,
+                         std::vector<std::pair<std::string, std::size_t>>* pieces,
+                         std::string* pending) {
+  if (node.is_object()) {
+    pending->push_back('{');
+    bool first = true;
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      if (!first) pending->push_back(',');
+      first = false;
+      pending->append(DumpRow(Json(it.key())));
+      pending->push_back(':');
+      if (!CompileTemplateText(it.value(), leaves, pieces, pending)) return false;
+    }
+    pending->push_back('}');
+    return true;
+  }
+  for (std::size_t k = 0; k < leaves.size(); ++k) {
+    if (leaves[k].first == &node) {
+      pieces->emplace_back(std::move(*pending), k);
+      pending->clear();
+      return true;
+    }
+  }
+  return false;
+}
 
 // The leaves of `node` (at `tokens`) with their accessors into *leaves; false when one is not
 // read directly (or is an array).
@@ -823,24 +859,39 @@ bool CollectLeaves(Json* node, std::vector<std::string>* tokens, const Sweep& sw
   return true;
 }
 
+// True when `value` is of the kind of the template's leaf `node` (so the leaf set to it dumps
+// as a freshly rendered row would).
+bool LeafTakes(const DirectValue& value, const Json& node) {
+  switch (value.kind) {
+    case DirectValue::kNumber:
+      return node.is_number_float();
+    case DirectValue::kUnsigned:
+      return node.is_number_unsigned();
+    case DirectValue::kBool:
+      return node.is_boolean();
+    case DirectValue::kString:
+      return node.is_string();
+    case DirectValue::kMissing:
+      return false;
+  }
+  return false;
+}
+
 // Sets `value` on the template's leaf `node` when it is of the leaf's own kind (so the dump is
 // the one of a freshly rendered row); false otherwise.
 bool SetLeaf(const DirectValue& value, Json* node) {
+  if (!LeafTakes(value, *node)) return false;
   switch (value.kind) {
     case DirectValue::kNumber:
-      if (!node->is_number_float()) return false;
       *node->get_ptr<double*>() = value.number;
       return true;
     case DirectValue::kUnsigned:
-      if (!node->is_number_unsigned()) return false;
       *node->get_ptr<std::uint64_t*>() = value.count;
       return true;
     case DirectValue::kBool:
-      if (!node->is_boolean()) return false;
       *node->get_ptr<bool*>() = value.flag;
       return true;
     case DirectValue::kString:
-      if (!node->is_string()) return false;
       node->get_ptr<std::string*>()->assign(value.text);
       return true;
     case DirectValue::kMissing:
@@ -891,11 +942,28 @@ void AddJsonRow(const RunPlan& plan, std::uint64_t i, const std::vector<double>&
 // `outcome`: the bytes of RenderDesignRow's row (explore_engine_test checks it). False, with
 // nothing written, when a leaf's value is not of the template's kind (render it instead).
 bool FillTemplate(const RunPlan& plan, std::uint64_t i, const std::vector<double>& point,
-                  const DesignOutcome& outcome, Worker* worker, BlockResult* out) {
+                  const DirectView& view, Worker* worker, BlockResult* out) {
   const Sweep& sweep = *plan.sweep;
-  const core::ImperialProperties imperial =
-      core::ToImperial(outcome.result.mass_properties, outcome.result.length_m);
-  const DirectView view = ViewOf(outcome);
+  const core::ImperialProperties imperial = core::ToImperial(*view.properties, view.length_m);
+  if (plan.format == RowFormat::kNdjson && sweep.objectives.empty() &&
+      !worker->template_pieces.empty()) {
+    // DumpRow's text of the template with its leaves set, written leaf by leaf.
+    std::string& text = out->rows.text;
+    const std::size_t start = text.size();
+    worker->template_memos.resize(worker->leaves.size());
+    for (const auto& [before, k] : worker->template_pieces) {
+      text.append(before);
+      const DirectValue value = ReadDirect(worker->leaves[k].second, i, point, view, imperial);
+      if (!LeafTakes(value, *worker->leaves[k].first)) {
+        text.resize(start);
+        return false;
+      }
+      AppendJsonValue(value, &worker->template_memos[k], &text);
+    }
+    text.append(worker->template_tail);
+    text.push_back('\n');
+    return true;
+  }
   for (auto& [node, accessor] : worker->leaves) {
     if (!SetLeaf(ReadDirect(accessor, i, point, view, imperial), node)) {
       // The template is left part-filled: the next design overwrites every leaf again.
@@ -1022,19 +1090,28 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
   if (sweep.binder) {
     if (!worker->scene) worker->scene = sweep.binder->base_scene();
     if (sweep.binder->Bind(point, &*worker->scene)) {
-      if (plan.lean) {
+      // Full rows go the lean path once a full evaluation has made the worker's template.
+      if (plan.lean && (plan.direct || worker->row_template)) {
         if (!worker->lean) {
           worker->lean.emplace(sweep.options, *worker->scene, sweep.binder->changes());
         }
         core::ClosedFormDesign& design = worker->lean_design;
         if (worker->lean->Evaluate(*worker->scene, &design)) {
-          const core::Placement at = design.max_exit_speed.placement;
-          out->beyond_tip += at == core::Placement::kBeyondTip;
-          out->before_knob += at == core::Placement::kBeforeKnob;
-          WriteDirectRow(plan, i, point, ViewOf(design, worker->lean->model()), worker, out);
-          return;
+          const DirectView view = ViewOf(design, worker->lean->model());
+          bool written = true;
+          if (plan.direct) {
+            WriteDirectRow(plan, i, point, view, worker, out);
+          } else {
+            written = FillTemplate(plan, i, point, view, worker, out);
+          }
+          if (written) {
+            const core::Placement at = design.max_exit_speed.placement;
+            out->beyond_tip += at == core::Placement::kBeyondTip;
+            out->before_knob += at == core::Placement::kBeforeKnob;
+            return;
+          }
         }
-        // Not vouched for by the lean path: evaluated in full below.
+        // Not vouched for by the lean path (or not a row of the template): evaluated in full.
       }
       DesignOutcome& outcome = worker->outcome;
       if (!worker->evaluator) worker->evaluator.emplace(sweep.options);
@@ -1046,7 +1123,9 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
       }
       if (outcome.feasible && !plan.direct && plan.columns->empty() &&
           plan.format != RowFormat::kCsv) {
-        if (worker->row_template && FillTemplate(plan, i, point, outcome, worker, out)) return;
+        if (worker->row_template && FillTemplate(plan, i, point, ViewOf(outcome), worker, out)) {
+          return;
+        }
         if (!worker->template_tried) {
           // The first feasible row: rendered, and kept as the template when it can be.
           worker->template_tried = true;
@@ -1063,6 +1142,11 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
           if (!CollectLeaves(&*worker->row_template, &tokens, sweep, &worker->leaves)) {
             worker->row_template.reset();
             worker->leaves.clear();
+          } else if (std::string tail; CompileTemplateText(*worker->row_template, worker->leaves,
+                                                           &worker->template_pieces, &tail)) {
+            worker->template_tail = std::move(tail);
+          } else {
+            worker->template_pieces.clear();
           }
           AddJsonRow(plan, i, point, std::move(row), std::nullopt, out);
           return;
@@ -1186,8 +1270,6 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
     }
     plan.imperial = NeedsImperial(plan.column_accessors) || NeedsImperial(plan.objective_accessors);
   }
-  // The lean path reads no collision efficiency (the outputs do not ask for it) and no centre
-  // of percussion (an output it does not take).
   if (plan.direct && format == RowFormat::kNdjson) {
     // A JSON object's keys are in std::map order, each once (the last value set wins; a path's
     // values are the same).
@@ -1204,7 +1286,10 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
       plan.ndjson_keys.emplace_back(c, DumpRow(Json(columns[c].path)) + ":");
     }
   }
-  plan.lean = plan.direct && !sweep.outputs.collision_efficiency &&
+  // The lean path reads no collision efficiency (the outputs do not ask for it) and no centre
+  // of percussion (an output it does not take).
+  plan.lean = (plan.direct || (sweep.binder && columns.empty() && format != RowFormat::kCsv)) &&
+              !sweep.outputs.collision_efficiency &&
               core::ClosedFormDesigns::Applies(sweep.options, sweep.binder->base_scene());
 
   std::vector<std::vector<double>> objective_values;
