@@ -698,7 +698,9 @@ struct JsonValueMemo {
   DirectValue::Kind kind = DirectValue::kMissing;  // kMissing: nothing remembered
   std::uint64_t bits = 0;                          // kNumber: the number's bits
   std::string source;                              // kString: the string
-  std::string text;                                // the JSON text
+  std::string text;                                // kString: its JSON text
+  std::array<char, 64> number;                     // kNumber: its JSON text, number_size long
+  std::size_t number_size = 0;
 };
 
 // Appends `v` as the serializer of DumpRow writes it (nlohmann's: its shortest round-trip text
@@ -722,17 +724,18 @@ void AppendJsonValue(const DirectValue& v, JsonValueMemo* memo, std::string* out
       if (memo->kind != DirectValue::kNumber || memo->bits != bits) {
         memo->kind = DirectValue::kNumber;
         memo->bits = bits;
+        char* const begin = memo->number.data();
         if (!std::isfinite(v.number)) {
-          memo->text = "null";
+          std::memcpy(begin, "null", 4);
+          memo->number_size = 4;
         } else {
           // What basic_json's serializer calls for a double (dump_float), in its buffer size.
-          std::array<char, 64> buffer;
           const char* end =
-              nlohmann::detail::to_chars(buffer.data(), buffer.data() + buffer.size(), v.number);
-          memo->text.assign(buffer.data(), static_cast<std::size_t>(end - buffer.data()));
+              nlohmann::detail::to_chars(begin, begin + memo->number.size(), v.number);
+          memo->number_size = static_cast<std::size_t>(end - begin);
         }
       }
-      out->append(memo->text);
+      out->append(memo->number.data(), memo->number_size);
       return;
     }
     case DirectValue::kString:
@@ -754,7 +757,7 @@ struct RunPlan {
   const std::vector<ExploreColumn>* columns = nullptr;
   std::vector<DirectAccessor> column_accessors;     // when `direct`
   std::vector<DirectAccessor> objective_accessors;  // when `direct`
-  bool direct = false;    // feasible bound rows are written without a JSON row
+  bool direct = false;  // feasible bound rows are written without a JSON row
   // Direct rows, and full rows filled in a worker's template, whose designs go the lean path
   // first (core::ClosedFormDesigns): the scene outputs only max_exit_speed by a closed form,
   // and no collision efficiency.
