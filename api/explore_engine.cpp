@@ -196,6 +196,26 @@ std::optional<DesignBinder> DesignBinder::Compile(const Json& base,
       binder.bindings_.push_back(binding);
     }
   }
+  // The bat changes through its three-segment shape only: no knot, material, wall or fill.
+  binder.only_shape_swept_ =
+      binder.bat_swept_ &&
+      std::none_of(binder.bindings_.begin(), binder.bindings_.end(), [](const Binding& b) {
+        switch (b.target) {
+          case T::kKnotX:
+          case T::kKnotRadius:
+          case T::kDensity:
+          case T::kYoungs:
+          case T::kShear:
+          case T::kPoisson:
+          case T::kMaterialCor:
+          case T::kWall:
+          case T::kFillDiameter:
+          case T::kFillDepth:
+            return true;
+          default:
+            return false;
+        }
+      });
   if (!binder.bat_swept_) {
     // The bat is the template's in every design: its mass properties are computed once
     // (a bat the JSON path would refuse as too small leaves them to each design).
@@ -297,8 +317,10 @@ bool DesignBinder::Bind(const std::vector<double>& values, core::Scene* scene) c
   // A scene output validates the scene itself (EvaluateScene, Bat::Validate among it); a
   // design it refuses is not feasible, and the engine gives it the JSON path's row.
   // The caps of the template's materials and fill hold unless one of their numbers is swept.
+  // The knots of a shape within its caps are within theirs (ThreeSegmentShape::KnotsInto: x in
+  // [0, L], radii r1 and r2).
   if (!scene->outputs.empty()) {
-    return !bat_swept_ ||
+    return !bat_swept_ || only_shape_swept_ ||
            (materials_swept_ ? bat.ValidateCaps(nullptr) : bat.ValidateKnotCaps(nullptr));
   }
   if (bat_swept_ && !bat.ValidateSize(nullptr)) return false;

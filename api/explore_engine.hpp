@@ -91,9 +91,10 @@ class DesignBinder {
   std::vector<Binding> bindings_;
   core::Scene scene_;
   std::optional<core::ThreeSegmentShape> shape_;  // the template's, when one is swept
-  bool bat_swept_ = false;        // some parameter changes the bat
-  bool materials_swept_ = false;  // some parameter is a number of the material or the fill
-  core::SceneChanges changes_;    // which parts of the scene the bindings change
+  bool bat_swept_ = false;                        // some parameter changes the bat
+  bool materials_swept_ = false;   // some parameter is a number of the material or the fill
+  bool only_shape_swept_ = false;  // the bat is swept only through its three-segment shape
+  core::SceneChanges changes_;     // which parts of the scene the bindings change
 };
 
 /// A validated sweep: everything needed to evaluate its designs, owned, so a streamed answer
