@@ -530,6 +530,11 @@ TEST(ExploreEngineTest, LeanPathRowsMatchTheJsonPath) {
                 {"outputs", {"max_exit_speed", "properties"}},
                 {"options", {{"model", model}}}};
       if (k + 1 < sweeps.size()) body["cor"] = 0.5;
+      if (k == 0) {  // Pareto objectives read from the lean path's rows too (the summary's front)
+        body["pareto"] = Json::parse(R"({"objectives": [
+            {"output": "max_exit_speed.exit_speed_mps", "sense": "max"},
+            {"output": "properties.mass_kg", "sense": "min"}]})");
+      }
       const ExploreRequest request = Parse(body);
       ASSERT_NE(request.sweep, nullptr);
       ASSERT_TRUE(request.sweep->binder.has_value());
