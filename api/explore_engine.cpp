@@ -1014,8 +1014,10 @@ bool FillTemplate(const RunPlan& plan, std::uint64_t i, const std::vector<double
   return true;
 }
 
-// The most characters of a direct CSV row written in a local buffer (WriteDirectRow).
+// The most characters of a direct CSV row written in a local buffer (WriteDirectRow), where a
+// field has room for 32 characters and its separator.
 constexpr std::size_t kCsvRowBytes = 512;
+static_assert(sizeof(CsvNumberMemo::text) <= 32, "a number's text copied whole into its room");
 
 // The row of feasible bound design `i` from its direct columns (plan.direct).
 void WriteDirectRow(const RunPlan& plan, std::uint64_t i, const std::vector<double>& point,
@@ -1048,9 +1050,12 @@ void WriteDirectRow(const RunPlan& plan, std::uint64_t i, const std::vector<doub
         case DirectValue::kMissing:
           break;
         case DirectValue::kNumber: {
-          const std::string_view text = CsvNumberText(value.number, &worker->csv_memos[c]);
-          std::memcpy(row + size, text.data(), text.size());
-          size += text.size();
+          // The memo's whole buffer (a fixed-size copy; the field's room is 32 characters),
+          // of which its text's characters count.
+          CsvNumberMemo& memo = worker->csv_memos[c];
+          const std::size_t length = CsvNumberText(value.number, &memo).size();
+          std::memcpy(row + size, memo.text, sizeof(memo.text));
+          size += length;
           break;
         }
         case DirectValue::kUnsigned:
