@@ -246,6 +246,9 @@ bool FlexibleImpactInputs::IsValid(std::string* why) const {
                                   ": must be finite and >= 0");
   if (!(std::isfinite(cor) && cor >= 0.0 && cor <= 1.0))
     return RefuseMessage(why, "cor = " + FormatNumber17(cor) + ": must be in [0, 1]");
+  if (!(std::isfinite(barrel_compliance_m_n) && barrel_compliance_m_n >= 0.0))
+    return RefuseMessage(why, "barrel_compliance_m_n = " + FormatNumber17(barrel_compliance_m_n) +
+                                  ": must be finite and >= 0");
   return true;
 }
 
@@ -355,8 +358,9 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
       }
       return std::max(0.0, flexibility - used);
     };
-    full.residual_compliance = residual_for(n_used);
-    out.residual_compliance_m_n = full.residual_compliance;
+    // The contact's series spring: the modes left out and the barrel's wall (both elastic).
+    full.residual_compliance = residual_for(n_used) + in.barrel_compliance_m_n;
+    out.residual_compliance_m_n = residual_for(n_used);
     const bool rotary = modes.rotary_inertia;
     // The knob-side segment's inertia: only the hands' loads need it.
     // Every mode's field at a quadrature point, the element's shapes evaluated once.
@@ -424,7 +428,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
       md.shear.resize(n);
       md.moment.resize(n);
       md.grip.resize(n);
-      md.residual_compliance = residual_for(n_flex);
+      md.residual_compliance = residual_for(n_flex) + in.barrel_compliance_m_n;
       return md;
     };
 

@@ -80,6 +80,12 @@ struct FlexibleImpactInputs {
   double ball_exponent = 1.5;         ///< p, in [1, 3].
   double surface_stiffness = 0.0;     ///< Bat surface Hertz K, N/m^1.5 (0 = rigid surface).
   double cor = 0.5;                   ///< e in [0, 1].
+  /// Compliance of a hollow barrel's wall at s, 1/k_b (BarrelWallAt), m/N (>= 0; 0 = a solid
+  /// surface, the behaviour without it bit for bit). An elastic spring in series with the
+  /// contact, as the residual static compliance is: the ball's hysteresis acts on the ball's
+  /// compression only and the wall returns all its energy (BarrelOptions::barrel_loss is not
+  /// applied here; for cor = 0 the wall's stored energy is counted with the released energy).
+  double barrel_compliance_m_n = 0.0;
 
   /// True when the inputs can be integrated; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
@@ -91,7 +97,8 @@ struct FlexibleImpactResult {
   double rigid_exit_speed_mps = 0.0;  ///< The free rigid bat's (same e, same mass properties), m/s.
   double contact_time_s = 0.0;        ///< First touch to last separation, s.
   double contact_time_estimate_s = 0.0;  ///< Rigid-bat estimate that sets the cutoff, s.
-  /// Static compliance of the modes left out at the impact point, m/N (0 without correction).
+  /// Static compliance of the modes left out at the impact point, m/N (0 without correction;
+  /// the inputs' barrel_compliance_m_n, in series with it, is not included).
   double residual_compliance_m_n = 0.0;
   int contacts = 0;                  ///< Separate contacts (1 = a single one).
   double peak_force_n = 0.0;         ///< Largest contact force, N.
