@@ -146,6 +146,12 @@ struct BbcorProtocol {
   /// The impact point, m from the barrel end (6 in; see docs/models.md, "BBCOR": the lab locates
   /// the sweet spot by testing, which a model without bending losses cannot do).
   double impact_from_tip_m = 0.1524;
+  /// The BBCOR scan's range (ComputeBbcorScan, bbcor_scan.hpp), m from the barrel end: this
+  /// service's choice (no source gives one), 4.0 to 8.0 in every 0.5 in. first <= last, step > 0,
+  /// at most 201 points.
+  double scan_first_from_tip_m = 4.0 * 0.0254;
+  double scan_last_from_tip_m = 8.0 * 0.0254;  ///< m from the barrel end.
+  double scan_step_m = 0.5 * 0.0254;           ///< m.
 };
 
 /// The BBCOR of a bat by the protocol.

@@ -98,6 +98,8 @@ std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model
     case SceneOutput::kBarrel:
     case SceneOutput::kBbcor:
       return {"mass_properties", kBarrelModel};
+    case SceneOutput::kBbcorScan:
+      return {"mass_properties", kFlexibleBeamModel, "flexible", kBarrelModel};
     case SceneOutput::kMaxExitSpeed:
     case SceneOutput::kSweetZone:
     case SceneOutput::kExitSpeedCurve:
@@ -135,6 +137,7 @@ void SceneResult::Reset() {
   least_sting_zone.reset();
   barrel.reset();
   bbcor.reset();
+  bbcor_scan.reset();
   timings.clear();
 }
 
@@ -176,7 +179,7 @@ void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
     const bool flexible_exit = needs_exit && options.model == CollisionModel::kFlexible;
     if (!scene.bat.has_value()) {
       for (SceneOutput o : {SceneOutput::kVibrationNode, SceneOutput::kLeastStingZone,
-                            SceneOutput::kBarrel, SceneOutput::kBbcor}) {
+                            SceneOutput::kBarrel, SceneOutput::kBbcor, SceneOutput::kBbcorScan}) {
         if (Wants(wanted, o)) {
           s.SetRefusal(TextRefusal("bat", std::string(SceneOutputName(o)) +
                                               " needs the bat's geometry (a bat, not only "
@@ -380,6 +383,36 @@ void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
         note(Termination::kFailure, bbcor.message);
       }
       book.Add(kBarrelModel, book.Since(tb), 1);
+    }
+    if (Wants(wanted, SceneOutput::kBbcorScan)) {
+      const auto& modes = flexible_modes.Impact();
+      if (!modes->summary.IsSolutionUsable()) {
+        const bool invalid = modes->summary.termination == Termination::kInvalidInput;
+        if (invalid && modes->summary.refusal.has_value()) {
+          refuse(Noted(*modes->summary.refusal, " (bbcor_scan)"));
+        } else {
+          note(invalid ? Termination::kInvalidInput : Termination::kFailure,
+               invalid ? modes->summary.message + " (bbcor_scan)"
+                       : "bbcor_scan: the bat's modes: " + modes->summary.message);
+        }
+        if (invalid) out.refused_field = "bat";
+      } else {
+        // The flexible impacts along the barrel (and, inside, the barrel model's fixed point:
+        // microseconds, booked with them).
+        const auto tb = book.Now();
+        BbcorScan scan = ComputeBbcorScan(*scene.bat, *modes, BbcorProtocol{},
+                                          options.flexible.impact, options.barrel);
+        const double seconds = book.Since(tb);
+        book.Add(CollisionModelName(CollisionModel::kFlexible), seconds,
+                 static_cast<int>(scan.points.size()));
+        book.Add(kBarrelModel, 0.0, 1);
+        for (const auto& w : scan.warnings) s.warnings.push_back("bbcor_scan: " + w);
+        if (scan.ok) {
+          out.bbcor_scan = std::move(scan);
+        } else {
+          note(Termination::kFailure, scan.message);
+        }
+      }
     }
     if (std::find(wanted.begin(), wanted.end(), SceneOutput::kExitSpeedCurve) != wanted.end()) {
       ExitSpeedCurveResult curve;

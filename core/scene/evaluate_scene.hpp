@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/collision/barrel.hpp"
+#include "core/collision/bbcor_scan.hpp"
 #include "core/mass_properties.hpp"
 #include "core/scene/scene.hpp"
 #include "core/scene/timing_book.hpp"
@@ -26,8 +27,9 @@ std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model
 /// The name of the barrel model (in models_used and timings).
 inline constexpr char kBarrelModel[] = "barrel";
 /// The size the barrel outputs added to SceneResult (Reset's size check).
-inline constexpr size_t kBarrelFieldsSize =
-    sizeof(std::optional<BarrelOutput>) + sizeof(std::optional<BbcorResult>);
+inline constexpr size_t kBarrelFieldsSize = sizeof(std::optional<BarrelOutput>) +
+                                            sizeof(std::optional<BbcorResult>) +
+                                            sizeof(std::optional<BbcorScan>);
 
 /// The answer of EvaluateScene. Outputs not requested (or not computed) are empty.
 struct SceneResult {
@@ -54,6 +56,7 @@ struct SceneResult {
   std::optional<LeastStingZoneResult> least_sting_zone;          ///< least_sting_zone.
   std::optional<BarrelOutput> barrel;                            ///< barrel.
   std::optional<BbcorResult> bbcor;                              ///< bbcor.
+  std::optional<BbcorScan> bbcor_scan;                           ///< bbcor_scan.
   std::vector<ModelTiming> timings;  ///< Time per model, in first-use order.
 
   /// Every field as a default-constructed result has it, the strings and vectors keeping their

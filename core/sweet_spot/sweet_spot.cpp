@@ -24,6 +24,7 @@ constexpr OutputName kOutputNames[] = {
     {SceneOutput::kLeastStingZone, "least_sting_zone"},
     {SceneOutput::kBarrel, "barrel"},
     {SceneOutput::kBbcor, "bbcor"},
+    {SceneOutput::kBbcorScan, "bbcor_scan"},
 };
 
 // A position x in a profile's coordinate (origin o from the knob) as metres from the knob, for

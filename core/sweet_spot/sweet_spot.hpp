@@ -26,10 +26,12 @@ enum class SceneOutput {
   kLeastStingZone,  ///< Flexible impacts swept along the bat: where the hands get least vibration.
   kBarrel,          ///< A hollow barrel's hoop mode, stiffness and effective COR (trampoline).
   kBbcor,           ///< BBCOR by the NCAA protocol (core/collision/barrel.hpp).
+  /// BBCOR along the barrel by the flexible model and its maximum (core/collision/bbcor_scan.hpp).
+  kBbcorScan,
 };
 
 /// Stable name: "max_exit_speed", "center_of_percussion", "vibration_node", "sweet_zone",
-/// "exit_speed_curve", "least_sting_zone", "barrel", "bbcor".
+/// "exit_speed_curve", "least_sting_zone", "barrel", "bbcor", "bbcor_scan".
 const char* SceneOutputName(SceneOutput output);
 /// The output called `name`, or nullopt.
 std::optional<SceneOutput> ParseSceneOutput(std::string_view name);

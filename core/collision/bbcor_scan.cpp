@@ -1,0 +1,181 @@
+// bbcor_scan: implementation; the model and its assumptions are stated in bbcor_scan.hpp.
+#include "core/collision/bbcor_scan.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "core/ball_catalogue.hpp"
+#include "core/collision/contact_law.hpp"
+#include "core/geometry_format.hpp"
+#include "core/mass_properties.hpp"
+#include "core/refusal.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+constexpr int kMaxScanPoints = 201;
+
+// The scan's positions from the tip: first, first + step, ... up to last (inclusive within a
+// millionth of a step).
+std::vector<double> ScanPositionsFromTip(const BbcorProtocol& p) {
+  std::vector<double> xs;
+  const double span = p.scan_last_from_tip_m - p.scan_first_from_tip_m;
+  const int n = static_cast<int>(std::floor(span / p.scan_step_m + 1e-6)) + 1;
+  for (int i = 0; i < n; ++i) xs.push_back(p.scan_first_from_tip_m + i * p.scan_step_m);
+  return xs;
+}
+
+}  // namespace
+
+bool BbcorScanRangeIsValid(const BbcorProtocol& p, std::string* why) {
+  if (!(std::isfinite(p.scan_first_from_tip_m) && p.scan_first_from_tip_m >= 0.0))
+    return RefuseMessage(why, Number17Refusal("protocol.scan_first_from_tip_m",
+                                              p.scan_first_from_tip_m, "must be finite and >= 0"));
+  if (!(std::isfinite(p.scan_last_from_tip_m) && p.scan_last_from_tip_m >= p.scan_first_from_tip_m))
+    return RefuseMessage(why,
+                         Number17Refusal("protocol.scan_last_from_tip_m", p.scan_last_from_tip_m,
+                                         "must be finite and >= scan_first_from_tip_m"));
+  if (!(std::isfinite(p.scan_step_m) && p.scan_step_m > 0.0))
+    return RefuseMessage(
+        why, Number17Refusal("protocol.scan_step_m", p.scan_step_m, "must be finite and > 0"));
+  if ((p.scan_last_from_tip_m - p.scan_first_from_tip_m) / p.scan_step_m + 1.0 > kMaxScanPoints)
+    return RefuseMessage(why, Number17Refusal("protocol.scan_step_m", p.scan_step_m,
+                                              "gives more than 201 scan points"));
+  return true;
+}
+
+BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes, const BbcorProtocol& protocol,
+                           const FlexibleImpactOptions& impact, const BarrelOptions& barrel) {
+  const auto t0 = std::chrono::steady_clock::now();
+  BbcorScan out;
+  out.ball = protocol.ball;
+  out.ball_speed_mps = protocol.ball_speed_mps;
+  out.pivot_from_knob_m = protocol.pivot_from_knob_m;
+  Summary guard;
+  CatchInternalError(&guard, [&] {
+    std::string why;
+    if (!bat.IsValid(&why) || !barrel.IsValid(&why) || !impact.IsValid(&why) ||
+        !BbcorScanRangeIsValid(protocol, &why)) {
+      out.message = "bbcor_scan: " + why;
+      return;
+    }
+    if (!(std::isfinite(protocol.ball_speed_mps) && protocol.ball_speed_mps > 0.0)) {
+      out.message =
+          "bbcor_scan: protocol.ball_speed_mps = " + FormatNumber17(protocol.ball_speed_mps) +
+          ": must be finite and > 0";
+      return;
+    }
+    const std::optional<BallPreset> ball = FindBallPreset(protocol.ball);
+    if (!ball) {
+      out.message = "bbcor_scan: unknown ball '" + protocol.ball + "'";
+      return;
+    }
+    if (!modes.summary.IsSolutionUsable()) {
+      out.message = "bbcor_scan: the bat's modes are not usable: " + modes.summary.message;
+      return;
+    }
+    const BbcorResult fixed = ComputeBbcor(bat, protocol, barrel);
+    if (!fixed.ok) {
+      out.message = fixed.message;
+      return;
+    }
+    out.fixed_point_value = fixed.value;
+    out.fixed_point_from_tip_m = protocol.impact_from_tip_m;
+    out.fixed_point_method = fixed.method;
+    out.ball_cor = fixed.ball_cor;
+    out.elements = modes.Elements();
+
+    const double length = bat.LengthM();
+    const double u = protocol.ball_speed_mps;
+    const double m = ball->mass_kg;
+    const double i_pivot = ComputeMassProperties(bat).MoiAboutKgM2(protocol.pivot_from_knob_m);
+    FlexibleImpactOptions o = impact;
+    o.hands_loads = false;  // only the exit speed is read
+    for (double from_tip : ScanPositionsFromTip(protocol)) {
+      const double x = length - from_tip;
+      const double z = x - protocol.pivot_from_knob_m;
+      if (!(x >= 0.0 && z > 0.0)) {
+        out.message = "bbcor_scan: the scan point " + FormatNumber17(from_tip) +
+                      " m from the tip is not on the bat beyond the pivot";
+        return;
+      }
+      const BarrelWall wall = BarrelWallAt(bat, x, barrel);
+      FlexibleImpactInputs in;
+      in.impact_from_knob_m = x;
+      in.hands_from_knob_m = protocol.pivot_from_knob_m;
+      in.ball_mass_kg = m;
+      in.ball_speed_mps = u;
+      in.approach_speed_mps = u;  // the bat at rest
+      in.ball_stiffness = ball->stiffness;
+      in.ball_exponent = ball->stiffness_exponent;
+      const double radius = bat.RadiusAtM(x);
+      if (radius > 0.0) {
+        in.surface_stiffness = BatSurfaceHertzStiffness(
+            bat.material.youngs_modulus_pa, bat.material.poissons_ratio, ball->radius_m, radius);
+      }
+      in.cor = out.ball_cor;
+      if (wall.hollow) in.barrel_compliance_m_n = 1.0 / wall.stiffness_n_m;
+      const FlexibleImpactResult fr = SolveFlexibleImpact(bat, modes, in, o);
+      out.steps += fr.steps;
+      for (const auto& w : fr.summary.warnings) {
+        if (std::find(out.warnings.begin(), out.warnings.end(), w) == out.warnings.end())
+          out.warnings.push_back(w);
+      }
+      if (!fr.summary.IsSolutionUsable()) {
+        out.message = "bbcor_scan: the impact " + FormatNumber17(from_tip) +
+                      " m from the tip: " + fr.summary.message;
+        return;
+      }
+      const double r = m * z * z / i_pivot;
+      BbcorScanPoint p;
+      p.position_from_tip_m = from_tip;
+      p.position_from_knob_m = x;
+      p.apparent_cor = fr.exit_speed_mps / u;
+      p.value = p.apparent_cor * (1.0 + r) + r;
+      p.rigid_value = fr.rigid_exit_speed_mps / u * (1.0 + r) + r;
+      p.barrel_stiffness_n_m = wall.hollow ? wall.stiffness_n_m : 0.0;
+      p.error_estimate = fr.error_estimate_exit_speed_mps / u * (1.0 + r);
+      p.modes_used = fr.modes_used;
+      out.error_estimate = std::max(out.error_estimate, p.error_estimate);
+      out.points.push_back(p);
+    }
+    const auto& pts = out.points;
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < pts.size(); ++i) {
+      if (pts[i].value > pts[best].value) best = i;
+    }
+    out.max_index = static_cast<int>(best);
+    out.max_value = pts[best].value;
+    out.max_from_tip_m = pts[best].position_from_tip_m;
+    out.refinement = "none";
+    if (best > 0 && best + 1 < pts.size()) {
+      // The parabola through the three points (equal spacing h): its vertex lies within
+      // +-h/2 of the middle one, since the middle value is the largest.
+      const double ym = pts[best - 1].value, y0 = pts[best].value, yp = pts[best + 1].value;
+      const double curvature = ym - 2.0 * y0 + yp;
+      if (curvature < 0.0) {
+        const double h = protocol.scan_step_m;
+        out.max_from_tip_m += 0.5 * h * (ym - yp) / curvature;
+        out.max_value = y0 - (ym - yp) * (ym - yp) / (8.0 * curvature);
+        out.refinement = "parabola";
+      }
+    } else {
+      out.warnings.push_back("the largest BBCOR is at an end of the scan range (" +
+                             FormatNumber17(out.max_from_tip_m) +
+                             " m from the tip): the maximum may lie outside it");
+    }
+    out.max_from_knob_m = length - out.max_from_tip_m;
+    out.ok = true;
+    out.message = "scanned " + std::to_string(pts.size()) + " points";
+  });
+  if (!guard.message.empty()) {
+    out.ok = false;
+    out.message = "bbcor_scan: " + guard.message;
+  }
+  out.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace sweetspot::core

@@ -1,0 +1,88 @@
+// bbcor_scan: the BBCOR along the barrel by the flexible model, and its maximum (issue 18 item 2;
+// docs/models.md, "BBCOR scan").
+//
+// The NCAA BBCOR standard certifies a bat at its maximum-BBCOR location, found by testing along
+// the barrel. ComputeBbcor (barrel.hpp) evaluates one fixed point (6 in from the tip) with a rigid
+// pivoted bat, whose BBCOR rises monotonically toward the handle (no bending loss): a rigid model
+// has no maximum to find. Here every point of a range is struck by the flexible model
+// (flexible_impact.hpp: the free-free modal beam, the ball's nonlinear contact, the residual
+// static compliance and, for a hollow bat, the barrel's spring 1/k_b from BarrelWallAt in series
+// with the contact, elastic):
+// - the protocol's ball (its catalogue mass, stiffness and COR law at the protocol's speed) at
+//   the protocol's speed onto the bat at rest;
+// - e_A = rebound speed / incoming speed, and BBCOR(x) = e_A (1 + r) + r with
+//   r = m z^2 / I_pivot, z = x - pivot: the lab's conversion, which assumes the rigid bat
+//   pivoted at 6 in from the knob. The flexible bat is free-free during the ~1 ms contact (the
+//   pivot's reaction does not reach the barrel in that time), so a rigid free bat converted the
+//   same way does not give the ball's COR exactly: each point also reports that rigid free-bat
+//   value (rigid_value) so the bending loss can be told from the free/pivoted difference.
+// - The range (default 4.0 to 8.0 in from the tip every 0.5 in) is this service's choice; no
+//   source gives it. The maximum is the largest sampled point, refined by the parabola through
+//   it and its two neighbours when it is interior (never outside them).
+// The bat's modes are computed once by the caller and reused for every point.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/bat.hpp"
+#include "core/collision/barrel.hpp"
+#include "core/collision/flexible_impact.hpp"
+#include "core/flexible/modes.hpp"
+
+namespace sweetspot::core {
+
+/// One point of the scan.
+struct BbcorScanPoint {
+  double position_from_tip_m = 0.0;   ///< m from the barrel end.
+  double position_from_knob_m = 0.0;  ///< m from the knob.
+  double apparent_cor = 0.0;          ///< e_A = rebound / incoming ball speed (dimensionless).
+  double value = 0.0;                 ///< BBCOR = e_A (1 + r) + r (dimensionless).
+  /// The rigid free bat's BBCOR by the same conversion (same e, same mass properties; the
+  /// barrel spring absent), dimensionless.
+  double rigid_value = 0.0;
+  double barrel_stiffness_n_m = 0.0;  ///< k_b in series with the contact (0 for a solid bat), N/m.
+  double error_estimate = 0.0;        ///< The impact's exit-speed error estimate on the BBCOR.
+  int modes_used = 0;                 ///< Bending modes in the superposition.
+};
+
+/// The BBCOR along the barrel and its maximum.
+struct BbcorScan {
+  bool ok = false;                    ///< False: invalid input or a model failure (message).
+  std::string message;                ///< Why not.
+  std::vector<std::string> warnings;  ///< The impacts' warnings (deduplicated).
+  std::string method = "flexible_free_free";  ///< The model that gives e_A.
+  std::string ball;                           ///< Ball used.
+  double ball_speed_mps = 0.0;                ///< m/s.
+  double ball_cor = 0.0;                      ///< The ball's COR at that speed.
+  double pivot_from_knob_m = 0.0;             ///< m.
+  std::vector<BbcorScanPoint> points;  ///< Every point, from the tip end of the range inwards.
+  int max_index = -1;                  ///< The point with the largest BBCOR.
+  double max_value = 0.0;              ///< The maximum BBCOR (refined), dimensionless.
+  double max_from_tip_m = 0.0;         ///< Its location, m from the barrel end (refined).
+  double max_from_knob_m = 0.0;        ///< The same, m from the knob.
+  /// "parabola" (through the largest point and its neighbours) or "none" (largest point at
+  /// an end of the range: a warning says so).
+  std::string refinement;
+  /// ComputeBbcor's value (rigid pivoted bat at the fixed point), beside it.
+  double fixed_point_value = 0.0;
+  double fixed_point_from_tip_m = 0.0;  ///< Its point, m from the barrel end.
+  std::string fixed_point_method;       ///< ComputeBbcor's method.
+  double error_estimate = 0.0;          ///< Largest point error estimate (dimensionless).
+  int elements = 0;                     ///< Beam mesh elements.
+  int steps = 0;                        ///< Integrator steps over all impacts.
+  double solve_time_s = 0.0;            ///< Wall time, s.
+};
+
+/// The scan range's rule: "protocol.field = value: rule" in *why when out of range.
+bool BbcorScanRangeIsValid(const BbcorProtocol& protocol, std::string* why);
+
+/// BBCOR of `bat` at every point of `protocol`'s scan range by the flexible model with the
+/// bat's `modes` (ComputeBatModes on that bat) and `impact` options (the hands' loads are not
+/// computed); `barrel` gives k_b for a hollow bat and the fixed-point value. Never throws.
+BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes,
+                           const BbcorProtocol& protocol = {},
+                           const FlexibleImpactOptions& impact = {},
+                           const BarrelOptions& barrel = {});
+
+}  // namespace sweetspot::core
