@@ -71,6 +71,10 @@ core::SceneResult ProbeResult(const std::vector<core::SceneOutput>& outputs) {
         r.bbcor.emplace();
         r.bbcor->method = "trampoline_quasi_static";
         break;
+      case core::SceneOutput::kBbcorScan:
+        r.bbcor_scan.emplace();
+        r.bbcor_scan->points.emplace_back();
+        break;
     }
   }
   return r;

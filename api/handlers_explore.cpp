@@ -352,7 +352,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
         reader.Fail("outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
                                    " is not one of properties, max_exit_speed, "
                                    "center_of_percussion, vibration_node, sweet_zone, "
-                                   "exit_speed_curve, least_sting_zone, barrel, bbcor, "
+                                   "exit_speed_curve, least_sting_zone, barrel, bbcor, bbcor_scan, "
                                    "collision_efficiency");
         return std::nullopt;
       }

@@ -104,11 +104,11 @@ bool ReadOutputs(ObjectReader& reader, core::Scene* scene) {
     const auto parsed =
         item.is_string() ? core::ParseSceneOutput(item.get<std::string>()) : std::nullopt;
     if (!parsed) {
-      return reader.Fail("outputs",
-                         "outputs[" + std::to_string(i) + "] = " + Show(item) +
-                             " is not one of max_exit_speed, center_of_percussion, "
-                             "vibration_node, sweet_zone, exit_speed_curve, least_sting_zone, barrel, "
-                             "bbcor");
+      return reader.Fail(
+          "outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
+                         " is not one of max_exit_speed, center_of_percussion, "
+                         "vibration_node, sweet_zone, exit_speed_curve, least_sting_zone, barrel, "
+                         "bbcor, bbcor_scan");
     }
     if (std::find(scene->outputs.begin(), scene->outputs.end(), *parsed) == scene->outputs.end()) {
       scene->outputs.push_back(*parsed);
@@ -386,6 +386,39 @@ Json BbcorToJson(const core::BbcorResult& b) {
            "at 6 in from the barrel end; BBCOR = e_A (1 + r) + r, r = m z^2 / I_pivot"}};
 }
 
+Json BbcorScanToJson(const core::BbcorScan& s) {
+  Json points = Json::array();
+  for (const auto& p : s.points) {
+    points.push_back({{"position_from_tip_m", p.position_from_tip_m},
+                      {"position_from_knob_m", p.position_from_knob_m},
+                      {"apparent_cor", p.apparent_cor},
+                      {"value", p.value},
+                      {"rigid_value", p.rigid_value},
+                      {"barrel_stiffness_n_m", p.barrel_stiffness_n_m},
+                      {"modes_used", p.modes_used}});
+  }
+  return {{"max_value", s.max_value},
+          {"max_from_tip_m", s.max_from_tip_m},
+          {"max_from_knob_m", s.max_from_knob_m},
+          {"refinement", s.refinement},
+          {"fixed_point_value", s.fixed_point_value},
+          {"fixed_point_from_tip_m", s.fixed_point_from_tip_m},
+          {"fixed_point_method", s.fixed_point_method},
+          {"points", std::move(points)},
+          {"ball", s.ball},
+          {"ball_speed_mps", s.ball_speed_mps},
+          {"ball_cor", s.ball_cor},
+          {"pivot_from_knob_m", s.pivot_from_knob_m},
+          {"method", s.method},
+          {"elements", s.elements},
+          {"protocol",
+           "NCAA BBCOR at every point of the scan range (4.0 to 8.0 in from the barrel end every "
+           "0.5 in: this service's choice): the ball fired at 136 mph onto the bat at rest, e_A "
+           "from the flexible free-free bat (barrel spring in series for a hollow bat), BBCOR = "
+           "e_A (1 + r) + r, r = m z^2 / I_pivot about the 6-in pivot; the maximum refined by a "
+           "parabola"}};
+}
+
 Json SceneResultToJson(const core::SceneResult& r) {
   Json out = Json::object();
   Json errors = Json::object();
@@ -451,6 +484,10 @@ Json SceneResultToJson(const core::SceneResult& r) {
   }
   if (r.barrel) out["barrel"] = BarrelOutputToJson(*r.barrel);
   if (r.bbcor) out["bbcor"] = BbcorToJson(*r.bbcor);
+  if (r.bbcor_scan) {
+    out["bbcor_scan"] = BbcorScanToJson(*r.bbcor_scan);
+    errors["bbcor_scan"] = {{"value", r.bbcor_scan->error_estimate}};
+  }
   out["error_estimate"] = std::move(errors);
   out["models_used"] = r.summary.models_used;
   out["exit_speed_model"] = r.exit_speed_model.empty() ? Json(nullptr) : Json(r.exit_speed_model);

@@ -76,6 +76,9 @@ nlohmann::json SceneResultToJson(const core::SceneResult& result);
 nlohmann::json BarrelOutputToJson(const core::BarrelOutput& barrel);
 /// The `bbcor` output: value and the protocol's ball, speed, impact point, pivot and method.
 nlohmann::json BbcorToJson(const core::BbcorResult& bbcor);
+/// The `bbcor_scan` output: every point (position, e_A, BBCOR, the rigid free bat's BBCOR), the
+/// maximum and its location, the fixed-point value beside it.
+nlohmann::json BbcorScanToJson(const core::BbcorScan& scan);
 
 /// One collision result: exit speed, model and what the model knows.
 nlohmann::json CollisionResultToJson(const core::CollisionResult& result);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/collision/bbcor_scan.hpp"
 #include "core/collision/collide.hpp"
 #include "core/collision/flexible_impact.hpp"
 #include "core/collision/hertz_contact.hpp"
@@ -191,6 +192,29 @@ BENCHMARK_CAPTURE(BM_FlexibleImpactModes, uncorrected, false)
     ->Arg(12)
     ->Arg(24)
     ->Unit(benchmark::kMicrosecond);
+
+// The BBCOR scan (bbcor_scan.hpp) of a preset with the scene's default options: 9 flexible
+// impacts at 136 mph, 4 to 8 in from the tip, on modes computed once outside the loop (the
+// refinement check on: each point is run three times). Counters: the maximum, its location
+// from the tip (in) and the fixed-point rigid value beside it.
+void BM_BbcorScan(benchmark::State& state, const char* preset) {
+  const Bat bat = FindPreset(preset)->bat;
+  const FlexibleOptions fo;
+  const BatModes modes = ComputeBatModes(bat, fo.ImpactModes());
+  BbcorScan scan;
+  for (auto _ : state) {
+    scan = ComputeBbcorScan(bat, modes, {}, fo.impact);
+    Keep(scan.max_value);
+  }
+  state.counters["max"] = scan.max_value;
+  state.counters["max_from_tip_in"] = scan.max_from_tip_m / 0.0254;
+  state.counters["fixed_point"] = scan.fixed_point_value;
+  state.counters["steps"] = scan.steps;
+}
+BENCHMARK_CAPTURE(BM_BbcorScan, wood_34_ash, "wood-34-ash")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BbcorScan, paper_wood, "paper-wood")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_BbcorScan, bbcor_33_aluminium, "bbcor-33-aluminium")
+    ->Unit(benchmark::kMillisecond);
 
 // Collide(kFlexible) as /v1/collision runs it: modes (12 to 1e-3) + impact with the refinement
 // runs; "cached" reuses the modes through a ModesCache.

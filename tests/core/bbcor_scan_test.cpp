@@ -72,7 +72,9 @@ void ExpectWellFormed(const std::string& preset) {
     const double r = m * z * z / i_pivot;
     EXPECT_NEAR(p.value, p.apparent_cor * (1.0 + r) + r, 1e-15);
     // A solid bat: the free rigid bat has no bending loss, so it is above the flexible one.
-    if (p.barrel_stiffness_n_m == 0.0) EXPECT_GT(p.rigid_value, p.value);
+    if (p.barrel_stiffness_n_m == 0.0) {
+      EXPECT_GT(p.rigid_value, p.value);
+    }
   }
 }
 

@@ -62,7 +62,9 @@ SpringCase BarrelSpringCase(double stiffening, bool without_modes) {
   in.barrel_compliance_m_n = 1.0 / wall.stiffness_n_m;
   const FlexibleImpactResult fr = SolveFlexibleImpact(stiff, modes, in, options);
   EXPECT_TRUE(fr.summary.IsSolutionUsable()) << fr.summary.message;
-  if (without_modes) EXPECT_EQ(fr.modes_used, 0);
+  if (without_modes) {
+    EXPECT_EQ(fr.modes_used, 0);
+  }
   const double b = x - modes.balance_point_m;
   const double inverse_mass = 1.0 / modes.mass_kg + b * b / modes.moi_centroid_kg_m2;
   SpringCase c;

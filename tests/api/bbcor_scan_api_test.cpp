@@ -1,0 +1,55 @@
+// The scene output `bbcor_scan` through the router: its fields, models_used, and `bbcor`
+// unchanged beside it.
+#include <gtest/gtest.h>
+
+#include "api/router.hpp"
+
+namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace bbcor_scan_api_test {
+namespace {
+
+Response Post(const std::string& path, const std::string& body) {
+  return Dispatch({"POST", path, body}, Context{});
+}
+
+TEST(BbcorScanApiTest, AluminiumPresetScanBesideTheFixedPointBbcor) {
+  const Response plain = Post("/v1/sweet-spot", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "outputs": ["bbcor"]})");
+  const Response r = Post("/v1/sweet-spot", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "outputs": ["bbcor", "bbcor_scan"]})");
+  ASSERT_EQ(plain.status, 200) << plain.body.dump();
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(r.body["bbcor"], plain.body["bbcor"]);
+  const auto& s = r.body["bbcor_scan"];
+  ASSERT_EQ(s["points"].size(), 9u) << s.dump();
+  EXPECT_NEAR(s["points"][0]["position_from_tip_m"].get<double>(), 4 * 0.0254, 1e-15);
+  EXPECT_NEAR(s["points"][8]["position_from_tip_m"].get<double>(), 8 * 0.0254, 1e-15);
+  EXPECT_EQ(s["fixed_point_value"], plain.body["bbcor"]["value"]);
+  EXPECT_EQ(s["method"], "flexible_free_free");
+  EXPECT_EQ(s["ball"], "ncaa-nfhs");
+  double largest = 0.0;
+  for (const auto& p : s["points"]) {
+    largest = std::max(largest, p["value"].get<double>());
+    EXPECT_GT(p["barrel_stiffness_n_m"].get<double>(), 1e8);
+  }
+  EXPECT_GE(s["max_value"].get<double>(), largest);
+  EXPECT_TRUE(r.body["error_estimate"]["bbcor_scan"]["value"].is_number());
+  EXPECT_EQ(r.body["models_used"],
+            nlohmann::json::array({"mass_properties", "barrel", "flexible_beam", "flexible"}))
+      << r.body["models_used"].dump();
+  // Not asked: not computed.
+  EXPECT_FALSE(plain.body.contains("bbcor_scan"));
+  EXPECT_EQ(plain.body["models_used"], nlohmann::json::array({"mass_properties", "barrel"}));
+}
+
+TEST(BbcorScanApiTest, UnknownOutputMessageNamesIt) {
+  const Response r = Post("/v1/sweet-spot", R"({"bat": {"preset": "wood-34-ash"},
+      "outputs": ["bbcor_scans"]})");
+  EXPECT_EQ(r.status, 400);
+  EXPECT_NE(r.body.dump().find("bbcor_scan"), std::string::npos) << r.body.dump();
+}
+
+}  // namespace
+}  // namespace bbcor_scan_api_test
+}  // namespace sweetspot::api
