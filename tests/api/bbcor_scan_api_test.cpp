@@ -43,6 +43,26 @@ TEST(BbcorScanApiTest, AluminiumPresetScanBesideTheFixedPointBbcor) {
   EXPECT_EQ(plain.body["models_used"], nlohmann::json::array({"mass_properties", "barrel"}));
 }
 
+TEST(BbcorScanApiTest, ExploreRowsAreTheSweetSpotAnswers) {
+  // Two walls of the aluminium preset: each row's scan is the single request's.
+  const Response r = Post("/v1/explore", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "parameters": [{"path": "wall_thickness_m", "min": 0.0025, "max": 0.003, "count": 2}],
+      "outputs": ["bbcor_scan"]})");
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  ASSERT_EQ(r.body["rows"].size(), 2u) << r.body.dump();
+  for (const auto& row : r.body["rows"]) {
+    nlohmann::json single = nlohmann::json::parse(R"({"bat": {"preset": "bbcor-33-aluminium"},
+        "outputs": ["bbcor_scan"]})");
+    single["bat"]["wall_thickness_m"] = row["parameters"]["wall_thickness_m"];
+    const Response s = Post("/v1/sweet-spot", single.dump());
+    ASSERT_EQ(s.status, 200) << s.body.dump();
+    EXPECT_EQ(row["bbcor_scan"]["max_value"], s.body["bbcor_scan"]["max_value"]) << row.dump();
+  }
+  // The thinner wall has the higher maximum.
+  EXPECT_GT(r.body["rows"][0]["bbcor_scan"]["max_value"].get<double>(),
+            r.body["rows"][1]["bbcor_scan"]["max_value"].get<double>());
+}
+
 TEST(BbcorScanApiTest, UnknownOutputMessageNamesIt) {
   const Response r = Post("/v1/sweet-spot", R"({"bat": {"preset": "wood-34-ash"},
       "outputs": ["bbcor_scans"]})");
