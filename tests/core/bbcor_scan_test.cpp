@@ -114,7 +114,8 @@ TEST(BbcorScan, AluminiumMaximumIsBelowTheLimitAndItsFixedPointValue) {
 
 TEST(BbcorScan, MoreModesMoveTheMaximaLessThanTheTolerance) {
   // 24 modes instead of 12 (wood-34-ash uses every computed mode at the default: its error
-  // estimate has no truncation part, so the check is made here).
+  // estimate has no truncation part, so the check is made here). Measured: the maxima move by
+  // 1.3e-4 (wood-34-ash), 6e-6 (paper-wood), 1.5e-5 (aluminium), the locations by <= 0.003 in.
   for (const char* preset : {"wood-34-ash", "paper-wood", "bbcor-33-aluminium"}) {
     const BbcorScan more = ScanWith(preset, 24);
     ASSERT_TRUE(more.ok) << more.message;
