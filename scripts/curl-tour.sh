@@ -32,6 +32,7 @@ post /v1/sweet-spot '{"bat": {"preset": "wood-34-ash"}, "ball": {"speed_mps": 40
 post /v1/sweet-spot '{"bat": {"three_segment": {"length_in": 33, "handle_diameter_in": 0.95, "barrel_diameter_in": 2.5, "taper_start_in": 11, "taper_end_in": 21}, "material": "hard-maple"}, "ball": {"speed_mph": 90}, "swing": {"angular_speed_rad_s": 40}, "report_units": "imperial"}'
 post /v1/sweet-spot '{"bat": {"preset": "wood-34-ash"}, "ball": {"preset": "mlb", "speed_mph": 90}, "swing": {"bat_speed_mph": 70}}'
 post /v1/sweet-spot '{"bat": {"preset": "bbcor-33-aluminium"}, "ball": {"preset": "ncaa-nfhs"}, "outputs": ["barrel", "bbcor"]}'
+post /v1/sweet-spot '{"bat": {"preset": "bbcor-33-aluminium"}, "outputs": ["bbcor", "bbcor_scan"]}'
 post /v1/collision '{"bat": {"preset": "wood-34-ash"}, "impact_from_knob_m": 0.70, "model": "hertz"}'
 post /v1/collision '{"bat": {"preset": "bbcor-33-aluminium"}, "impact_from_knob_m": 0.70, "model": "free_bat"}'
 post /v1/compare '{"baseline": {"preset": "paper-wood"}, "variants": [{"name": "cork-320", "bat": {"preset": "paper-wood", "fill": {"material": {"density_kg_m3": 320, "youngs_modulus_pa": 2e7}, "diameter_m": 0.0254, "depth_m": 0.254}}}]}'
