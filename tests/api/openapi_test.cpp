@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <set>
+#include <string>
 #include <utility>
 
 #include "api/router.hpp"
+#include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::api {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -42,6 +44,35 @@ TEST(OpenApiTest, PathsMatchTheRouterBothWays) {
   }
   for (const auto& entry : documented) {
     EXPECT_TRUE(routed.count(entry)) << "not routed: " << entry.first << " " << entry.second;
+  }
+}
+
+// The outputs an endpoint's schema lists are the ones its parser takes: every scene output of
+// core (SceneOutput, kMaxExitSpeed..kBbcorScan: extend the range with the enum) for
+// /v1/sweet-spot and /v1/compare, and with properties and collision_efficiency for /v1/explore.
+// The explore and compare lists had fallen behind the parser (least_sting_zone; barrel, bbcor,
+// bbcor_scan).
+TEST(OpenApiTest, OutputEnumsAreTheOutputsTheParsersTake) {
+  const Response r = Dispatch({"GET", "/openapi.json", ""}, Context{});
+  ASSERT_EQ(r.status, 200);
+  std::set<std::string> scene;
+  for (int i = 0; i <= static_cast<int>(core::SceneOutput::kBbcorScan); ++i) {
+    const std::string name = core::SceneOutputName(static_cast<core::SceneOutput>(i));
+    EXPECT_TRUE(core::ParseSceneOutput(name).has_value()) << name;
+    scene.insert(name);
+  }
+  std::set<std::string> explore = scene;
+  explore.insert({"properties", "collision_efficiency"});
+  for (const auto& [path, expected] : {std::pair{"/v1/sweet-spot", scene},
+                                       std::pair{"/v1/compare", scene},
+                                       std::pair{"/v1/explore", explore}}) {
+    const auto& enumerated = r.body["paths"][path]["post"]["requestBody"]["content"]
+                                    ["application/json"]["schema"]["properties"]["outputs"]
+                                    ["items"]["enum"];
+    ASSERT_TRUE(enumerated.is_array()) << path;
+    std::set<std::string> listed;
+    for (const auto& name : enumerated) listed.insert(name.get<std::string>());
+    EXPECT_EQ(listed, expected) << path;
   }
 }
 
