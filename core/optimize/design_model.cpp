@@ -510,18 +510,26 @@ J DesignModel::WallJet(DesignFunction f, const std::vector<double>& t,
   return ObjectiveOf<J, J>(w.v.data(), e);
 }
 
+design_detail::IntegralContext DesignModel::WallIntegralContext(
+    DesignFunction f, const std::vector<double>& t) const {
+  // ComputeBbcor's I_pivot is the rigid body's (the cross-sections' own moments included),
+  // whatever inertia model the objective uses; the objective's COR uses the objective's.
+  const bool rigid = f == DesignFunction::kBbcor ? true : rigid_;
+  return {t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, rigid, c0_};
+}
+
+bool DesignModel::WallIntegrals(DesignFunction f, const std::vector<double>& t, bool derivatives,
+                                design_detail::Integrals* in) const {
+  design_detail::ComputeIntegrals(WallIntegralContext(f, t), n(), derivatives, in);
+  return in->p[0] > 0.0;
+}
+
 bool DesignModel::WallFunctionOf(DesignFunction f, const std::vector<double>& t, double* value,
                                  double* gradient_row, int stride) const {
   *value = kNaN;
   if (f == DesignFunction::kBbcor ? bbcor_ == nullptr : barrel_cor_ == nullptr) return false;
-  // ComputeBbcor's I_pivot is the rigid body's (the cross-sections' own moments included),
-  // whatever inertia model the objective uses; the objective's COR uses the objective's.
-  const bool rigid = f == DesignFunction::kBbcor ? true : rigid_;
   design_detail::Integrals in;
-  const design_detail::IntegralContext context{
-      t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, rigid, c0_};
-  design_detail::ComputeIntegrals(context, n(), gradient_row != nullptr, &in);
-  if (!(in.p[0] > 0.0)) return false;
+  if (!WallIntegrals(f, t, gradient_row != nullptr, &in)) return false;
   std::array<int, 9> parameter_of{};
   const auto bj = WallJet<jet::Jet<9, false>>(f, t, {in.p[0], in.p[1], in.p[2]}, &parameter_of);
   *value = bj.v;
@@ -544,12 +552,8 @@ bool DesignModel::WallFunctionOf(DesignFunction f, const std::vector<double>& t,
 bool DesignModel::AddWallFunctionHessian(DesignFunction f, const std::vector<double>& t,
                                          double weight, Eigen::MatrixXd* h) const {
   if (f == DesignFunction::kBbcor ? bbcor_ == nullptr : barrel_cor_ == nullptr) return false;
-  const bool rigid = f == DesignFunction::kBbcor ? true : rigid_;
   design_detail::Integrals in;
-  const design_detail::IntegralContext context{
-      t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, rigid, c0_};
-  design_detail::ComputeIntegrals(context, n(), true, &in);
-  if (!(in.p[0] > 0.0)) return false;
+  if (!WallIntegrals(f, t, true, &in)) return false;
   std::array<int, 9> parameter_of{};
   const auto bj = WallJet<jet::Jet<9, true>>(f, t, {in.p[0], in.p[1], in.p[2]}, &parameter_of);
   if (!std::isfinite(bj.v)) return false;
@@ -567,8 +571,8 @@ bool DesignModel::AddWallFunctionHessian(DesignFunction f, const std::vector<dou
   }
   *h += weight * (local.transpose() * hb * local);
   // M, S1 and S2 are nonlinear in x: their own second derivatives, weighted by dF/dP.
-  design_detail::AddIntegralHessian(context, {weight * bj.g[0], weight * bj.g[1], weight * bj.g[2]},
-                                    h);
+  design_detail::AddIntegralHessian(WallIntegralContext(f, t),
+                                    {weight * bj.g[0], weight * bj.g[1], weight * bj.g[2]}, h);
   return h->allFinite();
 }
 
@@ -582,10 +586,7 @@ double DesignModel::CorAt(const double* x) const {
   if (barrel_cor_ == nullptr) return cor_;
   const std::vector<double> t = ParametersAt(x);
   design_detail::Integrals in;
-  design_detail::ComputeIntegrals(
-      {t, parameter_variable_, parameter_scale_, num_knots_, hollow_, has_fill_, rigid_, c0_}, n(),
-      false, &in);
-  if (!(in.p[0] > 0.0)) return kNaN;
+  if (!WallIntegrals(DesignFunction::kObjective, t, false, &in)) return kNaN;
   std::array<int, 9> parameter_of{};
   const auto w = WallInputsAt<jet::Jet<9, false>>(t, {in.p[0], in.p[1], in.p[2]},
                                                   barrel_cor_->impact_from_tip_m, &parameter_of);

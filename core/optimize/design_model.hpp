@@ -40,6 +40,8 @@ namespace design_detail {
 struct ModelBuilder;    // DesignModel::Build's steps (design_model_build.cpp)
 struct BbcorConstants;  // design_bbcor.hpp
 struct BarrelCorConstants;  // design_bbcor.hpp
+struct IntegralContext;     // design_integrals.hpp
+struct Integrals;           // design_integrals.hpp
 template <typename J>
 struct WallInputs;  // design_model.cpp
 }  // namespace design_detail
@@ -240,6 +242,15 @@ class DesignModel {
   // Adds weight times such a function's Hessian at parameters t into *h; false when not finite.
   bool AddWallFunctionHessian(DesignFunction f, const std::vector<double>& t, double weight,
                               Eigen::MatrixXd* h) const;
+  // The integrals' context at parameters t (kept by reference) for a function `f` of the wall:
+  // the rigid body's inertia for kBbcor (ComputeBbcor's I_pivot), the objective's model's
+  // otherwise.
+  design_detail::IntegralContext WallIntegralContext(DesignFunction f,
+                                                     const std::vector<double>& t) const;
+  // ComputeIntegrals in that context (with their derivatives when `derivatives`); false when the
+  // mass is not positive.
+  bool WallIntegrals(DesignFunction f, const std::vector<double>& t, bool derivatives,
+                     design_detail::Integrals* in) const;
   // True when `f` is a function of the wall (WallFunctionOf), not of P alone.
   bool IsWallFunction(DesignFunction f) const {
     return f == DesignFunction::kBbcor || (f == DesignFunction::kObjective && barrel_cor_);
