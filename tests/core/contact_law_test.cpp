@@ -146,6 +146,54 @@ TEST(ContactLaw, SeriesSpringForceMatchesTheLinearClosedForm) {
   EXPECT_EQ(SeriesContactForce(ball, loading, 0.0, 5e-3, &w), ball.LoadingForce(5e-3));
 }
 
+TEST(ContactLaw, SeriesSpringForceOnBothBranchesOfTheHertzBall) {
+  // p = 3/2 on a Hertz surface (the flexible model's law): loading takes the one-spring path
+  // (LoadingCompressionThreeHalves), unloading F_max (delta/delta_max)^q; Halley's iteration
+  // returns without a last evaluation once its step is below 1e-6 F. The residual
+  // compression(F) + c F - d must vanish to round-off whatever the start (1e-14: a few ulps of
+  // d from the compression's cbrt or pow and the sum).
+  const BallPowerLaw law(kBall, 1.5, kSurface);
+  for (double f : {1.0, 2.5e3, 1.7e4}) {
+    EXPECT_NEAR(law.LoadingCompressionThreeHalves(f) / law.LoadingCompression(f), 1.0, 1e-15) << f;
+  }
+  const double c = 3.0e-7;  // m/N
+  const double d_max = 6e-3;
+  ContactBranch unloading;
+  unloading.StartUnloading(law, d_max, law.LoadingForce(d_max), 0.5);
+  for (const ContactBranch& branch : {ContactBranch{}, unloading}) {
+    for (double start : {0.0, 1e9, 123.0, 4.0e3}) {
+      for (double d : {1e-6, 2e-3, 5.9e-3}) {
+        double w = start;
+        const double f = SeriesContactForce(law, branch, c, d, &w);
+        double comp = 0.0, compliance = 0.0, rate = 0.0;
+        branch.CompressionAndCompliance(law, f, &comp, &compliance, &rate);
+        EXPECT_NEAR((comp + c * f) / d, 1.0, 1e-14) << branch.unloading << " " << start << " " << d;
+        EXPECT_EQ(w, f);  // the cache holds the root
+      }
+    }
+  }
+}
+
+TEST(ContactLaw, ComplianceAndItsRateMatchDifferences) {
+  // d(delta)/dF and d2(delta)/dF2 on both branches against central differences of the
+  // compression (step 1e-4 F: truncation ~1e-8 relative, rounding ~1e-12; 1e-7 covers both).
+  const BallPowerLaw hertz(kBall, 1.5, kSurface);
+  const BallPowerLaw steep(kBall, 2.0, kSurface);  // the two-term path
+  for (const BallPowerLaw* law : {&hertz, &steep}) {
+    ContactBranch unloading;
+    unloading.StartUnloading(*law, 6e-3, law->LoadingForce(6e-3), 0.6);
+    for (const ContactBranch& branch : {ContactBranch{}, unloading}) {
+      const double f = 0.4 * law->LoadingForce(6e-3), h = 1e-4 * f;
+      double d0, c0, r0, dp, cp, rp, dm, cm, rm;
+      branch.CompressionAndCompliance(*law, f, &d0, &c0, &r0);
+      branch.CompressionAndCompliance(*law, f + h, &dp, &cp, &rp);
+      branch.CompressionAndCompliance(*law, f - h, &dm, &cm, &rm);
+      EXPECT_NEAR((dp - dm) / (2.0 * h) / c0, 1.0, 1e-7) << branch.unloading;
+      EXPECT_NEAR((cp - cm) / (2.0 * h) / r0, 1.0, 1e-7) << branch.unloading;
+    }
+  }
+}
+
 TEST(ContactLaw, ContactScalesOfALinearSpring) {
   // p = 1: a linear spring k against the inverse effective mass c11 is a harmonic oscillator
   // with omega = sqrt(k c11): compression amplitude v0 / omega, contact time pi / omega
