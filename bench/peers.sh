@@ -4,8 +4,9 @@
 #      BM_OptimizeSixteenKnots (Ipopt, limited-memory and exact Hessian) and the optimum of
 #      `sweetspot optimize` on the same problem;
 #   2. the per-design sweep: numpy mass properties + a bounded scalar search per design against
-#      the whole `sweetspot explore` process over the 100 x 200 grid of bench/peer_sweep.json
-#      (outputs max_exit_speed, then properties + max_exit_speed), answers compared to 1e-9.
+#      the whole `sweetspot explore` process over grids of bench/peer_sweep.json's bat (NDJSON
+#      with max_exit_speed, then properties + max_exit_speed; the 2-column CSV on one thread and
+#      on one per core), answers compared to 1e-9 on the peer's 100 x 200 grid.
 #   bench/peers.sh [BUILD_DIR]          (default: build; needs its bench/ and server/ programs)
 # Needs Debian's python3-scipy (`apt-get install python3-scipy`) for /usr/bin/python3. Never
 # run by the service, ctest or CI.
@@ -35,25 +36,50 @@ done
 "$bench" --benchmark_filter='BM_OptimizeSixteenKnots' --benchmark_min_time=0.5 \
   --benchmark_format=json >"$work/bench.json" 2>/dev/null
 
-# 2. The sweep: the whole CLI process, best of 3 (CPU = user + system), per outputs.
-sweep_ours() {  # $1 = outputs JSON array, $2 = name
-  "$py" -c 'import json,sys; r=json.load(open(sys.argv[1])); r["outputs"]=json.loads(sys.argv[2]); print(json.dumps(r))' \
-    "$here/peer_sweep.json" "$1" >"$work/sweep_$2.json"
-  for i in 1 2 3; do
-    /usr/bin/time -f '%e %U %S' -o "$work/time_$2_$i" "$cli" explore "$work/sweep_$2.json" \
-      >"$work/rows_$2.ndjson"
-  done
-  cat "$work"/time_"$2"_* >"$work/times_$2"
+# 2. The sweep: the whole CLI process, best of 3 (CPU = user + system), per outputs. The rows
+# the peer is compared with come from the peer's own 100 x 200 grid; the times from a larger
+# grid of the same bat (/usr/bin/time's 10 ms resolution is 0.5 us per design over 20,000):
+# NDJSON over 300 x 500 (150,000 designs) and the 2-column CSV over 1000 x 1000 (1,000,000),
+# on one thread (CPU per design) and on --explore-threads' default, one per core (wall).
+sweep_request() {  # $1 = outputs JSON array, $2 = "A B" counts, $3 = format, $4 = columns JSON or null, $5 = file
+  "$py" - "$here/peer_sweep.json" "$1" "$2" "$3" "$4" >"$5" <<'PYREQ'
+import json, sys
+r = json.load(open(sys.argv[1]))
+r["outputs"] = json.loads(sys.argv[2])
+a, b = (int(x) for x in sys.argv[3].split())
+r["parameters"][0]["count"], r["parameters"][1]["count"] = a, b
+r["format"] = sys.argv[4]
+if json.loads(sys.argv[5]) is not None:
+    r["columns"] = json.loads(sys.argv[5])
+print(json.dumps(r))
+PYREQ
 }
-sweep_ours '["max_exit_speed"]' mes
-sweep_ours '["properties", "max_exit_speed"]' props
+sweep_ours() {  # $1 = request, $2 = name, $3.. = extra CLI flags
+  local request=$1 name=$2
+  shift 2
+  for i in 1 2 3; do
+    /usr/bin/time -f '%e %U %S' -o "$work/time_${name}_$i" "$cli" "$@" explore "$request" \
+      >"$work/out_$name"
+  done
+  cat "$work"/time_"$name"_* >"$work/times_$name"
+}
+sweep_request '["max_exit_speed"]' "100 200" ndjson null "$work/sweep_rows.json"
+"$cli" explore "$work/sweep_rows.json" >"$work/rows_mes.ndjson"
+sweep_request '["max_exit_speed"]' "300 500" ndjson null "$work/sweep_mes.json"
+sweep_request '["properties", "max_exit_speed"]' "300 500" ndjson null "$work/sweep_props.json"
+sweep_request '["max_exit_speed"]' "1000 1000" csv \
+  '["parameters.three_segment.taper_start_m", "max_exit_speed.exit_speed_mps"]' "$work/sweep_csv.json"
+sweep_ours "$work/sweep_mes.json" mes
+sweep_ours "$work/sweep_props.json" props
+sweep_ours "$work/sweep_csv.json" csv1 --explore-threads 1
+sweep_ours "$work/sweep_csv.json" csv
 for v in bounded root; do
   "$py" "$here/scipy_peers.py" sweep "$here/peer_sweep.json" "$work/rows_mes.ndjson" \
     --variant "$v" >"$work/peer_$v.json"
 done
 
 "$py" - "$work" <<'PY'
-import json, sys
+import json, os, sys
 w = sys.argv[1]
 load = lambda name: json.load(open(f"{w}/{name}"))
 d = load("design16.json")
@@ -81,12 +107,14 @@ for v, p in peers.items():
     print(f"  SciPy ({p['peer']}): {p['us_per_design']:.1f} us wall, {p['cpu_us_per_design']:.1f} us "
           f"CPU per design over {p['designs']} designs; |diff| max: exit speed "
           f"{p['max_abs_diff_exit_speed_mps']:.1e} m/s, position {p['max_abs_diff_position_m']:.1e} m")
-for key, label in (("mes", "max_exit_speed"), ("props", "properties + max_exit_speed")):
+for key, label, n in (("mes", "max_exit_speed, ndjson, 300 x 500", 150000),
+                      ("props", "properties + max_exit_speed, ndjson, 300 x 500", 150000),
+                      ("csv1", "csv, 2 columns, 1000 x 1000, one thread", 1000000),
+                      ("csv", f"csv, 2 columns, 1000 x 1000, {os.cpu_count()} threads", 1000000)):
     rows = [list(map(float, line.split())) for line in open(f"{w}/times_{key}")]
     wall = min(r[0] for r in rows)
     cpu = min(r[1] + r[2] for r in rows)
-    n = 20000
-    print(f"  sweetspot explore ({label}, ndjson, whole process, best of 3): "
+    print(f"  sweetspot explore ({label}, whole process, best of 3): "
           f"{wall/n*1e6:.2f} us wall, {cpu/n*1e6:.2f} us CPU per design; "
           f"SciPy bounded / ours = {peers['bounded']['cpu_us_per_design']/(cpu/n*1e6):.1f}x (CPU), "
           f"{peers['bounded']['us_per_design']/(wall/n*1e6):.1f}x (wall)")
