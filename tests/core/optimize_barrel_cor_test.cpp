@@ -24,6 +24,7 @@
 #include "core/scene/resolved_scene.hpp"
 #include "core/scene/timing_book.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
+#include "tests/core/hollow_design_problems.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -88,30 +89,17 @@ std::vector<DesignProblem> GradientProblems() {
   std::vector<DesignProblem> out;
   DesignProblem a = PresetRequest();
   a.constraints = {};
-  a.variables = {
-      {"wall_thickness_m", 0.0020, 0.0035},          {"profile.knots[10].radius_m", 0.030, 0.0334},
-      {"profile.knots[11].radius_m", 0.030, 0.0334}, {"profile.knots[10].x_m", 0.50, 0.54},
-      {"profile.knots[11].x_m", 0.80, 0.83},         {"profile.knots[12].x_m", 0.835, 0.845},
-      {"material.density_kg_m3", 2500.0, 3000.0}};
+  a.variables = hollow_design_problems::PresetBarrelVariables();
   out.push_back(a);
   DesignProblem b = a;
   b.inertia_model = InertiaModel::kSlenderRod;
   b.objective = DesignObjective::kMaxExitSpeedSwingWeight;
-  b.variables.push_back(
-      {"barrel", 0.97, 1.03, {}, {"profile.knots[9].radius_m", "profile.knots[4].x_m"}});
+  b.variables.push_back(hollow_design_problems::PresetScaleVariable());
   out.push_back(b);
-  DesignProblem c;
-  c.three_segment = ThreeSegmentShape{0.84, 0.0125, 0.032, 0.25, 0.60};
-  c.bat.material = *FindMaterial("aluminium-7050");
-  c.bat.wall_thickness_m = 0.0025;
+  DesignProblem c = hollow_design_problems::ThreeSegmentAluminium(0.62, 0.75);
   MlbAtGameSpeed(&c);
   c.model = CollisionModel::kRigidPivot;
   c.swing.bat_speed_from_tip_m = 0.1;  // omega (x - pivot) at the COR's point then varies with L
-  c.variables = {{"three_segment.length_m", 0.80, 0.86},
-                 {"three_segment.barrel_radius_m", 0.030, 0.0333},
-                 {"three_segment.handle_radius_m", 0.011, 0.014},
-                 {"three_segment.taper_end_m", 0.62, 0.75},
-                 {"wall_thickness_m", 0.0018, 0.0035}};
   c.cor_from_barrel = true;
   out.push_back(c);
   return out;
