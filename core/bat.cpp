@@ -46,6 +46,15 @@ bool ThreeSegmentShape::IsValid(std::string* why) const {
 }
 
 bool ThreeSegmentShape::Validate(Refusal* why) const {
+  // Every check below at once (a sweep's shapes pass them all): finite, L, r1, r2 > 0 and
+  // 0 <= x1 <= x2 <= L. Only a shape that fails one is checked in order, for its refusal.
+  if (std::isfinite(length_m) && std::isfinite(handle_radius_m) &&
+      std::isfinite(barrel_radius_m) && std::isfinite(taper_start_m) &&
+      std::isfinite(taper_end_m) && length_m > 0.0 && handle_radius_m > 0.0 &&
+      barrel_radius_m > 0.0 && taper_start_m >= 0.0 && taper_start_m <= taper_end_m &&
+      taper_end_m <= length_m) {
+    return true;
+  }
   const struct {
     const char* name;
     double value;
@@ -141,6 +150,27 @@ bool Bat::ValidateGeometry(Refusal* why) const { return ValidateChecks(why, /*ma
 
 bool Bat::ValidateChecks(Refusal* why, bool materials) const {
   const std::size_t n = knots.size();
+  // The knots' checks below in one pass (a sweep's designs pass them all), with the smallest
+  // radius; only knots that fail one are checked again in order, for the refusal.
+  // Each knot: x finite and above the previous one's (the first's is 0), radius finite and
+  // positive; as comparisons combined without branches (a NaN fails them all).
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  bool knots_pass = n >= 2 && knots[0].x_m == 0.0;
+  double min_radius = kInf;  // as MinRadiusM()
+  double previous_x = -kInf;
+  for (const ProfileKnot& k : knots) {
+    const double x = k.x_m;
+    const double r = k.radius_m;
+    knots_pass &= (x > previous_x) & (x < kInf) & (r > 0.0) & (r < kInf);
+    previous_x = x;
+    min_radius = std::min(min_radius, r);
+  }
+  if (!knots_pass && !ValidateKnotOrder(why)) return false;
+  return ValidateBody(why, materials, min_radius);
+}
+
+bool Bat::ValidateKnotOrder(Refusal* why) const {
+  const std::size_t n = knots.size();
   if (n < 2) {
     return Refuse(why, "knots.size()", static_cast<double>(n), "must be at least 2");
   }
@@ -175,6 +205,10 @@ bool Bat::ValidateChecks(Refusal* why, bool materials) const {
                                      "must be positive");
     }
   }
+  return true;
+}
+
+bool Bat::ValidateBody(Refusal* why, bool materials, double min_radius) const {
   if (materials && !CheckMaterial(material, "material.", why)) return false;
 
   if (!std::isfinite(wall_thickness_m)) {
@@ -183,7 +217,6 @@ bool Bat::ValidateChecks(Refusal* why, bool materials) const {
   if (wall_thickness_m < 0.0) {
     return Refuse(why, "wall_thickness_m", wall_thickness_m, "must be non-negative (0 = solid)");
   }
-  const double min_radius = MinRadiusM();
   if (wall_thickness_m >= min_radius) {
     return Refuse(why, "wall_thickness_m", wall_thickness_m,
                   "must be less than the smallest outer radius " + FormatNumber(min_radius));

@@ -148,6 +148,12 @@ struct Bat {
  private:
   // Validate's checks in its order; the materials' own only when `materials`.
   bool ValidateChecks(Refusal* refusal, bool materials) const;
+  // The knots' checks of ValidateChecks, in order: their count, finite numbers, the first at 0,
+  // x strictly increasing, radii positive.
+  bool ValidateKnotOrder(Refusal* refusal) const;
+  // The rest of ValidateChecks, for valid knots whose smallest radius is `min_radius`: the
+  // materials (when `materials`), the wall and the fill.
+  bool ValidateBody(Refusal* refusal, bool materials, double min_radius) const;
 };
 
 /// A bat of the paper's three-segment shape (knots from shape.Knots()),
