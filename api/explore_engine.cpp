@@ -812,7 +812,6 @@ struct BlockResult {
 // A worker's reusable state.
 struct Worker {
   std::optional<core::Scene> scene;  // the binder's scene, bound design after design
-  std::vector<double> point;
   std::optional<core::DesignSequence> designs;  // the sweep's, with this worker's position
   DesignOutcome outcome;  // the last bound design's, refilled design after design
   std::optional<core::SceneEvaluator> evaluator;  // the sweep's options, validated once
@@ -1114,9 +1113,8 @@ void WriteDirectRow(const RunPlan& plan, std::uint64_t i, const std::vector<doub
 // Design `i` (the JSON path, or bound) into *out.
 void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResult* out) {
   const Sweep& sweep = *plan.sweep;
-  std::vector<double>& point = worker->point;
   if (!worker->designs) worker->designs.emplace(*sweep.designs);
-  worker->designs->DesignInto(i, &point);
+  const std::vector<double>& point = worker->designs->Design(i);
   if (sweep.binder) {
     if (!worker->scene) worker->scene = sweep.binder->base_scene();
     if (sweep.binder->Bind(point, &*worker->scene)) {

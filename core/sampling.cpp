@@ -31,6 +31,16 @@ std::uint64_t Below(std::mt19937_64& rng, std::uint64_t n) {
 
 double Lerp(const SweepDimension& d, double t) { return d.min + (d.max - d.min) * t; }
 
+// The number of grid values of dimension `d` (a count below 1 is taken as 1).
+std::uint64_t GridCountOf(const SweepDimension& d) {
+  return static_cast<std::uint64_t>(std::max(d.count, 1));
+}
+
+// Value j (< c = GridCountOf(d)) of grid dimension `d`.
+double GridValueOf(const SweepDimension& d, std::uint64_t c, std::uint64_t j) {
+  return c == 1 ? d.min : Lerp(d, static_cast<double>(j) / static_cast<double>(c - 1));
+}
+
 }  // namespace
 
 const char* SamplingMethodName(SamplingMethod method) {
@@ -122,10 +132,10 @@ void GridDesignInto(const SweepPlan& plan, std::uint64_t i, std::vector<double>*
   point.resize(plan.dimensions.size());
   for (std::size_t k = plan.dimensions.size(); k-- > 0;) {
     const SweepDimension& d = plan.dimensions[k];
-    const auto c = static_cast<std::uint64_t>(std::max(d.count, 1));
+    const std::uint64_t c = GridCountOf(d);
     const std::uint64_t j = i % c;
     i /= c;
-    point[k] = c == 1 ? d.min : Lerp(d, static_cast<double>(j) / static_cast<double>(c - 1));
+    point[k] = GridValueOf(d, c, j);
   }
 }
 
@@ -185,30 +195,65 @@ DesignSequence::DesignSequence(DesignSequence&&) noexcept = default;
 DesignSequence& DesignSequence::operator=(DesignSequence&&) noexcept = default;
 DesignSequence::~DesignSequence() = default;
 
-void DesignSequence::DesignInto(std::uint64_t i, std::vector<double>* out) {
+void DesignSequence::DesignInto(std::uint64_t i, std::vector<double>* out) { *out = Design(i); }
+
+const std::vector<double>& DesignSequence::Design(std::uint64_t i) {
   const std::size_t dims = plan_.dimensions.size();
-  std::vector<double>& point = *out;
   switch (plan_.method) {
     case SamplingMethod::kGrid:
-      GridDesignInto(plan_, i, out);
-      return;
+      // A block's designs come in index order: each one's values follow from the last one's
+      // by a step of its digits, each value computed as GridDesignInto computes it.
+      if (grid_set_ && i == grid_next_) {
+        StepGrid();
+      } else {
+        SeekGrid(i);
+      }
+      grid_next_ = i + 1;
+      break;
     case SamplingMethod::kLatinHypercube: {
       const double* row = table_->data() + static_cast<std::size_t>(i) * dims;
-      point.assign(row, row + dims);
-      return;
+      point_.assign(row, row + dims);
+      break;
     }
     case SamplingMethod::kSobol: {
       SobolState& s = *sobol_;
       // A jump costs one Gray-code update per bit of the index: only when not sequential.
       if (s.next != i) s.engine.seed(static_cast<boost::uintmax_t>(plan_.seed + i));
       const double scale = 1.0 / (static_cast<double>(boost::random::sobol::max()) + 1.0);
-      point.resize(dims);
+      point_.resize(dims);
       for (std::size_t k = 0; k < dims; ++k) {
-        point[k] = Lerp(plan_.dimensions[k], static_cast<double>(s.engine()) * scale);
+        point_[k] = Lerp(plan_.dimensions[k], static_cast<double>(s.engine()) * scale);
       }
       s.next = i + 1;
-      return;
+      break;
     }
+  }
+  return point_;
+}
+
+void DesignSequence::SeekGrid(std::uint64_t i) {
+  const std::size_t dims = plan_.dimensions.size();
+  grid_digits_.resize(dims);
+  point_.resize(dims);
+  for (std::size_t k = dims; k-- > 0;) {  // as GridDesignInto
+    const SweepDimension& d = plan_.dimensions[k];
+    const std::uint64_t c = GridCountOf(d);
+    grid_digits_[k] = i % c;
+    i /= c;
+    point_[k] = GridValueOf(d, c, grid_digits_[k]);
+  }
+  grid_set_ = true;
+}
+
+void DesignSequence::StepGrid() {
+  // The last digit moves on by one; a digit that reaches its count wraps to 0 and carries.
+  for (std::size_t k = grid_digits_.size(); k-- > 0;) {
+    const SweepDimension& d = plan_.dimensions[k];
+    const std::uint64_t c = GridCountOf(d);
+    std::uint64_t& j = grid_digits_[k];
+    j = j + 1 == c ? 0 : j + 1;
+    point_[k] = GridValueOf(d, c, j);
+    if (j != 0) return;
   }
 }
 

@@ -90,10 +90,23 @@ class DesignSequence {
 
   /// Design `i` (< plan.DesignCount()) into *point (resized; its storage reused).
   void DesignInto(std::uint64_t i, std::vector<double>* point);
+  /// Design `i` (< plan.DesignCount()), valid until the next call: this object's own vector,
+  /// which a grid's design that follows the last one only steps (no copy).
+  const std::vector<double>& Design(std::uint64_t i);
 
  private:
   struct SobolState;  // Boost's generator and the index of the next point it gives
+  // Grid: design `i`'s digits and values from its index, and from the last design's by one
+  // step when `i` follows it.
+  void SeekGrid(std::uint64_t i);
+  void StepGrid();
   SweepPlan plan_;
+  std::vector<double> point_;  // the last design (Design's)
+  // Grid: the last design's digits (dimension k's in [0, count_k), the last dimension's the
+  // fastest), whether they are set, and the index of the design after it.
+  std::vector<std::uint64_t> grid_digits_;
+  bool grid_set_ = false;
+  std::uint64_t grid_next_ = 0;
   std::shared_ptr<const std::vector<double>> table_;  // LHS: design i at [i * dims, (i+1) * dims)
   std::unique_ptr<SobolState> sobol_;
 };

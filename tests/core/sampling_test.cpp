@@ -110,6 +110,23 @@ TEST(SamplingTest, DesignSequenceGivesDesignIInAnyOrder) {
     c.DesignInto(i, &point);
     ASSERT_EQ(point, lhs[i]) << "design " << i;
   }
+
+  // A grid steps from the last design to the next (carries through a dimension of one value
+  // too), and seeks any other: GridDesign's values either way.
+  plan.method = SamplingMethod::kGrid;
+  plan.dimensions = {{0.1, 0.7, 3}, {-2.0, 3.0, 1}, {0.45, 0.7, 7}, {1.0, 2.0, 2}};
+  const std::uint64_t n = plan.DesignCount();
+  DesignSequence grid(plan);
+  for (const std::uint64_t first : {std::uint64_t{0}, std::uint64_t{5}, std::uint64_t{13}}) {
+    for (std::uint64_t i = first; i < n; ++i) {
+      grid.DesignInto(i, &point);
+      ASSERT_EQ(point, GridDesign(plan, i)) << "design " << i;
+    }
+  }
+  for (std::uint64_t i = n; i-- > 0;) {
+    grid.DesignInto(i, &point);
+    ASSERT_EQ(point, GridDesign(plan, i)) << "design " << i;
+  }
 }
 
 TEST(SamplingTest, ShardsPartitionTheDesigns) {
