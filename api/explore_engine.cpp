@@ -216,6 +216,8 @@ std::optional<DesignBinder> DesignBinder::Compile(const Json& base,
             return false;
         }
       });
+  // Bind gives such a bat the knots of a shape that passed ThreeSegmentShape::ValidateSize.
+  binder.changes_.knots_of_valid_shape = binder.only_shape_swept_;
   if (!binder.bat_swept_) {
     // The bat is the template's in every design: its mass properties are computed once
     // (a bat the JSON path would refuse as too small leaves them to each design).

@@ -169,6 +169,16 @@ bool Bat::ValidateChecks(Refusal* why, bool materials) const {
   return ValidateBody(why, materials, min_radius);
 }
 
+bool Bat::ValidateGeometryOfShapeKnots(Refusal* why) const {
+  if (knots.size() < 2) return ValidateGeometry(why);
+  double min_radius = knots.front().radius_m;  // as MinRadiusM(): the radii are finite
+  for (std::size_t i = 1; i < knots.size(); ++i) {
+    if (!(knots[i].x_m > knots[i - 1].x_m)) return ValidateGeometry(why);  // refused there
+    min_radius = std::min(min_radius, knots[i].radius_m);
+  }
+  return ValidateBody(why, /*materials=*/false, min_radius);
+}
+
 bool Bat::ValidateKnotOrder(Refusal* why) const {
   const std::size_t n = knots.size();
   if (n < 2) {

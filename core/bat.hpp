@@ -133,6 +133,12 @@ struct Bat {
   /// The caps on the knots alone (x and radius), the first check of ValidateCaps: for a bat
   /// whose material, wall and fill are known to pass theirs.
   bool ValidateKnotCaps(Refusal* refusal) const;
+  /// ValidateGeometry, the same verdict, for a bat whose knots are a valid shape's
+  /// (ThreeSegmentShape::KnotsInto of a shape that passes Validate): 2 to 4 knots, finite, the
+  /// first at 0, radii positive by the shape's own checks, so only their order is checked (a
+  /// step on a bat too short for a double to resolve it puts two knots at one x), then the
+  /// wall and the fill as ValidateGeometry checks them. For a sweep of a shape's fields.
+  bool ValidateGeometryOfShapeKnots(Refusal* refusal) const;
   /// L, m (the last knot's x; 0 without knots).
   double LengthM() const;
   /// Outer radius at x (from the knob), m; 0 outside [0, L].

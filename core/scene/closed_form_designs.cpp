@@ -38,9 +38,14 @@ bool ClosedFormDesigns::Evaluate(const Scene& scene, ClosedFormDesign* out) {
     if (!scene.Validate(nullptr)) return false;
     validated_ = true;  // what no design changes is valid from now on
   } else {
-    if (changes_.bat_materials ? !bat.Validate(nullptr)
-                               : changes_.bat_geometry && !bat.ValidateGeometry(nullptr)) {
-      return false;
+    if (changes_.bat_materials) {
+      if (!bat.Validate(nullptr)) return false;
+    } else if (changes_.bat_geometry) {
+      // A valid shape's knots pass their own checks: the same verdict without them.
+      if (!(changes_.knots_of_valid_shape ? bat.ValidateGeometryOfShapeKnots(nullptr)
+                                          : bat.ValidateGeometry(nullptr))) {
+        return false;
+      }
     }
     if (changes_.ball && !scene.ball.Validate(nullptr)) return false;
     if (changes_.swing && !scene.swing.Validate(nullptr)) return false;

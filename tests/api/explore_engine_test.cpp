@@ -480,7 +480,8 @@ TEST(ExploreEngineTest, ImperialRowsAndTradeUnitColumnsMatchTheJsonPath) {
 // The lean path (core::ClosedFormDesigns: max_exit_speed by a closed form, direct columns):
 // its rows are the JSON path's in every format, for designs that change the shape, the swing,
 // the COR, the ball, the wall and the material, the failing ones among them (each check the
-// lean path runs again per design is failed by some design).
+// lean path runs again per design is failed by some design). A sweep of the shape alone skips
+// the knots' own checks, not the wall's or the fill's: a hollow and a filled bat check them.
 TEST(ExploreEngineTest, LeanPathRowsMatchTheJsonPath) {
   const Json columns = {"index",
                         "feasible",
@@ -520,12 +521,26 @@ TEST(ExploreEngineTest, LeanPathRowsMatchTheJsonPath) {
       Json::parse(R"([{"path": "wall_thickness_m", "min": 0.0, "max": 0.02, "count": 5},
                       {"path": "three_segment.handle_radius_m", "min": 0.005, "max": 0.02,
                        "count": 4}])"),
+      // The shape of a hollow bat (its handle within the wall in some; steps in some).
+      Json::parse(R"([{"path": "three_segment.handle_radius_m", "min": 0.005, "max": 0.02,
+                       "count": 4},
+                      {"path": "three_segment.taper_end_m", "min": 0.3, "max": 0.55, "count": 3}])"),
+      // The shape of a filled bat (its barrel around the bore or not).
+      Json::parse(R"([{"path": "three_segment.barrel_radius_m", "min": 0.015, "max": 0.035,
+                       "count": 5},
+                      {"path": "three_segment.taper_end_m", "min": 0.45, "max": 0.8636,
+                       "count": 4}])"),
       // The material (a negative density, a COR above 1), the template's cor not given.
       Json::parse(R"([{"path": "material.density_kg_m3", "min": -100, "max": 900, "count": 6},
                       {"path": "material.cor", "min": 0.3, "max": 1.3, "count": 3}])")};
   for (const char* model : {"rigid_pivot", "free_bat"}) {
     for (std::size_t k = 0; k < sweeps.size(); ++k) {
-      Json body{{"bat", bat},
+      Json design_bat = bat;
+      if (k == 4) design_bat["wall_thickness_m"] = 0.008;
+      if (k == 5) {
+        design_bat["fill"] = {{"material", "cork"}, {"diameter_m", 0.04}, {"depth_m", 0.3}};
+      }
+      Json body{{"bat", design_bat},
                 {"parameters", sweeps[k]},
                 {"outputs", {"max_exit_speed", "properties"}},
                 {"options", {{"model", model}}}};

@@ -517,6 +517,71 @@ TEST(ClosedFormDesigns, VouchesOnlyForEvaluateScenesNumbers) {
     EXPECT_GT(refused, 40);
     EXPECT_GT(off_bat, 0) << CollisionModelName(model);
   }
+  // A sweep of a shape's fields alone (knots_of_valid_shape): the knots' own checks are left
+  // out, the wall's and the fill's are not. Shapes that put the handle inside the wall, the
+  // barrel around a bore too wide, a step, all handle or all barrel, and a step on a bat too
+  // short for its two knots to differ: each vouched for only when EvaluateScene gives it.
+  for (const bool hollow : {true, false}) {
+    SceneOptions o;
+    o.time_models = false;
+    Scene scene;
+    ThreeSegmentShape shape{0.8636, 0.0125, 0.033, 0.30, 0.55};
+    scene.bat = MakeThreeSegmentBat(shape, FindMaterial("ash").value());
+    if (hollow) {
+      scene.bat->wall_thickness_m = 0.008;
+    } else {
+      scene.bat->fill = Fill{FindMaterial("cork").value(), 0.04, 0.3};
+    }
+    scene.cor = 0.5;
+    scene.outputs = {SceneOutput::kMaxExitSpeed};
+    ASSERT_TRUE(scene.Validate(nullptr));
+    SceneChanges changes;
+    changes.bat_geometry = changes.knots_of_valid_shape = true;
+    ClosedFormDesigns lean(o, scene, changes);
+    ClosedFormDesign first;
+    ASSERT_TRUE(lean.Evaluate(scene, &first));  // the template, validated in full
+    int vouched = 0, refused = 0;
+    for (int k = 0; k < 200; ++k) {
+      Scene design = scene;
+      ThreeSegmentShape s = shape;
+      s.handle_radius_m = 0.006 + 0.002 * (k % 7);    // below the wall in some
+      s.barrel_radius_m = 0.015 + 0.005 * (k % 5);    // around the bore or not
+      s.taper_start_m = k % 4 == 0 ? 0.0 : 0.35;      // no handle in some
+      s.taper_end_m = k % 6 == 1 ? 0.35 : 0.6;        // a step in some
+      if (k % 9 == 4) s.taper_start_m = s.taper_end_m = s.length_m;  // all handle
+      if (k == 199) {  // a step of width L * kStepWidth that rounds to 0
+        s = {4e-312, 0.0125, 0.033, 2e-312, 2e-312};
+        design.swing.hands_from_knob_m = 0.0;
+        design.swing.pivot_from_knob_m = 0.0;
+      }
+      ASSERT_TRUE(s.Validate(nullptr)) << k;
+      s.KnotsInto(&design.bat->knots);
+      if (k == 199) {
+        EXPECT_FALSE(design.bat->ValidateGeometry(nullptr));
+        EXPECT_FALSE(design.bat->ValidateGeometryOfShapeKnots(nullptr));
+      }
+      EXPECT_EQ(design.bat->ValidateGeometryOfShapeKnots(nullptr),
+                design.bat->ValidateGeometry(nullptr))
+          << k;
+      ClosedFormDesign d;
+      const bool ok = lean.Evaluate(design, &d);
+      const SceneResult full = EvaluateScene(design, o);
+      if (!ok) {
+        ++refused;
+        continue;
+      }
+      ++vouched;
+      ASSERT_TRUE(full.summary.IsSolutionUsable()) << "design " << k << ": " << full.summary.message;
+      ASSERT_TRUE(full.max_exit_speed.has_value());
+      EXPECT_EQ(d.max_exit_speed.exit_speed_mps, full.max_exit_speed->exit_speed_mps) << k;
+      EXPECT_EQ(d.mass_properties.mass_kg, full.mass_properties.mass_kg) << k;
+      EXPECT_EQ(d.mass_properties.moi_centroid_kg_m2, full.mass_properties.moi_centroid_kg_m2)
+          << k;
+    }
+    EXPECT_GT(vouched, 40) << hollow;
+    EXPECT_GT(refused, 40) << hollow;
+  }
+
   // Not for what it does not take: another output, a bat speed, flexible, NLopt.
   SceneOptions o;
   Scene scene = PaperWood({SceneOutput::kMaxExitSpeed, SceneOutput::kCenterOfPercussion});
