@@ -550,8 +550,8 @@ DirectView ViewOf(const DesignOutcome& o) {
   return v;
 }
 
-// The lean path's design: max_exit_speed by the closed form of `model`.
-DirectView ViewOf(const core::ClosedFormDesign& d, core::CollisionModel model) {
+// The lean path's design: max_exit_speed by the closed form of the model named `model_name`.
+DirectView ViewOf(const core::ClosedFormDesign& d, std::string_view model_name) {
   DirectView v;
   v.properties = &d.mass_properties;
   v.length_m = d.length_m;
@@ -560,7 +560,7 @@ DirectView ViewOf(const core::ClosedFormDesign& d, core::CollisionModel model) {
   v.max_speed = d.max_exit_speed.exit_speed_mps;
   v.max_unconstrained = d.max_exit_speed.unconstrained_position_from_knob_m;
   v.max_placement = d.max_exit_speed.placement;
-  v.max_model = core::CollisionModelName(model);
+  v.max_model = model_name;
   v.max_method = "closed_form";  // ClosedFormMaxExitSpeed's
   return v;
 }
@@ -826,6 +826,7 @@ struct Worker {
   // The lean path (plan.lean): its evaluator and the last design's numbers.
   std::optional<core::ClosedFormDesigns> lean;
   core::ClosedFormDesign lean_design;
+  std::string_view lean_model_name;  // core::CollisionModelName of lean's model
   std::vector<CsvNumberMemo> csv_memos;   // per CSV column: the text of its last number
   std::vector<JsonValueMemo> json_memos;  // per NDJSON column: the text of its last value
   // The template's NDJSON text cut at its leaves (CompileTemplateText): the text before each
@@ -1124,10 +1125,11 @@ void EvaluateOne(const RunPlan& plan, std::uint64_t i, Worker* worker, BlockResu
       if (plan.lean && (plan.direct || worker->row_template)) {
         if (!worker->lean) {
           worker->lean.emplace(sweep.options, *worker->scene, sweep.binder->changes());
+          worker->lean_model_name = core::CollisionModelName(worker->lean->model());
         }
         core::ClosedFormDesign& design = worker->lean_design;
         if (worker->lean->Evaluate(*worker->scene, &design)) {
-          const DirectView view = ViewOf(design, worker->lean->model());
+          const DirectView view = ViewOf(design, worker->lean_model_name);
           bool written = true;
           if (plan.direct) {
             WriteDirectRow(plan, i, point, view, worker, out);
