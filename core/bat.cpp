@@ -39,6 +39,16 @@ double Interpolate(const std::vector<ProfileKnot>& knots, double x) {
   return a.radius_m + (b.radius_m - a.radius_m) * t;
 }
 
+// Every check of ThreeSegmentShape::Validate at once: finite, L, r1, r2 > 0 and
+// 0 <= x1 <= x2 <= L.
+bool ShapePassesEveryCheck(const ThreeSegmentShape& s) {
+  return std::isfinite(s.length_m) && std::isfinite(s.handle_radius_m) &&
+         std::isfinite(s.barrel_radius_m) && std::isfinite(s.taper_start_m) &&
+         std::isfinite(s.taper_end_m) && s.length_m > 0.0 && s.handle_radius_m > 0.0 &&
+         s.barrel_radius_m > 0.0 && s.taper_start_m >= 0.0 && s.taper_start_m <= s.taper_end_m &&
+         s.taper_end_m <= s.length_m;
+}
+
 }  // namespace
 
 bool ThreeSegmentShape::IsValid(std::string* why) const {
@@ -46,15 +56,9 @@ bool ThreeSegmentShape::IsValid(std::string* why) const {
 }
 
 bool ThreeSegmentShape::Validate(Refusal* why) const {
-  // Every check below at once (a sweep's shapes pass them all): finite, L, r1, r2 > 0 and
-  // 0 <= x1 <= x2 <= L. Only a shape that fails one is checked in order, for its refusal.
-  if (std::isfinite(length_m) && std::isfinite(handle_radius_m) &&
-      std::isfinite(barrel_radius_m) && std::isfinite(taper_start_m) &&
-      std::isfinite(taper_end_m) && length_m > 0.0 && handle_radius_m > 0.0 &&
-      barrel_radius_m > 0.0 && taper_start_m >= 0.0 && taper_start_m <= taper_end_m &&
-      taper_end_m <= length_m) {
-    return true;
-  }
+  // Every check below at once (a sweep's shapes pass them all); only a shape that fails one
+  // is checked in order, for its refusal.
+  if (ShapePassesEveryCheck(*this)) return true;
   const struct {
     const char* name;
     double value;
@@ -88,6 +92,11 @@ bool ThreeSegmentShape::Validate(Refusal* why) const {
 }
 
 bool ThreeSegmentShape::ValidateSize(Refusal* why) const {
+  // Validate's checks and the caps below at once (a sweep's shapes pass them all).
+  if (ShapePassesEveryCheck(*this) && length_m <= kMaxBatLengthM &&
+      handle_radius_m <= kMaxBatRadiusM && barrel_radius_m <= kMaxBatRadiusM) {
+    return true;
+  }
   // Validate holds x1 <= x2 <= L: the positions are then within the length's cap too.
   if (!Validate(why)) return false;
   // Validate holds L, r1, r2 finite and positive: within the caps, the checks below all pass
@@ -176,6 +185,8 @@ bool Bat::ValidateGeometryOfShapeKnots(Refusal* why) const {
     if (!(knots[i].x_m > knots[i - 1].x_m)) return ValidateGeometry(why);  // refused there
     min_radius = std::min(min_radius, knots[i].radius_m);
   }
+  // No fill and a wall in [0, min_radius) (so finite): ValidateBody's checks all pass.
+  if (!fill.has_value() && wall_thickness_m >= 0.0 && wall_thickness_m < min_radius) return true;
   return ValidateBody(why, /*materials=*/false, min_radius);
 }
 
