@@ -49,10 +49,7 @@ bool ClosedFormDesigns::Evaluate(const Scene& scene, ClosedFormDesign* out) {
     }
     if (changes_.ball && !scene.ball.Validate(nullptr)) return false;
     if (changes_.swing && !scene.swing.Validate(nullptr)) return false;
-    if (changes_.cor && scene.cor.has_value() &&
-        !(std::isfinite(*scene.cor) && *scene.cor >= 0.0 && *scene.cor <= 1.0)) {
-      return false;
-    }
+    if (changes_.cor && !scene.ValidateCor(nullptr)) return false;
   }
   double cor = 0.0;
   if (scene.cor.has_value()) {

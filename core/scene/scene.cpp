@@ -127,10 +127,15 @@ bool Scene::Validate(Refusal* why) const {
       return Refuse17(why, "mass_properties.moi_knob_kg_m2", mp.moi_knob_kg_m2, "must be finite");
   }
   if (!ball.Validate(why) || !swing.Validate(why)) return false;
-  if (cor.has_value() && !(std::isfinite(*cor) && *cor >= 0.0 && *cor <= 1.0))
-    return Refuse17(why, "cor", *cor, "must be in [0, 1]");
+  if (!ValidateCor(why)) return false;
   if (outputs.empty())
     return Refuse(why, TextRefusal("outputs", "empty: name at least one output"));
+  return true;
+}
+
+bool Scene::ValidateCor(Refusal* why) const {
+  if (cor.has_value() && !(std::isfinite(*cor) && *cor >= 0.0 && *cor <= 1.0))
+    return Refuse17(why, "cor", *cor, "must be in [0, 1]");
   return true;
 }
 

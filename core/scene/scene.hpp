@@ -127,6 +127,8 @@ struct Scene {
   bool IsValid(std::string* why) const;
   /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
   bool Validate(Refusal* refusal) const;
+  /// Validate's rule for `cor` alone: absent, or finite and in [0, 1] (dimensionless).
+  bool ValidateCor(Refusal* refusal) const;
 };
 
 /// A collision model.
