@@ -789,7 +789,7 @@ struct RunPlan {
   // kNdjson direct rows: the columns in the order of the JSON object's keys (sorted, each path
   // once), each with its key's text ("\"path\":").
   std::vector<std::pair<std::size_t, std::string>> ndjson_keys;
-  bool imperial = false;  // some direct column reads the imperial properties
+  bool imperial = false;    // some direct column reads the imperial properties
   bool row_twins = false;   // full rows carry the trade-unit fields (report_units imperial)
   bool json_twins = false;  // JSON rows get them before columns and objectives read them
   std::uint64_t in_shard = 0;
@@ -813,7 +813,7 @@ struct BlockResult {
 
 // A worker's reusable state.
 struct Worker {
-  std::optional<core::Scene> scene;  // the binder's scene, bound design after design
+  std::optional<core::Scene> scene;             // the binder's scene, bound design after design
   std::optional<core::DesignSequence> designs;  // the sweep's, with this worker's position
   DesignOutcome outcome;  // the last bound design's, refilled design after design
   std::optional<core::SceneEvaluator> evaluator;  // the sweep's options, validated once
@@ -826,7 +826,7 @@ struct Worker {
   // The lean path (plan.lean): its evaluator and the last design's numbers.
   std::optional<core::ClosedFormDesigns> lean;
   core::ClosedFormDesign lean_design;
-  std::string_view lean_model_name;  // core::CollisionModelName of lean's model
+  std::string_view lean_model_name;       // core::CollisionModelName of lean's model
   std::vector<CsvNumberMemo> csv_memos;   // per CSV column: the text of its last number
   std::vector<JsonValueMemo> json_memos;  // per NDJSON column: the text of its last value
   // The template's NDJSON text cut at its leaves (CompileTemplateText): the text before each
@@ -1251,7 +1251,8 @@ void EvaluateBlock(const RunPlan& plan, std::uint64_t first, std::uint64_t count
                    core::Progress* progress, Worker* worker, BlockResult* out, BlockCost* cost) {
   const auto start = std::chrono::steady_clock::now();
   if (plan.format != RowFormat::kJson && cost->bytes > 0.0) {
-    out->rows.text.reserve(static_cast<std::size_t>(cost->bytes * static_cast<double>(count) * 1.25));
+    out->rows.text.reserve(
+        static_cast<std::size_t>(cost->bytes * static_cast<double>(count) * 1.25));
   }
   for (std::uint64_t k = first; k < first + count; ++k) {
     if (core::IsCancelled(progress)) {

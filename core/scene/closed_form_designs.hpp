@@ -15,7 +15,7 @@ namespace sweetspot::core {
 
 /// Which parts of a scene a sweep's designs change (the checks Evaluate runs again per design).
 struct SceneChanges {
-  bool bat_geometry = false;   ///< Knots, shape, wall or fill size: Bat::ValidateGeometry.
+  bool bat_geometry = false;  ///< Knots, shape, wall or fill size: Bat::ValidateGeometry.
   /// With bat_geometry: the bat changes only through its knots, in every design those of a
   /// ThreeSegmentShape that passes Validate (KnotsInto): Bat::ValidateGeometryOfShapeKnots.
   bool knots_of_valid_shape = false;

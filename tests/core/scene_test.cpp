@@ -452,6 +452,38 @@ TEST(SceneEvaluatorReuse, InvalidOptionsRefuseEveryScene) {
   }
 }
 
+// One design of a lean sweep: true when ClosedFormDesigns vouches for it, and then its numbers
+// must be EvaluateScene's, field by field and bit for bit; *placement gets the maximum's.
+bool VouchedAndEqual(ClosedFormDesigns* lean, const Scene& design, const SceneOptions& o, int k,
+                     Placement* placement) {
+  ClosedFormDesign d;
+  if (!lean->Evaluate(design, &d)) return false;
+  const SceneResult full = EvaluateScene(design, o);
+  EXPECT_TRUE(full.summary.IsSolutionUsable()) << "design " << k << ": " << full.summary.message;
+  if (!full.max_exit_speed.has_value()) {
+    ADD_FAILURE() << "design " << k << ": vouched for, but EvaluateScene has no max_exit_speed";
+    return true;
+  }
+  const MaxExitSpeedResult& m = *full.max_exit_speed;
+  EXPECT_EQ(d.max_exit_speed.exit_speed_mps, m.exit_speed_mps) << k;
+  EXPECT_EQ(d.max_exit_speed.position_from_knob_m, m.position_from_knob_m) << k;
+  EXPECT_EQ(d.max_exit_speed.unconstrained_position_from_knob_m,
+            m.unconstrained_position_from_knob_m)
+      << k;
+  EXPECT_EQ(d.max_exit_speed.placement, m.placement) << k;
+  EXPECT_EQ(d.max_exit_speed.error_estimate_m, m.error_estimate_m) << k;
+  EXPECT_EQ(d.max_exit_speed.error_estimate_mps, m.error_estimate_mps) << k;
+  EXPECT_EQ(CollisionModelName(lean->model()), m.model) << k;
+  EXPECT_EQ(d.length_m, full.length_m) << k;
+  EXPECT_EQ(d.mass_properties.mass_kg, full.mass_properties.mass_kg) << k;
+  EXPECT_EQ(d.mass_properties.balance_point_m, full.mass_properties.balance_point_m) << k;
+  EXPECT_EQ(d.mass_properties.moi_knob_kg_m2, full.mass_properties.moi_knob_kg_m2) << k;
+  EXPECT_EQ(d.mass_properties.moi_centroid_kg_m2, full.mass_properties.moi_centroid_kg_m2) << k;
+  EXPECT_EQ(d.mass_properties.volume_m3, full.mass_properties.volume_m3) << k;
+  *placement = m.placement;
+  return true;
+}
+
 // The lean path of a sweep (ClosedFormDesigns): whenever it vouches for a design, its numbers
 // are EvaluateScene's, bit for bit; a design EvaluateScene refuses it never vouches for. The
 // designs change the geometry, the ball, the swing and the COR, some of them out of range.
@@ -483,34 +515,13 @@ TEST(ClosedFormDesigns, VouchesOnlyForEvaluateScenesNumbers) {
       design.swing.angular_speed_rad_s = k % 5 == 2 ? 0.0 : 17.288;
       design.ball.speed_mps = k % 3 == 1 ? 0.0 : 27.7;
       design.cor = k % 17 == 9 ? 1.5 : 0.5;  // out of range in some
-      ClosedFormDesign d;
-      const bool ok = lean.Evaluate(design, &d);
-      const SceneResult full = EvaluateScene(design, o);
-      if (!ok) {
+      Placement at = Placement::kOnBat;
+      if (!VouchedAndEqual(&lean, design, o, k, &at)) {
         ++refused;
         continue;
       }
       ++vouched;
-      ASSERT_TRUE(full.summary.IsSolutionUsable())
-          << "design " << k << ": " << full.summary.message;
-      ASSERT_TRUE(full.max_exit_speed.has_value());
-      const MaxExitSpeedResult& m = *full.max_exit_speed;
-      EXPECT_EQ(d.max_exit_speed.exit_speed_mps, m.exit_speed_mps) << k;
-      EXPECT_EQ(d.max_exit_speed.position_from_knob_m, m.position_from_knob_m) << k;
-      EXPECT_EQ(d.max_exit_speed.unconstrained_position_from_knob_m,
-                m.unconstrained_position_from_knob_m)
-          << k;
-      EXPECT_EQ(d.max_exit_speed.placement, m.placement) << k;
-      off_bat += m.placement != Placement::kOnBat;
-      EXPECT_EQ(d.max_exit_speed.error_estimate_m, m.error_estimate_m) << k;
-      EXPECT_EQ(d.max_exit_speed.error_estimate_mps, m.error_estimate_mps) << k;
-      EXPECT_EQ(CollisionModelName(lean.model()), m.model) << k;
-      EXPECT_EQ(d.length_m, full.length_m) << k;
-      EXPECT_EQ(d.mass_properties.mass_kg, full.mass_properties.mass_kg) << k;
-      EXPECT_EQ(d.mass_properties.balance_point_m, full.mass_properties.balance_point_m) << k;
-      EXPECT_EQ(d.mass_properties.moi_knob_kg_m2, full.mass_properties.moi_knob_kg_m2) << k;
-      EXPECT_EQ(d.mass_properties.moi_centroid_kg_m2, full.mass_properties.moi_centroid_kg_m2) << k;
-      EXPECT_EQ(d.mass_properties.volume_m3, full.mass_properties.volume_m3) << k;
+      off_bat += at != Placement::kOnBat;
     }
     // Both kinds of design, and a placement off the bat among the vouched ones.
     EXPECT_GT(vouched, 100);
@@ -544,10 +555,10 @@ TEST(ClosedFormDesigns, VouchesOnlyForEvaluateScenesNumbers) {
     for (int k = 0; k < 200; ++k) {
       Scene design = scene;
       ThreeSegmentShape s = shape;
-      s.handle_radius_m = 0.006 + 0.002 * (k % 7);    // below the wall in some
-      s.barrel_radius_m = 0.015 + 0.005 * (k % 5);    // around the bore or not
-      s.taper_start_m = k % 4 == 0 ? 0.0 : 0.35;      // no handle in some
-      s.taper_end_m = k % 6 == 1 ? 0.35 : 0.6;        // a step in some
+      s.handle_radius_m = 0.006 + 0.002 * (k % 7);                   // below the wall in some
+      s.barrel_radius_m = 0.015 + 0.005 * (k % 5);                   // around the bore or not
+      s.taper_start_m = k % 4 == 0 ? 0.0 : 0.35;                     // no handle in some
+      s.taper_end_m = k % 6 == 1 ? 0.35 : 0.6;                       // a step in some
       if (k % 9 == 4) s.taper_start_m = s.taper_end_m = s.length_m;  // all handle
       if (k == 199) {  // a step of width L * kStepWidth that rounds to 0
         s = {4e-312, 0.0125, 0.033, 2e-312, 2e-312};
@@ -563,20 +574,12 @@ TEST(ClosedFormDesigns, VouchesOnlyForEvaluateScenesNumbers) {
       EXPECT_EQ(design.bat->ValidateGeometryOfShapeKnots(nullptr),
                 design.bat->ValidateGeometry(nullptr))
           << k;
-      ClosedFormDesign d;
-      const bool ok = lean.Evaluate(design, &d);
-      const SceneResult full = EvaluateScene(design, o);
-      if (!ok) {
+      Placement at = Placement::kOnBat;
+      if (!VouchedAndEqual(&lean, design, o, k, &at)) {
         ++refused;
         continue;
       }
       ++vouched;
-      ASSERT_TRUE(full.summary.IsSolutionUsable()) << "design " << k << ": " << full.summary.message;
-      ASSERT_TRUE(full.max_exit_speed.has_value());
-      EXPECT_EQ(d.max_exit_speed.exit_speed_mps, full.max_exit_speed->exit_speed_mps) << k;
-      EXPECT_EQ(d.mass_properties.mass_kg, full.mass_properties.mass_kg) << k;
-      EXPECT_EQ(d.mass_properties.moi_centroid_kg_m2, full.mass_properties.moi_centroid_kg_m2)
-          << k;
     }
     EXPECT_GT(vouched, 40) << hollow;
     EXPECT_GT(refused, 40) << hollow;
