@@ -11,7 +11,6 @@
 namespace sweetspot::core {
 namespace {
 
-
 // The pieces of [a, b] between the breakpoints strictly inside it.
 std::vector<double> PiecesOf(double a, double b, const std::vector<double>& breakpoints) {
   std::vector<double> out = {a};
@@ -193,19 +192,59 @@ int BeamDofCount(BeamTheory theory, int elements) {
 
 namespace {
 
+using BeamElementMatrix = Eigen::Matrix<double, kElementDofs, kElementDofs>;
+using BeamElementVector = Eigen::Matrix<double, kElementDofs, 1>;
+
+// Element [a, b]'s K_e and, with `me` non-null, its M_e; otherwise its (M t)_e in *te and its
+// (M r0)_e in *re (AssembleBeamParts's integrals, one element).
+void IntegrateBeamElement(const Bat& bat, const std::vector<double>& breakpoints, double a,
+                          double b, bool timoshenko, bool rotary, BeamElementMatrix* ke,
+                          BeamElementMatrix* me, BeamElementVector* te, BeamElementVector* re) {
+  const double h = b - a;
+  ke->setZero();
+  if (me != nullptr) me->setZero();
+  te->setZero();
+  re->setZero();
+  IntegratePiecewise(a, b, breakpoints, [&](double x, double wgt) {
+    const BeamSection s = SectionAt(bat, x);
+    ElementShape n = EvaluateElementShape(h, (x - a) / h);
+    if (!timoshenko) {
+      for (int i : {2, 3, 6}) n.w[i] = 0.0;
+    }
+    const Eigen::Map<const BeamElementVector> nw(n.w), nt(n.theta), cv(n.curvature), sh(n.shear);
+    ke->noalias() += (wgt * s.bending_stiffness_n_m2) * (cv * cv.transpose());
+    if (timoshenko) ke->noalias() += (wgt * s.shear_stiffness_n) * (sh * sh.transpose());
+    if (me != nullptr) {
+      me->noalias() += (wgt * s.mass_per_length_kg_m) * (nw * nw.transpose());
+      if (rotary) me->noalias() += (wgt * s.rotary_inertia_kg_m) * (nt * nt.transpose());
+    } else {
+      te->noalias() += (wgt * s.mass_per_length_kg_m) * nw;
+      re->noalias() += (wgt * s.mass_per_length_kg_m * x) * nw;
+      if (rotary) re->noalias() += (wgt * s.rotary_inertia_kg_m) * nt;
+    }
+  });
+}
+
+// The element of `known` (in order) with nodes a and b, or null.
+const BeamElementParts* KnownElement(const std::vector<BeamElementParts>& known, double a,
+                                     double b) {
+  const auto it = std::lower_bound(known.begin(), known.end(), a,
+                                   [](const BeamElementParts& p, double x) { return p.a_m < x; });
+  return it != known.end() && it->a_m == a && it->b_m == b ? &*it : nullptr;
+}
+
 // AssembleBeam's loop. With `mass` null, M is not assembled; instead *mass_t and *mass_r0 (if
 // non-null) get M t and M r0 for the rigid translation t (w = 1) and rotation about the knob
 // r0 (w = x, theta = 1): the consistent loads of the mass distribution, integrated directly.
-void AssembleBeamParts(const Bat& bat, const BeamMesh& mesh, BeamTheory theory,
-                       bool rotary_inertia, Eigen::SparseMatrix<double>* stiffness,
-                       Eigen::SparseMatrix<double>* mass, Eigen::VectorXd* mass_t,
-                       Eigen::VectorXd* mass_r0) {
+// With `known` (and `mass` null), an element found there is taken from it.
+void AssembleBeamParts(const Bat& bat, const BeamMesh& mesh, BeamTheory theory, bool rotary_inertia,
+                       Eigen::SparseMatrix<double>* stiffness, Eigen::SparseMatrix<double>* mass,
+                       Eigen::VectorXd* mass_t, Eigen::VectorXd* mass_r0,
+                       const std::vector<BeamElementParts>* known = nullptr) {
   const int ne = mesh.Elements();
   const int ndof = BeamDofCount(theory, ne);
   const bool timoshenko = theory == BeamTheory::kTimoshenko;
   const bool rotary = timoshenko && rotary_inertia;
-  using Matrix7 = Eigen::Matrix<double, kElementDofs, kElementDofs>;
-  using Vector7 = Eigen::Matrix<double, kElementDofs, 1>;
   std::vector<Eigen::Triplet<double>> kt, mt;
   kt.reserve(static_cast<std::size_t>(ne) * 49);
   if (mass != nullptr) mt.reserve(static_cast<std::size_t>(ne) * 49);
@@ -214,28 +253,19 @@ void AssembleBeamParts(const Bat& bat, const BeamMesh& mesh, BeamTheory theory,
   for (int e = 0; e < ne; ++e) {
     const double a = mesh.nodes_m[static_cast<std::size_t>(e)];
     const double b = mesh.nodes_m[static_cast<std::size_t>(e) + 1];
-    const double h = b - a;
-    Matrix7 ke = Matrix7::Zero();
-    Matrix7 me = Matrix7::Zero();
-    Vector7 te = Vector7::Zero(), re = Vector7::Zero();
-    IntegratePiecewise(a, b, mesh.breakpoints_m, [&](double x, double wgt) {
-      const BeamSection s = SectionAt(bat, x);
-      ElementShape n = EvaluateElementShape(h, (x - a) / h);
-      if (!timoshenko) {
-        for (int i : {2, 3, 6}) n.w[i] = 0.0;
-      }
-      const Eigen::Map<const Vector7> nw(n.w), nt(n.theta), cv(n.curvature), sh(n.shear);
-      ke.noalias() += (wgt * s.bending_stiffness_n_m2) * (cv * cv.transpose());
-      if (timoshenko) ke.noalias() += (wgt * s.shear_stiffness_n) * (sh * sh.transpose());
-      if (mass != nullptr) {
-        me.noalias() += (wgt * s.mass_per_length_kg_m) * (nw * nw.transpose());
-        if (rotary) me.noalias() += (wgt * s.rotary_inertia_kg_m) * (nt * nt.transpose());
-      } else {
-        te.noalias() += (wgt * s.mass_per_length_kg_m) * nw;
-        re.noalias() += (wgt * s.mass_per_length_kg_m * x) * nw;
-        if (rotary) re.noalias() += (wgt * s.rotary_inertia_kg_m) * nt;
-      }
-    });
+    BeamElementMatrix ke, me;
+    BeamElementVector te, re;
+    const BeamElementParts* part =
+        known != nullptr && mass == nullptr ? KnownElement(*known, a, b) : nullptr;
+    if (part != nullptr) {
+      ke = Eigen::Map<const Eigen::Matrix<double, kElementDofs, kElementDofs, Eigen::RowMajor>>(
+          part->stiffness.data());
+      te = Eigen::Map<const BeamElementVector>(part->mass_t.data());
+      re = Eigen::Map<const BeamElementVector>(part->mass_r0.data());
+    } else {
+      IntegrateBeamElement(bat, mesh.breakpoints_m, a, b, timoshenko, rotary, &ke,
+                           mass != nullptr ? &me : nullptr, &te, &re);
+    }
     int idx[kElementDofs];
     ElementDofIndices(theory, e, idx);
     for (int i = 0; i < kElementDofs; ++i) {
@@ -262,8 +292,7 @@ void AssembleBeamParts(const Bat& bat, const BeamMesh& mesh, BeamTheory theory,
 BeamMatrices AssembleBeam(const Bat& bat, const BeamMesh& mesh, BeamTheory theory,
                           bool rotary_inertia) {
   BeamMatrices out;
-  AssembleBeamParts(bat, mesh, theory, rotary_inertia, &out.stiffness, &out.mass, nullptr,
-                    nullptr);
+  AssembleBeamParts(bat, mesh, theory, rotary_inertia, &out.stiffness, &out.mass, nullptr, nullptr);
   return out;
 }
 
@@ -272,6 +301,36 @@ BeamStiffnessAndInertia AssembleBeamStiffnessAndInertia(const Bat& bat, const Be
   BeamStiffnessAndInertia out;
   AssembleBeamParts(bat, mesh, theory, rotary_inertia, &out.stiffness, nullptr,
                     &out.mass_times_translation, &out.mass_times_rotation);
+  return out;
+}
+
+BeamStiffnessAndInertia AssembleBeamStiffnessAndInertia(
+    const Bat& bat, const BeamMesh& mesh, BeamTheory theory, bool rotary_inertia,
+    const std::vector<BeamElementParts>& known) {
+  BeamStiffnessAndInertia out;
+  AssembleBeamParts(bat, mesh, theory, rotary_inertia, &out.stiffness, nullptr,
+                    &out.mass_times_translation, &out.mass_times_rotation, &known);
+  return out;
+}
+
+std::vector<BeamElementParts> BeamElementPartsOf(const Bat& bat, const BeamMesh& mesh,
+                                                 BeamTheory theory, bool rotary_inertia) {
+  const bool timoshenko = theory == BeamTheory::kTimoshenko;
+  const bool rotary = timoshenko && rotary_inertia;
+  std::vector<BeamElementParts> out(static_cast<std::size_t>(mesh.Elements()));
+  for (std::size_t e = 0; e < out.size(); ++e) {
+    BeamElementParts& p = out[e];
+    p.a_m = mesh.nodes_m[e];
+    p.b_m = mesh.nodes_m[e + 1];
+    BeamElementMatrix ke;
+    BeamElementVector te, re;
+    IntegrateBeamElement(bat, mesh.breakpoints_m, p.a_m, p.b_m, timoshenko, rotary, &ke, nullptr,
+                         &te, &re);
+    Eigen::Map<Eigen::Matrix<double, kElementDofs, kElementDofs, Eigen::RowMajor>>(
+        p.stiffness.data()) = ke;
+    Eigen::Map<BeamElementVector>(p.mass_t.data()) = te;
+    Eigen::Map<BeamElementVector>(p.mass_r0.data()) = re;
+  }
   return out;
 }
 

@@ -27,6 +27,7 @@
 //   knob, which loses nothing.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -126,6 +127,29 @@ struct BeamStiffnessAndInertia {
 /// K of `bat` on `mesh` with M t and M r0 (see BeamStiffnessAndInertia), integrated directly.
 BeamStiffnessAndInertia AssembleBeamStiffnessAndInertia(const Bat& bat, const BeamMesh& mesh,
                                                         BeamTheory theory, bool rotary_inertia);
+
+/// One element's share of K, M t and M r0 (AssembleBeamStiffnessAndInertia's), in the element's
+/// local DOF order (ElementDofIndices).
+struct BeamElementParts {
+  double a_m = 0.0;  ///< The element's knob-side node, m from the knob.
+  double b_m = 0.0;  ///< Its tip-side node, m from the knob.
+  /// K_e, row-major (N/m, N, N m entries by DOF kind).
+  std::array<double, kElementDofs * kElementDofs> stiffness{};
+  std::array<double, kElementDofs> mass_t{};   ///< (M t)_e, kg per DOF unit.
+  std::array<double, kElementDofs> mass_r0{};  ///< (M r0)_e, kg m per DOF unit.
+};
+
+/// The parts of every element of `mesh`, in order (what AssembleBeamStiffnessAndInertia sums).
+std::vector<BeamElementParts> BeamElementPartsOf(const Bat& bat, const BeamMesh& mesh,
+                                                 BeamTheory theory, bool rotary_inertia);
+
+/// AssembleBeamStiffnessAndInertia, bit for bit, taking the parts of every element whose two
+/// nodes equal those of an element of `known` (BeamElementPartsOf of another mesh of the same
+/// bat, with the same breakpoints, theory and rotary_inertia; in order) from there instead of
+/// integrating them again.
+BeamStiffnessAndInertia AssembleBeamStiffnessAndInertia(const Bat& bat, const BeamMesh& mesh,
+                                                        BeamTheory theory, bool rotary_inertia,
+                                                        const std::vector<BeamElementParts>& known);
 
 /// Shape functions of one element of length h at xi in [0, 1], per local DOF.
 struct ElementShape {

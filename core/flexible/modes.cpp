@@ -134,8 +134,8 @@ bool SolveLevel(const Bat& bat, const BeamModesOptions& o, BeamMesh mesh, const 
     Eigen::VectorXd flex_values;
     Eigen::MatrixXd flex_vectors;
     int steps = 0;
-    if (ShiftInvertLanczos(mats.stiffness, mats.mass, rigid, o.num_modes, p - wanted, sigma,
-                           start, &flex_values, &flex_vectors, &steps)) {
+    if (ShiftInvertLanczos(mats.stiffness, mats.mass, rigid, o.num_modes, p - wanted, sigma, start,
+                           &flex_values, &flex_vectors, &steps)) {
       const double last = flex_values[o.num_modes - 1];
       // Between the last wanted eigenvalue and the next Ritz value (an upper bound of the next
       // eigenvalue), at most 5 % above the last: a missed mode below it changes the count.
@@ -457,6 +457,7 @@ BatModes ComputeBatModes(const Bat& bat, const BeamModesOptions& options) {
     out.mass_kg = fin.mass_kg;
     out.balance_point_m = fin.balance_point_m;
     out.moi_centroid_kg_m2 = fin.moi_centroid_kg_m2;
+    out.element_parts = BeamElementPartsOf(bat, fin.mesh, out.theory, out.rotary_inertia);
     // The previous level's modes, for the node error estimates.
     BatModes prev;
     if (levels.size() >= 2) {

@@ -89,6 +89,9 @@ struct BatModes {
   /// without = the slender-rod MOI).
   double moi_centroid_kg_m2 = 0.0;
   std::vector<BeamMode> modes;  ///< Flexible modes, ascending frequency (num_modes of them).
+  /// The final mesh's element parts of K, M t and M r0 (BeamElementPartsOf), which the static
+  /// flexibility under inertia relief reuses for the elements its mesh keeps (empty: none).
+  std::vector<BeamElementParts> element_parts;
 
   /// Number of elements of the final mesh.
   int Elements() const { return nodes_m.empty() ? 0 : static_cast<int>(nodes_m.size()) - 1; }

@@ -45,8 +45,12 @@ double InertiaReliefFlexibility(const Bat& bat, const BatModes& modes, double x_
   on_mesh.balance_point_m = modes.balance_point_m;
   on_mesh.moi_centroid_kg_m2 = modes.moi_centroid_kg_m2;
   // K and the products of M with the rigid modes (M itself is not needed).
+  // The elements the node at x leaves as they were: taken from the modes' (the same numbers).
   const BeamStiffnessAndInertia mats =
-      AssembleBeamStiffnessAndInertia(bat, mesh, modes.theory, modes.rotary_inertia);
+      modes.element_parts.empty()
+          ? AssembleBeamStiffnessAndInertia(bat, mesh, modes.theory, modes.rotary_inertia)
+          : AssembleBeamStiffnessAndInertia(bat, mesh, modes.theory, modes.rotary_inertia,
+                                            modes.element_parts);
   const int ne = mesh.Elements();
   const Eigen::Index n = mats.stiffness.rows();
   // The load: a unit force at x, as consistent nodal loads (the displacement shape functions).
