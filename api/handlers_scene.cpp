@@ -55,6 +55,7 @@ std::optional<SweetSpotRequest> ParseSweetSpot(const Json& body, const Context& 
     return std::nullopt;
   }
   request.options.flexible.modes_cache = context.modes_cache;
+  request.options.progress = context.progress;  // the server's cancel flag (or null)
   return request;
 }
 
@@ -215,6 +216,7 @@ std::optional<CompareRequest> ParseCompare(const Json& body, const Context& cont
   }
   if (!reader.Finish()) return std::nullopt;
   request.options.flexible.modes_cache = context.modes_cache;
+  request.options.progress = context.progress;  // the server's cancel flag (or null)
   return request;
 }
 

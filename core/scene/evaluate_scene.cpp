@@ -427,6 +427,12 @@ void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
       std::string error;
       for (double x : xs) {
         double v = 0.0, e = 0.0;
+        if (IsCancelled(options.progress)) {
+          ok = false;
+          error = "cancelled after " + std::to_string(curve.points.size()) + " of " +
+                  std::to_string(xs.size()) + " points";
+          break;
+        }
         if (!exit_model->Eval(x, &v, nullptr, &e, &error)) {
           ok = false;
           break;

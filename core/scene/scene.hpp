@@ -20,6 +20,7 @@
 #include "core/flexible/modes_cache.hpp"
 #include "core/mass_properties.hpp"
 #include "core/optimize/nlopt_search.hpp"
+#include "core/progress.hpp"
 #include "core/refusal.hpp"
 #include "core/sweet_spot/numeric.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
@@ -216,6 +217,10 @@ struct SceneOptions {
   /// closed forms and the mass properties read no clock (their timings are 0 s; the models
   /// and calls are still listed): /v1/explore's sweeps, whose rows report no timings.
   bool time_models = true;
+  /// A cancel flag polled between the points of an exit-speed curve (null: never
+  /// cancelled); once set, the evaluation stops with termination failure, "cancelled". Not a
+  /// value of the scene: the server sets it when a client leaves or a time budget ends.
+  const Progress* progress = nullptr;
 
   /// True when every field is in range; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;
