@@ -19,7 +19,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/stages.sh
 jobs="${SWEETSPOT_JOBS:-$(nproc)}"
-filter="${SWEETSPOT_TSAN_FILTER:-Job*:*Concurrent*:ServerTest.*:ServerLimits*:ExploreStream*:FaultsTest.*:ServingTest.ConnectionsPast*:ServingTest.IdleKeepAlive*:PostgresJobsTest.*}"
+filter="${SWEETSPOT_TSAN_FILTER:-Job*:*Concurrent*:ServerTest.*:ServerLimits*:ExploreStream*:FaultsTest.*:ServingTest.ConnectionsPast*:ServingTest.IdleKeepAlive*:PostgresJobsTest.*:AttackTest.Abandoned*:AttackTest.Shutdown*:AttackTest.ComputeRequestsHaveATimeBudget}"
 step="${SWEETSPOT_TSAN_STEP:-all}"
 build=build-tsan
 

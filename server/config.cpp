@@ -124,6 +124,32 @@ const std::vector<Option>& Options() {
          c->max_connections = static_cast<int>(n);
          return true;
        }},
+      {"--max-connections-per-client", "SWEETSPOT_MAX_CONNECTIONS_PER_CLIENT",
+       "open connections from one client address; beyond: 503 TooBusy at once, then closed; "
+       "behind a proxy every client has the proxy's address: set it to --max-connections "
+       "there (default 128)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1, 100000, &n, rule)) return false;
+         c->max_connections_per_client = static_cast<int>(n);
+         return true;
+       }},
+      {"--first-byte-timeout-s", "SWEETSPOT_FIRST_BYTE_TIMEOUT_S",
+       "a new connection must send its first byte within this many s; else it is closed "
+       "without an answer (default 2)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseSeconds(v, &c->first_byte_timeout_s, rule);
+       }},
+      {"--max-request-time-s", "SWEETSPOT_MAX_REQUEST_TIME_S",
+       "longest a request that runs models (the compute pool's) may compute, in s from when a "
+       "compute worker takes it; then it is stopped and answered 503 with Retry-After (a "
+       "streamed answer ends early); longer work belongs in POST /v1/jobs (default 120)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseSeconds(v, &c->max_request_time_s, rule);
+       }},
       {"--auth-token-file", "SWEETSPOT_AUTH_TOKEN_FILE",
        "file holding a bearer token required on every path but /health (default: none; "
        "SWEETSPOT_AUTH_TOKEN may hold the token itself)",
@@ -418,6 +444,10 @@ bool ServerConfig::IsValid(std::string* why) const {
   if (max_connections < 1) {
     return fail("max_connections = " + std::to_string(max_connections) + ": must be at least 1");
   }
+  if (max_connections_per_client < 1) {
+    return fail("max_connections_per_client = " + std::to_string(max_connections_per_client) +
+                ": must be at least 1");
+  }
   if (!auth_token.empty() && auth_token.size() < 16) {
     return fail("auth_token: must have at least 16 characters");
   }
@@ -425,7 +455,9 @@ bool ServerConfig::IsValid(std::string* why) const {
   for (const auto& [name, value] :
        {std::pair{"header_timeout_s", header_timeout_s},
         std::pair{"read_timeout_s", read_timeout_s}, std::pair{"write_timeout_s", write_timeout_s},
-        std::pair{"keep_alive_timeout_s", keep_alive_timeout_s}}) {
+        std::pair{"keep_alive_timeout_s", keep_alive_timeout_s},
+        std::pair{"first_byte_timeout_s", first_byte_timeout_s},
+        std::pair{"max_request_time_s", max_request_time_s}}) {
     if (!std::isfinite(value) || value <= 0 || value > 3600) {
       return fail(std::string(name) + " = " + core::FormatNumber(value) + ": must be in (0, 3600]");
     }

@@ -21,6 +21,9 @@ struct ServerConfig {
   int compute_threads = 0;               ///< Worker threads for requests that run models (explore, optimize, fit, modes, hertz and flexible scenes); 0 = one per core (--compute-threads, SWEETSPOT_COMPUTE_THREADS), 0..1024.
   int explore_threads = 0;               ///< Threads one /v1/explore sweep evaluates on (beyond its own: idle compute workers); 0 = one per core (--explore-threads, SWEETSPOT_EXPLORE_THREADS), 0..1024.
   int max_connections = 256;             ///< Open connections (reading, answered, idle keep-alive); beyond: 503 TooBusy at once, then closed (--max-connections, SWEETSPOT_MAX_CONNECTIONS).
+  int max_connections_per_client = 128;  ///< Open connections from one client address; beyond: 503 TooBusy at once, then closed; behind a proxy every client has the proxy's address, so set it to max_connections there (--max-connections-per-client, SWEETSPOT_MAX_CONNECTIONS_PER_CLIENT), 1..100000.
+  double first_byte_timeout_s = 2.0;     ///< A new connection must send its first byte within this, s; else closed without an answer (--first-byte-timeout-s, SWEETSPOT_FIRST_BYTE_TIMEOUT_S).
+  double max_request_time_s = 120.0;     ///< Longest a request that runs models may compute, s, from when a compute worker takes it; then stopped and answered 503 (a stream ends early) (--max-request-time-s, SWEETSPOT_MAX_REQUEST_TIME_S).
   std::string auth_token;                ///< If set, every path but /health needs "Authorization: Bearer <token>" (SWEETSPOT_AUTH_TOKEN, --auth-token-file).
   std::string cors_origin;               ///< CORS: the allowed Origin, or "*"; empty = no CORS headers (--cors-origin, SWEETSPOT_CORS_ORIGIN).
   std::size_t max_body_bytes = 1 << 20;  ///< Largest request body, bytes (--max-body-bytes, SWEETSPOT_MAX_BODY_BYTES).

@@ -44,6 +44,8 @@ const char* StatusText(int status) {
       return "Bad Request";
     case 408:
       return "Request Timeout";
+    case 414:
+      return "URI Too Long";
     case 431:
       return "Request Header Fields Too Large";
     case 503:
@@ -84,12 +86,25 @@ enum class Reason {
   kBadRequest,
   kIdle,
   kWriteTimeout,
+  kOverClientLimit,
+  kFirstByteTimeout,
+  kClientGone,
   kCount
 };
 
 constexpr std::array<const char*, static_cast<int>(Reason::kCount)> kReasonNames = {
-    "over_limit",     "header_timeout", "body_too_slow",   "read_timeout",
-    "head_too_large", "bad_request",    "keep_alive_idle", "write_timeout"};
+    "over_limit",        "header_timeout",     "body_too_slow",   "read_timeout",
+    "head_too_large",    "bad_request",        "keep_alive_idle", "write_timeout",
+    "over_client_limit", "first_byte_timeout", "client_gone"};
+
+// True when the client of `fd` closed its side (or the socket failed) and sent nothing
+// more that is still unread: nobody will read an answer. Never blocks.
+bool PeerGone(int fd) {
+  char byte = 0;
+  const ssize_t n = ::recv(fd, &byte, 1, MSG_PEEK | MSG_DONTWAIT);
+  if (n == 0) return true;
+  return n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
+}
 
 enum class State {
   kReadingHead,  // armed: waiting for the rest of a head
@@ -130,6 +145,13 @@ struct Connection {
   bool keep_open = false;            // the verdict on the request just answered
   bool peer_closed = false;          // the client shut its side: nothing more will arrive
   int served = 0;                    // requests answered on this connection
+  bool admitted = true;              // counts against max_connections (and its client's)
+  // The cancel flag of the compute request being answered (null otherwise), and when it
+  // must stop; `cancel_mutex` guards both (the deadline keeper reads them while a worker
+  // holds `mutex`).
+  std::mutex cancel_mutex;
+  RequestCancel* cancel = nullptr;
+  Clock::time_point cancel_deadline;
   std::string remote_ip, local_ip;
   int remote_port = 0, local_port = 0;
 };
@@ -227,6 +249,7 @@ struct ConnectionLoop::Impl {
 
   std::mutex map_mutex;
   std::unordered_map<std::uint64_t, ConnectionPtr> connections;
+  std::unordered_map<std::string, int> per_client;  // admitted connections by client address
   std::uint64_t next_id = 2;
 
   std::atomic<bool> stopping{false};
@@ -270,14 +293,20 @@ struct ConnectionLoop::Impl {
   void Close(Connection& c) {
     if (c.closed) return;
     c.closed = true;
-    if (c.state == State::kLingering) {
-      lingering.fetch_sub(1, std::memory_order_relaxed);
-    } else {
-      admitted.fetch_sub(1, std::memory_order_relaxed);
-    }
+    if (c.state == State::kLingering) lingering.fetch_sub(1, std::memory_order_relaxed);
     ::close(c.fd);  // also takes it out of the epoll set
     std::lock_guard<std::mutex> lock(map_mutex);
+    ReleaseAdmission(c);
     connections.erase(c.id);
+  }
+
+  // `c` no longer counts against max_connections and its client's limit (map_mutex held).
+  void ReleaseAdmission(Connection& c) {
+    if (!c.admitted) return;
+    c.admitted = false;
+    admitted.fetch_sub(1, std::memory_order_relaxed);
+    const auto it = per_client.find(c.remote_ip);
+    if (it != per_client.end() && --it->second <= 0) per_client.erase(it);
   }
 
   // Half-closes `c` and drains it until the client closes or linger_s passes,
@@ -285,7 +314,10 @@ struct ConnectionLoop::Impl {
   void Linger(Connection& c, Clock::time_point now) {
     ::shutdown(c.fd, SHUT_WR);
     if (c.state != State::kLingering) {
-      admitted.fetch_sub(1, std::memory_order_relaxed);
+      {
+        std::lock_guard<std::mutex> lock(map_mutex);
+        ReleaseAdmission(c);
+      }
       lingering.fetch_add(1, std::memory_order_relaxed);
       c.state = State::kLingering;
     }
@@ -348,13 +380,16 @@ struct ConnectionLoop::Impl {
       if (getsockname(fd, reinterpret_cast<sockaddr*>(&local), &local_len) == 0) {
         AddressOf(local, &c->local_ip, &c->local_port);
       }
+      int from_client = 0;
       {
         std::lock_guard<std::mutex> lock(map_mutex);
         c->id = next_id++;
         connections.emplace(c->id, c);
+        from_client = ++per_client[c->remote_ip];
       }
       accepted.fetch_add(1, std::memory_order_relaxed);
       const bool over = admitted.fetch_add(1, std::memory_order_relaxed) >= options.max_connections;
+      const bool over_client = from_client > options.max_connections_per_client;
       epoll_event event{};
       event.events = EPOLLIN | EPOLLRDHUP | EPOLLONESHOT;
       event.data.u64 = c->id;
@@ -366,6 +401,12 @@ struct ConnectionLoop::Impl {
         Refuse(*c, 503, api::ErrorCode::kTooBusy, Reason::kOverLimit,
                "the server has " + std::to_string(options.max_connections) +
                    " connections open (limit max_connections); retry later",
+               now);
+      } else if (over_client) {
+        Refuse(*c, 503, api::ErrorCode::kTooBusy, Reason::kOverClientLimit,
+               "the server has " + std::to_string(options.max_connections_per_client) +
+                   " connections open from " + c->remote_ip +
+                   " (limit max_connections_per_client); retry later",
                now);
       }
     }
@@ -425,17 +466,41 @@ struct ConnectionLoop::Impl {
                now);
         return Step::kWait;
       }
+      if (scan == HeadScan::kLineTooLong) {
+        Refuse(c, 431, api::ErrorCode::kTooBig, Reason::kHeadTooLarge,
+               "a header line is over " + std::to_string(kMaxHeaderLineBytes) +
+                   " bytes (its CRLF included)",
+               now);
+        return Step::kWait;
+      }
+      if (scan == HeadScan::kTargetTooLong) {
+        Refuse(c, 414, api::ErrorCode::kTooBig, Reason::kHeadTooLarge,
+               "the request line is over " + std::to_string(kMaxRequestLineBytes) +
+                   " bytes (its CRLF included): the URL is too long",
+               now);
+        return Step::kWait;
+      }
+      if (scan == HeadScan::kBareLineFeed) {
+        Refuse(c, 400, api::ErrorCode::kInvalidValue, Reason::kBadRequest,
+               "a line of the request head ends in a bare LF: every line must end in CRLF", now);
+        return Step::kWait;
+      }
       RequestHead& head = c.head;
       if (head.bad_content_length) {
         Refuse(c, 400, api::ErrorCode::kInvalidValue, Reason::kBadRequest,
                "header Content-Length: must be one decimal number of bytes", now);
         return Step::kWait;
       }
-      if (head.expects_continue) {
-        // "100 Continue" is sent here when the body is awaited; httplib must not send another.
-        const std::size_t n = head.expect_line_end - head.expect_line_begin;
-        c.in.erase(head.expect_line_begin, n);
-        head.head_bytes -= n;
+      // Lines httplib must not see, dropped from the last to the first: Expect ("100
+      // Continue" is sent here when the body is awaited; httplib must not send another), and
+      // Range (every answer is whole: httplib would build a multi-range body in memory, and
+      // cut a JSON answer to a 200 of the range's bytes).
+      std::vector<std::pair<std::size_t, std::size_t>> dropped = head.range_lines;
+      if (head.expects_continue) dropped.emplace_back(head.expect_line_begin, head.expect_line_end);
+      std::sort(dropped.begin(), dropped.end());
+      for (auto it = dropped.rbegin(); it != dropped.rend(); ++it) {
+        c.in.erase(it->first, it->second - it->first);
+        head.head_bytes -= it->second - it->first;
       }
       c.continue_sent = false;
       if (head.has_transfer_encoding || head.content_length > options.max_body_bytes) {
@@ -472,13 +537,14 @@ struct ConnectionLoop::Impl {
 
   // ------------------------------------------------------------ answering (c.mutex held)
   // Answers the framed request of `c` with httplib; sets c.keep_open.
-  void Answer(Connection& c, BusyCounter& busy) {
+  void Answer(Connection& c, BusyCounter& busy, RequestCancel* cancel = nullptr) {
     busy.Enter();
     bool keep_open = false;
     try {
       const std::string_view request(c.in.data(), c.request_bytes);
       RequestStream stream(c.fd, request, options.write_timeout_s, c.remote_ip, c.remote_port,
                            c.local_ip, c.local_port);
+      stream.set_cancel(cancel);
       const bool last = c.close_after || c.served + 1 >= options.keep_alive_max_requests ||
                         stopping.load(std::memory_order_relaxed);
       bool closed = false;
@@ -493,6 +559,51 @@ struct ConnectionLoop::Impl {
     busy.Leave();
     ++c.served;
     c.keep_open = keep_open;
+  }
+
+  // Answers the framed request of `c` on a compute worker, with a cancel flag the deadline
+  // keeper sets (client gone, max_request_time_s, shutdown). A request whose client left
+  // while it was queued is dropped; once the server stops, one still queued is refused.
+  void AnswerCompute(Connection& c) {
+    if (stopping.load(std::memory_order_relaxed)) {
+      Refuse(c, 503, api::ErrorCode::kTooBusy, Reason::kOverLimit,
+             "the server is shutting down; retry on another replica or later", Clock::now());
+      c.keep_open = false;
+      return;
+    }
+    if (PeerGone(c.fd)) {
+      closed_by[static_cast<int>(Reason::kClientGone)].fetch_add(1, std::memory_order_relaxed);
+      Close(c);
+      return;
+    }
+    RequestCancel cancel;
+    {
+      std::lock_guard<std::mutex> lock(c.cancel_mutex);
+      c.cancel = &cancel;
+      c.cancel_deadline = Clock::now() + Seconds(options.max_request_time_s);
+    }
+    Answer(c, compute_busy, &cancel);
+    {
+      std::lock_guard<std::mutex> lock(c.cancel_mutex);
+      c.cancel = nullptr;
+    }
+    if (cancel.Reason() == CancelReason::kClientGone) {
+      closed_by[static_cast<int>(Reason::kClientGone)].fetch_add(1, std::memory_order_relaxed);
+    }
+  }
+
+  // The deadline keeper's look at a request being answered (`c` held by its worker): sets
+  // its cancel flag when the client left, its time is up, or the server stops.
+  void CheckWorking(Connection& c, Clock::time_point now, bool shutting_down) {
+    std::lock_guard<std::mutex> lock(c.cancel_mutex);
+    if (c.cancel == nullptr || c.cancel->Reason() != CancelReason::kNone) return;
+    if (shutting_down) {
+      c.cancel->Cancel(CancelReason::kShutdown);
+    } else if (now >= c.cancel_deadline) {
+      c.cancel->Cancel(CancelReason::kDeadline);
+    } else if (PeerGone(c.fd)) {  // the fd stays open while c.cancel is set
+      c.cancel->Cancel(CancelReason::kClientGone);
+    }
   }
 
   // After an answer: closes (lingering) or goes back to waiting. Returns true
@@ -566,7 +677,12 @@ struct ConnectionLoop::Impl {
         compute->Push(c);
         return;
       }
-      Answer(*c, pool == Pool::kLight ? light_busy : compute_busy);
+      if (pool == Pool::kLight) {
+        Answer(*c, light_busy);
+      } else {
+        AnswerCompute(*c);
+        if (c->closed || c->state == State::kLingering) return;
+      }
       now = Clock::now();
       if (!AfterAnswer(*c, now)) return;
     }
@@ -630,7 +746,8 @@ struct ConnectionLoop::Impl {
     } give_back{budget};
     std::unique_lock<std::mutex> lock(c->mutex);
     if (c->closed) return;
-    Answer(*c, compute_busy);
+    AnswerCompute(*c);
+    if (c->closed || c->state == State::kLingering) return;
     const Clock::time_point now = Clock::now();
     if (AfterAnswer(*c, now)) Drive(c, lock, now, Pool::kCompute);
   }
@@ -640,7 +757,11 @@ struct ConnectionLoop::Impl {
     int idle = 0, reading = 0;
     for (const ConnectionPtr& c : Snapshot()) {
       std::unique_lock<std::mutex> lock(c->mutex, std::try_to_lock);
-      if (!lock.owns_lock() || c->closed) continue;  // a worker has it: not waiting
+      if (!lock.owns_lock()) {
+        CheckWorking(*c, now, /*shutting_down=*/false);  // a worker has it: answering
+        continue;
+      }
+      if (c->closed) continue;
       switch (c->state) {
         case State::kIdle:
           ++idle;
@@ -651,7 +772,12 @@ struct ConnectionLoop::Impl {
           break;
         case State::kReadingHead:
           ++reading;
-          if (now - c->started >= Seconds(options.header_timeout_s) ||
+          if (c->in.empty() && c->served == 0 &&
+              now - c->started >= Seconds(options.first_byte_timeout_s)) {
+            closed_by[static_cast<int>(Reason::kFirstByteTimeout)].fetch_add(
+                1, std::memory_order_relaxed);
+            Close(*c);
+          } else if (now - c->started >= Seconds(options.header_timeout_s) ||
               now - c->last_read >= Seconds(options.read_timeout_s)) {
             ExpireHead(*c, now);
           }
@@ -727,7 +853,11 @@ struct ConnectionLoop::Impl {
   std::size_t CloseWaiting(Clock::time_point now) {
     for (const ConnectionPtr& c : Snapshot()) {
       std::unique_lock<std::mutex> lock(c->mutex, std::try_to_lock);
-      if (!lock.owns_lock() || c->closed || c->state == State::kWorking) continue;
+      if (!lock.owns_lock()) {
+        CheckWorking(*c, now, /*shutting_down=*/true);  // being answered: stop its models
+        continue;
+      }
+      if (c->closed || c->state == State::kWorking) continue;
       if (c->state == State::kWriting && now < c->write_deadline) continue;
       Close(*c);
     }

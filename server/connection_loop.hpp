@@ -13,12 +13,22 @@
 // deadlines.
 //
 // What is answered without a handler, then the connection is closed:
-//   503 TooBusy   a connection past max_connections, at once (Retry-After: 1);
+//   503 TooBusy   a connection past max_connections, or past max_connections_per_client
+//                 from one address, at once (Retry-After: 1); a queued compute request
+//                 once the server is stopping;
 //   408 Timeout   a head not complete within header_timeout_s of its first byte
 //                 (of the accept, for a new connection), a body slower than
 //                 body_min_rate_bytes_per_s, or read_timeout_s without a byte;
-//   431 TooBig    a head over max_head_bytes;
-//   400           a Content-Length that is not one decimal number.
+//   431 TooBig    a head over max_head_bytes, or a header line over 8192 bytes;
+//   414 TooBig    a request line over 8192 bytes;
+//   400           a Content-Length that is not one decimal number, or a line that ends
+//                 in a bare LF.
+// A connection that sends no byte within first_byte_timeout_s is closed without an
+// answer. Range headers are dropped before httplib sees the request: every answer is
+// whole. A request of the compute pool carries a cancel flag (RequestCancel) that the
+// deadline keeper sets when its client closes the connection, when it has computed for
+// max_request_time_s, or when the server stops; a queued request whose client left is
+// dropped without computing.
 // A closed connection is first half-closed and drained for up to linger_s (so
 // that the client reads the answer instead of a reset), without counting
 // against the limit.
@@ -44,6 +54,12 @@ namespace sweetspot::server {
 struct ConnectionLoopOptions {
   /// Open connections admitted; beyond: 503.
   int max_connections = 256;
+  /// Open connections admitted from one client address; beyond: 503.
+  int max_connections_per_client = 128;
+  /// A new connection's first byte must arrive within this, s; else closed silently.
+  double first_byte_timeout_s = 2.0;
+  /// A compute-pool request is cancelled (CancelReason::kDeadline) after computing this long, s.
+  double max_request_time_s = 120.0;
   /// Largest request head, bytes; beyond: 431.
   std::size_t max_head_bytes = 65536;
   /// Larger bodies are not read (httplib answers 413).

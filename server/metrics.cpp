@@ -23,11 +23,20 @@ std::string Label(const std::string& value) {
 
 }  // namespace
 
+const char* Metrics::MethodLabel(std::string_view method) {
+  static constexpr std::array<const char*, 9> kKnown = {
+      "GET", "HEAD", "POST", "PUT", "DELETE", "PATCH", "OPTIONS", "CONNECT", "TRACE"};
+  for (const char* known : kKnown) {
+    if (method == known) return known;
+  }
+  return "other";
+}
+
 void Metrics::End(const std::string& route, const std::string& method, int status,
                   double duration_s) {
   in_flight_.fetch_sub(1, std::memory_order_relaxed);
   std::lock_guard<std::mutex> lock(mutex_);
-  ++requests_[{route, method, status}];
+  ++requests_[{route, MethodLabel(method), status}];
   Histogram& h = latency_[route];
   for (std::size_t i = 0; i < kBucketsS.size(); ++i) {
     if (duration_s <= kBucketsS[i]) {

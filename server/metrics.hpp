@@ -6,6 +6,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <tuple>
 
 namespace sweetspot::server {
@@ -21,8 +22,11 @@ class Metrics {
 
   /// A request started.
   void Begin() { in_flight_.fetch_add(1, std::memory_order_relaxed); }
+  /// The method's label: one of the nine HTTP methods, else "other" (a request the
+  /// loop refused may carry any bytes as its method: the label set stays bounded).
+  static const char* MethodLabel(std::string_view method);
   /// A request ended: its route pattern (not the raw path, so the label set
-  /// stays bounded), method, HTTP status and duration in s.
+  /// stays bounded), method (as MethodLabel), HTTP status and duration in s.
   void End(const std::string& route, const std::string& method, int status, double duration_s);
   /// The exposition text; `jobs_by_state` adds sweetspot_jobs{state=...}.
   std::string Render(const std::map<std::string, int>& jobs_by_state) const;

@@ -8,11 +8,36 @@
 
 #include <httplib.h>
 
+#include <atomic>
 #include <chrono>
 #include <string>
 #include <string_view>
 
+#include "core/progress.hpp"
+
 namespace sweetspot::server {
+
+/// Why the connection loop stopped a request that runs models.
+enum class CancelReason : int {
+  kNone = 0,    ///< Not stopped.
+  kClientGone,  ///< The client closed its connection: nobody reads the answer.
+  kDeadline,    ///< It computed for longer than max_request_time_s.
+  kShutdown,    ///< The server is stopping.
+};
+
+/// The cancel flag of one request the compute pool answers: its handler polls `progress`
+/// (api::Context::progress), the loop's deadline keeper sets it once, with the reason.
+struct RequestCancel {
+  core::Progress progress;         ///< What the models poll.
+  std::atomic<int> reason{0};      ///< A CancelReason; the first one set wins.
+  /// Stops the request for `why` (only the first call has an effect). Thread-safe.
+  void Cancel(CancelReason why) {
+    int none = static_cast<int>(CancelReason::kNone);
+    if (reason.compare_exchange_strong(none, static_cast<int>(why))) progress.Cancel();
+  }
+  /// Why it was stopped (kNone while it runs).
+  CancelReason Reason() const { return static_cast<CancelReason>(reason.load()); }
+};
 
 /// One request's bytes in, the answer out. Not thread-safe (one worker uses it).
 class RequestStream : public httplib::Stream {
@@ -49,6 +74,13 @@ class RequestStream : public httplib::Stream {
   /// False once a write failed: the connection must be closed.
   bool healthy() const { return healthy_; }
 
+  /// The request's bytes, head and body, as received.
+  std::string_view request() const { return request_; }
+  /// The request's cancel flag (requests of the compute pool), or null.
+  RequestCancel* cancel() const { return cancel_; }
+  /// Gives the request a cancel flag (owned by the caller; outlives the stream).
+  void set_cancel(RequestCancel* cancel) { cancel_ = cancel; }
+
   /// The stream of the request the calling thread is handling, or null: lets
   /// the handler that starts a streamed answer call WriteThrough().
   static RequestStream* Current();
@@ -68,6 +100,7 @@ class RequestStream : public httplib::Stream {
   bool write_through_ = false;
   bool healthy_ = true;
   RequestStream* previous_current_;
+  RequestCancel* cancel_ = nullptr;
 };
 
 }  // namespace sweetspot::server

@@ -61,16 +61,30 @@ int RunServerMain(const std::vector<std::string>& args) {
     if (finished.load()) return;
     std::cerr << "sweetspot-server: received " << (signal_number == SIGTERM ? "SIGTERM" : "SIGINT")
               << ", stopping\n";
-    // Stop() is a no-op before the listen loop starts: repeat until it returns.
-    while (!run_returned.load()) {
+    // Stop() is a no-op before the listen loop starts: repeat until it returns, listening
+    // for a second signal meanwhile.
+    bool second = false;
+    while (!run_returned.load() && !second) {
       server.Stop();
+      const timespec wait{0, 10 * 1000 * 1000};
+      second = sigtimedwait(&stop_signals, nullptr, &wait) > 0;
+    }
+    // A second signal ends the running jobs' grace period at once, and the process soon
+    // after: whatever still runs 2 s later (a job that ignores its cancel flag, an answer
+    // a client reads slowly) is abandoned. Jobs are kept in their store as they are, and a
+    // job that was running is resumed by the next start (or another replica).
+    if (!second) sigwait(&stop_signals, &signal_number);
+    if (finished.load()) return;
+    std::cerr << "sweetspot-server: received a second signal, interrupting the running jobs; "
+                 "exiting within 2 s\n";
+    server.EndShutdownGrace();
+    for (int i = 0; i < 200 && !finished.load(); ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
-    // A second signal ends the running jobs' grace period at once.
-    sigwait(&stop_signals, &signal_number);
     if (finished.load()) return;
-    std::cerr << "sweetspot-server: received a second signal, interrupting the running jobs\n";
-    server.EndShutdownGrace();
+    std::cerr << "sweetspot-server: still busy 2 s after the second signal: exiting now"
+              << std::endl;
+    std::_Exit(3);
   });
 
   std::cerr << "sweetspot-server: jobs "

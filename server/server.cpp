@@ -15,13 +15,17 @@
 #include <exception>
 #include <iostream>
 #include <mutex>
+#include <optional>
+#include <string_view>
 #include <thread>
 
 #include "server/jobs/job_manager.hpp"
 #include "api/router.hpp"
 #include "server/access_log.hpp"
+#include "core/geometry_format.hpp"
 #include "server/connection_loop.hpp"
 #include "server/metrics.hpp"
+#include "server/request_head.hpp"
 #include "server/request_stream.hpp"
 #include "server/jobs/postgres_job_service.hpp"
 #include "server/jobs/sqlite_job_store.hpp"
@@ -122,20 +126,90 @@ api::ErrorCode CodeForStatus(int status) {
   }
 }
 
+// The answer of a request the connection loop stopped (its cancel flag set while it
+// computed), in place of the handler's: 503 with Retry-After for the time budget and for
+// a shutdown; the handler's own for a client that left (nobody reads it).
+void StoppedAnswer(const RequestCancel& cancel, double max_request_time_s,
+                   api::Response* response) {
+  switch (cancel.Reason()) {
+    case CancelReason::kDeadline:
+      *response = api::ErrorResponse(
+          503, api::ErrorCode::kTimeout,
+          "the request computed for longer than max_request_time_s = " +
+              core::FormatNumber(max_request_time_s) +
+              " s and was stopped; run it as a job (POST /v1/jobs), which has its own time "
+              "limit");
+      break;
+    case CancelReason::kShutdown:
+      *response = api::ErrorResponse(503, api::ErrorCode::kTooBusy,
+                                     "the server is shutting down and stopped this request; "
+                                     "retry on another replica or later");
+      break;
+    case CancelReason::kNone:
+    case CancelReason::kClientGone:
+      break;
+  }
+}
+
 time_t WholeSeconds(double s) { return static_cast<time_t>(s < 1.0 ? 1.0 : s); }
 
 // "Bearer <token>" against the configured token, in time independent of
-// where the first difference is (no timing oracle for the token).
-bool TokenMatches(const std::string& header, const std::string& token) {
-  const std::string prefix = "Bearer ";
-  if (header.size() != prefix.size() + token.size() || header.compare(0, prefix.size(), prefix)) {
-    return false;
+// where the first difference is (no timing oracle for the token). The scheme's
+// name is case-insensitive (RFC 9110, 11.1); the token is compared byte for byte.
+bool TokenMatches(std::string_view header, const std::string& token) {
+  constexpr std::string_view prefix = "bearer ";
+  if (header.size() != prefix.size() + token.size()) return false;
+  for (std::size_t i = 0; i < prefix.size(); ++i) {
+    const char c = header[i];
+    if ((c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c) != prefix[i]) return false;
   }
   unsigned char diff = 0;
   for (std::size_t i = 0; i < token.size(); ++i) {
     diff |= static_cast<unsigned char>(header[prefix.size() + i] ^ token[i]);
   }
   return diff == 0;
+}
+
+// The value of header `name` as the client sent it (httplib percent-decodes the values it
+// parses: "Bearer%20x" would become "Bearer x"), from the raw head of the request the
+// calling thread answers; "" when absent. Names compare case-insensitively.
+std::string_view RawHeaderValue(std::string_view name) {
+  const RequestStream* stream = RequestStream::Current();
+  if (stream == nullptr) return {};
+  const std::string_view bytes = stream->request();
+  const std::size_t head_end = bytes.find("\r\n\r\n");
+  if (head_end == std::string_view::npos) return {};
+  std::size_t at = bytes.find("\r\n");  // past the request line
+  while (at < head_end) {
+    const std::size_t begin = at + 2;
+    const std::size_t end = bytes.find("\r\n", begin);
+    const std::string_view line = bytes.substr(begin, end - begin);
+    at = end;
+    if (line.size() <= name.size() || line[name.size()] != ':') continue;
+    bool same = true;
+    for (std::size_t i = 0; i < name.size() && same; ++i) {
+      const auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c + 32) : c; };
+      same = lower(line[i]) == lower(name[i]);
+    }
+    if (!same) continue;
+    std::string_view value = line.substr(name.size() + 1);
+    while (!value.empty() && (value.front() == ' ' || value.front() == '\t')) value.remove_prefix(1);
+    while (!value.empty() && (value.back() == ' ' || value.back() == '\t')) value.remove_suffix(1);
+    return value;
+  }
+  return {};
+}
+
+// What httplib must not do with a request, undone before routing (its setup hook):
+// a form-encoded body (the Content-Type of `curl -d` and urllib) is capped at 8192 bytes
+// in 0.11.4 and parsed into query parameters: the API reads every body as JSON, so that
+// Content-Type is dropped and max_body_bytes alone applies.
+void PrepareRequest(httplib::Request& req) {
+  const auto type = req.headers.find("Content-Type");
+  if (type != req.headers.end() &&
+      type->second.rfind("application/x-www-form-urlencoded", 0) == 0) {
+    req.headers.erase(type);
+  }
 }
 
 // The route label of static files in metrics and the access log (one label
@@ -204,7 +278,7 @@ class HttpServer : public httplib::Server {
 
   bool ServeOne(httplib::Stream& stream, bool close_connection, bool* connection_closed) {
     bool closed = false;
-    const bool ok = process_request(stream, close_connection, closed, nullptr);
+    const bool ok = process_request(stream, close_connection, closed, PrepareRequest);
     *connection_closed = closed;
     return ok;
   }
@@ -305,7 +379,7 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     // Static files carry no data: the page itself asks for the token.
     if (!config_.auth_token.empty() && req.path != "/health" &&
         !IsStaticRequest(req, *impl_->static_files) &&
-        !TokenMatches(req.get_header_value("Authorization"), config_.auth_token)) {
+        !TokenMatches(RawHeaderValue("Authorization"), config_.auth_token)) {
       WriteApiResponse(api::ErrorResponse(401, api::ErrorCode::kUnauthorized,
                                           "header Authorization: must be \"Bearer <token>\" "
                                           "with the server's token (everything but /health "
@@ -397,8 +471,19 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
       route = kStaticRoute;
       WriteStaticResponse(req, *impl_->static_files, res);
     } else {
-      api::Response response = api::Dispatch({req.method, req.path, req.body, req.params},
-                                             impl_->context, &route, /*allow_stream=*/true);
+      // A request of the compute pool carries the loop's cancel flag (client gone, time up,
+      // shutdown): its models poll it through the context.
+      RequestStream* stream = RequestStream::Current();
+      RequestCancel* cancel = stream != nullptr ? stream->cancel() : nullptr;
+      std::optional<api::Context> with_cancel;
+      if (cancel != nullptr) {
+        with_cancel.emplace(impl_->context);
+        with_cancel->progress = &cancel->progress;
+      }
+      api::Response response =
+          api::Dispatch({req.method, req.path, req.body, req.params},
+                        with_cancel ? *with_cancel : impl_->context, &route, /*allow_stream=*/true);
+      if (cancel != nullptr && !response.stream) StoppedAnswer(*cancel, config_.max_request_time_s, &response);
       internal_error = std::move(response.internal_error);
       WriteApiResponse(response, res);
     }
@@ -513,6 +598,9 @@ bool Server::Bind(std::string* error) {
   port_ = bound;
   ConnectionLoopOptions options;
   options.max_connections = config_.max_connections;
+  options.max_connections_per_client = config_.max_connections_per_client;
+  options.first_byte_timeout_s = config_.first_byte_timeout_s;
+  options.max_request_time_s = config_.max_request_time_s;
   options.max_head_bytes = config_.max_head_bytes;
   options.max_body_bytes = config_.max_body_bytes;
   options.header_timeout_s = config_.header_timeout_s;
@@ -530,7 +618,12 @@ bool Server::Bind(std::string* error) {
   };
   hooks.classify = [impl = impl_.get()](std::string_view method, std::string_view path,
                                         std::string_view body) {
-    return api::ClassifyWorkload(method, path, body, impl->context) == api::Workload::kCompute
+    // The router sees the path percent-decoded (httplib decodes it): so must the choice of
+    // pool, or "/v1/%65xplore" would run a sweep on a light worker.
+    const std::string decoded = path.find('%') == std::string_view::npos
+                                    ? std::string(path)
+                                    : PercentDecoded(path);
+    return api::ClassifyWorkload(method, decoded, body, impl->context) == api::Workload::kCompute
                ? Pool::kCompute
                : Pool::kLight;
   };

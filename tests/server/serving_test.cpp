@@ -71,10 +71,14 @@ double Seconds(double full_s, double floor_s = 1.0) {
 }
 
 // The server with its defaults; only what a test cannot share is set: an
-// ephemeral port, no jobs file (ServerProcess adds both) and, so that the test
-// log does not hold a line per request, no access log.
+// ephemeral port, no jobs file (ServerProcess adds both), so that the test
+// log does not hold a line per request, no access log, and no per-address
+// connection limit: these tests play up to 256 clients, which would come from
+// as many addresses, all from 127.0.0.1 (the limit has its own tests,
+// attack_test.cpp).
 bool StartWithDefaults(ServerProcess* server, std::vector<std::string> extra = {}) {
   extra.push_back("--no-access-log");
+  extra.insert(extra.end(), {"--max-connections-per-client", "100000"});
   return server->Start(extra);
 }
 
