@@ -57,8 +57,9 @@ stage "release: ctest" ctest --test-dir build --output-on-failure -j"$jobs"
 
 echo "== AddressSanitizer + UndefinedBehaviorSanitizer tests (Clang)" >&2
 stage_wait "asan: build"
-# The load test runs 30 s in the Release pass; 5 s is enough to exercise it here.
-SWEETSPOT_LOAD_SECONDS=5 \
+# The load test and the attack soak run 30 s in the Release pass; 5 s is enough to exercise
+# them here.
+SWEETSPOT_LOAD_SECONDS=5 SWEETSPOT_SOAK_SECONDS=5 \
 ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1" \
 UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
   stage "asan: ctest" ctest --test-dir build-asan --output-on-failure -j"$jobs"
