@@ -135,6 +135,17 @@ const std::vector<Option>& Options() {
          c->max_connections_per_client = static_cast<int>(n);
          return true;
        }},
+      {"--max-unsent-bytes-per-client", "SWEETSPOT_MAX_UNSENT_BYTES_PER_CLIENT",
+       "answer bytes one client address's connections may leave unread (held by the server "
+       "until they read them); an answer whose rest would exceed it is cut and its "
+       "connection closed (default 67108864)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 65536, 1LL << 40, &n, rule)) return false;
+         c->max_unsent_bytes_per_client = static_cast<std::size_t>(n);
+         return true;
+       }},
       {"--first-byte-timeout-s", "SWEETSPOT_FIRST_BYTE_TIMEOUT_S",
        "a new connection must send its first byte within this many s; else it is closed "
        "without an answer (default 2)",

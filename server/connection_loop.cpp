@@ -89,13 +89,14 @@ enum class Reason {
   kOverClientLimit,
   kFirstByteTimeout,
   kClientGone,
+  kUnsentOverLimit,
   kCount
 };
 
 constexpr std::array<const char*, static_cast<int>(Reason::kCount)> kReasonNames = {
     "over_limit",        "header_timeout",     "body_too_slow",   "read_timeout",
     "head_too_large",    "bad_request",        "keep_alive_idle", "write_timeout",
-    "over_client_limit", "first_byte_timeout", "client_gone"};
+    "over_client_limit", "first_byte_timeout", "client_gone",     "unsent_over_limit"};
 
 // True when the client of `fd` closed its side (or the socket failed) and sent nothing
 // more that is still unread: nobody will read an answer. Never blocks.
@@ -139,6 +140,7 @@ struct Connection {
   Clock::time_point idle_since;
   Clock::time_point linger_until;
   std::string unsent;                // the rest of an answer (kWriting)
+  std::size_t parked = 0;            // of `unsent`, the bytes counted against its client's budget
   Clock::time_point write_deadline;  // kWriting: the client must take more by then
   bool continue_sent = false;        // "100 Continue" sent for the current request
   bool close_after = false;          // close once the current request is answered
@@ -247,9 +249,11 @@ struct ConnectionLoop::Impl {
   const ConnectionLoopOptions options;
   const ConnectionLoopHooks hooks;
 
-  std::mutex map_mutex;
+  mutable std::mutex map_mutex;
   std::unordered_map<std::uint64_t, ConnectionPtr> connections;
   std::unordered_map<std::string, int> per_client;  // admitted connections by client address
+  // Unsent answer bytes held for each client address (max_unsent_bytes_per_client).
+  std::unordered_map<std::string, std::size_t> parked_by_client;
   std::uint64_t next_id = 2;
 
   std::atomic<bool> stopping{false};
@@ -297,7 +301,41 @@ struct ConnectionLoop::Impl {
     ::close(c.fd);  // also takes it out of the epoll set
     std::lock_guard<std::mutex> lock(map_mutex);
     ReleaseAdmission(c);
+    Unpark(c, c.parked);
     connections.erase(c.id);
+  }
+
+  // `n` of the bytes `c` has parked were sent or dropped (map_mutex held).
+  void Unpark(Connection& c, std::size_t n) {
+    n = std::min(n, c.parked);
+    if (n == 0) return;
+    c.parked -= n;
+    const auto it = parked_by_client.find(c.remote_ip);
+    if (it == parked_by_client.end()) return;
+    it->second -= std::min(n, it->second);
+    if (it->second == 0) parked_by_client.erase(it);
+  }
+
+  // The unsent answer bytes held for every client.
+  std::size_t UnsentBytes() const {
+    std::lock_guard<std::mutex> lock(map_mutex);
+    std::size_t total = 0;
+    for (const auto& [address, bytes] : parked_by_client) total += bytes;
+    return total;
+  }
+
+  // Counts the rest of c's answer against its client's budget of unsent bytes; false (and
+  // nothing counted) when it would exceed max_unsent_bytes_per_client.
+  bool Park(Connection& c) {
+    std::lock_guard<std::mutex> lock(map_mutex);
+    std::size_t& held = parked_by_client[c.remote_ip];
+    if (held + c.unsent.size() > options.max_unsent_bytes_per_client) {
+      if (held == 0) parked_by_client.erase(c.remote_ip);
+      return false;
+    }
+    held += c.unsent.size();
+    c.parked = c.unsent.size();
+    return true;
   }
 
   // `c` no longer counts against max_connections and its client's limit (map_mutex held).
@@ -617,7 +655,16 @@ struct ConnectionLoop::Impl {
     }
     if (!c.unsent.empty()) {
       // The client reads slower than the answer: send the rest as it reads,
-      // holding no worker (Writable), within the write timeout.
+      // holding no worker (Writable), within the write timeout, and within its
+      // address's budget of unsent bytes (else the answer is cut: closed).
+      if (!Park(c)) {
+        closed_by[static_cast<int>(Reason::kUnsentOverLimit)].fetch_add(
+            1, std::memory_order_relaxed);
+        c.unsent.clear();
+        c.unsent.shrink_to_fit();
+        Close(c);
+        return false;
+      }
       c.state = State::kWriting;
       c.write_deadline = now + Seconds(options.write_timeout_s);
       Arm(c);
@@ -652,6 +699,10 @@ struct ConnectionLoop::Impl {
       return false;
     }
     c.unsent.erase(0, at);
+    {
+      std::lock_guard<std::mutex> lock(map_mutex);
+      Unpark(c, at);
+    }
     if (!c.unsent.empty()) {
       c.write_deadline = now + Seconds(options.write_timeout_s);  // it took some: more time
       Arm(c);
@@ -951,6 +1002,10 @@ std::string ConnectionLoop::MetricsText() const {
       << "sweetspot_connections{state=\"idle\"} " << m.idle_gauge.load() << "\n"
       << "sweetspot_connections{state=\"reading\"} " << m.reading_gauge.load() << "\n"
       << "sweetspot_connections{state=\"lingering\"} " << m.lingering.load() << "\n"
+      << "# HELP sweetspot_unsent_bytes Answer bytes held for clients that read slower than "
+         "they are answered (bounded per client address by max_unsent_bytes_per_client).\n"
+      << "# TYPE sweetspot_unsent_bytes gauge\n"
+      << "sweetspot_unsent_bytes " << m.UnsentBytes() << "\n"
       << "# HELP sweetspot_connections_accepted_total Connections accepted.\n"
       << "# TYPE sweetspot_connections_accepted_total counter\n"
       << "sweetspot_connections_accepted_total " << m.accepted.load() << "\n"

@@ -24,8 +24,9 @@
 //   400           a Content-Length that is not one decimal number, or a line that ends
 //                 in a bare LF.
 // A connection that sends no byte within first_byte_timeout_s is closed without an
-// answer. Range headers are dropped before httplib sees the request: every answer is
-// whole. A request of the compute pool carries a cancel flag (RequestCancel) that the
+// answer; one whose unread answer would take its address past
+// max_unsent_bytes_per_client is closed with the answer cut. Range headers are
+// dropped before httplib sees the request: every answer is whole. A request of the compute pool carries a cancel flag (RequestCancel) that the
 // deadline keeper sets when its client closes the connection, when it has computed for
 // max_request_time_s, or when the server stops; a queued request whose client left is
 // dropped without computing.
@@ -56,6 +57,9 @@ struct ConnectionLoopOptions {
   int max_connections = 256;
   /// Open connections admitted from one client address; beyond: 503.
   int max_connections_per_client = 128;
+  /// Answer bytes one client address's connections may leave unread (held until the client
+  /// reads them); an answer whose rest would exceed it is cut (the connection closed).
+  std::size_t max_unsent_bytes_per_client = 64u << 20;
   /// A new connection's first byte must arrive within this, s; else closed silently.
   double first_byte_timeout_s = 2.0;
   /// A compute-pool request is cancelled (CancelReason::kDeadline) after computing this long, s.

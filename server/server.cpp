@@ -600,6 +600,7 @@ bool Server::Bind(std::string* error) {
   options.max_connections = config_.max_connections;
   options.max_connections_per_client = config_.max_connections_per_client;
   options.first_byte_timeout_s = config_.first_byte_timeout_s;
+  options.max_unsent_bytes_per_client = config_.max_unsent_bytes_per_client;
   options.max_request_time_s = config_.max_request_time_s;
   options.max_head_bytes = config_.max_head_bytes;
   options.max_body_bytes = config_.max_body_bytes;

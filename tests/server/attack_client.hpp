@@ -17,10 +17,15 @@
 namespace sweetspot::testing {
 
 /// A blocking TCP connection to 127.0.0.1:port from the loopback address `source`
-/// (e.g. "127.0.0.2": another client to the server's per-address limits), or -1.
-inline int ConnectFrom(int port, const char* source) {
+/// (e.g. "127.0.0.2": another client to the server's per-address limits), or -1. A positive
+/// `receive_buffer` sets SO_RCVBUF first (a small window: the server cannot send much
+/// to a client that does not read).
+inline int ConnectFrom(int port, const char* source, int receive_buffer = 0) {
   const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (fd < 0) return -1;
+  if (receive_buffer > 0) {
+    setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof receive_buffer);
+  }
   sockaddr_in local{};
   local.sin_family = AF_INET;
   inet_pton(AF_INET, source, &local.sin_addr);

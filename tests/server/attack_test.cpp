@@ -252,6 +252,45 @@ TEST(AttackTest, OneClientCannotTakeEveryConnectionSlot) {
   for (const int fd : held) close(fd);
 }
 
+// Item 10 (and 2): answers a client does not read were held whole, for every connection of
+// the client. One address's unread answers are bounded now (--max-unsent-bytes-per-client):
+// an answer whose rest would exceed it is cut and its connection closed, and another client
+// is served whole meanwhile.
+TEST(AttackTest, UnreadAnswersOfOneClientAreBounded) {
+  ServerProcess server;
+  ASSERT_TRUE(server.Start({"--no-access-log", "--max-unsent-bytes-per-client", "8388608"}));
+  Json compare = Json::parse(R"({"baseline": {"preset": "paper-wood"}, "variants": [],
+      "outputs": ["exit_speed_curve"], "options": {"curve_samples": 10000}})");
+  for (int i = 0; i < 8; ++i) {
+    compare["variants"].push_back({{"name", "v" + std::to_string(i)}, {"bat", {{"preset", "paper-wood"}}}});
+  }
+  const std::string body = compare.dump();  // a 7.2 MB answer, of which the kernel takes < 4.2 MB
+  std::vector<int> readers;
+  for (int i = 0; i < 6; ++i) {
+    const int fd = ConnectFrom(server.port(), "127.0.0.3", 4096);
+    ASSERT_GE(fd, 0);
+    ASSERT_TRUE(SendAll(fd, RawPost("/v1/compare", body)));
+    readers.push_back(fd);  // never read
+  }
+  // Each answer leaves 3-7 MB unsent: at most two fit in 8 MiB, so at least four are cut.
+  const std::string cut = R"(sweetspot_connections_closed_total{reason="unsent_over_limit"})";
+  double closed = 0;
+  for (int i = 0; i < 600 && closed < 4; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    closed = MetricValue(Metrics(server.port()), cut);
+  }
+  EXPECT_GE(closed, 4.0);
+  const double held = MetricValue(Metrics(server.port()), "sweetspot_unsent_bytes");
+  EXPECT_LE(held, 8388608.0);
+  httplib::Client client("127.0.0.1", server.port());
+  client.set_read_timeout(60, 0);
+  const auto whole = client.Post("/v1/compare", body, "application/json");
+  ASSERT_TRUE(whole);
+  ASSERT_EQ(whole->status, 200);
+  EXPECT_GT(whole->body.size(), 7000000u);
+  for (const int fd : readers) close(fd);
+}
+
 // Item 10: a connection that sends nothing is closed after first_byte_timeout_s (2 s), not
 // after the 10 s head timeout.
 TEST(AttackTest, SilentConnectionsCloseAfterTheFirstByteTimeout) {
