@@ -1,4 +1,5 @@
 // ClassifyWorkload: which of the server's worker pools a request belongs in.
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -53,15 +54,44 @@ const std::vector<std::string>& IterativeNames() {
   return names;
 }
 
-// True when `body` cannot name an iterative output or model: none of their
-// names appears in it, and it has no escape (a name could hide behind \u).
+// Curve points a scene body may ask for over all its bats (a compare's baseline and
+// variants) and still be answered in the light pool: a closed-form curve of 10,000 points
+// is a few ms and under 1 MB of JSON, but 65 bats of them are 57 MB of JSON and, while it
+// is built, about six times that in memory: such bodies go to the bounded compute pool
+// (whose requests also have a time budget and stop when their client leaves).
+constexpr double kLightCurvePoints = 10000;
+
+// True when `body` cannot name an iterative output or model, nor a long curve: none of
+// their names appears in it, and it has no escape (a name could hide behind \u).
 // Saves the JSON parse for the closed-form scenes that make most of the traffic.
 bool CannotNeedIterativeModel(std::string_view body) {
   if (body.find('\\') != std::string_view::npos) return false;
   for (const std::string& name : IterativeNames()) {
     if (body.find(name) != std::string_view::npos) return false;
   }
-  return true;
+  return body.find("exit_speed_curve") == std::string_view::npos;
+}
+
+// The curve points `body` asks for over all its bats (0 without exit_speed_curve).
+double CurvePoints(const Json& body, const std::vector<core::SceneOutput>& outputs) {
+  if (std::find(outputs.begin(), outputs.end(), core::SceneOutput::kExitSpeedCurve) ==
+      outputs.end()) {
+    return 0;
+  }
+  double points = 41;  // the default curve_samples
+  if (const auto options = body.find("options"); options != body.end() && options->is_object()) {
+    if (const auto n = options->find("curve_samples"); n != options->end() && n->is_number()) {
+      points = n->get<double>();
+    }
+    const auto at = options->find("curve_positions_from_knob_m");
+    if (at != options->end() && at->is_array()) points = static_cast<double>(at->size());
+  }
+  double bats = 1;
+  if (const auto variants = body.find("variants");
+      variants != body.end() && variants->is_array()) {
+    bats += static_cast<double>(variants->size());
+  }
+  return points * bats;
 }
 
 // A scene body (sweet-spot, compare, collision) needs the compute pool when an
@@ -90,7 +120,7 @@ Workload SceneWorkload(const Request& request, const Json& body) {
   for (const core::SceneOutput output : outputs) {
     if (NeedsIterativeModel(core::ModelsFor(output, model))) return Workload::kCompute;
   }
-  return Workload::kLight;
+  return CurvePoints(body, outputs) > kLightCurvePoints ? Workload::kCompute : Workload::kLight;
 }
 
 }  // namespace

@@ -35,6 +35,32 @@ TEST(WorkloadTest, CatalogueJobsHealthAndUnknownPathsAreLight) {
   EXPECT_EQ(Classify("GET", "/v1/explore", ""), Workload::kLight);
 }
 
+// A closed-form curve is light up to 10,000 points over all the bats of a body; a compare
+// of 65 bats x 10,000 points (57 MB of JSON, six times that while built) is compute work.
+TEST(WorkloadTest, LongCurvesOverManyBatsAreCompute) {
+  const std::string curve = R"("outputs": ["exit_speed_curve"], "options": {"curve_samples": )";
+  EXPECT_EQ(Classify("POST", "/v1/sweet-spot",
+                     R"({"bat": {"preset": "paper-wood"}, )" + curve + "10000}}"),
+            Workload::kLight);
+  EXPECT_EQ(Classify("POST", "/v1/sweet-spot",
+                     R"({"bat": {"preset": "paper-wood"}, "outputs": ["exit_speed_curve"]})"),
+            Workload::kLight);
+  const std::string compare = R"({"baseline": {"preset": "paper-wood"}, "variants": [)"
+                              R"({"name": "a", "bat": {"preset": "paper-wood"}}], )";
+  EXPECT_EQ(Classify("POST", "/v1/compare", compare + curve + "5000}}"), Workload::kLight);
+  EXPECT_EQ(Classify("POST", "/v1/compare", compare + curve + "5001}}"), Workload::kCompute);
+  // Explicit positions count like samples: 4000 positions x 3 bats.
+  std::string positions = "0.1";
+  for (int i = 1; i < 4000; ++i) positions += ", 0.1";
+  const std::string three = R"({"baseline": {"preset": "paper-wood"}, "variants": [)"
+                            R"({"name": "a", "bat": {"preset": "paper-wood"}},)"
+                            R"({"name": "b", "bat": {"preset": "paper-wood"}}], )";
+  EXPECT_EQ(Classify("POST", "/v1/compare",
+                     three + R"("outputs": ["exit_speed_curve"], "options": )"
+                             R"({"curve_positions_from_knob_m": [)" + positions + "]}}"),
+            Workload::kCompute);
+}
+
 TEST(WorkloadTest, ScenesAreComputeExactlyWhenAnOutputOrModelIsIterative) {
   const std::string bat = R"("bat": {"preset": "paper-wood"})";
   // Closed forms: light.
