@@ -366,7 +366,9 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     if (!impl_->jobs) impl_->startup_error = error;
   } else if (config_.jobs_db != kNoJobsDb) {
     std::string error;
-    impl_->job_store = SqliteJobStore::Open(config_.jobs_db, &error);
+    SqliteJobStoreOptions store_options;
+    store_options.max_bytes = config_.jobs_db_max_bytes;
+    impl_->job_store = SqliteJobStore::Open(config_.jobs_db, &error, store_options);
     if (!impl_->job_store) impl_->startup_error = error;
   }
   if (impl_->job_store) {
