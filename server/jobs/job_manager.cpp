@@ -484,6 +484,7 @@ void JobManager::KeepResultLocked(Job& job, std::size_t bytes, bool saved) {
     job.result_in_store = true;
     return;
   }
+  if (bytes == 0) return;  // Nothing to count (an empty body).
   job.memory_bytes = bytes;
   memory_results_bytes_ += bytes;
   in_memory_.push_back(job.id);
