@@ -357,8 +357,8 @@ const std::vector<Option>& Options() {
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          char* end = nullptr;
          const double value = std::strtod(v.c_str(), &end);
-         if (v.empty() || end == nullptr || *end != '\0' || !std::isfinite(value) ||
-             value <= 0 || value > 1e6) {
+         if (v.empty() || end == nullptr || *end != '\0' || !std::isfinite(value) || value <= 0 ||
+             value > 1e6) {
            *rule = "must be a number of seconds in (0, 1000000]";
            return false;
          }

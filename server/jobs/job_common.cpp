@@ -131,15 +131,14 @@ api::Response JobTimedOut(double max_time_s) {
   return api::ToResponse(api::ApiError{408, api::ErrorCode::kTimeout, text.str(), ""});
 }
 
-api::Response JobResultTooBig(std::size_t size, const std::string& keeper,
-                              const std::string& limit, std::size_t value,
-                              const std::string& flag) {
-  return api::ToResponse(api::ApiError{
-      413, api::ErrorCode::kTooBig,
-      "the job's result is " + std::to_string(size) + " bytes, more than " + keeper + " keeps (" +
-          limit + " = " + std::to_string(value) + "): ask for fewer rows or outputs, or raise " +
-          flag,
-      ""});
+api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const std::string& limit,
+                              std::size_t value, const std::string& flag) {
+  return api::ToResponse(api::ApiError{413, api::ErrorCode::kTooBig,
+                                       "the job's result is " + std::to_string(size) +
+                                           " bytes, more than " + keeper + " keeps (" + limit +
+                                           " = " + std::to_string(value) +
+                                           "): ask for fewer rows or outputs, or raise " + flag,
+                                       ""});
 }
 
 api::Response JobInterrupted(int resumes, int max_resumes, std::string* message) {

@@ -98,9 +98,8 @@ api::Response JobTimedOut(double max_time_s);
 /// 413 TooBig: "the job's result is `size` bytes, more than `keeper` keeps (`limit` =
 /// `value`): ... raise `flag`" (e.g. "the jobs database", "max_result_bytes",
 /// "--job-max-result-bytes").
-api::Response JobResultTooBig(std::size_t size, const std::string& keeper,
-                              const std::string& limit, std::size_t value,
-                              const std::string& flag);
+api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const std::string& limit,
+                              std::size_t value, const std::string& flag);
 
 /// The quoted id for messages ("\"abc\"", cut when long, control characters escaped).
 std::string QuoteJobId(const std::string& id);

@@ -425,11 +425,11 @@ void JobManager::WorkerLoop() {
       // message, saved as such (small), so the next start neither shows a result nor runs it
       // again. Should that save fail too, its row is deleted (below).
       KeepOnlyStatus(&job->result);  // Frees the answer that could not be stored.
-      job->result = ToResponse(
-          ApiError{503, api::ErrorCode::kUnavailable,
-                   "the job's result could not be saved in the jobs database (" + why +
-                       "): it is not kept; submit the job again later",
-                   ""});
+      job->result =
+          ToResponse(ApiError{503, api::ErrorCode::kUnavailable,
+                              "the job's result could not be saved in the jobs database (" + why +
+                                  "): it is not kept; submit the job again later",
+                              ""});
       job->error = FailureObject(job->result);
       job->state = State::kFailed;
       bytes = SerializeJobBody(job->result.body).size();

@@ -137,7 +137,7 @@ class JobManager final : public ServerJobService {
   // 0 while queued, 1 when done, else the runner's last report.
   static double ProgressOf(const Job& job);
   void WorkerLoop();
-  void WatchdogLoop();  // Sets the cancel flag of jobs running longer than max_time_s.
+  void WatchdogLoop();   // Sets the cancel flag of jobs running longer than max_time_s.
   void LoadFromStore();  // Before the workers start.
   double ToUnixSeconds(Clock::time_point time) const;
   Clock::time_point FromUnixSeconds(double unix_s) const;

@@ -190,13 +190,14 @@ bool SqliteJobStore::Initialize(const SqliteJobStoreOptions& options, std::strin
                                ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, "
                                "?13, ?14, ?15, ?16, ?17)";
   // Results over kMaxLoadedResultBytes are left out (sizes in bytes: a BLOB's length).
-  const std::string big = "(length(CAST(response_json AS BLOB)) + "
-                          "length(CAST(response_text AS BLOB)) > " +
-                          std::to_string(kMaxLoadedResultBytes) + ")";
+  const std::string big =
+      "(length(CAST(response_json AS BLOB)) + "
+      "length(CAST(response_text AS BLOB)) > " +
+      std::to_string(kMaxLoadedResultBytes) + ")";
   const std::string load_sql =
       "SELECT id, state, method, path, body, progress, cancel_requested, resumes, created_at, "
-      "created_unix_s, started_unix_s, finished_unix_s, status, CASE WHEN " + big +
-      " THEN '' ELSE response_json END, CASE WHEN " + big +
+      "created_unix_s, started_unix_s, finished_unix_s, status, CASE WHEN " +
+      big + " THEN '' ELSE response_json END, CASE WHEN " + big +
       " THEN '' ELSE response_text END, content_type, error, " + big +
       " FROM jobs ORDER BY created_unix_s, id";
   const char* delete_sql = "DELETE FROM jobs WHERE id = ?1";

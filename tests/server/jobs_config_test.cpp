@@ -127,9 +127,9 @@ TEST(JobsConfigTest, JobLimitsFlagsEnvironmentAndRules) {
   EXPECT_EQ(defaults.jobs.max_time_s, 600.0);
   EXPECT_EQ(defaults.jobs.max_results_memory_bytes, 256u << 20);
   EXPECT_EQ(defaults.jobs_db_max_bytes, 0u);
-  const auto parsed = Parse({"--job-max-time-s", "0.5", "--jobs-db-max-bytes=131072"},
-                            {{"SWEETSPOT_JOB_RESULTS_MEMORY_BYTES", "2500000"},
-                             {"SWEETSPOT_JOB_MAX_TIME_S", "30"}});
+  const auto parsed = Parse(
+      {"--job-max-time-s", "0.5", "--jobs-db-max-bytes=131072"},
+      {{"SWEETSPOT_JOB_RESULTS_MEMORY_BYTES", "2500000"}, {"SWEETSPOT_JOB_MAX_TIME_S", "30"}});
   ASSERT_EQ(parsed.error, "");
   EXPECT_EQ(parsed.config.jobs.max_time_s, 0.5);
   EXPECT_EQ(parsed.config.jobs.max_results_memory_bytes, 2500000u);
@@ -155,10 +155,9 @@ TEST(JobsConfigTest, JobLimitsFlagsEnvironmentAndRules) {
   EXPECT_FALSE(config.IsValid(&why));
   EXPECT_EQ(why, "jobs.max_time_s = -1: must be in (0, 1e+06]");
   const std::string usage = Usage("sweetspot-server");
-  for (const char* name :
-       {"--job-max-time-s", "SWEETSPOT_JOB_MAX_TIME_S", "(default 600)",
-        "--job-results-memory-bytes", "SWEETSPOT_JOB_RESULTS_MEMORY_BYTES", "--jobs-db-max-bytes",
-        "SWEETSPOT_JOBS_DB_MAX_BYTES"}) {
+  for (const char* name : {"--job-max-time-s", "SWEETSPOT_JOB_MAX_TIME_S", "(default 600)",
+                           "--job-results-memory-bytes", "SWEETSPOT_JOB_RESULTS_MEMORY_BYTES",
+                           "--jobs-db-max-bytes", "SWEETSPOT_JOBS_DB_MAX_BYTES"}) {
     EXPECT_NE(usage.find(name), std::string::npos) << name;
   }
 }

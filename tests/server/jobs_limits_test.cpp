@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
-#include <iostream>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <optional>
 #include <set>
 #include <string>
@@ -128,9 +128,8 @@ TEST(JobsLimitsTest, BigResultsStayInTheDatabaseNotInMemory) {
   // job's buffers and SQLite's page cache (2 MB): +0.5 to +2.0 MB measured, and once +19 MB
   // (one 16 MB string's capacity) sampled right after a job. Half of kept separates the two
   // with a margin both ways.
-  EXPECT_LT(after, before + kept / 2)
-      << "VmRSS " << before << " -> " << after << " bytes; " << kJobs << " results of "
-      << result_bytes << " bytes";
+  EXPECT_LT(after, before + kept / 2) << "VmRSS " << before << " -> " << after << " bytes; "
+                                      << kJobs << " results of " << result_bytes << " bytes";
   std::printf("VmRSS %zu -> %zu bytes (+%.1f MB) after %d jobs of %zu-byte results\n", before,
               after, (static_cast<double>(after) - static_cast<double>(before)) / 1e6, kJobs,
               result_bytes);
@@ -188,9 +187,9 @@ TEST(JobsLimitsTest, WithoutADatabaseTheOldestResultsAreDroppedBeyondTheBudget) 
   const Json failed = WaitFinished(server, big);
   EXPECT_EQ(failed["state"], "failed");
   EXPECT_EQ(failed["error"]["code"], "TooBig");
-  EXPECT_NE(failed["error"]["message"].get<std::string>().find(
-                "(max_results_memory_bytes = 2000000)"),
-            std::string::npos)
+  EXPECT_NE(
+      failed["error"]["message"].get<std::string>().find("(max_results_memory_bytes = 2000000)"),
+      std::string::npos)
       << failed.dump();
 }
 
@@ -222,8 +221,7 @@ TEST(JobsLimitsTest, AFullDatabaseNeverShowsAJobDoneWithoutItsStoredResult) {
 
     // Small jobs until the database is full: then a submit is refused, 503 + Retry-After.
     httplib::Client client = ClientOf(server);
-    const std::string submit = R"({"path": "/v1/sweet-spot", "body": )" +
-                               std::string(kQuick) + "}";
+    const std::string submit = R"({"path": "/v1/sweet-spot", "body": )" + std::string(kQuick) + "}";
     std::optional<httplib::Response> refused;
     for (int i = 0; i < 2000; ++i) {
       auto answer = client.Post("/v1/jobs", submit, "application/json");
@@ -239,7 +237,8 @@ TEST(JobsLimitsTest, AFullDatabaseNeverShowsAJobDoneWithoutItsStoredResult) {
       ASSERT_EQ(answer->status, 202) << answer->body;
       accepted.push_back(Json::parse(answer->body)["id"]);
     }
-    ASSERT_TRUE(refused.has_value()) << "no submit was refused after " << accepted.size() << " jobs";
+    ASSERT_TRUE(refused.has_value())
+        << "no submit was refused after " << accepted.size() << " jobs";
     EXPECT_EQ(refused->get_header_value("Retry-After"), "1");
     EXPECT_EQ(refused->get_header_value("Content-Type"), "application/json");
     const Json envelope = Json::parse(refused->body);
@@ -296,8 +295,7 @@ TEST(JobsLimitsTest, AFullDatabaseNeverShowsAJobDoneWithoutItsStoredResult) {
 TEST(JobsLimitsTest, AJobRunningPastTheTimeLimitIsStoppedAndFailed) {
   TempDir dir;
   testing::ServerProcess server;
-  ASSERT_TRUE(server.Start(Args(dir.File("jobs.db"), {"--job-max-time-s", "0.5"})))
-      << server.log();
+  ASSERT_TRUE(server.Start(Args(dir.File("jobs.db"), {"--job-max-time-s", "0.5"}))) << server.log();
   // 100 x 100 Hertz designs at ~1.5 ms each: ~15 s of work, far past the limit.
   Json sweep = Json::parse(testing::jobs::kSlowSweep);
   sweep["parameters"][0]["count"] = 100;
@@ -307,8 +305,7 @@ TEST(JobsLimitsTest, AJobRunningPastTheTimeLimitIsStoppedAndFailed) {
   EXPECT_EQ(job["state"], "failed") << job.dump();
   EXPECT_EQ(job["status"], 408);
   EXPECT_EQ(job["error"]["code"], "Timeout");
-  EXPECT_NE(job["error"]["message"].get<std::string>().find(
-                "ran longer than max_time_s = 0.5 s"),
+  EXPECT_NE(job["error"]["message"].get<std::string>().find("ran longer than max_time_s = 0.5 s"),
             std::string::npos)
       << job.dump();
   // Stopped at the limit: the sweep checks its cancel flag between designs (~1.5 ms each);

@@ -478,9 +478,9 @@ TEST_F(PostgresJobsTest, AJobRunningPastTheTimeLimitIsStoppedAndFailed) {
   const Json failed = WaitForState(*replica, id, "failed");
   EXPECT_EQ(failed["status"], 408);
   EXPECT_EQ(failed["error"]["code"], "Timeout");
-  EXPECT_NE(failed["error"]["message"].get<std::string>().find(
-                "ran longer than max_time_s = 0.5 s"),
-            std::string::npos)
+  EXPECT_NE(
+      failed["error"]["message"].get<std::string>().find("ran longer than max_time_s = 0.5 s"),
+      std::string::npos)
       << failed.dump();
   EXPECT_EQ(failed["resumes"], 0);
   // At the limit plus at most one renewal period (0.5 s) and the design in flight; 2 s more
