@@ -345,7 +345,9 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     api::Context job_context = context;
     job_context.progress = progress;
     job_context.batch = true;  // the rows go to the job's result: --max-batch-samples
-    api::Response response = api::Dispatch(inner, job_context);
+    // Streamed answers (CSV, NDJSON sweeps) are collected by the job service, which stops
+    // them at its result limit.
+    api::Response response = api::Dispatch(inner, job_context, nullptr, /*allow_stream=*/true);
     if (!response.internal_error.empty()) {
       // A job's 500 is logged like a request's: the job's path and the caught text.
       const std::string line = AccessLogLine({inner.method, inner.path, "job", response.status,

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <ctime>
 #include <sstream>
+#include <string_view>
 
 #include "api/json_reader.hpp"
 
@@ -132,13 +133,40 @@ api::Response JobTimedOut(double max_time_s) {
 }
 
 api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const std::string& limit,
-                              std::size_t value, const std::string& flag) {
+                              std::size_t value, const std::string& flag, bool stopped) {
   return api::ToResponse(api::ApiError{413, api::ErrorCode::kTooBig,
-                                       "the job's result is " + std::to_string(size) +
+                                       "the job's result is " +
+                                           std::string(stopped ? "at least " : "") +
+                                           std::to_string(size) +
                                            " bytes, more than " + keeper + " keeps (" + limit +
                                            " = " + std::to_string(value) +
                                            "): ask for fewer rows or outputs, or raise " + flag,
                                        ""});
+}
+
+StreamOutcome CollectJobStream(api::Response* response, std::size_t max_bytes,
+                               std::size_t* bytes) {
+  if (!response->stream) {
+    *bytes = response->text.size();
+    return StreamOutcome::kComplete;
+  }
+  std::string text;
+  std::size_t produced = 0;
+  bool over = false;
+  const bool complete = response->stream([&](std::string_view chunk) {
+    produced += chunk.size();
+    if (produced > max_bytes) {
+      over = true;
+      return false;  // Stops the producer.
+    }
+    text.append(chunk);
+    return true;
+  });
+  response->stream = nullptr;
+  response->text = std::move(text);
+  *bytes = produced;
+  if (over) return StreamOutcome::kOverLimit;
+  return complete ? StreamOutcome::kComplete : StreamOutcome::kStopped;
 }
 
 api::Response JobInterrupted(int resumes, int max_resumes, std::string* message) {

@@ -95,11 +95,26 @@ std::string InterruptedMessage(const std::string& resumes, int max_resumes);
 
 /// 408 Timeout: the job ran longer than max_time_s = `max_time_s` s and was stopped.
 api::Response JobTimedOut(double max_time_s);
-/// 413 TooBig: "the job's result is `size` bytes, more than `keeper` keeps (`limit` =
-/// `value`): ... raise `flag`" (e.g. "the jobs database", "max_result_bytes",
-/// "--job-max-result-bytes").
+/// 413 TooBig: "the job's result is [at least ]`size` bytes, more than `keeper` keeps (`limit`
+/// = `value`): ... raise `flag`" (e.g. "the jobs database", "max_result_bytes",
+/// "--job-max-result-bytes"); "at least" when `stopped`: its producer was stopped there.
 api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const std::string& limit,
-                              std::size_t value, const std::string& flag);
+                              std::size_t value, const std::string& flag, bool stopped = false);
+
+/// What CollectJobStream did.
+enum class StreamOutcome {
+  kComplete,   ///< The producer ran to its end: the whole body is in text.
+  kOverLimit,  ///< More than the limit arrived: the producer was told to stop.
+  kStopped,    ///< The producer stopped by itself (cancelled): the body is incomplete.
+};
+
+/// Runs a streamed answer's producer (Response::stream, e.g. a CSV sweep) into
+/// response->text, at most `max_bytes` of it: the chunk that goes over makes the sink refuse,
+/// which stops the sweep at once instead of after it built the whole body. Clears stream;
+/// *bytes gets the bytes produced (up to the first chunk over the limit). Without a stream:
+/// kComplete and text.size().
+StreamOutcome CollectJobStream(api::Response* response, std::size_t max_bytes,
+                               std::size_t* bytes);
 
 /// The quoted id for messages ("\"abc\"", cut when long, control characters escaped).
 std::string QuoteJobId(const std::string& id);

@@ -345,34 +345,41 @@ void JobManager::WorkerLoop() {
       threw = true;
     }
     inner = Request{};
-    // Outside the lock: a 2xx answer's size, its JSON serialised once for the size and the
-    // store (a sweep's result can be 100 MB).
-    const bool answered = !threw && response.status >= 200 && response.status < 300;
-    std::string serialized;
-    std::size_t bytes = 0;
-    if (answered) {
-      if (response.content_type.empty()) {
-        serialized = SerializeJobBody(response.body);
-        bytes = serialized.size();
-      } else {
-        bytes = response.text.size();
-      }
-    }
     // Without a store a result lives in memory: max_results_memory_bytes bounds it too.
     const bool memory_bound = persistence_.store == nullptr &&
                               config_.max_results_memory_bytes < config_.max_result_bytes;
     const std::size_t largest =
         memory_bound ? config_.max_results_memory_bytes : config_.max_result_bytes;
-    const bool too_big = answered && bytes > largest;
+    // Outside the lock: a streamed answer (a CSV or NDJSON sweep) is run here, stopped once
+    // over the limit; a 2xx answer's size, its JSON serialised once for the size and the
+    // store (a sweep's result can be 100 MB).
+    std::size_t bytes = 0;
+    StreamOutcome streamed = StreamOutcome::kComplete;
+    if (!threw) streamed = CollectJobStream(&response, largest, &bytes);
+    if (streamed == StreamOutcome::kStopped) {
+      // Cancelled (DELETE, the time limit, a shutdown): an incomplete body is no answer.
+      KeepOnlyStatus(&response);
+      response = ToResponse(ApiError{409, api::ErrorCode::kCancelled,
+                                     "the job was stopped before its answer was complete", ""});
+    }
+    const bool answered = !threw && response.status >= 200 && response.status < 300;
+    std::string serialized;
+    if (answered && response.content_type.empty()) {
+      serialized = SerializeJobBody(response.body);
+      bytes = serialized.size();
+    }
+    const bool too_big = answered && (bytes > largest || streamed == StreamOutcome::kOverLimit);
     if (too_big) {
+      const bool stopped = streamed == StreamOutcome::kOverLimit;
+      KeepOnlyStatus(&response);
       response = memory_bound
                      ? JobResultTooBig(bytes, "this server's memory", "max_results_memory_bytes",
-                                       largest, "--job-results-memory-bytes")
+                                       largest, "--job-results-memory-bytes", stopped)
                      : JobResultTooBig(bytes, "the job service", "max_result_bytes", largest,
-                                       "--job-max-result-bytes");
+                                       "--job-max-result-bytes", stopped);
       serialized.clear();
-      bytes = 0;
     }
+    if (!answered || too_big) bytes = 0;  // Counted below from the stored answer.
 
     lock.lock();
     --busy_;

@@ -525,6 +525,18 @@ bool PostgresJobService::Impl::ClaimAndRun() {
     }
   }
   inner = api::Request{};
+  // A streamed answer (a CSV or NDJSON sweep) runs here, stopped once over max_result_bytes.
+  std::size_t streamed_bytes = 0;
+  const StreamOutcome streamed =
+      threw ? StreamOutcome::kComplete
+            : CollectJobStream(&response, config.max_result_bytes, &streamed_bytes);
+  if (streamed == StreamOutcome::kStopped) {  // Cancelled: an incomplete body is no answer.
+    response = api::ToResponse(api::ApiError{
+        409, api::ErrorCode::kCancelled, "the job was stopped before its answer was complete", ""});
+  } else if (streamed == StreamOutcome::kOverLimit) {
+    response = JobResultTooBig(streamed_bytes, "the jobs database", "max_result_bytes",
+                               config.max_result_bytes, "--job-max-result-bytes", true);
+  }
   if (job->timed_out && !job->lost && !job->cancel_requested) {
     threw = false;  // Failed below with the limit named, whatever the runner answered.
     response = JobTimedOut(config.max_time_s);
