@@ -46,6 +46,9 @@ namespace sweetspot::api {
 /// cancelled job, anything else discarded), and may
 /// call progress->Report(fraction). A 2xx response makes the job done, any
 /// other status failed; an exception makes it failed with "internal error".
+/// It may answer with Response::stream: the job service then runs the producer
+/// on the same thread, stops it past its result limit, and takes a producer that
+/// returns false (cancelled) as no answer.
 using JobRunner = std::function<Response(const Request& inner, core::Progress* progress)>;
 
 /// GET /v1/jobs's query, validated by the handler (HandleJobList).

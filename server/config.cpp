@@ -366,13 +366,55 @@ const std::vector<Option>& Options() {
          return true;
        }},
       {"--job-max-result-bytes", "SWEETSPOT_JOB_MAX_RESULT_BYTES",
-       "PostgreSQL: the largest job result stored; a larger one fails the job with its size, "
-       "never truncated (default 268435456)",
+       "the largest job result kept (any jobs database); a larger one fails the job (413 "
+       "TooBig) with its size, never truncated (default 268435456)",
        true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          long long n = 0;
          if (!ParseLong(v, 1024, 1000000000, &n, rule)) return false;
          c->jobs.max_result_bytes = static_cast<std::size_t>(n);
+         return true;
+       }},
+      {"--job-results-memory-bytes", "SWEETSPOT_JOB_RESULTS_MEMORY_BYTES",
+       "finished jobs' results held in memory in total, bytes: with a SQLite jobs database, "
+       "results over 65536 bytes stay in the database only and the oldest small ones leave "
+       "memory beyond this; with --jobs-db none, the oldest finished jobs are dropped beyond "
+       "it and a larger result fails its job (default 268435456)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1024, 1000000000000LL, &n, rule)) return false;
+         c->jobs.max_results_memory_bytes = static_cast<std::size_t>(n);
+         return true;
+       }},
+      {"--job-max-time-s", "SWEETSPOT_JOB_MAX_TIME_S",
+       "the longest a job may run, s; then it is stopped and failed (408 Timeout) "
+       "(default 600)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         char* end = nullptr;
+         const double value = std::strtod(v.c_str(), &end);
+         if (v.empty() || end == nullptr || *end != '\0' || !std::isfinite(value) || value <= 0 ||
+             value > 1e6) {
+           *rule = "must be a number of seconds in (0, 1000000]";
+           return false;
+         }
+         c->jobs.max_time_s = value;
+         return true;
+       }},
+      {"--jobs-db-max-bytes", "SWEETSPOT_JOBS_DB_MAX_BYTES",
+       "SQLite: the largest the jobs database file may grow, bytes; past it saves fail as on a "
+       "full disk (submits answer 503, a job whose result cannot be saved fails) (default 0 = "
+       "no limit but the disk's)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 0, 1000000000000000LL, &n, rule)) return false;
+         if (n != 0 && n < 65536) {
+           *rule = "must be 0 (no limit) or at least 65536";
+           return false;
+         }
+         c->jobs_db_max_bytes = static_cast<std::size_t>(n);
          return true;
        }},
       {"--jobs-db", "SWEETSPOT_JOBS_DB",
@@ -478,6 +520,11 @@ bool ServerConfig::IsValid(std::string* why) const {
   if (jobs_db.empty()) {
     return fail("jobs_db = \"\": must be a file path, a postgresql:// URI, or \"" +
                 std::string(kNoJobsDb) + "\" for no persistence");
+  }
+  if (jobs_db_max_bytes != 0 &&
+      (jobs_db_max_bytes < 65536 || jobs_db_max_bytes > 1000000000000000ULL)) {
+    return fail("jobs_db_max_bytes = " + std::to_string(jobs_db_max_bytes) +
+                ": must be 0 (no limit) or in [65536, 1e15]");
   }
   if (!std::isfinite(shutdown_grace_s) || shutdown_grace_s < 0 || shutdown_grace_s > 3600) {
     return fail("shutdown_grace_s = " + core::FormatNumber(shutdown_grace_s) +

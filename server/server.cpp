@@ -419,7 +419,9 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     api::Context job_context = context;
     job_context.progress = progress;
     job_context.batch = true;  // the rows go to the job's result: --max-batch-samples
-    api::Response response = api::Dispatch(inner, job_context);
+    // Streamed answers (CSV, NDJSON sweeps) are collected by the job service, which stops
+    // them at its result limit.
+    api::Response response = api::Dispatch(inner, job_context, nullptr, /*allow_stream=*/true);
     if (!response.internal_error.empty()) {
       // A job's 500 is logged like a request's: the job's path and the caught text.
       const std::string line = AccessLogLine({inner.method, inner.path, "job", response.status,
@@ -440,7 +442,9 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     if (!impl_->jobs) impl_->startup_error = error;
   } else if (config_.jobs_db != kNoJobsDb) {
     std::string error;
-    impl_->job_store = SqliteJobStore::Open(config_.jobs_db, &error);
+    SqliteJobStoreOptions store_options;
+    store_options.max_bytes = config_.jobs_db_max_bytes;
+    impl_->job_store = SqliteJobStore::Open(config_.jobs_db, &error, store_options);
     if (!impl_->job_store) impl_->startup_error = error;
   }
   if (impl_->job_store) {

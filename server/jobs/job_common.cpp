@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <ctime>
 #include <sstream>
+#include <string_view>
 
 #include "api/json_reader.hpp"
 
@@ -17,6 +18,8 @@ constexpr int kMaxResumesLimit = 100;
 constexpr double kMaxLeaseS = 3600.0;
 constexpr std::size_t kMinResultBytes = 1024;
 constexpr std::size_t kMaxResultBytes = 1000000000;  // A PostgreSQL text value holds up to 1 GB.
+constexpr std::size_t kMaxResultsMemoryBytes = 1000000000000;
+constexpr double kMaxJobTimeS = 1e6;
 
 // Seconds rounded to microseconds (keeps the JSON short).
 double RoundedSeconds(double seconds) { return std::round(seconds * 1e6) / 1e6; }
@@ -61,6 +64,17 @@ bool JobConfig::IsValid(std::string* why) const {
   if (max_result_bytes < kMinResultBytes || max_result_bytes > kMaxResultBytes) {
     return fail("max_result_bytes = " + std::to_string(max_result_bytes) + ": must be in [" +
                 std::to_string(kMinResultBytes) + ", " + std::to_string(kMaxResultBytes) + "]");
+  }
+  if (max_results_memory_bytes < kMinResultBytes ||
+      max_results_memory_bytes > kMaxResultsMemoryBytes) {
+    return fail("max_results_memory_bytes = " + std::to_string(max_results_memory_bytes) +
+                ": must be in [" + std::to_string(kMinResultBytes) + ", " +
+                std::to_string(kMaxResultsMemoryBytes) + "]");
+  }
+  if (!std::isfinite(max_time_s) || max_time_s <= 0 || max_time_s > kMaxJobTimeS) {
+    std::ostringstream text;
+    text << "max_time_s = " << max_time_s << ": must be in (0, " << kMaxJobTimeS << "]";
+    return fail(text.str());
   }
   return true;
 }
@@ -108,6 +122,51 @@ std::string InterruptedMessage(const std::string& resumes, int max_resumes) {
   return "interrupted by a server restart: the job was running when the server "
          "died, and it had already been resumed " +
          resumes + " times (limit max_resumes = " + std::to_string(max_resumes) + ")";
+}
+
+api::Response JobTimedOut(double max_time_s) {
+  std::ostringstream text;
+  text << "the job ran longer than max_time_s = " << max_time_s
+       << " s and was stopped (--job-max-time-s): ask for fewer designs or starts, or raise "
+          "the limit";
+  return api::ToResponse(api::ApiError{408, api::ErrorCode::kTimeout, text.str(), ""});
+}
+
+api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const std::string& limit,
+                              std::size_t value, const std::string& flag, bool stopped) {
+  return api::ToResponse(api::ApiError{413, api::ErrorCode::kTooBig,
+                                       "the job's result is " +
+                                           std::string(stopped ? "at least " : "") +
+                                           std::to_string(size) +
+                                           " bytes, more than " + keeper + " keeps (" + limit +
+                                           " = " + std::to_string(value) +
+                                           "): ask for fewer rows or outputs, or raise " + flag,
+                                       ""});
+}
+
+StreamOutcome CollectJobStream(api::Response* response, std::size_t max_bytes,
+                               std::size_t* bytes) {
+  if (!response->stream) {
+    *bytes = response->text.size();
+    return StreamOutcome::kComplete;
+  }
+  std::string text;
+  std::size_t produced = 0;
+  bool over = false;
+  const bool complete = response->stream([&](std::string_view chunk) {
+    produced += chunk.size();
+    if (produced > max_bytes) {
+      over = true;
+      return false;  // Stops the producer.
+    }
+    text.append(chunk);
+    return true;
+  });
+  response->stream = nullptr;
+  response->text = std::move(text);
+  *bytes = produced;
+  if (over) return StreamOutcome::kOverLimit;
+  return complete ? StreamOutcome::kComplete : StreamOutcome::kStopped;
 }
 
 api::Response JobInterrupted(int resumes, int max_resumes, std::string* message) {

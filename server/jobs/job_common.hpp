@@ -29,10 +29,22 @@ struct JobConfig {
   /// replica running it renews it every lease_s / 4 (at most every 0.5 s); a replica that
   /// died leaves its jobs to the others after this long.
   double lease_s = 10.0;
-  /// PostgreSQL: the largest result stored, bytes, [1024, 1e9] (a text column holds up to
-  /// 1 GB). A larger result makes the job failed (status 413, code TooBig, as the contract pairs them) with its size in
-  /// the message: never truncated.
+  /// The largest result a job may have, bytes, [1024, 1e9] (a PostgreSQL text column holds up
+  /// to 1 GB), with every store (SQLite, PostgreSQL, memory only). A larger result makes the job
+  /// failed (status 413, code TooBig, as the contract pairs them) with its size and this limit
+  /// in the message: never truncated.
   std::size_t max_result_bytes = 256u << 20;
+  /// One process (JobManager): the finished jobs' results held in memory in total, bytes
+  /// (serialised size), [1024, 1e12]. With a SQLite store, results larger than
+  /// kMaxLoadedResultBytes live in the database only (read back on GET) and the oldest small
+  /// ones leave memory first once the total is over this; with no store (memory only), the
+  /// oldest finished jobs are dropped (their ids 404) until the rest fit, and a result larger
+  /// than this alone fails its job like max_result_bytes.
+  std::size_t max_results_memory_bytes = 256u << 20;
+  /// The longest a job may run, s, (0, 1e6]: then its cancel flag is set and it ends failed
+  /// (status 408, code Timeout) naming this limit. Per run: a job run again after a restart
+  /// gets it afresh.
+  double max_time_s = 600.0;
 
   /// True when every field is in range; otherwise "field = value: rule" in *why (if non-null).
   bool IsValid(std::string* why) const;
@@ -80,6 +92,29 @@ api::Response JobWasCancelled(const std::string& id);
 api::Response JobInterrupted(int resumes, int max_resumes, std::string* message);
 /// The message of JobInterrupted with `resumes` spelled as given (e.g. "%s" for a template).
 std::string InterruptedMessage(const std::string& resumes, int max_resumes);
+
+/// 408 Timeout: the job ran longer than max_time_s = `max_time_s` s and was stopped.
+api::Response JobTimedOut(double max_time_s);
+/// 413 TooBig: "the job's result is [at least ]`size` bytes, more than `keeper` keeps (`limit`
+/// = `value`): ... raise `flag`" (e.g. "the jobs database", "max_result_bytes",
+/// "--job-max-result-bytes"); "at least" when `stopped`: its producer was stopped there.
+api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const std::string& limit,
+                              std::size_t value, const std::string& flag, bool stopped = false);
+
+/// What CollectJobStream did.
+enum class StreamOutcome {
+  kComplete,   ///< The producer ran to its end: the whole body is in text.
+  kOverLimit,  ///< More than the limit arrived: the producer was told to stop.
+  kStopped,    ///< The producer stopped by itself (cancelled): the body is incomplete.
+};
+
+/// Runs a streamed answer's producer (Response::stream, e.g. a CSV sweep) into
+/// response->text, at most `max_bytes` of it: the chunk that goes over makes the sink refuse,
+/// which stops the sweep at once instead of after it built the whole body. Clears stream;
+/// *bytes gets the bytes produced (up to the first chunk over the limit). Without a stream:
+/// kComplete and text.size().
+StreamOutcome CollectJobStream(api::Response* response, std::size_t max_bytes,
+                               std::size_t* bytes);
 
 /// The quoted id for messages ("\"abc\"", cut when long, control characters escaped).
 std::string QuoteJobId(const std::string& id);

@@ -19,6 +19,22 @@ using api::Request;
 using api::Response;
 using api::ToResponse;
 
+namespace {
+
+// Frees a request's body. Assigning a new Request would not: a std::string moved from a short
+// one keeps its old buffer (libstdc++), so a 1 MB body stayed allocated.
+void Release(Request* request) { std::string().swap(request->body); }
+
+// Leaves only the status of a result, freeing its body (see Release: a 10 MB CSV text stayed
+// allocated per job when the result was replaced by assignment).
+void KeepOnlyStatus(Response* result) {
+  const int status = result->status;
+  Response empty(status, nullptr);
+  std::swap(*result, empty);  // `empty` now owns the old buffers and frees them here.
+}
+
+}  // namespace
+
 struct JobManager::Job {
   std::string id;                             // 32 hex digits.
   std::uint64_t seq = 0;                      // Submit order (for the list's ties).
@@ -36,6 +52,9 @@ struct JobManager::Job {
   Response result;                            // The inner response (done, failed, kept).
   bool kept_result = false;                   // Cancelled, with the runner's 2xx in result.
   nlohmann::json error;                       // The failure's error object (failed), else null.
+  bool timed_out = false;                     // The watchdog stopped it (max_time_s).
+  bool result_in_store = false;               // result holds only the status; the store has it.
+  std::size_t memory_bytes = 0;               // Its result's bytes counted in memory.
 };
 
 JobManager::JobManager(JobConfig config, JobRunner runner, JobPersistence persistence)
@@ -50,6 +69,7 @@ JobManager::JobManager(JobConfig config, JobRunner runner, JobPersistence persis
   if (!runner_) throw std::invalid_argument("invalid JobManager: the runner is empty");
   if (persistence_.store != nullptr) LoadFromStore();
   try {
+    watchdog_ = std::thread([this] { WatchdogLoop(); });
     workers_.reserve(static_cast<std::size_t>(config_.workers));
     for (int i = 0; i < config_.workers; ++i) workers_.emplace_back([this] { WorkerLoop(); });
   } catch (...) {
@@ -152,21 +172,45 @@ Response JobManager::List(const api::JobListQuery& query) const {
 }
 
 Response JobManager::Result(const std::string& id) const {
-  std::lock_guard lock(mutex_);
-  EvictLocked(Clock::now());
-  const std::shared_ptr<Job> job = FindLocked(id);
-  if (!job) return JobNotFound(id);
-  switch (job->state) {
-    case State::kDone:
-    case State::kFailed:
-      return job->result;
-    case State::kCancelled:
-      return job->kept_result ? job->result : JobWasCancelled(id);
-    case State::kQueued:
-    case State::kRunning:
-      break;
+  {
+    std::lock_guard lock(mutex_);
+    EvictLocked(Clock::now());
+    const std::shared_ptr<Job> job = FindLocked(id);
+    if (!job) return JobNotFound(id);
+    switch (job->state) {
+      case State::kDone:
+      case State::kFailed:
+        if (!job->result_in_store) return job->result;
+        break;
+      case State::kCancelled:
+        if (!job->kept_result) return JobWasCancelled(id);
+        if (!job->result_in_store) return job->result;
+        break;
+      case State::kQueued:
+      case State::kRunning:
+        return JobNotReady(id, StateName(job->state));
+    }
   }
-  return JobNotReady(id, StateName(job->state));
+  // Read back outside the lock (it can be 100 MB); a job deleted meanwhile has no row.
+  std::optional<JobRecord> record;
+  std::string error;
+  if (!persistence_.store->LoadResult(id, &record, &error)) {
+    if (persistence_.on_store_error) {
+      std::lock_guard lock(mutex_);  // on_store_error is called with the lock held.
+      persistence_.on_store_error("cannot read the result of job " + id + ": " + error);
+    }
+    return ToResponse(ApiError{503, api::ErrorCode::kUnavailable,
+                               "the job's result could not be read from the jobs database; "
+                               "retry later",
+                               ""});
+  }
+  if (!record) return JobNotFound(id);
+  if (!record->content_type.empty()) {
+    return Response::Text(record->status, std::move(record->response_text),
+                          std::move(record->content_type));
+  }
+  record->response_json += '\n';  // As the server ends a JSON body.
+  return Response::Text(record->status, std::move(record->response_json), "application/json");
 }
 
 Response JobManager::Cancel(const std::string& id) {
@@ -180,7 +224,7 @@ Response JobManager::Cancel(const std::string& id) {
       queue_.erase(std::find(queue_.begin(), queue_.end(), id));
       job->cancel_requested = true;
       job->progress.Cancel();
-      job->inner = Request{};  // Frees the body now.
+      Release(&job->inner);  // Frees the body now.
       FinishLocked(*job, State::kCancelled, now);
       SaveLocked(*job);
       nlohmann::json body = ToJsonLocked(*job, now);
@@ -201,6 +245,7 @@ Response JobManager::Cancel(const std::string& id) {
   }
   nlohmann::json body = ToJsonLocked(*job, now);
   body["deleted"] = true;
+  ForgetResultLocked(*job);
   finished_.erase(std::find(finished_.begin(), finished_.end(), id));
   jobs_.erase(id);
   ForgetLocked(id);
@@ -232,7 +277,7 @@ void JobManager::Shutdown(double grace_s) {
           Job& job = *jobs_.at(id);
           job.cancel_requested = true;
           job.progress.Cancel();
-          job.inner = Request{};
+          Release(&job.inner);
           FinishLocked(job, State::kCancelled, now);
         }
         queue_.clear();
@@ -258,6 +303,12 @@ void JobManager::Shutdown(double grace_s) {
     for (std::thread& worker : workers_) {
       if (worker.joinable()) worker.join();
     }
+    {
+      std::lock_guard lock(mutex_);
+      watchdog_stop_ = true;
+    }
+    watchdog_cv_.notify_all();
+    if (watchdog_.joinable()) watchdog_.join();
   });
 }
 
@@ -279,6 +330,8 @@ void JobManager::WorkerLoop() {
     job->state = State::kRunning;
     job->started = Clock::now();
     ++busy_;
+    running_.push_back(job);
+    watchdog_cv_.notify_all();
     // Saved with the request, so a job the process dies under can be resumed.
     SaveLocked(*job);
     Request inner = job->inner;  // The runner's copy: job->inner is read under the lock.
@@ -292,18 +345,60 @@ void JobManager::WorkerLoop() {
       threw = true;
     }
     inner = Request{};
+    // Without a store a result lives in memory: max_results_memory_bytes bounds it too.
+    const bool memory_bound = persistence_.store == nullptr &&
+                              config_.max_results_memory_bytes < config_.max_result_bytes;
+    const std::size_t largest =
+        memory_bound ? config_.max_results_memory_bytes : config_.max_result_bytes;
+    // Outside the lock: a streamed answer (a CSV or NDJSON sweep) is run here, stopped once
+    // over the limit; a 2xx answer's size, its JSON serialised once for the size and the
+    // store (a sweep's result can be 100 MB).
+    std::size_t bytes = 0;
+    StreamOutcome streamed = StreamOutcome::kComplete;
+    if (!threw) streamed = CollectJobStream(&response, largest, &bytes);
+    if (streamed == StreamOutcome::kStopped) {
+      // Cancelled (DELETE, the time limit, a shutdown): an incomplete body is no answer.
+      KeepOnlyStatus(&response);
+      response = ToResponse(ApiError{409, api::ErrorCode::kCancelled,
+                                     "the job was stopped before its answer was complete", ""});
+    }
+    const bool answered = !threw && response.status >= 200 && response.status < 300;
+    std::string serialized;
+    if (answered && response.content_type.empty()) {
+      serialized = SerializeJobBody(response.body);
+      bytes = serialized.size();
+    }
+    const bool too_big = answered && (bytes > largest || streamed == StreamOutcome::kOverLimit);
+    if (too_big) {
+      const bool stopped = streamed == StreamOutcome::kOverLimit;
+      KeepOnlyStatus(&response);
+      response = memory_bound
+                     ? JobResultTooBig(bytes, "this server's memory", "max_results_memory_bytes",
+                                       largest, "--job-results-memory-bytes", stopped)
+                     : JobResultTooBig(bytes, "the job service", "max_result_bytes", largest,
+                                       "--job-max-result-bytes", stopped);
+      serialized.clear();
+    }
+    if (!answered || too_big) bytes = 0;  // Counted below from the stored answer.
 
     lock.lock();
     --busy_;
+    running_.erase(std::find(running_.begin(), running_.end(), job));
     idle_cv_.notify_all();
     const Clock::time_point now = Clock::now();
     if (job->cancel_requested) {
-      // A 2xx answer is kept (an optimisation's best design so far); anything else is dropped.
-      if (!threw && response.status >= 200 && response.status < 300) {
+      // A 2xx answer is kept (an optimisation's best design so far) unless it is too big;
+      // anything else is dropped.
+      if (answered && !too_big) {
         job->result = std::move(response);
         job->kept_result = true;
       }
       FinishLocked(*job, State::kCancelled, now);
+    } else if (job->timed_out) {
+      job->result = JobTimedOut(config_.max_time_s);
+      job->error = FailureObject(job->result);
+      serialized.clear();
+      FinishLocked(*job, State::kFailed, now);
     } else if (job->interrupted) {
       // Shutdown cut it short: its result (if any) is discarded, and it is
       // queued again, saved for the next start, which runs it from the start.
@@ -316,7 +411,7 @@ void JobManager::WorkerLoop() {
       job->result = ToResponse(ApiError{500, api::ErrorCode::kInternalError, "internal error", ""});
       job->error = FailureObject(job->result);
       FinishLocked(*job, State::kFailed, now);
-    } else if (response.status >= 200 && response.status < 300) {
+    } else if (answered && !too_big) {
       job->result = std::move(response);
       FinishLocked(*job, State::kDone, now);
     } else {
@@ -324,9 +419,112 @@ void JobManager::WorkerLoop() {
       job->result = std::move(response);
       FinishLocked(*job, State::kFailed, now);
     }
-    job->inner = Request{};  // Frees the body; a finished job is never run again.
-    SaveLocked(*job);
+    Release(&job->inner);  // Frees the body; a finished job is never run again.
+    if (bytes == 0 && job->result.content_type.empty()) {
+      bytes = job->kept_result || job->state != State::kCancelled
+                  ? SerializeJobBody(job->result.body).size()  // An error object: small.
+                  : 0;
+    }
+    std::string why;
+    bool saved = SaveLocked(*job, &why, &serialized);
+    if (!saved && job->state != State::kCancelled) {
+      // Never done (or failed with an answer) without it stored: failed with the store's
+      // message, saved as such (small), so the next start neither shows a result nor runs it
+      // again. Should that save fail too, its row is deleted (below).
+      KeepOnlyStatus(&job->result);  // Frees the answer that could not be stored.
+      job->result =
+          ToResponse(ApiError{503, api::ErrorCode::kUnavailable,
+                              "the job's result could not be saved in the jobs database (" + why +
+                                  "): it is not kept; submit the job again later",
+                              ""});
+      job->error = FailureObject(job->result);
+      job->state = State::kFailed;
+      bytes = SerializeJobBody(job->result.body).size();
+      saved = SaveLocked(*job);
+    } else if (!saved && job->kept_result) {
+      job->kept_result = false;  // A cancelled job whose answer could not be stored keeps none.
+      KeepOnlyStatus(&job->result);
+      job->result.status = 0;
+      bytes = 0;
+      saved = SaveLocked(*job);
+    }
+    // Not even that fits (a full disk): no row is better than its "running" one, which the
+    // next start would run again and, after max_resumes, fail as if the server had died.
+    if (!saved) ForgetLocked(job->id);
+    KeepResultLocked(*job, bytes, saved);
     EvictLocked(now);
+  }
+}
+
+void JobManager::WatchdogLoop() {
+  const auto limit = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(config_.max_time_s));
+  std::unique_lock lock(mutex_);
+  while (!watchdog_stop_) {
+    const Clock::time_point now = Clock::now();
+    std::optional<Clock::time_point> next;
+    for (const std::shared_ptr<Job>& job : running_) {
+      if (job->timed_out) continue;
+      const Clock::time_point deadline = *job->started + limit;
+      if (deadline <= now) {
+        job->timed_out = true;  // The worker makes it failed when the runner returns.
+        job->progress.Cancel();
+      } else if (!next || deadline < *next) {
+        next = deadline;
+      }
+    }
+    if (next) {
+      watchdog_cv_.wait_until(lock, *next);
+    } else {
+      watchdog_cv_.wait(lock);
+    }
+  }
+}
+
+void JobManager::KeepResultLocked(Job& job, std::size_t bytes, bool saved) {
+  const bool has_result =
+      job.state == State::kDone || job.state == State::kFailed || job.kept_result;
+  if (!has_result) return;
+  if (persistence_.store != nullptr && !saved) return;  // An error object the store refused.
+  if (persistence_.store != nullptr && bytes > kMaxLoadedResultBytes) {
+    KeepOnlyStatus(&job.result);  // Read back by Result().
+    job.result_in_store = true;
+    return;
+  }
+  if (bytes == 0) return;  // Nothing to count (an empty body).
+  job.memory_bytes = bytes;
+  memory_results_bytes_ += bytes;
+  in_memory_.push_back(job.id);
+  TrimMemoryLocked();
+}
+
+void JobManager::ForgetResultLocked(Job& job) const {
+  if (job.memory_bytes == 0) return;
+  memory_results_bytes_ -= job.memory_bytes;
+  job.memory_bytes = 0;
+  // Usually the oldest (eviction); a DELETE may take any.
+  if (!in_memory_.empty() && in_memory_.front() == job.id) {
+    in_memory_.pop_front();
+  } else if (const auto it = std::find(in_memory_.begin(), in_memory_.end(), job.id);
+             it != in_memory_.end()) {
+    in_memory_.erase(it);
+  }
+}
+
+void JobManager::TrimMemoryLocked() {
+  while (memory_results_bytes_ > config_.max_results_memory_bytes && !in_memory_.empty()) {
+    const std::shared_ptr<Job> job = FindLocked(in_memory_.front());
+    in_memory_.pop_front();
+    if (!job || job->memory_bytes == 0) continue;
+    memory_results_bytes_ -= job->memory_bytes;
+    job->memory_bytes = 0;
+    if (persistence_.store != nullptr) {
+      KeepOnlyStatus(&job->result);  // Saved: Result() reads it back.
+      job->result_in_store = true;
+    } else {
+      finished_.erase(std::find(finished_.begin(), finished_.end(), job->id));
+      jobs_.erase(job->id);
+    }
   }
 }
 
@@ -345,6 +543,7 @@ void JobManager::EvictLocked(Clock::time_point now) const {
     const bool too_old = std::chrono::duration<double>(now - *it->second->finished).count() >=
                          config_.keep_results_s;
     if (!too_many && !too_old) break;
+    ForgetResultLocked(*it->second);
     jobs_.erase(it);
     ForgetLocked(finished_.front());
     finished_.pop_front();
@@ -407,7 +606,7 @@ JobManager::Clock::time_point JobManager::FromUnixSeconds(double unix_s) const {
                       std::chrono::duration<double>(unix_s - since_epoch.count()));
 }
 
-JobRecord JobManager::RecordLocked(const Job& job) const {
+JobRecord JobManager::RecordLocked(const Job& job, std::string* serialized) const {
   JobRecord record;
   record.id = job.id;
   record.state = StateName(job.state);
@@ -424,7 +623,9 @@ JobRecord JobManager::RecordLocked(const Job& job) const {
   if (job.state == State::kDone || job.state == State::kFailed || job.kept_result) {
     record.status = job.result.status;
     if (job.result.content_type.empty()) {
-      record.response_json = SerializeJobBody(job.result.body);
+      record.response_json = serialized != nullptr && !serialized->empty()
+                                 ? std::move(*serialized)
+                                 : SerializeJobBody(job.result.body);
     } else {
       record.response_text = job.result.text;
       record.content_type = job.result.content_type;
@@ -434,10 +635,11 @@ JobRecord JobManager::RecordLocked(const Job& job) const {
   return record;
 }
 
-bool JobManager::SaveLocked(const Job& job) const {
+bool JobManager::SaveLocked(const Job& job, std::string* why, std::string* serialized) const {
   if (persistence_.store == nullptr) return true;
   std::string error;
-  if (persistence_.store->Save(RecordLocked(job), &error)) return true;
+  if (persistence_.store->Save(RecordLocked(job, serialized), &error)) return true;
+  if (why != nullptr) *why = error;
   if (persistence_.on_store_error) {
     persistence_.on_store_error("cannot save job " + job.id + " (" + StateName(job.state) +
                                 "): " + error);
@@ -484,7 +686,12 @@ void JobManager::LoadFromStore() {
       job->kept_result = kept;
       job->progress.Report(record.progress);
       if (kept) job->progress.Cancel();
-      if (!record.content_type.empty()) {
+      const std::size_t bytes = record.response_json.size() + record.response_text.size();
+      if (record.result_in_store || bytes > kMaxLoadedResultBytes) {
+        job->result = Response(record.status, nullptr);  // Result() reads it back.
+        job->result_in_store = true;
+      } else if (!record.content_type.empty()) {
+        job->memory_bytes = bytes;
         job->result = Response::Text(record.status, std::move(record.response_text),
                                      std::move(record.content_type));
       } else {
@@ -499,6 +706,7 @@ void JobManager::LoadFromStore() {
           record.error.clear();
         }
         job->result = Response(record.status, std::move(body));
+        job->memory_bytes = bytes;
       }
       if (job->state == State::kFailed) {
         job->error = ReadStoredJobError(record.error, record.status, job->result.body);
@@ -540,7 +748,7 @@ void JobManager::LoadFromStore() {
     if (job->state == State::kQueued) {
       queue_.push_back(job->id);  // Records come oldest first: the queue keeps its order.
     } else {
-      job->inner = Request{};
+      Release(&job->inner);
       if (!job->finished) job->finished = now;
       finished.push_back(job);
     }
@@ -549,8 +757,15 @@ void JobManager::LoadFromStore() {
   }
   std::stable_sort(finished.begin(), finished.end(),
                    [](const auto& a, const auto& b) { return *a->finished < *b->finished; });
-  for (const auto& job : finished) finished_.push_back(job->id);
+  for (const auto& job : finished) {
+    finished_.push_back(job->id);
+    if (job->memory_bytes != 0) {
+      memory_results_bytes_ += job->memory_bytes;
+      in_memory_.push_back(job->id);
+    }
+  }
   EvictLocked(now);  // Drops (and deletes) what is too old or beyond max_kept.
+  TrimMemoryLocked();
 }
 
 std::string JobManager::NewIdLocked() {

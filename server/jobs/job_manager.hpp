@@ -15,6 +15,18 @@
 // code Interrupted) so that a request that kills the server cannot crash it forever. Shutdown with
 // a store keeps queued jobs queued and puts interrupted running ones back in the queue (state
 // "queued", saved) for the next start; without a store they are cancelled.
+//
+// A job is done only once its result is saved: when the store cannot save it (e.g. "database or
+// disk is full") the job is failed (503 Unavailable, the store's message) and saved as such, so
+// it is neither shown done nor run again at the next start (if even that save fails, its row is
+// deleted: the job is failed here until the process stops, and unknown after a restart).
+//
+// Limits (JobConfig): a result over max_result_bytes fails its job (413 TooBig). Results held
+// in memory are bounded: with a store, results over kMaxLoadedResultBytes live in the store
+// only and Result() reads them back (as the stored JSON text), and the small ones leave memory,
+// oldest first, once they total more than max_results_memory_bytes; with no store, the oldest
+// finished jobs are dropped (404) instead. A job running longer than max_time_s has its cancel
+// flag set (a watchdog thread) and ends failed (408 Timeout) naming the limit.
 #pragma once
 
 #include <chrono>
@@ -81,7 +93,9 @@ class JobManager final : public ServerJobService {
   api::Response List(const api::JobListQuery& query) const override;
 
   /// The job's result. done or failed: the inner response verbatim (status,
-  /// body, text, content type); a runner that threw gives 500 "InternalError".
+  /// body, text, content type; a result kept in the store only comes back as its
+  /// JSON text, content type application/json); a runner that threw gives 500
+  /// "InternalError"; 503 "Unavailable" when the store cannot read it.
   /// cancelled: the runner's 2xx answer when it gave one after the cancel (an
   /// optimisation's best design so far), else 409 "Cancelled".
   /// queued or running: 409 "NotReady"; unknown: 404.
@@ -123,14 +137,26 @@ class JobManager final : public ServerJobService {
   // 0 while queued, 1 when done, else the runner's last report.
   static double ProgressOf(const Job& job);
   void WorkerLoop();
+  void WatchdogLoop();   // Sets the cancel flag of jobs running longer than max_time_s.
   void LoadFromStore();  // Before the workers start.
   double ToUnixSeconds(Clock::time_point time) const;
   Clock::time_point FromUnixSeconds(double unix_s) const;
   // The following require mutex_ to be held.
   void FinishLocked(Job& job, State state, Clock::time_point now);
   void EvictLocked(Clock::time_point now) const;
-  JobRecord RecordLocked(const Job& job) const;
-  bool SaveLocked(const Job& job) const;  // False (and reported) when the store failed.
+  // `serialized`: the result's JSON already serialised (moved from), or null/empty.
+  JobRecord RecordLocked(const Job& job, std::string* serialized = nullptr) const;
+  // False (reported, and the store's message in *why if non-null) when the store failed.
+  bool SaveLocked(const Job& job, std::string* why = nullptr,
+                  std::string* serialized = nullptr) const;
+  // Counts a finished job's result of `bytes` in memory, or leaves it to the store (saved and
+  // over kMaxLoadedResultBytes), then trims memory to max_results_memory_bytes.
+  void KeepResultLocked(Job& job, std::size_t bytes, bool saved);
+  // Uncounts the job's result in memory (it leaves memory or the job is dropped).
+  void ForgetResultLocked(Job& job) const;
+  // Moves the oldest results out of memory (into the store only) or, without a store, drops
+  // the oldest finished jobs, until max_results_memory_bytes holds.
+  void TrimMemoryLocked();
   void ForgetLocked(const std::string& id) const;
   std::shared_ptr<Job> FindLocked(const std::string& id) const;
   nlohmann::json ToJsonLocked(const Job& job, Clock::time_point now) const;
@@ -154,6 +180,14 @@ class JobManager final : public ServerJobService {
   bool grace_ended_ = false;                  // Set by EndGrace().
   std::mt19937_64 random_;                    // Id source, seeded from std::random_device.
   std::uint64_t next_seq_ = 0;                // The next job's Job::seq.
+  // Bytes of the results held in memory, and their jobs' ids, oldest finished first (ids of
+  // jobs dropped meanwhile are skipped).
+  mutable std::size_t memory_results_bytes_ = 0;
+  mutable std::deque<std::string> in_memory_;
+  std::vector<std::shared_ptr<Job>> running_;  // For the watchdog.
+  std::condition_variable watchdog_cv_;        // Signalled when a job starts or at the stop.
+  bool watchdog_stop_ = false;                 // Set by Shutdown() once the workers are joined.
+  std::thread watchdog_;
 
   std::once_flag shutdown_once_;
   std::vector<std::thread> workers_;

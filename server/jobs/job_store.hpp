@@ -4,6 +4,7 @@
 // values, the store only saves, deletes and loads them.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,7 +31,14 @@ struct JobRecord {
   std::string response_text;  ///< A non-JSON inner response body (with content_type).
   std::string content_type;   ///< The non-JSON body's type; "" for a JSON body.
   std::string error;          ///< The failure's message (failed), else "".
+  /// LoadAll left the result (response_json, response_text) out because it is larger than
+  /// kMaxLoadedResultBytes: LoadResult reads it.
+  bool result_in_store = false;
 };
+
+/// LoadAll returns results up to this size (bytes of response_json plus response_text); larger
+/// ones stay in the store (JobRecord::result_in_store), so a restart does not load them all.
+inline constexpr std::size_t kMaxLoadedResultBytes = 64 * 1024;
 
 /// Saves, deletes and loads job records. Implementations are thread-safe.
 /// Every call reports failure by returning false with a message in *error
@@ -46,8 +54,14 @@ class JobStore {
   /// Removes the record with this id (no error if there is none).
   virtual bool Delete(const std::string& id, std::string* error) = 0;
 
-  /// Every stored record, oldest created first (replaces *records).
+  /// Every stored record, oldest created first (replaces *records); results larger than
+  /// kMaxLoadedResultBytes are left out (JobRecord::result_in_store).
   virtual bool LoadAll(std::vector<JobRecord>* records, std::string* error) = 0;
+
+  /// The stored result of job `id` (status, response_json, response_text, content_type; the
+  /// other fields may be left empty) in *record, or nullopt when there is no such job.
+  virtual bool LoadResult(const std::string& id, std::optional<JobRecord>* record,
+                          std::string* error) = 0;
 };
 
 }  // namespace sweetspot::server

@@ -279,6 +279,8 @@ struct PostgresJobService::Impl {
     std::atomic<bool> cancel_requested{false};  // Seen in the database (or asked here).
     std::atomic<bool> lost{false};              // Another replica owns it now.
     std::atomic<bool> interrupted{false};       // Shutdown hands it back to the queue.
+    std::atomic<bool> timed_out{false};         // Ran longer than max_time_s (the heartbeat).
+    Clock::time_point started = Clock::now();   // When this replica claimed it.
     // The finishing statement's parameters, while its commit waits for the database.
     std::optional<std::pair<std::string, std::vector<Param>>> unsaved;
   };
@@ -523,6 +525,22 @@ bool PostgresJobService::Impl::ClaimAndRun() {
     }
   }
   inner = api::Request{};
+  // A streamed answer (a CSV or NDJSON sweep) runs here, stopped once over max_result_bytes.
+  std::size_t streamed_bytes = 0;
+  const StreamOutcome streamed =
+      threw ? StreamOutcome::kComplete
+            : CollectJobStream(&response, config.max_result_bytes, &streamed_bytes);
+  if (streamed == StreamOutcome::kStopped) {  // Cancelled: an incomplete body is no answer.
+    response = api::ToResponse(api::ApiError{
+        409, api::ErrorCode::kCancelled, "the job was stopped before its answer was complete", ""});
+  } else if (streamed == StreamOutcome::kOverLimit) {
+    response = JobResultTooBig(streamed_bytes, "the jobs database", "max_result_bytes",
+                               config.max_result_bytes, "--job-max-result-bytes", true);
+  }
+  if (job->timed_out && !job->lost && !job->cancel_requested) {
+    threw = false;  // Failed below with the limit named, whatever the runner answered.
+    response = JobTimedOut(config.max_time_s);
+  }
 
   // What the job became, as the statement that commits it.
   std::optional<std::pair<std::string, std::vector<Param>>> finish;
@@ -555,7 +573,7 @@ bool PostgresJobService::Impl::ClaimAndRun() {
                    std::vector<Param>{job->id, owner, Decimal(job->progress.Fraction()),
                                       std::move(status), std::move(json), std::move(text),
                                       std::move(content_type)});
-  } else if (job->interrupted) {
+  } else if (job->interrupted && !job->timed_out) {
     // Back to the queue for another replica or the next start (no resume counted),
     // unless a DELETE arrived meanwhile.
     finish.emplace(
@@ -589,12 +607,8 @@ bool PostgresJobService::Impl::ClaimAndRun() {
     const std::size_t size = json.size() + text.size();
     if (size > config.max_result_bytes) {
       state = "failed";
-      const std::string message =
-          "the job's result is " + std::to_string(size) +
-          " bytes, more than the jobs database keeps (max_result_bytes = " +
-          std::to_string(config.max_result_bytes) +
-          "): ask for fewer rows or outputs, or raise --job-max-result-bytes";
-      response = api::ToResponse(api::ApiError{413, api::ErrorCode::kTooBig, message, ""});
+      response = JobResultTooBig(size, "the jobs database", "max_result_bytes",
+                                 config.max_result_bytes, "--job-max-result-bytes");
       error = StoredJobError(FailureObject(response));
       json = SerializeJobBody(response.body);
       text.clear();
@@ -693,6 +707,15 @@ void PostgresJobService::Impl::HeartbeatLoop() {
     std::vector<std::pair<std::shared_ptr<Running>, Unsaved>> jobs;
     for (const auto& [id, job] : running) jobs.emplace_back(job, job->unsaved);
     lock.unlock();
+    const Clock::time_point now = Clock::now();
+    for (const auto& [job, unsaved] : jobs) {
+      // The time limit, checked every period (at most 0.5 s late).
+      if (!unsaved && !job->timed_out &&
+          std::chrono::duration<double>(now - job->started).count() >= config.max_time_s) {
+        job->timed_out = true;
+        job->progress.Cancel();
+      }
+    }
     for (const auto& [job, unsaved] : jobs) {
       if (!Renew(*job)) break;  // The database is away: try again next period.
       if (unsaved && !job->lost) {

@@ -2,6 +2,7 @@
 
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <optional>
@@ -12,6 +13,8 @@ namespace sweetspot::server {
 namespace {
 
 constexpr double kMaxBusyTimeoutS = 60.0;
+constexpr std::size_t kMinMaxBytes = 65536;
+constexpr std::size_t kMaxMaxBytes = 1000000000000000;
 
 // The columns, in the order of the statements' parameters and results.
 constexpr const char* kColumns =
@@ -64,6 +67,13 @@ bool SqliteJobStoreOptions::IsValid(std::string* why) const {
       text << "busy_timeout_s = " << busy_timeout_s << ": must be in [0, " << kMaxBusyTimeoutS
            << "]";
       *why = text.str();
+    }
+    return false;
+  }
+  if (max_bytes != 0 && (max_bytes < kMinMaxBytes || max_bytes > kMaxMaxBytes)) {
+    if (why != nullptr) {
+      *why = "max_bytes = " + std::to_string(max_bytes) + ": must be 0 (no limit) or in [" +
+             std::to_string(kMinMaxBytes) + ", " + std::to_string(kMaxMaxBytes) + "]";
     }
     return false;
   }
@@ -165,16 +175,37 @@ bool SqliteJobStore::Initialize(const SqliteJobStoreOptions& options, std::strin
     return false;
   }
   if (!exec("COMMIT")) return false;
+  if (options.max_bytes != 0) {
+    std::string page_size;
+    if (!query_text("PRAGMA page_size", &page_size)) return false;
+    const long long pages =
+        static_cast<long long>(options.max_bytes) / std::max(1LL, std::atoll(page_size.c_str()));
+    std::string granted;  // SQLite never sets it below the file's current page count.
+    if (!query_text(("PRAGMA max_page_count = " + std::to_string(pages)).c_str(), &granted)) {
+      return false;
+    }
+  }
 
   const std::string save_sql = std::string("INSERT OR REPLACE INTO jobs (") + kColumns +
                                ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, "
                                "?13, ?14, ?15, ?16, ?17)";
+  // Results over kMaxLoadedResultBytes are left out (sizes in bytes: a BLOB's length).
+  const std::string big =
+      "(length(CAST(response_json AS BLOB)) + "
+      "length(CAST(response_text AS BLOB)) > " +
+      std::to_string(kMaxLoadedResultBytes) + ")";
   const std::string load_sql =
-      std::string("SELECT ") + kColumns + " FROM jobs ORDER BY created_unix_s, id";
+      "SELECT id, state, method, path, body, progress, cancel_requested, resumes, created_at, "
+      "created_unix_s, started_unix_s, finished_unix_s, status, CASE WHEN " +
+      big + " THEN '' ELSE response_json END, CASE WHEN " + big +
+      " THEN '' ELSE response_text END, content_type, error, " + big +
+      " FROM jobs ORDER BY created_unix_s, id";
   const char* delete_sql = "DELETE FROM jobs WHERE id = ?1";
+  const char* result_sql =
+      "SELECT status, response_json, response_text, content_type FROM jobs WHERE id = ?1";
   for (auto [sql, statement] :
        {std::pair{save_sql.c_str(), &save_}, std::pair{load_sql.c_str(), &load_},
-        std::pair{delete_sql, &delete_}}) {
+        std::pair{delete_sql, &delete_}, std::pair{result_sql, &result_}}) {
     if ((code = sqlite3_prepare_v2(db_, sql, -1, statement, nullptr)) != SQLITE_OK) {
       *error = Failure(std::string("prepare ") + sql, code);
       return false;
@@ -186,7 +217,7 @@ bool SqliteJobStore::Initialize(const SqliteJobStoreOptions& options, std::strin
 SqliteJobStore::~SqliteJobStore() {
   std::lock_guard lock(mutex_);
   // sqlite3_finalize returns the statement's last error, already reported.
-  for (sqlite3_stmt* statement : {save_, delete_, load_}) sqlite3_finalize(statement);
+  for (sqlite3_stmt* statement : {save_, delete_, load_, result_}) sqlite3_finalize(statement);
   // With every statement finalized, close cannot be SQLITE_BUSY; there is no
   // one left to report another failure to, and the OS releases the lock anyway.
   sqlite3_close(db_);
@@ -279,6 +310,7 @@ bool SqliteJobStore::LoadAll(std::vector<JobRecord>* records, std::string* error
     record.response_text = ColumnText(load_, 14);
     record.content_type = ColumnText(load_, 15);
     record.error = ColumnText(load_, 16);
+    record.result_in_store = sqlite3_column_int64(load_, 17) != 0;
     records->push_back(std::move(record));
   }
   const bool ok = code == SQLITE_DONE;
@@ -288,6 +320,31 @@ bool SqliteJobStore::LoadAll(std::vector<JobRecord>* records, std::string* error
   }
   Rewind(load_);
   return ok;
+}
+
+bool SqliteJobStore::LoadResult(const std::string& id, std::optional<JobRecord>* record,
+                                std::string* error) {
+  std::lock_guard lock(mutex_);
+  record->reset();
+  int code = sqlite3_bind_text64(result_, 1, id.data(), id.size(), SQLITE_STATIC, SQLITE_UTF8);
+  if (code == SQLITE_OK) {
+    code = sqlite3_step(result_);
+    if (code == SQLITE_ROW) {
+      JobRecord found;
+      found.id = id;
+      found.status = static_cast<int>(sqlite3_column_int64(result_, 0));
+      found.response_json = ColumnText(result_, 1);
+      found.response_text = ColumnText(result_, 2);
+      found.content_type = ColumnText(result_, 3);
+      *record = std::move(found);
+      code = SQLITE_OK;
+    } else if (code == SQLITE_DONE) {
+      code = SQLITE_OK;
+    }
+  }
+  if (code != SQLITE_OK && error != nullptr) *error = Failure("load the result of job " + id, code);
+  Rewind(result_);
+  return code == SQLITE_OK;
 }
 
 }  // namespace sweetspot::server

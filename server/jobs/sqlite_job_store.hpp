@@ -12,6 +12,7 @@
 // ("is locked") instead of running the first one's jobs too.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -29,6 +30,11 @@ struct SqliteJobStoreOptions {
   /// How long a statement waits for a lock another connection holds, s, in [0, 60].
   /// Only a second process on the same file waits (and is then refused).
   double busy_timeout_s = 2.0;
+
+  /// The largest the database file may grow, bytes; 0 = no limit but the disk's. Past it a save
+  /// fails with SQLite's "database or disk is full", as on a full disk (PRAGMA max_page_count,
+  /// rounded down to whole pages; never below the file's size at Open). 0 or in [65536, 1e15].
+  std::size_t max_bytes = 0;
 
   /// True when every field is in range; otherwise "field = value: rule" in *why (if non-null).
   bool IsValid(std::string* why) const;
@@ -58,8 +64,11 @@ class SqliteJobStore final : public JobStore {
   bool Save(const JobRecord& record, std::string* error) override;
   /// DELETE by id; true also when there was no such row.
   bool Delete(const std::string& id, std::string* error) override;
-  /// Every row, ordered by created_unix_s then id.
+  /// Every row, ordered by created_unix_s then id; results over kMaxLoadedResultBytes left out.
   bool LoadAll(std::vector<JobRecord>* records, std::string* error) override;
+  /// SELECT of one row's result columns.
+  bool LoadResult(const std::string& id, std::optional<JobRecord>* record,
+                  std::string* error) override;
 
  private:
   explicit SqliteJobStore(std::string path);
@@ -73,6 +82,7 @@ class SqliteJobStore final : public JobStore {
   sqlite3_stmt* save_ = nullptr;    // INSERT OR REPLACE INTO jobs ...
   sqlite3_stmt* delete_ = nullptr;  // DELETE FROM jobs WHERE id = ?1
   sqlite3_stmt* load_ = nullptr;    // SELECT ... FROM jobs ORDER BY ...
+  sqlite3_stmt* result_ = nullptr;  // SELECT status, response_json, ... WHERE id = ?1
 };
 
 }  // namespace sweetspot::server

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -49,7 +50,7 @@ class FakeStore : public JobStore {
  public:
   bool Save(const JobRecord& record, std::string* error) override {
     std::lock_guard lock(mutex_);
-    if (fail_saves_) {
+    if (fail_saves_ || record.response_json.size() + record.response_text.size() > room_) {
       *error = "disk full";
       return false;
     }
@@ -80,6 +81,19 @@ class FakeStore : public JobStore {
     return true;
   }
 
+  bool LoadResult(const std::string& id, std::optional<JobRecord>* record,
+                  std::string* /*error*/) override {
+    std::lock_guard lock(mutex_);
+    ++result_loads_;
+    const auto it = records_.find(id);
+    if (it == records_.end()) {
+      record->reset();
+    } else {
+      *record = it->second;
+    }
+    return true;
+  }
+
   std::optional<JobRecord> Get(const std::string& id) {
     std::lock_guard lock(mutex_);
     const auto it = records_.find(id);
@@ -98,6 +112,15 @@ class FakeStore : public JobStore {
     std::lock_guard lock(mutex_);
     fail_saves_ = fail;
   }
+  // Saves of records whose result is over `bytes` fail ("disk full"), as on a nearly full disk.
+  void RoomForResults(std::size_t bytes) {
+    std::lock_guard lock(mutex_);
+    room_ = bytes;
+  }
+  int result_loads() {
+    std::lock_guard lock(mutex_);
+    return result_loads_;
+  }
   void FailLoad(bool fail) {
     std::lock_guard lock(mutex_);
     fail_load_ = fail;
@@ -112,7 +135,9 @@ class FakeStore : public JobStore {
   std::map<std::string, JobRecord> records_;
   bool fail_saves_ = false;
   bool fail_load_ = false;
+  std::size_t room_ = std::numeric_limits<std::size_t>::max();
   int saves_ = 0;
+  int result_loads_ = 0;
 };
 
 // A one-shot signal between the test thread and runners.
@@ -783,6 +808,143 @@ TEST(JobStoreTest, WithoutAStoreShutdownStillCancelsWhatIsLeft) {
   jobs.Shutdown(0.05);
   EXPECT_EQ(jobs.Status(running).body["state"], "cancelled");
   EXPECT_EQ(jobs.Status(queued).body["state"], "cancelled");
+}
+
+// --- Limits: a result the store cannot keep, big results, the time limit ------------------
+
+// A job is done only once its result is saved: a store that refuses it ("disk full") makes
+// the job failed with the store's message, saved as such, so the next start neither shows a
+// result nor runs the job again.
+TEST(JobStoreTest, AResultTheStoreCannotSaveFailsTheJobAndIsNotRunAgain) {
+  FakeStore store;
+  store.RoomForResults(1000);
+  std::vector<std::string> errors;
+  std::string id;
+  {
+    JobManager jobs(
+        JobConfig{},
+        [](const Request&, core::Progress*) {
+          return Response{200, Json{{"rows", std::string(5000, 'x')}}};
+        },
+        On(&store, &errors));
+    id = IdOf(jobs.Submit(Post("/v1/explore")));
+    const Json failed = WaitForState(jobs, id, "failed");
+    EXPECT_EQ(failed["status"], 503);
+    EXPECT_EQ(failed["error"]["code"], "Unavailable");
+    EXPECT_EQ(failed["error"]["message"],
+              "the job's result could not be saved in the jobs database (disk full): it is not "
+              "kept; submit the job again later");
+    EXPECT_EQ(jobs.Result(id).status, 503);
+    ASSERT_EQ(errors.size(), 1u);
+    EXPECT_NE(errors[0].find(" (done): disk full"), std::string::npos) << errors[0];
+  }
+  ASSERT_TRUE(store.Get(id));
+  EXPECT_EQ(store.Get(id)->state, "failed");
+  std::atomic<int> calls{0};
+  JobManager restarted(JobConfig{}, CountingEcho{&calls}, On(&store));
+  const Response status = restarted.Status(id);
+  EXPECT_EQ(status.body["state"], "failed");
+  EXPECT_EQ(status.body["resumes"], 0);
+  EXPECT_EQ(calls.load(), 0);
+}
+
+// Results over kMaxLoadedResultBytes are not kept in memory: Result() reads them from the
+// store (as the stored JSON text), also after a restart; small ones stay in memory.
+TEST(JobStoreTest, BigResultsAreReadBackFromTheStore) {
+  FakeStore store;
+  const std::string rows(kMaxLoadedResultBytes, 'x');  // Serialised: 2 bytes more.
+  std::string big, small;
+  const auto runner = [&rows](const Request& inner, core::Progress* progress) {
+    return inner.body == "big" ? Response{200, Json{{"rows", rows}}} : Echo(inner, progress);
+  };
+  for (int start = 0; start < 2; ++start) {
+    JobManager jobs(JobConfig{}, runner, On(&store));
+    if (start == 0) {
+      big = IdOf(jobs.Submit(Post("/v1/explore", "big")));
+      small = IdOf(jobs.Submit(Post("/v1/explore", "small")));
+      WaitForState(jobs, big, "done");
+      WaitForState(jobs, small, "done");
+    }
+    const int loads = store.result_loads();
+    const Response result = jobs.Result(big);
+    EXPECT_EQ(store.result_loads(), loads + 1);
+    EXPECT_EQ(result.status, 200);
+    EXPECT_EQ(result.content_type, "application/json");
+    EXPECT_EQ(result.text, (Json{{"rows", rows}}.dump() + "\n"));
+    EXPECT_EQ(jobs.Result(small).body,
+              (Json{{"method", "POST"}, {"path", "/v1/explore"}, {"body", "small"}}));
+    EXPECT_EQ(store.result_loads(), loads + 1);  // The small one came from memory.
+  }
+}
+
+// With a store, the small results held in memory total at most max_results_memory_bytes:
+// beyond it the oldest leave memory (the store keeps them) and are read back.
+TEST(JobStoreTest, SmallResultsBeyondTheMemoryBudgetAreReadBackFromTheStore) {
+  FakeStore store;
+  JobConfig config;
+  config.workers = 1;
+  config.max_results_memory_bytes = 1024;
+  const auto runner = [](const Request&, core::Progress*) {
+    return Response{200, Json{{"rows", std::string(600, 'x')}}};  // ~611 bytes serialised.
+  };
+  JobManager jobs(config, runner, On(&store));
+  const std::string first = IdOf(jobs.Submit(Post("/v1/explore")));
+  WaitForState(jobs, first, "done");
+  const std::string second = IdOf(jobs.Submit(Post("/v1/explore")));
+  WaitForState(jobs, second, "done");
+  EXPECT_EQ(jobs.Result(second).body, (Json{{"rows", std::string(600, 'x')}}));
+  EXPECT_EQ(store.result_loads(), 0);
+  const Response oldest = jobs.Result(first);
+  EXPECT_EQ(store.result_loads(), 1);
+  EXPECT_EQ(oldest.text, (Json{{"rows", std::string(600, 'x')}}.dump() + "\n"));
+}
+
+// A job running longer than max_time_s has its cancel flag set and ends failed (408 Timeout)
+// naming the limit; a 2xx answer it gives after the cancel is not kept.
+TEST(JobStoreTest, AJobPastItsTimeLimitIsCancelledAndFailed) {
+  FakeStore store;
+  JobConfig config;
+  config.max_time_s = 0.2;
+  JobManager jobs(
+      config,
+      [](const Request& inner, core::Progress* progress) {
+        const auto deadline = Clock::now() + kMustHappen;
+        while (!progress->Cancelled() && Clock::now() < deadline) {
+          std::this_thread::sleep_for(milliseconds(1));
+        }
+        return Echo(inner, progress);
+      },
+      On(&store));
+  const std::string id = IdOf(jobs.Submit(Post("/v1/explore")));
+  const Json failed = WaitForState(jobs, id, "failed");
+  EXPECT_EQ(failed["status"], 408);
+  EXPECT_EQ(failed["error"]["code"], "Timeout");
+  EXPECT_EQ(failed["error"]["message"],
+            "the job ran longer than max_time_s = 0.2 s and was stopped (--job-max-time-s): ask "
+            "for fewer designs or starts, or raise the limit");
+  // Stopped at the limit: the runner polls every millisecond; 2 s (kPrompt) absorbs a loaded
+  // machine and still fails a job left to run to kMustHappen (10 s).
+  const double ran_s = failed["finished_s"].get<double>() - failed["started_s"].get<double>();
+  EXPECT_GE(ran_s, 0.2);
+  EXPECT_LT(ran_s, 0.2 + std::chrono::duration<double>(kPrompt).count());
+  EXPECT_EQ(jobs.Result(id).status, 408);
+  EXPECT_EQ(store.Get(id)->state, "failed");
+}
+
+TEST(JobStoreConfigTest, TimeAndMemoryLimitsDefaultsAndRanges) {
+  JobConfig config;
+  EXPECT_EQ(config.max_time_s, 600.0);
+  EXPECT_EQ(config.max_results_memory_bytes, 256u << 20);
+  std::string why;
+  config.max_time_s = 0;
+  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_EQ(why, "max_time_s = 0: must be in (0, 1e+06]");
+  config.max_time_s = 600;
+  config.max_results_memory_bytes = 1000;
+  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_EQ(why, "max_results_memory_bytes = 1000: must be in [1024, 1000000000000]");
+  config.max_results_memory_bytes = 1024;
+  EXPECT_TRUE(config.IsValid(&why));
 }
 
 }  // namespace

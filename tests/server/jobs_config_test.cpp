@@ -120,6 +120,48 @@ TEST(JobsConfigTest, HelpListsTheOptions) {
   }
 }
 
+// The limits of "Under attack, bounded": a job's time, its results in memory, the database's
+// size.
+TEST(JobsConfigTest, JobLimitsFlagsEnvironmentAndRules) {
+  const ServerConfig defaults;
+  EXPECT_EQ(defaults.jobs.max_time_s, 600.0);
+  EXPECT_EQ(defaults.jobs.max_results_memory_bytes, 256u << 20);
+  EXPECT_EQ(defaults.jobs_db_max_bytes, 0u);
+  const auto parsed = Parse(
+      {"--job-max-time-s", "0.5", "--jobs-db-max-bytes=131072"},
+      {{"SWEETSPOT_JOB_RESULTS_MEMORY_BYTES", "2500000"}, {"SWEETSPOT_JOB_MAX_TIME_S", "30"}});
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_EQ(parsed.config.jobs.max_time_s, 0.5);
+  EXPECT_EQ(parsed.config.jobs.max_results_memory_bytes, 2500000u);
+  EXPECT_EQ(parsed.config.jobs_db_max_bytes, 131072u);
+  EXPECT_EQ(Parse({}, {{"SWEETSPOT_JOBS_DB_MAX_BYTES", "0"}}).config.jobs_db_max_bytes, 0u);
+  EXPECT_EQ(Parse({"--job-max-time-s", "0"}).error,
+            "option --job-max-time-s = \"0\": must be a number of seconds in (0, 1000000]");
+  EXPECT_EQ(Parse({}, {{"SWEETSPOT_JOB_MAX_TIME_S", "inf"}}).error,
+            "environment SWEETSPOT_JOB_MAX_TIME_S = \"inf\": must be a number of seconds in "
+            "(0, 1000000]");
+  EXPECT_EQ(Parse({"--job-results-memory-bytes", "1000"}).error,
+            "option --job-results-memory-bytes = \"1000\": must be an integer in [1024, "
+            "1000000000000]");
+  EXPECT_EQ(Parse({"--jobs-db-max-bytes", "4096"}).error,
+            "option --jobs-db-max-bytes = \"4096\": must be 0 (no limit) or at least 65536");
+  ServerConfig config;
+  std::string why;
+  config.jobs_db_max_bytes = 1000;
+  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_EQ(why, "jobs_db_max_bytes = 1000: must be 0 (no limit) or in [65536, 1e15]");
+  config = ServerConfig{};
+  config.jobs.max_time_s = -1;
+  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_EQ(why, "jobs.max_time_s = -1: must be in (0, 1e+06]");
+  const std::string usage = Usage("sweetspot-server");
+  for (const char* name : {"--job-max-time-s", "SWEETSPOT_JOB_MAX_TIME_S", "(default 600)",
+                           "--job-results-memory-bytes", "SWEETSPOT_JOB_RESULTS_MEMORY_BYTES",
+                           "--jobs-db-max-bytes", "SWEETSPOT_JOBS_DB_MAX_BYTES"}) {
+    EXPECT_NE(usage.find(name), std::string::npos) << name;
+  }
+}
+
 TEST(JobsConfigTest, AnUnusableJobsDatabaseStopsTheServerWithTheReason) {
   const std::string path = ::testing::TempDir() + "sweetspot-no-such-dir/sub/jobs.db";
   const std::string reason = "jobs database \"" + path +

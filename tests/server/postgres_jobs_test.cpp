@@ -465,5 +465,34 @@ TEST_F(PostgresJobsTest, AResultOverTheLimitFailsTheJobWholeNeverTruncated) {
             WithoutTimings(PostJson(*replica, "/v1/bat/properties", kQuick).body));
 }
 
+// --job-max-time-s with PostgreSQL: the replica running the job checks the limit at each lease
+// renewal (every 0.5 s here at most), sets the job's cancel flag and commits it failed (408
+// Timeout) naming the limit; no replica runs it again.
+TEST_F(PostgresJobsTest, AJobRunningPastTheTimeLimitIsStoppedAndFailed) {
+  auto replica = Replica({"--job-max-time-s", "0.5"});
+  // 100 x 100 Hertz designs at ~1.5 ms each: ~15 s of work, far past the limit.
+  Json sweep = Json::parse(kSlowSweep);
+  sweep["parameters"][0]["count"] = 100;
+  sweep["parameters"][1]["count"] = 100;
+  const std::string id = SubmitJob(*replica, "/v1/explore", sweep.dump());
+  const Json failed = WaitForState(*replica, id, "failed");
+  EXPECT_EQ(failed["status"], 408);
+  EXPECT_EQ(failed["error"]["code"], "Timeout");
+  EXPECT_NE(
+      failed["error"]["message"].get<std::string>().find("ran longer than max_time_s = 0.5 s"),
+      std::string::npos)
+      << failed.dump();
+  EXPECT_EQ(failed["resumes"], 0);
+  // At the limit plus at most one renewal period (0.5 s) and the design in flight; 2 s more
+  // absorbs a loaded 2-core machine and still fails a job left to run its ~15 s.
+  const double ran_s = failed["finished_s"].get<double>() - failed["started_s"].get<double>();
+  std::cout << "[ measured ] a job over max_time_s = 0.5 s ran " << ran_s << " s\n";
+  EXPECT_GE(ran_s, 0.5);
+  EXPECT_LT(ran_s, 0.5 + 0.5 + 2.0) << failed.dump();
+  const Answer result = Get(*replica, "/v1/jobs/" + id + "/result");
+  EXPECT_EQ(result.status, 408);
+  EXPECT_EQ(result.body["code"], "Timeout");
+}
+
 }  // namespace
 }  // namespace sweetspot

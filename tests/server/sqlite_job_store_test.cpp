@@ -367,6 +367,63 @@ TEST(SqliteJobStoreTest, ErrorObjectsAndKeptResultsSurviveARestartAndOldErrorsAr
                             {"field", nullptr}}));
 }
 
+// Results over kMaxLoadedResultBytes stay out of LoadAll (result_in_store); LoadResult reads
+// them, byte for byte, and says when there is no such job.
+TEST(SqliteJobStoreTest, BigResultsAreLeftOutOfLoadAllAndReadByLoadResult) {
+  TempDir dir;
+  std::string error;
+  auto store = SqliteJobStore::Open(dir.File("jobs.db"), &error);
+  ASSERT_TRUE(store) << error;
+  JobRecord small = FullRecord("small", 1.0);
+  JobRecord big = FullRecord("big", 2.0);
+  big.response_text = std::string(kMaxLoadedResultBytes, 'x');  // Over: plus response_json.
+  ASSERT_TRUE(store->Save(small, &error)) << error;
+  ASSERT_TRUE(store->Save(big, &error)) << error;
+  std::vector<JobRecord> records;
+  ASSERT_TRUE(store->LoadAll(&records, &error)) << error;
+  ASSERT_EQ(records.size(), 2u);
+  ExpectSameRecord(records[0], small);
+  EXPECT_FALSE(records[0].result_in_store);
+  EXPECT_TRUE(records[1].result_in_store);
+  EXPECT_EQ(records[1].response_json, "");
+  EXPECT_EQ(records[1].response_text, "");
+  EXPECT_EQ(records[1].content_type, "text/csv");
+  std::optional<JobRecord> result;
+  ASSERT_TRUE(store->LoadResult("big", &result, &error)) << error;
+  ASSERT_TRUE(result);
+  EXPECT_EQ(result->status, big.status);
+  EXPECT_EQ(result->response_json, big.response_json);
+  EXPECT_EQ(result->response_text, big.response_text);
+  EXPECT_EQ(result->content_type, big.content_type);
+  ASSERT_TRUE(store->LoadResult("none", &result, &error)) << error;
+  EXPECT_FALSE(result);
+}
+
+// max_bytes caps the file (PRAGMA max_page_count): a save past it fails with SQLite's own
+// "database or disk is full", as on a full disk, and what was saved before stays readable.
+TEST(SqliteJobStoreTest, MaxBytesMakesSavesPastItFailAsOnAFullDisk) {
+  TempDir dir;
+  std::string error;
+  SqliteJobStoreOptions options;
+  options.max_bytes = 65536;
+  auto store = SqliteJobStore::Open(dir.File("jobs.db"), &error, options);
+  ASSERT_TRUE(store) << error;
+  ASSERT_TRUE(store->Save(FullRecord("small", 1.0), &error)) << error;
+  JobRecord big = FullRecord("big", 2.0);
+  big.response_text = std::string(100000, 'x');
+  EXPECT_FALSE(store->Save(big, &error));
+  EXPECT_EQ(error, "save job big: database or disk is full (code 13)");
+  std::vector<JobRecord> records;
+  ASSERT_TRUE(store->LoadAll(&records, &error)) << error;
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0].id, "small");
+  options.max_bytes = 1000;
+  EXPECT_FALSE(SqliteJobStore::Open(dir.File("other.db"), &error, options));
+  EXPECT_EQ(error,
+            "invalid SqliteJobStoreOptions: max_bytes = 1000: must be 0 (no limit) or in "
+            "[65536, 1000000000000000]");
+}
+
 }  // namespace
 }  // namespace sqlite_job_store_test
 }  // namespace sweetspot::server
