@@ -257,6 +257,8 @@ struct ConnectionLoop::Impl {
   std::uint64_t next_id = 2;
 
   std::atomic<bool> stopping{false};
+  std::atomic<long long> stop_ns{0};      // when Stop() was first called (steady clock)
+  std::atomic<bool> grace_ended{false};  // EndGrace(): no more time for requests in flight
   std::atomic<int> admitted{0};   // open connections that count against max_connections
   std::atomic<int> lingering{0};  // half-closed connections being drained
   std::atomic<bool> accept_paused{false};
@@ -602,8 +604,18 @@ struct ConnectionLoop::Impl {
   // Answers the framed request of `c` on a compute worker, with a cancel flag the deadline
   // keeper sets (client gone, max_request_time_s, shutdown). A request whose client left
   // while it was queued is dropped; once the server stops, one still queued is refused.
+  // True once the server stops and the requests in flight have had their grace.
+  bool GraceOver(Clock::time_point now) const {
+    if (!stopping.load()) return false;
+    if (grace_ended.load()) return true;
+    return now.time_since_epoch().count() - stop_ns.load() >=
+           std::chrono::duration_cast<Clock::duration>(
+               std::chrono::duration<double>(options.shutdown_grace_s))
+               .count();
+  }
+
   void AnswerCompute(Connection& c) {
-    if (stopping.load(std::memory_order_relaxed)) {
+    if (GraceOver(Clock::now())) {
       Refuse(c, 503, api::ErrorCode::kTooBusy, Reason::kOverLimit,
              "the server is shutting down; retry on another replica or later", Clock::now());
       c.keep_open = false;
@@ -905,7 +917,7 @@ struct ConnectionLoop::Impl {
     for (const ConnectionPtr& c : Snapshot()) {
       std::unique_lock<std::mutex> lock(c->mutex, std::try_to_lock);
       if (!lock.owns_lock()) {
-        CheckWorking(*c, now, /*shutting_down=*/true);  // being answered: stop its models
+        CheckWorking(*c, now, GraceOver(now));  // being answered: stopped once the grace ends
         continue;
       }
       if (c->closed || c->state == State::kWorking) continue;
@@ -939,7 +951,13 @@ ConnectionLoop::~ConnectionLoop() {
   if (m.wake_fd >= 0) ::close(m.wake_fd);
 }
 
-void ConnectionLoop::Stop() { impl_->stopping.store(true); }
+void ConnectionLoop::Stop() {
+  long long unset = 0;
+  impl_->stop_ns.compare_exchange_strong(unset, Clock::now().time_since_epoch().count());
+  impl_->stopping.store(true);
+}
+
+void ConnectionLoop::EndGrace() { impl_->grace_ended.store(true); }
 
 bool ConnectionLoop::Run() {
   Impl& m = *impl_;

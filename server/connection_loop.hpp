@@ -28,8 +28,9 @@
 // max_unsent_bytes_per_client is closed with the answer cut. Range headers are
 // dropped before httplib sees the request: every answer is whole. A request of the compute pool carries a cancel flag (RequestCancel) that the
 // deadline keeper sets when its client closes the connection, when it has computed for
-// max_request_time_s, or when the server stops; a queued request whose client left is
-// dropped without computing.
+// max_request_time_s, or shutdown_grace_s after the server began to stop; a queued
+// request whose client left is dropped without computing, and one still queued when the
+// grace ends is refused 503.
 // A closed connection is first half-closed and drained for up to linger_s (so
 // that the client reads the answer instead of a reset), without counting
 // against the limit.
@@ -64,6 +65,9 @@ struct ConnectionLoopOptions {
   double first_byte_timeout_s = 2.0;
   /// A compute-pool request is cancelled (CancelReason::kDeadline) after computing this long, s.
   double max_request_time_s = 120.0;
+  /// After Stop(), how long requests being answered (and queued compute requests) may still
+  /// finish, s; then they are cancelled (CancelReason::kShutdown) and queued ones refused.
+  double shutdown_grace_s = 8.0;
   /// Largest request head, bytes; beyond: 431.
   std::size_t max_head_bytes = 65536;
   /// Larger bodies are not read (httplib answers 413).
@@ -127,8 +131,11 @@ class ConnectionLoop {
   /// being answered finish (with Connection: close) and returns. Returns false
   /// if it could not start (epoll failed).
   bool Run();
-  /// Makes Run() return (after the in-flight requests); idempotent, any thread.
+  /// Makes Run() return (after the in-flight requests, within shutdown_grace_s); idempotent,
+  /// any thread.
   void Stop();
+  /// Ends the shutdown grace at once: the requests still computing are cancelled. Any thread.
+  void EndGrace();
 
   /// Prometheus text of the loop's gauges and counters (connections by state,
   /// refusals by reason, each pool's busy workers, their peak and queue).

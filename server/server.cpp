@@ -583,7 +583,10 @@ void Server::Shutdown() {
   }
 }
 
-void Server::EndShutdownGrace() { impl_->jobs->EndGrace(); }
+void Server::EndShutdownGrace() {
+  if (impl_->loop) impl_->loop->EndGrace();
+  impl_->jobs->EndGrace();
+}
 
 bool Server::Bind(std::string* error) {
   if (!impl_->startup_error.empty()) {
@@ -606,6 +609,7 @@ bool Server::Bind(std::string* error) {
   options.first_byte_timeout_s = config_.first_byte_timeout_s;
   options.max_unsent_bytes_per_client = config_.max_unsent_bytes_per_client;
   options.max_request_time_s = config_.max_request_time_s;
+  options.shutdown_grace_s = config_.shutdown_grace_s;
   options.max_head_bytes = config_.max_head_bytes;
   options.max_body_bytes = config_.max_body_bytes;
   options.header_timeout_s = config_.header_timeout_s;

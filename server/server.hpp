@@ -33,14 +33,16 @@ class Server {
   int compute_threads() const;
   /// Serves until Stop(); returns false if the listen loop failed.
   bool Run();
-  /// Stops accepting and makes Run() return (in-flight requests finish).
+  /// Stops accepting and makes Run() return: in-flight requests finish within
+  /// config.shutdown_grace_s, then their models are stopped (503).
   void Stop();
   /// After Run() returned: Stop(), then stops the jobs: no new ones, running
   /// ones get config.shutdown_grace_s seconds to finish, the rest are
   /// interrupted and (with a jobs database) kept queued for the next start.
   /// Logs to stderr what it waits for and what it keeps. Idempotent.
   void Shutdown();
-  /// Ends Shutdown()'s grace period now (from another thread, e.g. on a second signal).
+  /// Ends the grace periods of Stop() and Shutdown() now (from another thread, e.g. on a
+  /// second signal): requests and jobs still computing are stopped.
   void EndShutdownGrace();
 
  private:
