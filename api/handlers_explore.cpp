@@ -16,6 +16,7 @@
 #include "api/explore_shards.hpp"
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
+#include "api/memory_reserve.hpp"
 #include "api/scene_json.hpp"
 #include "api/trade_units.hpp"
 #include "core/sampling.hpp"
@@ -505,7 +506,7 @@ Response HandleExplore(const Request& request, const Context& context) {
       if (!sink(header)) return false;
       const SweepOutcome outcome = RunSweep(*sweep, RowFormat::kCsv, columns, progress,
                                             [&](BlockRows& rows) { return sink(rows.text); });
-      return !outcome.stopped && !outcome.cancelled;
+      return !outcome.stopped && !outcome.cancelled && !outcome.failed;  // else truncated
     };
     return streamed;
   }
@@ -523,6 +524,12 @@ Response HandleExplore(const Request& request, const Context& context) {
       const SweepOutcome outcome = RunSweep(*sweep, RowFormat::kNdjson, columns, progress,
                                             [&](BlockRows& rows) { return sink(rows.text); });
       if (outcome.stopped) return false;
+      if (outcome.failed) {
+        return line({{"error",
+                      {{"code", ErrorCodeName(ErrorCode::kUnavailable)},
+                       {"message", outcome.message},
+                       {"field", nullptr}}}});
+      }
       if (outcome.cancelled) {
         return line({{"error",
                       {{"code", ErrorCodeName(ErrorCode::kCancelled)},
@@ -539,6 +546,14 @@ Response HandleExplore(const Request& request, const Context& context) {
         for (Json& row : block.rows) rows.push_back(std::move(row));
         return true;
       });
+  if (outcome.failed) {
+    rows = Json();  // the memory back before the answer is made
+    RestoreMemoryReserve();
+    return ErrorResponse(503, ErrorCode::kUnavailable,
+                         outcome.message +
+                             "; retry later, or ask for \"format\": \"ndjson\" or \"csv\" "
+                             "(streamed)");
+  }
   if (outcome.cancelled) return ErrorResponse(409, ErrorCode::kCancelled, outcome.message);
   return {200, {{"rows", std::move(rows)}, {"summary", outcome.summary}}};
 }
