@@ -1287,8 +1287,9 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
     // An earlier allocation failed and its reserve cannot be taken back yet: a sweep now could
     // fail where nothing is left to unwind with (api/memory_reserve.hpp).
     outcome.failed = true;
-    outcome.message = "the server is low on memory (an allocation failed earlier and the memory "
-                      "it kept back cannot be taken again yet)";
+    outcome.message =
+        "the server is low on memory (an allocation failed earlier and the memory "
+        "it kept back cannot be taken again yet)";
     return outcome;
   }
   RunPlan plan;

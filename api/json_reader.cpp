@@ -360,9 +360,10 @@ bool ObjectReader::OptionalNumber(std::string_view key, const NumberRule& rule, 
   const double number = value->get<double>() * to_si;
   if (!rule.Accepts(number)) {
     // The rule is the SI field's: say what the value is in it.
-    return Fail(given_as, given_as == key ? DescribeRefusal(rule, number)
-                                          : DescribeRefusal(rule, number) + " as " + std::string(key) + " (" +
-                                                core::FormatNumber(number) + ")");
+    return Fail(given_as, given_as == key
+                              ? DescribeRefusal(rule, number)
+                              : DescribeRefusal(rule, number) + " as " + std::string(key) + " (" +
+                                    core::FormatNumber(number) + ")");
   }
   *out = number;
   return true;

@@ -12,10 +12,10 @@
 namespace sweetspot::api {
 namespace {
 
-std::mutex reserve_mutex;             // guards reserve and reserve_bytes
-void* reserve = nullptr;              // the reserve (malloc'd), or null when spent
-std::size_t reserve_bytes = 0;        // its size; 0 = not installed
-std::atomic<bool> memory_low{false};  // spent and not restored
+std::mutex reserve_mutex;                // guards reserve and reserve_bytes
+void* reserve = nullptr;                 // the reserve (malloc'd), or null when spent
+std::size_t reserve_bytes = 0;           // its size; 0 = not installed
+std::atomic<bool> memory_low{false};     // spent and not restored
 std::atomic<std::uint64_t> failures{0};  // allocations that failed
 
 // Called by operator new when malloc fails: frees the reserve (operator new then tries again);

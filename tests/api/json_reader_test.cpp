@@ -165,16 +165,17 @@ TEST(ObjectReaderTest, NumberBeyondTheDefaultMagnitudeNamesItsRange) {
 
 // The same through an endpoint: the answer names the field, the value and the range.
 TEST(ObjectReaderTest, NumberBeyondTheDefaultMagnitudeThroughAnEndpoint) {
-  const Response r = Dispatch(
-      {"POST", "/v1/bat/properties",
-       R"({"bat": {"three_segment": {"length_m": 1e301, "handle_radius_m": 0.0125,
+  const Response r =
+      Dispatch({"POST", "/v1/bat/properties",
+                R"({"bat": {"three_segment": {"length_m": 1e301, "handle_radius_m": 0.0125,
            "barrel_radius_m": 0.033, "taper_start_m": 0.3, "taper_end_m": 0.55}}})"},
-      Context{});
+               Context{});
   EXPECT_EQ(r.status, 400);
   EXPECT_EQ(r.body, (nlohmann::json{{"code", "InvalidValue"},
                                     {"field", "bat.three_segment.length_m"},
-                                    {"message", "bat.three_segment.length_m = 1e+301: must be a "
-                                                "number in [-1e+300, 1e+300]"}}));
+                                    {"message",
+                                     "bat.three_segment.length_m = 1e+301: must be a "
+                                     "number in [-1e+300, 1e+300]"}}));
 }
 
 TEST(ObjectReaderTest, MissingRequiredFieldIsMissingField) {

@@ -5,8 +5,8 @@
 // called after throwing an instance of 'std::bad_alloc'", exit 134 under a 4 GB cap).
 #include <gtest/gtest.h>
 #include <httplib.h>
-#include <nlohmann/json.hpp>
 #include <sys/wait.h>
+#include <nlohmann/json.hpp>
 
 #include <string>
 
