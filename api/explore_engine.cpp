@@ -7,14 +7,18 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstring>
+#include <exception>
 #include <map>
 #include <mutex>
+#include <new>
 #include <string_view>
+#include <system_error>
 #include <thread>
 #include <utility>
 
 #include "api/bat_json.hpp"
 #include "api/json_reader.hpp"
+#include "api/memory_reserve.hpp"
 #include "api/scene_json.hpp"
 #include "api/trade_units.hpp"
 #include "core/scene/timing_book.hpp"
@@ -777,6 +781,7 @@ void AppendJsonValue(const DirectValue& v, JsonValueMemo* memo, std::string* out
 // objectives, the designs.
 struct RunPlan {
   const Sweep* sweep = nullptr;
+  std::uint64_t memory_failures = 0;  // MemoryFailures() when the run started
   RowFormat format = RowFormat::kJson;
   const std::vector<ExploreColumn>* columns = nullptr;
   std::vector<DirectAccessor> column_accessors;     // when `direct`
@@ -1259,6 +1264,10 @@ void EvaluateBlock(const RunPlan& plan, std::uint64_t first, std::uint64_t count
       out->cancelled = true;
       return;
     }
+    // An allocation failed since the run started and the memory reserve was spent on it
+    // (api/memory_reserve.hpp): stop here, where unwinding has the reserve's memory, rather
+    // than at an allocation inside the json code.
+    if (MemoryFailures() != plan.memory_failures) throw std::bad_alloc();
     EvaluateOne(plan, plan.DesignIndex(k), worker, out);
     ++out->rows.count;
   }
@@ -1274,7 +1283,17 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
                       const std::vector<ExploreColumn>& columns, core::Progress* progress,
                       const std::function<bool(BlockRows&)>& emit) {
   SweepOutcome outcome;
+  if (!RestoreMemoryReserve()) {
+    // An earlier allocation failed and its reserve cannot be taken back yet: a sweep now could
+    // fail where nothing is left to unwind with (api/memory_reserve.hpp).
+    outcome.failed = true;
+    outcome.message =
+        "the server is low on memory (an allocation failed earlier and the memory "
+        "it kept back cannot be taken again yet)";
+    return outcome;
+  }
   RunPlan plan;
+  plan.memory_failures = MemoryFailures();
   plan.sweep = &sweep;
   plan.format = format;
   plan.columns = &columns;
@@ -1388,15 +1407,36 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
   int helpers = static_cast<int>(std::min<std::uint64_t>(
       static_cast<std::uint64_t>(std::max(1, sweep.threads) - 1), n > 0 ? n - 1 : 0));
   if (helpers > 0 && sweep.budget != nullptr) helpers = sweep.budget->TryTake(helpers);
+  // An exception (std::bad_alloc) in any thread of the sweep ends it as a failure: in a
+  // helper std::thread it would otherwise reach std::terminate and end the process.
+  const auto fail = [&](const std::exception_ptr& caught) {
+    outcome = SweepOutcome{};
+    outcome.failed = true;
+    std::string what = "an unknown exception";
+    try {
+      std::rethrow_exception(caught);
+    } catch (const std::bad_alloc&) {
+      what = "out of memory (std::bad_alloc)";
+    } catch (const std::system_error& e) {
+      what = std::string("a system error (") + e.code().message() + ")";
+    } catch (...) {
+    }
+    outcome.message = "the sweep failed after " + std::to_string(evaluated) + " designs: " + what;
+    return outcome;
+  };
   if (helpers <= 0) {
-    Worker worker;
-    BlockCost cost;
-    for (std::uint64_t k = 0; k < n;) {
-      BlockResult block;
-      const std::uint64_t count = std::min(n - k, BlockDesigns(cost));
-      EvaluateBlock(plan, k, count, progress, &worker, &block, &cost);
-      k += count;
-      if (!take(block)) return outcome;
+    try {
+      Worker worker;
+      BlockCost cost;
+      for (std::uint64_t k = 0; k < n;) {
+        BlockResult block;
+        const std::uint64_t count = std::min(n - k, BlockDesigns(cost));
+        EvaluateBlock(plan, k, count, progress, &worker, &block, &cost);
+        k += count;
+        if (!take(block)) return outcome;
+      }
+    } catch (...) {
+      return fail(std::current_exception());
     }
   } else {
     // Workers (this thread among them) take the next designs as a block; this thread hands
@@ -1409,6 +1449,7 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
     std::uint64_t in_flight = 0;                // blocks being evaluated
     BlockCost cost;                             // what a design of the last block cost
     bool stop = false;
+    std::exception_ptr failure;  // the first exception of any thread (then stop)
     const std::uint64_t window = 4 * static_cast<std::uint64_t>(helpers + 1);
     const auto has_room = [&] { return next < n && done.size() + in_flight < window; };
     // Takes the next block under the lock: [*first, *first + *count).
@@ -1430,43 +1471,75 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
       done.emplace(first, std::move(block));
       --in_flight;
     };
+    // Records the first exception of any thread and stops every thread (`lock` may or may not
+    // hold the mutex: an exception inside `evaluate` leaves it released).
+    const auto record_failure = [&](std::unique_lock<std::mutex>& lock) {
+      if (!lock.owns_lock()) lock.lock();
+      if (!failure) failure = std::current_exception();
+      stop = true;
+      lock.unlock();
+      ready.notify_all();
+      room.notify_all();
+    };
     const auto work = [&]() {
-      Worker worker;
-      std::unique_lock<std::mutex> lock(mutex);
-      for (;;) {
-        room.wait(lock, [&] { return stop || next >= n || has_room(); });
-        if (stop || next >= n) return;
-        std::uint64_t first = 0, count = 0;
-        claim(&first, &count);
-        evaluate(lock, first, count, &worker);
-        ready.notify_all();
+      std::unique_lock<std::mutex> lock(mutex, std::defer_lock);
+      try {
+        Worker worker;
+        lock.lock();
+        for (;;) {
+          room.wait(lock, [&] { return stop || next >= n || has_room(); });
+          if (stop || next >= n) return;
+          std::uint64_t first = 0, count = 0;
+          claim(&first, &count);
+          evaluate(lock, first, count, &worker);
+          ready.notify_all();
+        }
+      } catch (...) {
+        record_failure(lock);
       }
     };
     std::vector<std::thread> threads;
-    threads.reserve(static_cast<std::size_t>(helpers));
-    for (int t = 0; t < helpers; ++t) threads.emplace_back(work);
-    Worker own_worker;
     bool ok = true;
+    try {
+      threads.reserve(static_cast<std::size_t>(helpers));
+      for (int t = 0; t < helpers; ++t) threads.emplace_back(work);
+    } catch (...) {
+      // A thread that could not start (std::system_error: no memory for its stack): the
+      // threads that did start, and this one, do the work; the rest go back to the budget.
+    }
+    if (sweep.budget != nullptr) sweep.budget->Give(helpers - static_cast<int>(threads.size()));
     std::uint64_t handed = 0;  // the first design not handed on yet
-    while (ok && handed < n) {
-      BlockResult block;
-      {
-        std::unique_lock<std::mutex> lock(mutex);
-        ready.wait(lock, [&] { return done.count(handed) > 0 || has_room(); });
-        if (done.count(handed) == 0) {
-          // The next block is not finished and there is room: this thread evaluates one too.
-          std::uint64_t first = 0, count = 0;
-          claim(&first, &count);
-          evaluate(lock, first, count, &own_worker);
-          continue;
+    {
+      std::unique_lock<std::mutex> lock(mutex, std::defer_lock);
+      try {
+        Worker own_worker;
+        while (ok && handed < n) {
+          BlockResult block;
+          lock.lock();
+          ready.wait(lock, [&] { return failure || done.count(handed) > 0 || has_room(); });
+          if (failure) {
+            lock.unlock();
+            break;
+          }
+          if (done.count(handed) == 0) {
+            // The next block is not finished and there is room: this thread evaluates one too.
+            std::uint64_t first = 0, count = 0;
+            claim(&first, &count);
+            evaluate(lock, first, count, &own_worker);
+            lock.unlock();
+            continue;
+          }
+          block = std::move(done[handed]);
+          done.erase(handed);
+          // A cancelled block is short: what follows it is never handed on.
+          handed += block.cancelled ? n : block.rows.count;
+          lock.unlock();
+          room.notify_all();
+          ok = take(block);
         }
-        block = std::move(done[handed]);
-        done.erase(handed);
-        // A cancelled block is short: what follows it is never handed on.
-        handed += block.cancelled ? n : block.rows.count;
+      } catch (...) {
+        record_failure(lock);
       }
-      room.notify_all();
-      ok = take(block);
     }
     {
       std::lock_guard<std::mutex> lock(mutex);
@@ -1474,7 +1547,8 @@ SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
     }
     room.notify_all();
     for (std::thread& t : threads) t.join();
-    if (sweep.budget != nullptr) sweep.budget->Give(helpers);
+    if (sweep.budget != nullptr) sweep.budget->Give(static_cast<int>(threads.size()));
+    if (failure) return fail(failure);
     if (!ok) return outcome;
   }
 

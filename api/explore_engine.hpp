@@ -157,14 +157,18 @@ struct BlockRows {
 struct SweepOutcome {
   bool cancelled = false;  ///< Progress::Cancel() (message says after how many designs).
   bool stopped = false;    ///< The row sink refused a block (a streaming client went away).
-  std::string message;     ///< Why it was cancelled.
-  nlohmann::json summary;  ///< Set when neither.
+  /// An exception ended the sweep (out of memory: std::bad_alloc, or a thread that could not
+  /// start), in any of its threads; message says which and after how many designs.
+  bool failed = false;
+  std::string message;     ///< Why it was cancelled or failed.
+  nlohmann::json summary;  ///< Set when none of the three.
 };
 
 /// Evaluates the shard's designs on up to sweep.threads threads in blocks of consecutive
 /// designs, handing each block to `emit` in index order (false from it stops the sweep),
 /// and returns the summary. With `columns`, a row is the flat object (or CSV line) of
-/// those columns. Never throws.
+/// those columns. Never throws: an exception in any of its threads (std::bad_alloc) ends the
+/// sweep with SweepOutcome::failed, after every thread it started has been joined.
 SweepOutcome RunSweep(const Sweep& sweep, RowFormat format,
                       const std::vector<ExploreColumn>& columns, core::Progress* progress,
                       const std::function<bool(BlockRows&)>& emit);

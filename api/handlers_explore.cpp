@@ -13,9 +13,11 @@
 #include "api/explore_columns.hpp"
 #include "api/explore_design.hpp"
 #include "api/explore_engine.hpp"
+#include "api/explore_estimate.hpp"
 #include "api/explore_shards.hpp"
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
+#include "api/memory_reserve.hpp"
 #include "api/scene_json.hpp"
 #include "api/trade_units.hpp"
 #include "core/sampling.hpp"
@@ -467,15 +469,32 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   identity.erase("columns");
   identity.erase("report_units");
   sweep->provenance = Provenance(identity, Json::object(), sweep->plan.seed);
+  sweep->threads = std::max(1, context.explore_threads);
+  sweep->imperial = units == ReportUnits::kImperial;
+  {
+    // What the answer and the work will be, before the first design: a synchronous JSON
+    // answer is built in memory (rows, then their text), so its size is bounded; a job's
+    // CPU time and result are bounded at submit (ndjson and csv answers are streamed).
+    const SweepEstimate estimate = EstimateSweep(*sweep, format, columns);
+    std::optional<ApiError> over;
+    if (!context.batch && format == "json") {
+      over = CheckResponseSize(estimate, *sweep, context.limits);
+    }
+    if (!over && context.job) {
+      over = CheckJobEstimate(estimate, *sweep, sweep->threads, context.limits);
+    }
+    if (over) {
+      *error = std::move(*over);
+      return std::nullopt;
+    }
+  }
   // Designs by index: grids enumerated, Sobol by a jump of its generator, LHS from the table
   // drawn here (every shard draws the same table and takes its designs from it).
   sweep->designs.emplace(sweep->plan);
   // The sweep engine: the template resolved once, the swept values bound without JSON.
   sweep->binder =
       DesignBinder::Compile(sweep->base, sweep->parameters, sweep->outputs, sweep->limits);
-  sweep->threads = std::max(1, context.explore_threads);
   sweep->budget = context.thread_budget;
-  sweep->imperial = units == ReportUnits::kImperial;
 
   return ExploreRequest{std::move(sweep), std::move(format), std::move(columns)};
 }
@@ -505,7 +524,7 @@ Response HandleExplore(const Request& request, const Context& context) {
       if (!sink(header)) return false;
       const SweepOutcome outcome = RunSweep(*sweep, RowFormat::kCsv, columns, progress,
                                             [&](BlockRows& rows) { return sink(rows.text); });
-      return !outcome.stopped && !outcome.cancelled;
+      return !outcome.stopped && !outcome.cancelled && !outcome.failed;  // else truncated
     };
     return streamed;
   }
@@ -523,6 +542,12 @@ Response HandleExplore(const Request& request, const Context& context) {
       const SweepOutcome outcome = RunSweep(*sweep, RowFormat::kNdjson, columns, progress,
                                             [&](BlockRows& rows) { return sink(rows.text); });
       if (outcome.stopped) return false;
+      if (outcome.failed) {
+        return line({{"error",
+                      {{"code", ErrorCodeName(ErrorCode::kUnavailable)},
+                       {"message", outcome.message},
+                       {"field", nullptr}}}});
+      }
       if (outcome.cancelled) {
         return line({{"error",
                       {{"code", ErrorCodeName(ErrorCode::kCancelled)},
@@ -539,6 +564,14 @@ Response HandleExplore(const Request& request, const Context& context) {
         for (Json& row : block.rows) rows.push_back(std::move(row));
         return true;
       });
+  if (outcome.failed) {
+    rows = Json();  // the memory back before the answer is made
+    RestoreMemoryReserve();
+    return ErrorResponse(503, ErrorCode::kUnavailable,
+                         outcome.message +
+                             "; retry later, or ask for \"format\": \"ndjson\" or \"csv\" "
+                             "(streamed)");
+  }
   if (outcome.cancelled) return ErrorResponse(409, ErrorCode::kCancelled, outcome.message);
   return {200, {{"rows", std::move(rows)}, {"summary", outcome.summary}}};
 }

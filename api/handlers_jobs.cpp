@@ -144,6 +144,7 @@ Response HandleJobSubmit(const Request& request, const Context& context) {
   Context check = context;
   check.validate_only = true;
   check.batch = true;  // as the job will run (server/server.cpp's runner)
+  check.job = true;    // its estimated cost against the job limits (max_job_cpu_s, ...)
   check.progress = nullptr;
   Response checked = CallRoute(*job->target, inner, check);
   if (checked.status < 200 || checked.status >= 300) return checked;

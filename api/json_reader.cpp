@@ -152,6 +152,23 @@ bool NumberRule::Accepts(double value) const {
   return true;
 }
 
+namespace {
+
+// The rule's text for a value it refuses. Describe() leaves out a bound at the rule's default
+// magnitude (+-1e300, which AnyNumber, Positive, NonNegative have): a finite value beyond it
+// (1e301) was refused as "must be a number", which names no range. Such a value gets the
+// whole interval, that bound included.
+std::string DescribeRefusal(const NumberRule& rule, double value) {
+  const bool beyond_default = std::isfinite(value) && ((value > rule.max && !(rule.max < 1e299)) ||
+                                                       (value < rule.min && !(rule.min > -1e299)));
+  if (!beyond_default) return rule.Describe();
+  return std::string("must be ") + (rule.integer ? "an integer" : "a number") + " in " +
+         (rule.min_exclusive ? "(" : "[") + core::FormatNumber(rule.min) + ", " +
+         core::FormatNumber(rule.max) + (rule.max_exclusive ? ")" : "]");
+}
+
+}  // namespace
+
 NumberRule AnyNumber() { return NumberRule{}; }
 NumberRule Positive(double max) { return NumberRule{0.0, max, true, false, false}; }
 NumberRule NonNegative(double max) { return NumberRule{0.0, max, false, false, false}; }
@@ -343,9 +360,10 @@ bool ObjectReader::OptionalNumber(std::string_view key, const NumberRule& rule, 
   const double number = value->get<double>() * to_si;
   if (!rule.Accepts(number)) {
     // The rule is the SI field's: say what the value is in it.
-    return Fail(given_as, given_as == key ? rule.Describe()
-                                          : rule.Describe() + " as " + std::string(key) + " (" +
-                                                core::FormatNumber(number) + ")");
+    return Fail(given_as, given_as == key
+                              ? DescribeRefusal(rule, number)
+                              : DescribeRefusal(rule, number) + " as " + std::string(key) + " (" +
+                                    core::FormatNumber(number) + ")");
   }
   *out = number;
   return true;
@@ -388,7 +406,7 @@ bool ObjectReader::OptionalInteger(std::string_view key, long long min, long lon
     return true;
   }
   const double number = value->get<double>();
-  if (!rule.Accepts(number)) return Fail(key, rule.Describe());
+  if (!rule.Accepts(number)) return Fail(key, DescribeRefusal(rule, number));
   *out = static_cast<long long>(number);
   return true;
 }

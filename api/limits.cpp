@@ -15,12 +15,17 @@ bool ApiLimits::IsValid(std::string* why) const {
     return fail("max_json_depth = " + std::to_string(max_json_depth) + ": must be in [2, 512]");
   }
   const std::pair<const char*, std::size_t> sizes[] = {
-      {"max_array_length", max_array_length},   {"max_string_length", max_string_length},
-      {"max_knots", max_knots},                 {"max_variants", max_variants},
-      {"max_curve_samples", max_curve_samples}, {"max_samples", max_samples},
+      {"max_array_length", max_array_length},
+      {"max_string_length", max_string_length},
+      {"max_knots", max_knots},
+      {"max_variants", max_variants},
+      {"max_curve_samples", max_curve_samples},
+      {"max_samples", max_samples},
       {"max_batch_samples", max_batch_samples},
       {"max_design_variables", max_design_variables},
-      {"max_jobs_page", max_jobs_page}};
+      {"max_jobs_page", max_jobs_page},
+      {"max_response_bytes", max_response_bytes},
+      {"max_job_result_bytes", max_job_result_bytes}};
   for (const auto& [name, value] : sizes) {
     if (value < 1) return fail(std::string(name) + " = 0: must be at least 1");
   }
@@ -38,6 +43,13 @@ bool ApiLimits::IsValid(std::string* why) const {
   }
   if (!std::isfinite(max_time_s) || max_time_s <= 0) {
     return fail("max_time_s = " + core::FormatNumber(max_time_s) + ": must be > 0");
+  }
+  const std::pair<const char*, double> seconds[] = {{"max_job_cpu_s", max_job_cpu_s},
+                                                    {"max_job_time_s", max_job_time_s}};
+  for (const auto& [name, value] : seconds) {
+    if (!std::isfinite(value) || value <= 0) {
+      return fail(std::string(name) + " = " + core::FormatNumber(value) + ": must be > 0");
+    }
   }
   return true;
 }

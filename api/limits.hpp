@@ -27,6 +27,21 @@ struct ApiLimits {
   long long max_integration_steps = 10000000;  ///< ODE steps of one impact (hertz, flexible).
   /// Jobs on one page of GET /v1/jobs (the largest `limit` a client may ask for).
   std::size_t max_jobs_page = 1000;
+  /// Estimated bytes of an answer built in memory before it is sent: a synchronous
+  /// /v1/explore in JSON (rows x the bytes of a row as written; while it is built the server
+  /// holds about 6x that: 2000 rows x 1000 curve points, 160 MB of text, peaked at 0.93 GB).
+  /// 413 before the first design beyond it; ndjson and csv answers are streamed, not bounded.
+  std::size_t max_response_bytes = 64u << 20;
+  /// A job's estimated CPU time at submit, s: designs x the per-design cost of the models its
+  /// outputs need (api/explore_estimate.cpp). 413 at POST /v1/jobs beyond it.
+  double max_job_cpu_s = 3600.0;
+  /// A job's wall time, s. At submit: its estimated CPU time over its threads (413 beyond);
+  /// while it runs: enforced by the job runner (server/jobs). The server sets it from its
+  /// --job-max-time-s.
+  double max_job_time_s = 600.0;
+  /// A job's result, bytes. At submit: its estimate (413 beyond); when stored: enforced by the
+  /// job runner (server/jobs). The server sets it from its --job-max-result-bytes.
+  std::size_t max_job_result_bytes = 268435456;
 
   /// True when every limit is positive and sane; otherwise "field = value: rule" in *why.
   bool IsValid(std::string* why) const;

@@ -16,6 +16,7 @@
 
 #include "api/explore_shards.hpp"
 #include "api/json_reader.hpp"
+#include "api/memory_reserve.hpp"
 #include "api/router.hpp"
 #include "server/run.hpp"
 
@@ -150,6 +151,9 @@ int ExitCode(int status) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // As sweetspot-server's main (server/server_main.cpp): a sweep that runs out of memory ends
+  // with an error, in `sweetspot serve` and in the CLI's own sweeps.
+  sweetspot::api::InstallMemoryReserve(256u << 20);
   std::vector<std::string> args(argv + 1, argv + argc);
   if (!args.empty() && args[0] == "serve") {
     return sweetspot::server::RunServerMain(std::vector<std::string>(args.begin() + 1, args.end()));

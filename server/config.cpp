@@ -46,6 +46,19 @@ bool ParseSeconds(const std::string& text, double* out, std::string* rule) {
   return true;
 }
 
+// A number of seconds in (0, max] (a limit longer than ParseSeconds' hour).
+bool ParseSecondsUpTo(const std::string& text, double max, double* out, std::string* rule) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end == nullptr || *end != '\0' || !std::isfinite(value) || value <= 0 ||
+      value > max) {
+    *rule = "must be a number of seconds in (0, " + core::FormatNumber(max) + "]";
+    return false;
+  }
+  *out = value;
+  return true;
+}
+
 bool ParseBool(const std::string& text, bool* out, std::string* rule) {
   if (text == "1" || text == "true" || text == "yes" || text == "on") {
     *out = true;
@@ -296,6 +309,23 @@ const std::vector<Option>& Options() {
        true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->limits.max_batch_samples, v, rule);
+       }},
+      {"--max-response-bytes", "SWEETSPOT_MAX_RESPONSE_BYTES",
+       "estimated bytes of an answer built in memory (a synchronous /v1/explore in JSON: rows "
+       "x bytes per row); beyond it 413 before the first design (default 67108864)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         long long n = 0;
+         if (!ParseLong(v, 1024, 1LL << 40, &n, rule)) return false;
+         c->limits.max_response_bytes = static_cast<std::size_t>(n);
+         return true;
+       }},
+      {"--max-job-cpu-s", "SWEETSPOT_MAX_JOB_CPU_S",
+       "a job's estimated CPU time (designs x its models' cost per design), s; beyond it "
+       "POST /v1/jobs answers 413 (default 3600)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseSecondsUpTo(v, 1e7, &c->limits.max_job_cpu_s, rule);
        }},
       {"--max-design-variables", "SWEETSPOT_MAX_DESIGN_VARIABLES",
        "variables of one /v1/optimize design (default 200, the optimiser's ceiling)", true,
@@ -587,6 +617,9 @@ ParsedCommandLine ParseCommandLine(
       return out;
     }
   }
+  // One flag per job limit: the api's check at submit reads the job runner's limits.
+  out.config.limits.max_job_time_s = out.config.jobs.max_time_s;
+  out.config.limits.max_job_result_bytes = out.config.jobs.max_result_bytes;
   if (!out.config.IsValid(&rule)) out.error = rule;
   return out;
 }

@@ -406,6 +406,10 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
   impl_->static_files =
       std::make_unique<StaticFiles>(config_.web_root.empty() ? DefaultWebRoot() : config_.web_root);
   impl_->context.limits = config_.limits;
+  // A job's limits at submit (api/explore_estimate) are the job runner's (--job-max-time-s,
+  // --job-max-result-bytes): one flag each.
+  impl_->context.limits.max_job_time_s = config_.jobs.max_time_s;
+  impl_->context.limits.max_job_result_bytes = config_.jobs.max_result_bytes;
   impl_->context.modes_cache = &impl_->modes_cache;
   impl_->compute_budget =
       std::make_unique<api::ThreadBudget>(ComputeWorkers(config_.compute_threads));

@@ -150,6 +150,56 @@ TEST(JobSubmitTest, AnExploreJobHasTheBatchLimitAtSubmitToo) {
   EXPECT_EQ(jobs.submitted.size(), 1u);
 }
 
+// Issue "Under attack, bounded", item 11a: 1,000,000 flexible designs were accepted as a job
+// (~85 min of both cores). At submit, the estimated CPU time (designs x the per-design cost of
+// the models the outputs need), wall time and result size are checked against the job limits.
+TEST(JobSubmitTest, AnExploreJobOverItsEstimatedCostIsRefusedAtSubmit) {
+  auto sweep = [](int count, const char* model) {
+    return Json{{"bat", {{"preset", "paper-wood"}}},
+                {"parameters", {{{"path", "cor"}, {"min", 0.4}, {"max", 0.6}, {"count", count}}}},
+                {"outputs", {"max_exit_speed"}},
+                {"options", {{"model", model}}}};
+  };
+  RecordingJobs jobs;
+  const Response flexible = SubmitJob(&jobs, "/v1/explore", sweep(1000000, "flexible"));
+  ASSERT_EQ(flexible.status, 413) << flexible.body.dump();
+  EXPECT_EQ(flexible.body["code"], "TooBig");
+  EXPECT_EQ(flexible.body["field"], "parameters");
+  // 1e6 x 11.6 ms (benchmarks.md's flexible sweet spot with its modes fresh) = 11,600 s.
+  EXPECT_EQ(flexible.body["message"],
+            "a job of 1000000 designs: its CPU time is estimated at 11610 s (flexible exit "
+            "speeds: 0.012 s per design), over the limit max_job_cpu_s = 3600; split it into "
+            "shards (\"shard\": {\"index\", \"count\"}), fewer designs, or outputs that need "
+            "cheaper models");
+  // Half as many designs by the closed form (rigid_pivot: 10.5 us each, ~5 s; ~150 MB of rows)
+  // are a job.
+  EXPECT_EQ(SubmitJob(&jobs, "/v1/explore", sweep(500000, "rigid_pivot")).status, 202);
+  EXPECT_EQ(jobs.submitted.size(), 1u);
+
+  // Each limit is configuration, and each is named.
+  ApiLimits limits;
+  limits.max_job_time_s = 1;  // 1000 flexible designs: ~11.6 s on the api's one thread
+  const Response slow = SubmitJob(&jobs, "/v1/explore", sweep(1000, "flexible"), limits);
+  EXPECT_EQ(slow.status, 413);
+  EXPECT_NE(slow.body["message"].get<std::string>().find(
+                "its run time on 1 threads is estimated at 12 s"),
+            std::string::npos)
+      << slow.body.dump();
+  EXPECT_NE(slow.body["message"].get<std::string>().find("over the limit job_max_time_s = 1;"),
+            std::string::npos);
+  limits = ApiLimits{};
+  limits.max_job_result_bytes = 100000;  // 1000 rows of ~300 bytes: ~0.3 MB
+  const Response large = SubmitJob(&jobs, "/v1/explore", sweep(1000, "rigid_pivot"), limits);
+  EXPECT_EQ(large.status, 413);
+  EXPECT_NE(large.body["message"].get<std::string>().find(
+                "bytes per row), over the limit job_max_result_bytes = 100000;"),
+            std::string::npos)
+      << large.body.dump();
+  limits.max_job_result_bytes = 1000000;
+  EXPECT_EQ(SubmitJob(&jobs, "/v1/explore", sweep(1000, "rigid_pivot"), limits).status, 202);
+  EXPECT_EQ(jobs.submitted.size(), 2u);
+}
+
 TEST(JobSubmitTest, ValidateOnlyAnswersValidWithoutCallingCore) {
   Context context;
   context.validate_only = true;

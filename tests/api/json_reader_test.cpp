@@ -1,5 +1,7 @@
 #include "api/json_reader.hpp"
 
+#include "api/router.hpp"
+
 #include <gtest/gtest.h>
 
 #include <string>
@@ -120,6 +122,60 @@ TEST(ObjectReaderTest, MessagesNameFieldValueAndRule) {
     EXPECT_FALSE(reader.OptionalInteger("n", 1, 10, &n));
     EXPECT_EQ(error.message, "n = 2.5: must be an integer in [1, 10]");
   }
+}
+
+// A finite number past the rules' default magnitude (1e300) names that range and the value: it
+// was refused as "must be a number", as if it were a string (issue "Under attack", item 11d).
+TEST(ObjectReaderTest, NumberBeyondTheDefaultMagnitudeNamesItsRange) {
+  const nlohmann::json value =
+      nlohmann::json::parse(R"({"cor": 1e301, "speed_mps": -1e301, "length_in": 1e301})");
+  {
+    ApiError error;
+    ObjectReader reader(value, "", &error);
+    double cor = 0;
+    EXPECT_FALSE(reader.OptionalNumber("cor", AnyNumber(), &cor));
+    EXPECT_EQ(error.message, "cor = 1e+301: must be a number in [-1e+300, 1e+300]");
+    EXPECT_EQ(error.field, "cor");
+    EXPECT_EQ(error.code, ErrorCode::kInvalidValue);
+  }
+  {
+    ApiError error;
+    ObjectReader reader(value, "", &error);
+    double speed = 0;
+    EXPECT_FALSE(reader.OptionalNumber("speed_mps", Positive(), &speed));
+    EXPECT_EQ(error.message, "speed_mps = -1e+301: must be a number > 0");  // below its own bound
+  }
+  {
+    ApiError error;
+    ObjectReader reader(value, "", &error);
+    double length = 0;  // 1e301 in = 2.54e299 m: within [-1e300, 1e300], so accepted by AnyNumber
+    EXPECT_TRUE(reader.OptionalNumber("length_m", AnyNumber(), &length));
+    EXPECT_FALSE(reader.OptionalNumber("cor", Positive(), &length));
+    EXPECT_EQ(error.message, "cor = 1e+301: must be a number in (0, 1e+300]");
+  }
+  {
+    ApiError error;
+    const nlohmann::json huge = nlohmann::json::parse(R"({"n": 1e301})");
+    ObjectReader reader(huge, "", &error);
+    long long n = 0;
+    EXPECT_FALSE(reader.OptionalInteger("n", 1, 10, &n));
+    EXPECT_EQ(error.message, "n = 1e+301: must be an integer in [1, 10]");
+  }
+}
+
+// The same through an endpoint: the answer names the field, the value and the range.
+TEST(ObjectReaderTest, NumberBeyondTheDefaultMagnitudeThroughAnEndpoint) {
+  const Response r =
+      Dispatch({"POST", "/v1/bat/properties",
+                R"({"bat": {"three_segment": {"length_m": 1e301, "handle_radius_m": 0.0125,
+           "barrel_radius_m": 0.033, "taper_start_m": 0.3, "taper_end_m": 0.55}}})"},
+               Context{});
+  EXPECT_EQ(r.status, 400);
+  EXPECT_EQ(r.body, (nlohmann::json{{"code", "InvalidValue"},
+                                    {"field", "bat.three_segment.length_m"},
+                                    {"message",
+                                     "bat.three_segment.length_m = 1e+301: must be a "
+                                     "number in [-1e+300, 1e+300]"}}));
 }
 
 TEST(ObjectReaderTest, MissingRequiredFieldIsMissingField) {

@@ -75,6 +75,41 @@ TEST(ConfigTest, RequestAndBatchSampleLimitsAreSeparate) {
   EXPECT_NE(Usage("sweetspot-server").find("SWEETSPOT_MAX_BATCH_SAMPLES"), std::string::npos);
 }
 
+// Issue "Under attack, bounded", items 4 and 11a: the in-memory answer's estimated size and a
+// job's estimated cost are limits with flags, environment variables and documented defaults.
+TEST(ConfigTest, ResponseAndJobEstimateLimitsFromFlagsAndEnvironment) {
+  const ServerConfig defaults;
+  EXPECT_EQ(defaults.limits.max_response_bytes, 67108864u);
+  EXPECT_EQ(defaults.limits.max_job_cpu_s, 3600.0);
+  EXPECT_EQ(defaults.limits.max_job_time_s, 600.0);
+  EXPECT_EQ(defaults.limits.max_job_result_bytes, 268435456u);
+  const auto parsed =
+      Parse({"--max-response-bytes", "1048576", "--max-job-cpu-s", "7200"},
+            {{"SWEETSPOT_JOB_MAX_TIME_S", "30"}, {"SWEETSPOT_JOB_MAX_RESULT_BYTES", "2048"}});
+  ASSERT_EQ(parsed.error, "");
+  EXPECT_EQ(parsed.config.limits.max_response_bytes, 1048576u);
+  EXPECT_EQ(parsed.config.limits.max_job_cpu_s, 7200.0);
+  // One flag per job limit: the check at submit takes the job runner's.
+  EXPECT_EQ(parsed.config.jobs.max_time_s, 30.0);
+  EXPECT_EQ(parsed.config.limits.max_job_time_s, 30.0);
+  EXPECT_EQ(parsed.config.jobs.max_result_bytes, 2048u);
+  EXPECT_EQ(parsed.config.limits.max_job_result_bytes, 2048u);
+  EXPECT_EQ(Parse({"--job-max-result-bytes", "4096"}).config.limits.max_job_result_bytes, 4096u);
+  EXPECT_EQ(Parse({}, {{"SWEETSPOT_MAX_RESPONSE_BYTES", "5000"}}).config.limits.max_response_bytes,
+            5000u);
+  EXPECT_EQ(Parse({"--max-response-bytes", "10"}).error,
+            "option --max-response-bytes = \"10\": must be an integer in [1024, 1099511627776]");
+  EXPECT_EQ(Parse({"--max-job-cpu-s", "0"}).error,
+            "option --max-job-cpu-s = \"0\": must be a number of seconds in (0, 1e+07]");
+  const std::string usage = Usage("sweetspot-server");
+  for (const char* name :
+       {"--max-response-bytes", "SWEETSPOT_MAX_RESPONSE_BYTES", "--max-job-cpu-s",
+        "SWEETSPOT_MAX_JOB_CPU_S", "--job-max-time-s", "SWEETSPOT_JOB_MAX_TIME_S",
+        "--job-max-result-bytes", "SWEETSPOT_JOB_MAX_RESULT_BYTES"}) {
+    EXPECT_NE(usage.find(name), std::string::npos) << name;
+  }
+}
+
 TEST(ConfigTest, BadValuesNameFlagValueAndRule) {
   EXPECT_EQ(Parse({"--port", "70000"}).error,
             "option --port = \"70000\": must be an integer in [0, 65535]");

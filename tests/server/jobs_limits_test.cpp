@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "tests/server/attack_client.hpp"
 #include "tests/server/job_client.hpp"
 #include "tests/server/server_process.hpp"
 
@@ -149,20 +150,32 @@ TEST(JobsLimitsTest, AResultOverTheLimitFailsTheJobNamingIt) {
   testing::ServerProcess server;
   ASSERT_TRUE(server.Start(Args(dir.File("jobs.db"), {"--job-max-result-bytes", "1048576"})))
       << server.log();
-  const std::string id = SubmitJob(server, "/v1/explore", CsvSweep(40000));  // 10.1 MB.
+  // An explore whose estimated result is over the limit is refused at submit: no job.
+  const auto refused = ClientOf(server).Post(
+      "/v1/jobs", Json{{"path", "/v1/explore"}, {"body", Json::parse(CsvSweep(40000))}}.dump(),
+      "application/json");  // 10.1 MB
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 413);
+  EXPECT_NE(refused->body.find("over the limit job_max_result_bytes = 1048576"),
+            std::string::npos)
+      << refused->body;
+  // A result no estimate foresees (a compare of 9 bats x 10,000 curve points: 7.2 MB of
+  // JSON) fails its job when it is stored.
+  Json compare = Json::parse(R"({"baseline": {"preset": "paper-wood"}, "variants": [],
+      "outputs": ["exit_speed_curve"], "options": {"curve_samples": 10000}})");
+  for (int i = 0; i < 8; ++i) {
+    compare["variants"].push_back(
+        {{"name", "v" + std::to_string(i)}, {"bat", {{"preset", "paper-wood"}}}});
+  }
+  const std::string id = SubmitJob(server, "/v1/compare", compare.dump());
   const Json job = WaitFinished(server, id);
   EXPECT_EQ(job["state"], "failed") << job.dump();
   EXPECT_EQ(job["status"], 413);
   EXPECT_EQ(job["error"]["code"], "TooBig");
   const std::string message = job["error"]["message"].get<std::string>();
-  EXPECT_EQ(message.rfind("the job's result is at least ", 0), 0u) << message;
+  EXPECT_EQ(message.rfind("the job's result is ", 0), 0u) << message;
   EXPECT_NE(message.find("(max_result_bytes = 1048576)"), std::string::npos) << message;
   EXPECT_NE(message.find("--job-max-result-bytes"), std::string::npos) << message;
-  // Stopped near 1 MiB of 10.1 MB: about a tenth of the rows, plus the blocks the sweep's
-  // threads had in flight; half is far above that and far below a sweep run to its end (1).
-  EXPECT_LT(job["progress"].get<double>(), 0.5) << job.dump();
-  std::cout << "[ measured ] a 10.1 MB CSV job over max_result_bytes = 1 MiB stopped at progress "
-            << job["progress"].get<double>() << "\n";
   const Answer result = Get(server, "/v1/jobs/" + id + "/result");
   EXPECT_EQ(result.status, 413);
   EXPECT_EQ(result.body["code"], "TooBig");
@@ -302,11 +315,9 @@ TEST(JobsLimitsTest, AJobRunningPastTheTimeLimitIsStoppedAndFailed) {
   TempDir dir;
   testing::ServerProcess server;
   ASSERT_TRUE(server.Start(Args(dir.File("jobs.db"), {"--job-max-time-s", "0.5"}))) << server.log();
-  // 100 x 100 Hertz designs at ~1.5 ms each: ~15 s of work, far past the limit.
-  Json sweep = Json::parse(testing::jobs::kSlowSweep);
-  sweep["parameters"][0]["count"] = 100;
-  sweep["parameters"][1]["count"] = 100;
-  const std::string id = SubmitJob(server, "/v1/explore", sweep.dump());
+  // 10,000 flexible impacts (~40 s of work, far past the limit); an explore this long would
+  // be refused at submit by its estimate, a scene is not estimated.
+  const std::string id = SubmitJob(server, "/v1/sweet-spot", testing::kLongFlexibleCurve);
   const Json job = WaitFinished(server, id);
   EXPECT_EQ(job["state"], "failed") << job.dump();
   EXPECT_EQ(job["status"], 408);
@@ -314,9 +325,9 @@ TEST(JobsLimitsTest, AJobRunningPastTheTimeLimitIsStoppedAndFailed) {
   EXPECT_NE(job["error"]["message"].get<std::string>().find("ran longer than max_time_s = 0.5 s"),
             std::string::npos)
       << job.dump();
-  // Stopped at the limit: the sweep checks its cancel flag between designs (~1.5 ms each);
+  // Stopped at the limit: the curve checks its cancel flag between points (~4 ms each);
   // 2 s above the limit absorbs a loaded 2-core machine and still fails a job left to run
-  // its ~15 s.
+  // its ~40 s.
   const double ran_s = job["finished_s"].get<double>() - job["started_s"].get<double>();
   std::cout << "[ measured ] a job over max_time_s = 0.5 s ran " << ran_s << " s\n";
   EXPECT_GE(ran_s, 0.5);

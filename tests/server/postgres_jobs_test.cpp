@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "tests/sanitizers.hpp"
+#include "tests/server/attack_client.hpp"
 #include "tests/server/job_client.hpp"
 #include "tests/server/postgres_cluster.hpp"
 #include "tests/server/server_process.hpp"
@@ -445,9 +446,17 @@ TEST_F(PostgresJobsTest, DatabaseStoppedAndRestartedUnderLoadLosesNothing) {
 
 TEST_F(PostgresJobsTest, AResultOverTheLimitFailsTheJobWholeNeverTruncated) {
   auto replica = Replica({"--job-max-result-bytes", "4096"});
-  // The sweep's answer (kSlowSweepRows rows, at least 100) is far over 4 KiB; the
-  // properties' is under it.
-  const std::string big = SubmitJob(*replica, "/v1/explore", kSlowSweep);
+  // An explore whose estimated result is over 4 KiB is refused at submit (no job); a scene
+  // is not estimated: a 200-point curve (about 14 KB) fails its job when it is stored. The
+  // properties' answer is under the limit.
+  const auto refused = PostJson(*replica, "/v1/jobs",
+                                Json{{"path", "/v1/explore"}, {"body", Json::parse(kSlowSweep)}}
+                                    .dump());
+  EXPECT_EQ(refused.status, 413);
+  const std::string big =
+      SubmitJob(*replica, "/v1/sweet-spot",
+                R"({"bat": {"preset": "paper-wood"}, "outputs": ["exit_speed_curve"],
+                    "options": {"curve_samples": 200}})");
   const Json failed = WaitForState(*replica, big, "failed");
   EXPECT_EQ(failed["status"], 413);
   EXPECT_EQ(failed["error"]["code"], "TooBig");
@@ -470,11 +479,9 @@ TEST_F(PostgresJobsTest, AResultOverTheLimitFailsTheJobWholeNeverTruncated) {
 // Timeout) naming the limit; no replica runs it again.
 TEST_F(PostgresJobsTest, AJobRunningPastTheTimeLimitIsStoppedAndFailed) {
   auto replica = Replica({"--job-max-time-s", "0.5"});
-  // 100 x 100 Hertz designs at ~1.5 ms each: ~15 s of work, far past the limit.
-  Json sweep = Json::parse(kSlowSweep);
-  sweep["parameters"][0]["count"] = 100;
-  sweep["parameters"][1]["count"] = 100;
-  const std::string id = SubmitJob(*replica, "/v1/explore", sweep.dump());
+  // 10,000 flexible impacts (~40 s of work, far past the limit); an explore this long would
+  // be refused at submit by its estimate, a scene is not estimated.
+  const std::string id = SubmitJob(*replica, "/v1/sweet-spot", testing::kLongFlexibleCurve);
   const Json failed = WaitForState(*replica, id, "failed");
   EXPECT_EQ(failed["status"], 408);
   EXPECT_EQ(failed["error"]["code"], "Timeout");
@@ -483,8 +490,8 @@ TEST_F(PostgresJobsTest, AJobRunningPastTheTimeLimitIsStoppedAndFailed) {
       std::string::npos)
       << failed.dump();
   EXPECT_EQ(failed["resumes"], 0);
-  // At the limit plus at most one renewal period (0.5 s) and the design in flight; 2 s more
-  // absorbs a loaded 2-core machine and still fails a job left to run its ~15 s.
+  // At the limit plus at most one renewal period (0.5 s) and the curve point in flight; 2 s
+  // more absorbs a loaded 2-core machine and still fails a job left to run its ~40 s.
   const double ran_s = failed["finished_s"].get<double>() - failed["started_s"].get<double>();
   std::cout << "[ measured ] a job over max_time_s = 0.5 s ran " << ran_s << " s\n";
   EXPECT_GE(ran_s, 0.5);

@@ -4,13 +4,16 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace sweetspot::testing {
@@ -25,6 +28,13 @@ class ServerProcess {
     }
     if (reader_.joinable()) reader_.join();
   }
+
+  /// Sets `name` = `value` in the server's environment (before Start).
+  void SetEnvironment(std::string name, std::string value) {
+    environment_.emplace_back(std::move(name), std::move(value));
+  }
+  /// Caps the server's address space (RLIMIT_AS, as `prlimit --as`), bytes (before Start).
+  void SetAddressSpaceLimit(rlim_t bytes) { address_space_limit_ = bytes; }
 
   /// Starts the server with `args` (port 0 and host 127.0.0.1 are added, and
   /// --jobs-db none unless `args` name a jobs database: a shared default file
@@ -42,6 +52,11 @@ class ServerProcess {
     args.insert(args.begin(), {binary, "--host", "127.0.0.1", "--port", "0"});
     pid_ = fork();
     if (pid_ == 0) {
+      for (const auto& [name, value] : environment_) setenv(name.c_str(), value.c_str(), 1);
+      if (address_space_limit_ > 0) {
+        const rlimit limit{address_space_limit_, address_space_limit_};
+        if (setrlimit(RLIMIT_AS, &limit) != 0) _exit(126);
+      }
       dup2(fds[1], STDERR_FILENO);
       close(fds[0]);
       close(fds[1]);
@@ -119,6 +134,8 @@ class ServerProcess {
   std::thread reader_;
   std::mutex mutex_;
   std::string log_;
+  std::vector<std::pair<std::string, std::string>> environment_;
+  rlim_t address_space_limit_ = 0;
 };
 
 }  // namespace sweetspot::testing
