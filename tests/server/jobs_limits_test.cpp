@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "tests/sanitizers.hpp"
 #include "tests/server/attack_client.hpp"
 #include "tests/server/job_client.hpp"
 #include "tests/server/server_process.hpp"
@@ -129,8 +130,14 @@ TEST(JobsLimitsTest, BigResultsStayInTheDatabaseNotInMemory) {
   // job's buffers and SQLite's page cache (2 MB): +0.5 to +2.0 MB measured, and once +19 MB
   // (one 16 MB string's capacity) sampled right after a job. Half of kept separates the two
   // with a margin both ways.
+#if SWEETSPOT_UNDER_ASAN
+  // Under AddressSanitizer freed memory sits in its quarantine (256 MiB by default), so the
+  // resident size says nothing about what the server keeps; the Release pass checks it.
+  (void)kept;
+#else
   EXPECT_LT(after, before + kept / 2) << "VmRSS " << before << " -> " << after << " bytes; "
                                       << kJobs << " results of " << result_bytes << " bytes";
+#endif
   std::printf("VmRSS %zu -> %zu bytes (+%.1f MB) after %d jobs of %zu-byte results\n", before,
               after, (static_cast<double>(after) - static_cast<double>(before)) / 1e6, kJobs,
               result_bytes);
