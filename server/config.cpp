@@ -434,8 +434,8 @@ const std::vector<Option>& Options() {
        }},
       {"--jobs-db-max-bytes", "SWEETSPOT_JOBS_DB_MAX_BYTES",
        "SQLite: the largest the jobs database file may grow, bytes; past it saves fail as on a "
-       "full disk (submits answer 503, a job whose result cannot be saved fails) (default 0 = "
-       "no limit but the disk's)",
+       "full disk (submits answer 503, a job whose result cannot be saved fails); 0 = no limit "
+       "but the disk's (default 4294967296)",
        true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          long long n = 0;

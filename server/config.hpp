@@ -39,7 +39,7 @@ struct ServerConfig {
   api::ApiLimits limits;                 ///< Request limits (--max-json-depth, --max-knots, ...; see Usage()).
   JobConfig jobs;                   ///< Job pool (--job-workers, --job-queue, --job-keep-s, --jobs-kept, --job-max-resumes, --job-lease-s, --job-max-result-bytes, --job-results-memory-bytes, --job-max-time-s).
   std::string jobs_db = "sweetspot-jobs.db";  ///< Where jobs are kept: a SQLite file (relative to the working directory), a postgresql:// URI shared by replicas, or "none" = memory only (--jobs-db, SWEETSPOT_JOBS_DB).
-  std::size_t jobs_db_max_bytes = 0;     ///< SQLite: the largest the jobs database file may grow, bytes; 0 = no limit but the disk's, else [65536, 1e15] (--jobs-db-max-bytes, SWEETSPOT_JOBS_DB_MAX_BYTES).
+  std::size_t jobs_db_max_bytes = 4ULL << 30;  ///< SQLite: the largest the jobs database file may grow, bytes (4 GiB: 16 results at --job-max-result-bytes); 0 = no limit but the disk's, else [65536, 1e15] (--jobs-db-max-bytes, SWEETSPOT_JOBS_DB_MAX_BYTES).
   double shutdown_grace_s = 8.0;         ///< On SIGTERM/SIGINT, how long running jobs may still finish before they are interrupted, s, [0, 3600] (--shutdown-grace-s, SWEETSPOT_SHUTDOWN_GRACE_S).
   std::string web_root;                  ///< Folder of the design explorer's static files served at /; empty = "web" next to the executable (--web-root, SWEETSPOT_WEB_ROOT).
 

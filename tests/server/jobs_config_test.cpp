@@ -126,7 +126,7 @@ TEST(JobsConfigTest, JobLimitsFlagsEnvironmentAndRules) {
   const ServerConfig defaults;
   EXPECT_EQ(defaults.jobs.max_time_s, 600.0);
   EXPECT_EQ(defaults.jobs.max_results_memory_bytes, 256u << 20);
-  EXPECT_EQ(defaults.jobs_db_max_bytes, 0u);
+  EXPECT_EQ(defaults.jobs_db_max_bytes, 4294967296u);  // 4 GiB: a disk is never filled by default
   const auto parsed = Parse(
       {"--job-max-time-s", "0.5", "--jobs-db-max-bytes=131072"},
       {{"SWEETSPOT_JOB_RESULTS_MEMORY_BYTES", "2500000"}, {"SWEETSPOT_JOB_MAX_TIME_S", "30"}});
