@@ -648,8 +648,14 @@ bool Server::Bind(std::string* error) {
     impl_->metrics.Begin();
     impl_->metrics.End("unrouted", method, status, 0.0);
     if (config_.access_log) {
-      const nlohmann::json line{{"method", method}, {"path", path},         {"route", "unrouted"},
-                                {"status", status}, {"duration_s", 0.0}, {"bytes_in", 0}};
+      // A refused request's method and path may be any bytes, up to the head limit: the log
+      // line keeps their first 64 and 512 bytes.
+      const nlohmann::json line{{"method", method.substr(0, 64)},
+                                {"path", path.substr(0, 512)},
+                                {"route", "unrouted"},
+                                {"status", status},
+                                {"duration_s", 0.0},
+                                {"bytes_in", 0}};
       std::lock_guard<std::mutex> lock(impl_->log_mutex);
       std::cerr << Serialize(line) << "\n";
     }
