@@ -5,7 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -15,6 +17,15 @@ namespace sweetspot::api {
 /// Receives one chunk of a streamed body; false when the receiver is gone
 /// (e.g. the client disconnected) and the producer should stop.
 using ChunkSink = std::function<bool(std::string_view)>;
+
+/// A body read piece by piece from where it is kept (a job's stored result), so that it is
+/// never whole in memory: `bytes` in all; `read` appends at most `max` bytes from `offset` to
+/// *out, false when it cannot (the source is gone: the answer is cut). Must not throw;
+/// thread-safe; everything it uses outlives the answer (the server's job store does).
+struct BodySource {
+  std::uint64_t bytes = 0;  ///< The body's length, bytes.
+  std::function<bool(std::uint64_t offset, std::size_t max, std::string* out)> read;  ///< A piece.
+};
 
 /// A handler's answer: HTTP status code and body.
 struct Response {
@@ -40,6 +51,11 @@ struct Response {
   /// Only Dispatch(..., allow_stream = true) returns one; every other caller
   /// gets the chunks collected into `text`.
   std::function<bool(const ChunkSink&)> stream;
+  /// When set, the body (of `content_type`, source->bytes long) is read from here as the client
+  /// takes it (the server sends it with Content-Length, holding no worker and a piece of it
+  /// at a time). Only Dispatch(..., allow_stream = true) returns one; every other caller gets
+  /// the body read into `text`.
+  std::shared_ptr<const BodySource> source;
   /// What the top-level handler caught when it answered 500 InternalError
   /// (the exception's what()); empty otherwise. Never sent to the client:
   /// the server and the CLI write it to their stderr log.

@@ -133,6 +133,17 @@ Response CallRoute(const Route& route, const Request& request, const Context& co
       response.text = std::move(text);
       response.stream = nullptr;
     }
+    if (response.source && !allow_stream) {
+      std::string text;
+      constexpr std::size_t kPiece = 1 << 20;
+      for (std::uint64_t at = 0; at < response.source->bytes;) {
+        const std::size_t before = text.size();
+        if (!response.source->read(at, kPiece, &text) || text.size() == before) break;
+        at += text.size() - before;
+      }
+      response.text = std::move(text);
+      response.source = nullptr;
+    }
     return response;
   } catch (const std::exception& caught) {
     // The one place an unexpected exception becomes a 500: no details in

@@ -141,6 +141,10 @@ struct Connection {
   Clock::time_point linger_until;
   std::string unsent;                // the rest of an answer (kWriting)
   std::size_t parked = 0;            // of `unsent`, the bytes counted against its client's budget
+  // The rest of the answer's body still in its source (a stored job result), read a piece
+  // at a time into `unsent` as the client takes it: bytes [source_at, source_end).
+  std::shared_ptr<const api::BodySource> source;
+  std::uint64_t source_at = 0, source_end = 0;
   Clock::time_point write_deadline;  // kWriting: the client must take more by then
   bool continue_sent = false;        // "100 Continue" sent for the current request
   bool close_after = false;          // close once the current request is answered
@@ -300,6 +304,7 @@ struct ConnectionLoop::Impl {
     if (c.closed) return;
     c.closed = true;
     if (c.state == State::kLingering) lingering.fetch_sub(1, std::memory_order_relaxed);
+    c.source.reset();
     ::close(c.fd);  // also takes it out of the epoll set
     std::lock_guard<std::mutex> lock(map_mutex);
     ReleaseAdmission(c);
@@ -591,6 +596,8 @@ struct ConnectionLoop::Impl {
       const bool ok = hooks.serve(stream, last, &closed);
       // What the socket does not take now is sent as the client reads (kWriting).
       const bool sent = stream.SendWithoutWaiting(&c.unsent);
+      c.source = stream.TakeDeferred(&c.source_at, &c.source_end);
+      if (!sent) c.source.reset();
       keep_open = ok && sent && !last && !closed;
       if (!sent) c.unsent.clear();
     } catch (...) {
@@ -665,7 +672,7 @@ struct ConnectionLoop::Impl {
       c.scanned = 0;
       c.head = RequestHead{};
     }
-    if (!c.unsent.empty()) {
+    if (!c.unsent.empty() || c.source) {
       // The client reads slower than the answer: send the rest as it reads,
       // holding no worker (Writable), within the write timeout, and within its
       // address's budget of unsent bytes (else the answer is cut: closed).
@@ -695,30 +702,56 @@ struct ConnectionLoop::Impl {
   // the answer is out, go on as after any answer. Returns true when `c` waits
   // for its next request.
   bool Writable(Connection& c, Clock::time_point now) {
-    std::size_t at = 0;
     for (;;) {
-      const ssize_t n =
-          ::send(c.fd, c.unsent.data() + at, c.unsent.size() - at, MSG_NOSIGNAL | MSG_DONTWAIT);
-      if (n > 0) {
-        at += static_cast<std::size_t>(n);
-        if (at == c.unsent.size()) break;
-        continue;
+      if (c.unsent.empty() && c.source) {
+        if (c.source_at >= c.source_end) {
+          c.source.reset();
+          break;
+        }
+        // The next piece of a sourced body: one read chunk held per connection.
+        std::string piece;
+        const auto n = static_cast<std::size_t>(
+            std::min<std::uint64_t>(kReadChunk, c.source_end - c.source_at));
+        if (!c.source->read(c.source_at, n, &piece) || piece.empty()) {
+          Close(c);  // the source is gone (the job deleted): the answer is cut
+          return false;
+        }
+        c.source_at += piece.size();
+        c.unsent = std::move(piece);
+        std::lock_guard<std::mutex> lock(map_mutex);
+        parked_by_client[c.remote_ip] += c.unsent.size();
+        c.parked += c.unsent.size();
       }
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) break;
-      c.unsent.clear();
-      Close(c);  // the client is gone
-      return false;
-    }
-    c.unsent.erase(0, at);
-    {
-      std::lock_guard<std::mutex> lock(map_mutex);
-      Unpark(c, at);
-    }
-    if (!c.unsent.empty()) {
-      c.write_deadline = now + Seconds(options.write_timeout_s);  // it took some: more time
-      Arm(c);
-      return false;
+      if (c.unsent.empty()) break;
+      std::size_t at = 0;
+      bool blocked = false;
+      for (;;) {
+        const ssize_t n = ::send(c.fd, c.unsent.data() + at, c.unsent.size() - at,
+                                 MSG_NOSIGNAL | MSG_DONTWAIT);
+        if (n > 0) {
+          at += static_cast<std::size_t>(n);
+          if (at == c.unsent.size()) break;
+          continue;
+        }
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+          blocked = true;
+          break;
+        }
+        c.unsent.clear();
+        Close(c);  // the client is gone
+        return false;
+      }
+      c.unsent.erase(0, at);
+      {
+        std::lock_guard<std::mutex> lock(map_mutex);
+        Unpark(c, at);
+      }
+      if (at > 0) c.write_deadline = now + Seconds(options.write_timeout_s);  // it took some
+      if (blocked) {
+        Arm(c);
+        return false;
+      }
     }
     c.unsent.shrink_to_fit();
     c.state = State::kWorking;  // as after an answer
@@ -921,7 +954,8 @@ struct ConnectionLoop::Impl {
         continue;
       }
       if (c->closed || c->state == State::kWorking) continue;
-      if (c->state == State::kWriting && now < c->write_deadline) continue;
+      // An answer being sent gets its write timeout, and at most the grace.
+      if (c->state == State::kWriting && now < c->write_deadline && !GraceOver(now)) continue;
       Close(*c);
     }
     std::lock_guard<std::mutex> lock(map_mutex);

@@ -58,6 +58,12 @@ ssize_t RequestStream::read(char* ptr, size_t size) {
 
 ssize_t RequestStream::write(const char* ptr, size_t size) {
   if (!healthy_) return -1;
+  if (defer_next_write_) {
+    // The rest of the body comes from deferred_ (DeferBody): its bytes are not at ptr.
+    defer_next_write_ = false;
+    deferred_end_ = deferred_begin_ + size;
+    return static_cast<ssize_t>(size);
+  }
   if (write_through_) {
     if (!Flush() || !Send(ptr, size)) return -1;
     return static_cast<ssize_t>(size);
@@ -97,6 +103,24 @@ bool RequestStream::SendWithoutWaiting(std::string* unsent) {
 }
 
 void RequestStream::WriteThrough() { write_through_ = true; }
+
+bool RequestStream::DeferBody(std::shared_ptr<const api::BodySource> source,
+                              std::uint64_t offset) {
+  if (write_through_ || !healthy_) return false;
+  deferred_ = std::move(source);
+  deferred_begin_ = deferred_end_ = offset;
+  defer_next_write_ = true;
+  return true;
+}
+
+std::shared_ptr<const api::BodySource> RequestStream::TakeDeferred(std::uint64_t* begin,
+                                                                   std::uint64_t* end) {
+  *begin = deferred_begin_;
+  *end = deferred_end_;
+  defer_next_write_ = false;
+  if (deferred_end_ <= deferred_begin_) deferred_.reset();
+  return std::move(deferred_);
+}
 
 bool RequestStream::Send(const char* data, std::size_t size) {
   if (!healthy_) return false;

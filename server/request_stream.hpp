@@ -10,9 +10,12 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 
+#include "api/response.hpp"
 #include "core/progress.hpp"
 
 namespace sweetspot::server {
@@ -74,6 +77,13 @@ class RequestStream : public httplib::Stream {
   /// False once a write failed: the connection must be closed.
   bool healthy() const { return healthy_; }
 
+  /// The answer's body from `offset` on is `source`'s, sent by the connection loop as the
+  /// client takes it: the body's next write (of the rest's length) is counted, not copied.
+  /// False (nothing deferred) for a streamed answer (WriteThrough).
+  bool DeferBody(std::shared_ptr<const api::BodySource> source, std::uint64_t offset);
+  /// The deferred body (null when none), and its byte range [*begin, *end) of the source.
+  std::shared_ptr<const api::BodySource> TakeDeferred(std::uint64_t* begin, std::uint64_t* end);
+
   /// The request's bytes, head and body, as received.
   std::string_view request() const { return request_; }
   /// The request's cancel flag (requests of the compute pool), or null.
@@ -101,6 +111,9 @@ class RequestStream : public httplib::Stream {
   bool healthy_ = true;
   RequestStream* previous_current_;
   RequestCancel* cancel_ = nullptr;
+  std::shared_ptr<const api::BodySource> deferred_;  // the rest of the body (DeferBody)
+  bool defer_next_write_ = false;                    // the next write is the deferred rest
+  std::uint64_t deferred_begin_ = 0, deferred_end_ = 0;
 };
 
 }  // namespace sweetspot::server

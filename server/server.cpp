@@ -91,9 +91,36 @@ void WriteStreamedResponse(const api::Response& response, httplib::Response& res
       });
 }
 
+// A body read from where it is kept (a stored job result), with Content-Length: the
+// connection loop sends it as the client takes it, a piece at a time, holding no worker
+// (RequestStream::DeferBody); without the loop's stream, piece by piece here.
+void WriteSourcedResponse(const api::Response& response, httplib::Response& res) {
+  res.status = response.status;
+  std::shared_ptr<const api::BodySource> source = response.source;
+  res.set_content_provider(
+      static_cast<std::size_t>(source->bytes), response.content_type,
+      [source](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+        if (RequestStream* stream = RequestStream::Current();
+            stream != nullptr && stream->DeferBody(source, offset)) {
+          static const char kCounted = 0;  // never read: the stream counts the length only
+          return sink.write(&kCounted, length);
+        }
+        std::string piece;
+        if (!source->read(offset, std::min<std::size_t>(length, 64 * 1024), &piece) ||
+            piece.empty()) {
+          return false;
+        }
+        return sink.write(piece.data(), piece.size());
+      });
+}
+
 void WriteApiResponse(const api::Response& response, httplib::Response& res) {
   if (response.stream) {
     WriteStreamedResponse(response, res);
+    return;
+  }
+  if (response.source) {
+    WriteSourcedResponse(response, res);
     return;
   }
   res.status = response.status;

@@ -191,10 +191,11 @@ Response JobManager::Result(const std::string& id) const {
         return JobNotReady(id, StateName(job->state));
     }
   }
-  // Read back outside the lock (it can be 100 MB); a job deleted meanwhile has no row.
-  std::optional<JobRecord> record;
+  // Opened outside the lock, and read piece by piece as the client takes it (it can be
+  // 256 MiB: never whole in memory); a job deleted meanwhile has no row.
+  std::optional<StoredResult> stored;
   std::string error;
-  if (!persistence_.store->LoadResult(id, &record, &error)) {
+  if (!persistence_.store->OpenResult(id, &stored, &error)) {
     if (persistence_.on_store_error) {
       std::lock_guard lock(mutex_);  // on_store_error is called with the lock held.
       persistence_.on_store_error("cannot read the result of job " + id + ": " + error);
@@ -204,13 +205,27 @@ Response JobManager::Result(const std::string& id) const {
                                "retry later",
                                ""});
   }
-  if (!record) return JobNotFound(id);
-  if (!record->content_type.empty()) {
-    return Response::Text(record->status, std::move(record->response_text),
-                          std::move(record->content_type));
-  }
-  record->response_json += '\n';  // As the server ends a JSON body.
-  return Response::Text(record->status, std::move(record->response_json), "application/json");
+  if (!stored) return JobNotFound(id);
+  const bool json = stored->content_type.empty();
+  Response out = Response::Text(stored->status, std::string(),
+                                json ? "application/json" : stored->content_type);
+  auto source = std::make_shared<api::BodySource>();
+  // A JSON body ends with a newline, as the server ends one.
+  source->bytes = stored->bytes + (json ? 1 : 0);
+  source->read = [store = persistence_.store, stored = *stored, json](
+                     std::uint64_t offset, std::size_t max, std::string* piece) {
+    if (offset < stored.bytes) {
+      const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(max, stored.bytes - offset));
+      std::string ignored;
+      if (!store->ReadResult(stored, offset, n, piece, &ignored)) return false;
+      offset += n;
+      max -= n;
+    }
+    if (json && offset == stored.bytes && max > 0) piece->push_back('\n');
+    return true;
+  };
+  out.source = std::move(source);
+  return out;
 }
 
 Response JobManager::Cancel(const std::string& id) {

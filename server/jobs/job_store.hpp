@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,6 +42,16 @@ struct JobRecord {
 /// ones stay in the store (JobRecord::result_in_store), so a restart does not load them all.
 inline constexpr std::size_t kMaxLoadedResultBytes = 64 * 1024;
 
+/// Where a stored result is, for reading it piece by piece (JobStore::OpenResult, ReadResult).
+struct StoredResult {
+  int status = 0;            ///< The inner response's HTTP status.
+  std::string content_type;  ///< The non-JSON body's type; "" for a JSON body.
+  std::uint64_t bytes = 0;   ///< The body's length as stored, bytes.
+  std::int64_t row = 0;      ///< The store's handle of the record (SQLite: its rowid).
+  /// The body itself, when the store read it whole (JobStore's default OpenResult); else null.
+  std::shared_ptr<const std::string> loaded;
+};
+
 /// Saves, deletes and loads job records. Implementations are thread-safe.
 /// Every call reports failure by returning false with a message in *error
 /// (if non-null); none throws.
@@ -62,6 +74,37 @@ class JobStore {
   /// other fields may be left empty) in *record, or nullopt when there is no such job.
   virtual bool LoadResult(const std::string& id, std::optional<JobRecord>* record,
                           std::string* error) = 0;
+
+  /// Opens the stored result of job `id` for reading piece by piece (*result: nullopt when
+  /// there is no such job). This default reads it whole with LoadResult.
+  virtual bool OpenResult(const std::string& id, std::optional<StoredResult>* result,
+                          std::string* error) {
+    std::optional<JobRecord> record;
+    if (!LoadResult(id, &record, error)) return false;
+    result->reset();
+    if (!record) return true;
+    StoredResult out;
+    out.status = record->status;
+    out.content_type = record->content_type;
+    out.loaded = std::make_shared<const std::string>(
+        record->content_type.empty() ? std::move(record->response_json)
+                                     : std::move(record->response_text));
+    out.bytes = out.loaded->size();
+    *result = std::move(out);
+    return true;
+  }
+
+  /// Appends at most `max` bytes of `result`'s body from `offset` to *out; false when the
+  /// record is gone (deleted, replaced) or unreadable.
+  virtual bool ReadResult(const StoredResult& result, std::uint64_t offset, std::size_t max,
+                          std::string* out, std::string* error) {
+    if (!result.loaded || offset > result.loaded->size()) {
+      if (error != nullptr) *error = "the result is not open";
+      return false;
+    }
+    out->append(result.loaded->substr(offset, max));
+    return true;
+  }
 };
 
 }  // namespace sweetspot::server

@@ -347,4 +347,72 @@ bool SqliteJobStore::LoadResult(const std::string& id, std::optional<JobRecord>*
   return code == SQLITE_OK;
 }
 
+bool SqliteJobStore::OpenResult(const std::string& id, std::optional<StoredResult>* result,
+                                std::string* error) {
+  std::lock_guard lock(mutex_);
+  result->reset();
+  sqlite3_stmt* find = nullptr;
+  int code = sqlite3_prepare_v2(db_, "SELECT rowid, status, content_type FROM jobs WHERE id = ?1",
+                                -1, &find, nullptr);
+  if (code == SQLITE_OK) {
+    code = sqlite3_bind_text64(find, 1, id.data(), id.size(), SQLITE_STATIC, SQLITE_UTF8);
+  }
+  StoredResult found;
+  bool exists = false;
+  if (code == SQLITE_OK) {
+    code = sqlite3_step(find);
+    if (code == SQLITE_ROW) {
+      found.row = sqlite3_column_int64(find, 0);
+      found.status = static_cast<int>(sqlite3_column_int64(find, 1));
+      found.content_type = ColumnText(find, 2);
+      exists = true;
+      code = SQLITE_OK;
+    } else if (code == SQLITE_DONE) {
+      code = SQLITE_OK;
+    }
+  }
+  sqlite3_finalize(find);
+  if (code == SQLITE_OK && exists) {
+    sqlite3_blob* blob = nullptr;
+    code = sqlite3_blob_open(db_, "main", "jobs",
+                             found.content_type.empty() ? "response_json" : "response_text",
+                             found.row, 0, &blob);
+    if (code == SQLITE_OK) found.bytes = static_cast<std::uint64_t>(sqlite3_blob_bytes(blob));
+    sqlite3_blob_close(blob);
+  }
+  if (code != SQLITE_OK) {
+    if (error != nullptr) *error = Failure("open the result of job " + id, code);
+    return false;
+  }
+  if (exists) *result = std::move(found);
+  return true;
+}
+
+bool SqliteJobStore::ReadResult(const StoredResult& result, std::uint64_t offset,
+                                std::size_t max, std::string* out, std::string* error) {
+  if (offset >= result.bytes || max == 0) return true;
+  const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max, result.bytes - offset));
+  std::lock_guard lock(mutex_);
+  sqlite3_blob* blob = nullptr;
+  int code = sqlite3_blob_open(db_, "main", "jobs",
+                               result.content_type.empty() ? "response_json" : "response_text",
+                               result.row, 0, &blob);
+  if (code == SQLITE_OK && static_cast<std::uint64_t>(sqlite3_blob_bytes(blob)) != result.bytes) {
+    code = SQLITE_ABORT;  // the row now holds another result
+  }
+  if (code == SQLITE_OK) {
+    const std::size_t before = out->size();
+    out->resize(before + n);
+    code = sqlite3_blob_read(blob, out->data() + before, static_cast<int>(n),
+                             static_cast<int>(offset));
+    if (code != SQLITE_OK) out->resize(before);
+  }
+  sqlite3_blob_close(blob);
+  if (code != SQLITE_OK) {
+    if (error != nullptr) *error = Failure("read the result of row " + std::to_string(result.row), code);
+    return false;
+  }
+  return true;
+}
+
 }  // namespace sweetspot::server

@@ -69,6 +69,12 @@ class SqliteJobStore final : public JobStore {
   /// SELECT of one row's result columns.
   bool LoadResult(const std::string& id, std::optional<JobRecord>* record,
                   std::string* error) override;
+  /// The result's row and size, without reading it (SQLite's incremental blob I/O).
+  bool OpenResult(const std::string& id, std::optional<StoredResult>* result,
+                  std::string* error) override;
+  /// One piece of the result, read from its row (a record replaced or deleted since is gone).
+  bool ReadResult(const StoredResult& result, std::uint64_t offset, std::size_t max,
+                  std::string* out, std::string* error) override;
 
  private:
   explicit SqliteJobStore(std::string path);
