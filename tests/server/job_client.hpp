@@ -2,11 +2,14 @@
 // HTTP client for the real sweetspot-server (submit, poll, read results).
 #pragma once
 
+#include <gtest/gtest.h>
 #include <httplib.h>
+#include <stdlib.h>
 #include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <cstddef>
+#include <filesystem>
 #include <string>
 #include <thread>
 
@@ -136,5 +139,27 @@ inline Json WithoutTimings(Json json) {
   }
   return json;
 }
+
+/// A fresh directory under the test temp dir (named `prefix`-XXXXXX), removed with its files
+/// at the end.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& prefix = "sweetspot-jobs") {
+    std::string pattern =
+        (std::filesystem::path(::testing::TempDir()) / (prefix + "-XXXXXX")).string();
+    if (mkdtemp(pattern.data()) != nullptr) path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    if (!path_.empty()) std::filesystem::remove_all(path_, ignored);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  /// The path of `name` in the directory.
+  std::string File(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
 
 }  // namespace sweetspot::testing::jobs

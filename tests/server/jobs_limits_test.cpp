@@ -39,22 +39,7 @@ using testing::jobs::kQuick;
 using testing::jobs::PostJson;
 using testing::jobs::SubmitJob;
 
-// A fresh directory under the test temp dir, removed with its files at the end.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::path(::testing::TempDir()) / "sweetspot-limits-XXXXXX").string();
-    if (mkdtemp(pattern.data()) != nullptr) path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    if (!path_.empty()) fs::remove_all(path_, ignored);
-  }
-  std::string File(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
+using testing::jobs::TempDir;
 
 // A cheap CSV sweep over `count` values of the COR (the rigid model: microseconds a design);
 // its result is about 250 bytes a row with the bat's properties.
@@ -100,7 +85,7 @@ std::vector<std::string> Args(const std::string& db, std::vector<std::string> mo
 // 10 of them added 1.15 GB). Now results over 64 KiB live in the SQLite database only and are
 // read back on GET, byte for byte.
 TEST(JobsLimitsTest, BigResultsStayInTheDatabaseNotInMemory) {
-  TempDir dir;
+  TempDir dir("sweetspot-limits");
   testing::ServerProcess server;
   ASSERT_TRUE(server.Start(Args(dir.File("jobs.db"), {"--job-workers", "1"}))) << server.log();
   constexpr int kRows = 40000;
@@ -155,7 +140,7 @@ TEST(JobsLimitsTest, BigResultsStayInTheDatabaseNotInMemory) {
 // result held whole), and each gets the whole result once it reads. Before: each GET read the
 // result whole into memory and parked what the socket did not take.
 TEST(JobsLimitsTest, StoredResultsAreSentAsTheClientReads) {
-  TempDir dir;
+  TempDir dir("sweetspot-limits");
   testing::ServerProcess server;
   ASSERT_TRUE(server.Start(Args(dir.File("jobs.db"), {"--max-unsent-bytes-per-client", "1048576"})))
       << server.log();
@@ -213,7 +198,7 @@ TEST(JobsLimitsTest, StoredResultsAreSentAsTheClientReads) {
 // whatever the store (here SQLite; before, only PostgreSQL had the limit). A streamed sweep
 // (CSV) is stopped as soon as its rows pass the limit, not after it built them all.
 TEST(JobsLimitsTest, AResultOverTheLimitFailsTheJobNamingIt) {
-  TempDir dir;
+  TempDir dir("sweetspot-limits");
   testing::ServerProcess server;
   ASSERT_TRUE(server.Start(Args(dir.File("jobs.db"), {"--job-max-result-bytes", "1048576"})))
       << server.log();
@@ -286,7 +271,7 @@ TEST(JobsLimitsTest, WithoutADatabaseTheOldestResultsAreDroppedBeyondTheBudget) 
 // though its result was never saved, and after restarts it ran again until it failed as
 // "the server died".
 TEST(JobsLimitsTest, AFullDatabaseNeverShowsAJobDoneWithoutItsStoredResult) {
-  TempDir dir;
+  TempDir dir("sweetspot-limits");
   const std::string db = dir.File("jobs.db");
   std::vector<std::string> accepted;
   std::set<std::string> done_before;  // Shown done by the first server.
@@ -379,7 +364,7 @@ TEST(JobsLimitsTest, AFullDatabaseNeverShowsAJobDoneWithoutItsStoredResult) {
 // Before: a job ran as long as its request asked (a flexible 1,000,000-design sweep: ~85 min
 // of both cores). Now --job-max-time-s sets its cancel flag and it ends failed, naming it.
 TEST(JobsLimitsTest, AJobRunningPastTheTimeLimitIsStoppedAndFailed) {
-  TempDir dir;
+  TempDir dir("sweetspot-limits");
   testing::ServerProcess server;
   ASSERT_TRUE(server.Start(Args(dir.File("jobs.db"), {"--job-max-time-s", "0.5"}))) << server.log();
   // 10,000 flexible impacts (~40 s of work, far past the limit); an explore this long would

@@ -35,22 +35,7 @@ using testing::jobs::SubmitJob;
 using testing::jobs::WaitForState;
 using testing::jobs::WithoutTimings;
 
-// A fresh directory under the test temp dir, removed with its files at the end.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::path(::testing::TempDir()) / "sweetspot-jobs-XXXXXX").string();
-    if (mkdtemp(pattern.data()) != nullptr) path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    if (!path_.empty()) fs::remove_all(path_, ignored);
-  }
-  std::string File(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
+using testing::jobs::TempDir;
 
 std::vector<std::string> ServerArgs(const std::string& db, std::vector<std::string> more = {}) {
   std::vector<std::string> args{"--jobs-db", db, "--no-access-log"};
