@@ -93,9 +93,12 @@ TEST(RequestStreamTest, TheBodyClassifyParsedReachesTheAnswerAndTheFramingIsKnow
   ASSERT_GE(fd, 0);
   const auto exchange = [fd](const std::string& request) {
     testing::SendAll(fd, request);
-    return testing::ReadFor(fd, 5.0, [](const std::string& bytes) {
-             return bytes.size() >= 40 && bytes.compare(bytes.size() - 2, 2, "ok") == 0;
-           }).bytes;
+    return testing::ReadFor(fd, 5.0,
+                            [](const std::string& bytes) {
+                              return bytes.size() >= 40 &&
+                                     bytes.compare(bytes.size() - 2, 2, "ok") == 0;
+                            })
+        .bytes;
   };
   // Parsed by classify: the answer holds the same object; the body and its length are known.
   const std::string body = R"({"outputs": ["vibration_node"]})";
@@ -113,9 +116,9 @@ TEST(RequestStreamTest, TheBodyClassifyParsedReachesTheAnswerAndTheFramingIsKnow
     EXPECT_EQ(seen.parsed, seen.made);
   }
   // The next request on the same connection, not parsed by classify: nothing carried over.
-  EXPECT_NE(exchange("POST /other HTTP/1.1\r\nHost: x\r\nContent-Length: 2\r\n\r\n{}")
-                .find("200 OK"),
-            std::string::npos);
+  EXPECT_NE(
+      exchange("POST /other HTTP/1.1\r\nHost: x\r\nContent-Length: 2\r\n\r\n{}").find("200 OK"),
+      std::string::npos);
   {
     std::lock_guard<std::mutex> lock(seen.mutex);
     EXPECT_EQ(seen.requests, 2);
