@@ -68,6 +68,10 @@ nlohmann::json Provenance(const nlohmann::json& input, const nlohmann::json& opt
 
 std::optional<nlohmann::json> ParseObjectBody(const Request& request, const Context& context,
                                               Response* error_response) {
+  // Parsed already (ClassifyWorkload): taken once, so the body is parsed once.
+  if (request.parsed_body && request.parsed_body->is_object()) {
+    return std::move(*request.parsed_body);
+  }
   ApiError error;
   std::optional<nlohmann::json> body = ParseBody(request.body, context.limits, &error);
   if (body.has_value() && body->is_object()) return body;

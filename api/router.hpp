@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -29,6 +30,10 @@ struct Request {
   std::string body;    ///< Raw body (JSON for POST).
   /// The query string's parameters, decoded (GET /v1/jobs?state=running); empty for most routes.
   std::multimap<std::string, std::string> query{};
+  /// The body already parsed into a JSON object (by ClassifyWorkload, for the server's choice
+  /// of pool), or null. ParseObjectBody takes it (moving it out, leaving null JSON) instead of
+  /// parsing `body` again; a second ParseObjectBody of the same request parses `body`.
+  std::shared_ptr<nlohmann::json> parsed_body{};
 };
 
 /// What handlers may use besides the request: limits, and what only a
@@ -119,8 +124,12 @@ Response CallRoute(const Route& route, const Request& request, const Context& co
 /// do not parse (they are refused at once). Cost: path matching, plus one JSON
 /// parse of the body for scene routes. Never throws.
 /// Takes views so that a server can classify the bytes it received without copying them.
+/// When it parsed the body (a scene body naming an iterative model or output) and
+/// `parsed` is non-null, the parsed object goes to *parsed, for Request::parsed_body: the
+/// handler then does not parse the body a second time.
 Workload ClassifyWorkload(std::string_view method, std::string_view path, std::string_view body,
-                          const Context& context);
+                          const Context& context,
+                          std::shared_ptr<nlohmann::json>* parsed = nullptr);
 
 /// The error envelope {"code", "message", "field"} with `status` (pass
 /// ErrorCodeStatus(code) unless a documented exception applies).

@@ -1,5 +1,7 @@
 // ClassifyWorkload: which of the server's worker pools a request belongs in.
 #include <algorithm>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -126,7 +128,7 @@ Workload SceneWorkload(const Request& request, const Json& body) {
 }  // namespace
 
 Workload ClassifyWorkload(std::string_view method, std::string_view path, std::string_view body,
-                          const Context& context) {
+                          const Context& context, std::shared_ptr<Json>* parsed) {
   try {
     const Route* route = FindRoute(method, path);
     if (route == nullptr) return Workload::kLight;
@@ -139,8 +141,11 @@ Workload ClassifyWorkload(std::string_view method, std::string_view path, std::s
         if (CannotNeedIterativeModel(body)) return Workload::kLight;
         const Request request{std::string(method), std::string(path), std::string(body)};
         Response refused;
-        const auto parsed = ParseObjectBody(request, context, &refused);
-        return parsed ? SceneWorkload(request, *parsed) : Workload::kLight;
+        std::optional<Json> object = ParseObjectBody(request, context, &refused);
+        if (!object) return Workload::kLight;  // the handler refuses it (and parses it again)
+        const Workload workload = SceneWorkload(request, *object);
+        if (parsed != nullptr) *parsed = std::make_shared<Json>(std::move(*object));
+        return workload;
       }
     }
   } catch (...) {

@@ -134,6 +134,7 @@ struct Connection {
   std::size_t scanned = 0;        // how much of `in` the head scan has seen
   RequestHead head;               // the current request's framing (once its head is complete)
   std::size_t request_bytes = 0;  // head + body of the current request
+  std::shared_ptr<nlohmann::json> parsed_body;  // the current body, if classify parsed it
   Clock::time_point started;      // the current head's first byte (the accept for a new one)
   Clock::time_point last_read;    // the last byte received
   Clock::time_point body_deadline;
@@ -590,6 +591,8 @@ struct ConnectionLoop::Impl {
       RequestStream stream(c.fd, request, options.write_timeout_s, c.remote_ip, c.remote_port,
                            c.local_ip, c.local_port);
       stream.set_cancel(cancel);
+      stream.set_framing(c.head.head_bytes, c.head.content_length);
+      stream.set_parsed_body(std::move(c.parsed_body));
       const bool last = c.close_after || c.served + 1 >= options.keep_alive_max_requests ||
                         stopping.load(std::memory_order_relaxed);
       bool closed = false;
@@ -672,6 +675,7 @@ struct ConnectionLoop::Impl {
       c.scanned = 0;
       c.head = RequestHead{};
     }
+    c.parsed_body.reset();
     if (!c.unsent.empty() || c.source) {
       // The client reads slower than the answer: send the rest as it reads,
       // holding no worker (Writable), within the write timeout, and within its
@@ -767,8 +771,8 @@ struct ConnectionLoop::Impl {
       if (pool == Pool::kLight && hooks.classify &&
           hooks.classify(c->head.method, c->head.path,
                          std::string_view(c->in).substr(c->head.head_bytes,
-                                                        c->request_bytes - c->head.head_bytes)) ==
-              Pool::kCompute) {
+                                                        c->request_bytes - c->head.head_bytes),
+                         &c->parsed_body) == Pool::kCompute) {
         lock.unlock();
         compute->Push(c);
         return;

@@ -43,6 +43,8 @@
 #include <string>
 #include <string_view>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "api/error_code.hpp"
 #include "server/request_stream.hpp"
 
@@ -104,8 +106,12 @@ struct ConnectionLoopHooks {
   /// `close_connection` asks for "Connection: close". Returns false when the
   /// connection cannot be used again; sets *closed when the client asked to close.
   std::function<bool(RequestStream& stream, bool close_connection, bool* closed)> serve;
-  /// Which pool a complete request belongs in (called on a light worker).
-  std::function<Pool(std::string_view method, std::string_view path, std::string_view body)>
+  /// Which pool a complete request belongs in (called on a light worker). When it had to
+  /// parse the body to decide, it may leave the parsed body in *parsed: the request's
+  /// RequestStream carries it to the answer (RequestStream::parsed_body), so a body is
+  /// parsed once.
+  std::function<Pool(std::string_view method, std::string_view path, std::string_view body,
+                     std::shared_ptr<nlohmann::json>* parsed)>
       classify;
   /// The JSON error envelope (with its trailing newline) for an answer the loop gives itself.
   std::function<std::string(int status, api::ErrorCode code, const std::string& message)>

@@ -15,6 +15,8 @@
 #include <string>
 #include <string_view>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "api/response.hpp"
 #include "core/progress.hpp"
 
@@ -86,6 +88,26 @@ class RequestStream : public httplib::Stream {
 
   /// The request's bytes, head and body, as received.
   std::string_view request() const { return request_; }
+  /// Records the loop's framing of the request: its head's bytes (the closing blank line
+  /// included) and the Content-Length it declared (0 without one).
+  void set_framing(std::size_t head_bytes, std::uint64_t content_length) {
+    head_bytes_ = head_bytes;
+    content_length_ = content_length;
+    framed_ = true;
+  }
+  /// True once set_framing() was called (the loop always calls it before serving).
+  bool framed() const { return framed_; }
+  /// The request's body as received: what follows the head ("" when the loop did not read it:
+  /// a Content-Length over max_body_bytes, or a Transfer-Encoding).
+  std::string_view body() const {
+    return head_bytes_ < request_.size() ? request_.substr(head_bytes_) : std::string_view();
+  }
+  /// The Content-Length the head declared (0 without one).
+  std::uint64_t content_length() const { return content_length_; }
+  /// The body as a JSON object, when the choice of pool already parsed it (else null): the
+  /// handler takes it instead of parsing the body again (api::Request::parsed_body).
+  const std::shared_ptr<nlohmann::json>& parsed_body() const { return parsed_body_; }
+  void set_parsed_body(std::shared_ptr<nlohmann::json> parsed) { parsed_body_ = std::move(parsed); }
   /// The request's cancel flag (requests of the compute pool), or null.
   RequestCancel* cancel() const { return cancel_; }
   /// Gives the request a cancel flag (owned by the caller; outlives the stream).
@@ -114,6 +136,10 @@ class RequestStream : public httplib::Stream {
   std::shared_ptr<const api::BodySource> deferred_;  // the rest of the body (DeferBody)
   bool defer_next_write_ = false;                    // the next write is the deferred rest
   std::uint64_t deferred_begin_ = 0, deferred_end_ = 0;
+  std::size_t head_bytes_ = 0;
+  std::uint64_t content_length_ = 0;
+  bool framed_ = false;
+  std::shared_ptr<nlohmann::json> parsed_body_;
 };
 
 }  // namespace sweetspot::server

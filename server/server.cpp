@@ -10,6 +10,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -37,6 +38,15 @@ namespace {
 // Writes one JSON body: never throws on invalid UTF-8 (replaced instead).
 std::string Serialize(const nlohmann::json& body) {
   return body.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// Serialize(body) appended to *out (the serializer nlohmann::json::dump uses, on a string
+// the caller sized).
+void SerializeInto(const nlohmann::json& body, std::string* out) {
+  nlohmann::detail::serializer<nlohmann::json> serializer(
+      nlohmann::detail::output_adapter<char, std::string>(*out), ' ',
+      nlohmann::json::error_handler_t::replace);
+  serializer.dump(body, /*pretty_print=*/false, /*ensure_ascii=*/false, /*indent_step=*/0);
 }
 
 // The text of a caught exception, for the log.
@@ -114,6 +124,13 @@ void WriteSourcedResponse(const api::Response& response, httplib::Response& res)
       });
 }
 
+// The Content-Type of `res`, as Response::set_content sets it (one header, replaced).
+void SetContentType(httplib::Response& res, const char* type) {
+  const auto range = res.headers.equal_range("Content-Type");
+  res.headers.erase(range.first, range.second);
+  res.set_header("Content-Type", type);
+}
+
 void WriteApiResponse(const api::Response& response, httplib::Response& res) {
   if (response.stream) {
     WriteStreamedResponse(response, res);
@@ -129,7 +146,16 @@ void WriteApiResponse(const api::Response& response, httplib::Response& res) {
   if (!response.content_type.empty()) {
     res.set_content(response.text, response.content_type.c_str());
   } else {
-    res.set_content(Serialize(response.body) + "\n", "application/json");
+    // Serialised straight into the answer's body (set_content would copy it once more),
+    // with room reserved for the size of this thread's previous answer: the serializer
+    // appends a character at a time, and growing the string showed in the profile.
+    thread_local std::size_t last_bytes = 1024;
+    res.body.clear();
+    res.body.reserve(last_bytes + last_bytes / 4);
+    SerializeInto(response.body, &res.body);
+    res.body.push_back('\n');
+    last_bytes = std::min<std::size_t>(res.body.size(), 1u << 20);
+    SetContentType(res, "application/json");
   }
 }
 
@@ -293,6 +319,32 @@ void WriteStaticResponse(const httplib::Request& req, const StaticFiles& files,
 }  // namespace
 
 namespace {
+// The message of the 413 for a body over max_body_bytes (httplib's and the lean path's).
+constexpr const char* kBodyTooLargeMessage = "request body exceeds the configured max_body_bytes";
+
+// How the pre-routing hook answers a request: on httplib's own path (kHttplib), or itself,
+// with the body the loop received (kWithBody: the methods whose body httplib reads) or
+// without one (kWithoutBody: GET, HEAD, OPTIONS; httplib ignores their body).
+enum class LeanPath { kHttplib, kWithBody, kWithoutBody };
+
+LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream) {
+  if (stream == nullptr || !stream->framed()) return LeanPath::kHttplib;
+  const std::string& m = req.method;
+  const bool with_body = m == "POST" || m == "PUT" || m == "PATCH" || m == "DELETE";
+  if (!with_body && m != "GET" && m != "HEAD" && m != "OPTIONS") {
+    return LeanPath::kHttplib;  // httplib answers 400 (or reads the body first: 413)
+  }
+  if (!with_body) return LeanPath::kWithoutBody;
+  // Bodies httplib transforms before a handler sees them: multipart forms (parsed into
+  // files), compressed bodies (decoded, or 415).
+  if (req.has_header("Content-Encoding") || req.is_multipart_form_data()) {
+    return LeanPath::kHttplib;
+  }
+  return LeanPath::kWithBody;
+}
+}  // namespace
+
+namespace {
 // httplib's request handling (parsing, routing, our handlers, writing the
 // answer) for one request the connection loop has read completely.
 class HttpServer : public httplib::Server {
@@ -387,49 +439,6 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
   http.set_keep_alive_timeout(WholeSeconds(config_.keep_alive_timeout_s));
   http.set_keep_alive_max_count(static_cast<size_t>(config_.keep_alive_max_requests));
 
-  // Before the body is read: CORS preflights, authentication and chunked bodies.
-  http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    if (!config_.cors_origin.empty()) {
-      const std::string origin = req.get_header_value("Origin");
-      if (config_.cors_origin == "*" || origin == config_.cors_origin) {
-        res.set_header("Access-Control-Allow-Origin", config_.cors_origin == "*" ? "*" : origin);
-        res.set_header("Vary", "Origin");
-        if (req.method == "OPTIONS" && req.has_header("Access-Control-Request-Method")) {
-          res.status = 204;
-          res.set_header("Access-Control-Allow-Methods", "GET, POST, DELETE, OPTIONS");
-          res.set_header("Access-Control-Allow-Headers", "Content-Type, Authorization");
-          res.set_header("Access-Control-Max-Age", "600");
-          return httplib::Server::HandlerResponse::Handled;
-        }
-      }
-    }
-    // Static files carry no data: the page itself asks for the token.
-    if (!config_.auth_token.empty() && req.path != "/health" &&
-        !IsStaticRequest(req, *impl_->static_files) &&
-        !TokenMatches(RawHeaderValue("Authorization"), config_.auth_token)) {
-      WriteApiResponse(api::ErrorResponse(401, api::ErrorCode::kUnauthorized,
-                                          "header Authorization: must be \"Bearer <token>\" "
-                                          "with the server's token (everything but /health "
-                                          "and the explorer's static files needs it)",
-                                          "Authorization"),
-                       res);
-      res.set_header("WWW-Authenticate", "Bearer");
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    // A chunked body bypasses the payload limit in 0.11.4 (pitfalls.md): refuse it.
-    if (req.has_header("Transfer-Encoding")) {
-      WriteApiResponse(api::ErrorResponse(411, api::ErrorCode::kInvalidValue,
-                                          "header Transfer-Encoding = \"" +
-                                              req.get_header_value("Transfer-Encoding") +
-                                              "\": chunked bodies are not accepted; send "
-                                              "Content-Length",
-                                          "Transfer-Encoding"),
-                       res);
-      return httplib::Server::HandlerResponse::Handled;
-    }
-    return httplib::Server::HandlerResponse::Unhandled;
-  });
-
   impl_->static_files =
       std::make_unique<StaticFiles>(config_.web_root.empty() ? DefaultWebRoot() : config_.web_root);
   impl_->context.limits = config_.limits;
@@ -497,7 +506,10 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     return text;
   };
 
-  auto handle = [this](const httplib::Request& req, httplib::Response& res) {
+  // Answers a request for the API or the static files; `body` is the request's body (the
+  // bytes the connection loop received, or what httplib read on its own path).
+  auto answer = [this](const httplib::Request& req, std::string_view body,
+                       httplib::Response& res) {
     const auto start = std::chrono::steady_clock::now();
     impl_->metrics.Begin();
     std::string route;
@@ -515,9 +527,11 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
         with_cancel.emplace(impl_->context);
         with_cancel->progress = &cancel->progress;
       }
-      api::Response response =
-          api::Dispatch({req.method, req.path, req.body, req.params},
-                        with_cancel ? *with_cancel : impl_->context, &route, /*allow_stream=*/true);
+      api::Request request{req.method, req.path, std::string(body), req.params};
+      // The body the choice of pool parsed already (a scene naming an iterative model).
+      if (stream != nullptr) request.parsed_body = stream->parsed_body();
+      api::Response response = api::Dispatch(
+          request, with_cancel ? *with_cancel : impl_->context, &route, /*allow_stream=*/true);
       if (cancel != nullptr && !response.stream) StoppedAnswer(*cancel, config_.max_request_time_s, &response);
       internal_error = std::move(response.internal_error);
       WriteApiResponse(response, res);
@@ -529,10 +543,78 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
     // A caught exception is always logged, also with the access log off.
     if (config_.access_log || !internal_error.empty()) {
       const std::string line = AccessLogLine({req.method, req.path, route, res.status, duration_s,
-                                              req.body.size(), std::move(internal_error)});
+                                              body.size(), std::move(internal_error)});
       std::lock_guard<std::mutex> lock(impl_->log_mutex);
       std::cerr << line << "\n";
     }
+  };
+
+  // Every request the connection loop framed is answered here, before httplib's routing:
+  // no regex match against the path, and the body is not read into a second string (the
+  // loop holds the request's bytes). What httplib did after this hook is done here with
+  // the same answers: 413 for a Content-Length over max_body_bytes (from the head alone).
+  // Requests this does not answer (a method httplib does not route, a multipart or
+  // Content-Encoding body httplib decodes, no loop framing) take httplib's own path to
+  // the same handler, as before.
+  http.set_pre_routing_handler([this, answer](const httplib::Request& req,
+                                              httplib::Response& res) {
+    RequestStream* stream = RequestStream::Current();
+    if (!config_.cors_origin.empty()) {
+      const std::string origin = req.get_header_value("Origin");
+      if (config_.cors_origin == "*" || origin == config_.cors_origin) {
+        res.set_header("Access-Control-Allow-Origin", config_.cors_origin == "*" ? "*" : origin);
+        res.set_header("Vary", "Origin");
+        if (req.method == "OPTIONS" && req.has_header("Access-Control-Request-Method")) {
+          res.status = 204;
+          res.set_header("Access-Control-Allow-Methods", "GET, POST, DELETE, OPTIONS");
+          res.set_header("Access-Control-Allow-Headers", "Content-Type, Authorization");
+          res.set_header("Access-Control-Max-Age", "600");
+          return httplib::Server::HandlerResponse::Handled;
+        }
+      }
+    }
+    // Static files carry no data: the page itself asks for the token.
+    if (!config_.auth_token.empty() && req.path != "/health" &&
+        !IsStaticRequest(req, *impl_->static_files) &&
+        !TokenMatches(RawHeaderValue("Authorization"), config_.auth_token)) {
+      WriteApiResponse(api::ErrorResponse(401, api::ErrorCode::kUnauthorized,
+                                          "header Authorization: must be \"Bearer <token>\" "
+                                          "with the server's token (everything but /health "
+                                          "and the explorer's static files needs it)",
+                                          "Authorization"),
+                       res);
+      res.set_header("WWW-Authenticate", "Bearer");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    // A chunked body bypasses the payload limit in 0.11.4 (pitfalls.md): refuse it.
+    if (req.has_header("Transfer-Encoding")) {
+      WriteApiResponse(api::ErrorResponse(411, api::ErrorCode::kInvalidValue,
+                                          "header Transfer-Encoding = \"" +
+                                              req.get_header_value("Transfer-Encoding") +
+                                              "\": chunked bodies are not accepted; send "
+                                              "Content-Length",
+                                          "Transfer-Encoding"),
+                       res);
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    const LeanPath path = LeanPathOf(req, stream);
+    if (path == LeanPath::kHttplib) return httplib::Server::HandlerResponse::Unhandled;
+    std::string_view body;
+    if (path == LeanPath::kWithBody) {
+      // httplib's payload limit, from the head alone (the loop did not read such a body).
+      if (stream->content_length() > config_.max_body_bytes) {
+        WriteApiResponse(api::ErrorResponse(413, CodeForStatus(413), kBodyTooLargeMessage), res);
+        return httplib::Server::HandlerResponse::Handled;  // logged "unrouted", as before
+      }
+      body = stream->body();
+    }
+    answer(req, body, res);
+    return httplib::Server::HandlerResponse::Handled;
+  });
+
+  // httplib's own path (see above): its regex routing, the body it read.
+  auto handle = [answer](const httplib::Request& req, httplib::Response& res) {
+    answer(req, req.body, res);
   };
   for (const char* pattern : {".*"}) {
     http.Get(pattern, handle);
@@ -549,7 +631,7 @@ Server::Server(ServerConfig config) : config_(std::move(config)), impl_(std::mak
       httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
         if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
         std::string message = "HTTP status " + std::to_string(res.status);
-        if (res.status == 413) message = "request body exceeds the configured max_body_bytes";
+        if (res.status == 413) message = kBodyTooLargeMessage;
         if (res.status == 400) {
           message =
               "the request could not be read: malformed, or its body did not arrive within "
@@ -657,13 +739,18 @@ bool Server::Bind(std::string* error) {
     return impl->http.ServeOne(stream, close_connection, closed);
   };
   hooks.classify = [impl = impl_.get()](std::string_view method, std::string_view path,
-                                        std::string_view body) {
+                                        std::string_view body,
+                                        std::shared_ptr<nlohmann::json>* parsed) {
     // The router sees the path percent-decoded (httplib decodes it): so must the choice of
     // pool, or "/v1/%65xplore" would run a sweep on a light worker.
-    const std::string decoded = path.find('%') == std::string_view::npos
-                                    ? std::string(path)
-                                    : PercentDecoded(path);
-    return api::ClassifyWorkload(method, decoded, body, impl->context) == api::Workload::kCompute
+    std::string decoded;
+    if (path.find('%') != std::string_view::npos) {
+      decoded = PercentDecoded(path);
+      path = decoded;
+    }
+    // A scene body parsed to decide is handed on to its handler (parsed once).
+    return api::ClassifyWorkload(method, path, body, impl->context, parsed) ==
+                   api::Workload::kCompute
                ? Pool::kCompute
                : Pool::kLight;
   };

@@ -1,6 +1,9 @@
 // ClassifyWorkload: which worker pool the server answers a request in.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
+#include <memory>
 #include <string>
 
 #include "api/router.hpp"
@@ -95,6 +98,61 @@ TEST(WorkloadTest, ScenesAreComputeExactlyWhenAnOutputOrModelIsIterative) {
   // A body that does not parse is refused at once: light.
   EXPECT_EQ(Classify("POST", "/v1/sweet-spot", R"({"outputs": ["vibration_node")"),
             Workload::kLight);
+}
+
+// A scene body parsed to choose the pool is handed on: ClassifyWorkload gives the parsed
+// object, and the handler takes it instead of parsing the body (issue 33, item 4).
+TEST(WorkloadTest, AParsedSceneBodyIsHandedOnAndTheHandlerDoesNotParseItAgain) {
+  const std::string body =
+      R"({"bat": {"preset": "paper-wood"}, "outputs": ["max_exit_speed"],
+          "options": {"model": "hertz"}})";
+  std::shared_ptr<nlohmann::json> parsed;
+  EXPECT_EQ(ClassifyWorkload("POST", "/v1/sweet-spot", body, Context{}, &parsed),
+            Workload::kCompute);
+  ASSERT_TRUE(parsed);
+  EXPECT_EQ(*parsed, nlohmann::json::parse(body));
+
+  // Bodies that were not parsed to decide leave it null: closed-form scenes (the name scan
+  // decides), routes that never look at the body, bodies that do not parse.
+  std::shared_ptr<nlohmann::json> none;
+  EXPECT_EQ(ClassifyWorkload("POST", "/v1/sweet-spot", R"({"bat": {"preset": "paper-wood"}})",
+                             Context{}, &none),
+            Workload::kLight);
+  EXPECT_FALSE(none);
+  EXPECT_EQ(ClassifyWorkload("POST", "/v1/explore", body, Context{}, &none), Workload::kCompute);
+  EXPECT_FALSE(none);
+  EXPECT_EQ(ClassifyWorkload("POST", "/v1/sweet-spot", R"({"outputs": ["hertz")", Context{},
+                             &none),
+            Workload::kLight);
+  EXPECT_FALSE(none);
+
+  // The handler answers from the parsed object: its body text here is not JSON at all, so an
+  // answer of 200 shows it was not parsed. The object is taken (moved out) once.
+  Request request{"POST", "/v1/sweet-spot", "not JSON: the parsed body is used instead"};
+  request.parsed_body = std::make_shared<nlohmann::json>(
+      nlohmann::json::parse(R"({"bat": {"preset": "paper-wood"}, "outputs": ["max_exit_speed"]})"));
+  const Response answered = Dispatch(request, Context{});
+  EXPECT_EQ(answered.status, 200) << answered.body.dump();
+  EXPECT_TRUE(answered.body.contains("max_exit_speed")) << answered.body.dump();
+  EXPECT_TRUE(request.parsed_body->is_null());
+  // A second answer of the same request has nothing to take: it parses the text, and refuses it.
+  const Response again = Dispatch(request, Context{});
+  EXPECT_EQ(again.status, 400) << again.body.dump();
+  EXPECT_EQ(again.body["code"], "InvalidJson") << again.body.dump();
+
+  // The same answer as from the text: the hand-over changes nothing but the parse.
+  Request from_text{"POST", "/v1/sweet-spot", body};
+  Request from_parsed{"POST", "/v1/sweet-spot", body};
+  from_parsed.parsed_body = parsed;
+  Response a = Dispatch(from_text, Context{});
+  Response b = Dispatch(from_parsed, Context{});
+  ASSERT_EQ(a.status, 200) << a.body.dump();
+  EXPECT_EQ(a.status, b.status);
+  // Timings differ between two answers; the result is the same.
+  a.body["max_exit_speed"]["summary"].erase("solve_time_s");
+  b.body["max_exit_speed"]["summary"].erase("solve_time_s");
+  EXPECT_EQ(a.body["max_exit_speed"], b.body["max_exit_speed"]);
+  EXPECT_EQ(a.body["exit_speed_model"], b.body["exit_speed_model"]);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "tests/contract_example.hpp"
+#include "tests/server/wire.hpp"
 
 namespace sweetspot::server {
 namespace {
@@ -313,6 +314,108 @@ TEST(ServerLimitsTest, ConcurrentOptimisationsAllAgree) {
   EXPECT_EQ(agree.load(), 16);
   server.Stop();
   thread.join();
+}
+
+}  // namespace
+}  // namespace sweetspot::server
+
+// The refusals the pre-routing hook now gives itself (the lean path answers every request
+// the connection loop framed before httplib's routing and body reading): the same status,
+// code, message and field as when httplib produced them.
+namespace sweetspot::server {
+namespace {
+
+// One raw request on a new connection; the whole answer (the server closes after each here,
+// or the answer is complete once its Content-Length arrived).
+std::string RawExchange(int port, const std::string& request) {
+  const int fd = testing::Connect(port);
+  if (fd < 0) return {};
+  testing::SendAll(fd, request);
+  const auto read = testing::ReadFor(fd, 5.0, [](const std::string& bytes) {
+    const std::size_t head_end = bytes.find("\r\n\r\n");
+    if (head_end == std::string::npos) return false;
+    const std::size_t at = bytes.find("Content-Length: ");
+    if (at == std::string::npos || at > head_end) return false;
+    return bytes.size() >= head_end + 4 + std::stoul(bytes.substr(at + 16));
+  });
+  close(fd);
+  return read.bytes;
+}
+
+nlohmann::json BodyOf(const std::string& answer) {
+  const std::size_t at = answer.find("\r\n\r\n");
+  return at == std::string::npos ? nlohmann::json() : nlohmann::json::parse(answer.substr(at + 4));
+}
+
+TEST_F(ServerTest, PreRoutingRefusalsKeepTheirStatusCodeAndMessage) {
+  auto client = Client();
+  // 413 from the head alone, for every method whose body httplib would read.
+  const std::string big(4096, 'x');
+  for (const std::string method : {"POST", "PUT", "PATCH", "DELETE"}) {
+    const auto res = client.send([&] {
+      httplib::Request req;
+      req.method = method;
+      req.path = "/v1/sweet-spot";
+      req.body = big;
+      req.set_header("Content-Type", "application/json");
+      return req;
+    }());
+    ASSERT_TRUE(res) << method;
+    EXPECT_EQ(res->status, 413) << method;
+    EXPECT_EQ(res->get_header_value("Content-Type"), "application/json") << method;
+    EXPECT_EQ(res->get_header_value("Connection"), "close") << method;
+    const auto body = nlohmann::json::parse(res->body);
+    EXPECT_EQ(body, (nlohmann::json{{"code", "TooBig"},
+                                    {"message", "request body exceeds the configured max_body_bytes"},
+                                    {"field", nullptr}}))
+        << method;
+  }
+  // At the limit the body is read and parsed (the handler's refusal of "{}", not 413).
+  const auto at_limit =
+      client.Post("/v1/sweet-spot", "{" + std::string(1022, ' ') + "}", "application/json");
+  ASSERT_TRUE(at_limit);
+  EXPECT_EQ(at_limit->status, 400);
+  EXPECT_EQ(nlohmann::json::parse(at_limit->body)["code"], "MissingField") << at_limit->body;
+  // A GET's body was never read (httplib does not): no 413 for it.
+  const std::string get_with_body = RawExchange(
+      server_->port(), "GET /health HTTP/1.1\r\nHost: x\r\nContent-Length: 4096\r\n\r\n" + big);
+  EXPECT_EQ(get_with_body.rfind("HTTP/1.1 200 ", 0), 0u) << get_with_body;
+
+  // 411 for a Transfer-Encoding, with its field.
+  const std::string chunked = RawExchange(
+      server_->port(),
+      "POST /v1/sweet-spot HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n\r\n"
+      "2\r\n{}\r\n0\r\n\r\n");
+  EXPECT_EQ(chunked.rfind("HTTP/1.1 411 ", 0), 0u) << chunked;
+  EXPECT_EQ(BodyOf(chunked),
+            (nlohmann::json{{"code", "InvalidValue"},
+                            {"message",
+                             "header Transfer-Encoding = \"chunked\": chunked bodies are not "
+                             "accepted; send Content-Length"},
+                            {"field", "Transfer-Encoding"}}));
+
+  // A method httplib does not route still gets httplib's 400 envelope.
+  const std::string unknown =
+      RawExchange(server_->port(), "BREW /health HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\n\r\n");
+  EXPECT_EQ(unknown.rfind("HTTP/1.1 400 ", 0), 0u) << unknown;
+  EXPECT_EQ(BodyOf(unknown)["code"], "InvalidValue") << unknown;
+  EXPECT_EQ(BodyOf(unknown)["message"],
+            "the request could not be read: malformed, or its body did not arrive within the "
+            "read timeout")
+      << unknown;
+
+  // The refusals are counted as before: "unrouted", by method and status.
+  const auto metrics = client.Get("/metrics");
+  ASSERT_TRUE(metrics);
+  for (const std::string line :
+       {"sweetspot_requests_total{route=\"unrouted\",method=\"POST\",status=\"413\"} 1",
+        "sweetspot_requests_total{route=\"unrouted\",method=\"PUT\",status=\"413\"} 1",
+        "sweetspot_requests_total{route=\"unrouted\",method=\"DELETE\",status=\"413\"} 1",
+        "sweetspot_requests_total{route=\"unrouted\",method=\"POST\",status=\"411\"} 1",
+        "sweetspot_requests_total{route=\"/v1/sweet-spot\",method=\"POST\",status=\"400\"} 1",
+        "sweetspot_requests_total{route=\"/health\",method=\"GET\",status=\"200\"} 1"}) {
+    EXPECT_NE(metrics->body.find(line), std::string::npos) << line << "\n" << metrics->body;
+  }
 }
 
 }  // namespace
