@@ -479,6 +479,7 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
                          "min_moi", "min_sting"});
   problem.objective = *core::ParseDesignObjective(request.objective);
   request.base_properties = spec->properties->Of(scene.inertia_model);
+  problem.base_mass_properties = request.base_properties;  // computed once, by ParseBat
   request.cor_policy = core::ResolveDesignCor(scene, request.base_properties, &problem);
   reader.OptionalNumber("swing_weight_exponent", AnyNumber(), &problem.swing_weight_exponent);
   problem.swing_weight_reference_kg_m2 =

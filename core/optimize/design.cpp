@@ -671,6 +671,7 @@ MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,
     }
     DesignProblem p = problem;
     p.bat.material = materials[i];
+    p.base_mass_properties.reset();  // another bat's
     MaterialDesignResult r;
     r.material = materials[i].name;
     const double n = static_cast<double>(materials.size());

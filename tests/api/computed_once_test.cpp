@@ -113,7 +113,7 @@ TEST(ComputedOnceTest, SolversAndSweepsComputeEachBatOnce) {
       "options": {"backend": "nlopt_slsqp"}})");
   const Counted optimized = Post("/v1/optimize", optimize);
   EXPECT_EQ(optimized.status, 200);
-  EXPECT_EQ(optimized.computations, 4);
+  EXPECT_EQ(optimized.computations, 1 + 1) << "the base design's, the answer's";
 }
 
 }  // namespace
