@@ -18,12 +18,9 @@
 #include "api/json_path.hpp"
 #include "api/scene_json.hpp"
 #include "api/trade_units.hpp"
-#include "core/geometry_format.hpp"
 #include "core/optimize/design_cor.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "core/scene/sanity.hpp"
-#include "core/scene/resolved_scene.hpp"
-#include "core/scene/timing_book.hpp"
 
 namespace sweetspot::api {
 namespace {
