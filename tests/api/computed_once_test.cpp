@@ -131,6 +131,15 @@ TEST(ComputedOnceTest, SolversAndSweepsComputeEachBatOnce) {
   const Counted optimized = Post("/v1/optimize", optimize);
   EXPECT_EQ(optimized.status, 200);
   EXPECT_EQ(optimized.computations, 1 + 1) << "the base design's, the answer's";
+  // The bbcor rule re-checks the answer's BBCOR (twice: the constraint and the rule) with the
+  // answer's mass properties.
+  const Counted bbcor = Post("/v1/optimize", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "variables": [{"path": "wall_thickness_m", "min": 0.0015, "max": 0.004},
+                    {"paths": ["profile.knots[4].radius_m", "profile.knots[5].radius_m"],
+                     "min": 0.0105, "max": 0.0135}],
+      "objective": "min_moi", "constraints": {"rules": "bbcor"}})");
+  EXPECT_EQ(bbcor.status, 200);
+  EXPECT_EQ(bbcor.computations, 1 + 1) << "the base design's, the answer's";
 }
 
 }  // namespace
