@@ -131,6 +131,20 @@ TEST(ComputedOnceTest, SolversAndSweepsComputeEachBatOnce) {
   const Counted optimized = Post("/v1/optimize", optimize);
   EXPECT_EQ(optimized.status, 200);
   EXPECT_EQ(optimized.computations, 1 + 1) << "the base design's, the answer's";
+  // The COR from the ball's law at the base design (core::ResolveDesignCor): from the base
+  // design's properties, not computed again.
+  const Counted ball_law = Post("/v1/optimize", With(R"({"bat": $BAT, "ball": {"preset": "mlb"},
+      "variables": [{"path": "three_segment.taper_start_m", "min": 0.1, "max": 0.5}],
+      "constraints": {"mass_kg": {"max": 0.95}}, "objective": "max_exit_speed",
+      "options": {"backend": "nlopt_slsqp"}})"));
+  EXPECT_EQ(ball_law.status, 200);
+  EXPECT_EQ(ball_law.computations, 1 + 1) << "the base design's, the answer's";
+  // The general fit (unknowns by path) is the optimiser's.
+  const Counted design_fit = Post("/v1/bat/fit", R"({"bat": {"preset": "wood-34-ash"},
+      "unknowns": [{"path": "material.density_kg_m3", "min": 400, "max": 900}],
+      "targets": {"mass_oz": 30}})");
+  EXPECT_EQ(design_fit.status, 200);
+  EXPECT_EQ(design_fit.computations, 1 + 1) << "the base design's, the answer's";
   // The bbcor rule re-checks the answer's BBCOR (twice: the constraint and the rule) with the
   // answer's mass properties.
   const Counted bbcor = Post("/v1/optimize", R"({"bat": {"preset": "bbcor-33-aluminium"},
