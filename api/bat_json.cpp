@@ -243,12 +243,13 @@ std::optional<BatSpec> ParseBat(const Json& value, const std::string& path, cons
                                 ApiError* error) {
   auto spec = ParseBatGeometry(value, path, limits, error);
   if (!spec) return std::nullopt;
+  // Both inertia models from one computation; kept for the request (BatSpec::properties).
+  core::MassPropertiesOfBothModels properties = core::ComputeMassPropertiesOfBothModels(spec->bat);
   for (const core::InertiaModel model :
        {core::InertiaModel::kRigidBody, core::InertiaModel::kSlenderRod}) {
-    if (!CheckComputable(core::ComputeMassProperties(spec->bat, model), path, error)) {
-      return std::nullopt;
-    }
+    if (!CheckComputable(properties.Of(model), path, error)) return std::nullopt;
   }
+  spec->properties = properties;
   return spec;
 }
 

@@ -26,12 +26,17 @@ struct BatSpec {
   /// From one of the paper's presets ("paper-wood", "paper-wood-m885"): a scene's model auto
   /// is then the paper's rigid_pivot (core::Scene::paper_bat).
   bool paper = false;
+  /// The bat's mass properties under both inertia models, computed once by ParseBat (its
+  /// check that the bat is computable) for the request to use; ParseBatGeometry leaves them
+  /// unset (a scene's are computed by core).
+  std::optional<core::MassPropertiesOfBothModels> properties;
 };
 
 /// Parses the bat object at `path` (e.g. "bat"). On error returns nullopt with
 /// *error naming the field (e.g. "bat.profile.knots[2].x_m = 0.1: must be
 /// greater than knots[1].x_m = 0.2"); a bat too small or light to compute with
-/// (CheckComputable under either inertia model) is refused on `path`.
+/// (CheckComputable under either inertia model) is refused on `path`. The spec carries the
+/// mass properties it computed (`properties`), so the request computes them once.
 std::optional<BatSpec> ParseBat(const nlohmann::json& value, const std::string& path,
                                 const ApiLimits& limits, ApiError* error);
 

@@ -67,9 +67,10 @@ struct Endpoint {
   std::function<ProvenanceInputs(const Req& request, const nlohmann::json& body)> provenance;
   /// Whether a rendered result misses its targets (422 with it as "closest").
   std::function<std::optional<Unmet>(const Req& request, const Result& result)> unmet;
-  /// Notes on inputs no real bat, ball or swing has (SanityWarnings), appended to the
-  /// answer's "warnings"; empty = none.
-  std::function<std::vector<std::string>(const Req& request)> warnings;
+  /// Notes on inputs no real bat, ball or swing has (core::SanityWarnings, from the mass
+  /// properties the result carries: computed once), appended to the answer's "warnings";
+  /// empty = none.
+  std::function<std::vector<std::string>(const Req& request, const Result& result)> warnings;
 };
 
 namespace endpoint_detail {
@@ -139,7 +140,7 @@ Response ServeEndpoint(const Endpoint<Req, Result>& endpoint, const Request& req
     }
   }
   nlohmann::json out = endpoint.render(*parsed, result);
-  if (endpoint.warnings) AppendWarnings(endpoint.warnings(*parsed), &out);
+  if (endpoint.warnings) AppendWarnings(endpoint.warnings(*parsed, result), &out);
   if (units == ReportUnits::kImperial) AddImperial(&out);
   const core::Summary* summary = endpoint.summary ? &endpoint.summary(result) : nullptr;
   std::optional<ProvenanceInputs> provenance;

@@ -86,10 +86,9 @@ bool IsObjectAt(const Json& root, std::initializer_list<const char*> keys) {
 
 }  // namespace
 
-std::optional<DesignBinder> DesignBinder::Compile(const Json& base,
-                                                  const std::vector<SweepParameter>& parameters,
-                                                  const RowOutputs& outputs,
-                                                  const ApiLimits& limits) {
+std::optional<DesignBinder> DesignBinder::Compile(
+    const Json& base, const std::vector<SweepParameter>& parameters, const RowOutputs& outputs,
+    const ApiLimits& limits, const core::MassPropertiesOfBothModels* template_properties) {
   DesignBinder binder;
   ApiError error;
   if (!base.is_object() || !base.contains("bat")) return std::nullopt;
@@ -223,10 +222,13 @@ std::optional<DesignBinder> DesignBinder::Compile(const Json& base,
   // Bind gives such a bat the knots of a shape that passed ThreeSegmentShape::ValidateSize.
   binder.changes_.knots_of_valid_shape = binder.only_shape_swept_;
   if (!binder.bat_swept_) {
-    // The bat is the template's in every design: its mass properties are computed once
-    // (a bat the JSON path would refuse as too small leaves them to each design).
+    // The bat is the template's in every design: its mass properties are computed once, by
+    // the request's ParseBat when given (a bat the JSON path would refuse as too small leaves
+    // them to each design).
     const core::MassProperties p =
-        core::ComputeMassProperties(*binder.scene_.bat, binder.scene_.inertia_model);
+        template_properties != nullptr
+            ? template_properties->Of(binder.scene_.inertia_model)
+            : core::ComputeMassProperties(*binder.scene_.bat, binder.scene_.inertia_model);
     if (ApiError e; CheckComputable(p, "bat", &e)) binder.scene_.mass_properties = p;
   }
   return binder;

@@ -30,6 +30,7 @@
 #include "api/limits.hpp"
 #include "api/router.hpp"
 #include "api/thread_budget.hpp"
+#include "core/mass_properties.hpp"
 #include "core/progress.hpp"
 #include "core/sampling.hpp"
 #include "core/scene/closed_form_designs.hpp"
@@ -66,9 +67,13 @@ class DesignBinder {
  public:
   /// The binder of `parameters` on `base` (the template: bat and scene fields), or nullopt
   /// when a path is not one it binds (the sweep then runs on the JSON path).
-  static std::optional<DesignBinder> Compile(const nlohmann::json& base,
-                                             const std::vector<SweepParameter>& parameters,
-                                             const RowOutputs& outputs, const ApiLimits& limits);
+  /// `template_properties`: the template bat's mass properties as the request's ParseBat
+  /// computed them (BatSpec::properties), used when no parameter changes the bat; null:
+  /// computed here.
+  static std::optional<DesignBinder> Compile(
+      const nlohmann::json& base, const std::vector<SweepParameter>& parameters,
+      const RowOutputs& outputs, const ApiLimits& limits,
+      const core::MassPropertiesOfBothModels* template_properties = nullptr);
   /// The template's scene (outputs set; mass properties preset when no parameter changes the
   /// bat): a worker's starting scene, which Bind then changes in place.
   const core::Scene& base_scene() const { return scene_; }

@@ -7,9 +7,9 @@
 #include "api/bat_json.hpp"
 #include "api/endpoint.hpp"
 #include "api/handlers.hpp"
-#include "api/sanity.hpp"
 #include "api/trade_units.hpp"
 #include "core/presets.hpp"
+#include "core/scene/sanity.hpp"
 #include "core/shape_fit.hpp"
 
 namespace sweetspot::api {
@@ -52,7 +52,8 @@ const Endpoint<PropertiesRequest, core::MassProperties>& PropertiesEndpoint() {
     Endpoint<PropertiesRequest, core::MassProperties> e;
     e.parse = ParseProperties;
     e.run = [](const PropertiesRequest& request, const Context&) {
-      return core::ComputeMassProperties(request.spec.bat, request.inertia_model);
+      // Computed once, by ParseBat's check.
+      return request.spec.properties->Of(request.inertia_model);
     };
     e.render = [](const PropertiesRequest& request, const core::MassProperties& properties) {
       nlohmann::json out =
@@ -61,8 +62,8 @@ const Endpoint<PropertiesRequest, core::MassProperties>& PropertiesEndpoint() {
       out["method"] = "closed_form";
       return out;
     };
-    e.warnings = [](const PropertiesRequest& request) {
-      return SanityWarnings(&request.spec.bat, nullptr, nullptr);
+    e.warnings = [](const PropertiesRequest& request, const core::MassProperties& properties) {
+      return core::SanityWarnings(&request.spec.bat, &properties, nullptr, nullptr);
     };
     return e;
   }();

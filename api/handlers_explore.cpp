@@ -171,6 +171,8 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
     return std::nullopt;
   }
   bool paper_bat = false;  // the template's bat is one of the paper's (model auto: rigid_pivot)
+  // The template bat's mass properties, computed once by its check (ParseBat).
+  std::optional<core::MassPropertiesOfBothModels> template_properties;
   {  // The template itself must be a valid bat and scene.
     core::Scene scene;
     ObjectReader check(base, "", error);
@@ -180,6 +182,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
     scene.bat = spec->bat;
     scene.paper_bat = spec->paper;
     paper_bat = spec->paper;
+    template_properties = spec->properties;
     scene.outputs = {core::SceneOutput::kMaxExitSpeed};
     if (core::Refusal refusal; !scene.Validate(&refusal)) {
       CoreRefusal(refusal, "", error);
@@ -492,8 +495,9 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   // drawn here (every shard draws the same table and takes its designs from it).
   sweep->designs.emplace(sweep->plan);
   // The sweep engine: the template resolved once, the swept values bound without JSON.
-  sweep->binder =
-      DesignBinder::Compile(sweep->base, sweep->parameters, sweep->outputs, sweep->limits);
+  sweep->binder = DesignBinder::Compile(sweep->base, sweep->parameters, sweep->outputs,
+                                        sweep->limits,
+                                        template_properties ? &*template_properties : nullptr);
   sweep->budget = context.thread_budget;
 
   return ExploreRequest{std::move(sweep), std::move(format), std::move(columns)};

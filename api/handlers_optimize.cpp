@@ -16,13 +16,11 @@
 #include "api/endpoint.hpp"
 #include "api/handlers.hpp"
 #include "api/json_path.hpp"
-#include "api/sanity.hpp"
 #include "api/scene_json.hpp"
 #include "api/trade_units.hpp"
-#include "core/geometry_format.hpp"
+#include "core/optimize/design_cor.hpp"
 #include "core/optimize/design_problem.hpp"
-#include "core/scene/resolved_scene.hpp"
-#include "core/scene/timing_book.hpp"
+#include "core/scene/sanity.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -311,9 +309,10 @@ struct OptimizeRequest {
   std::vector<core::Material> material_choices;
   std::string objective;
   Json request_bat;
-  // "scene", the ball's law at the base design, the design's barrel ("barrel:<ball> recomputed
-  // for every design ..."); empty: the material's.
-  std::string cor_source;
+  // Where the COR comes from (core::ResolveDesignCor): the answer's "cor_source".
+  core::DesignCorPolicy cor_policy;
+  // The base bat's mass properties under problem.inertia_model, computed once (ParseBat).
+  core::MassProperties base_properties;
 };
 
 // What the optimiser returned: one design, or one per material and the best of them.
@@ -444,57 +443,6 @@ bool ReadVariables(ObjectReader& reader, const ApiLimits& limits, core::DesignPr
   return true;
 }
 
-// True when the design is hollow: the base bat, or wall_thickness_m among the variables' fields.
-bool HollowDesign(const core::DesignProblem& problem) {
-  if (problem.bat.IsHollow()) return true;
-  for (const core::DesignVariable& v : problem.variables) {
-    std::vector<std::string> paths = {v.path};
-    paths.insert(paths.end(), v.linked_paths.begin(), v.linked_paths.end());
-    paths.insert(paths.end(), v.scale_paths.begin(), v.scale_paths.end());
-    if (std::find(paths.begin(), paths.end(), "wall_thickness_m") != paths.end()) return true;
-  }
-  return false;
-}
-
-// The COR of the ball-bat pair (issue 18). A request's `cor` is held fixed ("scene"). Without
-// one, a ball with a COR law (ball.preset):
-// - on a hollow design with an exit-speed objective, the design's own barrel's COR, recomputed
-//   for every design (DesignProblem::cor_from_barrel: the trampoline at 0.1524 m from the tip);
-// - otherwise the law's value at the base design's impact speed (through the barrel for a hollow
-//   base), held fixed while the design changes.
-// Otherwise the material's (core's); a scene the base cannot resolve is left to core's validation.
-void ResolveOptimizeCor(const core::Scene& scene, core::DesignProblem* problem,
-                        std::string* cor_source) {
-  if (scene.cor.has_value()) {
-    *cor_source = "scene";
-    return;
-  }
-  const bool exit_speed = problem->objective == core::DesignObjective::kMaxExitSpeed ||
-                          problem->objective == core::DesignObjective::kMaxExitSpeedSwingWeight ||
-                          problem->objective == core::DesignObjective::kWidestSweetZone;
-  if (exit_speed && scene.ball.cor_law.has_value() && HollowDesign(*problem)) {
-    problem->cor_from_barrel = true;
-    const std::string ball = scene.ball.preset.empty() ? "custom" : scene.ball.preset;
-    *cor_source = "barrel:" + ball + " recomputed for every design at " +
-                  core::FormatNumber(core::kCorReferenceFromTipM) +
-                  " m from its tip, at its normal impact speed there (cor_impact_from_knob_m, "
-                  "cor_impact_speed_mps: the answer's); treated as constant along the bat";
-    return;
-  }
-  core::Scene base = scene;
-  base.bat = problem->bat;
-  core::TimingBook book(false);
-  core::ResolvedScene resolved;
-  core::Summary summary;
-  if (core::ResolveScene(base, true, &book, &resolved, &summary) &&
-      resolved.cor_source.rfind("material:", 0) != 0) {
-    problem->cor = resolved.cor;
-    *cor_source = resolved.cor_source + " at the base design's impact speed (" +
-                  core::FormatNumber(resolved.cor_impact_speed_mps.value_or(0.0)) +
-                  " m/s), held fixed while the design changes";
-  }
-}
-
 std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& context,
                                              ApiError* error) {
   ObjectReader reader(body, "", error);
@@ -527,7 +475,9 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
                         {"max_exit_speed", "max_exit_speed_swing_weight", "widest_sweet_zone",
                          "min_moi", "min_sting"});
   problem.objective = *core::ParseDesignObjective(request.objective);
-  ResolveOptimizeCor(scene, &problem, &request.cor_source);
+  request.base_properties = spec->properties->Of(scene.inertia_model);
+  problem.base_mass_properties = request.base_properties;  // computed once, by ParseBat
+  request.cor_policy = core::ResolveDesignCor(scene, request.base_properties, &problem);
   reader.OptionalNumber("swing_weight_exponent", AnyNumber(), &problem.swing_weight_exponent);
   problem.swing_weight_reference_kg_m2 =
       reader.MaybeNumber("swing_weight_reference_kg_m2", AnyNumber());  // range: core's
@@ -604,10 +554,8 @@ Json RenderOptimize(const OptimizeRequest& request, const OptimizeResult& result
           result.choice.per_material[static_cast<std::size_t>(result.choice.best)].material;
     }
   }
-  // Where the COR came from: the request, the ball's law, or (empty here) the material's.
-  out["cor_source"] = !request.cor_source.empty()
-                          ? request.cor_source
-                          : "material:" + result.Chosen()->bat.material.name;
+  // Where the COR came from: the request, the ball's law, or the chosen design's material.
+  out["cor_source"] = request.cor_policy.Describe(result.Chosen()->bat.material.name);
   out["objective"] = request.objective;
   if (request.problem.objective != core::DesignObjective::kMinMoi) {
     out["sweet_spot"]["model"] = core::CollisionModelName(request.problem.model);
@@ -633,10 +581,10 @@ const Endpoint<OptimizeRequest, OptimizeResult>& OptimizeEndpoint() {
     e.run = RunOptimize;
     e.failure = OptimizeFailure;
     e.render = RenderOptimize;
-    e.warnings = [](const OptimizeRequest& request) {
+    e.warnings = [](const OptimizeRequest& request, const OptimizeResult&) {
       // The base design's (the designs the solver finds are bounded by the variables).
       const core::DesignProblem& p = request.problem;
-      return SanityWarnings(&p.bat, &p.ball, &p.swing);
+      return core::SanityWarnings(&p.bat, &request.base_properties, &p.ball, &p.swing);
     };
     e.provenance = [](const OptimizeRequest& request, const Json& body) {
       return BodyOptions(body, request.options.seed);

@@ -3,8 +3,8 @@
 // Each is a typed endpoint (api/endpoint.hpp): parse -> core call -> render.
 #include "api/endpoint.hpp"
 #include "api/handlers.hpp"
-#include "api/sanity.hpp"
 #include "api/scene_json.hpp"
+#include "core/scene/sanity.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -82,7 +82,9 @@ const Endpoint<SweetSpotRequest, core::SceneResult>& SweetSpotEndpoint() {
     e.summary = [](const core::SceneResult& result) -> const core::Summary& {
       return result.summary;
     };
-    e.warnings = [](const SweetSpotRequest& request) { return SceneSanityWarnings(request.scene); };
+    e.warnings = [](const SweetSpotRequest& request, const core::SceneResult& result) {
+      return core::SceneSanityWarnings(request.scene, result.mass_properties);
+    };
     e.provenance = [](const SweetSpotRequest& request, const Json& body) {
       return BodyOptions(body, request.options.method == core::SweetSpotMethod::kNlopt
                                    ? std::optional<unsigned long long>(request.options.nlopt.seed)
@@ -151,7 +153,9 @@ const Endpoint<CollisionRequest, core::CollisionResult>& CollisionEndpoint() {
     e.summary = [](const core::CollisionResult& result) -> const core::Summary& {
       return result.summary;
     };
-    e.warnings = [](const CollisionRequest& request) { return SceneSanityWarnings(request.scene); };
+    e.warnings = [](const CollisionRequest& request, const core::CollisionResult& result) {
+      return core::SceneSanityWarnings(request.scene, result.mass_properties);
+    };
     e.provenance = [](const CollisionRequest&, const Json&) { return ProvenanceInputs{}; };
     return e;
   }();
@@ -312,12 +316,16 @@ const Endpoint<CompareRequest, CompareResult>& CompareEndpoint() {
     e.run = RunCompare;
     e.failure = CompareFailure;
     e.render = RenderCompare;
-    e.warnings = [](const CompareRequest& request) {
-      // The shared ball and swing once; each bat under its name.
+    e.warnings = [](const CompareRequest& request, const CompareResult& compare) {
+      // The shared ball and swing once; each bat under its name, with the mass properties its
+      // scene computed (a rendered comparison has a result for every bat).
       std::vector<std::string> out =
-          SanityWarnings(nullptr, &request.scene.ball, nullptr);
-      for (const auto& [name, spec] : request.bats) {
-        for (const std::string& w : SanityWarnings(&spec.bat, nullptr, &request.scene.swing)) {
+          core::SanityWarnings(nullptr, nullptr, &request.scene.ball, nullptr);
+      for (std::size_t i = 0; i < request.bats.size() && i < compare.results.size(); ++i) {
+        const auto& [name, spec] = request.bats[i];
+        for (const std::string& w : core::SanityWarnings(&spec.bat,
+                                                         &compare.results[i].mass_properties,
+                                                         nullptr, &request.scene.swing)) {
           out.push_back(name + ": " + w);
         }
       }

@@ -94,24 +94,60 @@ double MassProperties::MoiAboutKgM2(double pivot_from_knob_m) const {
   return moi_centroid_kg_m2 + mass_kg * (d * d);
 }
 
+namespace {
+
+// The probe of MassPropertiesComputationsOnThisThread: per thread, so no state is shared.
+thread_local long long computations_on_this_thread = 0;
+
+// The mass, balance point and volume of a valid bat (the same under both inertia models),
+// its moments left at 0.
+MassProperties MassWithoutMoments(const Bat& bat, const geometry::KnotListProfile& profile,
+                                  const geometry::BodyScalars<double>& body) {
+  const geometry::MassMoment<double> mm = geometry::ComputeMassMoment<double>(profile, body);
+  MassProperties out;
+  out.mass_kg = mm.mass;
+  out.balance_point_m = mm.moment / mm.mass;
+  out.volume_m3 = mm.bat_volume + FillVolumeSign(bat) * mm.fill_volume;
+  return out;
+}
+
+// `base` with its moments under `model`.
+MassProperties WithMoments(MassProperties out, InertiaModel model,
+                           const geometry::KnotListProfile& profile,
+                           const geometry::BodyScalars<double>& body) {
+  out.inertia_model = model;
+  out.moi_centroid_kg_m2 = geometry::ComputeCentroidalMoment(profile, body, out.balance_point_m,
+                                                             model == InertiaModel::kRigidBody);
+  out.moi_knob_kg_m2 = out.MoiAboutKgM2(0.0);
+  return out;
+}
+
+}  // namespace
+
+long long MassPropertiesComputationsOnThisThread() { return computations_on_this_thread; }
+
 MassProperties ComputeMassProperties(const Bat& bat, InertiaModel model) {
   if (!bat.IsValid(nullptr)) return NanProperties(model);
   return ComputeMassPropertiesOfValidBat(bat, model);
 }
 
 MassProperties ComputeMassPropertiesOfValidBat(const Bat& bat, InertiaModel model) {
+  ++computations_on_this_thread;
   const geometry::KnotListProfile profile(bat.knots);
   const geometry::BodyScalars<double> body = geometry::BodyOf(bat);
-  const geometry::MassMoment<double> mm = geometry::ComputeMassMoment<double>(profile, body);
-  MassProperties out;
-  out.inertia_model = model;
-  out.mass_kg = mm.mass;
-  out.balance_point_m = mm.moment / mm.mass;
-  out.volume_m3 = mm.bat_volume + FillVolumeSign(bat) * mm.fill_volume;
-  out.moi_centroid_kg_m2 = geometry::ComputeCentroidalMoment(profile, body, out.balance_point_m,
-                                                             model == InertiaModel::kRigidBody);
-  out.moi_knob_kg_m2 = out.MoiAboutKgM2(0.0);
-  return out;
+  return WithMoments(MassWithoutMoments(bat, profile, body), model, profile, body);
+}
+
+MassPropertiesOfBothModels ComputeMassPropertiesOfBothModels(const Bat& bat) {
+  if (!bat.IsValid(nullptr)) {
+    return {NanProperties(InertiaModel::kRigidBody), NanProperties(InertiaModel::kSlenderRod)};
+  }
+  ++computations_on_this_thread;
+  const geometry::KnotListProfile profile(bat.knots);
+  const geometry::BodyScalars<double> body = geometry::BodyOf(bat);
+  const MassProperties mass = MassWithoutMoments(bat, profile, body);
+  return {WithMoments(mass, InertiaModel::kRigidBody, profile, body),
+          WithMoments(mass, InertiaModel::kSlenderRod, profile, body)};
 }
 
 std::string DesignParameterLayout::Name(int index) const {

@@ -58,6 +58,29 @@ MassProperties ComputeMassProperties(const Bat& bat, InertiaModel model = Inerti
 MassProperties ComputeMassPropertiesOfValidBat(const Bat& bat,
                                                InertiaModel model = InertiaModel::kRigidBody);
 
+/// A test probe, not a statistic: how many mass-property computations (each
+/// ComputeMassPropertiesOfValidBat, which ComputeMassProperties and
+/// ComputeMassPropertiesWithGradient call, and each ComputeMassPropertiesOfBothModels) have run
+/// on the calling thread since it started. Thread-local, so the core keeps no mutable state
+/// shared between threads; only tests read it (tests/api/computed_once_test.cpp: one
+/// computation per request and per bat), by differences around a call on the same thread.
+long long MassPropertiesComputationsOnThisThread();
+
+/// A bat's mass properties under both inertia models from one computation (the mass, volume
+/// and balance point are the same in both; only the centroidal moment differs): the same
+/// numbers as ComputeMassProperties(bat, kRigidBody) and (bat, kSlenderRod). Precondition as
+/// ComputeMassProperties (for an invalid bat every field is NaN).
+struct MassPropertiesOfBothModels {
+  MassProperties rigid_body;   ///< InertiaModel::kRigidBody.
+  MassProperties slender_rod;  ///< InertiaModel::kSlenderRod.
+
+  /// The properties under `model`.
+  const MassProperties& Of(InertiaModel model) const {
+    return model == InertiaModel::kSlenderRod ? slender_rod : rigid_body;
+  }
+};
+MassPropertiesOfBothModels ComputeMassPropertiesOfBothModels(const Bat& bat);
+
 /// Where each design parameter sits in a gradient vector, for a bat with
 /// num_knots knots. The layout is always 2 * num_knots + 5 long:
 ///   [0, K)        "knots[i].radius_m"   (m)

@@ -328,7 +328,7 @@ TrampolineResult EffectiveCorAt(const Bat& bat, const MassProperties& mp, double
 }
 
 BbcorResult ComputeBbcor(const Bat& bat, const BbcorProtocol& protocol,
-                         const BarrelOptions& options) {
+                         const BarrelOptions& options, const MassProperties* rigid_body_properties) {
   BbcorResult out;
   out.ball = protocol.ball;
   out.ball_speed_mps = protocol.ball_speed_mps;
@@ -360,7 +360,8 @@ BbcorResult ComputeBbcor(const Bat& bat, const BbcorProtocol& protocol,
     return out;
   }
   out.method = "trampoline_quasi_static";
-  const MassProperties mp = ComputeMassProperties(bat);
+  const MassProperties mp =
+      rigid_body_properties != nullptr ? *rigid_body_properties : ComputeMassProperties(bat);
   const double i_pivot = mp.MoiAboutKgM2(protocol.pivot_from_knob_m);
   BarrelWall wall;
   const TrampolineResult r = barrel_detail::HollowImpact(

@@ -172,8 +172,11 @@ struct BbcorResult {
 /// BBCOR of `bat` by `protocol`. A solid bat gives the ball's COR at the protocol's speed (a
 /// rigid bat's BBCOR is e by construction); a hollow one the trampoline's e_eff for the bat
 /// pivoted at the protocol's pivot (M_e = I_pivot / z^2) at the protocol's impact point.
+/// `rigid_body_properties`: the bat's mass properties under InertiaModel::kRigidBody when the
+/// caller has computed them (a scene's, once per request); null: computed here.
 BbcorResult ComputeBbcor(const Bat& bat, const BbcorProtocol& protocol = {},
-                         const BarrelOptions& options = {});
+                         const BarrelOptions& options = {},
+                         const MassProperties* rigid_body_properties = nullptr);
 
 /// The effective COR (quasi-static trampoline) of a hollow bat at `x_m` for a ball of
 /// `ball_mass_kg`, `ball_radius_m`, `ball_stiffness`, `ball_exponent`, COR `ball_cor`,

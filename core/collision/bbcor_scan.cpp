@@ -47,7 +47,8 @@ bool BbcorScanRangeIsValid(const BbcorProtocol& p, std::string* why) {
 }
 
 BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes, const BbcorProtocol& protocol,
-                           const FlexibleImpactOptions& impact, const BarrelOptions& barrel) {
+                           const FlexibleImpactOptions& impact, const BarrelOptions& barrel,
+                           const MassProperties* rigid_body_properties) {
   const auto t0 = std::chrono::steady_clock::now();
   BbcorScan out;
   out.ball = protocol.ball;
@@ -76,7 +77,10 @@ BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes, const BbcorPro
       out.message = "bbcor_scan: the bat's modes are not usable: " + modes.summary.message;
       return;
     }
-    const BbcorResult fixed = ComputeBbcor(bat, protocol, barrel);
+    // The bat's mass properties once: the caller's, or computed here for both uses below.
+    const MassProperties properties =
+        rigid_body_properties != nullptr ? *rigid_body_properties : ComputeMassProperties(bat);
+    const BbcorResult fixed = ComputeBbcor(bat, protocol, barrel, &properties);
     if (!fixed.ok) {
       out.message = fixed.message;
       return;
@@ -90,7 +94,7 @@ BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes, const BbcorPro
     const double length = bat.LengthM();
     const double u = protocol.ball_speed_mps;
     const double m = ball->mass_kg;
-    const double i_pivot = ComputeMassProperties(bat).MoiAboutKgM2(protocol.pivot_from_knob_m);
+    const double i_pivot = properties.MoiAboutKgM2(protocol.pivot_from_knob_m);
     FlexibleImpactOptions o = impact;
     o.hands_loads = false;  // only the exit speed is read
     for (double from_tip : ScanPositionsFromTip(protocol)) {

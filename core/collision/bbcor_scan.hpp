@@ -80,9 +80,12 @@ bool BbcorScanRangeIsValid(const BbcorProtocol& protocol, std::string* why);
 /// BBCOR of `bat` at every point of `protocol`'s scan range by the flexible model with the
 /// bat's `modes` (ComputeBatModes on that bat) and `impact` options (the hands' loads are not
 /// computed); `barrel` gives k_b for a hollow bat and the fixed-point value. Never throws.
+/// `rigid_body_properties`: the bat's mass properties under InertiaModel::kRigidBody when the
+/// caller has computed them (a scene's, once per request); null: computed here.
 BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes,
                            const BbcorProtocol& protocol = {},
                            const FlexibleImpactOptions& impact = {},
-                           const BarrelOptions& barrel = {});
+                           const BarrelOptions& barrel = {},
+                           const MassProperties* rigid_body_properties = nullptr);
 
 }  // namespace sweetspot::core

@@ -86,6 +86,11 @@ std::vector<double> RandomStart(const DesignModel& model, std::mt19937_64& rng, 
   return x;
 }
 
+// `p` when its moments are the rigid body's (what the barrel models use), else null.
+const MassProperties* RigidBodyPropertiesOrNull(const MassProperties& p) {
+  return p.inertia_model == InertiaModel::kRigidBody ? &p : nullptr;
+}
+
 // The public re-evaluation of a design (ComputeMassProperties + the closed-form sweet spot;
 // min_sting: + Collide(kFlexible) there, with the error checks).
 struct PublicEvaluation {
@@ -178,8 +183,10 @@ double PublicConstraintValue(const DesignModel& model, const DesignConstraintSpe
     case DesignFunction::kDrop:
       return ToImperial(e.properties, bat.LengthM()).drop;
     case DesignFunction::kBbcor: {
-      // Recomputed through the public model (ComputeBbcor on the answer's bat).
-      const BbcorResult b = ComputeBbcor(bat);
+      // Recomputed through the public model (ComputeBbcor on the answer's bat, with the answer's
+      // mass properties when they are the rigid body's).
+      const BbcorResult b = ComputeBbcor(bat, BbcorProtocol{}, BarrelOptions{},
+                                         RigidBodyPropertiesOrNull(e.properties));
       return b.ok ? b.value : kNaN;
     }
     case DesignFunction::kLinear:
@@ -621,7 +628,7 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
       // The constraint's own acceptance: kFeasibleRelative of the limit (the re-check above).
       const double limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
       if (!BbcorRuleHolds(result.bat, &result.bbcor.emplace(), &bbcor_why,
-                          kFeasibleRelative * limit)) {
+                          kFeasibleRelative * limit, RigidBodyPropertiesOrNull(pub.properties))) {
         summary.termination = Termination::kInfeasible;
         summary.message = bbcor_why;
       }
@@ -671,6 +678,7 @@ MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,
     }
     DesignProblem p = problem;
     p.bat.material = materials[i];
+    p.base_mass_properties.reset();  // another bat's
     MaterialDesignResult r;
     r.material = materials[i].name;
     const double n = static_cast<double>(materials.size());

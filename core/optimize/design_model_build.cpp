@@ -384,7 +384,9 @@ bool ModelBuilder::SceneNumbers() {
     model.sting_scene_.flexible.modes_cache = nullptr;  // the model's own cache instead
     model.sting_modes_ = std::make_shared<ModesCache>(kStingModesCacheEntries);
   }
-  const MassProperties base_properties = ComputeMassProperties(base, problem.inertia_model);
+  const MassProperties base_properties = problem.base_mass_properties.has_value()
+                                             ? *problem.base_mass_properties
+                                             : ComputeMassProperties(base, problem.inertia_model);
   model.c0_ = base_properties.balance_point_m;
   if (!(std::isfinite(model.c0_) && base_properties.MoiSixInchKgM2() > 0.0)) {
     return Refuse(why, TextRefusal("bat", "its mass properties are not finite"));

@@ -224,6 +224,12 @@ struct DesignProblem {
   /// for /v1/sweet-spot). flexible.modes_cache is not used: every design has new modes, so each
   /// solve keeps its own small cache (repeated points) instead of filling a shared one.
   FlexibleOptions flexible;
+  /// The base design's mass properties under inertia_model when the caller has computed them
+  /// already (the api's ParseBat): the design model uses them instead of computing them again
+  /// (DesignProblem::Validate and OptimizeDesign each build one). Must be those of `bat` (with
+  /// three_segment's knots when given); unset = computed. OptimizeOverMaterials drops them (each
+  /// material is another bat).
+  std::optional<MassProperties> base_mass_properties;
 
   /// True when the problem is well formed (variables parse and apply to this design, bounds
   /// finite and ordered, constraints finite, the base bat valid, the rules' discrete limits

@@ -140,8 +140,9 @@ bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why) {
   return true;
 }
 
-bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why, double tolerance) {
-  *bbcor = ComputeBbcor(bat);
+bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why, double tolerance,
+                    const MassProperties* rigid_body_properties) {
+  *bbcor = ComputeBbcor(bat, BbcorProtocol{}, BarrelOptions{}, rigid_body_properties);
   const double limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
   if (!bbcor->ok) {
     if (why != nullptr) *why = "rules.bbcor: the BBCOR could not be computed: " + bbcor->message;

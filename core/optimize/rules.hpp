@@ -75,7 +75,9 @@ bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why);
 /// (the NCAA protocol, default barrel options). The design model holds BBCOR <= 0.50 as a
 /// constraint; this is the independent check of its answer. False, with "rules.bbcor: ..." in
 /// *why, when the value exceeds the limit by more than tolerance (>= 0; the optimiser passes its
-/// feasibility tolerance) or the model fails.
-bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why, double tolerance = 0.0);
+/// feasibility tolerance) or the model fails. `rigid_body_properties`: the bat's mass properties
+/// under InertiaModel::kRigidBody when the caller has them (null: computed, ComputeBbcor's).
+bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why, double tolerance = 0.0,
+                    const MassProperties* rigid_body_properties = nullptr);
 
 }  // namespace sweetspot::core

@@ -15,6 +15,13 @@
 namespace sweetspot::core {
 namespace {
 
+// The resolved mass properties when they are the rigid body's (what the barrel models use),
+// else null (the models then compute the rigid body's themselves).
+const MassProperties* SceneRigidBodyProperties(const ResolvedScene& r) {
+  return r.mass_properties.inertia_model == InertiaModel::kRigidBody ? &r.mass_properties
+                                                                     : nullptr;
+}
+
 Termination Worse(Termination a, Termination b) {
   auto rank = [](Termination t) {
     switch (t) {
@@ -376,7 +383,8 @@ void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
     }
     if (Wants(wanted, SceneOutput::kBbcor)) {
       const auto tb = book.Now();
-      BbcorResult bbcor = ComputeBbcor(*scene.bat, BbcorProtocol{}, options.barrel);
+      BbcorResult bbcor =
+          ComputeBbcor(*scene.bat, BbcorProtocol{}, options.barrel, SceneRigidBodyProperties(r));
       if (bbcor.ok) {
         out.bbcor = std::move(bbcor);
       } else {
@@ -400,8 +408,9 @@ void SceneEvaluator::Evaluate(const Scene& scene, SceneResult* out_ptr) {
         // The flexible impacts along the barrel (and, inside, the barrel model's fixed point:
         // microseconds, booked with them).
         const auto tb = book.Now();
-        BbcorScan scan = ComputeBbcorScan(*scene.bat, *modes, BbcorProtocol{},
-                                          options.flexible.impact, options.barrel);
+        BbcorScan scan =
+            ComputeBbcorScan(*scene.bat, *modes, BbcorProtocol{}, options.flexible.impact,
+                             options.barrel, SceneRigidBodyProperties(r));
         const double seconds = book.Since(tb);
         book.Add(CollisionModelName(CollisionModel::kFlexible), seconds,
                  static_cast<int>(scan.points.size()));

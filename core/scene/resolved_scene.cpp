@@ -47,9 +47,11 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
   } else if (scene.cor.has_value()) {
     r->cor = *scene.cor;
     r->cor_source = "scene";
+    r->cor_origin = CorOrigin::kScene;
   } else if (scene.bat.has_value() && scene.bat->material.cor.has_value()) {
     r->cor = *scene.bat->material.cor;
     r->cor_source = "material:" + scene.bat->material.name;
+    r->cor_origin = CorOrigin::kMaterial;
   } else {
     // About the scene's COR and the bat's material together, so no one field: the api names
     // the part of the request it was evaluating (the bat, a compared variant).
@@ -102,6 +104,7 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
     r->cor = scene.ball.cor_law->CorAt(v);
     const std::string ball_name = scene.ball.preset.empty() ? "custom" : scene.ball.preset;
     r->cor_source = "ball:" + ball_name;
+    r->cor_origin = CorOrigin::kBall;
     r->cor_impact_speed_mps = v;
     if (barrel_cor && v > 0.0) {
       const Ball& b = scene.ball;
@@ -115,6 +118,7 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
       }
       r->cor = t.effective_cor;
       r->cor_source = "barrel:" + ball_name;
+      r->cor_origin = CorOrigin::kBarrel;
     }
   }
   return true;

@@ -18,6 +18,15 @@
 
 namespace sweetspot::core {
 
+/// Where a resolved scene's COR came from (ResolvedScene::cor_source says the same as text).
+enum class CorOrigin {
+  kNone,      ///< No COR resolved (nothing wanted needs one).
+  kScene,     ///< The request's `cor`.
+  kBall,      ///< The ball's COR law at the impact speed.
+  kBarrel,    ///< A hollow bat: the trampoline's effective COR from the ball's law.
+  kMaterial,  ///< The bat material's COR.
+};
+
 /// A scene's shared quantities, computed once per request.
 struct ResolvedScene {
   MassProperties mass_properties;  ///< The bat's (computed from `bat`, or the scene's own).
@@ -30,6 +39,7 @@ struct ResolvedScene {
   /// hollow bat: the trampoline's effective COR from the ball's law) or "material:<name>";
   /// "" when `cor` is unset.
   std::string cor_source;
+  CorOrigin cor_origin = CorOrigin::kNone;  ///< cor_source as a value, to branch on.
   /// With cor_source "ball:...": the normal impact speed the ball's law was evaluated at, m/s.
   std::optional<double> cor_impact_speed_mps;
 };

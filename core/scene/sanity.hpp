@@ -1,15 +1,17 @@
 // Sanity warnings (issue 19): a bat, ball or swing far outside anything real is still
 // computed, but the answer says which value looks like a slip of units ("bat length = 33 m:
-// no bat is longer than 1.2 m (47 in); inches given as metres?").
+// no bat is longer than 1.2 m (47 in); inches given as metres?"). The bat's mass is read from
+// the mass properties the request computed once (never computed again here).
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "core/bat.hpp"
+#include "core/mass_properties.hpp"
 #include "core/scene/scene.hpp"
 
-namespace sweetspot::api {
+namespace sweetspot::core {
 
 /// The bounds of "real" (documented in docs/api.md, "Sanity warnings").
 struct SanityBounds {
@@ -23,13 +25,15 @@ struct SanityBounds {
   double max_bat_tip_speed_mps = 60.0;   ///< Elite bat speeds are ~40 m/s (90 mph).
 };
 
-/// The warnings for `bat` (may be null), `ball` and `swing` (null: not part of the request),
+/// The warnings for `bat` (may be null) with its `bat_properties` (the request's, computed
+/// once; null: the mass is not checked), `ball` and `swing` (null: not part of the request),
 /// each naming the quantity, its value and the likely slip. Empty for real equipment.
-std::vector<std::string> SanityWarnings(const core::Bat* bat, const core::Ball* ball,
-                                        const core::Swing* swing,
+std::vector<std::string> SanityWarnings(const Bat* bat, const MassProperties* bat_properties,
+                                        const Ball* ball, const Swing* swing,
                                         const SanityBounds& bounds = SanityBounds{});
 
-/// SanityWarnings of a scene (its bat when given, its ball and swing).
-std::vector<std::string> SceneSanityWarnings(const core::Scene& scene);
+/// SanityWarnings of a scene (its bat when given, with `bat_properties`, its ball and swing).
+std::vector<std::string> SceneSanityWarnings(const Scene& scene,
+                                             const MassProperties& bat_properties);
 
-}  // namespace sweetspot::api
+}  // namespace sweetspot::core
