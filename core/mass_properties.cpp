@@ -95,7 +95,7 @@ double MassProperties::MoiAboutKgM2(double pivot_from_knob_m) const {
 }
 
 MassProperties ComputeMassProperties(const Bat& bat, InertiaModel model) {
-  if (!bat.IsValid(nullptr)) return NanProperties(model);
+  if (!bat.Validate(nullptr)) return NanProperties(model);
   return ComputeMassPropertiesOfValidBat(bat, model);
 }
 

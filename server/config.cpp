@@ -545,7 +545,8 @@ bool ServerConfig::IsValid(std::string* why) const {
       return fail(std::string(name) + " = " + core::FormatNumber(value) + ": must be in (0, 3600]");
     }
   }
-  if (std::string limits_why; !limits.IsValid(&limits_why)) return fail("limits." + limits_why);
+  if (core::Refusal limits_why; !limits.Validate(&limits_why))
+    return fail("limits." + limits_why.Message());
   if (std::string jobs_why; !jobs.IsValid(&jobs_why)) return fail("jobs." + jobs_why);
   if (jobs_db.empty()) {
     return fail("jobs_db = \"\": must be a file path, a postgresql:// URI, or \"" +

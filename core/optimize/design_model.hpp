@@ -142,12 +142,9 @@ StingEvaluation EvaluateSting(const Bat& bat, const StingScene& scene, bool refi
 /// const methods are thread-safe.
 class DesignModel {
  public:
-  /// Builds the model; false (with "field = value: rule" in *why) for invalid input. A
-  /// constraint that no variable can change is checked here: if it fails, the model is still
-  /// built and fixed_violations() names it.
-  static bool Build(const DesignProblem& problem, const DesignOptions& options, DesignModel* out,
-                    std::string* why);
-  /// Build with the refusal as data in *why (if non-null): field (core's names), value, rule.
+  /// Builds the model; false, with the refusal in *why (if non-null: field in core's names,
+  /// value, rule), for invalid input. A constraint that no variable can change is checked
+  /// here: if it fails, the model is still built and fixed_violations() names it.
   static bool Build(const DesignProblem& problem, const DesignOptions& options, DesignModel* out,
                     Refusal* why);
 
