@@ -29,9 +29,9 @@ bool ApiLimits::Validate(core::Refusal* refusal) const {
     if (value < 1) return Refuse(refusal, IntegerRefusal(name, 0, "must be at least 1"));
   }
   if (max_curve_samples < 2) {
-    return Refuse(refusal, IntegerRefusal("max_curve_samples",
-                                          static_cast<long long>(max_curve_samples),
-                                          "must be at least 2 (a curve has two ends)"));
+    return Refuse(refusal,
+                  IntegerRefusal("max_curve_samples", static_cast<long long>(max_curve_samples),
+                                 "must be at least 2 (a curve has two ends)"));
   }
   if (max_knots < 2) {
     return Refuse(refusal, IntegerRefusal("max_knots", static_cast<long long>(max_knots),

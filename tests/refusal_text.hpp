@@ -13,7 +13,8 @@ namespace sweetspot {
 /// ("field = value: rule") in *why (if non-null).
 template <typename Checked>
 bool Validates(const Checked& checked, std::string* why) {
-  return core::ExplainRefusal(why, [&checked](core::Refusal* out) { return checked.Validate(out); });
+  return core::ExplainRefusal(why,
+                              [&checked](core::Refusal* out) { return checked.Validate(out); });
 }
 
 }  // namespace sweetspot

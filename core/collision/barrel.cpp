@@ -183,14 +183,13 @@ double RingFeHoopFrequencyHz(double youngs_modulus_pa, double poissons_ratio, do
 
 bool BarrelOptions::Validate(Refusal* why) const {
   if (!(std::isfinite(barrel_loss) && barrel_loss >= 0.0 && barrel_loss < 1.0))
-    return Refuse(why,
-                         Number17Refusal("barrel.barrel_loss", barrel_loss, "must be in [0, 1)"));
+    return Refuse(why, Number17Refusal("barrel.barrel_loss", barrel_loss, "must be in [0, 1)"));
   if (!(std::isfinite(shell_factor) && shell_factor > 0.0))
-    return Refuse(
-        why, Number17Refusal("barrel.shell_factor", shell_factor, "must be finite and > 0"));
+    return Refuse(why,
+                  Number17Refusal("barrel.shell_factor", shell_factor, "must be finite and > 0"));
   if (!(std::isfinite(effective_length_m) && effective_length_m >= 0.0))
     return Refuse(why, Number17Refusal("barrel.effective_length_m", effective_length_m,
-                                              "must be finite and >= 0 (0 = the default)"));
+                                       "must be finite and >= 0 (0 = the default)"));
   return ContactIntegrationValidate("barrel", relative_tolerance, max_steps, why);
 }
 

@@ -31,18 +31,17 @@ std::vector<double> ScanPositionsFromTip(const BbcorProtocol& p) {
 
 bool BbcorScanRangeValidate(const BbcorProtocol& p, Refusal* why) {
   if (!(std::isfinite(p.scan_first_from_tip_m) && p.scan_first_from_tip_m >= 0.0))
-    return Refuse(why, Number17Refusal("protocol.scan_first_from_tip_m",
-                                              p.scan_first_from_tip_m, "must be finite and >= 0"));
+    return Refuse(why, Number17Refusal("protocol.scan_first_from_tip_m", p.scan_first_from_tip_m,
+                                       "must be finite and >= 0"));
   if (!(std::isfinite(p.scan_last_from_tip_m) && p.scan_last_from_tip_m >= p.scan_first_from_tip_m))
-    return Refuse(why,
-                         Number17Refusal("protocol.scan_last_from_tip_m", p.scan_last_from_tip_m,
-                                         "must be finite and >= scan_first_from_tip_m"));
+    return Refuse(why, Number17Refusal("protocol.scan_last_from_tip_m", p.scan_last_from_tip_m,
+                                       "must be finite and >= scan_first_from_tip_m"));
   if (!(std::isfinite(p.scan_step_m) && p.scan_step_m > 0.0))
-    return Refuse(
-        why, Number17Refusal("protocol.scan_step_m", p.scan_step_m, "must be finite and > 0"));
+    return Refuse(why,
+                  Number17Refusal("protocol.scan_step_m", p.scan_step_m, "must be finite and > 0"));
   if ((p.scan_last_from_tip_m - p.scan_first_from_tip_m) / p.scan_step_m + 1.0 > kMaxScanPoints)
     return Refuse(why, Number17Refusal("protocol.scan_step_m", p.scan_step_m,
-                                              "gives more than 201 scan points"));
+                                       "gives more than 201 scan points"));
   return true;
 }
 

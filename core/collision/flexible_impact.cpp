@@ -223,20 +223,27 @@ bool FlexibleImpactInputs::Validate(Refusal* why) const {
   if (!std::isfinite(impact_from_knob_m))
     return Refuse(why, Number17Refusal("impact_from_knob_m", impact_from_knob_m, "must be finite"));
   if (!std::isfinite(hands_from_knob_m))
-    return Refuse(why, Number17Refusal("swing.hands_from_knob_m", hands_from_knob_m, "must be finite"));
+    return Refuse(why,
+                  Number17Refusal("swing.hands_from_knob_m", hands_from_knob_m, "must be finite"));
   if (!finite_pos(ball_mass_kg))
     return Refuse(why, Number17Refusal("ball.mass_kg", ball_mass_kg, "must be finite and > 0"));
   if (!(std::isfinite(ball_speed_mps) && ball_speed_mps >= 0.0))
-    return Refuse(why, Number17Refusal("ball.speed_mps", ball_speed_mps, "must be finite and >= 0"));
+    return Refuse(why,
+                  Number17Refusal("ball.speed_mps", ball_speed_mps, "must be finite and >= 0"));
   if (!finite_pos(approach_speed_mps))
-    return Refuse(why, Number17Refusal("approach_speed_mps", approach_speed_mps, "must be finite and > 0 (the ball and the bat must approach each other)"));
+    return Refuse(
+        why,
+        Number17Refusal("approach_speed_mps", approach_speed_mps,
+                        "must be finite and > 0 (the ball and the bat must approach each other)"));
   if (!BallLawValidate(ball_stiffness, ball_exponent, why)) return false;
   if (!(std::isfinite(surface_stiffness) && surface_stiffness >= 0.0))
-    return Refuse(why, Number17Refusal("surface_stiffness", surface_stiffness, "must be finite and >= 0"));
+    return Refuse(
+        why, Number17Refusal("surface_stiffness", surface_stiffness, "must be finite and >= 0"));
   if (!(std::isfinite(cor) && cor >= 0.0 && cor <= 1.0))
     return Refuse(why, Number17Refusal("cor", cor, "must be in [0, 1]"));
   if (!(std::isfinite(barrel_compliance_m_n) && barrel_compliance_m_n >= 0.0))
-    return Refuse(why, Number17Refusal("barrel_compliance_m_n", barrel_compliance_m_n, "must be finite and >= 0"));
+    return Refuse(why, Number17Refusal("barrel_compliance_m_n", barrel_compliance_m_n,
+                                       "must be finite and >= 0"));
   return true;
 }
 

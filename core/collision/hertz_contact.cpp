@@ -184,11 +184,16 @@ bool HertzProblem::Validate(Refusal* why) const {
   auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
   auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
   if (!finite_pos(approach_speed_mps))
-    return Refuse(why, Number17Refusal("hertz.approach_speed_mps", approach_speed_mps, "must be finite and > 0 (the ball and the bat must approach each other)"));
+    return Refuse(
+        why,
+        Number17Refusal("hertz.approach_speed_mps", approach_speed_mps,
+                        "must be finite and > 0 (the ball and the bat must approach each other)"));
   if (!finite_nonneg(ball_speed_mps))
-    return Refuse(why, Number17Refusal("hertz.ball_speed_mps", ball_speed_mps, "must be finite and >= 0"));
+    return Refuse(
+        why, Number17Refusal("hertz.ball_speed_mps", ball_speed_mps, "must be finite and >= 0"));
   if (!finite_pos(ball_mass_kg))
-    return Refuse(why, Number17Refusal("hertz.ball_mass_kg", ball_mass_kg, "must be finite and > 0"));
+    return Refuse(why,
+                  Number17Refusal("hertz.ball_mass_kg", ball_mass_kg, "must be finite and > 0"));
   if (!finite_pos(c11_per_kg))
     return Refuse(why, Number17Refusal("hertz.c11_per_kg", c11_per_kg, "must be finite and > 0"));
   if (!std::isfinite(c12_per_kg))
@@ -206,13 +211,16 @@ bool HertzProblem::Validate(Refusal* why) const {
   }
   if (!BallLawValidate(ball_stiffness, ball_exponent, why)) return false;
   if (!finite_nonneg(surface_stiffness))
-    return Refuse(why, Number17Refusal("hertz.surface_stiffness", surface_stiffness, "must be finite and >= 0"));
+    return Refuse(why, Number17Refusal("hertz.surface_stiffness", surface_stiffness,
+                                       "must be finite and >= 0"));
   if (!(std::isfinite(cor) && cor >= 0.0 && cor <= 1.0))
     return Refuse(why, Number17Refusal("cor", cor, "must be in [0, 1]"));
   if (!finite_nonneg(hands_stiffness_n_m))
-    return Refuse(why, Number17Refusal("hertz.hands_stiffness_n_m", hands_stiffness_n_m, "must be finite and >= 0"));
+    return Refuse(why, Number17Refusal("hertz.hands_stiffness_n_m", hands_stiffness_n_m,
+                                       "must be finite and >= 0"));
   if (!finite_nonneg(hands_damping_n_s_m))
-    return Refuse(why, Number17Refusal("hertz.hands_damping_n_s_m", hands_damping_n_s_m, "must be finite and >= 0"));
+    return Refuse(why, Number17Refusal("hertz.hands_damping_n_s_m", hands_damping_n_s_m,
+                                       "must be finite and >= 0"));
   return true;
 }
 

@@ -212,7 +212,8 @@ void FillBase(const DesignProblem& problem, DesignResult* result) {
   result->bat = problem.bat;
   if (problem.three_segment.has_value()) {
     result->three_segment = problem.three_segment;
-    if (problem.three_segment->Validate(nullptr)) result->bat.knots = problem.three_segment->Knots();
+    if (problem.three_segment->Validate(nullptr))
+      result->bat.knots = problem.three_segment->Knots();
   }
   result->properties = ComputeMassProperties(result->bat, problem.inertia_model);
   result->objective_value = kNaN;
@@ -432,8 +433,8 @@ void ClassifyFeasibility(const DesignModel& model, const DesignOptions& options,
       result->summary.iterations += iters;
       const bool isolated =
           !result->conflicts.empty() && std::isfinite(result->conflicts.front().achievable_min);
-      const bool geometric = !result->conflicts.empty() &&
-                             result->conflicts.front().kind == ConflictKind::kGeometric;
+      const bool geometric =
+          !result->conflicts.empty() && result->conflicts.front().kind == ConflictKind::kGeometric;
       if (isolated || geometric || solver_says_infeasible) {
         result->summary.termination = Termination::kInfeasible;
       }
@@ -467,7 +468,8 @@ void MarkCancelledMultiStart(const DesignOptions& options, const std::vector<Run
   Summary& summary = result->summary;
   if (!cut || summary.termination == Termination::kInvalidInput) return;
   if (summary.termination != Termination::kConverged) {
-    if (result->message_kind == DesignMessageKind::kCancelled) return;  // the chosen start's own cut
+    if (result->message_kind == DesignMessageKind::kCancelled)
+      return;  // the chosen start's own cut
     summary.message = "cancelled after " + std::to_string(runs.size()) + " of " +
                       std::to_string(options.starts) + " starts (the chosen start " +
                       std::to_string(result->spread.best_start) + ": " + summary.message +

@@ -174,7 +174,8 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
   for (int k : property) {
     const Reach r =
         ReachOf(model, k, structural, options, deadline, progress, evaluations, iterations);
-    if (excluded(model.constraints()[static_cast<std::size_t>(k)], r)) conflict(ConflictKind::kUnreachable, {k}, k, r, within);
+    if (excluded(model.constraints()[static_cast<std::size_t>(k)], r))
+      conflict(ConflictKind::kUnreachable, {k}, k, r, within);
   }
   if (!out.empty()) return out;
   // 3. Pairs of property constraints.

@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/refusal_text.hpp"
 #include <Eigen/Eigenvalues>
+#include "tests/refusal_text.hpp"
 
 #include "core/collision/hertz_contact.hpp"
 #include "core/flexible/beam_model.hpp"

@@ -12,8 +12,8 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/refusal_text.hpp"
 #include <Eigen/Eigenvalues>
+#include "tests/refusal_text.hpp"
 
 #include "core/flexible/beam_model.hpp"
 #include "core/mass_properties.hpp"

@@ -14,8 +14,8 @@
 #include "core/scene/evaluate_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 #include "tests/hard_cases/hard_case.hpp"
-#include "tests/refusal_text.hpp"
 #include "tests/hard_cases/reference.hpp"
+#include "tests/refusal_text.hpp"
 
 namespace sweetspot::hard_cases {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
