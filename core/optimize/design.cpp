@@ -328,15 +328,15 @@ void FillSpread(const std::vector<Run>& runs, DesignSpread* spread_out) {
 void ReportFixedViolations(const DesignModel& model, DesignResult* result) {
   result->summary.termination = Termination::kInfeasible;
   std::string text;
-  for (const std::string& v : model.fixed_violations()) {
+  for (const FixedViolation& v : model.fixed_violations()) {
     DesignConflict d;
-    d.constraints.push_back(v.substr(0, v.find(' ')));
+    d.constraints.push_back(v.constraint);
     d.requested_min = d.requested_max = d.achievable_min = d.achievable_max = kNaN;
     d.shortfall = kNaN;
-    d.message = v;
+    d.message = v.message;
     d.kind = ConflictKind::kFixed;
     result->conflicts.push_back(d);
-    text += (text.empty() ? "" : "; ") + v;
+    text += (text.empty() ? "" : "; ") + v.message;
   }
   result->summary.message = "infeasible: " + text;
   result->message_kind = DesignMessageKind::kInfeasible;
