@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <string>
 
+#include "core/refusal.hpp"
+
 namespace sweetspot::api {
 
 /// Request limits with their defaults.
@@ -43,8 +45,9 @@ struct ApiLimits {
   /// job runner (server/jobs). The server sets it from its --job-max-result-bytes.
   std::size_t max_job_result_bytes = 268435456;
 
-  /// True when every limit is positive and sane; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
+  /// True when every limit is positive and sane; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
+  bool Validate(core::Refusal* refusal) const;
 };
 
 }  // namespace sweetspot::api

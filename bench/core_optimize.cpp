@@ -112,7 +112,7 @@ BENCHMARK(BM_OptimizeThreeSegment)->Arg(0)->Arg(1)->ArgName("exact")->Unit(bench
 // The model alone: one evaluation with gradients, and one exact Hessian (16 knots, 14 variables).
 void BM_OptimizeModelEvaluate(benchmark::State& state) {
   DesignModel model;
-  std::string why;
+  Refusal why;
   DesignModel::Build(SixteenKnotProblem(), DesignOptions{}, &model, &why);
   const std::vector<double> x = model.BaseX();
   DesignPoint point;

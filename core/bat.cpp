@@ -51,10 +51,6 @@ bool ShapePassesEveryCheck(const ThreeSegmentShape& s) {
 
 }  // namespace
 
-bool ThreeSegmentShape::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool ThreeSegmentShape::Validate(Refusal* why) const {
   // Every check below at once (a sweep's shapes pass them all); only a shape that fails one
   // is checked in order, for its refusal.
@@ -147,10 +143,6 @@ void ThreeSegmentShape::KnotsInto(std::vector<ProfileKnot>* knots) const {
   if (x1 > 0.0) out.push_back({x1, r1});
   out.push_back({x2, r2});
   if (x2 < length) out.push_back({length, r2});
-}
-
-bool Bat::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
 }
 
 bool Bat::Validate(Refusal* why) const { return ValidateChecks(why, /*materials=*/true); }

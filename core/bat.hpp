@@ -62,9 +62,8 @@ struct ThreeSegmentShape {
   static constexpr double kStepWidth = 1e-12;
 
   /// True when the shape is well formed (finite; L, r1, r2 > 0;
-  /// 0 <= x1 <= x2 <= L); otherwise "field = value: rule" in *why (if non-null).
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// 0 <= x1 <= x2 <= L); otherwise the refusal in *refusal (if non-null): field, value and
+  /// rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
   /// Validate, then the plausible sizes: L in (0, kMaxBatLengthM], r1, r2 in
   /// (0, kMaxBatRadiusM] ("length_m = 200: must be in (0, 100]"); for a shape given from
@@ -103,18 +102,17 @@ struct Bat {
   double wall_thickness_m = 0.0;  ///< Hollow shell wall, m; 0 = solid (see the file comment).
   std::optional<Fill> fill;       ///< Optional fill.
 
-  /// True when the bat is physically valid; otherwise "field = value: rule"
-  /// in *why (if non-null), e.g. "knots[3].x_m = 0.2: must be greater than
+  /// True when the bat is physically valid; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule", e.g.
+  /// "knots[3].x_m = 0.2: must be greater than
   /// knots[2].x_m = 0.3". Refuses: fewer than 2 knots, non-finite numbers,
   /// first knot not at 0, x not strictly increasing, radius <= 0, an invalid
   /// material, wall < 0 or >= the smallest outer radius, a fill deeper than
   /// the bat, negative fill dimensions, a bore not strictly inside the
   /// material around it (outer radius, or inner radius of a hollow bat) over
   /// the fill's depth, an invalid non-empty fill material.
-  /// Does not allocate when why is null and the bat is valid.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): core's field name
-  /// ("wall_thickness_m", "knots[2].x_m", "fill.material.density_kg_m3"), value and rule.
+  /// Does not allocate when refusal is null and the bat is valid.
+  /// Core's field names: "wall_thickness_m", "knots[2].x_m", "fill.material.density_kg_m3".
   bool Validate(Refusal* refusal) const;
   /// Validate, then the plausible sizes: knots' x in [0, kMaxBatLengthM], radii in
   /// (0, kMaxBatRadiusM] (so the wall, below the smallest radius, and the fill's depth, within

@@ -127,7 +127,7 @@ MassProperties WithMoments(MassProperties out, InertiaModel model,
 long long MassPropertiesComputationsOnThisThread() { return computations_on_this_thread; }
 
 MassProperties ComputeMassProperties(const Bat& bat, InertiaModel model) {
-  if (!bat.IsValid(nullptr)) return NanProperties(model);
+  if (!bat.Validate(nullptr)) return NanProperties(model);
   return ComputeMassPropertiesOfValidBat(bat, model);
 }
 
@@ -139,7 +139,7 @@ MassProperties ComputeMassPropertiesOfValidBat(const Bat& bat, InertiaModel mode
 }
 
 MassPropertiesOfBothModels ComputeMassPropertiesOfBothModels(const Bat& bat) {
-  if (!bat.IsValid(nullptr)) {
+  if (!bat.Validate(nullptr)) {
     return {NanProperties(InertiaModel::kRigidBody), NanProperties(InertiaModel::kSlenderRod)};
   }
   ++computations_on_this_thread;

@@ -49,7 +49,7 @@ inline constexpr double kMaxPivotFromKnobM = 100.0;
 /// in *refusal (if non-null).
 bool ValidatePivotFromKnob(double pivot_from_knob_m, Refusal* refusal);
 
-/// Mass properties of `bat` (precondition: bat.IsValid(nullptr); for an
+/// Mass properties of `bat` (precondition: bat.Validate(nullptr); for an
 /// invalid bat every field is NaN). Never throws, never allocates; O(knots).
 MassProperties ComputeMassProperties(const Bat& bat, InertiaModel model = InertiaModel::kRigidBody);
 /// ComputeMassProperties of a bat the caller has checked (Bat::Validate passed, or

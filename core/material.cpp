@@ -159,10 +159,6 @@ const char* MaterialKindName(MaterialKind kind) {
   return "wood";
 }
 
-bool Material::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool Material::Validate(Refusal* why) const {
   if (!std::isfinite(density_kg_m3))
     return Refuse(why, "density_kg_m3", density_kg_m3, "must be finite");

@@ -54,12 +54,11 @@ struct Material {
   std::string source;  ///< Where the numbers come from (citation).
 
   /// True when every field is finite and in its physical range; otherwise
-  /// writes "field = value: rule" to *why (if non-null). Rules: density > 0,
+  /// stores the refusal in *refusal (if non-null): field, value and rule, its Message()
+  /// "field = value: rule". Rules: density > 0,
   /// E > 0, G >= 0, -1 < nu < 0.5, 0 <= cor <= 1, range bounds >= 0 and
   /// min <= max when both are given. The density range is informational: a
   /// density outside it is accepted (sweeps and custom materials use that).
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
   bool Validate(Refusal* refusal) const;
   /// Validate, then the plausible magnitudes: density in (0, kMaxDensityKgM3], E in
   /// (0, kMaxModulusPa], G in [0, kMaxModulusPa] ("density_kg_m3 = 2e+05: must be in

@@ -89,19 +89,4 @@ bool Refuse(Refusal* out, std::string_view field, double value, std::string_view
   return false;
 }
 
-bool RefuseMessage(std::string* why, const Refusal& refusal) {
-  if (why != nullptr) *why = refusal.Message();
-  return false;
-}
-
-bool RefuseMessage(std::string* why, std::string_view field, double value, std::string_view rule) {
-  if (why != nullptr) *why = NumberRefusal(field, value, rule).Message();
-  return false;
-}
-
-bool RefuseMessage(std::string* why, std::string message) {
-  if (why != nullptr) *why = std::move(message);
-  return false;
-}
-
 }  // namespace sweetspot::core

@@ -1,7 +1,8 @@
 // A refusal: why core's validation refused an input, as data (the field in core's own names,
-// the value, the rule) rather than as text. Message() writes it the one way every IsValid
-// writes it ("field = value: rule"); the api maps `field` to the request's path with one
-// function (api/json_reader.hpp: CoreRefusal) instead of reading the text back.
+// the value, the rule) rather than as text: every validator is `bool Validate(Refusal*) const`.
+// Message() writes it the one way users see it ("field = value: rule"); the api maps `field`
+// to the request's path with one function (api/json_reader.hpp: CoreRefusal) instead of
+// reading the text back.
 #pragma once
 
 #include <limits>
@@ -67,17 +68,9 @@ bool CheckIntegerInRange(Refusal* out, std::string_view field, long long value, 
 bool Refuse(Refusal* out, Refusal refusal);
 /// Refuse(out, NumberRefusal(field, value, rule)) without formatting when `out` is null.
 bool Refuse(Refusal* out, std::string_view field, double value, std::string_view rule);
-/// The string forms (named apart from Refuse so that a file's own helpers do not collide):
-/// stores refusal.Message() in *why (if non-null) and returns false.
-bool RefuseMessage(std::string* why, const Refusal& refusal);
-/// "field = value: rule" (NumberRefusal) in *why (if non-null; nothing is formatted when null).
-bool RefuseMessage(std::string* why, std::string_view field, double value, std::string_view rule);
-/// Stores a message composed by the caller in *why (if non-null) and returns false: for the
-/// validators that still compose text (the design model's nested checks, the rule sets).
-bool RefuseMessage(std::string* why, std::string message);
-
-/// The string form of a structured validator: `validate(Refusal*)` run with *why as the
-/// message (nothing is formatted when `why` is null).
+/// `validate(Refusal*)` run with its refusal's Message() in *why (nothing is formatted when
+/// `why` is null): for a caller that shows the refusal as text. Validators themselves have
+/// one form, `bool Validate(Refusal*) const`; none writes a string.
 template <typename Validate>
 bool ExplainRefusal(std::string* why, Validate&& validate) {
   if (why == nullptr) return validate(nullptr);

@@ -63,10 +63,6 @@ std::optional<SamplingMethod> ParseSamplingMethod(const std::string& name) {
   return std::nullopt;
 }
 
-bool SweepPlan::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool SweepPlan::Validate(Refusal* why) const {
   if (dimensions.empty() || dimensions.size() > 32) {
     return Refuse(why, "dimensions", static_cast<double>(dimensions.size()),
@@ -106,10 +102,6 @@ std::uint64_t SweepPlan::DesignCount() const {
     n *= c;
   }
   return n;
-}
-
-bool Shard::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
 }
 
 bool Shard::Validate(Refusal* why) const {

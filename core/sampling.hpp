@@ -39,9 +39,8 @@ struct SweepPlan {
   std::uint64_t samples = 0;  ///< LHS/Sobol: number of designs (>= 1); grid: ignored.
   std::uint64_t seed = 0;     ///< LHS: the generator's seed; Sobol: points skipped after the origin.
 
-  /// True when well formed; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when well formed; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
   /// Number of designs: the grid's product of counts, or `samples` (saturates at UINT64_MAX).
   std::uint64_t DesignCount() const;
@@ -53,9 +52,8 @@ struct Shard {
   std::uint64_t index = 0;  ///< This shard, in [0, count).
   std::uint64_t count = 1;  ///< Number of shards (>= 1).
 
-  /// True when index < count and count >= 1; otherwise "field = value: rule".
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when index < count and count >= 1; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
   /// True when design `i` belongs to this shard.
   bool Contains(std::uint64_t i) const { return i % count == index; }
@@ -63,7 +61,7 @@ struct Shard {
 
 /// The designs of `plan` (each a point in parameter units, one value per
 /// dimension), in design-index order. Deterministic: the same plan gives the
-/// same designs bit for bit. Precondition: plan.IsValid().
+/// same designs bit for bit. Precondition: plan.Validate(nullptr).
 std::vector<std::vector<double>> GenerateDesigns(const SweepPlan& plan);
 
 /// Design `i` of a grid plan without generating the others (row-major: the
@@ -78,7 +76,7 @@ void GridDesignInto(const SweepPlan& plan, std::uint64_t i, std::vector<double>*
 /// construction (n x dimensions doubles, shared by copies: its strata are a permutation of
 /// all n designs). Design i equals GenerateDesigns(plan)[i] bit for bit. Copies share the
 /// table and each has its own Sobol position, so give each thread its own copy.
-/// Precondition: plan.IsValid().
+/// Precondition: plan.Validate(nullptr).
 class DesignSequence {
  public:
   explicit DesignSequence(const SweepPlan& plan);

@@ -111,10 +111,6 @@ std::optional<FitVariable> FitVariableFromName(std::string_view name) {
   return std::nullopt;
 }
 
-bool ShapeFitOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool ShapeFitOptions::Validate(Refusal* why) const {
   if (!std::isfinite(mass_scale_kg) || mass_scale_kg < 0.0) {
     return Refuse(why, "mass_scale_kg", mass_scale_kg,
@@ -153,10 +149,6 @@ bool ShapeFitOptions::Validate(Refusal* why) const {
     return Refuse(why, "max_time_s", max_time_s, "must be finite and positive");
   }
   return true;
-}
-
-bool ShapeFitProblem::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
 }
 
 bool ShapeFitProblem::Validate(Refusal* why) const {
@@ -441,10 +433,9 @@ ShapeFitResult FitShape(const ShapeFitProblem& problem, const ShapeFitOptions& o
     summary.iterations = local_runs + gauss_newton_steps;
     summary.evaluations = model.evaluations();
     summary.constraint_violation = std::max(0.0, model.MaxViolationM(best.data()));
-    std::string bat_why;
-    if (!result.bat.IsValid(&bat_why)) {
+    if (Refusal bat_why; !result.bat.Validate(&bat_why)) {
       summary.termination = Termination::kFailure;
-      summary.message = "the fitted bat is invalid: " + bat_why;
+      summary.message = "the fitted bat is invalid: " + bat_why.Message();
       summary.objective = best_phi;
       summary.solve_time_s = elapsed_s();
       return result;

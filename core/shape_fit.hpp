@@ -90,9 +90,8 @@ struct ShapeFitProblem {
   std::vector<FitUnknown> unknowns;  ///< 1 to 10 distinct unknowns.
   FitTargets targets;                ///< What to meet.
 
-  /// True when the problem can be solved; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when the problem can be solved; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
   /// Validate, then every unknown's bounds at most kMaxFitBound ("unknowns[0].max = 2e+05:
   /// must be in [0, 1e+05]"); for a problem given from outside.
@@ -115,9 +114,8 @@ struct ShapeFitOptions {
   int max_evaluations = 20000;  ///< Budget of objective evaluations over the whole fit (>= 1).
   double max_time_s = 5.0;      ///< Wall-time budget, s (> 0).
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 

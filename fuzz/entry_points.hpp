@@ -251,8 +251,8 @@ inline Verdict RunParseBat(std::string_view input) {
     return {"ParseBat returned a bat and the error " + std::string(api::ErrorCodeName(*error.code)),
             ""};
   }
-  std::string why;
-  if (!spec->bat.IsValid(&why)) return {"ParseBat returned an invalid bat: " + why, ""};
+  if (core::Refusal why; !spec->bat.Validate(&why))
+    return {"ParseBat returned an invalid bat: " + why.Message(), ""};
   const double length = spec->bat.LengthM();
   for (const core::InertiaModel model :
        {core::InertiaModel::kRigidBody, core::InertiaModel::kSlenderRod}) {

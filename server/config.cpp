@@ -498,43 +498,44 @@ const std::vector<Option>& Options() {
 
 }  // namespace
 
-bool ServerConfig::IsValid(std::string* why) const {
-  auto fail = [why](const std::string& text) {
-    if (why != nullptr) *why = text;
-    return false;
-  };
-  if (host.empty()) return fail("host = \"\": must not be empty");
-  if (port < 0 || port > 65535)
-    return fail("port = " + std::to_string(port) + ": must be in [0, 65535]");
+bool ServerConfig::Validate(core::Refusal* refusal) const {
+  using core::IntegerRefusal;
+  using core::NumberRefusal;
+  auto fail = [refusal](core::Refusal why) { return core::Refuse(refusal, std::move(why)); };
+  if (host.empty()) return fail(core::QuotedRefusal("host", "\"\"", "must not be empty"));
+  if (port < 0 || port > 65535) return fail(IntegerRefusal("port", port, "must be in [0, 65535]"));
   if (threads < 1 || threads > 1024) {
-    return fail("threads = " + std::to_string(threads) + ": must be in [1, 1024]");
+    return fail(IntegerRefusal("threads", threads, "must be in [1, 1024]"));
   }
   if (compute_threads < 0 || compute_threads > 1024) {
-    return fail("compute_threads = " + std::to_string(compute_threads) +
-                ": must be in [0, 1024] (0 = one per core)");
+    return fail(IntegerRefusal("compute_threads", compute_threads,
+                               "must be in [0, 1024] (0 = one per core)"));
   }
   if (explore_threads < 0 || explore_threads > 1024) {
-    return fail("explore_threads = " + std::to_string(explore_threads) +
-                ": must be in [0, 1024] (0 = one per core)");
+    return fail(IntegerRefusal("explore_threads", explore_threads,
+                               "must be in [0, 1024] (0 = one per core)"));
   }
   if (max_head_bytes < 256) {
-    return fail("max_head_bytes = " + std::to_string(max_head_bytes) + ": must be at least 256");
+    return fail(IntegerRefusal("max_head_bytes", static_cast<long long>(max_head_bytes),
+                               "must be at least 256"));
   }
   if (!std::isfinite(body_min_rate_bytes_per_s) || body_min_rate_bytes_per_s < 1) {
-    return fail("body_min_rate_bytes_per_s = " + core::FormatNumber(body_min_rate_bytes_per_s) +
-                ": must be at least 1");
+    return fail(NumberRefusal("body_min_rate_bytes_per_s", body_min_rate_bytes_per_s,
+                              "must be at least 1"));
   }
   if (max_connections < 1) {
-    return fail("max_connections = " + std::to_string(max_connections) + ": must be at least 1");
+    return fail(IntegerRefusal("max_connections", static_cast<long long>(max_connections),
+                               "must be at least 1"));
   }
   if (max_connections_per_client < 1) {
-    return fail("max_connections_per_client = " + std::to_string(max_connections_per_client) +
-                ": must be at least 1");
+    return fail(IntegerRefusal("max_connections_per_client",
+                               static_cast<long long>(max_connections_per_client),
+                               "must be at least 1"));
   }
   if (!auth_token.empty() && auth_token.size() < 16) {
-    return fail("auth_token: must have at least 16 characters");
+    return fail(core::TextRefusal("auth_token", "must have at least 16 characters"));
   }
-  if (max_body_bytes < 1) return fail("max_body_bytes = 0: must be at least 1");
+  if (max_body_bytes < 1) return fail(IntegerRefusal("max_body_bytes", 0, "must be at least 1"));
   for (const auto& [name, value] :
        {std::pair{"header_timeout_s", header_timeout_s},
         std::pair{"read_timeout_s", read_timeout_s}, std::pair{"write_timeout_s", write_timeout_s},
@@ -542,27 +543,28 @@ bool ServerConfig::IsValid(std::string* why) const {
         std::pair{"first_byte_timeout_s", first_byte_timeout_s},
         std::pair{"max_request_time_s", max_request_time_s}}) {
     if (!std::isfinite(value) || value <= 0 || value > 3600) {
-      return fail(std::string(name) + " = " + core::FormatNumber(value) + ": must be in (0, 3600]");
+      return fail(NumberRefusal(name, value, "must be in (0, 3600]"));
     }
   }
-  if (std::string limits_why; !limits.IsValid(&limits_why)) return fail("limits." + limits_why);
-  if (std::string jobs_why; !jobs.IsValid(&jobs_why)) return fail("jobs." + jobs_why);
+  if (core::Refusal why; !limits.Validate(&why)) return fail(core::Prefixed("limits.", why));
+  if (core::Refusal why; !jobs.Validate(&why)) return fail(core::Prefixed("jobs.", why));
   if (jobs_db.empty()) {
-    return fail("jobs_db = \"\": must be a file path, a postgresql:// URI, or \"" +
-                std::string(kNoJobsDb) + "\" for no persistence");
+    return fail(core::QuotedRefusal("jobs_db", "\"\"",
+                                    "must be a file path, a postgresql:// URI, or \"" +
+                                        std::string(kNoJobsDb) + "\" for no persistence"));
   }
   if (jobs_db_max_bytes != 0 &&
       (jobs_db_max_bytes < 65536 || jobs_db_max_bytes > 1000000000000000ULL)) {
-    return fail("jobs_db_max_bytes = " + std::to_string(jobs_db_max_bytes) +
-                ": must be 0 (no limit) or in [65536, 1e15]");
+    return fail(core::QuotedRefusal("jobs_db_max_bytes", std::to_string(jobs_db_max_bytes),
+                                    "must be 0 (no limit) or in [65536, 1e15]"));
   }
   if (!std::isfinite(shutdown_grace_s) || shutdown_grace_s < 0 || shutdown_grace_s > 3600) {
-    return fail("shutdown_grace_s = " + core::FormatNumber(shutdown_grace_s) +
-                ": must be in [0, 3600]");
+    return fail(NumberRefusal("shutdown_grace_s", shutdown_grace_s, "must be in [0, 3600]"));
   }
   if (keep_alive_max_requests < 1) {
-    return fail("keep_alive_max_requests = " + std::to_string(keep_alive_max_requests) +
-                ": must be at least 1");
+    return fail(IntegerRefusal("keep_alive_max_requests",
+                               static_cast<long long>(keep_alive_max_requests),
+                               "must be at least 1"));
   }
   return true;
 }
@@ -620,7 +622,7 @@ ParsedCommandLine ParseCommandLine(
   // One flag per job limit: the api's check at submit reads the job runner's limits.
   out.config.limits.max_job_time_s = out.config.jobs.max_time_s;
   out.config.limits.max_job_result_bytes = out.config.jobs.max_result_bytes;
-  if (!out.config.IsValid(&rule)) out.error = rule;
+  if (core::Refusal why; !out.config.Validate(&why)) out.error = why.Message();
   return out;
 }
 

@@ -43,8 +43,9 @@ struct ServerConfig {
   double shutdown_grace_s = 8.0;         ///< On SIGTERM/SIGINT, how long running jobs may still finish before they are interrupted, s, [0, 3600] (--shutdown-grace-s, SWEETSPOT_SHUTDOWN_GRACE_S).
   std::string web_root;                  ///< Folder of the design explorer's static files served at /; empty = "web" next to the executable (--web-root, SWEETSPOT_WEB_ROOT).
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
+  /// True when every field is in range; otherwise the refusal in *refusal (if non-null): field,
+  /// value and rule, its Message() "field = value: rule".
+  bool Validate(core::Refusal* refusal) const;
 };
 
 /// The ServerConfig::jobs_db value that turns job persistence off.

@@ -181,17 +181,16 @@ double RingFeHoopFrequencyHz(double youngs_modulus_pa, double poissons_ratio, do
                                std::max(8, elements));
 }
 
-bool BarrelOptions::IsValid(std::string* why) const {
+bool BarrelOptions::Validate(Refusal* why) const {
   if (!(std::isfinite(barrel_loss) && barrel_loss >= 0.0 && barrel_loss < 1.0))
-    return RefuseMessage(why,
-                         Number17Refusal("barrel.barrel_loss", barrel_loss, "must be in [0, 1)"));
+    return Refuse(why, Number17Refusal("barrel.barrel_loss", barrel_loss, "must be in [0, 1)"));
   if (!(std::isfinite(shell_factor) && shell_factor > 0.0))
-    return RefuseMessage(
-        why, Number17Refusal("barrel.shell_factor", shell_factor, "must be finite and > 0"));
+    return Refuse(why,
+                  Number17Refusal("barrel.shell_factor", shell_factor, "must be finite and > 0"));
   if (!(std::isfinite(effective_length_m) && effective_length_m >= 0.0))
-    return RefuseMessage(why, Number17Refusal("barrel.effective_length_m", effective_length_m,
-                                              "must be finite and >= 0 (0 = the default)"));
-  return ContactIntegrationIsValid("barrel", relative_tolerance, max_steps, why);
+    return Refuse(why, Number17Refusal("barrel.effective_length_m", effective_length_m,
+                                       "must be finite and >= 0 (0 = the default)"));
+  return ContactIntegrationValidate("barrel", relative_tolerance, max_steps, why);
 }
 
 BarrelWall BarrelWallAt(const Bat& bat, double x_m, const BarrelOptions& options) {
@@ -222,9 +221,8 @@ BarrelWall BarrelWallAt(const Bat& bat, double x_m, const BarrelOptions& options
 TrampolineResult TrampolineImpact(const TrampolineProblem& p, const BarrelOptions& options) {
   using barrel_detail::TrampolineState;
   TrampolineResult out;
-  std::string why;
-  if (!options.IsValid(&why)) {
-    out.message = why;
+  if (Refusal why; !options.Validate(&why)) {
+    out.message = why.Message();
     return out;
   }
   const double rest = p.bat_effective_mass_kg - p.barrel_modal_mass_kg;
@@ -333,9 +331,8 @@ BbcorResult ComputeBbcor(const Bat& bat, const BbcorProtocol& protocol,
   out.ball = protocol.ball;
   out.ball_speed_mps = protocol.ball_speed_mps;
   out.pivot_from_knob_m = protocol.pivot_from_knob_m;
-  std::string why;
-  if (!bat.IsValid(&why) || !options.IsValid(&why)) {
-    out.message = why;
+  if (Refusal why; !bat.Validate(&why) || !options.Validate(&why)) {
+    out.message = why.Message();
     return out;
   }
   const std::optional<BallPreset> ball = FindBallPreset(protocol.ball);

@@ -77,8 +77,9 @@ struct BarrelOptions {
   double relative_tolerance = 1e-8;
   int max_steps = 200000;  ///< Accepted integrator steps per impact (>= 10).
 
-  /// True when every field is in range; otherwise "barrel.field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "barrel.field = value: rule".
+  bool Validate(Refusal* refusal) const;
 };
 
 /// The wall at one point along a hollow bat.

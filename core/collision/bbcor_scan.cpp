@@ -29,20 +29,19 @@ std::vector<double> ScanPositionsFromTip(const BbcorProtocol& p) {
 
 }  // namespace
 
-bool BbcorScanRangeIsValid(const BbcorProtocol& p, std::string* why) {
+bool BbcorScanRangeValidate(const BbcorProtocol& p, Refusal* why) {
   if (!(std::isfinite(p.scan_first_from_tip_m) && p.scan_first_from_tip_m >= 0.0))
-    return RefuseMessage(why, Number17Refusal("protocol.scan_first_from_tip_m",
-                                              p.scan_first_from_tip_m, "must be finite and >= 0"));
+    return Refuse(why, Number17Refusal("protocol.scan_first_from_tip_m", p.scan_first_from_tip_m,
+                                       "must be finite and >= 0"));
   if (!(std::isfinite(p.scan_last_from_tip_m) && p.scan_last_from_tip_m >= p.scan_first_from_tip_m))
-    return RefuseMessage(why,
-                         Number17Refusal("protocol.scan_last_from_tip_m", p.scan_last_from_tip_m,
-                                         "must be finite and >= scan_first_from_tip_m"));
+    return Refuse(why, Number17Refusal("protocol.scan_last_from_tip_m", p.scan_last_from_tip_m,
+                                       "must be finite and >= scan_first_from_tip_m"));
   if (!(std::isfinite(p.scan_step_m) && p.scan_step_m > 0.0))
-    return RefuseMessage(
-        why, Number17Refusal("protocol.scan_step_m", p.scan_step_m, "must be finite and > 0"));
+    return Refuse(why,
+                  Number17Refusal("protocol.scan_step_m", p.scan_step_m, "must be finite and > 0"));
   if ((p.scan_last_from_tip_m - p.scan_first_from_tip_m) / p.scan_step_m + 1.0 > kMaxScanPoints)
-    return RefuseMessage(why, Number17Refusal("protocol.scan_step_m", p.scan_step_m,
-                                              "gives more than 201 scan points"));
+    return Refuse(why, Number17Refusal("protocol.scan_step_m", p.scan_step_m,
+                                       "gives more than 201 scan points"));
   return true;
 }
 
@@ -56,10 +55,10 @@ BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes, const BbcorPro
   out.pivot_from_knob_m = protocol.pivot_from_knob_m;
   Summary guard;
   CatchInternalError(&guard, [&] {
-    std::string why;
-    if (!bat.IsValid(&why) || !barrel.IsValid(&why) || !impact.IsValid(&why) ||
-        !BbcorScanRangeIsValid(protocol, &why)) {
-      out.message = "bbcor_scan: " + why;
+    Refusal why;
+    if (!bat.Validate(&why) || !barrel.Validate(&why) || !impact.Validate(&why) ||
+        !BbcorScanRangeValidate(protocol, &why)) {
+      out.message = "bbcor_scan: " + why.Message();
       return;
     }
     if (!(std::isfinite(protocol.ball_speed_mps) && protocol.ball_speed_mps > 0.0)) {

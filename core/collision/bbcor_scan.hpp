@@ -74,8 +74,9 @@ struct BbcorScan {
   double solve_time_s = 0.0;            ///< Wall time, s.
 };
 
-/// The scan range's rule: "protocol.field = value: rule" in *why when out of range.
-bool BbcorScanRangeIsValid(const BbcorProtocol& protocol, std::string* why);
+/// The scan range's rule: false, with the refusal ("protocol.field") in *why (if non-null),
+/// when out of range.
+bool BbcorScanRangeValidate(const BbcorProtocol& protocol, Refusal* why);
 
 /// BBCOR of `bat` at every point of `protocol`'s scan range by the flexible model with the
 /// bat's `modes` (ComputeBatModes on that bat) and `impact` options (the hands' loads are not

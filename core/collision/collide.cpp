@@ -12,10 +12,6 @@
 
 namespace sweetspot::core {
 
-bool CollisionOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool CollisionOptions::Validate(Refusal* why) const {
   return hertz.Validate(why) && flexible.Validate(why);
 }

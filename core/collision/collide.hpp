@@ -25,9 +25,8 @@ struct CollisionOptions {
                                       ///< bat_surface_compliance too).
   FlexibleOptions flexible;           ///< Flexible-beam settings (model = kFlexible).
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 

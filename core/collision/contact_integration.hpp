@@ -76,38 +76,29 @@ inline bool ContactIntegrationValidate(std::string_view model, double relative_t
   return true;
 }
 
-/// ContactIntegrationValidate with "model.field = value: rule" in *why (if non-null).
-inline bool ContactIntegrationIsValid(std::string_view model, double relative_tolerance,
-                                      int max_steps, std::string* why) {
-  return ExplainRefusal(why, [&](Refusal* out) {
-    return ContactIntegrationValidate(model, relative_tolerance, max_steps, out);
-  });
-}
-
 /// The ball law's rules both contact models check, in this order: `ball_stiffness` (the power
-/// law's constant, N/m^exponent) finite and > 0, `ball_exponent` in [1, 3]. False, with
-/// "ball.field = value: rule" in *why (if non-null), when one is broken.
-inline bool BallLawIsValid(double ball_stiffness, double ball_exponent, std::string* why) {
+/// law's constant, N/m^exponent) finite and > 0, `ball_exponent` in [1, 3]. False, with the
+/// refusal ("ball.field") in *why (if non-null), when one is broken.
+inline bool BallLawValidate(double ball_stiffness, double ball_exponent, Refusal* why) {
   if (!(std::isfinite(ball_stiffness) && ball_stiffness > 0.0))
-    return RefuseMessage(
-        why, Number17Refusal("ball.stiffness", ball_stiffness, "must be finite and > 0"));
+    return Refuse(why, Number17Refusal("ball.stiffness", ball_stiffness, "must be finite and > 0"));
   if (!(std::isfinite(ball_exponent) && ball_exponent >= 1.0 && ball_exponent <= 3.0))
-    return RefuseMessage(
-        why, Number17Refusal("ball.stiffness_exponent", ball_exponent, "must be in [1, 3]"));
+    return Refuse(why,
+                  Number17Refusal("ball.stiffness_exponent", ball_exponent, "must be in [1, 3]"));
   return true;
 }
 
 /// Opens the summary of a contact model's solve: backend "odeint:runge_kutta_dopri5",
 /// models_used {`model`}. False, with the first refusal as the summary's message (its
 /// termination is left as it is, invalid input in a TimedSolve), when one of `checked` (in
-/// order, each with `bool IsValid(std::string*) const`) is not valid.
+/// order, each with `bool Validate(Refusal*) const`) is not valid.
 template <class... Checked>
 bool StartContactSolve(const char* model, Summary* summary, const Checked&... checked) {
   summary->backend = "odeint:runge_kutta_dopri5";
   summary->models_used = {model};
-  std::string why;
-  if ((checked.IsValid(&why) && ...)) return true;
-  summary->message = why;
+  Refusal why;
+  if ((checked.Validate(&why) && ...)) return true;
+  summary->message = why.Message();
   return false;
 }
 

@@ -194,10 +194,6 @@ void IntegrateAlong(const BatModes& modes, double a, double b, F&& f) {
 
 }  // namespace
 
-bool FlexibleImpactOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool FlexibleImpactOptions::Validate(Refusal* why) const {
   if (max_modes < 1 || max_modes > 50)
     return Refuse(why, IntegerRefusal("flexible.max_modes", max_modes, "must be in [1, 50]"));
@@ -222,33 +218,32 @@ bool FlexibleImpactOptions::Validate(Refusal* why) const {
   return true;
 }
 
-bool FlexibleImpactInputs::IsValid(std::string* why) const {
+bool FlexibleImpactInputs::Validate(Refusal* why) const {
   auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!std::isfinite(impact_from_knob_m))
-    return RefuseMessage(
-        why, "impact_from_knob_m = " + FormatNumber17(impact_from_knob_m) + ": must be finite");
+    return Refuse(why, Number17Refusal("impact_from_knob_m", impact_from_knob_m, "must be finite"));
   if (!std::isfinite(hands_from_knob_m))
-    return RefuseMessage(
-        why, "swing.hands_from_knob_m = " + FormatNumber17(hands_from_knob_m) + ": must be finite");
+    return Refuse(why,
+                  Number17Refusal("swing.hands_from_knob_m", hands_from_knob_m, "must be finite"));
   if (!finite_pos(ball_mass_kg))
-    return RefuseMessage(
-        why, "ball.mass_kg = " + FormatNumber17(ball_mass_kg) + ": must be finite and > 0");
+    return Refuse(why, Number17Refusal("ball.mass_kg", ball_mass_kg, "must be finite and > 0"));
   if (!(std::isfinite(ball_speed_mps) && ball_speed_mps >= 0.0))
-    return RefuseMessage(
-        why, "ball.speed_mps = " + FormatNumber17(ball_speed_mps) + ": must be finite and >= 0");
+    return Refuse(why,
+                  Number17Refusal("ball.speed_mps", ball_speed_mps, "must be finite and >= 0"));
   if (!finite_pos(approach_speed_mps))
-    return RefuseMessage(
-        why, "approach_speed_mps = " + FormatNumber17(approach_speed_mps) +
-                 ": must be finite and > 0 (the ball and the bat must approach each other)");
-  if (!BallLawIsValid(ball_stiffness, ball_exponent, why)) return false;
+    return Refuse(
+        why,
+        Number17Refusal("approach_speed_mps", approach_speed_mps,
+                        "must be finite and > 0 (the ball and the bat must approach each other)"));
+  if (!BallLawValidate(ball_stiffness, ball_exponent, why)) return false;
   if (!(std::isfinite(surface_stiffness) && surface_stiffness >= 0.0))
-    return RefuseMessage(why, "surface_stiffness = " + FormatNumber17(surface_stiffness) +
-                                  ": must be finite and >= 0");
+    return Refuse(
+        why, Number17Refusal("surface_stiffness", surface_stiffness, "must be finite and >= 0"));
   if (!(std::isfinite(cor) && cor >= 0.0 && cor <= 1.0))
-    return RefuseMessage(why, "cor = " + FormatNumber17(cor) + ": must be in [0, 1]");
+    return Refuse(why, Number17Refusal("cor", cor, "must be in [0, 1]"));
   if (!(std::isfinite(barrel_compliance_m_n) && barrel_compliance_m_n >= 0.0))
-    return RefuseMessage(why, "barrel_compliance_m_n = " + FormatNumber17(barrel_compliance_m_n) +
-                                  ": must be finite and >= 0");
+    return Refuse(why, Number17Refusal("barrel_compliance_m_n", barrel_compliance_m_n,
+                                       "must be finite and >= 0"));
   return true;
 }
 

@@ -63,9 +63,8 @@ struct FlexibleImpactOptions {
   /// vibration energy: the peaks are then reported as 0 and the impact costs ~30 % less.
   bool hands_loads = true;
 
-  /// True when every field is in range; otherwise "flexible.field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "flexible.field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 
@@ -87,8 +86,9 @@ struct FlexibleImpactInputs {
   /// applied here; for cor = 0 the wall's stored energy is counted with the released energy).
   double barrel_compliance_m_n = 0.0;
 
-  /// True when the inputs can be integrated; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
+  /// True when the inputs can be integrated; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
+  bool Validate(Refusal* refusal) const;
 };
 
 /// What the flexible model knows about one impact.

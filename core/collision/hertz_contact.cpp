@@ -180,65 +180,52 @@ const char* ContactLawName(ContactLaw law) {
   return "ball_power_law";
 }
 
-bool HertzProblem::IsValid(std::string* why) const {
+bool HertzProblem::Validate(Refusal* why) const {
   auto finite_pos = [](double v) { return std::isfinite(v) && v > 0.0; };
   auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
   if (!finite_pos(approach_speed_mps))
-    return RefuseMessage(
-        why, "hertz.approach_speed_mps = " + FormatNumber17(approach_speed_mps) +
-                 ": must be finite and > 0 (the ball and the bat must approach each other)");
+    return Refuse(
+        why,
+        Number17Refusal("hertz.approach_speed_mps", approach_speed_mps,
+                        "must be finite and > 0 (the ball and the bat must approach each other)"));
   if (!finite_nonneg(ball_speed_mps))
-    return RefuseMessage(why, "hertz.ball_speed_mps = " + FormatNumber17(ball_speed_mps) +
-                                  ": must be finite and >= 0");
+    return Refuse(
+        why, Number17Refusal("hertz.ball_speed_mps", ball_speed_mps, "must be finite and >= 0"));
   if (!finite_pos(ball_mass_kg))
-    return RefuseMessage(
-        why, "hertz.ball_mass_kg = " + FormatNumber17(ball_mass_kg) + ": must be finite and > 0");
+    return Refuse(why,
+                  Number17Refusal("hertz.ball_mass_kg", ball_mass_kg, "must be finite and > 0"));
   if (!finite_pos(c11_per_kg))
-    return RefuseMessage(
-        why, "hertz.c11_per_kg = " + FormatNumber17(c11_per_kg) + ": must be finite and > 0");
+    return Refuse(why, Number17Refusal("hertz.c11_per_kg", c11_per_kg, "must be finite and > 0"));
   if (!std::isfinite(c12_per_kg))
-    return RefuseMessage(why,
-                         "hertz.c12_per_kg = " + FormatNumber17(c12_per_kg) + ": must be finite");
+    return Refuse(why, Number17Refusal("hertz.c12_per_kg", c12_per_kg, "must be finite"));
   if (!finite_pos(c22_per_kg))
-    return RefuseMessage(
-        why, "hertz.c22_per_kg = " + FormatNumber17(c22_per_kg) + ": must be finite and > 0");
+    return Refuse(why, Number17Refusal("hertz.c22_per_kg", c22_per_kg, "must be finite and > 0"));
   if (law == ContactLaw::kPaperConstants) {
     if (!finite_pos(paper.k1))
-      return RefuseMessage(
-          why, "hertz.paper.k1 = " + FormatNumber17(paper.k1) + ": must be finite and > 0");
+      return Refuse(why, Number17Refusal("hertz.paper.k1", paper.k1, "must be finite and > 0"));
     if (!finite_nonneg(paper.k2))
-      return RefuseMessage(
-          why, "hertz.paper.k2 = " + FormatNumber17(paper.k2) + ": must be finite and >= 0");
+      return Refuse(why, Number17Refusal("hertz.paper.k2", paper.k2, "must be finite and >= 0"));
     if (!std::isfinite(paper.k3))
-      return RefuseMessage(why,
-                           "hertz.paper.k3 = " + FormatNumber17(paper.k3) + ": must be finite");
+      return Refuse(why, Number17Refusal("hertz.paper.k3", paper.k3, "must be finite"));
     return true;
   }
-  if (!BallLawIsValid(ball_stiffness, ball_exponent, why)) return false;
+  if (!BallLawValidate(ball_stiffness, ball_exponent, why)) return false;
   if (!finite_nonneg(surface_stiffness))
-    return RefuseMessage(why, "hertz.surface_stiffness = " + FormatNumber17(surface_stiffness) +
-                                  ": must be finite and >= 0");
+    return Refuse(why, Number17Refusal("hertz.surface_stiffness", surface_stiffness,
+                                       "must be finite and >= 0"));
   if (!(std::isfinite(cor) && cor >= 0.0 && cor <= 1.0))
-    return RefuseMessage(why, "cor = " + FormatNumber17(cor) + ": must be in [0, 1]");
+    return Refuse(why, Number17Refusal("cor", cor, "must be in [0, 1]"));
   if (!finite_nonneg(hands_stiffness_n_m))
-    return RefuseMessage(why, "hertz.hands_stiffness_n_m = " + FormatNumber17(hands_stiffness_n_m) +
-                                  ": must be finite and >= 0");
+    return Refuse(why, Number17Refusal("hertz.hands_stiffness_n_m", hands_stiffness_n_m,
+                                       "must be finite and >= 0"));
   if (!finite_nonneg(hands_damping_n_s_m))
-    return RefuseMessage(why, "hertz.hands_damping_n_s_m = " + FormatNumber17(hands_damping_n_s_m) +
-                                  ": must be finite and >= 0");
+    return Refuse(why, Number17Refusal("hertz.hands_damping_n_s_m", hands_damping_n_s_m,
+                                       "must be finite and >= 0"));
   return true;
-}
-
-bool HertzSolverOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
 }
 
 bool HertzSolverOptions::Validate(Refusal* why) const {
   return ContactIntegrationValidate("hertz", relative_tolerance, max_steps, why);
-}
-
-bool HertzOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
 }
 
 bool HertzOptions::Validate(Refusal* why) const {

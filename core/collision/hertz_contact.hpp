@@ -74,8 +74,9 @@ struct HertzProblem {
   double hands_damping_n_s_m = 0.0;  ///< c_h, N s/m (>= 0).
   PaperContactConstants paper;       ///< K1..K3 (kPaperConstants).
 
-  /// True when the coefficients can be integrated; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
+  /// True when the coefficients can be integrated; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
+  bool Validate(Refusal* refusal) const;
 };
 
 /// Integrator settings.
@@ -86,9 +87,8 @@ struct HertzSolverOptions {
   bool refine_check =
       true;  ///< Re-solve at tolerance / 16 and report the differences as error estimates.
 
-  /// True when the options are in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when the options are in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 
@@ -114,9 +114,8 @@ struct HertzOptions {
       true;  ///< Include the bat surface's Hertz stiffness (needs the bat's geometry).
   HertzSolverOptions solver;  ///< Integrator settings.
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 

@@ -66,7 +66,7 @@ struct BeamSection {
   double shear_stiffness_n = 0.0;       ///< kappa G A (bat + fill, Cowper kappa of each), N.
 };
 
-/// The section of `bat` at `x_m` metres from the knob (precondition: bat.IsValid(nullptr) and
+/// The section of `bat` at `x_m` metres from the knob (precondition: bat.Validate(nullptr) and
 /// 0 <= x_m <= L). At a fill's bottom the fill is included (x >= L - depth).
 BeamSection SectionAt(const Bat& bat, double x_m);
 

@@ -247,10 +247,6 @@ bool SolveLevel(const Bat& bat, const BeamModesOptions& o, BeamMesh mesh, const 
 
 }  // namespace
 
-bool BeamModesOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool BeamModesOptions::Validate(Refusal* why) const {
   if (num_modes < 1 || num_modes > 50)
     return Refuse(why, IntegerRefusal("num_modes", num_modes, "must be in [1, 50]"));

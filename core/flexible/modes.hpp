@@ -50,9 +50,8 @@ struct BeamModesOptions {
   int max_elements = 512;    ///< No mesh beyond this many elements (no_convergence), in [2, 4096].
   bool rotary_inertia = true;  ///< Timoshenko: include rho I (false only to compare theories).
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 

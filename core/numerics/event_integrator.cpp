@@ -8,25 +8,25 @@
 
 namespace sweetspot::core {
 
-bool EventIntegratorOptions::IsValid(std::string* why) const {
+bool EventIntegratorOptions::Validate(Refusal* why) const {
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   const char* const kPositive = "must be finite and > 0";
   if (!(std::isfinite(relative_tolerance) && relative_tolerance >= 1e-15 &&
         relative_tolerance <= 1.0))
-    return RefuseMessage(
+    return Refuse(
         why, Number17Refusal("relative_tolerance", relative_tolerance, "must be in [1e-15, 1]"));
   if (!positive(absolute_tolerance))
-    return RefuseMessage(why, Number17Refusal("absolute_tolerance", absolute_tolerance, kPositive));
-  if (!positive(max_step)) return RefuseMessage(why, Number17Refusal("max_step", max_step, kPositive));
+    return Refuse(why, Number17Refusal("absolute_tolerance", absolute_tolerance, kPositive));
+  if (!positive(max_step)) return Refuse(why, Number17Refusal("max_step", max_step, kPositive));
   if (!positive(initial_step))
-    return RefuseMessage(why, Number17Refusal("initial_step", initial_step, kPositive));
+    return Refuse(why, Number17Refusal("initial_step", initial_step, kPositive));
   if (!positive(min_restart_step))
-    return RefuseMessage(why, Number17Refusal("min_restart_step", min_restart_step, kPositive));
-  if (max_steps < 1) return RefuseMessage(why, IntegerRefusal("max_steps", max_steps, "must be >= 1"));
+    return Refuse(why, Number17Refusal("min_restart_step", min_restart_step, kPositive));
+  if (max_steps < 1) return Refuse(why, IntegerRefusal("max_steps", max_steps, "must be >= 1"));
   if (!positive(time_unit_s))
-    return RefuseMessage(why, Number17Refusal("time_unit_s", time_unit_s, kPositive));
+    return Refuse(why, Number17Refusal("time_unit_s", time_unit_s, kPositive));
   if (subject == nullptr) {
-    return RefuseMessage(why, Refusal{"subject", std::numeric_limits<double>::quiet_NaN(), "null",
+    return Refuse(why, Refusal{"subject", std::numeric_limits<double>::quiet_NaN(), "null",
                                "must name what is integrated"});
   }
   return true;

@@ -45,8 +45,9 @@ struct EventIntegratorOptions {
   /// What is integrated, for the step-bound message ("<subject> did not end within ...").
   const char* subject = "the integration";
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
+  bool Validate(Refusal* refusal) const;
 };
 
 /// How a run ended.
@@ -237,8 +238,8 @@ bool EventIntegrator<State>::Locate(const System& system, const EventSpec& event
 template <class State>
 template <class System>
 bool EventIntegrator<State>::Run(System& system, State* y, double* t) {
-  std::string why;
-  if (!options_.IsValid(&why)) return Fail(EventTermination::kInvalidOptions, why, *t, t);
+  if (Refusal why; !options_.Validate(&why))
+    return Fail(EventTermination::kInvalidOptions, why.Message(), *t, t);
   long& evaluations = summary_.evaluations;
   auto rhs = [&system, &evaluations](const State& s, State& ds, double tt) {
     ++evaluations;

@@ -219,7 +219,8 @@ void FillBase(const DesignProblem& problem, DesignResult* result) {
   result->bat = problem.bat;
   if (problem.three_segment.has_value()) {
     result->three_segment = problem.three_segment;
-    if (problem.three_segment->IsValid(nullptr)) result->bat.knots = problem.three_segment->Knots();
+    if (problem.three_segment->Validate(nullptr))
+      result->bat.knots = problem.three_segment->Knots();
   }
   result->properties = ComputeMassProperties(result->bat, problem.inertia_model);
   result->objective_value = kNaN;
@@ -334,16 +335,18 @@ void FillSpread(const std::vector<Run>& runs, DesignSpread* spread_out) {
 void ReportFixedViolations(const DesignModel& model, DesignResult* result) {
   result->summary.termination = Termination::kInfeasible;
   std::string text;
-  for (const std::string& v : model.fixed_violations()) {
+  for (const FixedViolation& v : model.fixed_violations()) {
     DesignConflict d;
-    d.constraints.push_back(v.substr(0, v.find(' ')));
+    d.constraints.push_back(v.constraint);
     d.requested_min = d.requested_max = d.achievable_min = d.achievable_max = kNaN;
     d.shortfall = kNaN;
-    d.message = v;
+    d.message = v.message;
+    d.kind = ConflictKind::kFixed;
     result->conflicts.push_back(d);
-    text += (text.empty() ? "" : "; ") + v;
+    text += (text.empty() ? "" : "; ") + v.message;
   }
   result->summary.message = "infeasible: " + text;
+  result->message_kind = DesignMessageKind::kInfeasible;
   result->summary.raw_status = 0;
   result->summary.error_estimate = kNaN;
 }
@@ -352,6 +355,7 @@ void ReportFixedViolations(const DesignModel& model, DesignResult* result) {
 void ReportNoDesign(const std::vector<Run>& runs, DesignResult* result) {
   result->summary.termination = Termination::kFailure;
   result->summary.message = "no local solve returned a design";
+  result->message_kind = DesignMessageKind::kNoDesign;
   if (!runs.empty()) {
     const LocalSolveOutcome& o = runs.front().outcome;
     result->summary.raw_status = o.raw_status;
@@ -364,17 +368,21 @@ void ReportNoDesign(const std::vector<Run>& runs, DesignResult* result) {
 // The termination and message from the chosen start, the validity of the bat and its sting.
 void ClassifyChosen(const DesignOptions& options, DesignBackend backend, const Run& chosen,
                     const PublicEvaluation& pub, const Bat& bat, DesignResult* result) {
-  std::string bat_why;
-  const bool bat_valid = bat.IsValid(&bat_why);
+  Refusal bat_why;
+  const bool bat_valid = bat.Validate(&bat_why);
   const LocalSolveOutcome& o = chosen.outcome;
   result->summary.raw_status = o.raw_status;
   result->summary.termination = o.termination;
   result->summary.message = o.status_name;
+  result->message_kind = DesignMessageKind::kSolver;
   if (!o.message.empty()) result->summary.message += ": " + o.message;
-  if (o.cancelled)
+  if (o.cancelled) {
     result->summary.message =
         "cancelled (" + result->summary.message + "); the best design so far is kept";
+    result->message_kind = DesignMessageKind::kCancelled;
+  }
   if (o.deadline_reached) {
+    result->message_kind = DesignMessageKind::kTimeBudget;
     result->summary.message = "time budget max_time_s = " + FormatNumber(options.max_time_s) +
                               " s reached (" + result->summary.message +
                               "); the best design so far is kept";
@@ -384,7 +392,8 @@ void ClassifyChosen(const DesignOptions& options, DesignBackend backend, const R
   }
   if (!bat_valid) {
     result->summary.termination = Termination::kFailure;
-    result->summary.message = "the optimised bat is invalid: " + bat_why;
+    result->summary.message = "the optimised bat is invalid: " + bat_why.Message();
+    result->message_kind = DesignMessageKind::kInvalidBat;
   }
   if (pub.sting.has_value()) {
     const StingEvaluation& st = *pub.sting;
@@ -400,6 +409,7 @@ void ClassifyChosen(const DesignOptions& options, DesignBackend backend, const R
     } else if (result->summary.termination != Termination::kFailure) {
       result->summary.termination = Termination::kFailure;
       result->summary.message = "the sting of the optimised bat cannot be computed: " + st.message;
+      result->message_kind = DesignMessageKind::kStingFailed;
     }
   }
 }
@@ -430,8 +440,8 @@ void ClassifyFeasibility(const DesignModel& model, const DesignOptions& options,
       result->summary.iterations += iters;
       const bool isolated =
           !result->conflicts.empty() && std::isfinite(result->conflicts.front().achievable_min);
-      const bool geometric = !result->conflicts.empty() &&
-                             result->conflicts.front().message.rfind("the variable bounds", 0) == 0;
+      const bool geometric =
+          !result->conflicts.empty() && result->conflicts.front().kind == ConflictKind::kGeometric;
       if (isolated || geometric || solver_says_infeasible) {
         result->summary.termination = Termination::kInfeasible;
       }
@@ -444,9 +454,11 @@ void ClassifyFeasibility(const DesignModel& model, const DesignOptions& options,
         text += (text.empty() ? "" : "; ") + d.message;
       result->summary.message = "infeasible: " + (text.empty() ? o.status_name : text) +
                                 "; the least-violating design found is returned";
+      result->message_kind = DesignMessageKind::kInfeasible;
     }
   } else if (result->summary.termination == Termination::kConverged) {
     result->summary.message = "converged (" + o.status_name + ")";
+    result->message_kind = DesignMessageKind::kConverged;
   }
 }
 
@@ -463,11 +475,13 @@ void MarkCancelledMultiStart(const DesignOptions& options, const std::vector<Run
   Summary& summary = result->summary;
   if (!cut || summary.termination == Termination::kInvalidInput) return;
   if (summary.termination != Termination::kConverged) {
-    if (summary.message.rfind("cancelled", 0) == 0) return;  // the chosen start's own cut
+    if (result->message_kind == DesignMessageKind::kCancelled)
+      return;  // the chosen start's own cut
     summary.message = "cancelled after " + std::to_string(runs.size()) + " of " +
                       std::to_string(options.starts) + " starts (the chosen start " +
                       std::to_string(result->spread.best_start) + ": " + summary.message +
                       "); the best design so far is kept";
+    result->message_kind = DesignMessageKind::kCancelledStarts;
     return;
   }
   summary.termination = Termination::kNoConvergence;
@@ -475,6 +489,7 @@ void MarkCancelledMultiStart(const DesignOptions& options, const std::vector<Run
                     std::to_string(options.starts) + " starts (the chosen start " +
                     std::to_string(result->spread.best_start) + ": " + summary.message +
                     "); the best design so far is kept";
+  result->message_kind = DesignMessageKind::kCancelledStarts;
 }
 
 // The optimisation, with the progress it reports mapped into [progress_from, progress_to]
@@ -631,14 +646,17 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
                           kFeasibleRelative * limit, RigidBodyPropertiesOrNull(pub.properties))) {
         summary.termination = Termination::kInfeasible;
         summary.message = bbcor_why;
+        result.message_kind = DesignMessageKind::kInfeasible;
       }
     }
   } catch (const std::bad_alloc&) {
     summary.termination = Termination::kFailure;
     summary.message = "out of memory";
+    result.message_kind = DesignMessageKind::kFailure;
   } catch (const std::exception& e) {
     summary.termination = Termination::kFailure;
     summary.message = std::string("failure: ") + e.what();
+    result.message_kind = DesignMessageKind::kFailure;
   }
   summary.solve_time_s = elapsed_s();
   return result;

@@ -116,10 +116,11 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
   const std::string within = has_structural
                                  ? "within the variable bounds and the geometric constraints"
                                  : "within the variable bounds";
-  auto conflict = [&](const std::vector<int>& names, int k, const Reach& r,
+  auto conflict = [&](ConflictKind kind, const std::vector<int>& names, int k, const Reach& r,
                       const std::string& context) {
     const DesignConstraintSpec& c = model.constraints()[static_cast<std::size_t>(k)];
     DesignConflict d;
+    d.kind = kind;
     for (int q : names)
       d.constraints.push_back(model.constraints()[static_cast<std::size_t>(q)].name);
     d.unit = c.unit;
@@ -156,6 +157,7 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
     const Run run = Finish(m, o);
     if (!run.feasible && o.termination == Termination::kInfeasible) {
       DesignConflict d;
+      d.kind = ConflictKind::kGeometric;
       std::string names;
       for (int k : structural) NoteViolation(model, k, run.x, &d, &names);
       d.achievable_min = d.achievable_max = d.requested_min = d.requested_max = kNaN;
@@ -172,7 +174,8 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
   for (int k : property) {
     const Reach r =
         ReachOf(model, k, structural, options, deadline, progress, evaluations, iterations);
-    if (excluded(model.constraints()[static_cast<std::size_t>(k)], r)) conflict({k}, k, r, within);
+    if (excluded(model.constraints()[static_cast<std::size_t>(k)], r))
+      conflict(ConflictKind::kUnreachable, {k}, k, r, within);
   }
   if (!out.empty()) return out;
   // 3. Pairs of property constraints.
@@ -184,7 +187,7 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
       const Reach r = ReachOf(model, k, keep, options, deadline, progress, evaluations, iterations);
       if (excluded(model.constraints()[static_cast<std::size_t>(k)], r)) {
         conflict(
-            {k, l}, k, r,
+            ConflictKind::kPair, {k, l}, k, r,
             "with " + Requested(model.constraints()[static_cast<std::size_t>(l)]) + " " + within);
       }
     }
@@ -193,6 +196,7 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
   // 4. The solver found no feasible point and nothing smaller explains it: name what the
   // least-violating design breaks.
   DesignConflict d;
+  d.kind = ConflictKind::kNotIsolated;
   std::string names;
   for (int k = 0; k < model.m(); ++k) NoteViolation(model, k, least_violating.x, &d, &names);
   d.achievable_min = d.achievable_max = d.requested_min = d.requested_max = kNaN;

@@ -138,16 +138,19 @@ struct StingEvaluation {
 StingEvaluation EvaluateSting(const Bat& bat, const StingScene& scene, bool refine_check,
                               ModesCache* cache);
 
+/// A constraint that no design variable changes and that fails at the base design.
+struct FixedViolation {
+  std::string constraint;  ///< Its name ("taper.knots[2]", "length_m", "length_m.min").
+  std::string message;     ///< One sentence, starting with the name and its value.
+};
+
 /// The design problem as an NLP over the variables x (user units). Immutable after Build;
 /// const methods are thread-safe.
 class DesignModel {
  public:
-  /// Builds the model; false (with "field = value: rule" in *why) for invalid input. A
-  /// constraint that no variable can change is checked here: if it fails, the model is still
-  /// built and fixed_violations() names it.
-  static bool Build(const DesignProblem& problem, const DesignOptions& options, DesignModel* out,
-                    std::string* why);
-  /// Build with the refusal as data in *why (if non-null): field (core's names), value, rule.
+  /// Builds the model; false, with the refusal in *why (if non-null: field in core's names,
+  /// value, rule), for invalid input. A constraint that no variable can change is checked
+  /// here: if it fails, the model is still built and fixed_violations() names it.
   static bool Build(const DesignProblem& problem, const DesignOptions& options, DesignModel* out,
                     Refusal* why);
 
@@ -155,8 +158,8 @@ class DesignModel {
   int m() const { return static_cast<int>(constraints_.size()); }                  ///< Constraints.
   const std::vector<DesignVariableSpec>& variables() const { return variables_; }  ///< Variables.
   const std::vector<DesignConstraintSpec>& constraints() const { return constraints_; }  ///< All.
-  /// Constraints that no variable changes and that fail at the base design (names + text).
-  const std::vector<std::string>& fixed_violations() const { return fixed_violations_; }
+  /// Constraints that no variable changes and that fail at the base design.
+  const std::vector<FixedViolation>& fixed_violations() const { return fixed_violations_; }
   const DesignFunctionSpec& objective() const { return objective_; }  ///< The objective.
   bool maximize() const { return maximize_; }                         ///< Objective sense.
   double objective_scale() const { return objective_scale_; }         ///< Typical |F|.
@@ -273,7 +276,7 @@ class DesignModel {
 
   std::vector<DesignVariableSpec> variables_;
   std::vector<DesignConstraintSpec> constraints_;
-  std::vector<std::string> fixed_violations_;
+  std::vector<FixedViolation> fixed_violations_;
   DesignFunctionSpec objective_;
   bool maximize_ = true;
   double objective_scale_ = 1.0;

@@ -482,12 +482,6 @@ bool ModelBuilder::Run() {
 }  // namespace design_detail
 
 bool DesignModel::Build(const DesignProblem& problem, const DesignOptions& options,
-                        DesignModel* out, std::string* why) {
-  return ExplainRefusal(why,
-                        [&](Refusal* refusal) { return Build(problem, options, out, refusal); });
-}
-
-bool DesignModel::Build(const DesignProblem& problem, const DesignOptions& options,
                         DesignModel* out, Refusal* why) {
   design_detail::ModelBuilder builder(problem, options, why);
   if (!builder.Run()) return false;

@@ -74,9 +74,9 @@ void ModelBuilder::AddLinear(const std::string& name, const std::string& min_nam
                                            std::abs(upper) < kInf ? std::abs(upper) : 0.0});
     if (v < lower - slack || v > upper + slack) {
       const std::string& n = lower == upper ? name : (v < lower ? min_name : max_name);
-      model.fixed_violations_.push_back(n + " = " + Num(v) + (unit.empty() ? "" : " " + unit) +
-                                        " must be " + RangeText(lower, upper) +
-                                        ", and no design variable changes it");
+      model.fixed_violations_.push_back({n, n + " = " + Num(v) + (unit.empty() ? "" : " " + unit) +
+                                                " must be " + RangeText(lower, upper) +
+                                                ", and no design variable changes it"});
     }
     return;
   }
@@ -142,8 +142,9 @@ bool ModelBuilder::LengthConstraint() {
     const std::string rule_name = std::string("rules.") + RuleSetName(rule) + ".length";
     if (equality) {
       if (lower > *limits.max_length_m) {
-        model.fixed_violations_.push_back("length_m = " + Num(lower) + " m exceeds " + rule_name +
-                                          ": at most " + Num(*limits.max_length_m) + " m");
+        model.fixed_violations_.push_back({"length_m", "length_m = " + Num(lower) + " m exceeds " +
+                                                           rule_name + ": at most " +
+                                                           Num(*limits.max_length_m) + " m"});
       }
       continue;
     }
@@ -151,8 +152,9 @@ bool ModelBuilder::LengthConstraint() {
     max_name = rule_name;
   }
   if (lower > upper) {
-    model.fixed_violations_.push_back("length_m.min = " + Num(lower) + " m exceeds " + max_name +
-                                      " = " + Num(upper) + " m");
+    model.fixed_violations_.push_back(
+        {"length_m.min",
+         "length_m.min = " + Num(lower) + " m exceeds " + max_name + " = " + Num(upper) + " m"});
   } else if (std::isfinite(lower) || std::isfinite(upper)) {
     const std::string name = equality || cons.length_m.has_value() ? "length_m" : max_name;
     AddLinear(name, equality ? name : "length_m.min", equality ? name : max_name, "m",

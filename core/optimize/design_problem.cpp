@@ -94,18 +94,9 @@ std::optional<DesignObjective> ParseDesignObjective(std::string_view name) {
   return std::nullopt;
 }
 
-bool DesignProblem::IsValid(std::string* why) const {
-  DesignModel built;  // not "model": that is the problem's exit-speed model
-  return DesignModel::Build(*this, DesignOptions{}, &built, why);
-}
-
 bool DesignProblem::Validate(Refusal* refusal) const {
-  DesignModel built;
+  DesignModel built;  // not "model": that is the problem's exit-speed model
   return DesignModel::Build(*this, DesignOptions{}, &built, refusal);
-}
-
-bool DesignOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
 }
 
 bool DesignOptions::Validate(Refusal* why) const {

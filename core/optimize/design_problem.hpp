@@ -233,9 +233,8 @@ struct DesignProblem {
 
   /// True when the problem is well formed (variables parse and apply to this design, bounds
   /// finite and ordered, constraints finite, the base bat valid, the rules' discrete limits
-  /// met); otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// met); otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 
@@ -293,9 +292,8 @@ struct DesignOptions {
   /// limit (ApiLimits::max_design_variables, server flag --max-design-variables).
   int max_variables = 200;
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 
@@ -329,8 +327,42 @@ struct DesignActiveConstraint {
   double multiplier = 0.0;
 };
 
+/// Which finding a DesignConflict states; code tells conflicts apart by this, never by reading
+/// their message back.
+enum class ConflictKind {
+  /// A constraint no design variable changes is violated (found when the problem is built,
+  /// without solving).
+  kFixed,
+  /// The variable bounds and the geometric constraints alone admit no design.
+  kGeometric,
+  /// One property constraint lies beyond what the bounds and the geometric constraints reach.
+  kUnreachable,
+  /// Two property constraints, each reachable alone, exclude each other.
+  kPair,
+  /// The solver found no feasible point and no smaller conflict explains it: what the
+  /// least-violating design misses.
+  kNotIsolated,
+};
+
+/// What a design's summary message states (DesignResult::message_kind).
+enum class DesignMessageKind {
+  kRefused,     ///< The input was refused before solving (summary.refusal).
+  kSolver,      ///< The chosen start's solver status: "<status>[: <solver message>]".
+  kConverged,   ///< "converged (<status>)".
+  kCancelled,   ///< The chosen start was cut by a cancel: "cancelled (...); the best ... kept".
+  kTimeBudget,  ///< The chosen start reached max_time_s: "time budget max_time_s = ... reached".
+  /// Progress::Cancel() cut the multi-start: "cancelled after i of n starts (...)".
+  kCancelledStarts,
+  kInvalidBat,   ///< "the optimised bat is invalid: ...".
+  kStingFailed,  ///< "the sting of the optimised bat cannot be computed: ...".
+  kInfeasible,   ///< "infeasible: ..." (the conflicts), or the BBCOR rule's refusal of the answer.
+  kNoDesign,     ///< "no local solve returned a design (...)".
+  kFailure,      ///< An internal failure ("out of memory", "failure: ...").
+};
+
 /// A conflict found for an infeasible request.
 struct DesignConflict {
+  ConflictKind kind = ConflictKind::kNotIsolated;  ///< Which finding this is.
   std::vector<std::string> constraints;  ///< The constraints involved, by name.
   std::string unit;                      ///< Unit of the numbers below.
   double requested_min = 0.0;            ///< What the first constraint asks (-inf if open).
@@ -399,6 +431,9 @@ struct DesignFrequency {
 ///   solve_time_s = wall time of the call.
 struct DesignResult {
   Summary summary;                                 ///< How it went (see above).
+  /// What summary.message states; code tells the outcomes apart by this, never by reading
+  /// the message back.
+  DesignMessageKind message_kind = DesignMessageKind::kRefused;
   Bat bat;                                         ///< The optimised bat.
   std::optional<ThreeSegmentShape> three_segment;  ///< Its shape, for three-segment designs.
   std::vector<DesignValue> variables;              ///< The variables' values (see DesignValue).

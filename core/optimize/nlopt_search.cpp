@@ -338,10 +338,6 @@ bool NloptAlgorithmNeedsGradient(NloptAlgorithm a) { return Info(a).name[1] == '
 bool NloptAlgorithmIsGlobal(NloptAlgorithm a) { return Info(a).name[0] == 'G'; }
 bool NloptAlgorithmIsStochastic(NloptAlgorithm a) { return a == NloptAlgorithm::kGnCrs2Lm; }
 
-bool ScalarSearchOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool ScalarSearchOptions::Validate(Refusal* why) const {
   if (!(std::isfinite(x_tolerance_m) && x_tolerance_m > 0.0))
     return Refuse(why,
@@ -373,9 +369,8 @@ ScalarSearchResult MaximizeScalar(const ScalarObjective& f, bool has_gradient, d
     s.solve_time_s = SecondsSince(t0);
     return out;
   };
-  std::string why;
-  if (!options.IsValid(&why)) {
-    s.message = why;
+  if (Refusal why; !options.Validate(&why)) {
+    s.message = why.Message();
     return finish();
   }
   const NloptAlgorithm alg = options.algorithm.value_or(has_gradient ? NloptAlgorithm::kLdSlsqp

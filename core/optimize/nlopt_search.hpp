@@ -62,9 +62,8 @@ struct ScalarSearchOptions {
   bool polish = true;                ///< GN_* only: polish the global result with a local method.
   unsigned seed = 1;  ///< Seed for stochastic algorithms (nlopt::srand before optimize()).
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 

@@ -85,10 +85,6 @@ bool IsWoodMaterial(const Material& material) {
   return false;
 }
 
-bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, std::string* why) {
-  return ExplainRefusal(why, [&](Refusal* out) { return RuleAllowsDesign(rule, facts, out); });
-}
-
 bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why) {
   const RuleSetLimits limits = LimitsOf(rule);
   // "rules.<name>: what is broken": the field is the rule set (the api maps it to the

@@ -63,12 +63,10 @@ struct RuleFacts {
   double cor = 0.5;                    ///< The ball-bat COR the scene uses (dimensionless).
 };
 
-/// True when nothing discrete in `facts` breaks `rule`; otherwise the reason in *why, naming
-/// the rule ("rules.mlb-wood: ..."). The continuous limits are not checked here (they are
-/// constraints of the design problem).
-bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, std::string* why);
-/// RuleAllowsDesign with the refusal as data in *why (if non-null): field "rules.<name>", the
-/// rule the broken part.
+/// True when nothing discrete in `facts` breaks `rule`; otherwise the refusal in *why (if
+/// non-null): field "rules.<name>", the rule the broken part (Message(): "rules.mlb-wood:
+/// ..."). The continuous limits are not checked here (they are constraints of the design
+/// problem).
 bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why);
 
 /// The `bbcor` rule's check of a finished hollow design, by recomputing: *bbcor = ComputeBbcor(bat)

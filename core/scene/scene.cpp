@@ -23,10 +23,6 @@ bool CheckRange(Refusal* out, std::string_view field, double value, double lo, d
 
 }  // namespace
 
-bool Ball::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool Ball::Validate(Refusal* why) const {
   // Floors of 1 mg and 1 µm: smaller values are not balls, and a subnormal
   // mass made 1/m infinite in the free-bat and Hertz models (found by fuzzing).
@@ -49,10 +45,6 @@ void ApplyBallPreset(const BallPreset& preset, Ball* ball) {
   ball->stiffness_exponent = preset.stiffness_exponent;
   ball->preset = preset.name;
   ball->cor_law = preset.cor_law;
-}
-
-bool Swing::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
 }
 
 bool Swing::Validate(Refusal* why) const {
@@ -96,10 +88,6 @@ bool ResolveSwing(const Swing& swing, double length_m, Swing* resolved, Refusal*
   return true;
 }
 
-bool Scene::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool Scene::Validate(Refusal* why) const {
   if (!bat.has_value() && !mass_properties.has_value())
     return Refuse(why, TextRefusal("bat", "missing (give a bat or precomputed mass_properties)"));
@@ -139,10 +127,6 @@ bool Scene::ValidateCor(Refusal* why) const {
   return true;
 }
 
-bool SceneOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool SceneOptions::Validate(Refusal* why) const {
   if (!nlopt.Validate(why)) return false;
   // Named by its unit, as a request names it.
@@ -167,13 +151,9 @@ bool SceneOptions::Validate(Refusal* why) const {
                       curve_positions_from_knob_m[i], "must be finite");
   }
   if (!hertz.Validate(why)) return false;
-  if (std::string barrel_why; !barrel.IsValid(&barrel_why))
-    return Refuse(why, TextRefusal("barrel", barrel_why));
+  if (Refusal barrel_why; !barrel.Validate(&barrel_why))
+    return Refuse(why, TextRefusal("barrel", barrel_why.Message()));
   return flexible.Validate(why);
-}
-
-bool FlexibleOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
 }
 
 bool FlexibleOptions::Validate(Refusal* why) const {

@@ -1,7 +1,7 @@
 // A scene: what is hit (the bat, or only its mass properties), by what (the ball), how (the
 // swing), with which COR, and what is wanted (the outputs); and the settings of its
 // computations (the collision models, the flexible beam, EvaluateScene's options). Plain values
-// with IsValid(); the computations are in core/scene/evaluate_scene.hpp and
+// with Validate(Refusal*); the computations are in core/scene/evaluate_scene.hpp and
 // core/collision/collide.hpp.
 #pragma once
 
@@ -65,9 +65,8 @@ struct Ball {
   /// (ResolveScene); unset = the bat material's COR, as before.
   std::optional<BallCorLaw> cor_law;
 
-  /// True when every field is in range; otherwise "ball.field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "ball.field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 
@@ -94,9 +93,8 @@ struct Swing {
   /// the default is 6 in, as swing sensors report.
   double bat_speed_from_tip_m = kCorReferenceFromTipM;
 
-  /// True when every field is finite and in range; otherwise "swing.field = value: rule".
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is finite and in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "swing.field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 
@@ -124,9 +122,8 @@ struct Scene {
   /// the paper's rigid_pivot for it, so the paper's numbers are reproduced.
   bool paper_bat = false;
 
-  /// True when the scene is well formed; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when the scene is well formed; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
   /// Validate's rule for `cor` alone: absent, or finite and in [0, 1] (dimensionless).
   bool ValidateCor(Refusal* refusal) const;
@@ -184,9 +181,8 @@ struct FlexibleOptions {
   /// Within a request the modes are computed once whatever this is.
   ModesCache* modes_cache = nullptr;
 
-  /// True when every field is in range; otherwise "flexible.field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "flexible.field = value: rule".
   bool Validate(Refusal* refusal) const;
   /// The modes options of vibration_node (2 modes to frequency_tolerance).
   BeamModesOptions VibrationModes() const;
@@ -222,9 +218,8 @@ struct SceneOptions {
   /// value of the scene: the server sets it when a client leaves or a time budget ends.
   const Progress* progress = nullptr;
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 

@@ -45,10 +45,6 @@ MaxExitSpeedResult SearchMaxExitSpeed(ExitSpeedFunction* model, double length_m,
   return out;
 }
 
-bool BracketSearchOptions::IsValid(std::string* why) const {
-  return ExplainRefusal(why, [this](Refusal* out) { return Validate(out); });
-}
-
 bool BracketSearchOptions::Validate(Refusal* why) const {
   if (samples < 3 || samples > 1001)
     return Refuse(why, IntegerRefusal("samples", samples, "must be in [3, 1001]"));

@@ -44,9 +44,8 @@ struct BracketSearchOptions {
   /// Brent's evaluation budget (then the result is kept, not converged), in [5, 1000].
   int max_iterations = 100;
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why.
-  bool IsValid(std::string* why) const;
-  /// IsValid with the refusal as data in *refusal (if non-null): field, value and rule.
+  /// True when every field is in range; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule".
   bool Validate(Refusal* refusal) const;
 };
 

@@ -30,51 +30,54 @@ nlohmann::json OptionalSeconds(const std::optional<double>& seconds) {
 
 }  // namespace
 
-bool JobConfig::IsValid(std::string* why) const {
-  auto fail = [why](const std::string& text) {
-    if (why != nullptr) *why = text;
-    return false;
+bool JobConfig::Validate(core::Refusal* refusal) const {
+  auto fail = [refusal](core::Refusal why) { return core::Refuse(refusal, std::move(why)); };
+  // "must be in [lo, hi]" with integer bounds.
+  auto in = [](long long lo, long long hi) {
+    return "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  };
+  // A double as a stream writes it (6 significant digits), as these messages always have.
+  auto streamed = [](double value) {
+    std::ostringstream text;
+    text << value;
+    return text.str();
   };
   if (workers < 1 || workers > kMaxWorkers) {
-    return fail("workers = " + std::to_string(workers) + ": must be in [1, " +
-                std::to_string(kMaxWorkers) + "]");
+    return fail(core::IntegerRefusal("workers", workers, in(1, kMaxWorkers)));
   }
   if (max_queued < 1 || max_queued > kMaxQueuedLimit) {
-    return fail("max_queued = " + std::to_string(max_queued) + ": must be in [1, " +
-                std::to_string(kMaxQueuedLimit) + "]");
+    return fail(
+        core::QuotedRefusal("max_queued", std::to_string(max_queued), in(1, kMaxQueuedLimit)));
   }
   if (max_kept < 1 || max_kept > kMaxKeptLimit) {
-    return fail("max_kept = " + std::to_string(max_kept) + ": must be in [1, " +
-                std::to_string(kMaxKeptLimit) + "]");
+    return fail(core::QuotedRefusal("max_kept", std::to_string(max_kept), in(1, kMaxKeptLimit)));
   }
   if (!std::isfinite(keep_results_s) || keep_results_s <= 0) {
-    std::ostringstream text;
-    text << "keep_results_s = " << keep_results_s << ": must be finite and > 0";
-    return fail(text.str());
+    return fail(
+        core::QuotedRefusal("keep_results_s", streamed(keep_results_s), "must be finite and > 0"));
   }
   if (max_resumes < 0 || max_resumes > kMaxResumesLimit) {
-    return fail("max_resumes = " + std::to_string(max_resumes) + ": must be in [0, " +
-                std::to_string(kMaxResumesLimit) + "]");
+    return fail(core::IntegerRefusal("max_resumes", max_resumes, in(0, kMaxResumesLimit)));
   }
   if (!std::isfinite(lease_s) || lease_s < 1 || lease_s > kMaxLeaseS) {
-    std::ostringstream text;
-    text << "lease_s = " << lease_s << ": must be in [1, " << kMaxLeaseS << "]";
-    return fail(text.str());
+    return fail(core::QuotedRefusal("lease_s", streamed(lease_s),
+                                    "must be in [1, " + streamed(kMaxLeaseS) + "]"));
   }
   if (max_result_bytes < kMinResultBytes || max_result_bytes > kMaxResultBytes) {
-    return fail("max_result_bytes = " + std::to_string(max_result_bytes) + ": must be in [" +
-                std::to_string(kMinResultBytes) + ", " + std::to_string(kMaxResultBytes) + "]");
+    return fail(core::QuotedRefusal("max_result_bytes", std::to_string(max_result_bytes),
+                                    "must be in [" + std::to_string(kMinResultBytes) + ", " +
+                                        std::to_string(kMaxResultBytes) + "]"));
   }
   if (max_results_memory_bytes < kMinResultBytes ||
       max_results_memory_bytes > kMaxResultsMemoryBytes) {
-    return fail("max_results_memory_bytes = " + std::to_string(max_results_memory_bytes) +
-                ": must be in [" + std::to_string(kMinResultBytes) + ", " +
-                std::to_string(kMaxResultsMemoryBytes) + "]");
+    return fail(core::QuotedRefusal("max_results_memory_bytes",
+                                    std::to_string(max_results_memory_bytes),
+                                    "must be in [" + std::to_string(kMinResultBytes) + ", " +
+                                        std::to_string(kMaxResultsMemoryBytes) + "]"));
   }
   if (!std::isfinite(max_time_s) || max_time_s <= 0 || max_time_s > kMaxJobTimeS) {
-    std::ostringstream text;
-    text << "max_time_s = " << max_time_s << ": must be in (0, " << kMaxJobTimeS << "]";
-    return fail(text.str());
+    return fail(core::QuotedRefusal("max_time_s", streamed(max_time_s),
+                                    "must be in (0, " + streamed(kMaxJobTimeS) + "]"));
   }
   return true;
 }

@@ -13,6 +13,7 @@
 
 #include "api/job_service.hpp"
 #include "api/response.hpp"
+#include "core/refusal.hpp"
 
 namespace sweetspot::server {
 
@@ -46,8 +47,9 @@ struct JobConfig {
   /// gets it afresh.
   double max_time_s = 600.0;
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why (if non-null).
-  bool IsValid(std::string* why) const;
+  /// True when every field is in range; otherwise the refusal in *refusal (if non-null): field,
+  /// value and rule, its Message() "field = value: rule".
+  bool Validate(core::Refusal* refusal) const;
 };
 
 /// A job service the server owns: the api's calls plus the server's stop.

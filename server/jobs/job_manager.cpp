@@ -64,8 +64,8 @@ JobManager::JobManager(JobConfig config, JobRunner runner, JobPersistence persis
       start_(Clock::now()),
       wall_start_(std::chrono::system_clock::now()),
       random_(SeededEngine()) {
-  std::string why;
-  if (!config_.IsValid(&why)) throw std::invalid_argument("invalid JobConfig: " + why);
+  if (core::Refusal why; !config_.Validate(&why))
+    throw std::invalid_argument("invalid JobConfig: " + why.Message());
   if (!runner_) throw std::invalid_argument("invalid JobManager: the runner is empty");
   if (persistence_.store != nullptr) LoadFromStore();
   try {

@@ -72,7 +72,7 @@ class JobManager final : public ServerJobService {
  public:
   /// Loads the jobs kept in persistence.store (if any; see the file comment),
   /// then starts config.workers threads. Throws std::invalid_argument when
-  /// !config.IsValid() (the message is IsValid's) or `runner` is empty, and
+  /// !config.Validate() (the message is its refusal's) or `runner` is empty, and
   /// std::runtime_error "cannot load the jobs: why" when the store cannot be read.
   JobManager(JobConfig config, JobRunner runner, JobPersistence persistence = {});
   /// Shutdown() with no grace period.

@@ -749,7 +749,8 @@ std::unique_ptr<PostgresJobService> PostgresJobService::Open(
   };
   std::string why;
   if (!IsPostgresUri(uri)) return fail("not a postgresql:// URI");
-  if (!config.IsValid(&why)) return fail("invalid JobConfig: " + why);
+  if (core::Refusal refused; !config.Validate(&refused))
+    return fail("invalid JobConfig: " + refused.Message());
   if (!runner) return fail("the runner is empty");
   auto impl = std::make_unique<Impl>(uri, config, std::move(runner), std::move(log));
   if (!impl->Migrate(&why)) return fail(why);

@@ -60,22 +60,20 @@ void Rewind(sqlite3_stmt* statement) {
 
 }  // namespace
 
-bool SqliteJobStoreOptions::IsValid(std::string* why) const {
+bool SqliteJobStoreOptions::Validate(core::Refusal* refusal) const {
   if (!std::isfinite(busy_timeout_s) || busy_timeout_s < 0 || busy_timeout_s > kMaxBusyTimeoutS) {
-    if (why != nullptr) {
-      std::ostringstream text;
-      text << "busy_timeout_s = " << busy_timeout_s << ": must be in [0, " << kMaxBusyTimeoutS
-           << "]";
-      *why = text.str();
-    }
-    return false;
+    if (refusal == nullptr) return false;
+    std::ostringstream shown, rule;  // written as a stream writes them (6 significant digits)
+    shown << busy_timeout_s;
+    rule << "must be in [0, " << kMaxBusyTimeoutS << "]";
+    return core::Refuse(refusal, core::QuotedRefusal("busy_timeout_s", shown.str(), rule.str()));
   }
   if (max_bytes != 0 && (max_bytes < kMinMaxBytes || max_bytes > kMaxMaxBytes)) {
-    if (why != nullptr) {
-      *why = "max_bytes = " + std::to_string(max_bytes) + ": must be 0 (no limit) or in [" +
-             std::to_string(kMinMaxBytes) + ", " + std::to_string(kMaxMaxBytes) + "]";
-    }
-    return false;
+    if (refusal == nullptr) return false;
+    return core::Refuse(
+        refusal, core::QuotedRefusal("max_bytes", std::to_string(max_bytes),
+                                     "must be 0 (no limit) or in [" + std::to_string(kMinMaxBytes) +
+                                         ", " + std::to_string(kMaxMaxBytes) + "]"));
   }
   return true;
 }
@@ -84,11 +82,11 @@ SqliteJobStore::SqliteJobStore(std::string path) : path_(std::move(path)) {}
 
 std::unique_ptr<SqliteJobStore> SqliteJobStore::Open(const std::string& path, std::string* error,
                                                      const SqliteJobStoreOptions& options) {
-  std::string why;
-  if (!options.IsValid(&why)) {
-    if (error != nullptr) *error = "invalid SqliteJobStoreOptions: " + why;
+  if (core::Refusal refused; !options.Validate(&refused)) {
+    if (error != nullptr) *error = "invalid SqliteJobStoreOptions: " + refused.Message();
     return nullptr;
   }
+  std::string why;
   std::unique_ptr<SqliteJobStore> store(new SqliteJobStore(path));
   if (!store->Initialize(options, &why)) {
     if (error != nullptr) *error = "jobs database \"" + path + "\": " + why;

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "core/refusal.hpp"
 #include "server/jobs/job_store.hpp"
 
 struct sqlite3;
@@ -36,8 +37,9 @@ struct SqliteJobStoreOptions {
   /// rounded down to whole pages; never below the file's size at Open). 0 or in [65536, 1e15].
   std::size_t max_bytes = 0;
 
-  /// True when every field is in range; otherwise "field = value: rule" in *why (if non-null).
-  bool IsValid(std::string* why) const;
+  /// True when every field is in range; otherwise the refusal in *refusal (if non-null): field,
+  /// value and rule, its Message() "field = value: rule".
+  bool Validate(core::Refusal* refusal) const;
 };
 
 /// A JobStore in one SQLite database file. Thread-safe: one connection,

@@ -3,6 +3,8 @@
 // max_design_variables bounds /v1/optimize's variables.
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <string>
 
 #include "api/router.hpp"
@@ -131,13 +133,13 @@ TEST(ConfiguredCapsTest, LimitsRefuseCurvesOfFewerThanTwoPointsAndZeroVariables)
   ApiLimits limits;
   std::string why;
   limits.max_curve_samples = 1;
-  EXPECT_FALSE(limits.IsValid(&why));
+  EXPECT_FALSE(Validates(limits, &why));
   EXPECT_EQ(why, "max_curve_samples = 1: must be at least 2 (a curve has two ends)");
   limits = ApiLimits{};
   limits.max_design_variables = 0;
-  EXPECT_FALSE(limits.IsValid(&why));
+  EXPECT_FALSE(Validates(limits, &why));
   EXPECT_EQ(why, "max_design_variables = 0: must be at least 1");
-  EXPECT_TRUE(ApiLimits{}.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(ApiLimits{}, &why)) << why;
 }
 
 }  // namespace

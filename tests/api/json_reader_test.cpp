@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <string>
 
 namespace sweetspot::api {
@@ -217,14 +219,14 @@ TEST(NumberRuleTest, DescribesIntervals) {
 
 TEST(LimitsTest, DefaultsAreValidAndRulesAreNamed) {
   std::string why;
-  EXPECT_TRUE(ApiLimits{}.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(ApiLimits{}, &why)) << why;
   ApiLimits limits;
   limits.max_json_depth = 1;
-  EXPECT_FALSE(limits.IsValid(&why));
+  EXPECT_FALSE(Validates(limits, &why));
   EXPECT_EQ(why, "max_json_depth = 1: must be in [2, 512]");
   limits = ApiLimits{};
   limits.max_time_s = 0;
-  EXPECT_FALSE(limits.IsValid(&why));
+  EXPECT_FALSE(Validates(limits, &why));
   EXPECT_EQ(why, "max_time_s = 0: must be > 0");
 }
 

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include "core/collision/collide.hpp"
 #include "core/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
@@ -40,7 +42,7 @@ TEST(BallCatalogue, NamesAreUniqueAndEveryEntryIsSourcedAndValid) {
     Ball ball;
     ApplyBallPreset(b, &ball);
     std::string message;
-    EXPECT_TRUE(ball.IsValid(&message)) << b.name << ": " << message;
+    EXPECT_TRUE(Validates(ball, &message)) << b.name << ": " << message;
     EXPECT_GE(b.mass_kg, b.mass_min_kg);
     EXPECT_LE(b.mass_kg, b.mass_max_kg);
   }

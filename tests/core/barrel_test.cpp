@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include "core/ball_catalogue.hpp"
 #include "core/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
@@ -181,11 +183,11 @@ TEST(Barrel, StiffBarrelGivesTheBallsCor) {
 }
 
 TEST(Barrel, OptionsAreCheckedWithTheirField) {
-  EXPECT_TRUE(BarrelOptions{}.IsValid(nullptr));
+  EXPECT_TRUE(BarrelOptions{}.Validate(nullptr));
   BarrelOptions o;
   o.barrel_loss = 1.0;
   std::string why;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "barrel.barrel_loss = 1: must be in [0, 1)");
   const BbcorResult r = ComputeBbcor(AluminiumPreset(), {}, o);
   EXPECT_FALSE(r.ok);

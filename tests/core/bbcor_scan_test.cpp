@@ -152,7 +152,7 @@ TEST(BbcorScan, TheRangeIsCheckedWithItsField) {
   EXPECT_EQ(s.points.size(), 1u);
   EXPECT_EQ(s.refinement, "none");
   EXPECT_EQ(s.warnings.size(), 1u);
-  EXPECT_TRUE(BbcorScanRangeIsValid(BbcorProtocol{}, nullptr));
+  EXPECT_TRUE(BbcorScanRangeValidate(BbcorProtocol{}, nullptr));
 }
 
 TEST(BbcorScan, SceneOutputIsTheCoreScanAndOnlyWhenAsked) {

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include "core/collision/collide.hpp"
 #include "core/presets.hpp"
 
@@ -155,16 +157,16 @@ TEST(HertzValidation, ExactMessages) {
   HertzProblem p = PaperProblem(27.7);
   p.approach_speed_mps = 0.0;
   std::string why;
-  EXPECT_FALSE(p.IsValid(&why));
+  EXPECT_FALSE(Validates(p, &why));
   EXPECT_EQ(why,
             "hertz.approach_speed_mps = 0: must be finite and > 0 (the ball and the bat "
             "must approach each other)");
   HertzSolverOptions o;
   o.relative_tolerance = 0.5;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "hertz.relative_tolerance = 0.5: must be in [1e-13, 1e-2]");
-  EXPECT_TRUE(HertzSolverOptions{}.IsValid(nullptr));
-  EXPECT_TRUE(HertzOptions{}.IsValid(nullptr));
+  EXPECT_TRUE(HertzSolverOptions{}.Validate(nullptr));
+  EXPECT_TRUE(HertzOptions{}.Validate(nullptr));
   const HertzImpact r = SolveHertzImpact(p, HertzSolverOptions{});
   EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
 }

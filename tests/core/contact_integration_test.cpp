@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
 namespace contact_integration_test {
@@ -18,8 +20,8 @@ namespace {
 struct Checked {
   bool valid = true;
   std::string why;
-  bool IsValid(std::string* out) const {
-    if (!valid) *out = why;
+  bool Validate(Refusal* out) const {
+    if (!valid && out != nullptr) *out = TextRefusal("", why);  // Message() == why
     return valid;
   }
 };
@@ -45,7 +47,7 @@ TEST(ContactIntegrationTest, IntegratorSettingsAreValidForAContact) {
   EXPECT_EQ(o.time_unit_s, 3e-5);
   EXPECT_STREQ(o.subject, "the contact");
   std::string why;
-  EXPECT_TRUE(o.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(o, &why)) << why;
 }
 
 TEST(ContactIntegrationTest, StartContactSolveRefusesWithTheFirstInvalidInput) {
@@ -62,8 +64,8 @@ TEST(ContactIntegrationTest, StartContactSolveRefusesWithTheFirstInvalidInput) {
   EXPECT_EQ(s.models_used, std::vector<std::string>{"flexible"});
 }
 
-// The integrator's and the ball law's rules are written once (ContactIntegrationIsValid,
-// BallLawIsValid) and both models refuse with them, each under its own field prefix; the texts
+// The integrator's and the ball law's rules are written once (ContactIntegrationValidate,
+// BallLawValidate) and both models refuse with them, each under its own field prefix; the texts
 // are the ones the api and the hard-case tables assert.
 TEST(ContactIntegrationTest, BothModelsRefuseTheSharedRulesWithTheirOwnPrefix) {
   std::string hertz_why, flexible_why;
@@ -71,21 +73,23 @@ TEST(ContactIntegrationTest, BothModelsRefuseTheSharedRulesWithTheirOwnPrefix) {
   hertz.max_steps = 9;
   FlexibleImpactOptions flexible;
   flexible.max_steps = 9;
-  EXPECT_FALSE(hertz.IsValid(&hertz_why));
-  EXPECT_FALSE(flexible.IsValid(&flexible_why));
+  EXPECT_FALSE(Validates(hertz, &hertz_why));
+  EXPECT_FALSE(Validates(flexible, &flexible_why));
   EXPECT_EQ(hertz_why, "hertz.max_steps = 9: must be >= 10");
   EXPECT_EQ(flexible_why, "flexible.max_steps = 9: must be >= 10");
 
   hertz = HertzSolverOptions{};
   hertz.relative_tolerance = 0.5;
-  EXPECT_FALSE(hertz.IsValid(&hertz_why));
+  EXPECT_FALSE(Validates(hertz, &hertz_why));
   EXPECT_EQ(hertz_why, "hertz.relative_tolerance = 0.5: must be in [1e-13, 1e-2]");
 
-  std::string ball_why;
-  EXPECT_TRUE(BallLawIsValid(1e7, 1.5, &ball_why));
-  EXPECT_FALSE(BallLawIsValid(1e7, 3.5, &ball_why));
-  EXPECT_EQ(ball_why, "ball.stiffness_exponent = 3.5: must be in [1, 3]");
-  EXPECT_FALSE(BallLawIsValid(0.0, 1.5, nullptr));  // nothing to write, still refused
+  Refusal ball_why;
+  EXPECT_TRUE(BallLawValidate(1e7, 1.5, &ball_why));
+  EXPECT_FALSE(BallLawValidate(1e7, 3.5, &ball_why));
+  EXPECT_EQ(ball_why.field, "ball.stiffness_exponent");
+  EXPECT_EQ(ball_why.value, 3.5);
+  EXPECT_EQ(ball_why.Message(), "ball.stiffness_exponent = 3.5: must be in [1, 3]");
+  EXPECT_FALSE(BallLawValidate(0.0, 1.5, nullptr));  // nothing to write, still refused
 }
 
 }  // namespace

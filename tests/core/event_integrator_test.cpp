@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -45,7 +47,7 @@ EventIntegratorOptions Tight() {
 
 TEST(EventIntegrator, DefaultOptionsAreValid) {
   std::string why;
-  EXPECT_TRUE(EventIntegratorOptions{}.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(EventIntegratorOptions{}, &why)) << why;
 }
 
 TEST(EventIntegrator, HarmonicOscillatorFirstZeroCrossing) {
@@ -224,7 +226,7 @@ TEST(EventIntegrator, InvalidOptionsAreReportedNotIntegrated) {
   EventIntegratorOptions o;
   o.relative_tolerance = 0.0;
   std::string why;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "relative_tolerance = 0: must be in [1e-15, 1]");
   EventIntegrator<State> integrator(o);
   State y{1.0, 0.0};
@@ -236,11 +238,11 @@ TEST(EventIntegrator, InvalidOptionsAreReportedNotIntegrated) {
   EXPECT_EQ(sys.steps_seen, 0);
   o = EventIntegratorOptions{};
   o.max_steps = 0;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "max_steps = 0: must be >= 1");
   o = EventIntegratorOptions{};
   o.time_unit_s = -1.0;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "time_unit_s = -1: must be finite and > 0");
 }
 

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include "core/ball_catalogue.hpp"
 #include "core/collision/barrel.hpp"
 #include "core/collision/contact_law.hpp"
@@ -130,7 +132,7 @@ TEST(FlexibleBarrelSpring, ZeroComplianceIsTheSolidSurfaceBitForBit) {
   // A negative compliance is refused, naming the field.
   with.barrel_compliance_m_n = -1e-9;
   std::string why;
-  EXPECT_FALSE(with.IsValid(&why));
+  EXPECT_FALSE(Validates(with, &why));
   EXPECT_EQ(why, "barrel_compliance_m_n = -1.0000000000000001e-09: must be finite and >= 0");
 }
 

@@ -7,7 +7,9 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
 #include <Eigen/Eigenvalues>
+#include "tests/refusal_text.hpp"
 
 #include "core/collision/hertz_contact.hpp"
 #include "core/flexible/beam_model.hpp"
@@ -51,18 +53,18 @@ FlexibleImpactInputs Inputs(const Bat& bat, double s) {
 
 TEST(FlexibleImpactOptions, DefaultsAreValidAndRulesAreNamed) {
   std::string why;
-  EXPECT_TRUE(FlexibleImpactOptions{}.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(FlexibleImpactOptions{}, &why)) << why;
   FlexibleImpactOptions o;
   o.cutoff_factor = 0.5;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "flexible.cutoff_factor = 0.5: must be in [1, 1000]");
   o = {};
   o.max_modes = 51;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "flexible.max_modes = 51: must be in [1, 50]");
   FlexibleImpactInputs in;
   in.approach_speed_mps = 0.0;
-  EXPECT_FALSE(in.IsValid(&why));
+  EXPECT_FALSE(Validates(in, &why));
   EXPECT_EQ(why,
             "approach_speed_mps = 0: must be finite and > 0 (the ball and the bat must approach "
             "each other)");

@@ -11,7 +11,9 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
 #include <Eigen/Eigenvalues>
+#include "tests/refusal_text.hpp"
 
 #include "core/flexible/beam_model.hpp"
 #include "core/mass_properties.hpp"
@@ -109,18 +111,18 @@ std::vector<double> ExactTimoshenkoHz(const Bat& bat, int count) {
 
 TEST(FlexibleModesOptions, DefaultsAreValidAndRulesAreNamed) {
   std::string why;
-  EXPECT_TRUE(BeamModesOptions{}.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(BeamModesOptions{}, &why)) << why;
   BeamModesOptions o;
   o.num_modes = 0;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "num_modes = 0: must be in [1, 50]");
   o = {};
   o.relative_tolerance = 1e-12;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "relative_tolerance = 9.9999999999999998e-13: must be in [1e-9, 0.1]");
   o = {};
   o.max_elements = 1;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "max_elements = 1: must be in [2, 4096]");
   EXPECT_EQ(ParseBeamTheory("euler_bernoulli"), BeamTheory::kEulerBernoulli);
   EXPECT_EQ(ParseBeamTheory(BeamTheoryName(BeamTheory::kTimoshenko)), BeamTheory::kTimoshenko);

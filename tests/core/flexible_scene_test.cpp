@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include "core/collision/collide.hpp"
 #include "core/flexible/modes_cache.hpp"
 #include "core/presets.hpp"
@@ -277,9 +279,9 @@ TEST(FlexibleSceneHardCases, MassPropertiesAloneCannotGiveTheFlexibleOutputs) {
 TEST(FlexibleSceneHardCases, OptionsAreValidatedWithNamedRules) {
   SceneOptions o;
   std::string why;
-  EXPECT_TRUE(o.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(o, &why)) << why;
   o.flexible.sting_zone_fraction = 0.0;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "flexible.sting_zone_fraction = 0: must be in (0, 1]");
   o = {};
   o.flexible.impact.hands_grip_length_m = -1.0;

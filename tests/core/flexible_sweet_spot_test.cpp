@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include "core/bat.hpp"
 #include "core/material.hpp"
 #include "core/presets.hpp"
@@ -145,19 +147,19 @@ TEST(FlexibleSweetSpot, AnOptimumAtTheTipIsTheTipExactly) {
 }
 
 TEST(FlexibleSweetSpot, BracketSearchOptionsAreChecked) {
-  EXPECT_TRUE(BracketSearchOptions{}.IsValid(nullptr));
+  EXPECT_TRUE(BracketSearchOptions{}.Validate(nullptr));
   std::string why;
   BracketSearchOptions o;
   o.samples = 2;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "samples = 2: must be in [3, 1001]");
   o = {};
   o.x_tolerance_m = 0.0;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_NE(why.find("x_tolerance_m"), std::string::npos);
   o = {};
   o.max_iterations = 4;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "max_iterations = 4: must be in [5, 1000]");
   // Through the scene: named with its prefix, and the solve refused.
   SceneOptions so = Flexible();

@@ -2,6 +2,8 @@
 // radius lookups.
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <cmath>
 #include <limits>
 #include <string>
@@ -49,12 +51,12 @@ TEST(GeometryThreeSegment, ZeroLengthTaperIsATinyStep) {
   EXPECT_EQ(knots[2].radius_m, 0.035);
   const Bat bat = MakeThreeSegmentBat(shape, *FindMaterial("paper-wood"));
   std::string why;
-  EXPECT_TRUE(bat.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(bat, &why)) << why;
 }
 
 TEST(GeometryThreeSegment, Validity) {
   std::string why;
-  EXPECT_TRUE((ThreeSegmentShape{0.855, 0.0125, 0.035, 0.3459, 0.6423}.IsValid(&why))) << why;
+  EXPECT_TRUE(Validates(ThreeSegmentShape{0.855, 0.0125, 0.035, 0.3459, 0.6423}, &why)) << why;
   struct Case {
     ThreeSegmentShape shape;
     const char* message;
@@ -69,7 +71,7 @@ TEST(GeometryThreeSegment, Validity) {
        "length_m = nan: must be finite"},
   };
   for (const Case& c : cases) {
-    EXPECT_FALSE(c.shape.IsValid(&why)) << c.message;
+    EXPECT_FALSE(Validates(c.shape, &why)) << c.message;
     EXPECT_EQ(why, c.message);
   }
 }
@@ -226,40 +228,40 @@ TEST(GeometryBat, RefusalsNameFieldValueAndRule) {
     Bat bat = PaperBat();
     c.edit(bat);
     std::string why;
-    EXPECT_FALSE(bat.IsValid(&why)) << c.message;
+    EXPECT_FALSE(Validates(bat, &why)) << c.message;
     EXPECT_EQ(why, c.message);
-    EXPECT_FALSE(bat.IsValid(nullptr)) << c.message;
+    EXPECT_FALSE(bat.Validate(nullptr)) << c.message;
   }
 }
 
 TEST(GeometryBat, AcceptedCases) {
   std::string why;
   Bat bat = PaperBat();
-  EXPECT_TRUE(bat.IsValid(&why)) << why;
-  EXPECT_TRUE(bat.IsValid(nullptr));
+  EXPECT_TRUE(Validates(bat, &why)) << why;
+  EXPECT_TRUE(bat.Validate(nullptr));
   // A step: two knots 1e-12 m apart.
   bat.knots = {{0, 0.015}, {0.5, 0.015}, {0.5 + 1e-12, 0.033}, {0.86, 0.033}};
-  EXPECT_TRUE(bat.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(bat, &why)) << why;
   // A bat 1 mm long and one 10 m long; micrometre radii.
   bat.knots = {{0, 1e-4}, {1e-3, 2e-4}};
-  EXPECT_TRUE(bat.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(bat, &why)) << why;
   bat.knots = {{0, 0.02}, {10.0, 0.05}};
-  EXPECT_TRUE(bat.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(bat, &why)) << why;
   bat.knots = {{0, 1e-6}, {0.86, 1e-6}};
-  EXPECT_TRUE(bat.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(bat, &why)) << why;
   // Hollow with a fill inside the cavity; an empty bore (cupped end); a fill
   // exactly as deep as the bat; a zero-size fill.
   bat = PaperBat();
   bat.wall_thickness_m = 0.003;
   bat.fill = Fill{*FindMaterial("rubber"), 0.018, 0.2};
-  EXPECT_TRUE(bat.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(bat, &why)) << why;
   bat = PaperBat();
   bat.fill = Fill{EmptyFillMaterial(), 0.03, 0.02};
-  EXPECT_TRUE(bat.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(bat, &why)) << why;
   bat.fill = Fill{*FindMaterial("cork"), 0.02, 0.855};
-  EXPECT_TRUE(bat.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(bat, &why)) << why;
   bat.fill = Fill{*FindMaterial("cork"), 0.0, 0.0};
-  EXPECT_TRUE(bat.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(bat, &why)) << why;
 }
 
 TEST(GeometryBat, RadiusLookups) {

@@ -64,7 +64,7 @@ TEST(MassPropertiesGradient, MatchesCentralDifferences) {
   for (const NamedBat& nb : GradientBats()) {
     for (InertiaModel model : {InertiaModel::kRigidBody, InertiaModel::kSlenderRod}) {
       const Bat& bat = nb.bat;
-      ASSERT_TRUE(bat.IsValid(nullptr)) << nb.name;
+      ASSERT_TRUE(bat.Validate(nullptr)) << nb.name;
       const MassPropertiesWithGradient g = ComputeMassPropertiesWithGradient(bat, model);
       const DesignParameterLayout& lay = g.layout;
       ASSERT_EQ(g.mass_gradient.size(), lay.Size());
@@ -79,8 +79,8 @@ TEST(MassPropertiesGradient, MatchesCentralDifferences) {
         minus[i] -= h;
         const Bat bp = WithDesignParameters(bat, plus);
         const Bat bm = WithDesignParameters(bat, minus);
-        ASSERT_TRUE(bp.IsValid(nullptr)) << nb.name << " " << lay.Name(i);
-        ASSERT_TRUE(bm.IsValid(nullptr)) << nb.name << " " << lay.Name(i);
+        ASSERT_TRUE(bp.Validate(nullptr)) << nb.name << " " << lay.Name(i);
+        ASSERT_TRUE(bm.Validate(nullptr)) << nb.name << " " << lay.Name(i);
         const MassProperties pp = ComputeMassProperties(bp, model);
         const MassProperties pm = ComputeMassProperties(bm, model);
         struct Item {

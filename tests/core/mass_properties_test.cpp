@@ -264,7 +264,7 @@ TEST(MassPropertiesQuadrature, RandomProfilesAgreeTo1e12) {
       fill.diameter_m = 1.8 * (around - bat.wall_thickness_m) * u(rng);
       bat.fill = fill;
     }
-    ASSERT_TRUE(bat.IsValid(nullptr)) << trial;
+    ASSERT_TRUE(bat.Validate(nullptr)) << trial;
     const Reference ref = Quadrature(bat);
     const MassProperties rigid = ComputeMassProperties(bat, InertiaModel::kRigidBody);
     const MassProperties slender = ComputeMassProperties(bat, InertiaModel::kSlenderRod);
@@ -413,7 +413,7 @@ TEST(MassPropertiesHard, StepTwoKnots1e12Apart) {
   Bat bat;
   bat.knots = {{0.0, a}, {xs, a}, {xs + 1e-12, b}, {L, b}};
   bat.material = Wood(rho);
-  ASSERT_TRUE(bat.IsValid(nullptr));
+  ASSERT_TRUE(bat.Validate(nullptr));
   const MassProperties p = ComputeMassProperties(bat);
   // Ideal step at xs + 0.5e-12 (the taper's volume centre is within 1e-12 of it).
   const double m1 = rho * M_PI * a * a * xs, m2 = rho * M_PI * b * b * (L - xs);
@@ -440,7 +440,7 @@ TEST(MassPropertiesHard, ScaleLawsFromAMillimetreToTenMetres) {
       k.radius_m *= s;
     }
     bat.knots.back().x_m = length;
-    ASSERT_TRUE(bat.IsValid(nullptr));
+    ASSERT_TRUE(bat.Validate(nullptr));
     const MassProperties p = ComputeMassProperties(bat);
     // Scaling adds one rounding per input; the properties are sums of
     // positive terms, so they follow to ~1e-15; 1e-13 leaves headroom.
@@ -472,7 +472,7 @@ TEST(MassPropertiesHard, CentroidalMomentOfAShortHeavyEndKeepsFullPrecision) {
                {std::nextafter(xs_d, 20.0), double(rb)},  // a one-ulp step
                {double(L), double(rb)}};
   bat.material = Wood(700.0);
-  ASSERT_TRUE(bat.IsValid(nullptr));
+  ASSERT_TRUE(bat.Validate(nullptr));
   const long double pi = 3.141592653589793238462643383279502884L;
   const long double xs = xs_d;
   const long double m1 = rho * pi * rh * rh * xs, m2 = rho * pi * rb * rb * (L - xs);
@@ -509,7 +509,7 @@ TEST(MassPropertiesHard, InvalidBatsGiveNaN) {
   Bat wide = Cylinder(0.86, 0.03, 700.0);
   wide.fill = Fill{*FindMaterial("cork"), 0.07, 0.2};
   for (const Bat& bat : {thick, deep, wide, Bat{}}) {
-    EXPECT_FALSE(bat.IsValid(nullptr));
+    EXPECT_FALSE(bat.Validate(nullptr));
     const MassProperties p = ComputeMassProperties(bat);
     EXPECT_TRUE(std::isnan(p.mass_kg));
     EXPECT_TRUE(std::isnan(p.volume_m3));
@@ -546,7 +546,7 @@ TEST(MassPropertiesHard, TinyRelativePerturbationsGiveTinyChanges) {
       delta[i] = theta[i] * ((is_step && position) ? common : (sign(rng) ? 1e-9 : -1e-9));
     }
     const Bat perturbed = WithDesignParameters(bat, theta + delta);
-    ASSERT_TRUE(perturbed.IsValid(nullptr)) << b;
+    ASSERT_TRUE(perturbed.Validate(nullptr)) << b;
     const MassProperties p0 = g.properties;
     const MassProperties p1 = ComputeMassProperties(perturbed);
     struct Check {

@@ -1,5 +1,7 @@
-// The materials catalogue and Material::IsValid.
+// The materials catalogue and Material::Validate.
 #include <gtest/gtest.h>
+
+#include "tests/refusal_text.hpp"
 
 #include <cmath>
 #include <limits>
@@ -20,7 +22,7 @@ TEST(MaterialsCatalogue, HasEveryEntryValidWithASource) {
   std::set<std::string> names;
   for (const Material& m : MaterialCatalogue()) {
     std::string why;
-    EXPECT_TRUE(m.IsValid(&why)) << m.name << ": " << why;
+    EXPECT_TRUE(Validates(m, &why)) << m.name << ": " << why;
     EXPECT_FALSE(m.source.empty()) << m.name;
     EXPECT_TRUE(names.insert(m.name).second) << "duplicate " << m.name;
   }
@@ -127,9 +129,9 @@ TEST(MaterialValidity, Refusals) {
     Material m = good;
     c.edit(m);
     std::string why;
-    EXPECT_FALSE(m.IsValid(&why)) << c.message;
+    EXPECT_FALSE(Validates(m, &why)) << c.message;
     EXPECT_EQ(why, c.message);
-    EXPECT_FALSE(m.IsValid(nullptr)) << c.message;
+    EXPECT_FALSE(m.Validate(nullptr)) << c.message;
   }
 }
 
@@ -139,17 +141,17 @@ TEST(MaterialValidity, CustomMaterialsAndRanges) {
   custom.density_kg_m3 = 500.0;
   custom.youngs_modulus_pa = 1e10;
   std::string why;
-  EXPECT_TRUE(custom.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(custom, &why)) << why;
   EXPECT_FALSE(custom.cor.has_value());
   // The density range is informational: cork at 400 kg/m^3 is accepted.
   Material cork = *FindMaterial("cork");
   cork.density_kg_m3 = 400.0;
-  EXPECT_TRUE(cork.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(cork, &why)) << why;
   // The empty fill is not a material of its own.
   const Material empty = EmptyFillMaterial();
   EXPECT_EQ(empty.name, "empty");
   EXPECT_EQ(empty.density_kg_m3, 0.0);
-  EXPECT_FALSE(empty.IsValid(nullptr));
+  EXPECT_FALSE(empty.Validate(nullptr));
 }
 
 }  // namespace

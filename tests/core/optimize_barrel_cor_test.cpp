@@ -113,8 +113,8 @@ TEST(OptimizeBarrelCor, ObjectiveGradientAndHessianMatchFiniteDifferencesAndTheS
   int problem_index = 0;
   for (const DesignProblem& p : GradientProblems()) {
     DesignModel model;
-    std::string why;
-    ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why;
+    Refusal why;
+    ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why.Message();
     ASSERT_TRUE(model.cor_from_barrel());
     const double objective_range = model.objective_scale();
     double cor_min = 1.0, cor_max = 0.0;

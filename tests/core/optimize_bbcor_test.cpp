@@ -102,8 +102,8 @@ TEST(OptimizeBbcor, ConstraintValueGradientAndHessianMatchComputeBbcorAndFiniteD
   double worst_value = 0.0, worst_gradient = 0.0, worst_hessian = 0.0;
   for (const DesignProblem& p : GradientProblems()) {
     DesignModel model;
-    std::string why;
-    ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why;
+    Refusal why;
+    ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why.Message();
     const int k = BbcorRow(model);
     ASSERT_GE(k, 0);
     EXPECT_EQ(model.constraints()[static_cast<std::size_t>(k)].name, "rules.bbcor.bbcor");
@@ -270,8 +270,8 @@ TEST(OptimizeBbcor, SolidBatsHaveNoBbcorConstraint) {
   p.constraints.rules = {RuleSet::kBbcor};
   p.cor = 0.48;
   DesignModel model;
-  std::string why;
-  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why;
+  Refusal why;
+  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why.Message();
   EXPECT_EQ(BbcorRow(model), -1);
   EXPECT_FALSE(OptimizeDesign(p).bbcor.has_value());
 }

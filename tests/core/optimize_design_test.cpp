@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <cmath>
 #include <string>
 #include <utility>
@@ -261,7 +263,7 @@ TEST(OptimizeConstraints, ContractExampleMeetsTheRulesAndReportsActiveOnes) {
   EXPECT_LE(props.balance_point_m, 0.60 + 1e-8);
   EXPECT_LE(props.MoiSixInchKgM2(), 0.20 + 1e-8);
   EXPECT_LE(2.0 * r.three_segment->barrel_radius_m, InchesToMetres(2.61) + 1e-8);
-  EXPECT_TRUE(r.bat.IsValid(nullptr));
+  EXPECT_TRUE(r.bat.Validate(nullptr));
   EXPECT_EQ(r.bat.wall_thickness_m, 0.0);
   ASSERT_EQ(r.variables.size(), 3u);
   EXPECT_EQ(r.variables[0].path, "three_segment.taper_start_m");
@@ -544,7 +546,7 @@ TEST(OptimizeInvalid, IllPosedRequestsAreRefusedByName) {
       "variables[1].max = 2e+12: must be in [-1e+12, 1e+12]");
   for (const Case& c : cases) {
     std::string why;
-    EXPECT_FALSE(c.problem.IsValid(&why)) << c.what;
+    EXPECT_FALSE(Validates(c.problem, &why)) << c.what;
     EXPECT_EQ(why.substr(0, c.message.size()), c.message) << c.what << ": " << why;
     const DesignResult r = OptimizeDesign(c.problem);
     EXPECT_EQ(r.summary.termination, Termination::kInvalidInput) << c.what;
@@ -552,24 +554,24 @@ TEST(OptimizeInvalid, IllPosedRequestsAreRefusedByName) {
     EXPECT_TRUE(std::isnan(r.objective_value)) << c.what;
   }
   std::string why;
-  EXPECT_TRUE(good.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(good, &why)) << why;
 }
 
 TEST(OptimizeInvalid, OptionsAreCheckedAndDefaultsAreValid) {
   std::string why;
-  EXPECT_TRUE(DesignOptions{}.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(DesignOptions{}, &why)) << why;
   DesignOptions o;
   o.starts = 0;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "starts = 0: must be between 1 and 64");
   const DesignResult r = OptimizeDesign(StepProblem(0.01, 0.016, 0.02, 0.04), o);
   EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
   EXPECT_EQ(r.summary.message, "options.starts = 0: must be between 1 and 64");
   o = DesignOptions{};
   o.derivative_check = DerivativeCheck::kSecondOrder;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   o.max_time_s = 0.0;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "max_time_s = 0: must be finite and positive");
 }
 
@@ -688,8 +690,8 @@ TEST(OptimizeConstraints, HandleRegionBoundsOnlyTheKnotsThatReachTheGrip) {
   p.constraints.min_handle_diameter_m = InchesToMetres(0.95);
   p.constraints.handle_region_from_knob_m = std::pair{0.0, 0.2};
   DesignModel model;
-  std::string why;
-  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why;
+  Refusal why;
+  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why.Message();
   std::vector<std::string> names;
   for (const auto& c : model.constraints()) {
     if (c.name.rfind("min_handle_diameter_m", 0) == 0) names.push_back(c.name);
@@ -710,7 +712,7 @@ TEST(OptimizeConstraints, HandleRegionBoundsOnlyTheKnotsThatReachTheGrip) {
   // Without the region the same limit binds at every knot (the whole bat), a different design.
   DesignProblem whole = p;
   whole.constraints.handle_region_from_knob_m.reset();
-  ASSERT_TRUE(DesignModel::Build(whole, DesignOptions{}, &model, &why)) << why;
+  ASSERT_TRUE(DesignModel::Build(whole, DesignOptions{}, &model, &why)) << why.Message();
   int count = 0;
   for (const auto& c : model.constraints()) count += c.name.rfind("min_handle", 0) == 0 ? 1 : 0;
   EXPECT_EQ(count, 14);  // the 14 variable knots
@@ -723,7 +725,7 @@ TEST(OptimizeConstraints, HandleRegionBoundsOnlyTheKnotsThatReachTheGrip) {
   auto handle_names = [&](double to) {
     three.constraints.handle_region_from_knob_m = std::pair{0.0, to};
     std::vector<std::string> out;
-    EXPECT_TRUE(DesignModel::Build(three, DesignOptions{}, &model, &why)) << why;
+    EXPECT_TRUE(DesignModel::Build(three, DesignOptions{}, &model, &why)) << why.Message();
     for (const auto& c : model.constraints()) {
       if (c.name.rfind("min_handle", 0) == 0) out.push_back(c.name);
     }
@@ -744,7 +746,7 @@ TEST(OptimizeMultiStart, CancellationAndTheTimeBudgetKeepTheBestDesign) {
   EXPECT_EQ(r.summary.raw_status, 5);  // User_Requested_Stop
   EXPECT_NE(r.summary.message.find("cancelled"), std::string::npos);
   EXPECT_EQ(r.spread.starts, 1);
-  EXPECT_TRUE(r.bat.IsValid(nullptr));
+  EXPECT_TRUE(r.bat.Validate(nullptr));
 
   o.max_time_s = 1e-9;
   r = OptimizeDesign(ContractExample(), o);
@@ -779,6 +781,61 @@ TEST(OptimizeMaterials, TheBestMaterialIsChosenAndEveryMaterialIsReported) {
     }
   }
   EXPECT_EQ(OptimizeOverMaterials(p, {}).summary.termination, Termination::kInvalidInput);
+}
+
+// design.cpp tells its outcomes apart by kinds, never by reading a message back: a conflict's
+// ConflictKind (a geometric conflict makes the answer infeasible) and the summary message's
+// DesignMessageKind (a chosen start cut by a cancel keeps its own "cancelled (...)" message
+// rather than being wrapped in "cancelled after i of n starts").
+TEST(OptimizeKinds, ConflictsAndMessagesSayWhatTheyAreAsData) {
+  DesignProblem unreachable = StepProblem(0.010, 0.016, 0.020, 0.040);
+  unreachable.constraints.mass_kg = DesignRange::Equal(0.3);
+  DesignResult r = OptimizeDesign(unreachable);
+  ASSERT_EQ(r.conflicts.size(), 1u);
+  EXPECT_EQ(r.conflicts[0].kind, ConflictKind::kUnreachable);
+  EXPECT_EQ(r.message_kind, DesignMessageKind::kInfeasible);
+
+  DesignProblem pair = StepProblem(0.010, 0.016, 0.020, 0.040);
+  pair.constraints.mass_kg = DesignRange::Equal(0.6);
+  pair.constraints.balance_point_m = DesignRange::Between(0.62, 0.63);
+  r = OptimizeDesign(pair);
+  ASSERT_EQ(r.conflicts.size(), 1u);
+  EXPECT_EQ(r.conflicts[0].kind, ConflictKind::kPair);
+  EXPECT_EQ(r.message_kind, DesignMessageKind::kInfeasible);
+
+  DesignProblem fixed;
+  fixed.bat = FindPreset("wood-34-ash")->bat;
+  fixed.variables = {{"profile.knots[12].radius_m", 0.030, 0.034}};
+  fixed.constraints.taper = TaperRule::kNonDecreasing;
+  r = OptimizeDesign(fixed);
+  ASSERT_FALSE(r.conflicts.empty());
+  for (const DesignConflict& c : r.conflicts) EXPECT_EQ(c.kind, ConflictKind::kFixed);
+  EXPECT_EQ(r.message_kind, DesignMessageKind::kInfeasible);
+
+  r = OptimizeDesign(ContractExample());
+  ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.FullReport();
+  EXPECT_EQ(r.message_kind, DesignMessageKind::kConverged);
+
+  // The chosen (only) start is itself cancelled: its message stands, not rewrapped.
+  Progress progress;
+  progress.Cancel();
+  DesignOptions o;
+  o.starts = 3;
+  r = OptimizeDesign(ContractExample(), o, &progress);
+  EXPECT_EQ(r.message_kind, DesignMessageKind::kCancelled) << r.summary.message;
+  EXPECT_EQ(r.summary.message.rfind("cancelled (", 0), 0u) << r.summary.message;
+
+  o = DesignOptions{};
+  o.max_time_s = 1e-9;
+  r = OptimizeDesign(ContractExample(), o);
+  EXPECT_EQ(r.message_kind, DesignMessageKind::kTimeBudget) << r.summary.message;
+
+  DesignProblem refused = ContractExample();
+  o = DesignOptions{};
+  o.max_iterations = 0;
+  r = OptimizeDesign(refused, o);
+  EXPECT_EQ(r.summary.termination, Termination::kInvalidInput);
+  EXPECT_EQ(r.message_kind, DesignMessageKind::kRefused);
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 // first mode is pushed above the unconstrained optimum's (Ipopt and NLopt SLSQP).
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <cmath>
 #include <string>
 #include <vector>
@@ -53,8 +55,8 @@ const DesignActiveConstraint* FindActive(const DesignResult& r, const std::strin
 // node (the derivative jumps there: the boundary term uses one element's shape functions).
 void ExpectGradientMatches(const DesignProblem& p, const std::vector<double>& x) {
   DesignModel model;
-  std::string why;
-  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why;
+  Refusal why;
+  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why.Message();
   int k = -1;
   for (int c = 0; c < model.m(); ++c) {
     if (model.constraints()[static_cast<std::size_t>(c)].f.function ==
@@ -86,8 +88,8 @@ TEST(OptimizeFrequency, StartFrequencyIsTheModesCodes) {
   DesignProblem p = MlbProblem();
   p.constraints.min_frequency_hz = 100.0;
   DesignModel model;
-  std::string why;
-  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why;
+  Refusal why;
+  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why.Message();
   const std::vector<double> x0 = model.BaseX();
   const BatModes modes = ComputeBatModes(model.BatAt(x0.data()), p.flexible.VibrationModes());
   ASSERT_TRUE(modes.summary.IsSolutionUsable());
@@ -230,7 +232,7 @@ TEST(OptimizeFrequency, RefusesBadBoundsAndTheExactHessian) {
   DesignProblem p = MlbProblem();
   p.constraints.min_frequency_hz = 0.0;
   std::string why;
-  EXPECT_FALSE(p.IsValid(&why));
+  EXPECT_FALSE(Validates(p, &why));
   EXPECT_EQ(why, "constraints.min_frequency_hz = 0: must be in (0, 1e+05]");
   p.constraints.min_frequency_hz = 150.0;
   DesignOptions o;

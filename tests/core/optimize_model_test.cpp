@@ -96,8 +96,8 @@ const DesignObjective kObjectives[] = {DesignObjective::kMaxExitSpeed,
 
 DesignModel Build(const DesignProblem& p) {
   DesignModel model;
-  std::string why;
-  EXPECT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why;
+  Refusal why;
+  EXPECT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why.Message();
   return model;
 }
 
@@ -138,7 +138,7 @@ TEST(OptimizeModel, PropertiesMatchThePublicMassProperties) {
       DesignPoint point;
       ASSERT_TRUE(model.Evaluate(x.data(), false, &point));
       const Bat bat = model.BatAt(x.data());
-      ASSERT_TRUE(bat.IsValid(nullptr));
+      ASSERT_TRUE(bat.Validate(nullptr));
       const MassProperties props = ComputeMassProperties(bat);
       // Same integrals, other summation order and reference point: rounding only.
       EXPECT_NEAR(point.mass_kg, props.mass_kg, 1e-13);

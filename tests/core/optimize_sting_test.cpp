@@ -5,6 +5,8 @@
 // properties; reproducibility; time budget and cancellation; refusals; infeasible requests.
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -222,7 +224,7 @@ TEST(OptimizeSting, TheTimeBudgetAndCancellationKeepTheBestDesign) {
       << r.summary.message;
   EXPECT_EQ(r.summary.raw_status, -5);  // FORCED_STOP, before any evaluation: the start
   EXPECT_NEAR(r.objective_value, base, 1e-12 * base);
-  EXPECT_TRUE(r.bat.IsValid(nullptr));
+  EXPECT_TRUE(r.bat.Validate(nullptr));
 
   // A budget shorter than the solve (~20 evaluations of ~5 ms, plus the start's when the problem
   // is built): stopped on the way, or before the first evaluation on a slow machine, with a
@@ -248,7 +250,7 @@ TEST(OptimizeSting, RefusalsNameTheField) {
   DesignProblem p = TaperEndProblem(0.85, 1.25);
   p.flexible.max_elements = 1;
   std::string why;
-  EXPECT_FALSE(p.IsValid(&why));
+  EXPECT_FALSE(Validates(p, &why));
   EXPECT_EQ(why, "flexible.max_elements = 1: must be in [2, 4096]");
   EXPECT_EQ(OptimizeDesign(p).summary.termination, Termination::kInvalidInput);
 
@@ -267,7 +269,7 @@ TEST(OptimizeSting, RefusalsNameTheField) {
   p.three_segment = ThreeSegmentShape{0.12, 0.0125, 0.033, 0.03, 0.05};  // L < 4 x 0.033 m
   p.swing.hands_from_knob_m = 0.05;
   p.variables = {{"three_segment.taper_end_m", 0.04, 0.06}};
-  EXPECT_FALSE(p.IsValid(&why));
+  EXPECT_FALSE(Validates(p, &why));
   EXPECT_EQ(why.rfind("objective = min_sting: the sting of the start", 0), 0u) << why;
   EXPECT_NE(why.find("slender"), std::string::npos) << why;
   r = OptimizeDesign(p);

@@ -1,6 +1,8 @@
 // The built-in bats and where their numbers come from.
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <algorithm>
 #include <set>
 #include <string>
@@ -24,7 +26,7 @@ TEST(Presets, AllValidWithSourcesAndUniqueNames) {
   std::set<std::string> names;
   for (const BatPreset& p : BatPresets()) {
     std::string why;
-    EXPECT_TRUE(p.bat.IsValid(&why)) << p.name << ": " << why;
+    EXPECT_TRUE(Validates(p.bat, &why)) << p.name << ": " << why;
     EXPECT_FALSE(p.description.empty()) << p.name;
     EXPECT_FALSE(p.source.empty()) << p.name;
     EXPECT_FALSE(p.bat.material.source.empty()) << p.name;

@@ -3,6 +3,8 @@
 #include <boost/random/sobol.hpp>
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -17,7 +19,7 @@ namespace {
 TEST(SamplingTest, GridIsTheRowMajorProductWithExactEnds) {
   SweepPlan plan;
   plan.dimensions = {{0.0, 1.0, 3}, {10.0, 20.0, 2}};
-  ASSERT_TRUE(plan.IsValid(nullptr));
+  ASSERT_TRUE(plan.Validate(nullptr));
   EXPECT_EQ(plan.DesignCount(), 6u);
   const auto designs = GenerateDesigns(plan);
   const std::vector<std::vector<double>> expected = {{0.0, 10.0}, {0.0, 20.0}, {0.5, 10.0},
@@ -134,13 +136,13 @@ TEST(SamplingTest, ShardsPartitionTheDesigns) {
     std::vector<int> owners(100, 0);
     for (std::uint64_t index = 0; index < count; ++index) {
       const Shard shard{index, count};
-      ASSERT_TRUE(shard.IsValid(nullptr));
+      ASSERT_TRUE(shard.Validate(nullptr));
       for (std::uint64_t i = 0; i < 100; ++i) owners[i] += shard.Contains(i) ? 1 : 0;
     }
     EXPECT_TRUE(std::all_of(owners.begin(), owners.end(), [](int n) { return n == 1; }));
   }
   std::string why;
-  EXPECT_FALSE((Shard{3, 3}).IsValid(&why));
+  EXPECT_FALSE(Validates(Shard{3, 3}, &why));
   EXPECT_EQ(why, "shard.index = 3: must be below shard.count = 3");
 }
 
@@ -211,14 +213,14 @@ TEST(SamplingTest, TwoObjectiveParetoFrontAgreesWithBruteForce) {
 TEST(SamplingTest, InvalidPlansAreNamed) {
   SweepPlan plan;
   std::string why;
-  EXPECT_FALSE(plan.IsValid(&why));
+  EXPECT_FALSE(Validates(plan, &why));
   EXPECT_EQ(why, "dimensions = 0: must have 1 to 32 parameters");
   plan.dimensions = {{1.0, 0.0, 2}};
-  EXPECT_FALSE(plan.IsValid(&why));
+  EXPECT_FALSE(Validates(plan, &why));
   EXPECT_EQ(why, "dimensions[0].max = 0: must be finite and >= min = 1");
   plan.dimensions = {{0.0, 1.0, 2}};
   plan.method = SamplingMethod::kLatinHypercube;
-  EXPECT_FALSE(plan.IsValid(&why));
+  EXPECT_FALSE(Validates(plan, &why));
   EXPECT_EQ(why, "samples = 0: must be >= 1");
 }
 

@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include "core/optimize/nlopt_search.hpp"
 #include "core/presets.hpp"
 
@@ -29,12 +31,12 @@ Scene PaperWood(std::vector<SceneOutput> outputs = {SceneOutput::kMaxExitSpeed})
 
 TEST(SceneDefaults, AreValidAndMatchTheContract) {
   std::string why;
-  EXPECT_TRUE(Ball{}.IsValid(&why)) << why;
-  EXPECT_TRUE(Swing{}.IsValid(&why)) << why;
-  EXPECT_TRUE(SceneOptions{}.IsValid(&why)) << why;
-  EXPECT_TRUE(CollisionOptions{}.IsValid(&why)) << why;
-  EXPECT_TRUE(ScalarSearchOptions{}.IsValid(&why)) << why;
-  EXPECT_TRUE(PaperWood().IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(Ball{}, &why)) << why;
+  EXPECT_TRUE(Validates(Swing{}, &why)) << why;
+  EXPECT_TRUE(Validates(SceneOptions{}, &why)) << why;
+  EXPECT_TRUE(Validates(CollisionOptions{}, &why)) << why;
+  EXPECT_TRUE(Validates(ScalarSearchOptions{}, &why)) << why;
+  EXPECT_TRUE(Validates(PaperWood(), &why)) << why;
   EXPECT_EQ(Ball{}.mass_kg, 0.145);
   EXPECT_EQ(Ball{}.radius_m, 0.0366);
   EXPECT_EQ(Ball{}.speed_mps, 27.7);
@@ -46,43 +48,43 @@ TEST(SceneDefaults, AreValidAndMatchTheContract) {
 TEST(SceneValidation, ExactMessages) {
   std::string why;
   Scene s;
-  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_FALSE(Validates(s, &why));
   EXPECT_EQ(why, "bat: missing (give a bat or precomputed mass_properties)");
   s = PaperWood();
   s.ball.speed_mps = -3;
-  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_FALSE(Validates(s, &why));
   EXPECT_EQ(why, "ball.speed_mps = -3: must be in [0, 1000]");
   s = PaperWood();
   s.cor = 1.5;
-  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_FALSE(Validates(s, &why));
   EXPECT_EQ(why, "cor = 1.5: must be in [0, 1]");
   s = PaperWood();
   s.outputs.clear();
-  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_FALSE(Validates(s, &why));
   EXPECT_EQ(why, "outputs: empty: name at least one output");
   s = PaperWood();
   s.ball.stiffness_exponent = 4;
-  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_FALSE(Validates(s, &why));
   EXPECT_EQ(why, "ball.stiffness_exponent = 4: must be in [1, 3]");
   SceneOptions o;
   o.curve_samples = 1;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "curve_samples = 1: must be in [2, 10000]");
   o = SceneOptions{};
   o.sweet_zone_tolerance = -1;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "sweet_zone_tolerance_mps = -1: must be in [0, 1000]");
   o.sweet_zone_unit = ToleranceUnit::kPercent;  // named by its unit, as in a request
   o.sweet_zone_tolerance = 100.5;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "sweet_zone_tolerance_percent = 100.5: must be in [0, 100]");
   o = SceneOptions{};
   o.nlopt.x_tolerance_m = 0;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "nlopt.x_tolerance_m = 0: must be finite and > 0");
   o = SceneOptions{};
   o.hertz.hands_stiffness_n_m = -1;
-  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_FALSE(Validates(o, &why));
   EXPECT_EQ(why, "hertz.hands_stiffness_n_m = -1: must be finite and >= 0");
   // An invalid scene still returns a summary.
   s = PaperWood();

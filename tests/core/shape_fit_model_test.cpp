@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <cmath>
 #include <vector>
 
@@ -80,7 +82,7 @@ TEST(ShapeFitModelTest, ResidualsAreThePublicMassProperties) {
   bat.fill->depth_m = value(FitVariable::kFillDepth);
   bat.fill->material.density_kg_m3 = value(FitVariable::kFillDensity);
   std::string why;
-  ASSERT_TRUE(bat.IsValid(&why)) << why;
+  ASSERT_TRUE(Validates(bat, &why)) << why;
   const MassProperties p = ComputeMassProperties(bat);
   EXPECT_NEAR(r[0], (p.mass_kg - 0.9) / 0.9, 1e-14);
   EXPECT_NEAR(r[1], (p.balance_point_m - 0.55) / 0.55, 1e-14);

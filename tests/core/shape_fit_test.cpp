@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <cmath>
 #include <thread>
 #include <vector>
@@ -200,7 +202,7 @@ TEST(ShapeFitFill, BoreMustStayInsideTheWood) {
   const ShapeFitResult fit = FitShape(problem);
   ASSERT_EQ(fit.summary.termination, Termination::kInfeasible) << fit.summary.FullReport();
   std::string why;
-  EXPECT_TRUE(fit.bat.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(fit.bat, &why)) << why;
   const double x_at_25mm = 0.3459 + (0.025 - 0.0125) / 0.0225 * (0.6423 - 0.3459);
   // The margin of the strict rule is 1e-9 of the radius: depth within 1e-6 m.
   EXPECT_NEAR(fit.values[0], kL - x_at_25mm, 1e-6);
@@ -208,8 +210,8 @@ TEST(ShapeFitFill, BoreMustStayInsideTheWood) {
 
 TEST(ShapeFitValidity, DefaultsAreValid) {
   std::string why;
-  EXPECT_TRUE(ShapeFitOptions{}.IsValid(&why)) << why;
-  EXPECT_TRUE(Table2Problem().IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(ShapeFitOptions{}, &why)) << why;
+  EXPECT_TRUE(Validates(Table2Problem(), &why)) << why;
 }
 
 TEST(ShapeFitValidity, OptionRefusals) {
@@ -236,7 +238,7 @@ TEST(ShapeFitValidity, OptionRefusals) {
     ShapeFitOptions options;
     c.edit(options);
     std::string why;
-    EXPECT_FALSE(options.IsValid(&why));
+    EXPECT_FALSE(Validates(options, &why));
     EXPECT_EQ(why, c.message);
     const ShapeFitResult fit = FitShape(Table2Problem(), options);
     EXPECT_EQ(fit.summary.termination, Termination::kInvalidInput);
@@ -310,7 +312,7 @@ TEST(ShapeFitValidity, ProblemRefusals) {
     ShapeFitProblem problem = Table2Problem();
     c.edit(problem);
     std::string why;
-    EXPECT_FALSE(problem.IsValid(&why)) << c.message;
+    EXPECT_FALSE(Validates(problem, &why)) << c.message;
     EXPECT_EQ(why, c.message);
     const ShapeFitResult fit = FitShape(problem);
     EXPECT_EQ(fit.summary.termination, Termination::kInvalidInput);

@@ -15,6 +15,7 @@
 #include "core/sweet_spot/sweet_spot.hpp"
 #include "tests/hard_cases/hard_case.hpp"
 #include "tests/hard_cases/reference.hpp"
+#include "tests/refusal_text.hpp"
 
 namespace sweetspot::hard_cases {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -71,10 +72,10 @@ long double Pick(const ReferenceProperties& p, Quantity q) {
   }
 }
 
-// The bat's property (or its IsValid refusal).
+// The bat's property (or its Validate refusal).
 Outcome Property(const Bat& bat, Quantity q, core::InertiaModel model) {
   std::string why;
-  if (!bat.IsValid(&why)) return Invalid(why);
+  if (!Validates(bat, &why)) return Invalid(why);
   return Value(Pick(core::ComputeMassProperties(bat, model), q));
 }
 
@@ -95,7 +96,7 @@ CoreCase AgainstClosedForm(std::string name, MakeBat make, Quantity q,
           Reference(std::move(exact), rel_tolerance)};
 }
 
-// A row whose bat must be refused by Bat::IsValid with `phrase` in the reason.
+// A row whose bat must be refused by Bat::Validate with `phrase` in the reason.
 CoreCase InvalidBat(std::string name, MakeBat make, std::string phrase) {
   return {std::move(name),
           [make] { return Property(make(), Quantity::kMass, core::InertiaModel::kRigidBody); },

@@ -4,7 +4,7 @@
 //   - an exact value (closed form) with a tolerance justified next to the row,
 //   - a bounded error against a reference (closed form, long double, or a refined solution),
 //   - a bounded range (the model gives no closed form, but the answer must lie in an interval),
-//   - a named refusal: core `IsValid` false or a Summary termination, with a phrase of the
+//   - a named refusal: core `Validate` false or a Summary termination, with a phrase of the
 //     message; api: HTTP status + error `code` + `field`.
 // Every endpoint row also checks the invariants of the service: never a 500, never a NaN or an
 // infinity anywhere in the body, and a refusal always carries code, message and field.
@@ -34,9 +34,9 @@ inline constexpr double kEps = std::numeric_limits<double>::epsilon();
 /// What a core row produced.
 struct Outcome {
   /// "converged", "no_convergence", "infeasible", "failure", "invalid_input" (the last also
-  /// for an `IsValid(&why)` that returned false).
+  /// for a `Validate` that returned false).
   std::string termination;
-  std::string message;       ///< The summary's message or the `why` of IsValid.
+  std::string message;       ///< The summary's message or the refusal's Message().
   long double value = kNaN;  ///< The quantity under test (NaN when not computed).
 };
 
@@ -44,7 +44,7 @@ struct Outcome {
 Outcome Value(long double value);
 /// A value with the Summary of the solve that produced it.
 Outcome FromSummary(const core::Summary& summary, long double value);
-/// An `IsValid` refusal: termination "invalid_input", message = why.
+/// A `Validate` refusal: termination "invalid_input", message = its Message().
 Outcome Invalid(std::string why);
 
 /// What a core row must produce.

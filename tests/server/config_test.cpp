@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <map>
 
 namespace sweetspot::server {
@@ -21,7 +23,7 @@ ParsedCommandLine Parse(const std::vector<std::string>& args,
 TEST(ConfigTest, DefaultsAreValidAndLoopback) {
   const ServerConfig config;
   std::string why;
-  EXPECT_TRUE(config.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(config, &why)) << why;
   EXPECT_EQ(config.host, "127.0.0.1");
   EXPECT_EQ(config.port, 8080);
   EXPECT_EQ(config.threads, 8);
@@ -127,15 +129,15 @@ TEST(ConfigTest, IsValidRefusesOutOfRange) {
   ServerConfig config;
   config.threads = 0;
   std::string why;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "threads = 0: must be in [1, 1024]");
   config = ServerConfig{};
   config.read_timeout_s = -1;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "read_timeout_s = -1: must be in (0, 3600]");
   // The value as given, every digit (an ostream's 6 digits wrote "3600" here).
   config.read_timeout_s = 3600.0001;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "read_timeout_s = 3600.0001: must be in (0, 3600]");
 }
 
@@ -164,7 +166,7 @@ TEST(ConfigTest, ServingLimitsFromFlagsAndEnvironment) {
   ServerConfig config;
   config.body_min_rate_bytes_per_s = 0.5;
   std::string why;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "body_min_rate_bytes_per_s = 0.5: must be at least 1");
 }
 

@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "tests/refusal_text.hpp"
 #include "tests/server/running_server.hpp"
 
 namespace sweetspot::server {
@@ -263,7 +264,7 @@ TEST(ExploreCsvEndToEndTest, ExploreThreadsChangeNothingButTheThreads) {
   ServerConfig bad;
   bad.explore_threads = 2000;
   std::string why;
-  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_FALSE(Validates(bad, &why));
   EXPECT_EQ(why, "explore_threads = 2000: must be in [0, 1024] (0 = one per core)");
 }
 

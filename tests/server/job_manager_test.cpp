@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -127,9 +129,9 @@ void ExpectError(const Response& response, int status, const std::string& code,
 TEST(JobConfigTest, DefaultsAreValid) {
   const JobConfig config;
   std::string why = "untouched";
-  EXPECT_TRUE(config.IsValid(&why));
+  EXPECT_TRUE(Validates(config, &why));
   EXPECT_EQ(why, "untouched");
-  EXPECT_TRUE(config.IsValid(nullptr));
+  EXPECT_TRUE(config.Validate(nullptr));
   EXPECT_EQ(config.workers, 2);
   EXPECT_EQ(config.max_queued, 64u);
   EXPECT_EQ(config.max_kept, 1000u);
@@ -138,8 +140,8 @@ TEST(JobConfigTest, DefaultsAreValid) {
 
 std::string WhyInvalid(const JobConfig& config) {
   std::string why;
-  EXPECT_FALSE(config.IsValid(&why));
-  EXPECT_FALSE(config.IsValid(nullptr));
+  EXPECT_FALSE(Validates(config, &why));
+  EXPECT_FALSE(config.Validate(nullptr));
   return why;
 }
 
@@ -150,7 +152,7 @@ TEST(JobConfigTest, EachRuleNamesFieldValueAndRule) {
   config.workers = 65;
   EXPECT_EQ(WhyInvalid(config), "workers = 65: must be in [1, 64]");
   config.workers = 64;
-  EXPECT_TRUE(config.IsValid(nullptr));
+  EXPECT_TRUE(config.Validate(nullptr));
 
   config = JobConfig{};
   config.max_queued = 0;

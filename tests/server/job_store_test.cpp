@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/refusal_text.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -273,14 +275,14 @@ TEST(JobStoreConfigTest, MaxResumesDefaultAndRange) {
   EXPECT_EQ(config.max_resumes, 2);
   std::string why;
   config.max_resumes = 0;
-  EXPECT_TRUE(config.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(config, &why)) << why;
   config.max_resumes = 100;
-  EXPECT_TRUE(config.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(config, &why)) << why;
   config.max_resumes = -1;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "max_resumes = -1: must be in [0, 100]");
   config.max_resumes = 101;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "max_resumes = 101: must be in [0, 100]");
 }
 
@@ -948,14 +950,14 @@ TEST(JobStoreConfigTest, TimeAndMemoryLimitsDefaultsAndRanges) {
   EXPECT_EQ(config.max_results_memory_bytes, 256u << 20);
   std::string why;
   config.max_time_s = 0;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "max_time_s = 0: must be in (0, 1e+06]");
   config.max_time_s = 600;
   config.max_results_memory_bytes = 1000;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "max_results_memory_bytes = 1000: must be in [1024, 1000000000000]");
   config.max_results_memory_bytes = 1024;
-  EXPECT_TRUE(config.IsValid(&why));
+  EXPECT_TRUE(Validates(config, &why));
 }
 
 }  // namespace

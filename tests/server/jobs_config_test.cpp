@@ -1,5 +1,5 @@
 // The job persistence and shutdown options: defaults, flags, environment,
-// IsValid's messages, --help, and a server whose jobs database is unusable.
+// Validate's messages, --help, and a server whose jobs database is unusable.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -10,6 +10,7 @@
 
 #include "server/config.hpp"
 #include "server/server.hpp"
+#include "tests/refusal_text.hpp"
 #include "tests/server/server_process.hpp"
 
 namespace sweetspot::server {
@@ -33,7 +34,7 @@ TEST(JobsConfigTest, Defaults) {
   EXPECT_EQ(config.jobs.max_resumes, 2);
   EXPECT_STREQ(kNoJobsDb, "none");
   std::string why;
-  EXPECT_TRUE(config.IsValid(&why)) << why;
+  EXPECT_TRUE(Validates(config, &why)) << why;
 }
 
 TEST(JobsConfigTest, FlagsAndEnvironment) {
@@ -86,28 +87,28 @@ TEST(JobsConfigTest, IsValidRefusesOutOfRange) {
   std::string why;
   ServerConfig config;
   config.jobs_db = "";
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why,
             "jobs_db = \"\": must be a file path, a postgresql:// URI, or \"none\" for no "
             "persistence");
   config = ServerConfig{};
   config.jobs.lease_s = 0.0;
-  EXPECT_FALSE(config.jobs.IsValid(&why));
+  EXPECT_FALSE(Validates(config.jobs, &why));
   EXPECT_EQ(why, "lease_s = 0: must be in [1, 3600]");
   config.jobs.lease_s = 10.0;
   config.jobs.max_result_bytes = 10;
-  EXPECT_FALSE(config.jobs.IsValid(&why));
+  EXPECT_FALSE(Validates(config.jobs, &why));
   EXPECT_EQ(why, "max_result_bytes = 10: must be in [1024, 1000000000]");
   config = ServerConfig{};
   config.shutdown_grace_s = -0.5;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "shutdown_grace_s = -0.5: must be in [0, 3600]");
   config.shutdown_grace_s = std::nan("");
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "shutdown_grace_s = nan: must be in [0, 3600]");
   config = ServerConfig{};
   config.jobs.max_resumes = -1;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "jobs.max_resumes = -1: must be in [0, 100]");
 }
 
@@ -148,11 +149,11 @@ TEST(JobsConfigTest, JobLimitsFlagsEnvironmentAndRules) {
   ServerConfig config;
   std::string why;
   config.jobs_db_max_bytes = 1000;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "jobs_db_max_bytes = 1000: must be 0 (no limit) or in [65536, 1e15]");
   config = ServerConfig{};
   config.jobs.max_time_s = -1;
-  EXPECT_FALSE(config.IsValid(&why));
+  EXPECT_FALSE(Validates(config, &why));
   EXPECT_EQ(why, "jobs.max_time_s = -1: must be in (0, 1e+06]");
   const std::string usage = Usage("sweetspot-server");
   for (const char* name : {"--job-max-time-s", "SWEETSPOT_JOB_MAX_TIME_S", "(default 600)",

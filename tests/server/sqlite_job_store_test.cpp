@@ -4,8 +4,10 @@
 #include "server/jobs/sqlite_job_store.hpp"
 
 #include <gtest/gtest.h>
+
 #include <sqlite3.h>
 #include <stdlib.h>
+#include "tests/refusal_text.hpp"
 
 #include <chrono>
 #include <filesystem>
@@ -101,14 +103,14 @@ std::vector<JobRecord> LoadAll(SqliteJobStore& store) {
 TEST(SqliteJobStoreOptionsTest, DefaultsAreValidAndTheRangeIsChecked) {
   SqliteJobStoreOptions options;
   std::string why = "untouched";
-  EXPECT_TRUE(options.IsValid(&why));
+  EXPECT_TRUE(Validates(options, &why));
   EXPECT_EQ(why, "untouched");
   EXPECT_EQ(options.busy_timeout_s, 2.0);
   options.busy_timeout_s = -1;
-  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_FALSE(Validates(options, &why));
   EXPECT_EQ(why, "busy_timeout_s = -1: must be in [0, 60]");
   options.busy_timeout_s = 61;
-  EXPECT_FALSE(options.IsValid(nullptr));
+  EXPECT_FALSE(options.Validate(nullptr));
   std::string error;
   EXPECT_EQ(SqliteJobStore::Open(":memory:", &error, options), nullptr);
   EXPECT_EQ(error, "invalid SqliteJobStoreOptions: busy_timeout_s = 61: must be in [0, 60]");
