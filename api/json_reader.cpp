@@ -2,6 +2,7 @@
 
 #include "api/trade_units.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
@@ -9,6 +10,47 @@
 #include "core/geometry_format.hpp"
 
 namespace sweetspot::api {
+namespace {
+
+// The optimal-string-alignment distance of `a` and `b` (insertions, deletions,
+// substitutions and swaps of two neighbours each count 1), or limit + 1 once it exceeds
+// `limit`.
+std::size_t TypoDistance(std::string_view a, std::string_view b, std::size_t limit) {
+  if (a.size() > b.size() + limit || b.size() > a.size() + limit) return limit + 1;
+  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
+  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) {
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+      }
+    }
+  }
+  return std::min(d[a.size()][b.size()], limit + 1);
+}
+
+}  // namespace
+
+std::string NearestName(std::string_view written, const std::vector<std::string>& names) {
+  // One typo in a short name, two in a longer one: "masss_kg" -> "mass_kg",
+  // "lenght_in" -> "length_in", but "x_m" is not "r_m"'s typo.
+  const std::size_t limit = written.size() < 6 ? 1 : 2;
+  std::string best;
+  std::size_t best_distance = limit + 1;
+  for (const std::string& name : names) {
+    if (name == written) continue;
+    const std::size_t distance = TypoDistance(written, name, limit);
+    if (distance < best_distance) {
+      best_distance = distance;
+      best = name;
+    }
+  }
+  return best;
+}
+
 namespace {
 
 using Json = nlohmann::json;
@@ -307,6 +349,21 @@ bool ObjectReader::Fail(std::string_view key, const std::string& rule, ErrorCode
 }
 
 bool ObjectReader::Missing(std::string_view key) {
+  // A required field that is absent, beside a field this object does not know that is one
+  // typo away from it or from one of its trade forms ("lenght_in" for length_m): the field
+  // as the user wrote it is the error, with the name meant.
+  if (value_->is_object()) {
+    std::vector<std::string> names = {std::string(key)};
+    for (const TradeForm& form : TradeForms(key)) names.push_back(form.key);
+    for (const auto& item : value_->items()) {
+      if (known_.count(item.key()) != 0) continue;
+      const std::string nearest = NearestName(item.key(), names);
+      if (nearest.empty()) continue;
+      known_.insert(std::string(key));
+      return SetError(error_, ErrorCode::kUnknownField, PathOf(item.key()), nullptr,
+                      "is not a known field; did you mean " + nearest + "?");
+    }
+  }
   return SetError(error_, ErrorCode::kMissingField, PathOf(key), nullptr, "is required");
 }
 
@@ -463,10 +520,14 @@ bool ObjectReader::Finish() {
     if (known_.count(item.key()) == 0) {
       std::string list;
       for (const auto& k : known_) list += (list.empty() ? "" : ", ") + k;
+      const std::string nearest =
+          NearestName(item.key(), std::vector<std::string>(known_.begin(), known_.end()));
       return SetError(
           error_, ErrorCode::kUnknownField, PathOf(item.key()), nullptr,
-          "is not a known field" + (list.empty() ? std::string(" (this object takes no fields)")
-                                                 : " (known: " + list + ")"));
+          "is not a known field" +
+              (nearest.empty() ? std::string() : "; did you mean " + nearest + "?") +
+              (list.empty() ? std::string(" (this object takes no fields)")
+                            : " (known: " + list + ")"));
     }
   }
   return true;

@@ -69,6 +69,11 @@ std::string Show(const nlohmann::json& value);
 /// Joins a parent path and a key: ("bat", "material") -> "bat.material".
 std::string JoinPath(std::string_view parent, std::string_view key);
 
+/// The name of `names` that `written` is one typo away from (two for names of 6 characters
+/// or more; a typo: a character added, dropped, changed, or two neighbours swapped), or ""
+/// when none is: the "did you mean" of an unknown field.
+std::string NearestName(std::string_view written, const std::vector<std::string>& names);
+
 /// Reads one JSON object field by field. The first problem is recorded in
 /// *error; later calls then do nothing and return false/nullopt. Finish()
 /// refuses any field that was not read (a typo must not fall back silently).

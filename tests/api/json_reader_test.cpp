@@ -2,6 +2,7 @@
 
 #include "api/router.hpp"
 
+#include <tuple>
 #include <gtest/gtest.h>
 
 #include "tests/refusal_text.hpp"
@@ -88,7 +89,41 @@ TEST(ObjectReaderTest, ReadsNumbersAndRefusesUnknownFields) {
   EXPECT_FALSE(reader.Finish());
   EXPECT_EQ(error.code, ErrorCode::kUnknownField);
   EXPECT_EQ(error.field, "ball.masss_kg");
-  EXPECT_EQ(error.message, "ball.masss_kg is not a known field (known: mass_kg)");
+  EXPECT_EQ(error.message, "ball.masss_kg is not a known field; did you mean mass_kg? (known: mass_kg)");
+}
+
+// A required field that is absent beside a typo of it, or of one of its trade forms: the
+// error names the field as written and the name meant (issue 33, item 2: "lenght_in" was
+// reported as "length_m is required"). A field that is no typo of it is still "required".
+TEST(ObjectReaderTest, ATypoOfARequiredFieldIsNamedAsWrittenWithTheNameMeant) {
+  for (const auto& [body, field, message] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {R"({"lenght_in": 33})", "bat.lenght_in",
+            "bat.lenght_in is not a known field; did you mean length_in?"},
+           {R"({"legnth_m": 0.8})", "bat.legnth_m",
+            "bat.legnth_m is not a known field; did you mean length_m?"},
+           {R"({"colour": "red"})", "bat.length_m", "bat.length_m is required"}}) {
+    const auto value = nlohmann::json::parse(body);
+    ApiError error;
+    ObjectReader reader(value, "bat", &error);
+    double length = 0;
+    EXPECT_FALSE(reader.Number("length_m", Positive(), &length));
+    EXPECT_EQ(error.field, field);
+    EXPECT_EQ(error.message, message);
+    EXPECT_EQ(error.code, field == "bat.length_m" ? ErrorCode::kMissingField
+                                                  : ErrorCode::kUnknownField);
+  }
+}
+
+// One typo in a name under 6 characters, two in a longer one; the nearest wins.
+TEST(ObjectReaderTest, NearestNameIsATypoAway) {
+  const std::vector<std::string> names = {"length_m", "length_in", "x_m", "radius_m"};
+  EXPECT_EQ(NearestName("lenght_in", names), "length_in");  // a swap
+  EXPECT_EQ(NearestName("lengthh_m", names), "length_m");   // an insertion
+  EXPECT_EQ(NearestName("radus_m", names), "radius_m");     // a deletion
+  EXPECT_EQ(NearestName("r_m", names), "x_m");              // one change in a short name
+  EXPECT_EQ(NearestName("rr_mm", names), "");               // two in a short name: none
+  EXPECT_EQ(NearestName("diameter_in", names), "");
+  EXPECT_EQ(NearestName("radius_m", names), "");            // itself is no suggestion
 }
 
 TEST(ObjectReaderTest, MessagesNameFieldValueAndRule) {
