@@ -59,7 +59,7 @@ struct Context {
   bool validate_only = false;
   /// True when the request is a job's inner request checked at POST /v1/jobs: /v1/explore
   /// then refuses (413) a sweep whose estimated CPU time, wall time or result is over
-  /// limits.max_job_cpu_s, max_job_time_s or max_job_result_bytes (api/explore_estimate.hpp).
+  /// limits.max_job_cpu_s, max_job_time_s or max_job_result_bytes (api/explore/estimate.hpp).
   bool job = false;
 };
 
