@@ -13,9 +13,18 @@ namespace sweetspot::server {
 
 namespace config_options {
 
-// Stopping (the grace), the web root, the access log.
+// Stopping (the drain, the grace), the web root, the access log.
 const std::vector<Option>& ProcessOptions() {
   static const std::vector<Option> options = {
+      {"--drain-s", "SWEETSPOT_DRAIN_S",
+       "on SIGTERM/SIGINT, how long the server keeps accepting and answering while GET /ready "
+       "answers 503, so that a load balancer takes it out first, s; then it stops accepting "
+       "and --shutdown-grace-s begins (default 0 = stop accepting at once; 5 behind "
+       "Kubernetes)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return ParseSecondsOrZero(v, &c->drain_s, rule);
+       }},
       {"--shutdown-grace-s", "SWEETSPOT_SHUTDOWN_GRACE_S",
        "on SIGTERM, how long running jobs may finish before they are interrupted and kept "
        "for the next start, s (default 8; 0 = interrupt at once)",
@@ -127,6 +136,9 @@ bool ServerConfig::Validate(core::Refusal* refusal) const {
       (jobs_db_max_bytes < 65536 || jobs_db_max_bytes > 1000000000000000ULL)) {
     return fail(core::QuotedRefusal("jobs_db_max_bytes", std::to_string(jobs_db_max_bytes),
                                     "must be 0 (no limit) or in [65536, 1e15]"));
+  }
+  if (!std::isfinite(drain_s) || drain_s < 0 || drain_s > 3600) {
+    return fail(NumberRefusal("drain_s", drain_s, "must be in [0, 3600]"));
   }
   if (!std::isfinite(shutdown_grace_s) || shutdown_grace_s < 0 || shutdown_grace_s > 3600) {
     return fail(NumberRefusal("shutdown_grace_s", shutdown_grace_s, "must be in [0, 3600]"));

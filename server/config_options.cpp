@@ -186,8 +186,8 @@ const std::vector<Option>& ConnectionOptions() {
          return ParseSeconds(v, &c->max_request_time_s, rule);
        }},
       {"--auth-token-file", "SWEETSPOT_AUTH_TOKEN_FILE",
-       "file holding a bearer token required on every path but /health (default: none; "
-       "SWEETSPOT_AUTH_TOKEN may hold the token itself)",
+       "file holding a bearer token required on every path but /health and /ready (default: "
+       "none; SWEETSPOT_AUTH_TOKEN may hold the token itself)",
        true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          std::ifstream in(v);

@@ -5,7 +5,7 @@
 //   RequestReadingOptions()  head and body sizes and deadlines, keep-alive (config_options.cpp)
 //   LimitOptions()    request limits: bodies, JSON, arrays, samples, solvers (config_limits.cpp)
 //   JobOptions()      the job pool and its store (config_limits.cpp)
-//   ProcessOptions()  stopping (the grace), the web root, the access log (config.cpp)
+//   ProcessOptions()  stopping (drain, grace), the web root, the access log (config.cpp)
 #pragma once
 
 #include <cstddef>

@@ -203,6 +203,8 @@ void ConnectionLoop::Stop() {
   impl_->stopping.store(true);
 }
 
+void ConnectionLoop::BeginDrain() { impl_->draining.store(true); }
+
 void ConnectionLoop::EndGrace() { impl_->grace_ended.store(true); }
 
 bool ConnectionLoop::Run() {

@@ -280,6 +280,7 @@ struct ConnectionLoop::Impl {
   std::uint64_t next_id = 2;
 
   std::atomic<bool> stopping{false};
+  std::atomic<bool> draining{false};      // BeginDrain(): answers carry Connection: close
   std::atomic<long long> stop_ns{0};      // when Stop() was first called (steady clock)
   std::atomic<bool> grace_ended{false};  // EndGrace(): no more time for requests in flight
   std::atomic<int> admitted{0};   // open connections that count against max_connections

@@ -130,7 +130,8 @@ void ConnectionLoop::Impl::Answer(Connection& c, BusyCounter& busy, RequestCance
     stream.set_framing(c.head.head_bytes, c.head.content_length);
     stream.set_parsed_body(std::move(c.parsed_body));
     const bool last = c.close_after || c.served + 1 >= options.keep_alive_max_requests ||
-                      stopping.load(std::memory_order_relaxed);
+                      stopping.load(std::memory_order_relaxed) ||
+                      draining.load(std::memory_order_relaxed);
     bool closed = false;
     const bool ok = hooks.serve(stream, last, &closed);
     // What the socket does not take now is sent as the client reads (kWriting).

@@ -57,6 +57,7 @@ struct Server::Impl {
   const ServerConfig& config;  // the Server's, which outlives this
   HttpServer http;
   std::atomic<bool> stop_requested{false};
+  std::atomic<bool> draining{false};  // BeginDrain() was called: GET /ready answers 503
   api::Context context;
   Metrics metrics;
   core::ModesCache modes_cache;               // bending modes kept across requests (bounded LRU)
@@ -98,6 +99,7 @@ void Server::Impl::Configure() {
   context.limits.max_job_time_s = config.jobs.max_time_s;
   context.limits.max_job_result_bytes = config.jobs.max_result_bytes;
   context.modes_cache = &modes_cache;
+  context.draining = [this] { return draining.load(); };
   compute_budget =
       std::make_unique<api::ThreadBudget>(ComputeWorkers(config.compute_threads));
   context.thread_budget = compute_budget.get();
@@ -222,14 +224,14 @@ httplib::Server::HandlerResponse Server::Impl::PreRoute(const httplib::Request& 
       }
     }
   }
-  // Static files carry no data: the page itself asks for the token.
-  if (!config.auth_token.empty() && req.path != "/health" &&
+  // Static files carry no data: the page itself asks for the token. Nor do the probes.
+  if (!config.auth_token.empty() && req.path != "/health" && req.path != "/ready" &&
       !IsStaticRequest(req, *static_files) &&
       !TokenMatches(RawHeaderValue("Authorization"), config.auth_token)) {
     WriteApiResponse(api::ErrorResponse(401, api::ErrorCode::kUnauthorized,
                                         "header Authorization: must be \"Bearer <token>\" "
-                                        "with the server's token (everything but /health "
-                                        "and the explorer's static files needs it)",
+                                        "with the server's token (everything but /health, "
+                                        "/ready and the explorer's static files needs it)",
                                         "Authorization"),
                      res);
     res.set_header("WWW-Authenticate", "Bearer");
@@ -465,6 +467,11 @@ bool Server::Run() {
   if (!impl_->loop) return false;
   if (impl_->stop_requested.load()) impl_->loop->Stop();
   return impl_->loop->Run();
+}
+
+void Server::BeginDrain() {
+  impl_->draining.store(true);
+  if (impl_->loop) impl_->loop->BeginDrain();
 }
 
 void Server::Stop() {
