@@ -470,8 +470,9 @@ bool Server::Run() {
 }
 
 void Server::BeginDrain() {
-  impl_->draining.store(true);
+  // The loop first: once /ready says 503, every answer carries Connection: close.
   if (impl_->loop) impl_->loop->BeginDrain();
+  impl_->draining.store(true);
 }
 
 void Server::Stop() {
