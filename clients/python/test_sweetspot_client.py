@@ -9,9 +9,12 @@ client's answers are compared with the server's direct answer to the same reques
 http.client request), timings left out.
 """
 
+import contextlib
 import http.client
+import io
 import json
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -502,6 +505,29 @@ class JobsTest(unittest.TestCase):
             for _ in job.result_rows():
                 pass
         self.assertEqual(caught.exception.code, "Cancelled")
+
+
+class DocumentedPipelineTest(unittest.TestCase):
+    def test_the_example_pipeline_runs(self):
+        import example_pipeline
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            example_pipeline.main(MAIN.url, TOKEN)
+        text = out.getvalue()
+        self.assertIn("sweep: 10000 designs", text)
+        self.assertEqual(text.count("(converged)"), 4, text)
+
+    def test_the_documented_python_compiles(self):
+        root = os.path.dirname(os.path.dirname(HERE))
+        blocks = 0
+        for name in ("README.md", os.path.join("docs", "api.md")):
+            with open(os.path.join(root, name), encoding="utf-8") as document:
+                text = document.read()
+            for block in re.findall(r"```python\n(.*?)```", text, re.S):
+                if "sweetspot_client" in block:
+                    compile(block, name, "exec")
+                    blocks += 1
+        self.assertGreaterEqual(blocks, 2)
 
 
 if __name__ == "__main__":
