@@ -109,7 +109,8 @@ def direct(server, method, path, body=None, token=TOKEN):
     response = connection.getresponse()
     data = response.read()
     connection.close()
-    if "json" in response.getheader("Content-Type", "") and b"\n{" not in data:
+    content_type = response.getheader("Content-Type", "")
+    if "json" in content_type and "ndjson" not in content_type:
         return response.status, json.loads(data)
     return response.status, data.decode()
 
