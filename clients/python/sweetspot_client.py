@@ -31,12 +31,39 @@ import time
 import urllib.parse
 from typing import Any, Callable, Dict, Iterator, List, Optional
 
-__all__ = ["Client", "Job", "RowStream", "SweetspotError", "statcast_launches"]
+__all__ = ["Client", "ENDPOINTS", "Job", "RowStream", "SweetspotError", "statcast_launches"]
 __version__ = "0.1.0"
 
 JsonDict = Dict[str, Any]
 
 _TERMINAL_JOB_STATES = ("done", "failed", "cancelled")
+
+# Every operation of the OpenAPI document (docs/openapi.json, GET /openapi.json) and the
+# Client method that calls it; the test checks the server's document against this table.
+ENDPOINTS = {
+    ("GET", "/health"): "health",
+    ("GET", "/openapi.json"): "openapi",
+    ("GET", "/metrics"): "metrics",
+    ("GET", "/v1/version"): "version",
+    ("GET", "/v1/speed-vs-error"): "speed_vs_error",
+    ("GET", "/v1/materials"): "materials",
+    ("GET", "/v1/presets"): "presets",
+    ("GET", "/v1/balls"): "balls",
+    ("POST", "/v1/bat/properties"): "bat_properties",
+    ("POST", "/v1/bat/fit"): "bat_fit",
+    ("POST", "/v1/bat/modes"): "bat_modes",
+    ("POST", "/v1/sweet-spot"): "sweet_spot",
+    ("POST", "/v1/collision"): "collision",
+    ("POST", "/v1/compare"): "compare",
+    ("POST", "/v1/optimize"): "optimize",
+    ("POST", "/v1/explore"): "explore",
+    ("POST", "/v1/flight"): "flight",
+    ("POST", "/v1/jobs"): "submit",
+    ("GET", "/v1/jobs"): "jobs",
+    ("GET", "/v1/jobs/{id}"): "job",
+    ("DELETE", "/v1/jobs/{id}"): "cancel_job",
+    ("GET", "/v1/jobs/{id}/result"): "job_result",
+}
 
 
 class SweetspotError(Exception):
