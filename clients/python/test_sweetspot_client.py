@@ -473,6 +473,8 @@ class StreamingTest(unittest.TestCase):
         # the same rows in a list, moves it by tens of MB.
         self.assertLess(streamed_mb, 4, figures)
         self.assertGreater(held_mb, 5 * max(streamed_mb, 2), figures)
+        # And the first row came long before the last: read as the server sent it.
+        self.assertLess(figures["first_row_s"], figures["ndjson_s"] / 4, figures)
 
 
 class JobsTest(unittest.TestCase):
