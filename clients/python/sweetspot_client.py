@@ -42,6 +42,7 @@ _TERMINAL_JOB_STATES = ("done", "failed", "cancelled")
 # Client method that calls it; the test checks the server's document against this table.
 ENDPOINTS = {
     ("GET", "/health"): "health",
+    ("GET", "/ready"): "ready",
     ("GET", "/openapi.json"): "openapi",
     ("GET", "/metrics"): "metrics",
     ("GET", "/v1/version"): "version",
@@ -343,9 +344,12 @@ class Client:
             return http.client.HTTPSConnection(self._host, self._port, timeout=self.timeout_s)
         return http.client.HTTPConnection(self._host, self._port, timeout=self.timeout_s)
 
-    def _send(self, method: str, path: str, body: Any, query: Optional[JsonDict]):
-        """Sends one request, retrying 429/503 and refused connections; returns the open
-        connection and its response (status < 400), or raises SweetspotError."""
+    def _send(self, method: str, path: str, body: Any, query: Optional[JsonDict],
+               retries: Optional[int] = None):
+        """Sends one request, retrying 429/503 and refused connections (``retries``, default
+        the client's); returns the open connection and its response (status < 400), or raises
+        SweetspotError."""
+        retries = self.retries if retries is None else retries
         url = self._prefix + path
         if query:
             pairs = [(k, v) for k, v in query.items() if v is not None]
@@ -376,12 +380,12 @@ class Client:
                 retry_after = _retry_after_seconds(response.getheader("Retry-After"))
                 error = _error_from(status, response.read(), retry_after)
                 connection.close()
-                if status not in (429, 503) or attempt >= self.retries:
+                if status not in (429, 503) or attempt >= retries:
                     raise error
             except (ConnectionRefusedError, ConnectionResetError, BrokenPipeError,
                     http.client.RemoteDisconnected, http.client.BadStatusLine) as exc:
                 connection.close()
-                if attempt >= self.retries:
+                if attempt >= retries:
                     raise SweetspotError(None, "ConnectionError", "%s %s: %s"
                                          % (method, url, exc)) from exc
             except OSError as exc:  # a timeout, an unreachable host
@@ -429,6 +433,19 @@ class Client:
     def health(self) -> JsonDict:
         """``GET /health``: ``{"status": "ok"}`` (no token needed)."""
         return self.request("GET", "/health")
+
+    def ready(self) -> bool:
+        """``GET /ready``: True while the server takes new requests, False while it drains
+        before stopping (503, not retried: a readiness check says what is, now)."""
+        try:
+            connection, response = self._send("GET", "/ready", None, None, retries=0)
+        except SweetspotError as error:
+            if error.status == 503:
+                return False
+            raise
+        response.read()
+        connection.close()
+        return True
 
     def openapi(self) -> JsonDict:
         """``GET /openapi.json``: the OpenAPI 3 document."""

@@ -164,6 +164,9 @@ class EndpointsTest(unittest.TestCase):
             with self.subTest(path=path):
                 self.same(method(), path)
         self.assertIn("sweetspot_requests_total", self.client.metrics())
+        if "/ready" in self.client.openapi()["paths"]:  # a server with the drain (GET /ready)
+            self.same({"status": "ready"}, "/ready")
+            self.assertIs(Client(MAIN.url).ready(), True)  # needs no token
 
     def test_every_openapi_operation_has_a_method(self):
         """The client covers the server's OpenAPI document: a method per operation."""
@@ -310,6 +313,22 @@ class ErrorsTest(unittest.TestCase):
                                  (401, "Unauthorized"))
         self.assertEqual(Client(MAIN.url).health(), {"status": "ok"})  # needs no token
         self.assertIn("presets", Client(MAIN.url, token=TOKEN).presets())
+
+    def test_ready_is_false_while_the_server_drains(self):
+        if "/ready" not in self.client.openapi()["paths"]:
+            self.skipTest("this server has no GET /ready")
+        server = ServerProcess(["--drain-s", "2"])
+        try:
+            client = Client(server.url)
+            self.assertIs(client.ready(), True)
+            server.process.terminate()  # the drain: still answering, /ready 503
+            deadline = time.monotonic() + 1.5
+            while client.ready() and time.monotonic() < deadline:
+                time.sleep(0.02)
+            self.assertIs(client.ready(), False)
+            self.assertIn("presets", client.presets())  # still served while it drains
+        finally:
+            server.stop()
 
     def test_404_job(self):
         with self.assertRaises(SweetspotError) as caught:
