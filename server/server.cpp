@@ -25,6 +25,7 @@
 #include "server/access_log.hpp"
 #include "core/geometry_format.hpp"
 #include "server/connection_loop.hpp"
+#include "server/cpu_quota.hpp"
 #include "server/metrics.hpp"
 #include "server/request_head.hpp"
 #include "server/request_stream.hpp"
@@ -396,11 +397,11 @@ int Listen(const std::string& host, int port, int* bound_port) {
   return fd;
 }
 
-// The compute pool's size: the configured count, or (0) the cores.
+// The compute pool's size: the configured count, or (0) the CPUs this process may use (its
+// affinity mask and cgroup cpu.max quota, server/cpu_quota.hpp), not the node's cores.
 int ComputeWorkers(int configured) {
   if (configured > 0) return configured;
-  const unsigned cores = std::thread::hardware_concurrency();
-  return cores == 0 ? 1 : static_cast<int>(cores);
+  return DefaultThreadCount();
 }
 }  // namespace
 
