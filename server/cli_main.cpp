@@ -160,6 +160,75 @@ int ExitCode(int status) {
   return 1;
 }
 
+// `sweetspot threads`: what the default thread count comes from, for an operator checking
+// a pod or a job.
+int ThreadsCommand() {
+  const auto known = [](std::optional<int> n) { return n ? nlohmann::json(*n) : nlohmann::json(); };
+  std::cout << nlohmann::json{{"threads", sweetspot::server::DefaultThreadCount()},
+                              {"affinity_cpus", known(sweetspot::server::AffinityCpus())},
+                              {"cgroup_cpu_quota", known(sweetspot::server::CgroupCpuQuota())},
+                              {"hardware_concurrency", std::thread::hardware_concurrency()}}
+                   .dump()
+            << "\n";
+  return 0;
+}
+
+// `--shard I/N` into the explore request `*body`: false (the reason on stderr) when it is not
+// a shard of an explore request.
+bool ShardBody(const std::string& shard, const std::string& full_path,
+               const sweetspot::api::ApiLimits& limits, std::string* body) {
+  unsigned long long index = 0, count = 0;
+  if (full_path != "/v1/explore" || !ParseShard(shard, &index, &count)) {
+    std::cerr << "sweetspot: --shard \"" << shard
+              << "\": must be I/N with 0 <= I < N, and only for explore\n";
+    return false;
+  }
+  // Parsed with the service's limits (depth first: a deep body must not crash the CLI).
+  sweetspot::api::ApiError error;
+  std::optional<nlohmann::json> request = sweetspot::api::ParseBody(*body, limits, &error);
+  if (!request || !request->is_object()) {
+    std::cerr << "sweetspot: --shard needs the request as a JSON object"
+              << (error.message.empty() ? "" : ": " + error.message) << "\n";
+    return false;
+  }
+  (*request)["shard"] = {{"index", index}, {"count", count}};
+  // NDJSON (with its summary, which the merge checks), or CSV when the request asks for it.
+  if (request->value("format", std::string()) != "csv") (*request)["format"] = "ndjson";
+  *body = request->dump();
+  return true;
+}
+
+// Prints the answer on stdout (a stream as its chunks come, its progress on stderr as
+// `options` says): false when a stream did not finish.
+bool PrintResponse(const sweetspot::api::Response& response, const std::string& path,
+                   const sweetspot::server::ProgressOptions& options,
+                   const sweetspot::core::Progress& progress) {
+  if (response.stream) {
+    // The same chunks the server sends, written as they come: memory stays bounded.
+    std::atomic<std::uint64_t> lines{0};
+    sweetspot::server::ProgressReporter reporter(path, "rows", options, [&progress, &lines] {
+      return sweetspot::server::ProgressSample{progress.Fraction(),
+                                               lines.load(std::memory_order_relaxed)};
+    });
+    const bool finished = response.stream([&lines](std::string_view chunk) {
+      lines.fetch_add(static_cast<std::uint64_t>(std::count(chunk.begin(), chunk.end(), '\n')),
+                      std::memory_order_relaxed);
+      std::cout.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+      return static_cast<bool>(std::cout);
+    });
+    std::cout.flush();
+    reporter.Finish();
+    return finished;
+  }
+  if (!response.content_type.empty()) {
+    std::cout << response.text;
+  } else {
+    std::cout << response.body.dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+              << "\n";
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -174,17 +243,7 @@ int main(int argc, char** argv) {
     std::cout << Usage();
     return 0;
   }
-  if (args.size() == 1 && args[0] == "threads") {
-    // What the default thread count comes from, for an operator checking a pod or a job.
-    const auto known = [](std::optional<int> n) { return n ? nlohmann::json(*n) : nlohmann::json(); };
-    std::cout << nlohmann::json{{"threads", sweetspot::server::DefaultThreadCount()},
-                                {"affinity_cpus", known(sweetspot::server::AffinityCpus())},
-                                {"cgroup_cpu_quota", known(sweetspot::server::CgroupCpuQuota())},
-                                {"hardware_concurrency", std::thread::hardware_concurrency()}}
-                     .dump()
-              << "\n";
-    return 0;
-  }
+  if (args.size() == 1 && args[0] == "threads") return ThreadsCommand();
   sweetspot::server::ProgressOptions progress_options;
   if (!TakeProgressFlag(&args, &progress_options)) return 2;
   if (!args.empty() && args[0] == "explore-merge") {
@@ -259,29 +318,9 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  if (!shard.empty()) {
-    unsigned long long index = 0, count = 0;
-    if (full_path != "/v1/explore" || !ParseShard(shard, &index, &count)) {
-      std::cerr << "sweetspot: --shard \"" << shard
-                << "\": must be I/N with 0 <= I < N, and only for explore\n";
-      return 2;
-    }
-    // Parsed with the service's limits (depth first: a deep body must not crash the CLI).
-    sweetspot::api::ApiError error;
-    std::optional<nlohmann::json> request = sweetspot::api::ParseBody(body, context.limits, &error);
-    if (!request || !request->is_object()) {
-      std::cerr << "sweetspot: --shard needs the request as a JSON object"
-                << (error.message.empty() ? "" : ": " + error.message) << "\n";
-      return 2;
-    }
-    (*request)["shard"] = {{"index", index}, {"count", count}};
-    // NDJSON (with its summary, which the merge checks), or CSV when the request asks for it.
-    if (request->value("format", std::string()) != "csv") (*request)["format"] = "ndjson";
-    body = request->dump();
-  }
+  if (!shard.empty() && !ShardBody(shard, full_path, context.limits, &body)) return 2;
   // The sweep reports its fraction here (the CLI never cancels it); stderr shows it.
   sweetspot::core::Progress progress;
-  std::atomic<std::uint64_t> lines_written{0};
   context.progress = &progress;
   const auto response = sweetspot::api::Dispatch({method, full_path, body}, context, nullptr,
                                                  /*allow_stream=*/true);
@@ -293,27 +332,6 @@ int main(int argc, char** argv) {
                      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
               << "\n";
   }
-  if (response.stream) {
-    // The same chunks the server sends, written as they come: memory stays bounded.
-    sweetspot::server::ProgressReporter reporter(
-        path, "rows", progress_options, [&progress, &lines_written] {
-          return sweetspot::server::ProgressSample{progress.Fraction(),
-                                                   lines_written.load(std::memory_order_relaxed)};
-        });
-    const bool finished = response.stream([&lines_written](std::string_view chunk) {
-      lines_written.fetch_add(static_cast<std::uint64_t>(std::count(chunk.begin(), chunk.end(), '\n')),
-                              std::memory_order_relaxed);
-      std::cout.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
-      return static_cast<bool>(std::cout);
-    });
-    std::cout.flush();
-    reporter.Finish();
-    if (!finished) return 1;
-  } else if (!response.content_type.empty()) {
-    std::cout << response.text;
-  } else {
-    std::cout << response.body.dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
-              << "\n";
-  }
+  if (!PrintResponse(response, path, progress_options, progress)) return 1;
   return ExitCode(response.status);
 }
