@@ -11,6 +11,7 @@
 #include <iostream>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -198,26 +199,18 @@ bool ShardBody(const std::string& shard, const std::string& full_path,
   return true;
 }
 
-// Prints the answer on stdout (a stream as its chunks come, its progress on stderr as
-// `options` says): false when a stream did not finish.
-bool PrintResponse(const sweetspot::api::Response& response, const std::string& path,
-                   const sweetspot::server::ProgressOptions& options,
-                   const sweetspot::core::Progress& progress) {
+// Prints the answer on stdout (a stream as its chunks come, counting its lines into
+// `*lines`): false when a stream did not finish.
+bool PrintResponse(const sweetspot::api::Response& response, std::atomic<std::uint64_t>* lines) {
   if (response.stream) {
     // The same chunks the server sends, written as they come: memory stays bounded.
-    std::atomic<std::uint64_t> lines{0};
-    sweetspot::server::ProgressReporter reporter(path, "rows", options, [&progress, &lines] {
-      return sweetspot::server::ProgressSample{progress.Fraction(),
-                                               lines.load(std::memory_order_relaxed)};
-    });
-    const bool finished = response.stream([&lines](std::string_view chunk) {
-      lines.fetch_add(static_cast<std::uint64_t>(std::count(chunk.begin(), chunk.end(), '\n')),
-                      std::memory_order_relaxed);
+    const bool finished = response.stream([lines](std::string_view chunk) {
+      lines->fetch_add(static_cast<std::uint64_t>(std::count(chunk.begin(), chunk.end(), '\n')),
+                       std::memory_order_relaxed);
       std::cout.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
       return static_cast<bool>(std::cout);
     });
     std::cout.flush();
-    reporter.Finish();
     return finished;
   }
   if (!response.content_type.empty()) {
@@ -319,9 +312,19 @@ int main(int argc, char** argv) {
     }
   }
   if (!shard.empty() && !ShardBody(shard, full_path, context.limits, &body)) return 2;
-  // The sweep reports its fraction here (the CLI never cancels it); stderr shows it.
+  // The long runs report their fraction here (the CLI never cancels them); stderr shows it:
+  // a sweep's rows as they are written, the starts of an optimisation, the bats compared.
   sweetspot::core::Progress progress;
   context.progress = &progress;
+  std::atomic<std::uint64_t> lines{0};
+  std::unique_ptr<sweetspot::server::ProgressReporter> reporter;
+  if (full_path == "/v1/explore" || full_path == "/v1/optimize" || full_path == "/v1/compare") {
+    reporter = std::make_unique<sweetspot::server::ProgressReporter>(
+        path, full_path == "/v1/explore" ? "rows" : "", progress_options, [&progress, &lines] {
+          return sweetspot::server::ProgressSample{progress.Fraction(),
+                                                   lines.load(std::memory_order_relaxed)};
+        });
+  }
   const auto response = sweetspot::api::Dispatch({method, full_path, body}, context, nullptr,
                                                  /*allow_stream=*/true);
   if (!response.internal_error.empty()) {
@@ -332,6 +335,8 @@ int main(int argc, char** argv) {
                      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
               << "\n";
   }
-  if (!PrintResponse(response, path, progress_options, progress)) return 1;
+  const bool printed = PrintResponse(response, &lines);
+  if (reporter) reporter->Finish();
+  if (!printed) return 1;
   return ExitCode(response.status);
 }

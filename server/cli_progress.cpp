@@ -64,20 +64,26 @@ std::string FormatProgress(std::string_view label, std::string_view unit,
   const double eta_s = eta_known ? elapsed_s * (1 - f) / f : 0.0;
   char percent[16];
   std::snprintf(percent, sizeof percent, "%5.1f%%", 100 * f);
+  // Without a unit (an optimisation's starts), the fraction and the times only.
+  const std::string counts =
+      unit.empty() ? std::string()
+                   : (plain ? std::to_string(sample.done) + " " + std::string(unit) + " " +
+                                  std::to_string(std::llround(rate)) + " " + std::string(unit) +
+                                  "/s "
+                            : ShortNumber(static_cast<double>(sample.done)) + " " +
+                                  std::string(unit) + "  " + ShortNumber(rate) + " " +
+                                  std::string(unit) + "/s  ");
   if (plain) {
     char text[256];
-    std::snprintf(text, sizeof text, "%.*s: %.1f%% %llu %.*s %.0f %.*s/s elapsed %.1f s ETA %s",
-                  static_cast<int>(label.size()), label.data(), 100 * f,
-                  static_cast<unsigned long long>(sample.done), static_cast<int>(unit.size()),
-                  unit.data(), rate, static_cast<int>(unit.size()), unit.data(), elapsed_s,
+    std::snprintf(text, sizeof text, "%.*s: %.1f%% %selapsed %.1f s ETA %s",
+                  static_cast<int>(label.size()), label.data(), 100 * f, counts.c_str(), elapsed_s,
                   eta_known ? (std::to_string(std::lround(eta_s)) + " s").c_str() : "unknown");
     return text;
   }
   const int filled = static_cast<int>(std::floor(f * width));
   std::string bar = std::string(label) + " [" + std::string(static_cast<std::size_t>(filled), '#') +
                     std::string(static_cast<std::size_t>(width - filled), '-') + "] " + percent +
-                    "  " + ShortNumber(static_cast<double>(sample.done)) + " " + std::string(unit) +
-                    "  " + ShortNumber(rate) + " " + std::string(unit) + "/s  ";
+                    "  " + counts;
   bar += f >= 1 ? "in " + ClockText(elapsed_s) : "ETA " + (eta_known ? ClockText(eta_s) : "?");
   return bar;
 }

@@ -39,8 +39,10 @@ struct ProgressSample {
   std::uint64_t done = 0;  ///< Units done (rows, bytes), for the rate.
 };
 
-/// "[#####-----]  42.0%  1.2M rows  310k rows/s  ETA 0:07" (the bar `width` wide), or the
-/// plain line "explore: 42.0% 1200000 rows 310000 rows/s elapsed 3.9 s ETA 7 s" when `plain`.
+/// "explore [#####-----]  42.0%  1.2M rows  310.0k rows/s  ETA 0:07" (the bar `width` wide;
+/// "in 0:11" once done; "ETA ?" before any progress), or the plain line "explore: 42.0% 1200000
+/// rows 310000 rows/s elapsed 3.9 s ETA 7 s" when `plain`. An empty `unit` leaves out the
+/// counts and the rate (a run that reports only its fraction).
 std::string FormatProgress(std::string_view label, std::string_view unit,
                            const ProgressSample& sample, double elapsed_s, bool plain,
                            int width = 30);

@@ -35,7 +35,9 @@ TEST(CpuQuotaTest, TheCgroupFolderIsTheV2LineUnderTheMount) {
 TEST(CpuQuotaTest, TheDefaultIsAtLeastOneAndAtMostTheAffinity) {
   const int threads = DefaultThreadCount();
   EXPECT_GE(threads, 1);
-  if (const auto affinity = AffinityCpus()) EXPECT_LE(threads, *affinity);
+  if (const auto affinity = AffinityCpus()) {
+    EXPECT_LE(threads, *affinity);
+  }
 }
 
 }  // namespace
