@@ -59,23 +59,66 @@ std::optional<std::string> OwnCgroupFolder(const std::string& proc_self_cgroup_t
   return std::nullopt;
 }
 
+std::optional<int> CpusFromCfs(std::string_view quota_us, std::string_view period_us) {
+  const auto trim = [](std::string_view t) {
+    while (!t.empty() && (t.back() == '\n' || t.back() == ' ')) t.remove_suffix(1);
+    return t;
+  };
+  quota_us = trim(quota_us);
+  if (quota_us == "-1") return std::nullopt;
+  return CpusFromCpuMax(std::string(quota_us) + " " + std::string(trim(period_us)));
+}
+
+std::optional<std::string> OwnCgroupV1CpuFolder(const std::string& proc_self_cgroup_text,
+                                                const std::string& mount) {
+  std::istringstream lines(proc_self_cgroup_text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    const std::size_t first = line.find(':');
+    const std::size_t second = first == std::string::npos ? first : line.find(':', first + 1);
+    if (second == std::string::npos) continue;
+    std::istringstream controllers(line.substr(first + 1, second - first - 1));
+    std::string controller;
+    bool cpu = false;
+    while (std::getline(controllers, controller, ',')) cpu = cpu || controller == "cpu";
+    if (!cpu) continue;
+    std::string path = line.substr(second + 1);
+    if (path.empty() || path.front() != '/') return std::nullopt;
+    while (path.size() > 1 && path.back() == '/') path.pop_back();
+    return path == "/" ? mount + "/cpu" : mount + "/cpu" + path;
+  }
+  return std::nullopt;
+}
+
 std::optional<int> CgroupCpuQuota() {
   const std::optional<std::string> self = ReadText("/proc/self/cgroup");
   if (!self) return std::nullopt;
-  const std::string mount = "/sys/fs/cgroup";
+  std::string mount = "/sys/fs/cgroup";
   std::optional<std::string> folder = OwnCgroupFolder(*self, mount);
+  const bool v1 = !folder || !ReadText(mount + "/cgroup.controllers");
+  if (v1) {
+    folder = OwnCgroupV1CpuFolder(*self, mount);
+    mount += "/cpu";
+  }
   std::optional<int> quota;
   // A quota on a parent limits its children too (a pod's on its containers): the smallest.
+  // In a container the path may be the host's, absent here: the walk reaches the mount.
   while (folder) {
-    if (const std::optional<std::string> text = ReadText(*folder + "/cpu.max")) {
-      if (const std::optional<int> cpus = CpusFromCpuMax(*text)) {
-        quota = quota ? std::min(*quota, *cpus) : *cpus;
+    std::optional<int> cpus;
+    if (!v1) {
+      if (const std::optional<std::string> text = ReadText(*folder + "/cpu.max")) {
+        cpus = CpusFromCpuMax(*text);
       }
+    } else {
+      const std::optional<std::string> q = ReadText(*folder + "/cpu.cfs_quota_us");
+      const std::optional<std::string> p = ReadText(*folder + "/cpu.cfs_period_us");
+      if (q && p) cpus = CpusFromCfs(*q, *p);
     }
+    if (cpus) quota = quota ? std::min(*quota, *cpus) : *cpus;
     if (*folder == mount) break;
     const std::size_t slash = folder->rfind('/');
     if (slash == std::string::npos || slash < mount.size()) break;
-    folder = folder->substr(0, slash);
+    folder = slash == mount.size() ? mount : folder->substr(0, slash);
   }
   return quota;
 }

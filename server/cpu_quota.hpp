@@ -19,8 +19,18 @@ std::optional<int> CpusFromCpuMax(std::string_view text);
 std::optional<std::string> OwnCgroupFolder(const std::string& proc_self_cgroup_text,
                                            const std::string& mount = "/sys/fs/cgroup");
 
+/// cgroup v1's form of the same: `cpu.cfs_quota_us` ("-1": no quota) over
+/// `cpu.cfs_period_us`, rounded up, at least 1.
+std::optional<int> CpusFromCfs(std::string_view quota_us, std::string_view period_us);
+
+/// The cgroup v1 cpu controller's folder from /proc/self/cgroup's "N:...cpu...:<path>" line
+/// (the controller list holding "cpu"), under `mount`/cpu; nullopt when there is none.
+std::optional<std::string> OwnCgroupV1CpuFolder(const std::string& proc_self_cgroup_text,
+                                                const std::string& mount = "/sys/fs/cgroup");
+
 /// The smallest quota of this process's cgroup and its parents' (each folder's cpu.max,
-/// walking up to the mount), or nullopt when none sets one.
+/// walking up to the mount; on cgroup v1 its cpu controller's cpu.cfs_quota_us and
+/// cpu.cfs_period_us), or nullopt when none sets one.
 std::optional<int> CgroupCpuQuota();
 
 /// CPUs in this process's affinity mask (sched_getaffinity; `taskset -c 0` gives 1), or

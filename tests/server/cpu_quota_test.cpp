@@ -1,5 +1,5 @@
-// The default thread count's sources (server/cpu_quota.hpp): cgroup v2 cpu.max and the cgroup
-// folder of /proc/self/cgroup. The affinity path is tested with `taskset` in cli_merge_test.cpp.
+// The default thread count's sources (server/cpu_quota.hpp): cgroup v2 cpu.max (v1: cpu.cfs_*)
+// and the cgroup folder of /proc/self/cgroup. The affinity path is tested with `taskset` in cli_merge_test.cpp.
 #include "server/cpu_quota.hpp"
 
 #include <gtest/gtest.h>
@@ -30,6 +30,17 @@ TEST(CpuQuotaTest, TheCgroupFolderIsTheV2LineUnderTheMount) {
   EXPECT_EQ(OwnCgroupFolder("12:cpu,cpuacct:/x\n0::/user.slice/\n", "/cg"), "/cg/user.slice");
   EXPECT_EQ(OwnCgroupFolder("4:memory:/a\n1:cpu:/\n"), std::nullopt);  // cgroup v1 only
   EXPECT_EQ(OwnCgroupFolder(""), std::nullopt);
+}
+
+TEST(CpuQuotaTest, CgroupV1GivesTheCfsQuotaOverItsPeriod) {
+  EXPECT_EQ(CpusFromCfs("-1\n", "100000\n"), std::nullopt);  // no quota
+  EXPECT_EQ(CpusFromCfs("150000\n", "100000\n"), 2);
+  EXPECT_EQ(CpusFromCfs("50000", "100000"), 1);
+  EXPECT_EQ(CpusFromCfs("50000", "0"), std::nullopt);
+  EXPECT_EQ(OwnCgroupV1CpuFolder("4:memory:/a\n2:cpu,cpuacct:/docker/abc\n"),
+            "/sys/fs/cgroup/cpu/docker/abc");
+  EXPECT_EQ(OwnCgroupV1CpuFolder("2:cpuacct:/x\n1:cpu:/\n0::/\n"), "/sys/fs/cgroup/cpu");
+  EXPECT_EQ(OwnCgroupV1CpuFolder("2:cpuacct,cpuset:/x\n0::/\n"), std::nullopt);
 }
 
 TEST(CpuQuotaTest, TheDefaultIsAtLeastOneAndAtMostTheAffinity) {
