@@ -51,7 +51,7 @@ std::string Usage() {
        << "  --shard I/N  explore only: run shard I (0-based) of N of the sweep, as\n"
        << "        NDJSON (or CSV when the request's format is csv); design i is in\n"
        << "        shard i mod N\n"
-       << "  --progress=auto|on|off|lines  explore and explore-merge: a progress bar\n"
+       << "  --progress=auto|on|off|lines  explore, explore-merge, optimize, compare: a bar\n"
        << "        with the rate and the time left on stderr (auto: only when stderr is a\n"
        << "        terminal; lines: one plain line every 5 s, for batch logs); stdout is\n"
        << "        the same bytes whatever the mode\n"

@@ -146,6 +146,14 @@ TEST_F(CliMergeTest, ProgressGoesToStderrOnlyWhenAskedAndLeavesStdoutAlone) {
   EXPECT_EQ(merged.exit_code, 0);
   EXPECT_NE(merged.err.find("explore-merge [#"), std::string::npos) << merged.err;
   EXPECT_EQ(Cli("--progress=sometimes explore " + request).exit_code, 2);
+  // auto on a terminal (util-linux's `script` gives the CLI a pseudo-terminal; stdout still
+  // goes to a file): the bar, and the same rows.
+  const std::string binary = std::string(SWEETSPOT_BINARY_DIR) + "/server/sweetspot";
+  const std::string command = "script -qec '" + binary + " explore " + request + " >" + dir_ +
+                              "/rows' /dev/null >" + dir_ + "/tty 2>&1 </dev/null";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  EXPECT_NE(Slurp(dir_ + "/tty").find("explore [###"), std::string::npos) << Slurp(dir_ + "/tty");
+  EXPECT_EQ(Slurp(dir_ + "/rows"), plain.out);
 }
 
 TEST_F(CliMergeTest, ThreadsFollowTheAffinityMask) {
