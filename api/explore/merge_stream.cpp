@@ -3,7 +3,6 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <cmath>
 
 #include "api/explore/merge_reader.hpp"
 #include "api/explore_shards.hpp"
@@ -405,7 +404,7 @@ StreamedMerge MergeNdjsonShards(const std::vector<std::string>& names, const Sha
     std::string why = ScanNdjson(&reader, &scans[f]);
     if (reader.failed()) return Stop(&out, MergeStatus::kUnreadable, "cannot read " + names[f]);
     if (!why.empty()) return Stop(&out, MergeStatus::kRefused, std::move(why));
-    scans[f].first_row = scans[f].first_row.is_object() ? scans[f].first_row : Json::object();
+    if (!scans[f].first_row.is_object()) scans[f].first_row = Json::object();  // no rows
   }
   NdjsonPlan plan;
   if (std::string why = PlanNdjson(scans, &plan); !why.empty()) {
