@@ -2,12 +2,13 @@
 # Peak memory and wall time of `sweetspot explore-merge` (issue 38: a 10,000,000-design merge
 # in at most 100 MB). A Sobol sweep of the bat of bench/peer_sweep.json, outputs max_exit_speed
 # and properties, a Pareto front over exit speed (max) and 6-in MOI (min): ~870 bytes a row in
-# NDJSON, ~330 in CSV. It is run as SHARDS shards (`explore --shard I/N`) into a folder under
+# NDJSON, ~280 in CSV. It is run as SHARDS shards (`explore --shard I/N`) into a folder under
 # /tmp, merged with GNU time -v (its "Maximum resident set size"), the merged bytes compared
 # with the unsharded sweep's (both hashed as they stream, with the summary's timing_s, a
 # measured time, taken out of the NDJSON), and the folder deleted.
 #   bench/merge_memory.sh [BUILD_DIR] [DESIGNS] [SHARDS] [FORMAT]    (FORMAT ndjson or csv)
-# Prints "format designs shards shard_MB merge_wall_s merge_peak_KiB same_bytes".
+# Prints "format designs shards shard_MB merge_wall merge_cpu_s merge_peak_KiB same_bytes"
+# (shard_MB: du -m; merge_cpu_s: user + system, steadier than the wall time on a shared machine).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 build=${1:-$here/../build}
@@ -41,6 +42,7 @@ merged=$( { /usr/bin/time -v -o "$work/time" "$cli" --progress=off explore-merge
 whole=$("$cli" --progress=off explore "$work/sweep.json" | untimed | sha256sum | cut -d' ' -f1)
 wall=$(awk -F': ' '/Elapsed \(wall clock\)/ {print $2}' "$work/time")
 peak=$(awk -F': ' '/Maximum resident set size/ {print $2}' "$work/time")
+cpu=$(awk -F': ' '/User time/ {u = $2} /System time/ {s = $2} END {printf "%.1f", u + s}' "$work/time")
 same=$([ "$merged" = "$whole" ] && echo yes || echo NO)
-echo "format designs shards shard_MB merge_wall merge_peak_KiB same_bytes"
-echo "$format $designs $shards $shard_mb $wall $peak $same"
+echo "format designs shards shard_MB merge_wall merge_cpu_s merge_peak_KiB same_bytes"
+echo "$format $designs $shards $shard_mb $wall $cpu $peak $same"
