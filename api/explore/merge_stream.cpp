@@ -5,8 +5,8 @@
 #include <algorithm>
 
 #include "api/explore/merge_reader.hpp"
-#include "api/explore_shards.hpp"
-#include "core/sampling.hpp"
+#include "api/explore/shards.hpp"
+#include "core/explore/sampling.hpp"
 
 namespace sweetspot::api {
 namespace {

@@ -60,7 +60,7 @@ struct StreamedMerge {
 
 /// Merges the shards named `names` (labels for messages; shard k is opened by `open(k)`),
 /// writing the merged sweep to `sink`. The checks of MergeExploreShards
-/// (api/explore_shards.hpp) for NDJSON shards (same provenance, count, designs, sampling,
+/// (api/explore/shards.hpp) for NDJSON shards (same provenance, count, designs, sampling,
 /// seed, objectives and report_units; every shard once; every row once and in its shard;
 /// no error line, a summary line last). CSV shards carry no summary: they must have the same
 /// header, with an `index` column, each shard's rows the indices s, s + N, s + 2N, … (N is
