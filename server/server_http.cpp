@@ -14,6 +14,7 @@
 
 #include "api/router.hpp"
 #include "core/geometry_format.hpp"
+#include "server/cpu_quota.hpp"
 
 namespace sweetspot::server::http {
 
@@ -351,11 +352,11 @@ int Listen(const std::string& host, int port, int* bound_port) {
   return fd;
 }
 
-// The compute pool's size: the configured count, or (0) the cores.
+// The compute pool's size: the configured count, or (0) the CPUs this process may use (its
+// affinity mask and cgroup CPU quota, server/cpu_quota.hpp), not the node's cores.
 int ComputeWorkers(int configured) {
   if (configured > 0) return configured;
-  const unsigned cores = std::thread::hardware_concurrency();
-  return cores == 0 ? 1 : static_cast<int>(cores);
+  return DefaultThreadCount();
 }
 
 }  // namespace sweetspot::server::http

@@ -101,7 +101,8 @@ class HttpServer : public httplib::Server {
 /// kernel's largest backlog. Returns the socket or -1; *bound_port gets the port.
 int Listen(const std::string& host, int port, int* bound_port);
 
-/// The compute pool's size: the configured count, or (0) the cores.
+/// The compute pool's size: the configured count, or (0) the CPUs this process may use
+/// (DefaultThreadCount, server/cpu_quota.hpp).
 int ComputeWorkers(int configured);
 
 }  // namespace sweetspot::server::http
