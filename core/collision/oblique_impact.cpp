@@ -120,7 +120,7 @@ ObliqueImpactResult SolveObliqueImpact(const ObliqueImpactInputs& in) {
     const Vec2 v_bat{in.bat_speed_mps * std::cos(attack), in.bat_speed_mps * std::sin(attack)};
     const double omega = -in.ball_backspin_rad_s;  // a pitch's backspin turns clockwise here
     const Vec2 w = v_ball - v_bat;
-    const double speed = std::hypot(w.x, w.y);
+    const double speed = std::sqrt(Dot(w, w));  // speeds <= 500 m/s: no overflow
     if (!(speed > 0.0)) {
       out.summary.SetRefusal(TextRefusal(
           "bat_speed_mps", "the ball and the bat move together: there is no impact"));
@@ -182,7 +182,7 @@ ObliqueImpactResult SolveObliqueImpact(const ObliqueImpactInputs& in) {
     const double omega_after = omega - j_t / (alpha * m * big_r);
     out.velocity_x_mps = v_after.x;
     out.velocity_y_mps = v_after.y;
-    out.exit_speed_mps = std::hypot(v_after.x, v_after.y);
+    out.exit_speed_mps = std::sqrt(Dot(v_after, v_after));
     out.launch_angle_deg = std::atan2(v_after.y, v_after.x) * kDegPerRad;
     out.backspin_rad_s = omega_after;
     out.backspin_rpm = RadPerSecondToRpm(omega_after);
