@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "core/collision/free_bat.hpp"
+#include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
 #include "core/geometry_format.hpp"
 
@@ -144,6 +145,65 @@ TEST(ObliqueImpact, AModelsOwnNormalImpulseIsUsedAtTheNormalApproachSpeed) {
   };
   const ObliqueImpactResult c = Solve(law);
   EXPECT_NEAR(c.normal_cor, 0.6 - 0.001 * c.normal_approach_speed_mps, 1e-13);
+}
+
+// The normal part from an ODE model: the contact model (soft ball's power law, free bat) fired
+// at v_n with the bat at rest at the impact point, as the scene would wire hertz (flexible alike).
+HertzProblem FreeBatContact(double bat_mass_kg, double normal_mass_kg) {
+  HertzProblem p;
+  p.law = ContactLaw::kBallPowerLaw;
+  p.ball_mass_kg = 0.145;
+  p.c11_per_kg = 1.0 / 0.145 + 1.0 / normal_mass_kg;
+  p.c12_per_kg = 1.0 / bat_mass_kg;
+  p.c22_per_kg = 1.0 / bat_mass_kg;
+  p.ball_stiffness = 4.0e7;
+  p.ball_exponent = 1.5;
+  p.surface_stiffness = 0.0;
+  p.cor = 0.5;
+  p.hands_stiffness_n_m = 0.0;  // free bat
+  return p;
+}
+
+TEST(ObliqueImpact, TheContactModelFeedsTheNormalPart) {
+  const FreeBatInputs bat = PaperFreeBat();
+  const double s = 0.72;
+  const double mn = FreeBatNormalMass(bat, s);
+  const HertzProblem contact = FreeBatContact(bat.bat_mass_kg, mn);
+  HertzSolverOptions options;
+  options.refine_check = false;
+  int calls = 0;
+  auto law = [&](double v_n) {
+    ++calls;
+    HertzProblem at = contact;
+    at.approach_speed_mps = v_n;
+    at.ball_speed_mps = v_n;  // the bat at rest at the impact point
+    const HertzImpact r = SolveHertzImpact(at, options);
+    EXPECT_EQ(r.summary.termination, Termination::kConverged) << r.summary.message;
+    return r.ball_impulse_n_s;
+  };
+  // Head-on: the contact model's own exit speed at u + V (the same integration, so equal to
+  // rounding in the final -u + J/m).
+  ObliqueImpactInputs in = HeadOn(bat, s, 4.0);
+  in.normal.ball_normal_impulse_n_s = law;
+  const ObliqueImpactResult head_on = Solve(in);
+  HertzProblem direct = contact;
+  direct.approach_speed_mps = in.ball_speed_mps + in.bat_speed_mps;
+  direct.ball_speed_mps = in.ball_speed_mps;
+  const HertzImpact reference = SolveHertzImpact(direct, options);
+  EXPECT_NEAR(head_on.exit_speed_mps, reference.exit_speed_mps, 1e-12);
+  EXPECT_EQ(head_on.backspin_rpm, 0.0);
+  EXPECT_NEAR(head_on.launch_angle_deg, 4.0, 1e-12);
+  // Its unloading returns e^2 of the work, so the two-body COR is e: the pair (M_n, e) agrees to
+  // the integration tolerance (1e-8 relative; 1e-6 allowed).
+  ObliqueImpactInputs pair = HeadOn(bat, s, 4.0);
+  EXPECT_NEAR(head_on.exit_speed_mps, Solve(pair).exit_speed_mps, 1e-6 * head_on.exit_speed_mps);
+  // Oblique: the model sees v_n = |w| cos psi, and the normal COR it implies is e again.
+  in.undercut_m = InchesToMetres(1.0);
+  pair.undercut_m = in.undercut_m;
+  const ObliqueImpactResult oblique = Solve(in);
+  EXPECT_NEAR(oblique.normal_cor, 0.5, 1e-6);
+  EXPECT_NEAR(oblique.backspin_rpm, Solve(pair).backspin_rpm, 1e-6 * oblique.backspin_rpm);
+  EXPECT_EQ(calls, 2);
 }
 
 TEST(ObliqueImpact, IssueCaseAgainstTheIndependentScript) {
