@@ -71,7 +71,7 @@
 //  - alpha = 0.4 (a uniform sphere) by default: a baseball's layered core is close to uniform;
 //    no measured value was found (flight-notes.md uses 0.4 as well).
 //
-// Cost: a closed form (a few dozen flops, two sin/cos pairs, sqrt, asin, atan2): ~130 ns of CPU
+// Cost: a closed form (a few dozen flops, two sin/cos pairs, sqrt, asin, atan2): ~120 ns of CPU
 // with its Summary (bench/core_collision.cpp, BM_ObliqueImpact).
 //
 // ---------------------------------------------------------------------------------------------
