@@ -9,7 +9,7 @@ def add(a,b): return (a[0]+b[0], a[1]+b[1])
 def mul(s,a): return (s*a[0], s*a[1])
 def dot(a,b): return a[0]*b[0]+a[1]*b[1]
 def solve(u=40.2336, delta=6.0, s_in_rpm=0.0, V=31.2928, A=10.0, D=0.0, r=0.0334, m=0.145,
-          R=0.0366, alpha=0.4, Iroll=6.0e-4, Mn=float('inf'), e=0.5, ex=0.4, mu=0.5):
+          R=0.0366, alpha=0.4, Iroll=4.0e-4, Mn=float('inf'), e=0.5, ex=0.4, mu=0.5):
     d=math.radians(delta); a=math.radians(A)
     vb=(-u*math.cos(d), -u*math.sin(d)); vB=(V*math.cos(a), V*math.sin(a))
     om=-s_in_rpm*2*math.pi/60
@@ -36,7 +36,7 @@ def solve(u=40.2336, delta=6.0, s_in_rpm=0.0, V=31.2928, A=10.0, D=0.0, r=0.0334
     return dict(speed=math.hypot(*vba), la=math.degrees(math.atan2(vba[1],vba[0])),
                 rpm=oma*60/(2*math.pi), Jn=Jn, Jt=Jt, reg=reg)
 def table():
-    print("Issue case: 90 mph pitch 6 deg down, 2200 rpm backspin; 70 mph bat 10 deg up; M_n 0.5 kg, e 0.5")
+    print("Issue case: 90 mph pitch 6 deg down, 2200 rpm backspin; 70 mph bat 10 deg up; M_n 0.5 kg, e 0.5, I_roll 4e-4 kg m^2")
     print("| undercut (in) | e_x | exit speed (mph) | launch (deg) | backspin (rpm) | Statcast relation -763 + 120 LA (rpm) |")
     print("|---|---|---|---|---|---|")
     for ex in [0.4, 0.2, 0.0]:
@@ -53,5 +53,17 @@ def table():
         psi = math.degrees(math.asin(D_in*0.0254/(0.0366+1.5*0.0254)))
         print("| %.1f | %.1f | %.0f | %.0f | %.0f |" % (D_in, psi, a['rpm'], b['rpm'], c['rpm']))
 
+def pins():
+    print("pins (tests/core/oblique_impact_test.cpp):")
+    for D_in in [0.0, 0.25, 0.5, 0.75, 1.0, 1.5]:
+        r = solve(D=D_in*0.0254, Mn=0.5, s_in_rpm=2200)
+        print("  {%s, %.6f, %.6f, %.6f}," % (D_in, r['speed'], r['la'], r['rpm']))
+    for ex in [0.4, 0.0]:
+        f = solve(D=0.75*0.0254, Mn=0.5, s_in_rpm=2200, ex=ex)['rpm']
+        c = solve(D=0.75*0.0254, Mn=0.5, s_in_rpm=-1500, ex=ex)['rpm']
+        print("  curveball - fastball, e_x %.1f: %.6f rpm" % (ex, c - f))
+
 if __name__=='__main__':
     table()
+    print()
+    pins()

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "core/bat/geometry_integrals.hpp"
 #include "core/geometry_format.hpp"
 
 namespace sweetspot::core {
@@ -33,6 +34,24 @@ double Dot(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
 Vec2 TurnLeft(Vec2 a) { return {-a.y, a.x}; }  // +90 degrees
 
 }  // namespace
+
+double BatRollMoiKgM2(const Bat& bat) {
+  const geometry::BodyScalars<double> body = geometry::BodyOf(bat);
+  double disk = 0.0;  // integral of pi (r_o^4 - r_i^4) / 4
+  for (std::size_t i = 0; i + 1 < bat.knots.size(); ++i) {
+    const ProfileKnot& a = bat.knots[i];
+    const ProfileKnot& b = bat.knots[i + 1];
+    disk += geometry::IntegrateSegment<double>(b.x_m - a.x_m, a.radius_m, b.radius_m, body.wall,
+                                                body.hollow)
+                .disk;
+  }
+  double moi = 2.0 * body.density * disk;
+  if (body.has_fill) {
+    const double r2 = body.fill_radius * body.fill_radius;
+    moi += body.FillExcessDensity() * 0.5 * kPi * r2 * r2 * body.fill_depth;
+  }
+  return moi;
+}
 
 const char* TangentialRegimeName(TangentialRegime regime) {
   switch (regime) {

@@ -61,8 +61,8 @@
 //    obtained by rolling contact"; in this law the spin of a spinless ball is (1 + e_x) times
 //    rolling's, so e_x <= 0.4. The spin scales with 1 + e_x: e_x = 0 gives 1/1.4 of the default.
 //    Against the Statcast spin-launch relation of Nathan's trajectory calculator (backspin ~
-//    -763 + 120 LA rpm) the default gives about 1.6x the game spin at fly-ball launch angles,
-//    e_x = 0.2 within about 20 % (docs/validation.md): the value for distance is the lead's call.
+//    -763 + 120 LA rpm) the default gives about 1.5x the game spin at fly-ball launch angles,
+//    e_x = 0.2 within about 15 % (docs/validation.md): the value for distance is the lead's call.
 //  - mu_f = 0.5 by default: no measured baseball-on-wood value was found. Sawicki, Hubbard,
 //    Stronge, Am. J. Phys. 71, 1152 (2003) (abstract): "post-impact conditions are found to be
 //    independent of the ball-bat coefficient of friction"; here too the grip needs
@@ -100,6 +100,7 @@
 #include <limits>
 #include <string>
 
+#include "core/bat/bat.hpp"
 #include "core/summary.hpp"
 #include "core/units.hpp"
 
@@ -119,10 +120,17 @@ inline constexpr double kDefaultTangentialCor = 0.4;
 inline constexpr double kDefaultBallBatFriction = 0.5;
 /// I / (m R^2) of a uniform sphere: the default for a baseball.
 inline constexpr double kUniformSphereGyrationRatio = 0.4;
-/// Default moment of inertia of a solid wood bat about its long axis, kg m^2: (1/2) rho pi r^4 L
-/// of a barrel 0.45 m long of radius 0.0334 m (2.63 in diameter) at 649 kg/m^3 (the paper's
-/// wood), 5.7e-4, rounded up for the taper and handle. The scene should pass its bat's own.
-inline constexpr double kDefaultBatRollMoiKgM2 = 6.0e-4;
+/// Default moment of inertia of a solid wood bat about its long axis, kg m^2: between the
+/// presets' BatRollMoiKgM2, 3.6e-4 (wood-34-ash) and 4.7e-4 (paper-wood). The scene should pass
+/// its bat's own (BatRollMoiKgM2).
+inline constexpr double kDefaultBatRollMoiKgM2 = 4.0e-4;
+
+/// A bat's moment of inertia about its long axis, kg m^2: its material's density times the
+/// integral of pi (r_o^4 - r_i^4) / 2 along the profile (exact per segment: the mass properties'
+/// own cross-section integrals, core/bat/geometry_integrals.hpp), plus a fill's excess
+/// density times pi r_f^4 depth / 2. What ObliqueImpactInputs::bat_roll_moi_kg_m2 wants; the
+/// bat must be valid (Bat::Validate).
+double BatRollMoiKgM2(const Bat& bat);
 
 /// How the tangential impulse came out.
 enum class TangentialRegime {
