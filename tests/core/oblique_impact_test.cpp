@@ -443,6 +443,28 @@ TEST(ObliqueImpact, FixedCylinderScatteredSpinDoesNotDependOnTheIncidentSpin) {
   }
 }
 
+TEST(ObliqueImpact, ImmovableSurfaceFollowsCrossesRelation) {
+  // A ball (I = alpha m R^2) on an immovable surface with tangential COR e_x (Cross 2002; the
+  // relation quoted in flight-notes.md): omega' = [(alpha - e_x) omega + (1 + e_x) v_t / R] /
+  // (1 + alpha), v_t the tangential speed of the ball's centre over the surface (= u sin psi
+  // here), omega in the same sense (the pitch's backspin counts negative in this view).
+  for (double e_x : {0.0, 0.25, 0.4, 1.0}) {
+    for (double spin_rpm : {-1800.0, 0.0, 2400.0}) {
+      ObliqueImpactInputs in = FixedCylinder(1.0, spin_rpm);
+      in.tangential.tangential_cor = e_x;
+      in.tangential.friction_coefficient = kInf;
+      const ObliqueImpactResult r = Solve(in);
+      const double alpha = in.ball_gyration_ratio;
+      const double v_t = in.ball_speed_mps * in.undercut_m / MaxUndercutM(in);
+      const double omega = -in.ball_backspin_rad_s;
+      const double expected =
+          ((alpha - e_x) * omega + (1.0 + e_x) * v_t / in.ball_radius_m) / (1.0 + alpha);
+      // Rounding of terms of ~2e3 rad/s: 1e-10 rad/s.
+      EXPECT_NEAR(r.backspin_rad_s, expected, 1e-10) << e_x << " " << spin_rpm;
+    }
+  }
+}
+
 TEST(ObliqueImpact, ASpinlessBallSpinsOnePlusExTimesRolling) {
   // Kensrud, Nathan, Smith (2017), abstract: "a spin that was up to 40% greater than would be
   // obtained by rolling contact": for a spinless ball the law gives (1 + e_x) times rolling,
