@@ -77,6 +77,12 @@
 // ---------------------------------------------------------------------------------------------
 // Interface note for OptimalUndercutForDistance (the later "distance_sweet_spot" output: impact
 // position x undercut for the longest carry). Not implemented here; what it can rely on:
+//  - The adapter from a scene (issue 34's fields): ball.speed_mps -> ball_speed_mps,
+//    ball.descent_angle_deg -> descent_angle_deg, ball.spin_rpm -> ball_backspin_rad_s
+//    (RpmToRadPerSecond), swing.attack_angle_deg -> attack_angle_deg, contact.undercut_m ->
+//    undercut_m; per impact position x: bat_speed_mps = omega (x - pivot) (the resolved swing),
+//    bat_radius_m = Bat::RadiusAtM(x), normal = the model's law at x; once per bat:
+//    bat_roll_moi_kg_m2 = BatRollMoiKgM2(bat); the ball's mass and radius from its preset.
 //  - SolveObliqueImpact is pure and re-entrant (value in, value out, never throws), so a grid or
 //    a search may call it from many threads.
 //  - Over the undercut it is continuous and piecewise smooth: kinks only where the tangential
