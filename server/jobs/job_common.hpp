@@ -6,14 +6,18 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <cstdint>
+#include <functional>
 #include <cstddef>
 #include <optional>
 #include <random>
 #include <string>
+#include <string_view>
 
 #include "api/job_service.hpp"
 #include "api/response.hpp"
 #include "core/refusal.hpp"
+#include "server/jobs/job_store.hpp"
 
 namespace sweetspot::server {
 
@@ -105,18 +109,40 @@ api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const
 
 /// What CollectJobStream did.
 enum class StreamOutcome {
-  kComplete,   ///< The producer ran to its end: the whole body is in text.
-  kOverLimit,  ///< More than the limit arrived: the producer was told to stop.
-  kStopped,    ///< The producer stopped by itself (cancelled): the body is incomplete.
+  kComplete,     ///< The producer ran to its end: the whole body is in text or written.
+  kOverLimit,    ///< More than the limit arrived: the producer was told to stop.
+  kStopped,      ///< The producer stopped by itself (cancelled): the body is incomplete.
+  kWriteFailed,  ///< A piece could not be written (CollectedStream::write_error): stopped.
 };
 
-/// Runs a streamed answer's producer (Response::stream, e.g. a CSV sweep) into
-/// response->text, at most `max_bytes` of it: the chunk that goes over makes the sink refuse,
-/// which stops the sweep at once instead of after it built the whole body. Clears stream;
-/// *bytes gets the bytes produced (up to the first chunk over the limit). Without a stream:
-/// kComplete and text.size().
-StreamOutcome CollectJobStream(api::Response* response, std::size_t max_bytes,
-                               std::size_t* bytes);
+/// Receives piece `seq` (0, 1, ...; kResultChunkBytes each but the last) of a result as it is
+/// produced; false with *error when it cannot keep it (the producer is then stopped).
+using ResultChunkWriter =
+    std::function<bool(std::uint64_t seq, std::string_view bytes, std::string* error)>;
+
+/// What CollectJobStream produced.
+struct CollectedStream {
+  StreamOutcome outcome = StreamOutcome::kComplete;  ///< How the producer ended.
+  std::size_t bytes = 0;    ///< Bytes produced (up to the first chunk over the limit).
+  bool chunked = false;     ///< The body went to the writer in pieces; text is empty.
+  std::uint64_t pieces = 0; ///< Pieces written.
+  std::string write_error;  ///< The writer's message (kWriteFailed).
+};
+
+/// Runs a streamed answer's producer (Response::stream, e.g. a sweep) into response->text, at
+/// most `max_bytes` of it: the chunk that goes over makes the sink refuse, which stops the
+/// sweep at once instead of after it built the whole body. With `write`, a body that grows
+/// past kResultChunkBytes is handed to it in pieces of that size as it is produced (text then
+/// holds less than one piece at a time and is empty at the end, `chunked`): never whole in
+/// memory. Clears stream. Without a stream: kComplete and text.size().
+CollectedStream CollectJobStream(api::Response* response, std::size_t max_bytes,
+                                 const ResultChunkWriter& write = nullptr);
+
+/// A result the job services keep: a streamed JSON answer (content type application/json,
+/// in text) kept whole in memory becomes its parsed body again (stored and sent as any JSON
+/// answer: the same bytes); its content type is "" when its bytes are JSON (also in pieces).
+/// Returns false (and leaves it) when the text is not JSON.
+bool NormalizeJsonResult(api::Response* response, bool chunked);
 
 /// The quoted id for messages ("\"abc\"", cut when long, control characters escaped).
 std::string QuoteJobId(const std::string& id);
