@@ -17,7 +17,7 @@ constexpr std::size_t kMaxKeptLimit = 1000000;
 constexpr int kMaxResumesLimit = 100;
 constexpr double kMaxLeaseS = 3600.0;
 constexpr std::size_t kMinResultBytes = 1024;
-constexpr std::size_t kMaxResultBytes = 1000000000;  // A PostgreSQL text value holds up to 1 GB.
+constexpr std::size_t kMaxResultBytes = 1000000000000;  // In pieces: no column holds it whole.
 constexpr std::size_t kMaxResultsMemoryBytes = 1000000000000;
 constexpr double kMaxJobTimeS = 1e6;
 

@@ -6,9 +6,9 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <cstddef>
 #include <optional>
 #include <random>
 #include <string>
@@ -34,10 +34,11 @@ struct JobConfig {
   /// replica running it renews it every lease_s / 4 (at most every 0.5 s); a replica that
   /// died leaves its jobs to the others after this long.
   double lease_s = 10.0;
-  /// The largest result a job may have, bytes, [1024, 1e9] (a PostgreSQL text column holds up
-  /// to 1 GB), with every store (SQLite, PostgreSQL, memory only). A larger result makes the job
-  /// failed (status 413, code TooBig, as the contract pairs them) with its size and this limit
-  /// in the message: never truncated.
+  /// The largest result a job may have, bytes, [1024, 1e12], with every store (SQLite,
+  /// PostgreSQL, memory only; a result over kResultChunkBytes is stored in pieces as it is
+  /// produced, so no column holds it whole). A larger result makes the job failed (status 413,
+  /// code TooBig, as the contract pairs them) with its size and this limit in the message: never
+  /// truncated; a streamed one is stopped as soon as it passes it.
   std::size_t max_result_bytes = 256u << 20;
   /// One process (JobManager): the finished jobs' results held in memory in total, bytes
   /// (serialised size), [1024, 1e12]. With a SQLite store, results larger than
@@ -123,10 +124,10 @@ using ResultChunkWriter =
 /// What CollectJobStream produced.
 struct CollectedStream {
   StreamOutcome outcome = StreamOutcome::kComplete;  ///< How the producer ended.
-  std::size_t bytes = 0;    ///< Bytes produced (up to the first chunk over the limit).
-  bool chunked = false;     ///< The body went to the writer in pieces; text is empty.
-  std::uint64_t pieces = 0; ///< Pieces written.
-  std::string write_error;  ///< The writer's message (kWriteFailed).
+  std::size_t bytes = 0;     ///< Bytes produced (up to the first chunk over the limit).
+  bool chunked = false;      ///< The body went to the writer in pieces; text is empty.
+  std::uint64_t pieces = 0;  ///< Pieces written.
+  std::string write_error;   ///< The writer's message (kWriteFailed).
 };
 
 /// Runs a streamed answer's producer (Response::stream, e.g. a sweep) into response->text, at

@@ -20,7 +20,6 @@ using api::Request;
 using api::Response;
 using api::ToResponse;
 
-
 JobManager::JobManager(JobConfig config, JobRunner runner, JobPersistence persistence)
     : config_(config),
       runner_(std::move(runner)),

@@ -25,14 +25,17 @@
 // in memory are bounded: with a store, results over kMaxLoadedResultBytes live in the store
 // only and Result() reads them back (as the stored JSON text), and the small ones leave memory,
 // oldest first, once they total more than max_results_memory_bytes; with no store, the oldest
-// finished jobs are dropped (404) instead. A job running longer than max_time_s has its cancel
+// finished jobs are dropped (404) instead. A store that keeps pieces (SQLite) gets a streamed
+// answer (a sweep; /v1/explore's json too, for a job) as it is produced: past kResultChunkBytes
+// it is written in 1 MiB pieces, so a result is never whole in memory, running or read back
+// (a piece at a time, as the client takes it). A job running longer than max_time_s has its cancel
 // flag set (a watchdog thread) and ends failed (408 Timeout) naming the limit.
 #pragma once
 
 #include <chrono>
 #include <condition_variable>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <map>
@@ -139,14 +142,14 @@ class JobManager final : public ServerJobService {
   static double ProgressOf(const Job& job);
   // What a run produced (RunJob, outside the lock), for FinishRunLocked.
   struct RunOutcome {
-    api::Response response;   // The answer (or the error it became).
-    bool threw = false;       // The runner threw.
-    bool answered = false;    // A 2xx answer.
-    bool too_big = false;     // Over the result limit: response is the 413.
+    api::Response response;     // The answer (or the error it became).
+    bool threw = false;         // The runner threw.
+    bool answered = false;      // A 2xx answer.
+    bool too_big = false;       // Over the result limit: response is the 413.
     bool memory_bound = false;  // No store: max_results_memory_bytes was the limit.
-    std::size_t bytes = 0;    // The kept answer's bytes; 0 when none is kept.
-    std::string serialized;   // A JSON answer serialised once (for the store), or "".
-    std::uint64_t chunks = 0;  // Result pieces written to the store.
+    std::size_t bytes = 0;      // The kept answer's bytes; 0 when none is kept.
+    std::string serialized;     // A JSON answer serialised once (for the store), or "".
+    std::uint64_t chunks = 0;   // Result pieces written to the store.
     std::optional<std::uint64_t> chunked_bytes;  // The answer is in the pieces: its bytes.
   };
   void WorkerLoop();

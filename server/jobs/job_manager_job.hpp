@@ -29,7 +29,7 @@ struct JobManager::Job {
   std::string id;                             // 32 hex digits.
   std::uint64_t seq = 0;                      // Submit order (for the list's ties).
   std::string path;                           // The inner request's path.
-  api::Request inner;                              // Cleared once the job is finished.
+  api::Request inner;                         // Cleared once the job is finished.
   State state = State::kQueued;               // Current state.
   core::Progress progress;                    // Shared with the runner.
   bool cancel_requested = false;              // DELETE or Shutdown asked it to stop.
@@ -39,7 +39,7 @@ struct JobManager::Job {
   std::optional<Clock::time_point> started;   // When a worker took it.
   std::optional<Clock::time_point> finished;  // When it reached a final state.
   std::string created_at;                     // Submit time, ISO-8601 UTC.
-  api::Response result;                            // The inner response (done, failed, kept).
+  api::Response result;                       // The inner response (done, failed, kept).
   bool kept_result = false;                   // Cancelled, with the runner's 2xx in result.
   nlohmann::json error;                       // The failure's error object (failed), else null.
   bool timed_out = false;                     // The watchdog stopped it (max_time_s).

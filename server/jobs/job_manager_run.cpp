@@ -55,8 +55,8 @@ JobManager::RunOutcome JobManager::RunJob(Job& job, Request inner) {
   }
   ReleaseJobRequest(&inner);
   // Without a store a result lives in memory: max_results_memory_bytes bounds it too.
-  run.memory_bound = persistence_.store == nullptr &&
-                     config_.max_results_memory_bytes < config_.max_result_bytes;
+  run.memory_bound =
+      persistence_.store == nullptr && config_.max_results_memory_bytes < config_.max_result_bytes;
   const std::size_t largest =
       run.memory_bound ? config_.max_results_memory_bytes : config_.max_result_bytes;
   // A store that keeps pieces gets a streamed answer's bytes as they are produced: a result
@@ -80,11 +80,11 @@ JobManager::RunOutcome JobManager::RunJob(Job& job, Request inner) {
                                        "the job was stopped before its answer was complete", ""});
   } else if (streamed.outcome == StreamOutcome::kWriteFailed) {
     KeepOnlyJobStatus(&run.response);
-    run.response = ToResponse(ApiError{503, api::ErrorCode::kUnavailable,
-                                       "the job's result could not be saved in the jobs database (" +
-                                           streamed.write_error +
-                                           "): it is not kept; submit the job again later",
-                                       ""});
+    run.response = ToResponse(
+        ApiError{503, api::ErrorCode::kUnavailable,
+                 "the job's result could not be saved in the jobs database (" +
+                     streamed.write_error + "): it is not kept; submit the job again later",
+                 ""});
   } else if (!run.threw && !NormalizeJsonResult(&run.response, streamed.chunked)) {
     run.threw = true;  // A JSON stream that is not JSON: the handler's bug.
   }
@@ -168,11 +168,10 @@ void JobManager::FinishRunLocked(const std::shared_ptr<Job>& job, RunOutcome run
     // message, saved as such (small), so the next start neither shows a result nor runs it
     // again. Should that save fail too, its row is deleted (below).
     KeepOnlyJobStatus(&job->result);  // Frees the answer that could not be stored.
-    job->result =
-        ToResponse(ApiError{503, api::ErrorCode::kUnavailable,
-                            "the job's result could not be saved in the jobs database (" + why +
-                                "): it is not kept; submit the job again later",
-                            ""});
+    job->result = ToResponse(ApiError{503, api::ErrorCode::kUnavailable,
+                                      "the job's result could not be saved in the jobs database (" +
+                                          why + "): it is not kept; submit the job again later",
+                                      ""});
     job->error = FailureObject(job->result);
     job->state = State::kFailed;
     if (job->chunked_bytes) DropChunksLocked(job->id, run.chunks);

@@ -49,13 +49,13 @@ bool Execute(PGconn* connection, const std::string& sql, const std::vector<Param
     formats[binary.index - 1] = 1;
   }
   const bool plain = params.empty() && binary.index == 0 && !binary.binary_result;
-  PgResult result(plain ? PQexec(connection, sql.c_str())
-                        : PQexecParams(connection, sql.c_str(), static_cast<int>(values.size()),
-                                       nullptr, values.data(),
-                                       lengths.empty() ? nullptr : lengths.data(),
-                                       formats.empty() ? nullptr : formats.data(),
-                                       binary.binary_result ? 1 : 0),
-                  &PQclear);
+  PgResult result(
+      plain
+          ? PQexec(connection, sql.c_str())
+          : PQexecParams(connection, sql.c_str(), static_cast<int>(values.size()), nullptr,
+                         values.data(), lengths.empty() ? nullptr : lengths.data(),
+                         formats.empty() ? nullptr : formats.data(), binary.binary_result ? 1 : 0),
+      &PQclear);
   const ExecStatusType status = result ? PQresultStatus(result.get()) : PGRES_FATAL_ERROR;
   if (status != PGRES_COMMAND_OK && status != PGRES_TUPLES_OK) {
     *error = Message(result ? PQresultErrorMessage(result.get()) : PQerrorMessage(connection));

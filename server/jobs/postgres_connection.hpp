@@ -27,9 +27,9 @@ using PgResult = std::unique_ptr<PGresult, decltype(&PQclear)>;
 /// A statement's parameters beyond the text ones: `binary` is sent as the bytes of parameter
 /// number `index` (1-based, bytea), and the result is asked for in binary when `binary_result`.
 struct BinaryParts {
-  int index = 0;                ///< The binary parameter's number; 0: none.
-  std::string_view binary;      ///< Its bytes.
-  bool binary_result = false;   ///< Results in binary (bytea as its bytes).
+  int index = 0;               ///< The binary parameter's number; 0: none.
+  std::string_view binary;     ///< Its bytes.
+  bool binary_result = false;  ///< Results in binary (bytea as its bytes).
 };
 
 /// libpq's message without its trailing newline.
@@ -114,8 +114,13 @@ class Connections {
   // A new connection of its own (not pooled; PQfinish it), or null with *error.
   PGconn* Connect(std::string* error) const {
     // The URI's own settings win over these defaults (later keywords override).
-    const char* keys[] = {"connect_timeout", "keepalives_idle", "keepalives_interval",
-                          "keepalives_count", "application_name", "dbname", nullptr};
+    const char* keys[] = {"connect_timeout",
+                          "keepalives_idle",
+                          "keepalives_interval",
+                          "keepalives_count",
+                          "application_name",
+                          "dbname",
+                          nullptr};
     const char* values[] = {"3", "10", "3", "3", "sweetspot-server", uri_.c_str(), nullptr};
     PGconn* connection = PQconnectdbParams(keys, values, /*expand_dbname=*/1);
     if (connection == nullptr || PQstatus(connection) != CONNECTION_OK) {

@@ -46,16 +46,17 @@ struct PostgresJobService::Impl {
     std::atomic<bool> lost{false};              // Another replica owns it now.
     std::atomic<bool> interrupted{false};       // Shutdown hands it back to the queue.
     std::atomic<bool> timed_out{false};         // Ran longer than max_time_s (the heartbeat).
-    std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();   // When this replica claimed it.
+    std::chrono::steady_clock::time_point started =
+        std::chrono::steady_clock::now();  // When this replica claimed it.
     // The finishing statement's parameters, while its commit waits for the database.
     std::optional<std::pair<std::string, std::vector<pg::Param>>> unsaved;
-    std::uint64_t chunks = 0;  // Result pieces written to the database by this run.
+    std::uint64_t chunks = 0;   // Result pieces written to the database by this run.
     bool keeps_pieces = false;  // The finishing statement names them (result_bytes).
   };
   // What a run produced (RunClaimed), for FinishStatement.
   struct RunOutcome {
-    api::Response response;   // The answer (or the error it became).
-    bool threw = false;       // The runner threw.
+    api::Response response;                      // The answer (or the error it became).
+    bool threw = false;                          // The runner threw.
     std::optional<std::uint64_t> chunked_bytes;  // The answer is in the pieces: its bytes.
   };
   using Statement = std::pair<std::string, std::vector<pg::Param>>;
@@ -67,9 +68,9 @@ struct PostgresJobService::Impl {
         log(std::move(log_in)),
         db(std::move(uri_in)),
         owner(pg::LeaseOwner()),
-        wall_start_unix_s(std::chrono::duration<double>(
-                              std::chrono::system_clock::now().time_since_epoch())
-                              .count()),
+        wall_start_unix_s(
+            std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+                .count()),
         random(SeededEngine()) {}
 
   bool Migrate(std::string* error);
@@ -104,19 +105,19 @@ struct PostgresJobService::Impl {
   const double wall_start_unix_s;  // The wall clock when this replica started, s.
 
   mutable std::mutex mutex;
-  std::condition_variable work_cv;   // `wakeups` moved, or stopping.
-  std::uint64_t wakeups = 0;         // Bumped by a submit here or a NOTIFY from a replica.
+  std::condition_variable work_cv;       // `wakeups` moved, or stopping.
+  std::uint64_t wakeups = 0;             // Bumped by a submit here or a NOTIFY from a replica.
   std::atomic<bool> listen_stop{false};  // Ends ListenLoop.
   std::thread listener;
-  std::condition_variable idle_cv;   // A runner returned, or the grace ended.
-  std::condition_variable beat_cv;   // The heartbeat must stop.
+  std::condition_variable idle_cv;  // A runner returned, or the grace ended.
+  std::condition_variable beat_cv;  // The heartbeat must stop.
   std::map<std::string, std::shared_ptr<Running>> running;  // Claimed here, not yet committed.
-  int busy = 0;                      // Runners running.
-  bool stopping = false;             // Shutdown started: no claims, no submits.
-  bool grace_ended = false;          // EndGrace().
-  bool heartbeat_stop = false;       // The workers are joined.
+  int busy = 0;                                             // Runners running.
+  bool stopping = false;                      // Shutdown started: no claims, no submits.
+  bool grace_ended = false;                   // EndGrace().
+  bool heartbeat_stop = false;                // The workers are joined.
   mutable std::atomic<bool> reachable{true};  // For logging each outage once.
-  std::mt19937_64 random;            // Ids, under `mutex`.
+  std::mt19937_64 random;                     // Ids, under `mutex`.
   std::once_flag shutdown_once;
   std::vector<std::thread> workers;
   std::thread heartbeat;

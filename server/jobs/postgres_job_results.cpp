@@ -29,8 +29,8 @@ bool PostgresJobService::Impl::WriteChunk(Running& job, std::uint64_t seq, std::
               "data = EXCLUDED.data",
               {job.id, std::to_string(seq), std::nullopt, owner}, &written, &why, binary)) {
     *error = why;
-    Report("cannot save piece " + std::to_string(seq) + " of the result of job " + job.id +
-           ": " + why);
+    Report("cannot save piece " + std::to_string(seq) + " of the result of job " + job.id + ": " +
+           why);
     return false;
   }
   if (std::atoll(PQcmdTuples(written.get())) == 0) {
@@ -59,8 +59,8 @@ bool ReadPieces(Connections& db, const std::string& id, std::uint64_t offset, st
     // substring counts from 1; EXTERNAL storage reads only the part asked for.
     if (!db.Run("SELECT substring(data FROM $3::integer FOR $4::integer) FROM "
                 "sweetspot_job_result_chunks WHERE id = $1 AND seq = $2::bigint",
-                {id, std::to_string(seq), std::to_string(within + 1), std::to_string(take)},
-                &piece, &ignored, binary) ||
+                {id, std::to_string(seq), std::to_string(within + 1), std::to_string(take)}, &piece,
+                &ignored, binary) ||
         PQntuples(piece.get()) != 1) {
       return false;  // The database is away, or the job was deleted meanwhile.
     }
@@ -100,8 +100,8 @@ api::Response PostgresJobService::Result(const std::string& id) const {
     if (json) body.push_back('\n');
     return api::Response::Text(status, std::move(body), type);
   }
-  const auto bytes = static_cast<std::uint64_t>(std::strtoull(PQgetvalue(found.get(), 0, 5),
-                                                              nullptr, 10));
+  const auto bytes =
+      static_cast<std::uint64_t>(std::strtoull(PQgetvalue(found.get(), 0, 5), nullptr, 10));
   api::Response out = api::Response::Text(status, std::string(), type);
   auto source = std::make_shared<api::BodySource>();
   source->bytes = bytes + (json ? 1 : 0);

@@ -52,15 +52,15 @@ std::shared_ptr<PostgresJobService::Impl::Running> PostgresJobService::Impl::Cla
       ", lease_owner = $1, lease_expires_unix_s = " SWEETSPOT_NOW
       " + $3 FROM next WHERE j.id = next.id RETURNING j.id, j.method, j.path, j.body";
   PgResult claimed(nullptr, &PQclear);
-  if (!Query(claim,
-             {owner, std::to_string(config.max_resumes), Decimal(config.lease_s)}, &claimed) ||
+  if (!Query(claim, {owner, std::to_string(config.max_resumes), Decimal(config.lease_s)},
+             &claimed) ||
       PQntuples(claimed.get()) == 0) {
     return nullptr;
   }
   auto job = std::make_shared<Running>();
   job->id = Text(claimed.get(), 0, 0);
-  *inner = api::Request{Text(claimed.get(), 0, 1), Text(claimed.get(), 0, 2),
-                        Text(claimed.get(), 0, 3)};
+  *inner =
+      api::Request{Text(claimed.get(), 0, 1), Text(claimed.get(), 0, 2), Text(claimed.get(), 0, 3)};
   claimed.reset();
   {
     std::lock_guard lock(mutex);
@@ -103,11 +103,11 @@ PostgresJobService::Impl::RunOutcome PostgresJobService::Impl::RunClaimed(Runnin
     run.response = JobResultTooBig(streamed.bytes, "the jobs database", "max_result_bytes",
                                    config.max_result_bytes, "--job-max-result-bytes", true);
   } else if (streamed.outcome == StreamOutcome::kWriteFailed) {
-    run.response = api::ToResponse(api::ApiError{
-        503, api::ErrorCode::kUnavailable,
-        "the job's result could not be saved in the jobs database (" + streamed.write_error +
-            "): it is not kept; submit the job again later",
-        ""});
+    run.response = api::ToResponse(
+        api::ApiError{503, api::ErrorCode::kUnavailable,
+                      "the job's result could not be saved in the jobs database (" +
+                          streamed.write_error + "): it is not kept; submit the job again later",
+                      ""});
   } else if (!run.threw) {
     if (!NormalizeJsonResult(&run.response, streamed.chunked)) run.threw = true;
     if (streamed.chunked) run.chunked_bytes = streamed.bytes;
@@ -154,13 +154,14 @@ std::optional<PostgresJobService::Impl::Statement> PostgresJobService::Impl::Fin
         content_type.clear();
       }
     }
-    return Statement("UPDATE sweetspot_jobs SET state = 'cancelled', progress = $3, body = '', "
-                     "status = $4, response_json = $5, response_text = $6, content_type = $7, "
-                     "result_bytes = $8, finished_unix_s = " SWEETSPOT_NOW
-                     ", lease_owner = NULL, lease_expires_unix_s = NULL" + where,
-                     {job.id, owner, Decimal(job.progress.Fraction()), std::move(status),
-                      std::move(json), std::move(text), std::move(content_type),
-                      std::move(result_bytes)});
+    return Statement(
+        "UPDATE sweetspot_jobs SET state = 'cancelled', progress = $3, body = '', "
+        "status = $4, response_json = $5, response_text = $6, content_type = $7, "
+        "result_bytes = $8, finished_unix_s = " SWEETSPOT_NOW
+        ", lease_owner = NULL, lease_expires_unix_s = NULL" +
+            where,
+        {job.id, owner, Decimal(job.progress.Fraction()), std::move(status), std::move(json),
+         std::move(text), std::move(content_type), std::move(result_bytes)});
   }
   if (job.interrupted && !job.timed_out) {
     // Back to the queue for another replica or the next start (no resume counted),
@@ -168,7 +169,8 @@ std::optional<PostgresJobService::Impl::Statement> PostgresJobService::Impl::Fin
     return Statement(
         "UPDATE sweetspot_jobs SET state = CASE WHEN cancel_requested THEN 'cancelled' ELSE "
         "'queued' END, progress = 0, started_unix_s = NULL, finished_unix_s = CASE WHEN "
-        "cancel_requested THEN " SWEETSPOT_NOW " ELSE NULL END, body = CASE WHEN "
+        "cancel_requested THEN " SWEETSPOT_NOW
+        " ELSE NULL END, body = CASE WHEN "
         "cancel_requested THEN '' ELSE body END, lease_owner = NULL, lease_expires_unix_s = NULL" +
             where,
         {job.id, owner});
@@ -231,7 +233,8 @@ void PostgresJobService::Impl::Commit(const std::shared_ptr<Running>& job,
     --busy;
   }
   if (!saved) {
-    Report("job " + job->id + " finished while the database was away: its result is kept "
+    Report("job " + job->id +
+           " finished while the database was away: its result is kept "
            "here until it can be committed");
   }
   idle_cv.notify_all();
@@ -261,18 +264,19 @@ void PostgresJobService::Impl::Sweep() {
   // asked for it, else failed with the reason.
   const std::string message = InterruptedMessage("%s", config.max_resumes);
   PgResult ignored(nullptr, &PQclear);
-  Query("WITH expired AS (SELECT id FROM sweetspot_jobs WHERE state = 'running' AND "
-        "lease_expires_unix_s < " SWEETSPOT_NOW
-        " AND (cancel_requested OR resumes >= $1) FOR UPDATE SKIP LOCKED) "
-        "UPDATE sweetspot_jobs j SET state = CASE WHEN j.cancel_requested THEN 'cancelled' ELSE "
-        "'failed' END, status = CASE WHEN j.cancel_requested THEN 0 ELSE 503 END, error = CASE "
-        "WHEN j.cancel_requested THEN '' ELSE json_build_object('code', 'Interrupted', "
-        "'message', format($2, j.resumes), 'field', NULL)::text END, response_json = CASE "
-        "WHEN j.cancel_requested THEN '' ELSE json_build_object('code', 'Interrupted', "
-        "'message', format($2, j.resumes), 'field', NULL)::text END, body = '', "
-        "finished_unix_s = " SWEETSPOT_NOW
-        ", lease_owner = NULL, lease_expires_unix_s = NULL FROM expired WHERE j.id = expired.id",
-        {std::to_string(config.max_resumes), message}, &ignored);
+  Query(
+      "WITH expired AS (SELECT id FROM sweetspot_jobs WHERE state = 'running' AND "
+      "lease_expires_unix_s < " SWEETSPOT_NOW
+      " AND (cancel_requested OR resumes >= $1) FOR UPDATE SKIP LOCKED) "
+      "UPDATE sweetspot_jobs j SET state = CASE WHEN j.cancel_requested THEN 'cancelled' ELSE "
+      "'failed' END, status = CASE WHEN j.cancel_requested THEN 0 ELSE 503 END, error = CASE "
+      "WHEN j.cancel_requested THEN '' ELSE json_build_object('code', 'Interrupted', "
+      "'message', format($2, j.resumes), 'field', NULL)::text END, response_json = CASE "
+      "WHEN j.cancel_requested THEN '' ELSE json_build_object('code', 'Interrupted', "
+      "'message', format($2, j.resumes), 'field', NULL)::text END, body = '', "
+      "finished_unix_s = " SWEETSPOT_NOW
+      ", lease_owner = NULL, lease_expires_unix_s = NULL FROM expired WHERE j.id = expired.id",
+      {std::to_string(config.max_resumes), message}, &ignored);
   // Finished jobs past keep_results_s, and the oldest beyond max_kept.
   Query("DELETE FROM sweetspot_jobs WHERE finished_unix_s <= " SWEETSPOT_NOW
         " - $1 OR id IN (SELECT id FROM sweetspot_jobs WHERE finished_unix_s IS NOT NULL "

@@ -481,9 +481,9 @@ bool SqliteJobStore::ReadResult(const StoredResult& result, std::uint64_t offset
 bool SqliteJobStore::ReadChunksLocked(const StoredResult& result, std::uint64_t offset,
                                       std::size_t n, std::string* out, std::string* error) {
   sqlite3_stmt* find = nullptr;
-  int code = sqlite3_prepare_v2(
-      db_, "SELECT rowid FROM job_result_chunks WHERE job_id = ?1 AND seq = ?2", -1, &find,
-      nullptr);
+  int code =
+      sqlite3_prepare_v2(db_, "SELECT rowid FROM job_result_chunks WHERE job_id = ?1 AND seq = ?2",
+                         -1, &find, nullptr);
   const std::size_t before = out->size();
   while (code == SQLITE_OK && n > 0) {
     const std::uint64_t seq = offset / kResultChunkBytes;
@@ -497,7 +497,8 @@ bool SqliteJobStore::ReadChunksLocked(const StoredResult& result, std::uint64_t 
     if (code == SQLITE_ROW) code = SQLITE_OK;
     Rewind(find);
     sqlite3_blob* blob = nullptr;
-    if (code == SQLITE_OK) code = sqlite3_blob_open(db_, "main", "job_result_chunks", "data", row, 0, &blob);
+    if (code == SQLITE_OK)
+      code = sqlite3_blob_open(db_, "main", "job_result_chunks", "data", row, 0, &blob);
     std::size_t take = 0;
     if (code == SQLITE_OK) {
       const int length = sqlite3_blob_bytes(blob);

@@ -5,8 +5,8 @@
 //
 // The database: one table `jobs` (one row per job, the columns of
 // JobRecord) and `job_result_chunks` (a result over kResultChunkBytes, in pieces written
-// while its job ran: JobStore::SaveResultChunk), schema version in PRAGMA user_version (kSchemaVersion; a
-// newer version is refused, never rewritten). WAL journal with
+// while its job ran: JobStore::SaveResultChunk), schema version in PRAGMA user_version
+// (kSchemaVersion; a newer version is refused, never rewritten). WAL journal with
 // synchronous=NORMAL: a commit survives the process being killed (SIGKILL, a
 // crash), though the last commits may be lost on a power failure. Exclusive
 // locking mode: one server per database file; a second one is refused at Open
@@ -100,12 +100,12 @@ class SqliteJobStore final : public JobStore {
                         std::string* out, std::string* error);
 
   const std::string path_;
-  std::mutex mutex_;                // Serializes every use of the connection and statements.
-  sqlite3* db_ = nullptr;           // The connection.
-  sqlite3_stmt* save_ = nullptr;    // INSERT OR REPLACE INTO jobs ...
-  sqlite3_stmt* delete_ = nullptr;  // DELETE FROM jobs WHERE id = ?1
-  sqlite3_stmt* load_ = nullptr;    // SELECT ... FROM jobs ORDER BY ...
-  sqlite3_stmt* result_ = nullptr;  // SELECT status, response_json, ... WHERE id = ?1
+  std::mutex mutex_;                       // Serializes every use of the connection and statements.
+  sqlite3* db_ = nullptr;                  // The connection.
+  sqlite3_stmt* save_ = nullptr;           // INSERT OR REPLACE INTO jobs ...
+  sqlite3_stmt* delete_ = nullptr;         // DELETE FROM jobs WHERE id = ?1
+  sqlite3_stmt* load_ = nullptr;           // SELECT ... FROM jobs ORDER BY ...
+  sqlite3_stmt* result_ = nullptr;         // SELECT status, response_json, ... WHERE id = ?1
   sqlite3_stmt* save_chunk_ = nullptr;     // INSERT OR REPLACE INTO job_result_chunks ...
   sqlite3_stmt* delete_chunks_ = nullptr;  // DELETE FROM job_result_chunks WHERE job_id = ?1
 };
