@@ -213,6 +213,12 @@ bool NormalizeJsonResult(api::Response* response, bool chunked) {
     response->content_type.clear();  // Its pieces are the JSON text, as response_json holds it.
     return true;
   }
+  if (response->text.size() > kResultChunkBytes) {
+    // Kept in memory whole (no store keeps pieces): sent as it is, with the newline the server
+    // ends a JSON answer with, rather than parsed into values several times its size.
+    response->text.push_back('\n');
+    return true;
+  }
   nlohmann::json body = nlohmann::json::parse(response->text, nullptr, false);
   if (body.is_discarded()) return false;
   std::string().swap(response->text);

@@ -139,10 +139,12 @@ struct CollectedStream {
 CollectedStream CollectJobStream(api::Response* response, std::size_t max_bytes,
                                  const ResultChunkWriter& write = nullptr);
 
-/// A result the job services keep: a streamed JSON answer (content type application/json,
-/// in text) kept whole in memory becomes its parsed body again (stored and sent as any JSON
-/// answer: the same bytes); its content type is "" when its bytes are JSON (also in pieces).
-/// Returns false (and leaves it) when the text is not JSON.
+/// A result the job services keep, from a streamed JSON answer (content type application/json,
+/// in text): in pieces (`chunked`), its content type becomes "" (the pieces are the JSON text,
+/// as a store keeps a JSON body); whole and at most kResultChunkBytes, it becomes its parsed
+/// body again (stored and sent as any JSON answer: the same bytes); larger (a store without
+/// pieces, or none), it stays text, ended by the newline the server ends JSON answers with.
+/// Returns false (and leaves it) when a text to parse is not JSON.
 bool NormalizeJsonResult(api::Response* response, bool chunked);
 
 /// The quoted id for messages ("\"abc\"", cut when long, control characters escaped).

@@ -85,7 +85,8 @@ JobManager::RunOutcome JobManager::RunJob(Job& job, Request inner) {
                  "the job's result could not be saved in the jobs database (" +
                      streamed.write_error + "): it is not kept; submit the job again later",
                  ""});
-  } else if (!run.threw && !NormalizeJsonResult(&run.response, streamed.chunked)) {
+  } else if (streamed.outcome == StreamOutcome::kComplete && !run.threw &&
+             !NormalizeJsonResult(&run.response, streamed.chunked)) {
     run.threw = true;  // A JSON stream that is not JSON: the handler's bug.
   }
   run.answered = !run.threw && run.response.status >= 200 && run.response.status < 300;

@@ -1,11 +1,15 @@
 // PostgresJobService's results: a result over kResultChunkBytes is written to
 // sweetspot_job_result_chunks piece by piece while its job runs (only while this replica holds
-// the job's lease), and every result is read back as the client takes it: never whole in memory.
+// the job's lease), and every result is read back as the client takes it, a piece of 1 MiB
+// at a time: never whole in memory.
 #include <libpq-fe.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <memory>
+#include <mutex>
+#include <string>
 #include <utility>
 
 #include "api/json_reader.hpp"
@@ -44,31 +48,40 @@ bool PostgresJobService::Impl::WriteChunk(Running& job, std::uint64_t seq, std::
 
 namespace {
 
+// The piece of a result a fetch last read (each GET holds at most one: 1 MiB), so that the
+// connection loop's 64 KiB refills cost one query per piece, not one each.
+struct PieceCache {
+  std::mutex mutex;
+  std::int64_t seq = -1;  // The piece in `data`; -1: none yet.
+  std::string data;
+};
+
 // Appends `n` bytes of job `id`'s result pieces from `offset` to *out (one or two pieces).
-bool ReadPieces(Connections& db, const std::string& id, std::uint64_t offset, std::size_t n,
-                std::string* out) {
+bool ReadPieces(Connections& db, const std::string& id, PieceCache& cache, std::uint64_t offset,
+                std::size_t n, std::string* out) {
+  std::lock_guard lock(cache.mutex);
   while (n > 0) {
-    const std::uint64_t seq = offset / kResultChunkBytes;
+    const auto seq = static_cast<std::int64_t>(offset / kResultChunkBytes);
     const std::uint64_t within = offset % kResultChunkBytes;
-    const std::size_t take =
-        static_cast<std::size_t>(std::min<std::uint64_t>(n, kResultChunkBytes - within));
-    BinaryParts binary;
-    binary.binary_result = true;
-    PgResult piece(nullptr, &PQclear);
-    std::string ignored;
-    // substring counts from 1; EXTERNAL storage reads only the part asked for.
-    if (!db.Run("SELECT substring(data FROM $3::integer FOR $4::integer) FROM "
-                "sweetspot_job_result_chunks WHERE id = $1 AND seq = $2::bigint",
-                {id, std::to_string(seq), std::to_string(within + 1), std::to_string(take)}, &piece,
-                &ignored, binary) ||
-        PQntuples(piece.get()) != 1) {
-      return false;  // The database is away, or the job was deleted meanwhile.
+    if (cache.seq != seq) {
+      BinaryParts binary;
+      binary.binary_result = true;
+      PgResult piece(nullptr, &PQclear);
+      std::string ignored;
+      if (!db.Run("SELECT data FROM sweetspot_job_result_chunks WHERE id = $1 AND seq = $2",
+                  {id, std::to_string(seq)}, &piece, &ignored, binary) ||
+          PQntuples(piece.get()) != 1) {
+        return false;  // The database is away, or the job was deleted meanwhile.
+      }
+      cache.data.assign(PQgetvalue(piece.get(), 0, 0),
+                        static_cast<std::size_t>(PQgetlength(piece.get(), 0, 0)));
+      cache.seq = seq;
     }
-    const int length = PQgetlength(piece.get(), 0, 0);
-    if (length <= 0) return false;  // Shorter than the job's row says.
-    out->append(PQgetvalue(piece.get(), 0, 0), static_cast<std::size_t>(length));
-    offset += static_cast<std::uint64_t>(length);
-    n -= std::min<std::size_t>(n, static_cast<std::size_t>(length));
+    if (within >= cache.data.size()) return false;  // Shorter than the job's row says.
+    const std::size_t take = std::min<std::size_t>(n, cache.data.size() - within);
+    out->append(cache.data, static_cast<std::size_t>(within), take);
+    offset += take;
+    n -= take;
   }
   return true;
 }
@@ -105,11 +118,11 @@ api::Response PostgresJobService::Result(const std::string& id) const {
   api::Response out = api::Response::Text(status, std::string(), type);
   auto source = std::make_shared<api::BodySource>();
   source->bytes = bytes + (json ? 1 : 0);
-  source->read = [db = &self.db, id, bytes, json](std::uint64_t offset, std::size_t max,
-                                                  std::string* piece) {
+  source->read = [db = &self.db, id, bytes, json, cache = std::make_shared<PieceCache>()](
+                     std::uint64_t offset, std::size_t max, std::string* piece) {
     if (offset < bytes) {
       const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(max, bytes - offset));
-      if (!ReadPieces(*db, id, offset, n, piece)) return false;
+      if (!ReadPieces(*db, id, *cache, offset, n, piece)) return false;
       offset += n;
       max -= n;
     }

@@ -51,8 +51,8 @@ CREATE INDEX sweetspot_jobs_finished ON sweetspot_jobs (finished_unix_s)
   WHERE finished_unix_s IS NOT NULL;
 )sql",
     // 2: a result over kResultChunkBytes in pieces, written while its job runs (result_bytes
-    // says how long it is; NULL: in response_json/response_text). Stored uncompressed, so that
-    // a piece is read back in parts without reading it whole.
+    // says how long it is; NULL: in response_json/response_text). Stored uncompressed: a piece
+    // is written once and read back whole, without decompression's CPU.
     R"sql(
 ALTER TABLE sweetspot_jobs ADD COLUMN result_bytes bigint;
 CREATE TABLE sweetspot_job_result_chunks (
