@@ -14,7 +14,7 @@
 #include <thread>
 #include <vector>
 
-#include "api/explore_shards.hpp"
+#include "api/explore/shards.hpp"
 #include "api/json_reader.hpp"
 #include "api/memory_reserve.hpp"
 #include "api/router.hpp"

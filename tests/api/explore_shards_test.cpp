@@ -1,7 +1,7 @@
 // MergeExploreShards: the NDJSON outputs of a sweep's shards merge into the
 // unsharded sweep's NDJSON, row for row and in the summary (but timing_s);
 // shards that do not make one complete sweep are refused with the reason.
-#include "api/explore_shards.hpp"
+#include "api/explore/shards.hpp"
 
 #include <gtest/gtest.h>
 
