@@ -174,10 +174,23 @@ struct FitRequest {
 };
 
 // Reads "unknowns" (default: the paper's question, where the taper starts and ends).
-const std::vector<std::string> kFitNames = {
-    "taper_start_m",    "taper_end_m",  "length_m",        "handle_radius_m",
-    "barrel_radius_m",  "density_kg_m3", "wall_thickness_m", "fill.diameter_m",
-    "fill.depth_m",     "fill.density_kg_m3"};
+// The three-segment fit's unknowns by name: the table of fields' fit names (api/fields.hpp), in
+// core's FitVariable order (the order the refusal of an unknown name lists them in).
+const std::vector<std::string>& FitUnknownNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::pair<int, std::string>> ordered;
+    for (const Field& field : Fields()) {
+      if (field.fit_name.empty()) continue;
+      const std::string name(field.fit_name);
+      ordered.emplace_back(static_cast<int>(*core::FitVariableFromName(name)), name);
+    }
+    std::sort(ordered.begin(), ordered.end());
+    std::vector<std::string> out;
+    for (auto& [variable, name] : ordered) out.push_back(std::move(name));
+    return out;
+  }();
+  return names;
+}
 
 bool ReadFitUnknowns(ObjectReader& reader, const core::ThreeSegmentShape& shape,
                      core::ShapeFitProblem* problem,
@@ -200,7 +213,7 @@ bool ReadFitUnknowns(ObjectReader& reader, const core::ThreeSegmentShape& shape,
     const auto use = u.ok() ? ResolveField(name, FieldScope::kFitName) : std::nullopt;
     if (u.ok() && !use) {
       std::string refused;
-      u.String("name", &refused, kFitNames);  // the refusal that lists the names
+      u.String("name", &refused, FitUnknownNames());  // the refusal that lists the names
       reader.error()->message += DidYouMeanField(name, FieldScope::kFitName);
       return false;
     }
