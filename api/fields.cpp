@@ -165,7 +165,9 @@ std::string WithIndices(std::string_view pattern, const std::vector<std::size_t>
   std::size_t next = 0;
   for (std::size_t k = 0; k < pattern.size(); ++k) {
     if (pattern.compare(k, 2, "[]") == 0 && next < indices.size()) {
-      out += "[" + std::to_string(indices[next++]) + "]";
+      out += '[';  // piece by piece: GCC 12 warns (falsely) on "[" + to_string(i)
+      out += std::to_string(indices[next++]);
+      out += ']';
       ++k;
     } else {
       out += pattern[k];

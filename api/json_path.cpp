@@ -132,7 +132,9 @@ std::string FormatJsonPath(const std::vector<PathStep>& steps) {
       if (!out.empty()) out += '.';
       out += *key;
     } else {
-      out += "[" + std::to_string(std::get<std::size_t>(step)) + "]";
+      out += '[';  // appended piece by piece: GCC 12 warns (falsely) on "[" + to_string(i)
+      out += std::to_string(std::get<std::size_t>(step));
+      out += ']';
     }
   }
   return out;

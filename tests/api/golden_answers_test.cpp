@@ -374,7 +374,9 @@ TEST(GoldenAnswersTest, EveryAnswerIsTheKeptOne) {
         << text.substr(0, 2000);
     ++compared;
   }
-  if (!update) EXPECT_EQ(compared, static_cast<int>(Requests().size()));
+  if (!update) {
+    EXPECT_EQ(compared, static_cast<int>(Requests().size()));
+  }
 }
 
 }  // namespace
