@@ -14,44 +14,44 @@ namespace {
 using G = FieldGroup;
 using H = FieldHost;
 
-core::Bat& BatOf(const H& h) { return *h.scene->bat; }
-core::Material& MaterialOf(const H& h) { return BatOf(h).material; }
-core::Fill& FillOf(const H& h) { return *BatOf(h).fill; }
+core::Bat& BatOf(const H& h) { return *h.bat; }
+core::Material& MaterialOf(const H& h) { return h.bat->material; }
+core::Fill& FillOf(const H& h) { return *h.fill; }
 
 // The rows. The ranges are those the request's reader and core's Validate(Size) hold.
 std::vector<Field> MakeFields() {
   std::vector<Field> f;
   // The ball, the swing, the COR: explore parameters only.
   f.push_back({"ball.mass_kg", "kg", G::kBall, core::kMinBallMassKg, core::kMaxBallMassKg, true,
-               false, "", [](const H& h) { return h.scene->ball.mass_kg; },
-               [](const H& h, double v) { h.scene->ball.mass_kg = v; }});
+               false, "", [](const H& h) { return h.ball->mass_kg; },
+               [](const H& h, double v) { h.ball->mass_kg = v; }});
   f.push_back({"ball.radius_m", "m", G::kBall, core::kMinBallRadiusM, core::kMaxBallRadiusM, true,
-               false, "", [](const H& h) { return h.scene->ball.radius_m; },
-               [](const H& h, double v) { h.scene->ball.radius_m = v; }});
+               false, "", [](const H& h) { return h.ball->radius_m; },
+               [](const H& h, double v) { h.ball->radius_m = v; }});
   f.push_back({"ball.speed_mps", "m/s", G::kBall, 0.0, core::kMaxBallSpeedMps, true, false, "",
-               [](const H& h) { return h.scene->ball.speed_mps; },
-               [](const H& h, double v) { h.scene->ball.speed_mps = v; }});
+               [](const H& h) { return h.ball->speed_mps; },
+               [](const H& h, double v) { h.ball->speed_mps = v; }});
   f.push_back({"ball.stiffness_n_m_p", "N/m^p", G::kBall, 0.0, core::kMaxBallStiffness, true,
-               false, "", [](const H& h) { return h.scene->ball.stiffness; },
-               [](const H& h, double v) { h.scene->ball.stiffness = v; }});
+               false, "", [](const H& h) { return h.ball->stiffness; },
+               [](const H& h, double v) { h.ball->stiffness = v; }});
   f.push_back({"ball.stiffness_exponent", "1", G::kBall, 1.0, 3.0, true, false, "",
-               [](const H& h) { return h.scene->ball.stiffness_exponent; },
-               [](const H& h, double v) { h.scene->ball.stiffness_exponent = v; }});
+               [](const H& h) { return h.ball->stiffness_exponent; },
+               [](const H& h, double v) { h.ball->stiffness_exponent = v; }});
   f.push_back({"swing.angular_speed_rad_s", "rad/s", G::kSwing, 0.0,
                core::kMaxSwingAngularSpeedRadS, true, false, "",
-               [](const H& h) { return h.scene->swing.angular_speed_rad_s; },
-               [](const H& h, double v) { h.scene->swing.angular_speed_rad_s = v; }});
+               [](const H& h) { return h.swing->angular_speed_rad_s; },
+               [](const H& h, double v) { h.swing->angular_speed_rad_s = v; }});
   f.push_back({"swing.pivot_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,
                core::kMaxSwingOffsetM, true, false, "",
-               [](const H& h) { return h.scene->swing.pivot_from_knob_m; },
-               [](const H& h, double v) { h.scene->swing.pivot_from_knob_m = v; }});
+               [](const H& h) { return h.swing->pivot_from_knob_m; },
+               [](const H& h, double v) { h.swing->pivot_from_knob_m = v; }});
   f.push_back({"swing.hands_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,
                core::kMaxSwingOffsetM, true, false, "",
-               [](const H& h) { return h.scene->swing.hands_from_knob_m; },
-               [](const H& h, double v) { h.scene->swing.hands_from_knob_m = v; }});
+               [](const H& h) { return h.swing->hands_from_knob_m; },
+               [](const H& h, double v) { h.swing->hands_from_knob_m = v; }});
   f.push_back({"cor", "1", G::kCor, 0.0, 1.0, true, false, "",
-               [](const H& h) { return h.scene->cor.value_or(0.0); },
-               [](const H& h, double v) { h.scene->cor = v; }});
+               [](const H& h) { return h.cor->value_or(0.0); },
+               [](const H& h, double v) { *h.cor = v; }});
   // The three-segment shape.
   f.push_back({"bat.three_segment.length_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true, true,
                "length_m", [](const H& h) { return h.shape->length_m; },
@@ -177,6 +177,38 @@ std::string WithIndices(std::string_view pattern, const std::vector<std::size_t>
 }
 
 }  // namespace
+
+FieldHost FieldHost::Of(core::Scene* scene, core::ThreeSegmentShape* shape) {
+  FieldHost host;
+  host.ball = &scene->ball;
+  host.swing = &scene->swing;
+  host.cor = &scene->cor;
+  if (scene->bat.has_value()) {
+    host.bat = &*scene->bat;
+    if (host.bat->fill.has_value()) host.fill = &*host.bat->fill;
+  }
+  host.shape = shape;
+  return host;
+}
+
+std::string_view FieldKey(const Field& field) {
+  return field.path.substr(field.path.rfind('.') + 1);
+}
+
+bool ReadFieldGroup(ObjectReader& reader, FieldGroup group, bool required, const FieldHost& host) {
+  for (const Field& field : Fields()) {
+    if (field.group != group) continue;
+    double value = field.get(host);
+    if (required) {
+      reader.Number(FieldKey(field), AnyNumber(), &value);
+    } else {
+      reader.OptionalNumber(FieldKey(field), AnyNumber(), &value);
+    }
+    if (!reader.ok()) return false;
+    field.set(host, value);
+  }
+  return reader.ok();
+}
 
 const std::vector<Field>& Fields() {
   static const std::vector<Field> fields = MakeFields();

@@ -18,6 +18,7 @@
 #include <string_view>
 #include <vector>
 
+#include "api/json_reader.hpp"
 #include "core/bat/bat.hpp"
 #include "core/scene/scene.hpp"
 
@@ -36,12 +37,20 @@ enum class FieldGroup {
   kFillMaterial,  ///< "bat.fill.material.*".
 };
 
-/// Where a field's accessor reads and writes: the scene's parts, a three-segment shape (whose
-/// knots the bat gets from it) and a knot's index. Null where the request has no such part.
+/// Where a field's accessor reads and writes: the parts of a request a field sits in, each null
+/// where the caller has no such part (the parser reading a three-segment object has only its
+/// shape), and a knot's index.
 struct FieldHost {
-  core::Scene* scene = nullptr;
-  core::ThreeSegmentShape* shape = nullptr;
+  core::Ball* ball = nullptr;
+  core::Swing* swing = nullptr;
+  std::optional<double>* cor = nullptr;
+  core::Bat* bat = nullptr;                   ///< Knots, material, wall.
+  core::ThreeSegmentShape* shape = nullptr;   ///< A three-segment bat's shape.
+  core::Fill* fill = nullptr;                 ///< The bat's fill.
   std::size_t knot = 0;
+
+  /// Every part of `scene` (its bat's fill when it has one), and `shape`.
+  static FieldHost Of(core::Scene* scene, core::ThreeSegmentShape* shape = nullptr);
 };
 
 /// One settable field.
@@ -69,6 +78,16 @@ struct Field {
 
 /// Every settable field, once.
 const std::vector<Field>& Fields();
+
+/// The field's key in its object: the last key of its path ("taper_start_m").
+std::string_view FieldKey(const Field& field);
+
+/// Reads the fields of `group` from `reader`'s object by their keys (each also in its trade
+/// forms, as ObjectReader reads a number), in the table's order, into `host`: each required
+/// (ObjectReader::Number) or optional (OptionalNumber: an absent one keeps the host's value).
+/// False when the reader has an error. The request's parser reads the three-segment shape,
+/// the fill's size and the ball this way.
+bool ReadFieldGroup(ObjectReader& reader, FieldGroup group, bool required, const FieldHost& host);
 
 /// The field whose path (SI, indices as "[]") is `pattern`, or nullptr.
 const Field* FindField(std::string_view pattern);

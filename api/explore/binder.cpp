@@ -166,7 +166,7 @@ std::optional<DesignBinder> DesignBinder::Compile(
 bool DesignBinder::Bind(const std::vector<double>& values, core::Scene* scene) const {
   core::Bat& bat = *scene->bat;
   std::optional<core::ThreeSegmentShape> shape = shape_;
-  FieldHost host{scene, shape ? &*shape : nullptr, 0};
+  FieldHost host = FieldHost::Of(scene, shape ? &*shape : nullptr);
   for (const Binding& b : bindings_) {
     host.knot = b.index;
     b.field->set(host, parameters_[b.parameter].TargetValue(b.target_index, values[b.parameter]));

@@ -76,7 +76,8 @@ std::optional<Parsed> Parse(const Json& request, std::string* why) {
 }
 
 double Get(const Field& field, Parsed* parsed) {
-  FieldHost host{&parsed->scene, parsed->shape ? &*parsed->shape : nullptr, 1};
+  FieldHost host = FieldHost::Of(&parsed->scene, parsed->shape ? &*parsed->shape : nullptr);
+  host.knot = 1;
   return field.get(host);
 }
 
