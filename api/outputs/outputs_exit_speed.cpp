@@ -47,7 +47,8 @@ const DirectField kMaxExitSpeedFields[] = {
      }},
     {"unconstrained_position_from_knob_m", true,
      [](const OutputView& v) {
-       return FromMax(v, [](const auto& m) { return Number(m.unconstrained_position_from_knob_m); });
+       return FromMax(v,
+                      [](const auto& m) { return Number(m.unconstrained_position_from_knob_m); });
      }},
     {"placement", false,
      [](const OutputView& v) {
@@ -111,7 +112,6 @@ extern const ApiOutputDecl kSweetZoneApi{core::SceneOutput::kSweetZone, oes::Ren
                                          oes::ProbeSweetZone};
 
 extern const ApiOutputDecl kExitSpeedCurveApi{core::SceneOutput::kExitSpeedCurve,
-                                              oes::RenderExitSpeedCurve,
-                                              oes::ProbeExitSpeedCurve};
+                                              oes::RenderExitSpeedCurve, oes::ProbeExitSpeedCurve};
 
 }  // namespace sweetspot::api

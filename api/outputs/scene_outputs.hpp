@@ -43,8 +43,8 @@ struct OutputView {
 /// A field of an output's block that a sweep reads directly: the same value, under the same
 /// name, as the rendered block holds (ExploreEngineTest checks every one against the JSON row).
 struct DirectField {
-  const char* name;                          ///< The field's key in the output's block.
-  bool number;                               ///< A number (a trade-unit twin may convert it).
+  const char* name;                             ///< The field's key in the output's block.
+  bool number;                                  ///< A number (a trade-unit twin may convert it).
   DirectValue (*read)(const OutputView& view);  ///< Its value; kMissing when the output is absent.
 };
 

@@ -26,7 +26,8 @@ enum class SceneOutput {
 };
 
 /// The number of outputs (ids run from 0 to kSceneOutputCount - 1).
-inline constexpr std::size_t kSceneOutputCount = static_cast<std::size_t>(SceneOutput::kBbcorScan) + 1;
+inline constexpr std::size_t kSceneOutputCount =
+    static_cast<std::size_t>(SceneOutput::kBbcorScan) + 1;
 
 /// Stable name, the declaration's: "max_exit_speed", "center_of_percussion", "vibration_node",
 /// "sweet_zone", "exit_speed_curve", "least_sting_zone", "barrel", "bbcor", "bbcor_scan".

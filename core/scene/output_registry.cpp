@@ -13,9 +13,9 @@ const std::vector<const SceneOutputDecl*>& SceneOutputTable() {
   // THE table: one row per output, in the order they are computed (an output another reads,
   // needs_output, comes before it). Adding an output: its declaration, and its row here.
   static const std::vector<const SceneOutputDecl*> table = {
-      &kMaxExitSpeedOutput,   &kSweetZoneOutput,      &kCenterOfPercussionOutput,
-      &kVibrationNodeOutput,  &kLeastStingZoneOutput, &kBarrelOutput,
-      &kBbcorOutput,          &kBbcorScanOutput,      &kExitSpeedCurveOutput,
+      &kMaxExitSpeedOutput,  &kSweetZoneOutput,      &kCenterOfPercussionOutput,
+      &kVibrationNodeOutput, &kLeastStingZoneOutput, &kBarrelOutput,
+      &kBbcorOutput,         &kBbcorScanOutput,      &kExitSpeedCurveOutput,
   };
   return table;
 }

@@ -46,8 +46,8 @@ struct SceneOutputDecl {
   bool uses_exit_model = false;
   /// The models it runs when it does not use the exit-speed model, in run order (null-ended).
   std::array<const char*, 5> models{};
-  bool needs_geometry = false;  ///< It needs the bat (not only mass_properties).
-  bool needs_cor = false;       ///< It runs an impact (every impact model uses the COR).
+  bool needs_geometry = false;             ///< It needs the bat (not only mass_properties).
+  bool needs_cor = false;                  ///< It runs an impact (every impact model uses the COR).
   OutputModes modes = OutputModes::kNone;  ///< The modes fetched (and checked) before it runs.
   /// With modes: the words before the modes' message when they failed ("<name>: <this><message>").
   const char* modes_failure = "";
@@ -102,11 +102,11 @@ class OutputContext {
         out(*the_out),
         messages_(messages) {}
 
-  const Scene& scene;              ///< The scene.
-  const SceneOptions& options;     ///< The evaluator's options (valid).
-  const ResolvedScene& resolved;   ///< Resolved once (its COR when an output needs one).
-  TimingBook& book;                ///< Where models book their time.
-  SceneResult& out;                ///< The result (each output writes its slot).
+  const Scene& scene;                    ///< The scene.
+  const SceneOptions& options;           ///< The evaluator's options (valid).
+  const ResolvedScene& resolved;         ///< Resolved once (its COR when an output needs one).
+  TimingBook& book;                      ///< Where models book their time.
+  SceneResult& out;                      ///< The result (each output writes its slot).
   ExitSpeedModel* exit_model = nullptr;  ///< Set when an output uses the exit-speed model.
   CollisionModel model = CollisionModel::kFreeBat;  ///< The resolved exit-speed model.
   /// The exit-speed model has a closed-form profile and the method is closed_form.

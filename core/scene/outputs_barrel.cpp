@@ -13,8 +13,7 @@ namespace {
 // The resolved mass properties when they are the rigid body's (what the barrel models use),
 // else null (the models then compute the rigid body's themselves).
 const MassProperties* SceneRigidBodyProperties(const ResolvedScene& r) {
-  return r.mass_properties.inertia_model == InertiaModel::kRigidBody ? &r.mass_properties
-                                                                     : nullptr;
+  return r.mass_properties.inertia_model == InertiaModel::kRigidBody ? &r.mass_properties : nullptr;
 }
 
 void ComputeBarrel(OutputContext& c) {

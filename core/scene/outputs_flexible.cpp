@@ -74,7 +74,9 @@ void ComputeLeastStingZone(OutputContext& c) {
   }
 }
 
-double VibrationNodeError(const SceneOutputResults& r) { return r.vibration_node->error_estimate_m; }
+double VibrationNodeError(const SceneOutputResults& r) {
+  return r.vibration_node->error_estimate_m;
+}
 double LeastStingZoneError(const SceneOutputResults& r) {
   return r.least_sting_zone->error_estimate_m;
 }

@@ -54,13 +54,13 @@ TEST(OutputRegistryTest, AnOutputReadByAnotherComesBeforeIt) {
 
 TEST(OutputRegistryTest, WorkloadClassFollowsTheModels) {
   for (const SceneOutputDecl* d : SceneOutputTable()) {
-    for (const CollisionModel m : {CollisionModel::kAuto, CollisionModel::kRigidPivot,
-                                   CollisionModel::kFreeBat, CollisionModel::kHertz,
-                                   CollisionModel::kFlexible}) {
+    for (const CollisionModel m :
+         {CollisionModel::kAuto, CollisionModel::kRigidPivot, CollisionModel::kFreeBat,
+          CollisionModel::kHertz, CollisionModel::kFlexible}) {
       bool iterative = false;
       for (const std::string& model : ModelsFor(d->id, m)) {
-        iterative = iterative || model == kFlexibleBeamModel || model == "flexible" ||
-                    model == "hertz";
+        iterative =
+            iterative || model == kFlexibleBeamModel || model == "flexible" || model == "hertz";
       }
       EXPECT_EQ(WorkloadOf(d->id, m) == OutputWorkload::kCompute, iterative)
           << d->name << " with " << CollisionModelName(m);
