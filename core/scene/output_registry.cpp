@@ -1,5 +1,6 @@
 #include "core/scene/output_registry.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace sweetspot::core {
@@ -101,16 +102,18 @@ OutputWorkload WorkloadOf(SceneOutput output, CollisionModel exit_model) {
 std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model) {
   if (exit_model == CollisionModel::kAuto) exit_model = CollisionModel::kFreeBat;
   const SceneOutputDecl& d = SceneOutputDeclaration(output);
+  std::vector<std::string> models;
   if (d.uses_exit_model) {
     if (exit_model == CollisionModel::kFlexible) {
-      return {"mass_properties", kFlexibleBeamModel, "flexible"};
+      models = {"mass_properties", kFlexibleBeamModel, "flexible"};
+    } else {
+      models = {"mass_properties", CollisionModelName(exit_model)};
     }
-    return {"mass_properties", CollisionModelName(exit_model)};
   }
-  std::vector<std::string> models;
+  // Then its own (a flight output: the exit-speed model's, then "flight"), each once.
   for (const char* m : d.models) {
     if (m == nullptr) break;
-    models.emplace_back(m);
+    if (std::find(models.begin(), models.end(), m) == models.end()) models.emplace_back(m);
   }
   return models;
 }

@@ -44,7 +44,8 @@ struct SceneOutputDecl {
   /// It reads the scene's exit-speed model (max_exit_speed, sweet_zone, exit_speed_curve): its
   /// models are that model's, and model = flexible needs the bat's geometry.
   bool uses_exit_model = false;
-  /// The models it runs when it does not use the exit-speed model, in run order (null-ended).
+  /// The models it runs itself, in run order (null-ended), after the exit-speed model's when it
+  /// uses that (e.g. a flight output: {"flight"}).
   std::array<const char*, 5> models{};
   bool needs_geometry = false;             ///< It needs the bat (not only mass_properties).
   bool needs_cor = false;                  ///< It runs an impact (every impact model uses the COR).
