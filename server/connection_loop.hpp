@@ -139,6 +139,10 @@ class ConnectionLoop {
   /// Makes Run() return (after the in-flight requests, within shutdown_grace_s); idempotent,
   /// any thread.
   void Stop();
+  /// The drain before Stop(): every answer from now on carries "Connection: close", so that
+  /// keep-alive clients reconnect (through their load balancer, to another replica) while this
+  /// one still accepts. Any thread.
+  void BeginDrain();
   /// Ends the shutdown grace at once: the requests still computing are cancelled. Any thread.
   void EndGrace();
 

@@ -60,6 +60,8 @@ struct MergedSweep {
 /// unsharded sweep's: totals and failures summed, shard {0, 1}, the Pareto
 /// front over all rows, timing_s the sum of the shards' (CPU-like). Rows may be the flat rows
 /// of "columns" (with index, and the Pareto objectives' paths as keys). Never throws.
+/// The texts in memory: MergeShardStreams (api/explore/merge_stream.hpp) over them, which
+/// also takes CSV shards and is what `sweetspot explore-merge` runs on files.
 MergedSweep MergeExploreShards(const std::vector<ShardOutput>& shards);
 
 }  // namespace sweetspot::api

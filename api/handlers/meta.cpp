@@ -11,6 +11,13 @@ namespace sweetspot::api {
 
 Response HandleHealth() { return {200, nlohmann::json{{"status", "ok"}}}; }
 
+Response HandleReady(bool draining) {
+  if (!draining) return {200, nlohmann::json{{"status", "ready"}}};
+  return ErrorResponse(503, ErrorCode::kUnavailable,
+                       "draining: the server is stopping; it still answers until its drain "
+                       "period (--drain-s) ends, then stops accepting connections");
+}
+
 Response HandleOpenApi(const Request&, const Context&) {
   static const nlohmann::json document = nlohmann::json::parse(OpenApiDocumentText());
   return {200, document};

@@ -36,6 +36,11 @@ const std::vector<Route>& Routes() {
   static const std::vector<Route> routes = {
       {"GET", "/health", "Liveness: {\"status\": \"ok\"}.",
        [](const Request&, const Context&) { return HandleHealth(); }},
+      {"GET", "/ready",
+       "Readiness: {\"status\": \"ready\"}, or 503 while the server drains before it stops.",
+       [](const Request&, const Context& context) {
+         return HandleReady(context.draining && context.draining());
+       }},
       {"GET", "/openapi.json", "The OpenAPI 3 document of every endpoint.", HandleOpenApi},
       {"GET", "/metrics", "Prometheus text: requests by route and status, latency, jobs.",
        HandleMetrics},
