@@ -8,6 +8,7 @@
 #include "api/bat_json.hpp"
 #include "api/fields.hpp"
 #include "api/router.hpp"
+#include "core/scene/output_registry.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -91,11 +92,8 @@ bool ReadOutputs(ObjectReader& reader, core::Scene* scene) {
     const auto parsed =
         item.is_string() ? core::ParseSceneOutput(item.get<std::string>()) : std::nullopt;
     if (!parsed) {
-      return reader.Fail(
-          "outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
-                         " is not one of max_exit_speed, center_of_percussion, "
-                         "vibration_node, sweet_zone, exit_speed_curve, least_sting_zone, barrel, "
-                         "bbcor, bbcor_scan");
+      return reader.Fail("outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
+                                        " is not one of " + core::SceneOutputNameList());
     }
     if (std::find(scene->outputs.begin(), scene->outputs.end(), *parsed) == scene->outputs.end()) {
       scene->outputs.push_back(*parsed);
