@@ -44,10 +44,12 @@ std::vector<Field> MakeFields() {
                [](const H& h, double v) { h.swing->angular_speed_rad_s = v; }});
   // The bat's speed: it sets the angular speed once the bat's length is known
   // (core::ResolveSwing); the parser takes one of it and the angular speed (ReadSwing).
-  f.push_back({"swing.bat_speed_mps", "m/s", G::kSwing, 0.0, core::kMaxBatSpeedMps, false, false,
+  // A sweep of it on a template with the angular speed is refused before its first design
+  // (explore's probe of the template), so the binder sets it only where the parser would.
+  f.push_back({"swing.bat_speed_mps", "m/s", G::kSwing, 0.0, core::kMaxBatSpeedMps, true, false,
                "", [](const H& h) { return h.swing->bat_speed_mps.value_or(0.0); },
                [](const H& h, double v) { h.swing->bat_speed_mps = v; }});
-  f.push_back({"swing.bat_speed_from_tip_m", "m", G::kSwing, 0.0, core::kMaxSwingOffsetM, false,
+  f.push_back({"swing.bat_speed_from_tip_m", "m", G::kSwing, 0.0, core::kMaxSwingOffsetM, true,
                false, "", [](const H& h) { return h.swing->bat_speed_from_tip_m; },
                [](const H& h, double v) { h.swing->bat_speed_from_tip_m = v; }});
   f.push_back({"swing.pivot_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,

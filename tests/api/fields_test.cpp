@@ -192,6 +192,8 @@ TEST(FieldsTest, EveryFieldRoundTripsThroughParserBinderAndOptimizeVariable) {
       EXPECT_EQ(bound.swing.angular_speed_rad_s, parsed->scene.swing.angular_speed_rad_s);
       EXPECT_EQ(bound.swing.pivot_from_knob_m, parsed->scene.swing.pivot_from_knob_m);
       EXPECT_EQ(bound.swing.hands_from_knob_m, parsed->scene.swing.hands_from_knob_m);
+      EXPECT_EQ(bound.swing.bat_speed_mps, parsed->scene.swing.bat_speed_mps);
+      EXPECT_EQ(bound.swing.bat_speed_from_tip_m, parsed->scene.swing.bat_speed_from_tip_m);
       EXPECT_EQ(bound.cor, parsed->scene.cor);
     }
 
@@ -237,6 +239,14 @@ TEST(FieldsTest, TradeFormsResolveToTheirField) {
   const auto speed = ResolveField("ball.speed_mph", FieldScope::kRequest);
   ASSERT_TRUE(speed);
   EXPECT_EQ(speed->si, "ball.speed_mps");
+  const auto bat_speed = ResolveField("swing.bat_speed_mph", FieldScope::kRequest);
+  ASSERT_TRUE(bat_speed);  // bound by the sweep's binder since it is a row
+  EXPECT_EQ(bat_speed->si, "swing.bat_speed_mps");
+  EXPECT_TRUE(bat_speed->field->swept);
+  // A knot's index as the JSON path reads it: the variable is core's, named as written.
+  const auto padded = ResolveField("profile.knots[02].radius_m", FieldScope::kVariable);
+  ASSERT_TRUE(padded);
+  EXPECT_EQ(padded->si, "profile.knots[2].radius_m");
   EXPECT_FALSE(ResolveField("wall_thickness_oz", FieldScope::kVariable));
   EXPECT_FALSE(ResolveField("ball.speed_mps", FieldScope::kVariable));
   EXPECT_EQ(DidYouMeanField("three_segment.taper_strat_in", FieldScope::kVariable),
