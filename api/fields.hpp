@@ -45,10 +45,10 @@ struct FieldHost {
   core::Ball* ball = nullptr;
   core::Swing* swing = nullptr;
   std::optional<double>* cor = nullptr;
-  core::Bat* bat = nullptr;                   ///< Knots, wall.
-  core::Material* material = nullptr;         ///< The bat's material (a material object's rows).
-  core::ThreeSegmentShape* shape = nullptr;   ///< A three-segment bat's shape.
-  core::Fill* fill = nullptr;                 ///< The bat's fill.
+  core::Bat* bat = nullptr;                  ///< Knots, wall.
+  core::Material* material = nullptr;        ///< The bat's material (a material object's rows).
+  core::ThreeSegmentShape* shape = nullptr;  ///< A three-segment bat's shape.
+  core::Fill* fill = nullptr;                ///< The bat's fill.
   std::size_t knot = 0;
 
   /// Every part of `scene` (its bat's material, and fill when it has one), and `shape`.
