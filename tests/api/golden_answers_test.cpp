@@ -195,6 +195,31 @@ const std::vector<GoldenRequest>& Requests() {
       {"fit_trade_unknown_typo", "POST", "/v1/bat/fit",
        R"({"bat": {"preset": "paper-wood"}, "targets": {"mass_kg": 0.9},
            "unknowns": [{"name": "barel_diameter_in", "min": 2, "max": 3}]})"},
+      // Issue 33, item 2: the material's, the wall's, the knots' and the swing's numbers read
+      // from the table of fields, in the trade's units, and their refusals.
+      {"properties_profile_trade", "POST", "/v1/bat/properties",
+       R"({"bat": {"profile": {"knots": [{"x_in": 0, "diameter_in": 1.0},
+           {"x_in": 12, "diameter_in": 1.0}, {"x_in": 24, "diameter_in": 2.6},
+           {"x_in": 33, "diameter_in": 2.6}]},
+           "material": {"base": "aluminium-7046", "density_kg_m3": 2800, "cor": 0.55},
+           "wall_thickness_in": 0.1, "fill": {"material": "cork", "diameter_in": 1,
+           "depth_in": 6}}, "report_units": "imperial"})"},
+      {"properties_material_missing", "POST", "/v1/bat/properties",
+       R"({"bat": {"preset": "paper-wood", "material": {"youngs_modulus_pa": 1e10}}})"},
+      {"sweet_spot_swing_trade", "POST", "/v1/sweet-spot",
+       R"({"bat": {"preset": "wood-34-ash"}, "ball": {"preset": "mlb", "speed_mph": 85},
+           "swing": {"bat_speed_mph": 72, "bat_speed_from_tip_in": 5,
+                     "pivot_from_knob_in": -2, "hands_from_knob_in": 4},
+           "outputs": ["max_exit_speed", "center_of_percussion"]})"},
+      {"sweet_spot_swing_both_speeds", "POST", "/v1/sweet-spot",
+       R"({"bat": {"preset": "wood-34-ash"},
+           "swing": {"angular_speed_rad_s": 30, "bat_speed_mph": 72}})"},
+      {"explore_swing_trade_columns", "POST", "/v1/explore",
+       R"({"bat": {"preset": "wood-34-ash"}, "outputs": ["max_exit_speed"], "format": "csv",
+           "columns": ["parameters.swing.hands_from_knob_in", "parameters.ball.speed_mph",
+                       "max_exit_speed.exit_speed_mph"],
+           "parameters": [{"path": "swing.hands_from_knob_in", "min": 4, "max": 8, "count": 2},
+                          {"path": "ball.speed_mph", "min": 80, "max": 90, "count": 2}]})"},
   };
   return requests;
 }
