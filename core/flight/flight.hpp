@@ -156,10 +156,10 @@ struct AeroOptions {
 struct FlightOptions {
   /// Relative tolerance of a step's local error. The default keeps the distance within
   /// 0.1 ft (3 cm) of a converged answer (docs/speed-vs-error.md). In [1e-13, 1e-2].
-  double relative_tolerance = 1e-6;
+  double relative_tolerance = 1e-5;
   /// Absolute tolerance of a step's local error in position, m (velocity: per second).
   /// In [1e-12, 1].
-  double absolute_tolerance_m = 1e-4;
+  double absolute_tolerance_m = 1e-3;
   /// The flight's time limit, s (simulated): a ball still up then is reported as
   /// kTimeLimit, not integrated on. In (0, 600].
   double max_flight_time_s = 30.0;
