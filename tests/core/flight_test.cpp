@@ -186,8 +186,8 @@ TEST(FlightTest, RulesOfThumb) {
 }
 
 // The launch angle that carries farthest at 100 mph, by a 0.5° scan: with the Statcast spin
-// relation's backspin (published optimum for home runs: about 25-30°, Nathan, "Optimizing the
-// Swing", Hardball Times 2015) and without spin (drag only: lower than the vacuum's 45° but
+// relation's backspin (the optimum commonly quoted for home runs: about 25-30°, after Nathan's
+// Statcast analyses; not read from a primary text here) and without spin (drag only: lower than the vacuum's 45° but
 // above the spun ball's; a spinless ball needs a steeper launch to stay up).
 TEST(FlightTest, OptimumLaunchAngleWithAndWithoutBackspin) {
   auto best = [](bool spin) {
