@@ -281,11 +281,20 @@ std::optional<FlightRequest> ParseFlight(const nlohmann::json& body, const ApiLi
       Refused(refusal, "options", given, error);
       return std::nullopt;
     }
-    // A trajectory is bounded by the answer's size: at most 10,000 samples a flight.
-    if (request.options.max_flight_time_s / request.options.trajectory_interval_s > 10000.0) {
-      o.Fail("trajectory_interval_s",
-             "gives more than 10000 samples over max_flight_time_s = " +
-                 core::FormatNumber(request.options.max_flight_time_s) + " s");
+  }
+  // A trajectory is bounded by the answer's size: at most kMaxTrajectorySamples samples over
+  // all launches (about 8 MB of JSON), counted at the time limit (a flight's most).
+  if (request.trajectory) {
+    const double per_flight =
+        std::floor(request.options.max_flight_time_s / request.options.trajectory_interval_s) + 2;
+    const double total = per_flight * static_cast<double>(request.launches.size());
+    if (total > kMaxTrajectorySamples) {
+      SetError(error, ErrorCode::kTooBig, "outputs", nullptr,
+               "asks for up to " + core::FormatNumber(total) +
+                   " trajectory samples (launches x (max_flight_time_s / trajectory_interval_s "
+                   "+ 2)), over the limit of " + core::FormatNumber(kMaxTrajectorySamples) +
+                   ": fewer launches, a longer options.trajectory_interval_s or a shorter "
+                   "options.max_flight_time_s");
       return std::nullopt;
     }
   }

@@ -38,6 +38,9 @@ bool ReadEnvironment(ObjectReader& reader, core::flight::Environment* environmen
 /// validates it (AeroOptions::Validate).
 bool ReadAero(ObjectReader& reader, core::flight::AeroOptions* aero);
 
+/// The most trajectory samples one /v1/flight answer may carry, over all its launches.
+inline constexpr double kMaxTrajectorySamples = 100000;
+
 /// A parsed /v1/flight request.
 struct FlightRequest {
   std::vector<core::flight::Launch> launches;     ///< One or many.

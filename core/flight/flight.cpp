@@ -411,12 +411,10 @@ FlightResult Fly(const Launch& launch, const Environment& environment, const Aer
   double previous_error_ratio = 1e-4;  // PI controller memory (Hairer's DOPRI5 "facold").
 
   while (true) {
-    if (r.steps >= options.max_steps) {
-      r.termination = FlightTermination::kStepLimit;
-      return r;
-    }
-    if (t >= options.max_flight_time_s) {
-      r.termination = FlightTermination::kTimeLimit;
+    if (r.steps >= options.max_steps || t >= options.max_flight_time_s) {
+      r.termination = r.steps >= options.max_steps ? FlightTermination::kStepLimit
+                                                   : FlightTermination::kTimeLimit;
+      r.error_estimate_m = error_sum;  // of the flight so far
       return r;
     }
     h = std::min(h, options.max_flight_time_s - t);

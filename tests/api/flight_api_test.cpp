@@ -158,6 +158,14 @@ TEST(FlightApiTest, TooManyLaunchesIs413) {
   EXPECT_EQ(r.status, 413);
   EXPECT_EQ(r.body["code"], "TooBig");
   EXPECT_EQ(r.body["field"], "launches");
+  // Trajectories are bounded over all launches: 4 x (30 s / 0.001 s + 2) samples is too many.
+  const Response t = Post(R"({"launches": [{"exit_speed_mps": 40, "launch_angle_deg": 20},
+      {"exit_speed_mps": 40, "launch_angle_deg": 20},
+      {"exit_speed_mps": 40, "launch_angle_deg": 20},
+      {"exit_speed_mps": 40, "launch_angle_deg": 20}], "outputs": ["trajectory"],
+      "options": {"trajectory_interval_s": 0.001}})");
+  EXPECT_EQ(t.status, 413);
+  EXPECT_EQ(t.body["field"], "outputs");
 }
 
 // A ball that never lands within the time limit: a clear 422, not a hang; in a batch, its row.
