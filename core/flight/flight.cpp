@@ -403,18 +403,16 @@ FlightResult Fly(const Launch& launch, const Environment& environment, const Aer
   double h = std::min(0.05, std::pow(rtol, 0.2) * 0.5);
   State k1 = Derivative(m, t, y);
   r.evaluations = 1;
-  double next_sample_t = 0.0;
-  if (trajectory != nullptr) {
-    trajectory->push_back(Sample(0.0, y));
-    next_sample_t = options.trajectory_interval_s;
-  }
+  long long next_sample = 1;  // the next sample is at next_sample · trajectory_interval_s
+  if (trajectory != nullptr) trajectory->push_back(Sample(0.0, y));
   double error_sum = 0.0;
   double previous_error_ratio = 1e-4;  // PI controller memory (Hairer's DOPRI5 "facold").
 
   while (true) {
-    if (r.steps >= options.max_steps || t >= options.max_flight_time_s) {
-      r.termination = r.steps >= options.max_steps ? FlightTermination::kStepLimit
-                                                   : FlightTermination::kTimeLimit;
+    // Rejected steps count too: a step size shrinking forever must end as well.
+    const bool step_limit = r.steps + r.rejected_steps >= options.max_steps;
+    if (step_limit || t >= options.max_flight_time_s) {
+      r.termination = step_limit ? FlightTermination::kStepLimit : FlightTermination::kTimeLimit;
       r.error_estimate_m = error_sum;  // of the flight so far
       return r;
     }
@@ -511,9 +509,9 @@ FlightResult Fly(const Launch& launch, const Environment& environment, const Aer
     const double theta_land = lands ? RootOf(dense, 2, y.z, y_new.z) : 1.0;
     const double t_end = t + theta_land * h;
     if (trajectory != nullptr) {
-      while (next_sample_t < t_end) {
-        trajectory->push_back(Sample(next_sample_t, dense.At((next_sample_t - t) / h)));
-        next_sample_t += options.trajectory_interval_s;
+      for (double ts = next_sample * options.trajectory_interval_s; ts < t_end;
+           ts = ++next_sample * options.trajectory_interval_s) {
+        trajectory->push_back(Sample(ts, dense.At((ts - t) / h)));
       }
     }
     if (lands) {

@@ -163,7 +163,8 @@ struct FlightOptions {
   /// The flight's time limit, s (simulated): a ball still up then is reported as
   /// kTimeLimit, not integrated on. In (0, 600].
   double max_flight_time_s = 30.0;
-  /// Step limit (a bound on the work of one flight). In [10, 1e6].
+  /// Step limit, accepted and rejected steps together (a bound on the work of one flight).
+  /// In [10, 1e6].
   int max_steps = 20000;
   /// Sampling interval of a requested trajectory, s. In [1e-3, 10].
   double trajectory_interval_s = 0.05;
@@ -211,7 +212,7 @@ Classification Classify(double exit_speed_mps, double launch_angle_deg);
 enum class FlightTermination {
   kLanded,        ///< The ball reached the ground: the result is usable.
   kTimeLimit,     ///< Still in the air at max_flight_time_s: no landing.
-  kStepLimit,     ///< max_steps taken before landing: no landing.
+  kStepLimit,     ///< max_steps (accepted + rejected) taken before landing: no landing.
   kNonFinite,     ///< The equations gave a NaN or an infinity: no landing.
   kInvalidInput,  ///< Refused before flying: see `refusal`.
 };
