@@ -137,7 +137,7 @@ bool ReadEnvironment(ObjectReader& parent, core::flight::Environment* environmen
                &environment->elevation_m, &given);
   ReadQuantity(reader, "relative_humidity_pct", {{"relative_humidity_pct"}},
                &environment->relative_humidity_pct, &given);
-  ReadQuantity(reader, "pressure_pa",
+  ReadQuantity(reader, "sea_level_pressure_pa",
                {{"pressure_hpa", flight_json::kPaPerHpa}, {"pressure_inhg", flight_json::kPaPerInHg}},
                &environment->sea_level_pressure_pa, &given);
   flight_json::ReadWind(reader, &environment->wind, &given);

@@ -226,7 +226,7 @@ bool Environment::Validate(Refusal* why) const {
   return CheckInRange(why, "temperature_c", temperature_c, -40.0, 60.0) &&
          CheckInRange(why, "elevation_m", elevation_m, -500.0, 5000.0) &&
          CheckInRange(why, "relative_humidity_pct", relative_humidity_pct, 0.0, 100.0) &&
-         CheckInRange(why, "pressure_pa", sea_level_pressure_pa, 80000.0, 110000.0) &&
+         CheckInRange(why, "sea_level_pressure_pa", sea_level_pressure_pa, 80000.0, 110000.0) &&
          CheckInRange(why, "wind.speed_mps", wind.speed_mps, 0.0, 50.0) &&
          CheckInRange(why, "wind.direction_deg", wind.direction_deg, -360.0, 360.0);
 }

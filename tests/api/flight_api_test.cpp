@@ -146,6 +146,9 @@ TEST(FlightApiTest, BadInputIsRefusedNamingTheField) {
   const Response wind = Post(cases[3].body);
   EXPECT_EQ(wind.body["message"],
             "environment.wind.speed_mph = 500: must be in [0, 50] as speed_mps (223.52)");
+  EXPECT_EQ(Post(cases[12].body).body["message"],
+            "environment.pressure_hpa = 5: must be in [80000, 110000] as sea_level_pressure_pa "
+            "(500)");
 }
 
 TEST(FlightApiTest, TooManyLaunchesIs413) {
