@@ -247,9 +247,12 @@ struct FlightResult {
   Spin spin;                       ///< The spin flown (given or estimated), rpm.
   SpinSource spin_source = SpinSource::kGiven;  ///< Where the spin came from.
   Classification classification;                ///< Statcast's labels of the launch.
-  /// Estimated error of distance_m, m: the sum over accepted steps of the embedded 4th-order
-  /// pair's local position error (the answer carries the 5th-order solution, so this
-  /// over-estimates; tests/core/flight_test.cpp checks it against a tight-tolerance run).
+  /// Estimated error of distance_m, m: the embedded 4th-order pair's local position errors
+  /// summed over the accepted steps, plus each step's local velocity error carried to the
+  /// landing, plus the landing interpolant's error (a cubic Hermite against the 4th-order dense
+  /// output). An estimate, not a bound: measured over a grid of launches the error was at most
+  /// 3.6 times it (nathan-2016, custom; tests/core/flight_test.cpp); sawicki-2003's lift law
+  /// has a kink it cannot see.
   double error_estimate_m = 0.0;
   int steps = 0;           ///< Accepted steps.
   int rejected_steps = 0;  ///< Rejected steps.

@@ -211,8 +211,8 @@ TEST(FlightTest, OptimumLaunchAngleWithAndWithoutBackspin) {
 }
 
 // The error estimate against a run at 1e-12: the default tolerance's distance is within 0.1 ft
-// (the target of bench/core_flight.cpp) of the reference, and the estimate bounds the actual
-// error (it sums the embedded 4th-order pair's local errors; the answer is 5th-order).
+// (the target of bench/core_flight.cpp) of the reference, and here the estimate bounds the
+// actual error.
 TEST(FlightTest, ErrorEstimateBoundsTheErrorAgainstATightReference) {
   FlightOptions tight;
   tight.relative_tolerance = 1e-12;
@@ -227,6 +227,44 @@ TEST(FlightTest, ErrorEstimateBoundsTheErrorAgainstATightReference) {
     EXPECT_LE(error, r.error_estimate_m) << la;
     EXPECT_LT(ref.error_estimate_m, 1e-6) << la;
     EXPECT_LT(r.steps, 40) << la;  // the speed budget: tens of steps, not thousands
+  }
+}
+
+// Over a grid of launches (25-55 m/s, -5° to 85°, calm and 10-20 m/s winds out and across), the
+// default tolerance keeps every distance within 0.1 ft of a 1e-12 run, for every model. The
+// estimate is an estimate, not a bound: with 5-6 long steps it can be low; measured, the error
+// is at most 3.6 times it for the smooth models (so 4 here). sawicki-2003's lift law has a kink
+// at S = 0.1, which the estimate cannot see (up to 29 times): only its 0.1 ft is checked.
+TEST(FlightTest, DefaultToleranceMeetsATenthOfAFootOverAGrid) {
+  FlightOptions tight;
+  tight.relative_tolerance = 1e-12;
+  tight.absolute_tolerance_m = 1e-12;
+  for (AeroModel model : {AeroModel::kNathan2016, AeroModel::kSawicki2003, AeroModel::kCustom}) {
+    AeroOptions aero;
+    aero.model = model;
+    for (double v : {25.0, 35.0, 45.0, 55.0}) {
+      for (double la = -5.0; la <= 85.0; la += 5.0) {
+        for (double wind : {0.0, 10.0, 20.0}) {
+          for (double direction : {0.0, 135.0}) {
+            Launch launch;
+            launch.exit_speed_mps = v;
+            launch.launch_angle_deg = la;
+            Environment environment;
+            environment.wind.speed_mps = wind;
+            environment.wind.direction_deg = direction;
+            const FlightResult r = Fly(launch, environment, aero);
+            const FlightResult ref = Fly(launch, environment, aero, tight);
+            ASSERT_TRUE(r.Landed() && ref.Landed());
+            const double error = std::abs(r.distance_m - ref.distance_m);
+            EXPECT_LT(error, 0.1 * kFt) << AeroModelName(model) << " " << v << " " << la;
+            if (model != AeroModel::kSawicki2003) {
+              EXPECT_LE(error, 4.0 * r.error_estimate_m + 1e-9)
+                  << AeroModelName(model) << " " << v << " " << la << " " << wind;
+            }
+          }
+        }
+      }
+    }
   }
 }
 
