@@ -3,7 +3,7 @@
 #include <cmath>
 #include <utility>
 
-#include "core/presets.hpp"
+#include "core/bat/presets.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -119,8 +119,8 @@ std::optional<core::Material> ParseMaterial(const Json& value, const std::string
     }
     material = *found;
     material.name = "custom";
-    material.source = "base " + found->name + " with the request's overrides; base source: " +
-                      found->source;
+    material.source =
+        "base " + found->name + " with the request's overrides; base source: " + found->source;
     // A density range is the base's; given another density, it is not this material's.
     material.density_min_kg_m3 = material.density_max_kg_m3 = 0.0;
   }

@@ -10,9 +10,9 @@
 
 #include "api/json_reader.hpp"
 #include "api/limits.hpp"
-#include "core/bat.hpp"
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
 
 namespace sweetspot::api {
 
@@ -21,7 +21,7 @@ namespace sweetspot::api {
 struct BatSpec {
   core::Bat bat;                ///< The bat (valid).
   nlohmann::json request_form;  ///< The bat object as the request wrote it.
-  std::string shape_form;       ///< "preset", "three_segment" or "profile": where the shape came from.
+  std::string shape_form;  ///< "preset", "three_segment" or "profile": where the shape came from.
   std::optional<core::ThreeSegmentShape> three_segment;  ///< Set for the three_segment form.
   /// From one of the paper's presets ("paper-wood", "paper-wood-m885"): a scene's model auto
   /// is then the paper's rigid_pivot (core::Scene::paper_bat).

@@ -36,7 +36,7 @@ struct ApiLimits {
   /// 413 before the first design beyond it; ndjson and csv answers are streamed, not bounded.
   std::size_t max_response_bytes = 64u << 20;
   /// A job's estimated CPU time at submit, s: designs x the per-design cost of the models its
-  /// outputs need (api/explore_estimate.cpp). 413 at POST /v1/jobs beyond it.
+  /// outputs need (api/explore/estimate.cpp). 413 at POST /v1/jobs beyond it.
   double max_job_cpu_s = 3600.0;
   /// A job's wall time, s. At submit: its estimated CPU time over its threads (413 beyond);
   /// while it runs: enforced by the job runner (server/jobs). The server sets it from its

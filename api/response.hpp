@@ -65,4 +65,8 @@ struct Response {
 /// GET /health: {"status": "ok"}.
 Response HandleHealth();
 
+/// GET /ready: 200 {"status": "ready"}, or, while the server drains before it stops, 503
+/// Unavailable (a load balancer's readiness probe then takes it out of rotation).
+Response HandleReady(bool draining);
+
 }  // namespace sweetspot::api

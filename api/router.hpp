@@ -42,6 +42,9 @@ struct Context {
   ApiLimits limits;                           ///< Request limits (configuration).
   JobService* jobs = nullptr;                 ///< The jobs (server only; server/jobs/).
   std::function<std::string()> metrics_text;  ///< Prometheus text (server only).
+  /// True while the server drains before it stops (SIGTERM, --drain-s): GET /ready answers 503.
+  /// Null: never (the CLI).
+  std::function<bool()> draining;
   core::Progress* progress = nullptr;         ///< Cancel flag and progress (inside a job).
   core::ModesCache* modes_cache = nullptr;    ///< Bending modes kept across requests (server only).
   /// True when the answer goes to a job's result or the CLI's output rather than to a waiting
@@ -59,7 +62,7 @@ struct Context {
   bool validate_only = false;
   /// True when the request is a job's inner request checked at POST /v1/jobs: /v1/explore
   /// then refuses (413) a sweep whose estimated CPU time, wall time or result is over
-  /// limits.max_job_cpu_s, max_job_time_s or max_job_result_bytes (api/explore_estimate.hpp).
+  /// limits.max_job_cpu_s, max_job_time_s or max_job_result_bytes (api/explore/estimate.hpp).
   bool job = false;
 };
 

@@ -9,7 +9,7 @@
 
 #include "api/bat_json.hpp"
 #include "api/json_reader.hpp"
-#include "core/collision/collide.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::api {

@@ -1,5 +1,5 @@
 // ThreadBudget: the threads a process lends to /v1/explore sweeps beyond each sweep's own
-// (the server's compute pool; api/explore_engine.hpp takes from it).
+// (the server's compute pool; api/explore/engine.hpp takes from it).
 #pragma once
 
 #include <memory>

@@ -10,13 +10,13 @@
 #include <string>
 #include <vector>
 
+#include "core/bat/presets.hpp"
 #include "core/collision/bbcor_scan.hpp"
-#include "core/collision/collide.hpp"
 #include "core/collision/flexible_impact.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/flexible/modes_cache.hpp"
-#include "core/presets.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {

@@ -4,10 +4,10 @@
 
 #include <cmath>
 
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
-#include "core/presets.hpp"
-#include "core/shape_fit.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
+#include "core/optimize/shape_fit.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).

@@ -29,7 +29,7 @@ import time
 import numpy as np
 from scipy.optimize import brentq, minimize, minimize_scalar
 
-# The scene's defaults (core/scene/scene.hpp) and the ash of core/material.cpp.
+# The scene's defaults (core/scene/scene.hpp) and the ash of core/bat/material.cpp.
 BALL_MASS_KG = 0.145
 BALL_SPEED_MPS = 27.7
 OMEGA_RAD_S = 17.288
@@ -50,7 +50,7 @@ ROOT_XTOL_M = 1e-13
 def mass_properties(x, r, density):
     """Solid piecewise-conical bat: mass (kg), balance point (m from the knob), moment of inertia
     about the centroid (kg m^2, rigid body: the discs' own moments included). The exact integrals
-    of core/geometry_integrals.hpp, about each segment's midpoint."""
+    of core/bat/geometry_integrals.hpp, about each segment's midpoint."""
     x = np.asarray(x, dtype=float)
     r = np.asarray(r, dtype=float)
     half = 0.5 * (x[1:] - x[:-1])

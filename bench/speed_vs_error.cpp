@@ -38,15 +38,15 @@
 #include <sched.h>
 #include <time.h>
 
-#include "core/ball_catalogue.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 #include "core/collision/barrel.hpp"
-#include "core/collision/collide.hpp"
 #include "core/flight/flight.hpp"
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
-#include "core/optimize/nlopt_search.hpp"
+#include "core/numerics/nlopt_search.hpp"
 #include "core/optimize/design_problem.hpp"
-#include "core/presets.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/version.hpp"
 
@@ -396,7 +396,7 @@ void RigidAndFreeSweetSpotRows(const TimingOptions& timing, bool quick, Report* 
        "(core::ResolveExitModel). With method = nlopt the default algorithm is "
        "LD_SLSQP and x_tolerance_m = " +
            Tol(default_search.x_tolerance_m) +
-           " (core::ScalarSearchOptions, core/optimize/nlopt_search.hpp)"});
+           " (core::ScalarSearchOptions, core/numerics/nlopt_search.hpp)"});
   core::SceneOptions closed;
   closed.model = core::CollisionModel::kRigidPivot;
   SweetSpotRows("rigid_pivot_sweet_spot", core::CollisionModel::kRigidPivot, true, {}, closed, all,
@@ -551,9 +551,9 @@ void BarrelHoopRows(const TimingOptions& timing, bool quick, Report* report) {
            Fixed(wall.thickness_m / wall.mid_radius_m, 3) + " is the closed form's error)",
        "the closed form: core::BarrelWallAt (core/collision/barrel.hpp); the FE model is the "
        "check, never run by a request"});
-  const double ref = core::RingFeHoopFrequencyHz(m.youngs_modulus_pa, m.poissons_ratio,
-                                                 m.density_kg_m3, wall.mid_radius_m,
-                                                 wall.thickness_m, ref_elements);
+  const double ref =
+      core::RingFeHoopFrequencyHz(m.youngs_modulus_pa, m.poissons_ratio, m.density_kg_m3,
+                                  wall.mid_radius_m, wall.thickness_m, ref_elements);
   auto push = [&](Row row) {
     report->rows.push_back(std::move(row));
     Progress(*report);
@@ -955,7 +955,7 @@ void DesignRows(const TimingOptions& timing, bool quick, Report* report) {
        "objective's (max exit speed's) difference",
        "hessian = limited_memory, tolerance = " + Tol(defaults.tolerance) +
            ", backend ipopt: core::DesignOptions (core/optimize/design_problem.hpp), request "
-           "default \"limited_memory\" (api/handlers_optimize.cpp)"});
+           "default \"limited_memory\" (api/handlers/optimize.cpp)"});
   const core::DesignProblem problem = SixteenKnotProblem();
   core::DesignOptions ref_o;
   ref_o.hessian = core::HessianMode::kExact;

@@ -23,7 +23,7 @@
 #include "api/json_reader.hpp"
 #include "api/limits.hpp"
 #include "api/router.hpp"
-#include "core/mass_properties.hpp"
+#include "core/bat/mass_properties.hpp"
 
 namespace sweetspot::fuzz {
 
@@ -65,7 +65,7 @@ inline const std::vector<FuzzRoute>& PostRoutes() {
   static const std::vector<FuzzRoute> routes = {
       {'p', "/v1/bat/properties"}, {'f', "/v1/bat/fit"}, {'s', "/v1/sweet-spot"},
       {'c', "/v1/collision"},      {'m', "/v1/compare"}, {'o', "/v1/optimize"},
-      {'x', "/v1/explore"},        {'j', "/v1/jobs"},         {'b', "/v1/bat/modes"},
+      {'x', "/v1/explore"},        {'j', "/v1/jobs"},    {'b', "/v1/bat/modes"},
       {'l', "/v1/flight"},
   };
   return routes;
@@ -210,9 +210,9 @@ inline Verdict RunParseBody(std::string_view input) {
     return {};
   }
   if (error.code) {
-    return {"ParseBody returned a value and the error " +
-                std::string(api::ErrorCodeName(*error.code)),
-            ""};
+    return {
+        "ParseBody returned a value and the error " + std::string(api::ErrorCodeName(*error.code)),
+        ""};
   }
   if (internal::Depth(*value) > limits.max_json_depth) {
     return {"ParseBody accepted depth " + std::to_string(internal::Depth(*value)) +

@@ -26,6 +26,8 @@ else
     wrk nginx
     # a single-node Slurm for the sharded-sweep test (scripts/slurm-smoke.sh)
     slurm-wlm munge bc
+    # the Python client's test (clients/python/): the interpreter and its standard library
+    python3
     # browser tests of the design explorer (headless, driven by playwright-core)
     chromium
   )

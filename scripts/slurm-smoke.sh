@@ -1,25 +1,38 @@
 #!/usr/bin/env bash
 # Runs a sharded /v1/explore sweep on a real single-node Slurm cluster and
-# checks the merged result equals the unsharded sweep (but timing_s):
-# installs Debian's slurm-wlm and munge if missing, starts munged, slurmctld
-# and slurmd in a temporary folder on free loopback ports (nothing in /etc),
-# submits deploy/slurm/submit.sh (an array of 4 shard tasks and the merge that
-# depends on it), waits for sweep.ndjson, compares, and stops the daemons.
+# checks the merged result equals the unsharded sweep: the rows byte for byte,
+# the summary but its timing_s. Installs Debian's slurm-wlm and munge if
+# missing, starts munged, slurmctld and slurmd in a temporary folder on free
+# loopback ports (nothing in /etc), submits deploy/slurm/submit.sh (an array of
+# 4 shard tasks and the merge that depends on it), waits for sweep.ndjson,
+# compares, and stops the daemons.
 #
-#   scripts/slurm-smoke.sh [--build-dir DIR] [--shards N]
+#   scripts/slurm-smoke.sh [--build-dir DIR] [--shards N] [--fail-shard K]
+#
+# --fail-shard K: shard K fails on the first submission (SWEETSPOT_CLI is a
+# wrapper that exits 1 for `--shard K/N` while a marker file exists). Checks the
+# other shards are written, shard K is not, and Slurm cancels the merge at once
+# (--kill-on-invalid-dep) instead of leaving it pending; then removes the marker,
+# re-runs shard K alone (submit.sh --only-missing: an array of that one task, N
+# unchanged) with a new merge, and compares as above.
 #
 # Needs root (the daemons run as root here, as in a test container). Prints
-# each stage's wall time; exits non-zero on any failure, with the logs. The
-# test command runs it as the ctest test Slurm.ExploreArrayMergesIntoTheSweep.
+# each stage's wall time; exits non-zero on any failure, with the logs, and 77
+# (ctest: skipped) when slurm-wlm or munge cannot be installed. The test command
+# runs it as the ctest tests Slurm.ExploreArrayMergesIntoTheSweep and, with
+# --fail-shard 2, Slurm.FailedShardRerunAloneMergesIntoTheSweep.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build
 shards=4
+fail_shard=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --build-dir) build="$2"; shift ;;
     --shards) shards="$2"; shift ;;
-    *) echo "usage: scripts/slurm-smoke.sh [--build-dir DIR] [--shards N]" >&2; exit 2 ;;
+    --fail-shard) fail_shard="$2"; shift ;;
+    *) echo "usage: scripts/slurm-smoke.sh [--build-dir DIR] [--shards N] [--fail-shard K]" >&2
+       exit 2 ;;
   esac
   shift
 done
@@ -37,8 +50,11 @@ for p in slurm-wlm munge bc; do
 done
 if [ ${#missing[@]} -gt 0 ]; then
   export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  if ! { apt-get update -qq && apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null; }
+  then
+    echo "slurm-smoke: SKIPPED: cannot install ${missing[*]} from Debian's registry" >&2
+    exit 77
+  fi
 fi
 stage "install (${missing[*]:-nothing missing})"
 case "$build" in /*) ;; *) build="$PWD/$build" ;; esac
@@ -92,6 +108,11 @@ for _ in $(seq 1 100); do [ -S "$work/munge.sock" ] && break; sleep 0.05; done
 ctld_port=$(free_port)
 slurmd_port=$(free_port "$ctld_port")
 mkdir -p "$work/state" "$work/spool" "$work/out"
+# The scripts ask for --mem (1G a shard, 2G the merge), which needs RealMemory on the node line.
+# Nothing enforces it here (no cgroups); config_overrides lets a small machine claim the 4 GiB
+# the scripts' requests fit in rather than refuse them.
+memory_mb=$(( $(awk '/^MemTotal:/ {print $2}' /proc/meminfo) / 1024 ))
+[ "$memory_mb" -ge 4096 ] || memory_mb=4096
 cat >"$work/slurm.conf" <<EOF
 ClusterName=sweetspot-smoke
 SlurmctldHost=localhost
@@ -119,7 +140,8 @@ SelectTypeParameters=CR_Core
 JobCompType=jobcomp/none
 AccountingStorageType=accounting_storage/none
 MailProg=/bin/true
-NodeName=node0 NodeAddr=127.0.0.1 NodeHostname=localhost CPUs=$(nproc) State=UNKNOWN
+SlurmdParameters=config_overrides
+NodeName=node0 NodeAddr=127.0.0.1 NodeHostname=localhost CPUs=$(nproc) RealMemory=$memory_mb State=UNKNOWN
 PartitionName=debug Nodes=node0 Default=YES MaxTime=INFINITE State=UP
 EOF
 export SLURM_CONF="$work/slurm.conf"
@@ -147,28 +169,80 @@ cat >"$work/sweep.json" <<'EOF'
  "format": "ndjson"}
 EOF
 export SWEETSPOT_CLI="$cli"
-read -r array merge <<<"$(deploy/slurm/submit.sh "$work/sweep.json" "$work/out" "$shards")"
-echo "slurm-smoke: submitted array job $array ($shards tasks) and merge job $merge" >&2
-for _ in $(seq 1 600); do  # up to 60 s
-  [ -f "$work/out/sweep.ndjson" ] && break
-  if [ -z "$(squeue -h -j "$array,$merge" 2>/dev/null)" ] && [ ! -f "$work/out/sweep.ndjson" ]; then
-    sleep 0.5
-    [ -f "$work/out/sweep.ndjson" ] || fail "the jobs ended without sweep.ndjson"
-  fi
-  sleep 0.1
-done
-[ -f "$work/out/sweep.ndjson" ] || fail "no sweep.ndjson within 60 s"
-stage "array of $shards shards and the merge"
+# Waits up to $2 s for OUT/sweep.ndjson, failing when the jobs $1 all left the queue without it.
+wait_for_sweep() {
+  for _ in $(seq 1 $(($2 * 10))); do
+    [ -f "$work/out/sweep.ndjson" ] && return
+    if [ -z "$(squeue -h -j "$1" 2>/dev/null)" ]; then
+      sleep 0.5
+      [ -f "$work/out/sweep.ndjson" ] && return
+      fail "the jobs $1 ended without sweep.ndjson"
+    fi
+    sleep 0.1
+  done
+  fail "no sweep.ndjson within $2 s"
+}
 
-# The unsharded sweep, and the comparison without the timings.
-"$cli" explore "$work/sweep.json" >"$work/whole.ndjson"
-strip() { sed -e 's/"timing_s":[^,}]*,\{0,1\}//' "$1"; }
-rows=$(($(wc -l <"$work/whole.ndjson") - 1))
-if ! diff <(strip "$work/whole.ndjson") <(strip "$work/out/sweep.ndjson") >"$work/diff.log"; then
-  fail "the merged sweep differs from the unsharded one (diff.log)"
+if [ -n "$fail_shard" ]; then
+  # The wrapper the jobs run: shard K fails while the marker exists; any other call is the CLI.
+  cat >"$work/cli-failing.sh" <<EOF
+#!/bin/sh
+case " \$* " in
+  *" --shard $fail_shard/$shards "*)
+    if [ -e "$work/fail-shard" ]; then echo "slurm-smoke: shard $fail_shard made to fail" >&2; exit 1; fi ;;
+esac
+exec "$cli" "\$@"
+EOF
+  chmod 755 "$work/cli-failing.sh"
+  touch "$work/fail-shard"
+  export SWEETSPOT_CLI="$work/cli-failing.sh"
+  read -r array merge <<<"$(deploy/slurm/submit.sh "$work/sweep.json" "$work/out" "$shards")"
+  echo "slurm-smoke: submitted array job $array ($shards tasks, shard $fail_shard failing)" \
+       "and merge job $merge" >&2
+  for _ in $(seq 1 300); do  # up to 30 s for every task to end and the merge to leave the queue
+    [ -z "$(squeue -h -j "$array,$merge" 2>/dev/null)" ] && break
+    sleep 0.1
+  done
+  [ -z "$(squeue -h -j "$array,$merge" 2>/dev/null)" ] ||
+    fail "jobs still queued 30 s after a shard failed: $(squeue -h -j "$array,$merge" -o '%i %T %r')"
+  merge_state="$(scontrol -o show job "$merge" | grep -o 'JobState=[A-Z_]*' || true)"
+  [ "$merge_state" = "JobState=CANCELLED" ] ||
+    fail "the merge after a failed shard is '${merge_state:-gone}', not JobState=CANCELLED"
+  [ ! -e "$work/out/sweep.ndjson" ] || fail "sweep.ndjson written although shard $fail_shard failed"
+  [ ! -e "$work/out/shard-$fail_shard.ndjson" ] || fail "shard-$fail_shard.ndjson written although it failed"
+  for ((i = 0; i < shards; i++)); do
+    [ "$i" = "$fail_shard" ] || [ -f "$work/out/shard-$i.ndjson" ] || fail "shard-$i.ndjson missing"
+  done
+  stage "shard $fail_shard failed, the merge cancelled"
+  rm "$work/fail-shard"
+  read -r array merge <<<"$(deploy/slurm/submit.sh --only-missing "$work/sweep.json" "$work/out" "$shards")"
+  echo "slurm-smoke: re-submitted shard $fail_shard alone as array job $array, merge job $merge" >&2
+  wait_for_sweep "$array,$merge" 60
+  ran="$(cd "$work/out" && ls slurm-"${array}"_*.out)"
+  [ "$ran" = "slurm-${array}_$fail_shard.out" ] || fail "the re-run ran tasks: $ran"
+  grep -q "shard $fail_shard made to fail" "$work/out"/slurm-*_"$fail_shard".out ||
+    fail "the first run of shard $fail_shard did not fail as made to"
+  stage "shard $fail_shard re-run alone and the merge"
+else
+  read -r array merge <<<"$(deploy/slurm/submit.sh "$work/sweep.json" "$work/out" "$shards")"
+  echo "slurm-smoke: submitted array job $array ($shards tasks) and merge job $merge" >&2
+  wait_for_sweep "$array,$merge" 60
+  stage "array of $shards shards and the merge"
 fi
+
+# The unsharded sweep: the rows byte for byte, the summary but its timing_s (the shards' sum).
+"$cli" explore "$work/sweep.json" >"$work/whole.ndjson"
+rows=$(($(wc -l <"$work/whole.ndjson") - 1))
+cmp <(head -n "$rows" "$work/whole.ndjson") <(head -n "$rows" "$work/out/sweep.ndjson") \
+  >"$work/diff.log" 2>&1 || fail "the merged rows differ from the unsharded sweep's (diff.log)"
+strip() { tail -n +"$((rows + 1))" "$1" | sed -e 's/"timing_s":[^,}]*,\{0,1\}//'; }
+if ! diff <(strip "$work/whole.ndjson") <(strip "$work/out/sweep.ndjson") >"$work/diff.log"; then
+  fail "the merged summary differs from the unsharded one (diff.log)"
+fi
+[ "$(wc -l <"$work/out/sweep.ndjson")" = "$((rows + 1))" ] || fail "sweep.ndjson has extra lines"
 for ((i = 0; i < shards; i++)); do
   [ -f "$work/out/shard-$i.ndjson" ] || fail "shard-$i.ndjson missing"
 done
 stage "compare with the unsharded sweep"
-echo "slurm-smoke: ok: $shards shards of $rows designs merged by Slurm equal the unsharded sweep" >&2
+echo "slurm-smoke: ok: $shards shards of $rows designs merged by Slurm equal the unsharded sweep" \
+     "${fail_shard:+(shard $fail_shard failed, then re-run alone)}" >&2

@@ -4,20 +4,25 @@
 // `sweetspot explore --shard I/N FILE` runs shard I of N of a sweep (NDJSON);
 // `sweetspot explore-merge FILE...` merges the shards' outputs into the sweep's.
 // A sweep's rows (ndjson, csv) are written to stdout as they are evaluated.
+#include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "api/explore_shards.hpp"
 #include "api/json_reader.hpp"
 #include "api/memory_reserve.hpp"
 #include "api/router.hpp"
+#include "server/cli_merge.hpp"
+#include "server/cli_progress.hpp"
+#include "server/cpu_quota.hpp"
 #include "server/run.hpp"
 
 namespace {
@@ -27,7 +32,8 @@ std::string Usage() {
   text << "Usage: sweetspot [-X METHOD] [--max-batch-samples N|none] [--explore-threads N]\n"
        << "                 PATH [FILE|-]\n"
        << "       sweetspot explore --shard I/N [FILE|-]\n"
-       << "       sweetspot explore-merge FILE...\n"
+       << "       sweetspot explore-merge [--progress=MODE] FILE...\n"
+       << "       sweetspot threads   (the default thread count and what it comes from)\n"
        << "       sweetspot serve [SERVER OPTIONS]   (as sweetspot-server; see its --help)\n"
        << "  PATH  an endpoint path without the leading /v1/ (e.g. bat/properties);\n"
        << "        health, openapi.json and metrics name the top-level paths\n"
@@ -39,15 +45,21 @@ std::string Usage() {
        << "        (also SWEETSPOT_MAX_BATCH_SAMPLES; default none: no limit, the rows are\n"
        << "        streamed to stdout)\n"
        << "  --explore-threads N  explore only: threads to evaluate the designs on, 1 to\n"
-       << "        1024 (also SWEETSPOT_EXPLORE_THREADS; default: one per core); the rows\n"
-       << "        and their order are the same whatever N\n"
+       << "        1024 (also SWEETSPOT_EXPLORE_THREADS; default: the CPUs this process may\n"
+       << "        use: its affinity mask and its cgroup's cpu.max quota); the rows and\n"
+       << "        their order are the same whatever N\n"
        << "  --shard I/N  explore only: run shard I (0-based) of N of the sweep, as\n"
-       << "        NDJSON (the request's shard and format are set); design i is in\n"
+       << "        NDJSON (or CSV when the request's format is csv); design i is in\n"
        << "        shard i mod N\n"
-       << "  explore-merge  reads the NDJSON outputs of all N shards of one sweep and\n"
-       << "        prints the sweep's NDJSON: rows in index order, then the summary of\n"
-       << "        the whole sweep (Pareto front over all rows); refuses shards of\n"
-       << "        different sweeps, missing or repeated shards, unfinished shards\n"
+       << "  --progress=auto|on|off|lines  explore, explore-merge, optimize, compare: a bar\n"
+       << "        with the rate and the time left on stderr (auto: only when stderr is a\n"
+       << "        terminal; lines: one plain line every 5 s, for batch logs); stdout is\n"
+       << "        the same bytes whatever the mode\n"
+       << "  explore-merge  reads the outputs of all N shards of one sweep (all NDJSON or\n"
+       << "        all CSV) as streams and prints the sweep's output: rows in index order\n"
+       << "        (NDJSON: then the summary of the whole sweep, Pareto front over all\n"
+       << "        rows), the unsharded sweep's bytes but timing_s; refuses shards of\n"
+       << "        different sweeps, missing (named) or repeated shards, unfinished shards\n"
        << "Prints the response body; exit status 0 for a 2xx answer, 2 for 4xx,\n"
        << "1 otherwise.\n\nPaths:\n";
   for (const auto& route : sweetspot::api::Routes()) {
@@ -73,29 +85,30 @@ bool ReadFile(const std::string& file, std::string* text) {
   return true;
 }
 
-// sweetspot explore-merge FILE...: the merged NDJSON on stdout; 2 when the
-// shards do not make one complete sweep (the reason on stderr).
-int ExploreMerge(const std::vector<std::string>& files) {
-  if (files.empty()) {
-    std::cerr << "sweetspot explore-merge: give the NDJSON output of every shard of one sweep\n";
-    return 2;
-  }
-  std::vector<sweetspot::api::ShardOutput> shards;
-  for (const std::string& file : files) {
-    sweetspot::api::ShardOutput shard{file, {}};
-    if (!ReadFile(file, &shard.text)) {
-      std::cerr << "sweetspot explore-merge: cannot read " << file << "\n";
-      return 1;
+// Takes "--progress=MODE" or "--progress MODE" out of `args` into *options: false (and the
+// reason on stderr) for a mode that is not auto, on, off or lines.
+bool TakeProgressFlag(std::vector<std::string>* args,
+                      sweetspot::server::ProgressOptions* options) {
+  for (std::size_t i = 0; i < args->size(); ++i) {
+    std::string value;
+    std::size_t taken = 1;
+    if ((*args)[i].rfind("--progress=", 0) == 0) {
+      value = (*args)[i].substr(11);
+    } else if ((*args)[i] == "--progress" && i + 1 < args->size()) {
+      value = (*args)[i + 1];
+      taken = 2;
+    } else {
+      continue;
     }
-    shards.push_back(std::move(shard));
+    if (!sweetspot::server::ParseProgressMode(value, &options->mode)) {
+      std::cerr << "sweetspot: --progress \"" << value << "\": must be auto, on, off or lines\n";
+      return false;
+    }
+    args->erase(args->begin() + static_cast<std::ptrdiff_t>(i),
+                args->begin() + static_cast<std::ptrdiff_t>(i + taken));
+    --i;
   }
-  const sweetspot::api::MergedSweep merged = sweetspot::api::MergeExploreShards(shards);
-  if (!merged.ok) {
-    std::cerr << "sweetspot explore-merge: " << merged.error << "\n";
-    return 2;
-  }
-  std::cout << merged.ndjson;
-  return 0;
+  return true;
 }
 
 // "I/N" with 0 <= I < N.
@@ -148,6 +161,67 @@ int ExitCode(int status) {
   return 1;
 }
 
+// `sweetspot threads`: what the default thread count comes from, for an operator checking
+// a pod or a job.
+int ThreadsCommand() {
+  const auto known = [](std::optional<int> n) { return n ? nlohmann::json(*n) : nlohmann::json(); };
+  std::cout << nlohmann::json{{"threads", sweetspot::server::DefaultThreadCount()},
+                              {"affinity_cpus", known(sweetspot::server::AffinityCpus())},
+                              {"cgroup_cpu_quota", known(sweetspot::server::CgroupCpuQuota())},
+                              {"hardware_concurrency", std::thread::hardware_concurrency()}}
+                   .dump()
+            << "\n";
+  return 0;
+}
+
+// `--shard I/N` into the explore request `*body`: false (the reason on stderr) when it is not
+// a shard of an explore request.
+bool ShardBody(const std::string& shard, const std::string& full_path,
+               const sweetspot::api::ApiLimits& limits, std::string* body) {
+  unsigned long long index = 0, count = 0;
+  if (full_path != "/v1/explore" || !ParseShard(shard, &index, &count)) {
+    std::cerr << "sweetspot: --shard \"" << shard
+              << "\": must be I/N with 0 <= I < N, and only for explore\n";
+    return false;
+  }
+  // Parsed with the service's limits (depth first: a deep body must not crash the CLI).
+  sweetspot::api::ApiError error;
+  std::optional<nlohmann::json> request = sweetspot::api::ParseBody(*body, limits, &error);
+  if (!request || !request->is_object()) {
+    std::cerr << "sweetspot: --shard needs the request as a JSON object"
+              << (error.message.empty() ? "" : ": " + error.message) << "\n";
+    return false;
+  }
+  (*request)["shard"] = {{"index", index}, {"count", count}};
+  // NDJSON (with its summary, which the merge checks), or CSV when the request asks for it.
+  if (request->value("format", std::string()) != "csv") (*request)["format"] = "ndjson";
+  *body = request->dump();
+  return true;
+}
+
+// Prints the answer on stdout (a stream as its chunks come, counting its lines into
+// `*lines`): false when a stream did not finish.
+bool PrintResponse(const sweetspot::api::Response& response, std::atomic<std::uint64_t>* lines) {
+  if (response.stream) {
+    // The same chunks the server sends, written as they come: memory stays bounded.
+    const bool finished = response.stream([lines](std::string_view chunk) {
+      lines->fetch_add(static_cast<std::uint64_t>(std::count(chunk.begin(), chunk.end(), '\n')),
+                       std::memory_order_relaxed);
+      std::cout.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+      return static_cast<bool>(std::cout);
+    });
+    std::cout.flush();
+    return finished;
+  }
+  if (!response.content_type.empty()) {
+    std::cout << response.text;
+  } else {
+    std::cout << response.body.dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+              << "\n";
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -162,8 +236,12 @@ int main(int argc, char** argv) {
     std::cout << Usage();
     return 0;
   }
+  if (args.size() == 1 && args[0] == "threads") return ThreadsCommand();
+  sweetspot::server::ProgressOptions progress_options;
+  if (!TakeProgressFlag(&args, &progress_options)) return 2;
   if (!args.empty() && args[0] == "explore-merge") {
-    return ExploreMerge(std::vector<std::string>(args.begin() + 1, args.end()));
+    return sweetspot::server::ExploreMergeCommand(
+        std::vector<std::string>(args.begin() + 1, args.end()), progress_options);
   }
   std::string method;
   if (args.size() >= 2 && args[0] == "-X") {
@@ -196,8 +274,8 @@ int main(int argc, char** argv) {
               << "\": must be an integer in [1, 10^15] or none\n";
     return 2;
   }
-  const unsigned cores = std::thread::hardware_concurrency();
-  context.explore_threads = cores == 0 ? 1 : static_cast<int>(cores);
+  // The CPUs this process may use (cgroup cpu.max, affinity), not the node's cores.
+  context.explore_threads = sweetspot::server::DefaultThreadCount();
   if (!explore_threads.empty() && !ParseThreads(explore_threads, &context.explore_threads)) {
     std::cerr << "sweetspot: --explore-threads (or SWEETSPOT_EXPLORE_THREADS) \"" << explore_threads
               << "\": must be an integer in [1, 1024]\n";
@@ -233,24 +311,19 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  if (!shard.empty()) {
-    unsigned long long index = 0, count = 0;
-    if (full_path != "/v1/explore" || !ParseShard(shard, &index, &count)) {
-      std::cerr << "sweetspot: --shard \"" << shard
-                << "\": must be I/N with 0 <= I < N, and only for explore\n";
-      return 2;
-    }
-    // Parsed with the service's limits (depth first: a deep body must not crash the CLI).
-    sweetspot::api::ApiError error;
-    std::optional<nlohmann::json> request = sweetspot::api::ParseBody(body, context.limits, &error);
-    if (!request || !request->is_object()) {
-      std::cerr << "sweetspot: --shard needs the request as a JSON object"
-                << (error.message.empty() ? "" : ": " + error.message) << "\n";
-      return 2;
-    }
-    (*request)["shard"] = {{"index", index}, {"count", count}};
-    (*request)["format"] = "ndjson";
-    body = request->dump();
+  if (!shard.empty() && !ShardBody(shard, full_path, context.limits, &body)) return 2;
+  // The long runs report their fraction here (the CLI never cancels them); stderr shows it:
+  // a sweep's rows as they are written, the starts of an optimisation, the bats compared.
+  sweetspot::core::Progress progress;
+  context.progress = &progress;
+  std::atomic<std::uint64_t> lines{0};
+  std::unique_ptr<sweetspot::server::ProgressReporter> reporter;
+  if (full_path == "/v1/explore" || full_path == "/v1/optimize" || full_path == "/v1/compare") {
+    reporter = std::make_unique<sweetspot::server::ProgressReporter>(
+        path, full_path == "/v1/explore" ? "rows" : "", progress_options, [&progress, &lines] {
+          return sweetspot::server::ProgressSample{progress.Fraction(),
+                                                   lines.load(std::memory_order_relaxed)};
+        });
   }
   const auto response = sweetspot::api::Dispatch({method, full_path, body}, context, nullptr,
                                                  /*allow_stream=*/true);
@@ -262,19 +335,8 @@ int main(int argc, char** argv) {
                      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
               << "\n";
   }
-  if (response.stream) {
-    // The same chunks the server sends, written as they come: memory stays bounded.
-    const bool finished = response.stream([](std::string_view chunk) {
-      std::cout.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
-      return static_cast<bool>(std::cout);
-    });
-    std::cout.flush();
-    if (!finished) return 1;
-  } else if (!response.content_type.empty()) {
-    std::cout << response.text;
-  } else {
-    std::cout << response.body.dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
-              << "\n";
-  }
+  const bool printed = PrintResponse(response, &lines);
+  if (reporter) reporter->Finish();
+  if (!printed) return 1;
   return ExitCode(response.status);
 }

@@ -25,7 +25,7 @@ struct ServerConfig {
   std::size_t max_unsent_bytes_per_client = 64u << 20;  ///< Answer bytes one client address's connections may leave unread, held by the server until they read them; an answer whose rest would exceed it is cut and its connection closed (--max-unsent-bytes-per-client, SWEETSPOT_MAX_UNSENT_BYTES_PER_CLIENT).
   double first_byte_timeout_s = 2.0;     ///< A new connection must send its first byte within this, s; else closed without an answer (--first-byte-timeout-s, SWEETSPOT_FIRST_BYTE_TIMEOUT_S).
   double max_request_time_s = 120.0;     ///< Longest a request that runs models may compute, s, from when a compute worker takes it; then stopped and answered 503 (a stream ends early) (--max-request-time-s, SWEETSPOT_MAX_REQUEST_TIME_S).
-  std::string auth_token;                ///< If set, every path but /health needs "Authorization: Bearer <token>" (SWEETSPOT_AUTH_TOKEN, --auth-token-file).
+  std::string auth_token;                ///< If set, every path but /health and /ready needs "Authorization: Bearer <token>" (SWEETSPOT_AUTH_TOKEN, --auth-token-file).
   std::string cors_origin;               ///< CORS: the allowed Origin, or "*"; empty = no CORS headers (--cors-origin, SWEETSPOT_CORS_ORIGIN).
   std::size_t max_body_bytes = 1 << 20;  ///< Largest request body, bytes (--max-body-bytes, SWEETSPOT_MAX_BODY_BYTES).
   std::size_t max_head_bytes = 65536;    ///< Largest request head (request line and headers), bytes; beyond: 431 (--max-head-bytes, SWEETSPOT_MAX_HEAD_BYTES).
@@ -40,6 +40,7 @@ struct ServerConfig {
   JobConfig jobs;                   ///< Job pool (--job-workers, --job-queue, --job-keep-s, --jobs-kept, --job-max-resumes, --job-lease-s, --job-max-result-bytes, --job-results-memory-bytes, --job-max-time-s).
   std::string jobs_db = "sweetspot-jobs.db";  ///< Where jobs are kept: a SQLite file (relative to the working directory), a postgresql:// URI shared by replicas, or "none" = memory only (--jobs-db, SWEETSPOT_JOBS_DB).
   std::size_t jobs_db_max_bytes = 4ULL << 30;  ///< SQLite: the largest the jobs database file may grow, bytes (4 GiB: 16 results at --job-max-result-bytes); 0 = no limit but the disk's, else [65536, 1e15] (--jobs-db-max-bytes, SWEETSPOT_JOBS_DB_MAX_BYTES).
+  double drain_s = 0.0;                  ///< On SIGTERM/SIGINT, how long the server keeps accepting and answering while GET /ready answers 503 (answers then carry Connection: close), s, [0, 3600]; then it stops accepting and shutdown_grace_s begins; 0 = stop accepting at once; a second signal ends it (--drain-s, SWEETSPOT_DRAIN_S).
   double shutdown_grace_s = 8.0;         ///< On SIGTERM/SIGINT, how long running jobs may still finish before they are interrupted, s, [0, 3600] (--shutdown-grace-s, SWEETSPOT_SHUTDOWN_GRACE_S).
   std::string web_root;                  ///< Folder of the design explorer's static files served at /; empty = "web" next to the executable (--web-root, SWEETSPOT_WEB_ROOT).
 

@@ -26,13 +26,12 @@
 // A connection that sends no byte within first_byte_timeout_s is closed without an
 // answer; one whose unread answer would take its address past
 // max_unsent_bytes_per_client is closed with the answer cut. Range headers are
-// dropped before httplib sees the request: every answer is whole. A request of the compute pool carries a cancel flag (RequestCancel) that the
-// deadline keeper sets when its client closes the connection, when it has computed for
-// max_request_time_s, or shutdown_grace_s after the server began to stop; a queued
-// request whose client left is dropped without computing, and one still queued when the
-// grace ends is refused 503.
-// A closed connection is first half-closed and drained for up to linger_s (so
-// that the client reads the answer instead of a reset), without counting
+// dropped before httplib sees the request: every answer is whole. A request of the compute pool
+// carries a cancel flag (RequestCancel) that the deadline keeper sets when its client closes the
+// connection, when it has computed for max_request_time_s, or shutdown_grace_s after the server
+// began to stop; a queued request whose client left is dropped without computing, and one still
+// queued when the grace ends is refused 503. A closed connection is first half-closed and drained
+// for up to linger_s (so that the client reads the answer instead of a reset), without counting
 // against the limit.
 #pragma once
 
@@ -91,7 +90,7 @@ struct ConnectionLoopOptions {
   /// Threads for requests that run models.
   int compute_workers = 2;
   /// The compute pool's threads as a budget (null: none): a compute worker takes one while it
-  /// answers, waiting when sweeps have borrowed them all (api/explore_engine.hpp).
+  /// answers, waiting when sweeps have borrowed them all (api/explore/engine.hpp).
   api::ThreadBudget* compute_budget = nullptr;
   /// How long a closed connection is drained, s.
   double linger_s = 1.0;
@@ -140,6 +139,10 @@ class ConnectionLoop {
   /// Makes Run() return (after the in-flight requests, within shutdown_grace_s); idempotent,
   /// any thread.
   void Stop();
+  /// The drain before Stop(): every answer from now on carries "Connection: close", so that
+  /// keep-alive clients reconnect (through their load balancer, to another replica) while this
+  /// one still accepts. Any thread.
+  void BeginDrain();
   /// Ends the shutdown grace at once: the requests still computing are cancelled. Any thread.
   void EndGrace();
 

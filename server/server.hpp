@@ -33,6 +33,9 @@ class Server {
   int compute_threads() const;
   /// Serves until Stop(); returns false if the listen loop failed.
   bool Run();
+  /// Starts the drain that precedes Stop(): GET /ready answers 503 and every answer carries
+  /// "Connection: close", while the server keeps accepting and answering. Any thread.
+  void BeginDrain();
   /// Stops accepting and makes Run() return: in-flight requests finish within
   /// config.shutdown_grace_s, then their models are stopped (503).
   void Stop();

@@ -9,10 +9,10 @@
 
 #include <Eigen/Dense>
 
-#include "core/ball_catalogue.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/mass_properties.hpp"
 #include "core/collision/contact_integration.hpp"
 #include "core/geometry_format.hpp"
-#include "core/mass_properties.hpp"
 #include "core/numerics/event_integrator.hpp"
 #include "core/units.hpp"
 
@@ -326,7 +326,8 @@ TrampolineResult EffectiveCorAt(const Bat& bat, const MassProperties& mp, double
 }
 
 BbcorResult ComputeBbcor(const Bat& bat, const BbcorProtocol& protocol,
-                         const BarrelOptions& options, const MassProperties* rigid_body_properties) {
+                         const BarrelOptions& options,
+                         const MassProperties* rigid_body_properties) {
   BbcorResult out;
   out.ball = protocol.ball;
   out.ball_speed_mps = protocol.ball_speed_mps;

@@ -42,9 +42,9 @@
 #include <string>
 #include <vector>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/mass_properties.hpp"
 #include "core/collision/contact_law.hpp"
-#include "core/mass_properties.hpp"
 
 namespace sweetspot::core {
 

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <optional>
 
-#include "core/ball_catalogue.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/mass_properties.hpp"
 #include "core/collision/contact_law.hpp"
 #include "core/geometry_format.hpp"
-#include "core/mass_properties.hpp"
 #include "core/refusal.hpp"
 
 namespace sweetspot::core {

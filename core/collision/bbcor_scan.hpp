@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
 #include "core/collision/barrel.hpp"
 #include "core/collision/flexible_impact.hpp"
 #include "core/flexible/modes.hpp"

@@ -33,7 +33,7 @@
 #include <string>
 #include <vector>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
 #include "core/collision/contact_law.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/summary.hpp"

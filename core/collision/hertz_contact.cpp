@@ -13,8 +13,8 @@
 #include "core/collision/contact_law.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/event_integrator.hpp"
+#include "core/numerics/timing_book.hpp"
 #include "core/refusal.hpp"
-#include "core/scene/timing_book.hpp"
 
 namespace sweetspot::core {
 namespace {

@@ -13,7 +13,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
-#include "core/mass_properties.hpp"
+#include "core/bat/mass_properties.hpp"
 #include "core/numerics/gauss_legendre.hpp"
 #include "core/numerics/jet.hpp"
 #include "core/units.hpp"
@@ -21,7 +21,6 @@
 namespace sweetspot::core {
 namespace beam_frequency_detail {
 namespace {
-
 
 // The local parameters of one knot segment: its two knot positions and radii, L, the wall, the
 // density, the fill's diameter, depth and density.
@@ -98,8 +97,8 @@ Section<T> SectionOf(const FixedMeshBeam& b, const T& r, bool in_fill, const Par
     s.rho_a = s.rho_a + p.fill_rho * a_f;
     s.rho_i = s.rho_i + p.fill_rho * i_f;
     s.ei = s.ei + b.fill_youngs_modulus_pa * i_f;
-    s.kga = s.kga + (CowperShearCoefficient(b.fill_poissons_ratio, 0.0) * b.fill_shear_modulus_pa) *
-                        a_f;
+    s.kga = s.kga +
+            (CowperShearCoefficient(b.fill_poissons_ratio, 0.0) * b.fill_shear_modulus_pa) * a_f;
   }
   return s;
 }
@@ -199,9 +198,9 @@ void VisitQuadrature(const FixedMeshBeam& b, const std::vector<double>& t, Visit
       const Cut& lo = cuts[c];
       const Cut& hi = cuts[c + 1];
       const double mid = 0.5 * (lo.v + hi.v);
-      int e = static_cast<int>(std::upper_bound(node_v.begin(), node_v.end(), mid) -
-                               node_v.begin()) -
-              1;
+      int e =
+          static_cast<int>(std::upper_bound(node_v.begin(), node_v.end(), mid) - node_v.begin()) -
+          1;
       e = std::clamp(e, 0, ne - 1);
       const bool in_fill = b.has_fill && mid >= bottom_v;
       const T a_e = b.node_fractions[static_cast<std::size_t>(e)] * p.length;
@@ -304,8 +303,7 @@ bool SolveFirst(const FixedMeshBeam& b, const BeamMatrices& mats, FirstBendingMo
     } else {
       ++stalled;
     }
-    const bool done =
-        residual <= kResidualTolerance || (best <= kStallResidual && stalled >= 3);
+    const bool done = residual <= kResidualTolerance || (best <= kStallResidual && stalled >= 3);
     // Rayleigh-Ritz in the shift-invert form: Y' (K + sigma M) Y = Y' M X, no product with K.
     Eigen::MatrixXd kr = y.transpose() * mx;
     Eigen::MatrixXd mr = y.transpose() * (mats.mass * y);
@@ -349,29 +347,29 @@ Eigen::VectorXd LambdaGradient(const FixedMeshBeam& b, const std::vector<double>
   const bool rotary = timoshenko && b.rotary_inertia;
   std::vector<LocalJet> per_segment(static_cast<std::size_t>(std::max(b.num_knots - 1, 0)),
                                     LocalJet(0.0));
-  VisitQuadrature<LocalJet>(
-      b, t,
-      [&](int segment, int e, const Shape<LocalJet>& n, const Section<LocalJet>& s,
-          const LocalJet& wgt) {
-        int idx[kElementDofs];
-        ElementDofIndices(b.theory, e, idx);
-        LocalJet w(0.0), theta(0.0), curvature(0.0), shear(0.0);
-        for (int i = 0; i < kElementDofs; ++i) {
-          if (idx[i] < 0) continue;
-          const double d = phi[idx[i]];
-          const auto si = static_cast<std::size_t>(i);
-          const bool shear_dof = i == 2 || i == 3 || i == 6;
-          if (!shear_dof || timoshenko) w = w + n.w[si] * d;
-          theta = theta + n.theta[si] * d;
-          curvature = curvature + n.curvature[si] * d;
-          if (timoshenko) shear = shear + n.shear[si] * d;
-        }
-        LocalJet q = s.ei * (curvature * curvature) - lambda * (s.rho_a * (w * w));
-        if (timoshenko) q = q + s.kga * (shear * shear);
-        if (rotary) q = q - lambda * (s.rho_i * (theta * theta));
-        LocalJet& acc = per_segment[static_cast<std::size_t>(segment)];
-        acc = acc + wgt * q;
-      });
+  VisitQuadrature<LocalJet>(b, t,
+                            [&](int segment, int e, const Shape<LocalJet>& n,
+                                const Section<LocalJet>& s, const LocalJet& wgt) {
+                              int idx[kElementDofs];
+                              ElementDofIndices(b.theory, e, idx);
+                              LocalJet w(0.0), theta(0.0), curvature(0.0), shear(0.0);
+                              for (int i = 0; i < kElementDofs; ++i) {
+                                if (idx[i] < 0) continue;
+                                const double d = phi[idx[i]];
+                                const auto si = static_cast<std::size_t>(i);
+                                const bool shear_dof = i == 2 || i == 3 || i == 6;
+                                if (!shear_dof || timoshenko) w = w + n.w[si] * d;
+                                theta = theta + n.theta[si] * d;
+                                curvature = curvature + n.curvature[si] * d;
+                                if (timoshenko) shear = shear + n.shear[si] * d;
+                              }
+                              LocalJet q =
+                                  s.ei * (curvature * curvature) - lambda * (s.rho_a * (w * w));
+                              if (timoshenko) q = q + s.kga * (shear * shear);
+                              if (rotary) q = q - lambda * (s.rho_i * (theta * theta));
+                              LocalJet& acc = per_segment[static_cast<std::size_t>(segment)];
+                              acc = acc + wgt * q;
+                            });
   for (int i = 0; i + 1 < b.num_knots; ++i) {
     const LocalJet& q = per_segment[static_cast<std::size_t>(i)];
     const int map[kLocal] = {lay.KnotPosition(i),
@@ -440,8 +438,7 @@ FirstBendingMode ComputeFirstBendingMode(const FixedMeshBeam& beam, const std::v
     const BeamMatrices mats = beam_frequency_detail::Assemble(beam, t);
     if (!beam_frequency_detail::SolveFirst(beam, mats, &out)) return out;
     if (gradient) {
-      out.lambda_gradient =
-          beam_frequency_detail::LambdaGradient(beam, t, out.vector, out.lambda);
+      out.lambda_gradient = beam_frequency_detail::LambdaGradient(beam, t, out.vector, out.lambda);
       if (!out.lambda_gradient.allFinite()) {
         out.message = "the frequency's gradient is not finite";
         return out;

@@ -29,7 +29,7 @@
 
 #include <Eigen/Core>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
 #include "core/flexible/beam_model.hpp"
 
 namespace sweetspot::core {
@@ -39,16 +39,16 @@ namespace sweetspot::core {
 struct FixedMeshBeam {
   BeamTheory theory = BeamTheory::kTimoshenko;  ///< The beam theory.
   bool rotary_inertia = true;                   ///< Timoshenko: rho I in M.
-  std::vector<double> node_fractions;  ///< Nodes / L, strictly increasing from 0 to 1.
-  int num_knots = 0;                   ///< Knots of the profile (coincident ones allowed).
-  bool hollow = false;                 ///< The shell of wall t[WallThickness()] applies.
-  bool has_fill = false;               ///< The fill entries apply.
-  double youngs_modulus_pa = 0.0;      ///< The bat material's E, Pa (fixed).
-  double shear_modulus_pa = 0.0;       ///< Its effective G, Pa (fixed).
-  double poissons_ratio = 0.0;         ///< Its nu (fixed).
-  double fill_youngs_modulus_pa = 0.0;  ///< The fill's E, Pa (fixed).
-  double fill_shear_modulus_pa = 0.0;   ///< The fill's effective G, Pa (fixed).
-  double fill_poissons_ratio = 0.0;     ///< The fill's nu (fixed).
+  std::vector<double> node_fractions;           ///< Nodes / L, strictly increasing from 0 to 1.
+  int num_knots = 0;                            ///< Knots of the profile (coincident ones allowed).
+  bool hollow = false;                          ///< The shell of wall t[WallThickness()] applies.
+  bool has_fill = false;                        ///< The fill entries apply.
+  double youngs_modulus_pa = 0.0;               ///< The bat material's E, Pa (fixed).
+  double shear_modulus_pa = 0.0;                ///< Its effective G, Pa (fixed).
+  double poissons_ratio = 0.0;                  ///< Its nu (fixed).
+  double fill_youngs_modulus_pa = 0.0;          ///< The fill's E, Pa (fixed).
+  double fill_shear_modulus_pa = 0.0;           ///< The fill's effective G, Pa (fixed).
+  double fill_poissons_ratio = 0.0;             ///< The fill's nu (fixed).
   /// Start basis of the subspace iteration (DOFs x p, p >= 3): the rigid translation and
   /// rotation, then flexible modes of a nearby design.
   Eigen::MatrixXd start_basis;
@@ -62,14 +62,13 @@ struct FixedMeshBeam {
 /// knob, 0 to the bat's length), for parameters with `num_knots` knots; `hollow` and `has_fill`
 /// as the parameters will be used. The start basis and shift are left empty.
 FixedMeshBeam MakeFixedMeshBeam(const Bat& bat, const std::vector<double>& nodes_m, int num_knots,
-                                bool hollow, bool has_fill, BeamTheory theory,
-                                bool rotary_inertia);
+                                bool hollow, bool has_fill, BeamTheory theory, bool rotary_inertia);
 
 /// The first bending mode at one design.
 struct FirstBendingMode {
-  bool ok = false;        ///< False when the eigenpair could not be computed (see message).
-  std::string message;    ///< Why not.
-  double lambda = 0.0;    ///< omega^2 of the first bending mode, rad²/s².
+  bool ok = false;            ///< False when the eigenpair could not be computed (see message).
+  std::string message;        ///< Why not.
+  double lambda = 0.0;        ///< omega^2 of the first bending mode, rad²/s².
   double frequency_hz = 0.0;  ///< sqrt(lambda) / (2 pi), Hz.
   Eigen::VectorXd vector;     ///< Mass-normalised mode (the fixed mesh's DOFs).
   /// d lambda / d t over DesignParameterLayout{num_knots} (when requested), rad²/s² per unit.

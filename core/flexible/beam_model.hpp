@@ -36,7 +36,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
 
 namespace sweetspot::core {
 

@@ -13,7 +13,7 @@
 
 #include "core/flexible/eigensolvers.hpp"
 #include "core/geometry_format.hpp"
-#include "core/scene/timing_book.hpp"
+#include "core/numerics/timing_book.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {

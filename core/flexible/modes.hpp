@@ -35,7 +35,7 @@
 
 #include <Eigen/Core>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
 #include "core/flexible/beam_model.hpp"
 #include "core/summary.hpp"
 

@@ -14,7 +14,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
 #include "core/flexible/modes.hpp"
 
 namespace sweetspot::core {

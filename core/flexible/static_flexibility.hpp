@@ -4,7 +4,7 @@
 // the contact (the residual flexibility, docs/models.md "Flexible bat").
 #pragma once
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
 #include "core/flexible/modes.hpp"
 
 namespace sweetspot::core {

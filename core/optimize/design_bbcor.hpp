@@ -29,10 +29,10 @@
 #include <cmath>
 #include <limits>
 
-#include "core/ball_catalogue.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/material.hpp"
 #include "core/collision/barrel.hpp"
 #include "core/collision/contact_law.hpp"
-#include "core/material.hpp"
 #include "core/numerics/jet.hpp"
 #include "core/units.hpp"
 

@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "core/geometry_format.hpp"
+#include "core/numerics/timing_book.hpp"
 #include "core/scene/resolved_scene.hpp"
-#include "core/scene/timing_book.hpp"
 
 namespace sweetspot::core {
 

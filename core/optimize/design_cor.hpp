@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "core/mass_properties.hpp"
+#include "core/bat/mass_properties.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "core/scene/scene.hpp"
 

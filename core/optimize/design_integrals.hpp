@@ -1,7 +1,7 @@
 // Internal to core: the design code's one parametrisation of a bat and its mass integrals,
 // shared by the design model (design_model.cpp) and the shape fit (shape_fit_model.cpp).
 //
-// Parameters: DesignParameterLayout order (core/mass_properties.hpp): the knots' radii and
+// Parameters: DesignParameterLayout order (core/bat/mass_properties.hpp): the knots' radii and
 // positions, then density, wall, fill diameter, depth and density. A three-segment shape is
 // the 4 knots (0, r1), (x1, r1), (x2, r2), (L, r2); each design variable sets one or two of
 // these parameters (DesignParametersOf), each parameter its coefficient (parameter_scale: 1,
@@ -16,8 +16,8 @@
 
 #include <Eigen/Core>
 
-#include "core/bat.hpp"
-#include "core/mass_properties.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/mass_properties.hpp"
 #include "core/optimize/design_problem.hpp"
 
 namespace sweetspot::core::design_detail {

@@ -8,16 +8,16 @@
 #include <exception>
 #include <set>
 
-#include "core/collision/collide.hpp"
+#include "core/bat/geometry_integrals.hpp"
 #include "core/collision/exit_speed_algebra.hpp"
 #include "core/collision/rigid_pivot.hpp"
 #include "core/flexible/beam_frequency.hpp"
 #include "core/geometry_format.hpp"
-#include "core/geometry_integrals.hpp"
 #include "core/numerics/jet.hpp"
 #include "core/numerics/limits.hpp"
 #include "core/optimize/design_bbcor.hpp"
 #include "core/optimize/design_integrals.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 #include "core/units.hpp"
@@ -320,8 +320,8 @@ T DesignModel::ObjectiveOf(const T* p, const E& e) const {
     // Moments about c0: S1 = M (C - c0), so C = c0 + S1/M and I_cm = S2 - S1^2/M.
     origin = c0_ + p[1] / p[0];
     const T i_cm = p[2] - p[1] * p[1] / p[0];
-    form = {T(u),         (1.0 + e) * i_cm, u + omega * (origin - pivot), i_cm * (1.0 + m / p[0]),
-            T(m),         omega};
+    form = {T(u), (1.0 + e) * i_cm, u + omega * (origin - pivot), i_cm * (1.0 + m / p[0]), T(m),
+            omega};
   } else {
     // exit_speed::RigidPivotForm's fields, with e a double or a jet.
     form = {T(u), (1.0 + e) * j, T(u), j, T(m), omega};

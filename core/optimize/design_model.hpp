@@ -28,7 +28,7 @@
 
 #include <Eigen/Core>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
 #include "core/flexible/modes_cache.hpp"
 #include "core/optimize/design_problem.hpp"
 
@@ -37,8 +37,8 @@ namespace sweetspot::core {
 struct FixedMeshBeam;  // core/flexible/beam_frequency.hpp
 
 namespace design_detail {
-struct ModelBuilder;    // DesignModel::Build's steps (design_model_build.cpp)
-struct BbcorConstants;  // design_bbcor.hpp
+struct ModelBuilder;        // DesignModel::Build's steps (design_model_build.cpp)
+struct BbcorConstants;      // design_bbcor.hpp
 struct BarrelCorConstants;  // design_bbcor.hpp
 struct IntegralContext;     // design_integrals.hpp
 struct Integrals;           // design_integrals.hpp
@@ -116,7 +116,7 @@ struct StingScene {
   double cor = 0.5;                                       ///< The COR used.
   InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< For the mass properties.
   FlexibleOptions flexible;                               ///< The flexible beam's settings.
-  CollisionModel model = CollisionModel::kRigidPivot;  ///< The sweet spot's closed form.
+  CollisionModel model = CollisionModel::kRigidPivot;     ///< The sweet spot's closed form.
 };
 
 /// One sting evaluation (internal).
@@ -173,7 +173,7 @@ class DesignModel {
   double CorAt(const double* x) const;
   /// With cor_from_barrel(): where the barrel COR is taken, m from the tip (NaN otherwise).
   double cor_impact_from_tip_m() const;
-  double reference_moi_six_inch_kg_m2() const { return i6_ref_; }     ///< I6_ref.
+  double reference_moi_six_inch_kg_m2() const { return i6_ref_; }  ///< I6_ref.
   /// omega of the swing for a design with MOI `i6` about the 6-in point and length `length_m`,
   /// rad/s (the length matters for a swing given by its bat speed, omega0 = v / (L - d - p)).
   double AngularSpeedFor(double i6_kg_m2, double length_m) const;

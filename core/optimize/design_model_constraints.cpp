@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/ball_catalogue.hpp"
+#include "core/ball/ball_catalogue.hpp"
 #include "core/collision/barrel.hpp"
 #include "core/flexible/beam_frequency.hpp"
 #include "core/flexible/modes.hpp"
@@ -338,9 +338,9 @@ bool ModelBuilder::FrequencyConstraint() {
   const std::vector<double> t0 = model.ParametersAt(x0.data());
   const FirstBendingMode check = ComputeFirstBendingMode(beam, t0, false);
   if (!check.ok) {
-    return Refuse(why, "constraints.min_frequency_hz", bound,
-                  "the first bending mode of the start cannot be computed on its mesh: " +
-                      check.message);
+    return Refuse(
+        why, "constraints.min_frequency_hz", bound,
+        "the first bending mode of the start cannot be computed on its mesh: " + check.message);
   }
   model.frequency_beam_ = std::make_shared<const FixedMeshBeam>(std::move(beam));
   DesignConstraintSpec c;

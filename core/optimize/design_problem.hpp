@@ -16,12 +16,12 @@
 #include <utility>
 #include <vector>
 
-#include "core/bat.hpp"
-#include "core/collision/collide.hpp"
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
 #include "core/optimize/rules.hpp"
 #include "core/progress.hpp"
+#include "core/scene/collide.hpp"
 #include "core/summary.hpp"
 
 namespace sweetspot::core {
@@ -363,10 +363,10 @@ enum class DesignMessageKind {
 /// A conflict found for an infeasible request.
 struct DesignConflict {
   ConflictKind kind = ConflictKind::kNotIsolated;  ///< Which finding this is.
-  std::vector<std::string> constraints;  ///< The constraints involved, by name.
-  std::string unit;                      ///< Unit of the numbers below.
-  double requested_min = 0.0;            ///< What the first constraint asks (-inf if open).
-  double requested_max = 0.0;            ///< (+inf if open).
+  std::vector<std::string> constraints;            ///< The constraints involved, by name.
+  std::string unit;                                ///< Unit of the numbers below.
+  double requested_min = 0.0;   ///< What the first constraint asks (-inf if open).
+  double requested_max = 0.0;   ///< (+inf if open).
   double achievable_min = 0.0;  ///< The least value reachable under the others (NaN if unknown).
   double achievable_max = 0.0;  ///< The largest value reachable under the others (NaN if unknown).
   double shortfall = 0.0;       ///< Distance between the two intervals (unit above; >= 0).
@@ -430,7 +430,7 @@ struct DesignFrequency {
 ///   residual of the scaled problem at the answer (NaN for min_sting: no derivative);
 ///   solve_time_s = wall time of the call.
 struct DesignResult {
-  Summary summary;                                 ///< How it went (see above).
+  Summary summary;  ///< How it went (see above).
   /// What summary.message states; code tells the outcomes apart by this, never by reading
   /// the message back.
   DesignMessageKind message_kind = DesignMessageKind::kRefused;
@@ -451,7 +451,7 @@ struct DesignResult {
   /// Sweet spot of the answer (rigid pivot, closed form, at angular_speed_rad_s), m from the
   /// knob; NaN when no COR is known (min_moi without one).
   double sweet_spot_from_knob_m = 0.0;
-  double max_exit_speed_mps = 0.0;   ///< Max exit speed there, m/s (NaN as above).
+  double max_exit_speed_mps = 0.0;  ///< Max exit speed there, m/s (NaN as above).
   /// omega of the swing for the answer, rad/s (from its swing weight and, for a bat speed,
   /// its length).
   double angular_speed_rad_s = 0.0;

@@ -18,8 +18,8 @@
 #include <coin/IpSolveStatistics.hpp>
 #include <coin/IpTNLP.hpp>
 
+#include "core/numerics/termination.hpp"
 #include "core/optimize/design_backends.hpp"
-#include "core/optimize/termination.hpp"
 
 namespace sweetspot::core {
 namespace {

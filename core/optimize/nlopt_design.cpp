@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "core/numerics/nlopt_run.hpp"
+#include "core/numerics/termination.hpp"
 #include "core/optimize/design_backends.hpp"
-#include "core/optimize/nlopt_run.hpp"
-#include "core/optimize/termination.hpp"
 
 namespace sweetspot::core {
 namespace {

@@ -9,9 +9,9 @@
 #include <string_view>
 #include <vector>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/material.hpp"
 #include "core/collision/barrel.hpp"
-#include "core/material.hpp"
 #include "core/refusal.hpp"
 
 namespace sweetspot::core {

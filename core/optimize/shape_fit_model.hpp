@@ -1,5 +1,6 @@
-// Internal to core (public only so that tests can check it): the shape fit (core/shape_fit.hpp)
-// as a design problem with a least-squares objective. No solver headers here.
+// Internal to core (public only so that tests can check it): the shape fit
+// (core/optimize/shape_fit.hpp) as a design problem with a least-squares objective. No solver
+// headers here.
 //
 // One parametrisation: the design code's (design_integrals.hpp). A fit unknown is the design
 // variable of the same field ("three_segment.taper_start_m", "material.density_kg_m3", ...);
@@ -17,7 +18,7 @@
 #include <Eigen/Core>
 
 #include "core/optimize/design_problem.hpp"
-#include "core/shape_fit.hpp"
+#include "core/optimize/shape_fit.hpp"
 
 namespace sweetspot::core::fit_detail {
 

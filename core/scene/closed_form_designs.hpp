@@ -7,7 +7,7 @@
 // single request gets.
 #pragma once
 
-#include "core/mass_properties.hpp"
+#include "core/bat/mass_properties.hpp"
 #include "core/scene/scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 

@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "core/bat/mass_properties.hpp"
 #include "core/collision/barrel.hpp"
 #include "core/collision/bbcor_scan.hpp"
-#include "core/mass_properties.hpp"
+#include "core/numerics/timing_book.hpp"
 #include "core/scene/scene.hpp"
-#include "core/scene/timing_book.hpp"
 #include "core/summary.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
@@ -46,8 +46,8 @@ struct SceneResult {
   /// The swing used, its angular speed resolved (from bat_speed_mps when given); the default
   /// swing when refused before it was resolved.
   Swing swing;
-  std::string exit_speed_model;    ///< The exit-speed model used ("" when none was needed).
-  std::string model_reason;        ///< Why that model (auto).
+  std::string exit_speed_model;  ///< The exit-speed model used ("" when none was needed).
+  std::string model_reason;      ///< Why that model (auto).
   std::optional<MaxExitSpeedResult> max_exit_speed;              ///< max_exit_speed.
   std::optional<CenterOfPercussionResult> center_of_percussion;  ///< center_of_percussion.
   std::optional<SweetZoneResult> sweet_zone;                     ///< sweet_zone.

@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "core/bat/mass_properties.hpp"
+#include "core/collision/flexible_impact.hpp"
 #include "core/collision/free_bat.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
-#include "core/collision/flexible_impact.hpp"
-#include "core/mass_properties.hpp"
+#include "core/numerics/timing_book.hpp"
 #include "core/scene/scene.hpp"
-#include "core/scene/timing_book.hpp"
 #include "core/summary.hpp"
 
 namespace sweetspot::core {
@@ -34,7 +34,7 @@ struct ResolvedScene {
   /// The scene's swing with its angular speed resolved (from bat_speed_mps when given): what
   /// every model adapter below uses.
   Swing swing;
-  std::optional<double> cor;       ///< The COR; unset when nothing wanted needs one.
+  std::optional<double> cor;  ///< The COR; unset when nothing wanted needs one.
   /// "scene" (the request's `cor`), "ball:<preset>" (the ball's COR law), "barrel:<preset>" (a
   /// hollow bat: the trampoline's effective COR from the ball's law) or "material:<name>";
   /// "" when `cor` is unset.

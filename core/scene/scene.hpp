@@ -2,7 +2,7 @@
 // swing), with which COR, and what is wanted (the outputs); and the settings of its
 // computations (the collision models, the flexible beam, EvaluateScene's options). Plain values
 // with Validate(Refusal*); the computations are in core/scene/evaluate_scene.hpp and
-// core/collision/collide.hpp.
+// core/scene/collide.hpp.
 #pragma once
 
 #include <optional>
@@ -10,16 +10,16 @@
 #include <string_view>
 #include <vector>
 
-#include "core/ball_catalogue.hpp"
-#include "core/bat.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/mass_properties.hpp"
 #include "core/collision/barrel.hpp"
 #include "core/collision/flexible_impact.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/flexible/beam_model.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/flexible/modes_cache.hpp"
-#include "core/mass_properties.hpp"
-#include "core/optimize/nlopt_search.hpp"
+#include "core/numerics/nlopt_search.hpp"
 #include "core/progress.hpp"
 #include "core/refusal.hpp"
 #include "core/sweet_spot/numeric.hpp"

@@ -10,9 +10,9 @@
 
 #include "core/collision/exit_speed_profile.hpp"
 #include "core/flexible/modes.hpp"
+#include "core/numerics/timing_book.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/scene/scene.hpp"
-#include "core/scene/timing_book.hpp"
 #include "core/sweet_spot/numeric.hpp"
 
 namespace sweetspot::core {

@@ -11,8 +11,8 @@
 #include <boost/math/tools/roots.hpp>
 
 #include "core/geometry_format.hpp"
+#include "core/numerics/timing_book.hpp"
 #include "core/refusal.hpp"
-#include "core/scene/timing_book.hpp"
 
 namespace sweetspot::core {
 

@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "core/optimize/nlopt_search.hpp"
+#include "core/numerics/nlopt_search.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {

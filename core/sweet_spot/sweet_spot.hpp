@@ -10,8 +10,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/bat/mass_properties.hpp"
 #include "core/collision/exit_speed_profile.hpp"
-#include "core/mass_properties.hpp"
 #include "core/summary.hpp"
 
 namespace sweetspot::core {

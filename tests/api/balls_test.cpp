@@ -6,7 +6,7 @@
 #include <string>
 
 #include "api/router.hpp"
-#include "core/ball_catalogue.hpp"
+#include "core/ball/ball_catalogue.hpp"
 
 namespace sweetspot::api {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).

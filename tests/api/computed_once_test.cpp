@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "api/router.hpp"
-#include "core/mass_properties.hpp"
+#include "core/bat/mass_properties.hpp"
 
 namespace sweetspot::api {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -72,8 +72,7 @@ const std::vector<Case>& Cases() {
       {"sweet_spot_least_sting", "/v1/sweet-spot",
        R"({"bat": {"preset": "wood-34-ash"}, "outputs": ["least_sting_zone"]})", 200, 1},
       {"sweet_spot_bbcor_scan", "/v1/sweet-spot",
-       R"({"bat": {"preset": "bbcor-33-aluminium"}, "outputs": ["bbcor", "bbcor_scan"]})", 200,
-       1},
+       R"({"bat": {"preset": "bbcor-33-aluminium"}, "outputs": ["bbcor", "bbcor_scan"]})", 200, 1},
       {"collision_flexible", "/v1/collision",
        R"({"bat": {"preset": "wood-34-ash"}, "impact_from_knob_m": 0.70, "model": "flexible"})",
        200, 1},

@@ -1,8 +1,8 @@
-// The typed-endpoint driver (api/endpoint.hpp): a refused body or request never reaches
+// The typed-endpoint driver (api/handlers/endpoint.hpp): a refused body or request never reaches
 // the core call, a failure is answered before rendering, a 200 carries timing_s (and the
 // summary and provenance the endpoint declares), unmet targets are a 422 with the answer as
 // "closest", and an exception from a core call reaches the router's one catch (500).
-#include "api/endpoint.hpp"
+#include "api/handlers/endpoint.hpp"
 
 #include <gtest/gtest.h>
 

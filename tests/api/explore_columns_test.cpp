@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "api/explore_columns.hpp"
-#include "api/explore_shards.hpp"
+#include "api/explore/columns.hpp"
+#include "api/explore/shards.hpp"
 #include "api/router.hpp"
 
 namespace sweetspot::api {

@@ -1,4 +1,4 @@
-// The sweep engine (api/explore_engine.hpp): its rows are the JSON path's, byte for byte, in
+// The sweep engine (api/explore/engine.hpp): its rows are the JSON path's, byte for byte, in
 // every format, for every path it binds and every column it reads directly, for feasible and
 // failing designs alike; and they do not depend on the number of threads.
 #include <gtest/gtest.h>
@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "api/explore_engine.hpp"
+#include "api/explore/engine.hpp"
 #include "api/router.hpp"
 #include "api/thread_budget.hpp"
-#include "core/sampling.hpp"
+#include "core/explore/sampling.hpp"
 
 namespace sweetspot::api {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -247,19 +247,20 @@ TEST(ExploreEngineTest, ParetoFrontCutAsItGrowsEqualsTheFrontOfAllTheRows) {
   std::vector<std::vector<double>> points;
   std::vector<std::uint64_t> index;
   sweep.pareto_cut_min = 1u << 30;  // no cut before the end
-  const SweepOutcome whole = RunSweep(sweep, RowFormat::kCsv, columns, nullptr, [&](BlockRows& rows) {
-    std::size_t pos = 0;
-    while (pos < rows.text.size()) {
-      const std::size_t end = rows.text.find('\n', pos);
-      unsigned long long i = 0;
-      double v = 0.0, m = 0.0;
-      EXPECT_EQ(std::sscanf(rows.text.c_str() + pos, "%llu,%lf,%lf", &i, &v, &m), 3);
-      points.push_back({v, m});  // %lf reads the shortest round-trip text back exactly
-      index.push_back(i);
-      pos = end + 1;
-    }
-    return true;
-  });
+  const SweepOutcome whole =
+      RunSweep(sweep, RowFormat::kCsv, columns, nullptr, [&](BlockRows& rows) {
+        std::size_t pos = 0;
+        while (pos < rows.text.size()) {
+          const std::size_t end = rows.text.find('\n', pos);
+          unsigned long long i = 0;
+          double v = 0.0, m = 0.0;
+          EXPECT_EQ(std::sscanf(rows.text.c_str() + pos, "%llu,%lf,%lf", &i, &v, &m), 3);
+          points.push_back({v, m});  // %lf reads the shortest round-trip text back exactly
+          index.push_back(i);
+          pos = end + 1;
+        }
+        return true;
+      });
   ASSERT_EQ(points.size(), 12000u);
   Json expected = Json::array();
   for (const std::size_t k :
@@ -300,8 +301,8 @@ TEST(ExploreEngineTest, LinkedAndScaledPathsSetEveryFieldAndMatchTheJsonPath) {
                {"max", 1.1},
                {"count", 2}}}},
             {"outputs", {"properties", "max_exit_speed"}}};
-  const std::string rows = ExpectSameRows(body, true,
-                                          Json{"parameters.handle_scale", "properties.mass_kg"});
+  const std::string rows =
+      ExpectSameRows(body, true, Json{"parameters.handle_scale", "properties.mass_kg"});
   ASSERT_FALSE(rows.empty());
   // Design 0: barrel radius 0.030 m on both knots, the handle scaled by 0.9.
   const Json row = Json::parse(rows.substr(0, rows.find('\n')));
@@ -312,8 +313,8 @@ TEST(ExploreEngineTest, LinkedAndScaledPathsSetEveryFieldAndMatchTheJsonPath) {
   single["profile"]["knots"][3]["radius_m"] = 0.030;
   single["profile"]["knots"][0]["radius_m"] = 0.0125 * 0.9;
   single["profile"]["knots"][1]["radius_m"] = 0.0125 * 0.9;
-  const Response one = Dispatch({"POST", "/v1/bat/properties", Json{{"bat", single}}.dump()},
-                                Context{});
+  const Response one =
+      Dispatch({"POST", "/v1/bat/properties", Json{{"bat", single}}.dump()}, Context{});
   ASSERT_EQ(one.status, 200) << one.body.dump();
   EXPECT_EQ(row["properties"]["mass_kg"], one.body["mass_kg"]);  // the same bat, bit for bit
 

@@ -1,12 +1,12 @@
-// /v1/explore's estimate before the first design (api/explore_estimate.hpp): a synchronous JSON
+// /v1/explore's estimate before the first design (api/explore/estimate.hpp): a synchronous JSON
 // answer over max_response_bytes is a 413 naming the designs, the curve points, the estimate
 // and the limit (issue "Under attack, bounded", item 4: 100,000 designs x 10,000 curve samples,
 // a 162-byte body, ended the server); streamed formats are not bounded by it; the estimate is
 // close to the bytes a sweep really answers.
 #include <gtest/gtest.h>
 
-#include "api/explore_engine.hpp"
-#include "api/explore_estimate.hpp"
+#include "api/explore/engine.hpp"
+#include "api/explore/estimate.hpp"
 #include "api/router.hpp"
 
 namespace sweetspot::api {

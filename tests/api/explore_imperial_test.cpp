@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "api/explore_shards.hpp"
+#include "api/explore/shards.hpp"
 #include "api/router.hpp"
 
 namespace sweetspot::api {

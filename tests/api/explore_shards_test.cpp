@@ -1,7 +1,7 @@
 // MergeExploreShards: the NDJSON outputs of a sweep's shards merge into the
 // unsharded sweep's NDJSON, row for row and in the summary (but timing_s);
 // shards that do not make one complete sweep are refused with the reason.
-#include "api/explore_shards.hpp"
+#include "api/explore/shards.hpp"
 
 #include <gtest/gtest.h>
 
@@ -117,7 +117,7 @@ TEST(ExploreShardsTest, ShardsThatDoNotMakeOneCompleteSweepAreRefusedWithTheReas
   std::vector<ShardOutput> missing = {shards[0], shards[2]};
   MergedSweep r = MergeExploreShards(missing);
   EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.error, "the shards are incomplete: 2 of 3 given; missing shard(s) 1");
+  EXPECT_EQ(r.error, "the shards are incomplete: shard 1 of 3 missing (2 of 3 given)");
 
   std::vector<ShardOutput> repeated = {shards[0], shards[1], shards[1]};
   r = MergeExploreShards(repeated);

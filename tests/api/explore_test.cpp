@@ -4,7 +4,7 @@
 #include <map>
 #include <set>
 
-#include "api/explore_design.hpp"
+#include "api/explore/design.hpp"
 #include "api/json_path.hpp"
 #include "api/router.hpp"
 
@@ -51,7 +51,8 @@ TEST(ExploreTest, GridRowsMatchSingleRequests) {
 TEST(ExploreTest, UnionOfShardsEqualsTheUnshardedSweepRowForRow) {
   for (const char* sampling : {"grid", "lhs", "sobol"}) {
     Json body = CorkSweep();
-    body["parameters"].push_back({{"path", "ball.speed_mps"}, {"min", 20}, {"max", 40}, {"count", 3}});
+    body["parameters"].push_back(
+        {{"path", "ball.speed_mps"}, {"min", 20}, {"max", 40}, {"count", 3}});
     body["sampling"] = sampling;
     if (std::string(sampling) != "grid") {
       body["samples"] = 40;
@@ -124,8 +125,8 @@ TEST(ExploreTest, RowsWithoutAnImpactNeedNoCor) {
       "material": {"density_kg_m3": 649, "youngs_modulus_pa": 1.814e10}},
       "parameters": [{"path": "material.density_kg_m3", "min": 600, "max": 700, "count": 2}],
       "outputs": ["properties"]})");
-  for (const Json& outputs : {Json::array({"properties"}),
-                              Json::array({"properties", "center_of_percussion"})}) {
+  for (const Json& outputs :
+       {Json::array({"properties"}), Json::array({"properties", "center_of_percussion"})}) {
     body["outputs"] = outputs;
     const Response r = Explore(body);
     ASSERT_EQ(r.status, 200) << r.body.dump();
@@ -133,10 +134,8 @@ TEST(ExploreTest, RowsWithoutAnImpactNeedNoCor) {
     ASSERT_EQ(r.body["rows"].size(), 2u);
     // The mass scales with the density (no fill, solid): 1.0078 kg at 649 kg/m3 (paper-wood),
     // so 1.0078 * 600 / 649 and 1.0078 * 700 / 649, to the 1e-4 of the preset's rounding.
-    EXPECT_NEAR(r.body["rows"][0]["properties"]["mass_kg"].get<double>(), 1.0078 * 600 / 649,
-                1e-4);
-    EXPECT_NEAR(r.body["rows"][1]["properties"]["mass_kg"].get<double>(), 1.0078 * 700 / 649,
-                1e-4);
+    EXPECT_NEAR(r.body["rows"][0]["properties"]["mass_kg"].get<double>(), 1.0078 * 600 / 649, 1e-4);
+    EXPECT_NEAR(r.body["rows"][1]["properties"]["mass_kg"].get<double>(), 1.0078 * 700 / 649, 1e-4);
     EXPECT_EQ(r.body["rows"][0].contains("center_of_percussion"), outputs.size() == 2);
   }
   // An exit-speed row still needs one: a failed row with the same refusal.
@@ -183,7 +182,8 @@ TEST(ExploreTest, ParetoFrontOverTwoObjectives) {
   for (const auto& a : rows) {
     bool dominated = false;
     for (const auto& b : rows) {
-      const double va = a["max_exit_speed"]["exit_speed_mps"], vb = b["max_exit_speed"]["exit_speed_mps"];
+      const double va = a["max_exit_speed"]["exit_speed_mps"],
+                   vb = b["max_exit_speed"]["exit_speed_mps"];
       const double ma = a["properties"]["mass_kg"], mb = b["properties"]["mass_kg"];
       dominated = dominated || (vb >= va && mb <= ma && (vb > va || mb < ma));
     }
@@ -371,8 +371,11 @@ TEST(JsonPathTest, ParsesSetsAndRefuses) {
   ASSERT_TRUE(steps.has_value()) << why;
   ASSERT_EQ(steps->size(), 4u);
   EXPECT_EQ(std::get<std::size_t>((*steps)[2]), 3u);
-  Json doc = {{"profile", {{"knots", Json::array({{{"radius_m", 1}}, {{"radius_m", 2}},
-                                                  {{"radius_m", 3}}, {{"radius_m", 4}}})}}}};
+  Json doc = {
+      {"profile",
+       {{"knots",
+         Json::array(
+             {{{"radius_m", 1}}, {{"radius_m", 2}}, {{"radius_m", 3}}, {{"radius_m", 4}}})}}}};
   EXPECT_TRUE(SetNumberAtPath(&doc, *steps, 0.5, &why)) << why;
   EXPECT_EQ(doc["profile"]["knots"][3]["radius_m"], 0.5);
   EXPECT_EQ(NumberAtPath(doc, *steps, &why), 0.5);

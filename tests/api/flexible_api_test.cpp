@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "api/handlers_modes.hpp"
+#include "api/handlers/modes.hpp"
 #include "api/router.hpp"
 #include "core/flexible/modes_cache.hpp"
 

@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-#include "api/handlers.hpp"
+#include "api/handlers/handlers.hpp"
 #include "api/job_service.hpp"
 #include "api/router.hpp"
 #include "tests/contract_example.hpp"

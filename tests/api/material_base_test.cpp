@@ -7,7 +7,7 @@
 #include <string>
 
 #include "api/router.hpp"
-#include "core/material.hpp"
+#include "core/bat/material.hpp"
 
 namespace sweetspot::api {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -62,8 +62,9 @@ TEST(MaterialBaseTest, BaseInheritsEverythingElse) {
   // Only the density overridden: the mass scales with it exactly, every other field is the
   // base's (the flexible beam's frequency uses E and G: equal E/rho ratio check below).
   const core::Material maple = *core::FindMaterial("hard-maple");
-  const Response base = Post("/v1/bat/properties",
-                             {{"bat", ThreeSegment({{"base", "hard-maple"}, {"density_kg_m3", 650}})}});
+  const Response base =
+      Post("/v1/bat/properties",
+           {{"bat", ThreeSegment({{"base", "hard-maple"}, {"density_kg_m3", 650}})}});
   const Response named = Post("/v1/bat/properties", {{"bat", ThreeSegment("hard-maple")}});
   ASSERT_EQ(base.status, 200) << base.body.dump();
   const double ratio = 650.0 / maple.density_kg_m3;
@@ -71,9 +72,9 @@ TEST(MaterialBaseTest, BaseInheritsEverythingElse) {
   EXPECT_NEAR(base.body["mass_kg"].get<double>(), ratio * named.body["mass_kg"].get<double>(),
               1e-14 * named.body["mass_kg"].get<double>());
   // COR inherited: a scene takes the base's 0.5 (a custom object without cor has none).
-  const Response scene = Post("/v1/collision", {{"bat", ThreeSegment({{"base", "maple"},
-                                                                       {"density_kg_m3", 650}})},
-                                                {"impact_from_knob_m", 0.7}});
+  const Response scene =
+      Post("/v1/collision", {{"bat", ThreeSegment({{"base", "maple"}, {"density_kg_m3", 650}})},
+                             {"impact_from_knob_m", 0.7}});
   ASSERT_EQ(scene.status, 200) << scene.body.dump();
   EXPECT_EQ(scene.body["cor"], 0.5);
   EXPECT_EQ(scene.body["cor_source"], "material:custom");
@@ -83,11 +84,11 @@ TEST(MaterialBaseTest, BaseInheritsEverythingElse) {
                         {"shear_modulus_pa", maple.shear_modulus_pa},
                         {"poissons_ratio", maple.poissons_ratio},
                         {"cor", 0.5}};
-  const Response a = Post("/v1/sweet-spot", {{"bat", ThreeSegment({{"base", "hard-maple"},
-                                                                   {"density_kg_m3", 650}})},
-                                             {"outputs", {"vibration_node"}}});
-  const Response b = Post("/v1/sweet-spot", {{"bat", ThreeSegment(written)},
-                                             {"outputs", {"vibration_node"}}});
+  const Response a = Post("/v1/sweet-spot",
+                          {{"bat", ThreeSegment({{"base", "hard-maple"}, {"density_kg_m3", 650}})},
+                           {"outputs", {"vibration_node"}}});
+  const Response b =
+      Post("/v1/sweet-spot", {{"bat", ThreeSegment(written)}, {"outputs", {"vibration_node"}}});
   ASSERT_EQ(a.status, 200) << a.body.dump();
   ASSERT_EQ(b.status, 200) << b.body.dump();
   // The same numbers reach the same computation: bit-identical.
@@ -95,8 +96,8 @@ TEST(MaterialBaseTest, BaseInheritsEverythingElse) {
 }
 
 TEST(MaterialBaseTest, UnknownBaseNamesFieldValueAndList) {
-  const Response r =
-      Post("/v1/bat/properties", {{"bat", ThreeSegment({{"base", "oak"}, {"density_kg_m3", 650}})}});
+  const Response r = Post("/v1/bat/properties",
+                          {{"bat", ThreeSegment({{"base", "oak"}, {"density_kg_m3", 650}})}});
   EXPECT_EQ(r.status, 400);
   EXPECT_EQ(r.body["field"], "bat.material.base");
   const std::string message = r.body["message"];
@@ -107,13 +108,13 @@ TEST(MaterialBaseTest, UnknownBaseNamesFieldValueAndList) {
 TEST(MaterialBaseTest, MlbWoodChecksKindAndSpeciesNotName) {
   // Based on hard-maple, named otherwise: wood of an allowed species.
   const Response maple =
-      Post("/v1/optimize", Optimize({{"base", "hard-maple"}, {"name", "hard-maple-30oz"},
-                                     {"density_kg_m3", 650}}));
+      Post("/v1/optimize",
+           Optimize({{"base", "hard-maple"}, {"name", "hard-maple-30oz"}, {"density_kg_m3", 650}}));
   EXPECT_EQ(maple.status, 200) << maple.body.dump();
   EXPECT_EQ(Post("/v1/optimize", Optimize("birch")).status, 200);
   // A metal base: refused on bat.material whatever it is called.
-  const Response metal = Post("/v1/optimize", Optimize({{"base", "aluminium-7050"},
-                                                        {"name", "hard-maple"}}));
+  const Response metal =
+      Post("/v1/optimize", Optimize({{"base", "aluminium-7050"}, {"name", "hard-maple"}}));
   EXPECT_EQ(metal.status, 400);
   EXPECT_EQ(metal.body["field"], "bat.material");
   EXPECT_NE(metal.body["message"].get<std::string>().find("of kind metal"), std::string::npos)

@@ -15,6 +15,24 @@ TEST(RouterTest, HealthAnswersOk) {
   EXPECT_EQ(route, "/health");
 }
 
+TEST(RouterTest, ReadyAnswersReadyAnd503WhileDraining) {
+  std::string route;
+  const Response ready = Dispatch({"GET", "/ready", ""}, Context{}, &route);
+  EXPECT_EQ(ready.status, 200);
+  EXPECT_EQ(ready.body, nlohmann::json({{"status", "ready"}}));
+  EXPECT_EQ(route, "/ready");
+  Context draining;
+  draining.draining = [] { return true; };
+  const Response refused = Dispatch({"GET", "/ready", ""}, draining);
+  EXPECT_EQ(refused.status, 503);
+  EXPECT_EQ(refused.body["code"], "Unavailable");
+  EXPECT_EQ(refused.body["message"],
+            "draining: the server is stopping; it still answers until its drain period "
+            "(--drain-s) ends, then stops accepting connections");
+  draining.draining = [] { return false; };
+  EXPECT_EQ(Dispatch({"GET", "/ready", ""}, draining).status, 200);
+}
+
 TEST(RouterTest, UnknownPathIs404WithEnvelope) {
   std::string route;
   const Response response = Dispatch({"GET", "/nope", ""}, Context{}, &route);

@@ -1,7 +1,7 @@
-// The ball catalogue (core/ball_catalogue.hpp): its numbers against the cited rule books and
+// The ball catalogue (core/ball/ball_catalogue.hpp): its numbers against the cited rule books and
 // test conditions, the COR law (monotone, clamped), the stiffness conversions, and how a scene
 // takes its COR from a ball preset (cor_source) while scenes without one are unchanged.
-#include "core/ball_catalogue.hpp"
+#include "core/ball/ball_catalogue.hpp"
 
 #include <cmath>
 #include <set>
@@ -10,8 +10,8 @@
 
 #include "tests/refusal_text.hpp"
 
-#include "core/collision/collide.hpp"
-#include "core/presets.hpp"
+#include "core/bat/presets.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {

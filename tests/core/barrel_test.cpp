@@ -9,8 +9,8 @@
 
 #include "tests/refusal_text.hpp"
 
-#include "core/ball_catalogue.hpp"
-#include "core/presets.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/units.hpp"
 

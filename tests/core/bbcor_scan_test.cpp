@@ -9,10 +9,10 @@
 
 #include <gtest/gtest.h>
 
-#include "core/ball_catalogue.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/presets.hpp"
 #include "core/flexible/modes.hpp"
-#include "core/mass_properties.hpp"
-#include "core/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/scene/scene.hpp"
 

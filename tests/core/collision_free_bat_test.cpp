@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "core/collision/rigid_pivot.hpp"
-#include "core/optimize/nlopt_search.hpp"
+#include "core/numerics/nlopt_search.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 #include "core/units.hpp"
 

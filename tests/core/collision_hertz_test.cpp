@@ -7,8 +7,8 @@
 
 #include "tests/refusal_text.hpp"
 
-#include "core/collision/collide.hpp"
-#include "core/presets.hpp"
+#include "core/bat/presets.hpp"
+#include "core/scene/collide.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).

@@ -4,11 +4,11 @@
 
 #include <gtest/gtest.h>
 
-#include "core/ball_catalogue.hpp"
-#include "core/mass_properties.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/presets.hpp"
 #include "core/optimize/design_cor.hpp"
 #include "core/optimize/design_problem.hpp"
-#include "core/presets.hpp"
 #include "core/scene/sanity.hpp"
 #include "core/scene/scene.hpp"
 
@@ -68,9 +68,10 @@ TEST(DesignCorTest, AHollowDesignRecomputesItsBarrelsCorForEveryDesign) {
   EXPECT_EQ(policy.kind, DesignCorPolicyKind::kBarrelPerDesign);
   EXPECT_TRUE(c.problem.cor_from_barrel);
   EXPECT_FALSE(c.problem.cor.has_value());
-  EXPECT_EQ(policy.Describe("aluminium").rfind("barrel:mlb recomputed for every design at 0.1524 "
-                                               "m from its tip",
-                                               0),
+  EXPECT_EQ(policy.Describe("aluminium")
+                .rfind("barrel:mlb recomputed for every design at 0.1524 "
+                       "m from its tip",
+                       0),
             0u)
       << policy.Describe("aluminium");
 }

@@ -8,12 +8,12 @@
 
 #include "tests/refusal_text.hpp"
 
-#include "core/ball_catalogue.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/presets.hpp"
 #include "core/collision/barrel.hpp"
 #include "core/collision/contact_law.hpp"
 #include "core/collision/flexible_impact.hpp"
 #include "core/flexible/modes.hpp"
-#include "core/presets.hpp"
 #include "core/scene/scene.hpp"
 
 namespace sweetspot::core {

@@ -11,12 +11,12 @@
 #include <Eigen/Eigenvalues>
 #include "tests/refusal_text.hpp"
 
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/flexible/beam_model.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/flexible/static_flexibility.hpp"
-#include "core/material.hpp"
-#include "core/presets.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {

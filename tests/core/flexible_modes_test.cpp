@@ -15,9 +15,9 @@
 #include <Eigen/Eigenvalues>
 #include "tests/refusal_text.hpp"
 
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/presets.hpp"
 #include "core/flexible/beam_model.hpp"
-#include "core/mass_properties.hpp"
-#include "core/presets.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -339,7 +339,7 @@ struct FormerModes {
   BeamTheory theory;
   int elements;
   std::vector<double> frequencies_hz;
-  std::vector<double> first_node_m;  // nodes_from_knob_m.front() of every mode
+  std::vector<double> first_node_m;      // nodes_from_knob_m.front() of every mode
   std::vector<double> tip_displacement;  // Displacement(vector, L): mass-normalised
 };
 

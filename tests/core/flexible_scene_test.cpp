@@ -9,9 +9,9 @@
 
 #include "tests/refusal_text.hpp"
 
-#include "core/collision/collide.hpp"
+#include "core/bat/presets.hpp"
 #include "core/flexible/modes_cache.hpp"
-#include "core/presets.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {

@@ -10,9 +10,9 @@
 
 #include "tests/refusal_text.hpp"
 
-#include "core/bat.hpp"
-#include "core/material.hpp"
-#include "core/presets.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/sweet_spot/numeric.hpp"
 

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "core/bat.hpp"
-#include "core/material.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/material.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).

@@ -5,11 +5,11 @@
 
 #include <gtest/gtest.h>
 
-#include "core/collision/collide.hpp"
+#include "core/bat/presets.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
-#include "core/optimize/nlopt_search.hpp"
-#include "core/presets.hpp"
+#include "core/numerics/nlopt_search.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 

@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "core/material.hpp"
+#include "core/bat/material.hpp"
 #include "core/optimize/design_problem.hpp"
 
 namespace sweetspot::core::hollow_design_problems {

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
-#include "core/presets.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).

@@ -1,6 +1,6 @@
 // Mass properties: analytic solids, Gauss-Legendre quadrature on random
 // profiles, the paper's numbers (shared/docs/paper-notes.md) and hard cases.
-#include "core/mass_properties.hpp"
+#include "core/bat/mass_properties.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <random>
 #include <vector>
 
-#include "core/bat.hpp"
-#include "core/material.hpp"
-#include "core/presets.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {

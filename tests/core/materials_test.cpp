@@ -8,7 +8,7 @@
 #include <set>
 #include <string>
 
-#include "core/material.hpp"
+#include "core/bat/material.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).

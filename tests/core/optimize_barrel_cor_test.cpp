@@ -14,15 +14,15 @@
 
 #include <gtest/gtest.h>
 
-#include "core/ball_catalogue.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 #include "core/collision/barrel.hpp"
-#include "core/material.hpp"
+#include "core/numerics/timing_book.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
-#include "core/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/scene/resolved_scene.hpp"
-#include "core/scene/timing_book.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 #include "tests/core/hollow_design_problems.hpp"
 

@@ -12,11 +12,11 @@
 
 #include <gtest/gtest.h>
 
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 #include "core/collision/barrel.hpp"
-#include "core/material.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
-#include "core/presets.hpp"
 #include "tests/core/hollow_design_problems.hpp"
 
 namespace sweetspot::core {

@@ -8,7 +8,7 @@
 #include <thread>
 #include <vector>
 
-#include "core/material.hpp"
+#include "core/bat/material.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "tests/sanitizers.hpp"
 

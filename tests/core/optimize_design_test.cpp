@@ -12,10 +12,10 @@
 #include <utility>
 #include <vector>
 
-#include "core/mass_properties.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 #include "core/optimize/design_model.hpp"
-#include "core/material.hpp"
-#include "core/presets.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -498,7 +498,9 @@ TEST(OptimizeInvalid, IllPosedRequestsAreRefusedByName) {
       "constraints.handle_region_from_knob_m[0] = -0.1: must be in [0, 100]");
   with(
       "grip alone",
-      [](DesignProblem& p) { p.constraints.handle_region_from_knob_m = std::pair{0.0, 0.3}; },
+      [](DesignProblem& p) {
+        p.constraints.handle_region_from_knob_m = std::pair{0.0, 0.3};
+      },
       "constraints.handle_region_from_knob_m: needs constraints.min_handle_diameter_m");
   with(
       "reference 0",
@@ -676,9 +678,9 @@ TEST(OptimizeObjectives, SwingWeightReferenceIsTheOneThatSwingsAtOmega0) {
   const double i6_base =
       ComputeMassProperties(MakeThreeSegmentBat(*p.three_segment, p.bat.material)).MoiSixInchKgM2();
   ASSERT_GT(std::abs(i6_base - 0.20), 1e-3);
-  EXPECT_GT(std::abs(r.angular_speed_rad_s - Swing{}.angular_speed_rad_s *
-                                                 std::pow(r.properties.MoiSixInchKgM2() / i6_base,
-                                                          -0.27)),
+  EXPECT_GT(std::abs(r.angular_speed_rad_s -
+                     Swing{}.angular_speed_rad_s *
+                         std::pow(r.properties.MoiSixInchKgM2() / i6_base, -0.27)),
             1e-3);
 }
 
@@ -698,10 +700,9 @@ TEST(OptimizeConstraints, HandleRegionBoundsOnlyTheKnotsThatReachTheGrip) {
   }
   // Knot 0 is fixed (not a variable) and meets the limit (its diameter 0.985 in), so it is
   // checked at build time and not added.
-  EXPECT_EQ(names, (std::vector<std::string>{"min_handle_diameter_m.knots[1]",
-                                             "min_handle_diameter_m.knots[2]",
-                                             "min_handle_diameter_m.knots[3]",
-                                             "min_handle_diameter_m.knots[4]"}));
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "min_handle_diameter_m.knots[1]", "min_handle_diameter_m.knots[2]",
+                       "min_handle_diameter_m.knots[3]", "min_handle_diameter_m.knots[4]"}));
   const DesignResult r = OptimizeDesign(p);
   ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.FullReport();
   // The profile is linear between knots: over the grip the diameter is at least 0.95 in (1e-8
@@ -732,8 +733,8 @@ TEST(OptimizeConstraints, HandleRegionBoundsOnlyTheKnotsThatReachTheGrip) {
     return out;
   };
   EXPECT_TRUE(handle_names(0.08).empty());
-  EXPECT_EQ(handle_names(0.2), (std::vector<std::string>{
-                                   "min_handle_diameter_m.three_segment.barrel_radius_m"}));
+  EXPECT_EQ(handle_names(0.2),
+            (std::vector<std::string>{"min_handle_diameter_m.three_segment.barrel_radius_m"}));
 }
 
 TEST(OptimizeMultiStart, CancellationAndTheTimeBudgetKeepTheBestDesign) {

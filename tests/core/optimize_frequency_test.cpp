@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
 #include "core/flexible/modes.hpp"
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "core/units.hpp"
@@ -79,8 +79,7 @@ void ExpectGradientMatches(const DesignProblem& p, const std::vector<double>& x)
     xm[jj] -= h;
     const double fd = (model.Value(f, xp.data()) - model.Value(f, xm.data())) / (2.0 * h);
     const double exact = point.jacobian(k, j);
-    EXPECT_NEAR(exact, fd, 1e-6 * std::abs(exact) + 1e-10 * f0 / h)
-        << model.variables()[jj].path;
+    EXPECT_NEAR(exact, fd, 1e-6 * std::abs(exact) + 1e-10 * f0 / h) << model.variables()[jj].path;
   }
 }
 

@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "core/ball_catalogue.hpp"
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
+#include "core/ball/ball_catalogue.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 #include "core/numerics/jet.hpp"
-#include "core/presets.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/scene/scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"

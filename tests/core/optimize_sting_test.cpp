@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "core/collision/collide.hpp"
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
 #include "core/optimize/design_problem.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {
@@ -295,9 +295,8 @@ TEST(OptimizeSting, AnImpossibleMassIsExplained) {
 // A discrete choice of material: the least sting wins (minimised, not maximised).
 TEST(OptimizeSting, TheMaterialWithTheLeastStingIsChosen) {
   const DesignProblem p = TaperEndProblem(0.70, 1.25);
-  const MaterialChoiceResult r =
-      OptimizeOverMaterials(p, {*FindMaterial("ash"), *FindMaterial("hard-maple")},
-                            StingTestOptions());
+  const MaterialChoiceResult r = OptimizeOverMaterials(
+      p, {*FindMaterial("ash"), *FindMaterial("hard-maple")}, StingTestOptions());
   ASSERT_EQ(r.per_material.size(), 2u);
   ASSERT_GE(r.best, 0);
   EXPECT_EQ(r.summary.backend, "nlopt:LN_COBYLA");

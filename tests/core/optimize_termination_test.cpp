@@ -1,7 +1,7 @@
-// The termination mapping of every backend (core/optimize/termination.hpp) and the NLopt
-// trampoline (core/optimize/nlopt_run.hpp): every NLopt result code and exception type, every
+// The termination mapping of every backend (core/numerics/termination.hpp) and the NLopt
+// trampoline (core/numerics/nlopt_run.hpp): every NLopt result code and exception type, every
 // Ipopt status, and the trampoline's stops (callback failure, cancellation, deadline).
-#include "core/optimize/termination.hpp"
+#include "core/numerics/termination.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 // The test throws NLopt's own exception types (header-only classes; no solver code runs).
 #include <nlopt.hpp>
 
-#include "core/optimize/nlopt_run.hpp"
+#include "core/numerics/nlopt_run.hpp"
 
 namespace sweetspot::core {
 namespace {

@@ -1,5 +1,5 @@
 // The paper's analyses regenerated (paper-notes.md section 2 gives every expected value).
-#include "core/paper_analyses.hpp"
+#include "core/scene/paper_analyses.hpp"
 
 #include <cmath>
 

@@ -7,8 +7,8 @@
 #include <set>
 #include <string>
 
-#include "core/mass_properties.hpp"
-#include "core/presets.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/presets.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {

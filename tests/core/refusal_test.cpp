@@ -7,13 +7,13 @@
 #include <cmath>
 #include <string>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/material.hpp"
 #include "core/collision/hertz_contact.hpp"
+#include "core/explore/sampling.hpp"
 #include "core/geometry_format.hpp"
-#include "core/material.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
-#include "core/sampling.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/scene/scene.hpp"
 

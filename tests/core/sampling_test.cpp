@@ -1,7 +1,7 @@
-#include "core/sampling.hpp"
+#include "core/explore/sampling.hpp"
 
-#include <boost/random/sobol.hpp>
 #include <gtest/gtest.h>
+#include <boost/random/sobol.hpp>
 
 #include "tests/refusal_text.hpp"
 

@@ -1,7 +1,7 @@
 // Scenes: validation, "model only what is needed", NLopt backend mapping and algorithms,
 // auto model choice, refusals, determinism across threads.
-#include "core/collision/collide.hpp"
 #include "core/scene/closed_form_designs.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 
 #include <cmath>
@@ -13,8 +13,8 @@
 
 #include "tests/refusal_text.hpp"
 
-#include "core/optimize/nlopt_search.hpp"
-#include "core/presets.hpp"
+#include "core/bat/presets.hpp"
+#include "core/numerics/nlopt_search.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -387,8 +387,8 @@ std::string Describe(const SceneResult& r) {
   std::ostringstream o;
   o.precision(17);
   const Summary& s = r.summary;
-  o << TerminationName(s.termination) << '|' << s.message << '|' << s.backend << '|'
-    << s.raw_status << '|' << s.iterations << '|' << s.evaluations << '|' << s.objective << '|'
+  o << TerminationName(s.termination) << '|' << s.message << '|' << s.backend << '|' << s.raw_status
+    << '|' << s.iterations << '|' << s.evaluations << '|' << s.objective << '|'
     << s.constraint_violation << '|' << s.error_estimate << '|' << s.refusal.has_value() << '|';
   for (const auto& m : s.models_used) o << m << ',';
   for (const auto& w : s.warnings) o << w << ',';
@@ -396,9 +396,9 @@ std::string Describe(const SceneResult& r) {
     << r.cor_source << '|' << r.mass_properties.mass_kg << '|' << r.mass_properties.balance_point_m
     << '|' << r.length_m << '|' << r.exit_speed_model << '|' << r.model_reason << '|';
   if (r.max_exit_speed) {
-    o << "max " << r.max_exit_speed->position_from_knob_m << ' '
-      << r.max_exit_speed->exit_speed_mps << ' ' << r.max_exit_speed->model << ' '
-      << r.max_exit_speed->method << ' ' << r.max_exit_speed->summary.message;
+    o << "max " << r.max_exit_speed->position_from_knob_m << ' ' << r.max_exit_speed->exit_speed_mps
+      << ' ' << r.max_exit_speed->model << ' ' << r.max_exit_speed->method << ' '
+      << r.max_exit_speed->summary.message;
   }
   if (r.center_of_percussion) o << "|cop " << r.center_of_percussion->position_from_knob_m;
   if (r.sweet_zone) o << "|zone " << r.sweet_zone->to_knob_m;
@@ -429,8 +429,8 @@ TEST(SceneEvaluatorReuse, EachResultEqualsAFreshEvaluation) {
   Scene given_cor = PaperWood();
   given_cor.cor = 0.45;
   int compared = 0;
-  for (const Scene* scene : {&all, &refused, &all, &no_bat, &cop_beyond, &given_cor, &all,
-                             &refused, &given_cor}) {
+  for (const Scene* scene :
+       {&all, &refused, &all, &no_bat, &cop_beyond, &given_cor, &all, &refused, &given_cor}) {
     evaluator.Evaluate(*scene, &reused);
     EXPECT_EQ(Describe(reused), Describe(EvaluateScene(*scene, o))) << "scene " << compared;
     ++compared;

@@ -1,5 +1,5 @@
 // Shape fit: the paper's infeasible Table 2, exact fits, refusals, threads.
-#include "core/shape_fit.hpp"
+#include "core/optimize/shape_fit.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,9 +9,9 @@
 #include <thread>
 #include <vector>
 
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
-#include "core/presets.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).

@@ -5,9 +5,9 @@
 
 #include <gtest/gtest.h>
 
-#include "core/collision/collide.hpp"
+#include "core/bat/presets.hpp"
 #include "core/collision/rigid_pivot.hpp"
-#include "core/presets.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 
 namespace sweetspot::core {

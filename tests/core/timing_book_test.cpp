@@ -1,6 +1,6 @@
-// The frame of a timed solve (core/scene/timing_book.hpp): TimedSolve and TimedRequest fill
+// The frame of a timed solve (core/numerics/timing_book.hpp): TimedSolve and TimedRequest fill
 // the time, the timings and the models used however the body ends, and let no exception out.
-#include "core/scene/timing_book.hpp"
+#include "core/numerics/timing_book.hpp"
 
 #include <stdexcept>
 #include <string>
@@ -32,9 +32,8 @@ TEST(TimingBookTest, AddsPerModelInFirstUseOrder) {
 }
 
 TEST(TimingBookTest, TimedSolveStartsAsInvalidInputAndTimesTheBody) {
-  const FakeResult refused = TimedSolve<FakeResult>([](FakeResult& out) {
-    out.summary.message = "x = -1: must be positive";
-  });
+  const FakeResult refused = TimedSolve<FakeResult>(
+      [](FakeResult& out) { out.summary.message = "x = -1: must be positive"; });
   EXPECT_EQ(refused.summary.termination, Termination::kInvalidInput);
   EXPECT_EQ(refused.summary.message, "x = -1: must be positive");
   EXPECT_GE(refused.summary.solve_time_s, 0.0);

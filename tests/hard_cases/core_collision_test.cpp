@@ -1,5 +1,5 @@
 // Hard cases of the collision models and sweet spots (core/collision/*, core/sweet_spot.*,
-// core/optimize/nlopt_search.*, core/scene.*): extreme masses, speeds and CORs against long double
+// core/numerics/nlopt_search.*, core/scene.*): extreme masses, speeds and CORs against long double
 // closed forms, stiff and soft contacts against the exact power-law contact, and every NLopt
 // algorithm on a flat objective.
 #include <gtest/gtest.h>
@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "core/collision/collide.hpp"
+#include "core/bat/presets.hpp"
 #include "core/collision/free_bat.hpp"
 #include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
-#include "core/optimize/nlopt_search.hpp"
-#include "core/presets.hpp"
+#include "core/numerics/nlopt_search.hpp"
+#include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 #include "tests/hard_cases/hard_case.hpp"

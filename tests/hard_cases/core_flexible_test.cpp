@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "core/bat.hpp"
-#include "core/collision/collide.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 #include "core/flexible/modes.hpp"
-#include "core/material.hpp"
-#include "core/presets.hpp"
+#include "core/scene/collide.hpp"
 #include "tests/hard_cases/hard_case.hpp"
 #include "tests/hard_cases/reference.hpp"
 

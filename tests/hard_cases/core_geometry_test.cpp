@@ -1,5 +1,6 @@
-// Hard cases of the bat geometry and its mass properties (core/bat.*, core/mass_properties.*,
-// core/sweet_spot.* centre of percussion), against the long double reference of reference.hpp.
+// Hard cases of the bat geometry and its mass properties (core/bat/bat.*,
+// core/bat/mass_properties.*, core/sweet_spot.* centre of percussion), against the long double
+// reference of reference.hpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "core/bat.hpp"
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
-#include "core/presets.hpp"
+#include "core/bat/bat.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
+#include "core/bat/presets.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 #include "tests/hard_cases/hard_case.hpp"

@@ -1,16 +1,16 @@
-// Hard cases of the solvers that design bats: the shape fit (core/shape_fit.*) and the design
-// optimisation (core/optimize/*, Ipopt and NLopt SLSQP): starts far from feasible, infeasible
-// requests, flat objectives, parameters across nine decades, budgets too small.
+// Hard cases of the solvers that design bats: the shape fit (core/optimize/shape_fit.*) and the
+// design optimisation (core/optimize/*, Ipopt and NLopt SLSQP): starts far from feasible,
+// infeasible requests, flat objectives, parameters across nine decades, budgets too small.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 #include <vector>
 
-#include "core/mass_properties.hpp"
-#include "core/material.hpp"
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
 #include "core/optimize/design_problem.hpp"
-#include "core/shape_fit.hpp"
+#include "core/optimize/shape_fit.hpp"
 #include "tests/hard_cases/hard_case.hpp"
 #include "tests/hard_cases/reference.hpp"
 

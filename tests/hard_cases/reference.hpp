@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "core/bat.hpp"
+#include "core/bat/bat.hpp"
 
 namespace sweetspot::hard_cases {
 

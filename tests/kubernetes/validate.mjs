@@ -3,14 +3,19 @@
 // apiVersion and kind; an unknown kind fails), then the project's rules for
 // pods: non-root, a RuntimeDefault seccomp profile, and each container with a
 // read-only root filesystem, no privilege escalation, all capabilities
-// dropped, and CPU and memory requests and limits.
+// dropped, and CPU and memory requests and limits. A kustomization
+// (kustomize.config.k8s.io Kustomization or Component, which no API server
+// knows) is checked instead for what `kubectl apply -k` needs: its resources and
+// components exist, every image is pinned by a sha256 digest, and every
+// replacement's source and targets name an object of its resources.
 //
 //   node validate.mjs FILE.yaml...
 //
 // Run from a folder where `npm ci` installed package-lock.json's packages (the
 // build copies this file there: build/tests/kubernetes/). Prints one line per
 // document and exits 1 if any fails.
-import { readFileSync } from "node:fs";
+import { existsSync, readFileSync, statSync } from "node:fs";
+import { dirname, join } from "node:path";
 import { parseAllDocuments } from "yaml";
 
 const files = process.argv.slice(2);
@@ -62,6 +67,57 @@ function podRules(pod) {
   return problems;
 }
 
+// The objects ({kind, name}) of a kustomization's resources (files or folders with
+// their own kustomization.yaml), for its replacements.
+function objectsOf(folder, doc) {
+  const objects = [];
+  for (const resource of doc.resources ?? []) {
+    const path = join(folder, resource);
+    if (!existsSync(path) || statSync(path).isDirectory()) continue;
+    for (const parsed of parseAllDocuments(readFileSync(path, "utf8"))) {
+      const object = parsed.toJS();
+      if (object?.kind) objects.push({ kind: object.kind, name: object.metadata?.name });
+    }
+  }
+  return objects;
+}
+
+function kustomizationRules(file, doc) {
+  const problems = [];
+  if (!["Kustomization", "Component"].includes(doc.kind)) {
+    return [`unknown kustomize kind ${doc.kind}`];
+  }
+  const folder = dirname(file);
+  for (const entry of [...(doc.resources ?? []), ...(doc.components ?? [])]) {
+    const path = join(folder, entry);
+    if (!existsSync(path)) {
+      problems.push(`${entry} does not exist`);
+    } else if (statSync(path).isDirectory() && !existsSync(join(path, "kustomization.yaml"))) {
+      problems.push(`${entry}/kustomization.yaml does not exist`);
+    }
+  }
+  for (const image of doc.images ?? []) {
+    if (!image.name) problems.push("an images entry without a name");
+    if (!/^sha256:[0-9a-f]{64}$/.test(image.digest ?? "")) {
+      problems.push(`image ${image.name}: must be pinned by a digest (sha256:<64 hex>), not ${image.newTag ?? "a tag"}`);
+    }
+  }
+  const objects = objectsOf(folder, doc);
+  const known = (select) =>
+    objects.some((o) => o.kind === select?.kind && (select?.name === undefined || o.name === select.name));
+  for (const replacement of doc.replacements ?? []) {
+    if (!known(replacement.source)) {
+      problems.push(`replacement source ${replacement.source?.kind}/${replacement.source?.name} is not among the resources`);
+    }
+    for (const target of replacement.targets ?? []) {
+      if (!known(target.select)) {
+        problems.push(`replacement target ${target.select?.kind}/${target.select?.name} is not among the resources`);
+      }
+    }
+  }
+  return problems;
+}
+
 let failed = 0;
 let documents = 0;
 for (const file of files) {
@@ -77,6 +133,16 @@ for (const file of files) {
     documents++;
     const name = `${file}: ${doc.kind ?? "?"}/${doc.metadata?.name ?? "?"}`;
     const problems = [];
+    if ((doc.apiVersion ?? "").startsWith("kustomize.config.k8s.io/")) {
+      problems.push(...kustomizationRules(file, doc));
+      if (problems.length > 0) {
+        failed++;
+        console.log(`FAIL ${name}\n  ${problems.join("\n  ")}`);
+      } else {
+        console.log(`ok   ${name}`);
+      }
+      continue;
+    }
     const models = await modelsOf(doc.apiVersion ?? "");
     const Model = models?.[doc.kind];
     if (!Model) {

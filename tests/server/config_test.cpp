@@ -125,6 +125,22 @@ TEST(ConfigTest, BadValuesNameFlagValueAndRule) {
   EXPECT_EQ(Parse({"--port"}).error, "option --port needs a value");
 }
 
+TEST(ConfigTest, DrainSecondsFromFlagsAndEnvironment) {
+  EXPECT_EQ(ServerConfig{}.drain_s, 0.0);  // stop accepting at once unless told otherwise
+  EXPECT_EQ(Parse({}, {{"SWEETSPOT_DRAIN_S", "5"}}).config.drain_s, 5.0);
+  EXPECT_EQ(Parse({"--drain-s", "1.5"}, {{"SWEETSPOT_DRAIN_S", "5"}}).config.drain_s, 1.5);
+  EXPECT_EQ(Parse({"--drain-s", "0"}).config.drain_s, 0.0);
+  EXPECT_EQ(Parse({"--drain-s", "-1"}).error,
+            "option --drain-s = \"-1\": must be a number of seconds in [0, 3600]");
+  EXPECT_EQ(Parse({"--drain-s", "3601"}).error,
+            "option --drain-s = \"3601\": must be a number of seconds in [0, 3600]");
+  ServerConfig config;
+  config.drain_s = -0.5;
+  std::string why;
+  EXPECT_FALSE(Validates(config, &why));
+  EXPECT_EQ(why, "drain_s = -0.5: must be in [0, 3600]");
+}
+
 TEST(ConfigTest, IsValidRefusesOutOfRange) {
   ServerConfig config;
   config.threads = 0;

@@ -27,6 +27,7 @@
 #include <thread>
 #include <vector>
 
+#include "server/cpu_quota.hpp"
 #include "tests/sanitizers.hpp"
 #include "tests/server/server_process.hpp"
 #include "tests/server/wire.hpp"
@@ -593,7 +594,8 @@ TEST(ServingTest, ModelWorkStaysInItsBoundedPoolAndCheapRequestsPassIt) {
   ServerProcess server;
   ASSERT_TRUE(StartWithDefaults(&server)) << server.log();
   const int port = server.port();
-  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  // The CPUs the server may use (its default compute pool): affinity and cgroup quota.
+  const int cores = server::DefaultThreadCount();
   // A sweep of 5000 designs (the cork fill's depth): ~60 ms per request in a
   // Release build, several times that under the sanitizers.
   const std::string explore =

@@ -1,0 +1,604 @@
+// POST /v1/optimize: Ipopt design of a bat's profile and material under
+// length, mass, balance-point, MOI, diameter, taper and league-rule
+// constraints (min_sting: NLopt COBYLA over the flexible beam's sting). The
+// answer's bat is in the request's own form, so it can be sent straight back
+// to /v1/bat/properties.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "api/bat_json.hpp"
+#include "api/handlers/endpoint.hpp"
+#include "api/handlers/handlers.hpp"
+#include "api/json_path.hpp"
+#include "api/scene_json.hpp"
+#include "api/trade_units.hpp"
+#include "core/optimize/design_cor.hpp"
+#include "core/optimize/design_problem.hpp"
+#include "core/scene/sanity.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using Json = nlohmann::json;
+
+Json Finite(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+// A constraint: a number (equality) or {"min", "max"} (either optional). The limits' ranges
+// are core's (DesignProblem::Validate).
+bool ReadRange(ObjectReader& reader, const char* key, std::optional<core::DesignRange>* out) {
+  const NumberRule rule = AnyNumber();
+  // The SI key or a trade spelling ("mass_oz": {"min": 30, "max": 31}), converted to SI.
+  std::string given_as;
+  double to_si = 1.0;
+  const Json* value = reader.GetInUnits(key, &given_as, &to_si);
+  if (value == nullptr || !reader.ok()) return reader.ok();
+  if (value->is_number()) {
+    double v = 0;
+    if (!reader.OptionalNumber(key, rule, &v)) return false;
+    *out = core::DesignRange::Equal(v);
+    return true;
+  }
+  ObjectReader range(*value, reader.PathOf(given_as), reader.error());
+  core::DesignRange r;
+  r.min = range.MaybeNumber("min", rule);
+  r.max = range.MaybeNumber("max", rule);
+  if (r.min) *r.min *= to_si;
+  if (r.max) *r.max *= to_si;
+  if (!range.Finish()) return false;
+  if (!r.min && !r.max) return range.Fail("min", "give min, max or both", ErrorCode::kMissingField);
+  if (r.min && r.max && *r.min > *r.max) {
+    return range.Fail("max", "must be >= min = " + Show(Json(*r.min)));
+  }
+  *out = r;
+  return true;
+}
+
+bool ReadConstraints(ObjectReader& top, core::DesignConstraints* c) {
+  const Json* value = top.Get("constraints");
+  if (value == nullptr || !top.ok()) return top.ok();
+  ObjectReader reader(*value, "constraints", top.error());
+  // Presence and types here; the ranges are core's (DesignProblem::Validate).
+  ReadRange(reader, "length_m", &c->length_m);
+  ReadRange(reader, "mass_kg", &c->mass_kg);
+  ReadRange(reader, "balance_point_m", &c->balance_point_m);
+  ReadRange(reader, "moi_six_inch_kg_m2", &c->moi_six_inch_kg_m2);
+  c->max_barrel_diameter_m = reader.MaybeNumber("max_barrel_diameter_m", AnyNumber());
+  c->min_handle_diameter_m = reader.MaybeNumber("min_handle_diameter_m", AnyNumber());
+  if (const Json* region = reader.Get("handle_region_from_knob_m")) {
+    // [from, to], m from the knob; the numbers' ranges and order are core's.
+    if (!region->is_array() || region->size() != 2 || !(*region)[0].is_number() ||
+        !(*region)[1].is_number()) {
+      return reader.Fail("handle_region_from_knob_m",
+                         "must be [from, to]: two numbers, m from the knob");
+    }
+    c->handle_region_from_knob_m =
+        std::pair{(*region)[0].get<double>(), (*region)[1].get<double>()};
+  }
+  c->min_frequency_hz = reader.MaybeNumber("min_frequency_hz", AnyNumber());
+  if (const Json* taper = reader.Get("taper")) {
+    if (taper->is_string() && taper->get<std::string>() == "non_decreasing") {
+      c->taper = core::TaperRule::kNonDecreasing;
+    } else if (taper->is_object()) {
+      ObjectReader t(*taper, "constraints.taper", top.error());
+      t.Number("max_slope", AnyNumber(), &c->max_taper_slope);
+      t.OptionalInt("first_knot", &c->taper_first_knot);
+      t.OptionalInt("last_knot", &c->taper_last_knot);
+      if (!t.Finish()) return false;
+      c->taper = core::TaperRule::kMaxSlope;
+    } else {
+      return reader.Fail("taper", "must be \"non_decreasing\" or {\"max_slope\": dr/dx}");
+    }
+  }
+  if (const Json* rules = reader.Get("rules")) {
+    std::vector<Json> names;
+    if (rules->is_string()) {
+      names.push_back(*rules);
+    } else if (rules->is_array()) {
+      names.assign(rules->begin(), rules->end());
+    } else {
+      return reader.Fail("rules", "must be a rule-set name or an array of names");
+    }
+    for (const Json& name : names) {
+      const auto rule =
+          name.is_string() ? core::ParseRuleSet(name.get<std::string>()) : std::nullopt;
+      if (!rule) return reader.Fail("rules", "must name rule sets among mlb-wood, bbcor, usssa");
+      c->rules.push_back(*rule);
+    }
+  }
+  return reader.Finish();
+}
+
+// "options": the solver's settings, and "flexible" (min_sting: the flexible
+// beam's settings, as for /v1/sweet-spot). Without "backend", min_sting runs
+// nlopt_cobyla (the only solver it can use) and the other objectives ipopt.
+bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjective objective,
+                 core::DesignOptions* o, core::FlexibleOptions* flexible,
+                 core::CollisionModel* model) {
+  // Defaults never exceed the configured limits.
+  o->max_iterations = std::min(o->max_iterations, limits.max_iterations);
+  o->max_time_s = std::min(o->max_time_s, limits.max_time_s);
+  // Core enforces the configured cap on the variables (--max-design-variables).
+  o->max_variables = static_cast<int>(std::min<std::size_t>(
+      limits.max_design_variables, static_cast<std::size_t>(std::numeric_limits<int>::max())));
+  ClampToLimits(limits, flexible);
+  const bool sting = objective == core::DesignObjective::kMinSting;
+  if (sting) o->backend = core::DesignBackend::kNloptCobyla;
+  const Json* value = top.Get("options");
+  if (value == nullptr || !top.ok()) return top.ok();
+  ObjectReader reader(*value, "options", top.error());
+  std::string backend = sting ? "nlopt_cobyla" : "ipopt", hessian = "limited_memory",
+              check = "none";
+  reader.OptionalString("backend", &backend, {"ipopt", "nlopt_slsqp", "nlopt_cobyla"});
+  reader.OptionalString("hessian", &hessian, {"limited_memory", "exact"});
+  reader.OptionalString("derivative_check", &check, {"none", "first_order", "second_order"});
+  // The exit-speed model: the closed forms only (the design's derivatives are exact).
+  std::string model_name = "auto";
+  reader.OptionalString("model", &model_name, {"auto", "rigid_pivot", "free_bat"});
+  *model = *core::ParseCollisionModel(model_name);
+  o->backend = backend == "ipopt"         ? core::DesignBackend::kIpopt
+               : backend == "nlopt_slsqp" ? core::DesignBackend::kNloptSlsqp
+                                          : core::DesignBackend::kNloptCobyla;
+  o->hessian = hessian == "exact" ? core::HessianMode::kExact : core::HessianMode::kLimitedMemory;
+  o->derivative_check = check == "first_order"    ? core::DerivativeCheck::kFirstOrder
+                        : check == "second_order" ? core::DerivativeCheck::kSecondOrder
+                                                  : core::DerivativeCheck::kNone;
+  // The budgets are the server's configured limits (checked here); the seed is any integer
+  // a JSON number holds exactly; the other ranges are core's (DesignOptions::Validate).
+  long long iterations = o->max_iterations;
+  long long seed = 1;
+  reader.OptionalInteger("max_iterations", 1, limits.max_iterations, &iterations);
+  reader.OptionalInt("starts", &o->starts);
+  reader.OptionalInteger("seed", 0, 1LL << 53, &seed);
+  o->max_iterations = static_cast<int>(iterations);
+  o->seed = static_cast<std::uint64_t>(seed);
+  reader.OptionalNumber("max_time_s", Positive(limits.max_time_s), &o->max_time_s);
+  reader.OptionalNumber("max_cpu_time_s", NonNegative(limits.max_time_s), &o->max_cpu_time_s);
+  reader.OptionalNumber("tolerance", AnyNumber(), &o->tolerance);
+  reader.OptionalNumber("constraint_tolerance", AnyNumber(), &o->constraint_tolerance);
+  reader.OptionalBool("explain_infeasibility", &o->explain_infeasibility);
+  if (const Json* f = reader.Get("flexible")) {
+    if (!ReadFlexibleOptions(*f, reader.PathOf("flexible"), limits, flexible, top.error())) {
+      return false;
+    }
+  }
+  if (!reader.Finish()) return false;
+  if (core::Refusal refusal; !o->Validate(&refusal)) {
+    return CoreRefusal(refusal, "options", top.error());
+  }
+  return true;
+}
+
+// A material written out whole, as a request gives one (no source or density range; no
+// null cor).
+Json MaterialInRequestForm(const core::Material& m) {
+  Json material = MaterialToJson(m);
+  material.erase("source");
+  material.erase("density_range_kg_m3");
+  if (material["cor"].is_null()) material.erase("cor");
+  return material;
+}
+
+// The answer's bat in the request's own form: each variable written back at
+// its path; where the request's form lacks the path's parent (a preset), the
+// shape or material block is written out whole.
+Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r) {
+  Json bat = request_bat;
+  for (const core::DesignValue& v : r.variables) {
+    if (v.scale_factor) continue;  // a factor: its fields follow it in the list
+    std::string why;
+    const auto steps = ParseJsonPath(v.path, &why);
+    // In the request's own units: "taper_start_in" stays inches.
+    if (steps && SetNumberInRequestForm(&bat, *steps, v.value, &why)) continue;
+    if (v.path.rfind("three_segment.", 0) == 0 && r.three_segment) {
+      const auto& s = *r.three_segment;
+      bat["three_segment"] = {{"length_m", s.length_m},
+                              {"handle_radius_m", s.handle_radius_m},
+                              {"barrel_radius_m", s.barrel_radius_m},
+                              {"taper_start_m", s.taper_start_m},
+                              {"taper_end_m", s.taper_end_m}};
+    } else if (v.path.rfind("profile.", 0) == 0) {
+      bat["profile"] = BatToJson(r.bat)["profile"];
+    } else if (v.path.rfind("material.", 0) == 0) {
+      bat["material"] = MaterialInRequestForm(r.bat.material);
+    } else if (v.path.rfind("fill.", 0) == 0 || v.path == "wall_thickness_m") {
+      const Json built = BatToJson(r.bat);
+      if (built.contains("fill")) bat["fill"] = built["fill"];
+      if (built.contains("wall_thickness_m")) bat["wall_thickness_m"] = built["wall_thickness_m"];
+    }
+  }
+  return bat;
+}
+
+Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
+  Json variables = Json::object();
+  for (const auto& v : r.variables) variables[v.path] = v.value;
+  Json active = Json::array();
+  for (const auto& a : r.active_constraints) {
+    active.push_back({{"name", a.name},
+                      {"unit", a.unit},
+                      {"value", a.value},
+                      {"bound", a.bound},
+                      {"multiplier", Finite(a.multiplier)}});  // null for min_sting
+  }
+  Json runs = Json::array();
+  for (const auto& s : r.spread.runs) {
+    runs.push_back({{"index", s.index},
+                    {"termination", core::TerminationName(s.termination)},
+                    {"raw_status", s.raw_status},
+                    {"iterations", s.iterations},
+                    {"objective", Finite(s.objective)},
+                    {"constraint_violation", Finite(s.constraint_violation)}});
+  }
+  Json summary = SummaryToJson(r.summary);
+  summary["constraint_violation"] = Finite(r.summary.constraint_violation);
+  summary["error_estimate"] = Finite(r.summary.error_estimate);  // null for min_sting
+  summary["active_constraints"] = std::move(active);
+  summary["spread"] = {{"starts", r.spread.starts},
+                       {"converged", r.spread.converged},
+                       {"feasible", r.spread.feasible},
+                       {"best_start", r.spread.best_start},
+                       {"objective_min", Finite(r.spread.objective_min)},
+                       {"objective_max", Finite(r.spread.objective_max)},
+                       {"objective_median", Finite(r.spread.objective_median)},
+                       {"runs", std::move(runs)}};
+  if (r.derivative_check_errors >= 0) {
+    summary["derivative_check"] = {{"errors", r.derivative_check_errors},
+                                   {"report", r.derivative_check_report}};
+  }
+  Json conflicts = Json::array();
+  for (const auto& c : r.conflicts) {
+    conflicts.push_back({{"constraints", c.constraints},
+                         {"unit", c.unit},
+                         {"requested_min", Finite(c.requested_min)},
+                         {"requested_max", Finite(c.requested_max)},
+                         {"achievable_min", Finite(c.achievable_min)},
+                         {"achievable_max", Finite(c.achievable_max)},
+                         {"shortfall", Finite(c.shortfall)},
+                         {"message", c.message}});
+  }
+  Json out{{"bat", BatInRequestForm(request_bat, r)},
+           {"variables", std::move(variables)},
+           {"properties", PropertiesToJson(r.properties, r.bat.LengthM())},
+           {"objective_value", Finite(r.objective_value)},
+           {"objective_unit", r.objective_unit},
+           {"cor", r.cor},
+           {"sweet_spot",
+            {{"position_from_knob_m", Finite(r.sweet_spot_from_knob_m)},
+             {"placement", core::PlacementName(r.sweet_spot_placement)},
+             {"exit_speed_mps", Finite(r.max_exit_speed_mps)},
+             {"angular_speed_rad_s", Finite(r.angular_speed_rad_s)}}},
+           {"summary", std::move(summary)}};
+  if (!conflicts.empty()) out["conflicts"] = std::move(conflicts);
+  if (std::isfinite(r.cor_impact_from_knob_m)) {
+    // The design's own barrel COR (cor_from_barrel): where and at what speed it was taken.
+    out["cor_impact_from_knob_m"] = r.cor_impact_from_knob_m;
+    out["cor_impact_speed_mps"] = Finite(r.cor_impact_speed_mps);
+    out["cor_ball"] = Finite(r.cor_ball);
+  }
+  if (r.bbcor) out["bbcor"] = BbcorToJson(*r.bbcor);
+  if (r.first_bending_mode) {
+    const core::DesignFrequency& f = *r.first_bending_mode;
+    out["first_bending_mode"] = {{"frequency_hz", Finite(f.frequency_hz)},
+                                 {"error_estimate_hz", Finite(f.error_estimate_hz)},
+                                 {"elements", f.elements},
+                                 {"model_frequency_hz", Finite(f.model_frequency_hz)},
+                                 {"model_elements", f.model_elements}};
+  }
+  if (r.sting) {
+    out["sting"] = {{"position_from_knob_m", r.sting->impact_from_knob_m},
+                    {"hands_vibration_energy_j", r.sting->hands_vibration_energy_j},
+                    {"error_estimate_j", r.sting->error_estimate_j},
+                    {"flexible", FlexibleImpactToJson(r.sting->impact)}};
+  }
+  return out;
+}
+
+// A parsed /v1/optimize request: the problem, the solver's options, the materials to choose
+// among (empty = no choice), the objective's name and the bat as written (the answer's bat
+// is given back in its form).
+struct OptimizeRequest {
+  core::DesignProblem problem;
+  std::string model_reason;  // why problem.model (core::ResolveExitModel)
+  core::DesignOptions options;
+  std::vector<core::Material> material_choices;
+  std::string objective;
+  Json request_bat;
+  // Where the COR comes from (core::ResolveDesignCor): the answer's "cor_source".
+  core::DesignCorPolicy cor_policy;
+  // The base bat's mass properties under problem.inertia_model, computed once (ParseBat).
+  core::MassProperties base_properties;
+};
+
+// What the optimiser returned: one design, or one per material and the best of them.
+struct OptimizeResult {
+  bool by_material = false;
+  core::MaterialChoiceResult choice;  // by_material
+  core::DesignResult single;          // otherwise
+
+  // The design answered with; null when no material gives a usable design.
+  const core::DesignResult* Chosen() const {
+    if (!by_material) return &single;
+    if (choice.best < 0) return nullptr;
+    return &choice.per_material[static_cast<std::size_t>(choice.best)].result;
+  }
+};
+
+// Reads "variables": continuous design variables into `problem`, a "material" choice into
+// `material_choices`.
+bool ReadVariables(ObjectReader& reader, const ApiLimits& limits, core::DesignProblem* problem,
+                   std::vector<core::Material>* material_choices) {
+  ApiError* error = reader.error();
+  const Json* variables = reader.Get("variables");
+  if (reader.ok() && variables == nullptr) reader.Missing("variables");
+  if (!reader.ok()) return false;
+  const std::size_t max_variables = limits.max_design_variables;
+  if (!variables->is_array() || variables->empty() || variables->size() > max_variables) {
+    return reader.Fail("variables", "must be an array of 1 to " + std::to_string(max_variables) +
+                                        " {\"path\", \"min\", \"max\"}");
+  }
+  std::set<std::string> scale_names;  // the scale variables' names, each once
+  for (std::size_t i = 0; i < variables->size(); ++i) {
+    const std::string where = "variables[" + std::to_string(i) + "]";
+    ObjectReader v((*variables)[i], where, error);
+    core::DesignVariable variable;
+    if (!v.ok()) return false;  // not an object
+    // One field ("path"), several set to the value ("paths"), or several each the base
+    // design's value times it ("scale_paths"): exactly one form, as /v1/explore's parameters.
+    const char* const kForms[] = {"path", "paths", "scale_paths"};
+    std::vector<const char*> given;
+    for (const char* form : kForms) {
+      if (v.Has(form)) given.push_back(form);
+    }
+    if (!v.ok()) return false;
+    if (given.size() != 1) {
+      return v.Fail(given.empty() ? "path" : given[1],
+                    "give exactly one of path, paths (several fields set to one value) and "
+                    "scale_paths (several fields scaled by one value)",
+                    given.empty() ? ErrorCode::kMissingField : ErrorCode::kInvalidValue);
+    }
+    const std::string form = given.front();
+    if (v.Has("name") && form != "scale_paths") {
+      return v.Fail("name",
+                    "names a scale variable: give it with scale_paths only (a path is "
+                    "its own name)");
+    }
+    if (form != "path") {
+      // paths: the first is the variable's path, the rest linked. scale_paths: the fields of a
+      // scale variable named by "name" (default "scale:" and the paths joined with "+").
+      const Json* paths = v.Get(form);
+      if (!paths->is_array() || paths->empty() || paths->size() > 32) {
+        return v.Fail(form, "must be an array of 1 to 32 variable paths");
+      }
+      std::string joined;
+      for (std::size_t k = 0; k < paths->size(); ++k) {
+        const Json& item = (*paths)[k];
+        const std::string field = where + "." + form + "[" + std::to_string(k) + "]";
+        if (!item.is_string() || !core::ParseDesignVariablePath(item.get<std::string>())) {
+          return SetError(error, ErrorCode::kInvalidValue, field, &item,
+                          "is not a design variable path (profile.knots[i].radius_m, ...; "
+                          "material choices cannot be linked or scaled)");
+        }
+        const std::string path = item.get<std::string>();
+        if (form == "scale_paths") {
+          variable.scale_paths.push_back(path);
+          joined += (k == 0 ? "" : "+") + path;
+        } else if (k == 0) {
+          variable.path = path;
+        } else {
+          variable.linked_paths.push_back(path);
+        }
+      }
+      if (form == "scale_paths") {
+        variable.path = "scale:" + joined;
+        v.OptionalString("name", &variable.path);
+        if (!v.ok()) return false;
+        if (variable.path.empty() || variable.path == "material" ||
+            core::ParseDesignVariablePath(variable.path)) {
+          return v.Fail("name",
+                        "must be a non-empty name that is not a design variable path "
+                        "(the answer's variables list the scale under it beside its "
+                        "fields)");
+        }
+        if (!scale_names.insert(variable.path).second) {
+          return v.Fail(v.Has("name") ? "name" : "scale_paths",
+                        "names a scale variable \"" + variable.path +
+                            "\" already given: each needs its own name");
+        }
+      }
+    } else {
+      v.String("path", &variable.path);
+    }
+    if (v.ok() && variable.path == "material") {  // a discrete choice among materials
+      const Json* choices = v.Get("choices");
+      if (choices == nullptr || !choices->is_array() || choices->empty() || choices->size() > 16) {
+        return v.Fail("choices", "must be an array of 1 to 16 material names");
+      }
+      for (std::size_t k = 0; k < choices->size(); ++k) {
+        auto m = ParseMaterial((*choices)[k], where + ".choices[" + std::to_string(k) + "]", false,
+                               error);
+        if (!m) return false;
+        material_choices->push_back(*m);
+      }
+      if (!v.Finish()) return false;
+      continue;
+    }
+    v.Number("min", AnyNumber(), &variable.min);  // the bounds' ranges: core's
+    v.Number("max", AnyNumber(), &variable.max);
+    if (!v.Finish()) return false;
+    if (variable.scale_paths.empty() && !core::ParseDesignVariablePath(variable.path)) {
+      return SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*variables)[i]["path"],
+                      "is not a design variable (profile.knots[i].radius_m, profile.knots[i].x_m, "
+                      "three_segment.<field>, material.density_kg_m3, wall_thickness_m, "
+                      "fill.diameter_m, fill.depth_m, fill.material.density_kg_m3, or material "
+                      "with choices)");
+    }
+    problem->variables.push_back(variable);
+  }
+  return true;
+}
+
+std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& context,
+                                             ApiError* error) {
+  ObjectReader reader(body, "", error);
+  const Json* bat_json = reader.Get("bat");
+  if (bat_json == nullptr) {
+    reader.Missing("bat");
+    return std::nullopt;
+  }
+  const auto spec = ParseBat(*bat_json, "bat", context.limits, error);
+  if (!spec) return std::nullopt;
+  OptimizeRequest request;
+  request.request_bat = *bat_json;
+  core::DesignProblem& problem = request.problem;
+  problem.bat = spec->bat;
+  problem.three_segment = spec->three_segment;
+  core::Scene scene;
+  if (!ReadSceneCommon(reader, &scene)) return std::nullopt;
+  // A swing by its bat speed (swing.bat_speed_mps or _mph) is core's to resolve: omega per
+  // design from the design's length (DesignModel; the answer's sweet_spot.angular_speed_rad_s).
+  problem.ball = scene.ball;
+  problem.swing = scene.swing;
+  problem.cor = scene.cor;
+  problem.inertia_model = scene.inertia_model;
+  if (!ReadVariables(reader, context.limits, &problem, &request.material_choices) ||
+      !ReadConstraints(reader, &problem.constraints)) {
+    return std::nullopt;
+  }
+  request.objective = "max_exit_speed";
+  reader.OptionalString("objective", &request.objective,
+                        {"max_exit_speed", "max_exit_speed_swing_weight", "widest_sweet_zone",
+                         "min_moi", "min_sting"});
+  problem.objective = *core::ParseDesignObjective(request.objective);
+  request.base_properties = spec->properties->Of(scene.inertia_model);
+  problem.base_mass_properties = request.base_properties;  // computed once, by ParseBat
+  request.cor_policy = core::ResolveDesignCor(scene, request.base_properties, &problem);
+  reader.OptionalNumber("swing_weight_exponent", AnyNumber(), &problem.swing_weight_exponent);
+  problem.swing_weight_reference_kg_m2 =
+      reader.MaybeNumber("swing_weight_reference_kg_m2", AnyNumber());  // range: core's
+  reader.OptionalNumber("sweet_zone_tolerance_mps", AnyNumber(), &problem.sweet_zone_tolerance_mps);
+  core::CollisionModel model = core::CollisionModel::kAuto;
+  if (!ReadOptions(reader, context.limits, problem.objective, &request.options, &problem.flexible,
+                   &model) ||
+      !reader.Finish()) {
+    return std::nullopt;
+  }
+  // "auto" as the scenes resolve it: the free bat, or the paper's rigid_pivot for its bats.
+  scene.paper_bat = spec->paper;
+  problem.model = core::ResolveExitModel(model, scene, &request.model_reason);
+  if (problem.variables.empty()) {
+    reader.Fail("variables", "needs at least one continuous variable besides a material choice");
+    return std::nullopt;
+  }
+  if (core::Refusal refusal; !problem.Validate(&refusal)) {
+    CoreRefusal(refusal, "", error);
+    return std::nullopt;
+  }
+  return request;
+}
+
+OptimizeResult RunOptimize(const OptimizeRequest& request, const Context& context) {
+  OptimizeResult result;
+  result.by_material = !request.material_choices.empty();
+  if (result.by_material) {
+    result.choice = core::OptimizeOverMaterials(request.problem, request.material_choices,
+                                                request.options, context.progress);
+  } else {
+    result.single = core::OptimizeDesign(request.problem, request.options, context.progress);
+  }
+  return result;
+}
+
+// No usable material (422), or a problem the optimiser refused (400).
+std::optional<Response> OptimizeFailure(const OptimizeRequest&, const OptimizeResult& result) {
+  const core::DesignResult* chosen = result.Chosen();
+  if (chosen == nullptr) {
+    return ErrorResponse(422, ErrorCode::kInfeasible,
+                         "no material gives a usable design: " + result.choice.summary.message,
+                         "variables");
+  }
+  if (chosen->summary.termination == core::Termination::kInvalidInput) {
+    ApiError error;
+    CoreRefusal(chosen->summary, "", &error);
+    return ToResponse(error);
+  }
+  return std::nullopt;
+}
+
+Json RenderOptimize(const OptimizeRequest& request, const OptimizeResult& result) {
+  Json out = ResultToJson(*result.Chosen(), request.request_bat);
+  if (result.by_material) {
+    Json per_material = Json::array();
+    for (const auto& m : result.choice.per_material) {
+      per_material.push_back({{"material", m.material},
+                              {"termination", core::TerminationName(m.result.summary.termination)},
+                              {"message", m.result.summary.message},
+                              {"objective_value", Finite(m.result.objective_value)}});
+    }
+    out["materials"] = std::move(per_material);
+    // The bat comes back in the chosen material: by name, or written out whole when a
+    // material field is also a variable (the request's own material object would be stale).
+    const core::DesignResult& chosen = *result.Chosen();
+    const bool material_field_varies =
+        std::any_of(chosen.variables.begin(), chosen.variables.end(),
+                    [](const core::DesignValue& v) { return v.path.rfind("material.", 0) == 0; });
+    if (material_field_varies) {
+      out["bat"]["material"] = MaterialInRequestForm(chosen.bat.material);
+    } else {
+      out["bat"]["material"] =
+          result.choice.per_material[static_cast<std::size_t>(result.choice.best)].material;
+    }
+  }
+  // Where the COR came from: the request, the ball's law, or the chosen design's material.
+  out["cor_source"] = request.cor_policy.Describe(result.Chosen()->bat.material.name);
+  out["objective"] = request.objective;
+  if (request.problem.objective != core::DesignObjective::kMinMoi) {
+    out["sweet_spot"]["model"] = core::CollisionModelName(request.problem.model);
+    out["sweet_spot"]["model_reason"] = request.model_reason;
+  }
+  return out;
+}
+
+// Infeasible: 422 with the closest design. Converged, no_convergence and failure are 200s
+// whose summary says which.
+std::optional<Unmet> OptimizeUnmet(const OptimizeRequest&, const OptimizeResult& result) {
+  const core::DesignResult& chosen = *result.Chosen();
+  if (chosen.summary.termination != core::Termination::kInfeasible) return std::nullopt;
+  std::string message = "no design meets the constraints";
+  if (!chosen.conflicts.empty()) message += ": " + chosen.conflicts.front().message;
+  return Unmet{ErrorCode::kInfeasible, std::move(message), "constraints"};
+}
+
+const Endpoint<OptimizeRequest, OptimizeResult>& OptimizeEndpoint() {
+  static const auto endpoint = [] {
+    Endpoint<OptimizeRequest, OptimizeResult> e;
+    e.parse = ParseOptimize;
+    e.run = RunOptimize;
+    e.failure = OptimizeFailure;
+    e.render = RenderOptimize;
+    e.warnings = [](const OptimizeRequest& request, const OptimizeResult&) {
+      // The base design's (the designs the solver finds are bounded by the variables).
+      const core::DesignProblem& p = request.problem;
+      return core::SanityWarnings(&p.bat, &request.base_properties, &p.ball, &p.swing);
+    };
+    e.provenance = [](const OptimizeRequest& request, const Json& body) {
+      return BodyOptions(body, request.options.seed);
+    };
+    e.unmet = OptimizeUnmet;
+    return e;
+  }();
+  return endpoint;
+}
+
+}  // namespace
+
+Response HandleOptimize(const Request& request, const Context& context) {
+  return ServeEndpoint(OptimizeEndpoint(), request, context);
+}
+
+}  // namespace sweetspot::api

@@ -1,0 +1,167 @@
+// The bat: a solid of revolution along x, from the knob (x = 0) to the barrel
+// tip (x = L), with a piecewise-linear outer radius, a material, an optional
+// hollow shell and an optional fill bored from the barrel end.
+//
+// Geometry conventions (everything SI, positions from the knob):
+// - Outer radius: linear between knots; knots strictly increasing in x from 0
+//   to L. A step in the radius is two knots a tiny distance apart (1e-12 m
+//   works: the mass properties integrate each segment without dividing by its
+//   length, so a short segment costs no accuracy).
+// - Hollow shell (wall_thickness_m = t > 0): the inner radius is r(x) - t at
+//   every x (the wall is measured radially, not normal to the surface), and
+//   the shell is an OPEN tube: both ends are open, no end cap and no solid
+//   knob plug are modelled (a real metal bat's end cap and knob add a few tens
+//   of grams; put them into the profile or the wall if they matter). The
+//   cavity holds nothing unless a fill is given. t = 0 is a solid bat; t must
+//   be less than the smallest outer radius.
+// - Fill: a coaxial cylinder of radius diameter_m / 2 occupying
+//   [L - depth_m, L]. In a solid bat it is bored out of the bat's material and
+//   holds the fill material (density 0 = left empty, e.g. a cupped end); in a
+//   hollow bat it sits inside the cavity, so it must fit inside the inner
+//   radius. Either way it must lie strictly inside the material around it
+//   over its whole depth, and depth_m <= L.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/bat/material.hpp"
+
+namespace sweetspot::core {
+
+// The sizes a bat given from outside (a request) is held to, by ValidateSize. Core's numerics
+// work far beyond them (tests/hard_cases: a megametre bat); these say what is plausible.
+/// Largest length of a bat and largest position along one (knots, taper, fill depth), m: a
+/// 100 m bat is already absurd.
+inline constexpr double kMaxBatLengthM = 100.0;
+/// Largest radius of a bat (knots, handle, barrel; so also of its wall thickness), m.
+inline constexpr double kMaxBatRadiusM = 10.0;
+/// Largest diameter of a fill's bore, m.
+inline constexpr double kMaxFillDiameterM = 10.0;
+
+/// One knot of the outer radius profile.
+struct ProfileKnot {
+  double x_m = 0.0;       ///< Position from the knob, m.
+  double radius_m = 0.0;  ///< Outer radius at x_m, m (> 0).
+};
+
+/// The paper's three-segment shape: handle cylinder r1 on [0, x1], linear
+/// taper to r2 on [x1, x2], barrel cylinder r2 on [x2, L].
+struct ThreeSegmentShape {
+  double length_m = 0.0;         ///< L, m (> 0).
+  double handle_radius_m = 0.0;  ///< r1, m (> 0).
+  double barrel_radius_m = 0.0;  ///< r2, m (> 0).
+  double taper_start_m = 0.0;    ///< x1 from the knob, m (0 <= x1 <= x2).
+  double taper_end_m = 0.0;      ///< x2 from the knob, m (x2 <= L).
+
+  /// Width of the step that stands for a zero-length taper (0 < x1 = x2 < L,
+  /// r1 != r2), relative to L: the two knots sit at x1 -+ L * kStepWidth / 2.
+  /// The mass properties then differ from the ideal step's by less than
+  /// kStepWidth / 6 relative (the exact integrals of the short taper).
+  static constexpr double kStepWidth = 1e-12;
+
+  /// True when the shape is well formed (finite; L, r1, r2 > 0;
+  /// 0 <= x1 <= x2 <= L); otherwise the refusal in *refusal (if non-null): field, value and
+  /// rule, its Message() "field = value: rule".
+  bool Validate(Refusal* refusal) const;
+  /// Validate, then the plausible sizes: L in (0, kMaxBatLengthM], r1, r2 in
+  /// (0, kMaxBatRadiusM] ("length_m = 200: must be in (0, 100]"); for a shape given from
+  /// outside.
+  bool ValidateSize(Refusal* refusal) const;
+  /// The knots of this shape, x strictly increasing: (0, r1), (x1, r1),
+  /// (x2, r2), (L, r2) with coincident knots merged (x1 = 0: no handle knot;
+  /// x2 = L: no barrel knot; x1 = x2 with r1 = r2: one knot; x1 = x2 = 0 or
+  /// x1 = x2 = L: the bat is all barrel or all handle; 0 < x1 = x2 < L with
+  /// r1 != r2: a step of width L * kStepWidth). 2 to 4 knots.
+  std::vector<ProfileKnot> Knots() const;
+  /// Knots() into *knots (its buffer reused: a sweep's designs).
+  void KnotsInto(std::vector<ProfileKnot>* knots) const;
+};
+
+/// A cylinder bored from the barrel end along the axis and filled.
+struct Fill {
+  /// What fills the bore (density 0 = left empty; see EmptyFillMaterial()).
+  Material material;
+  double diameter_m = 0.0;  ///< Bore diameter, m (>= 0).
+  /// Bore depth from the barrel tip towards the knob, m (0 <= depth_m <= L).
+  double depth_m = 0.0;
+
+  /// Bore radius, m.
+  double RadiusM() const { return 0.5 * diameter_m; }
+  /// True when the bore holds nothing (material density 0).
+  bool IsEmpty() const { return material.density_kg_m3 == 0.0; }
+};
+
+/// A complete bat.
+struct Bat {
+  /// Outer radius; x strictly increasing from 0 to L (a step is two knots at
+  /// nearly the same x).
+  std::vector<ProfileKnot> knots;
+  Material material;              ///< The bat's material.
+  double wall_thickness_m = 0.0;  ///< Hollow shell wall, m; 0 = solid (see the file comment).
+  std::optional<Fill> fill;       ///< Optional fill.
+
+  /// True when the bat is physically valid; otherwise the refusal in *refusal (if
+  /// non-null): field, value and rule, its Message() "field = value: rule", e.g.
+  /// "knots[3].x_m = 0.2: must be greater than
+  /// knots[2].x_m = 0.3". Refuses: fewer than 2 knots, non-finite numbers,
+  /// first knot not at 0, x not strictly increasing, radius <= 0, an invalid
+  /// material, wall < 0 or >= the smallest outer radius, a fill deeper than
+  /// the bat, negative fill dimensions, a bore not strictly inside the
+  /// material around it (outer radius, or inner radius of a hollow bat) over
+  /// the fill's depth, an invalid non-empty fill material.
+  /// Does not allocate when refusal is null and the bat is valid.
+  /// Core's field names: "wall_thickness_m", "knots[2].x_m", "fill.material.density_kg_m3".
+  bool Validate(Refusal* refusal) const;
+  /// Validate, then the plausible sizes: knots' x in [0, kMaxBatLengthM], radii in
+  /// (0, kMaxBatRadiusM] (so the wall, below the smallest radius, and the fill's depth, within
+  /// the length, are capped too), fill diameter in [0, kMaxFillDiameterM], the materials'
+  /// Material::ValidateSize ("knots[1].x_m = 150: must be in [0, 100]"); for a bat given from
+  /// outside.
+  bool ValidateSize(Refusal* refusal) const;
+  /// Validate without the materials' own checks (the bat's material and a non-empty fill's):
+  /// for a bat whose materials are known to pass them, as a sweep's designs that change only
+  /// the geometry, the wall or the fill's size. Does not allocate when the bat is valid and
+  /// refusal is null.
+  bool ValidateGeometry(Refusal* refusal) const;
+  /// The caps of ValidateSize alone (ValidateSize = Validate, then this): for a bat that
+  /// Validate checks elsewhere.
+  bool ValidateCaps(Refusal* refusal) const;
+  /// The caps on the knots alone (x and radius), the first check of ValidateCaps: for a bat
+  /// whose material, wall and fill are known to pass theirs.
+  bool ValidateKnotCaps(Refusal* refusal) const;
+  /// ValidateGeometry, the same verdict, for a bat whose knots are a valid shape's
+  /// (ThreeSegmentShape::KnotsInto of a shape that passes Validate): 2 to 4 knots, finite, the
+  /// first at 0, radii positive by the shape's own checks, so only their order is checked (a
+  /// step on a bat too short for a double to resolve it puts two knots at one x), then the
+  /// wall and the fill as ValidateGeometry checks them. For a sweep of a shape's fields.
+  bool ValidateGeometryOfShapeKnots(Refusal* refusal) const;
+  /// L, m (the last knot's x; 0 without knots).
+  double LengthM() const;
+  /// Outer radius at x (from the knob), m; 0 outside [0, L].
+  double RadiusAtM(double x_m) const;
+  /// True for a hollow shell (wall_thickness_m > 0).
+  bool IsHollow() const { return wall_thickness_m > 0.0; }
+  /// Inner radius of the shell at x, m: RadiusAtM(x) - wall for a hollow bat,
+  /// 0 for a solid bat or outside [0, L].
+  double InnerRadiusAtM(double x_m) const;
+  /// Smallest outer radius over the bat, m (0 without knots).
+  double MinRadiusM() const;
+
+ private:
+  // Validate's checks in its order; the materials' own only when `materials`.
+  bool ValidateChecks(Refusal* refusal, bool materials) const;
+  // The knots' checks of ValidateChecks, in order: their count, finite numbers, the first at 0,
+  // x strictly increasing, radii positive.
+  bool ValidateKnotOrder(Refusal* refusal) const;
+  // The rest of ValidateChecks, for valid knots whose smallest radius is `min_radius`: the
+  // materials (when `materials`), the wall and the fill.
+  bool ValidateBody(Refusal* refusal, bool materials, double min_radius) const;
+};
+
+/// A bat of the paper's three-segment shape (knots from shape.Knots()),
+/// solid, without fill.
+Bat MakeThreeSegmentBat(const ThreeSegmentShape& shape, const Material& material);
+
+}  // namespace sweetspot::core

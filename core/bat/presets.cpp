@@ -1,0 +1,137 @@
+#include "core/bat/presets.hpp"
+
+#include <initializer_list>
+#include <utility>
+
+#include "core/units.hpp"
+
+namespace sweetspot::core {
+namespace {
+
+// Knots from (position from the knob in inches, DIAMETER in inches) pairs.
+std::vector<ProfileKnot> FromInches(std::initializer_list<std::pair<double, double>> points) {
+  std::vector<ProfileKnot> out;
+  out.reserve(points.size());
+  for (const auto& [x_in, diameter_in] : points) {
+    out.push_back({InchesToMetres(x_in), 0.5 * InchesToMetres(diameter_in)});
+  }
+  return out;
+}
+
+// Wall thickness of "bbcor-33-aluminium", m: the root of mass(wall) = 30 oz
+// (0.850485694 kg) for its profile and 7050 aluminium, solved by bisection
+// to 1e-12 m (presets_test re-solves it and checks the weight).
+constexpr double kBbcorWallM = 0.0027614431802374;
+
+std::vector<BatPreset> BuildPresets() {
+  std::vector<BatPreset> out;
+  const Material paper_wood = *FindMaterial("paper-wood");
+
+  BatPreset paper;
+  paper.name = "paper-wood";
+  paper.bat = MakeThreeSegmentBat(PaperThreeSegmentShape(), paper_wood);
+  paper.description =
+      "The seed paper's bat: 0.855 m, handle radius 0.0125 m to x1 = 0.3459 m, taper to barrel "
+      "radius 0.035 m at x2 = 0.6423 m, wood of 649 kg/m3; 1.0078 kg, balance point 0.6090 m.";
+  paper.source =
+      "Seed paper Table 2 and its x1, x2 (0.3459, 0.6423); its '7 cm' and '2.5 cm' radii are "
+      "read as diameters, the only reading that gives a bat of realistic mass "
+      "(shared/docs/paper-notes.md, shared/docs/api-contract.md). The paper's own targets "
+      "M = 0.885 kg, C = 0.564 m cannot both be met by this family (see shape_fit).";
+  out.push_back(paper);
+
+  BatPreset m885 = paper;
+  m885.name = "paper-wood-m885";
+  m885.bat.material.name = "custom";
+  m885.bat.material.density_kg_m3 = 569.9;
+  m885.bat.material.source =
+      "paper-wood with density 569.9 kg/m3, the density at which the paper's shape weighs the "
+      "paper's 0.885 kg (shared/docs/paper-notes.md).";
+  m885.description =
+      "The paper's bat shape at 569.9 kg/m3 so that it weighs the paper's 0.885 kg; balance "
+      "point 0.6090 m (independent of density).";
+  m885.source = "As paper-wood, density scaled so that M = 0.885 kg (paper Table 2's mass).";
+  out.push_back(m885);
+
+  BatPreset ash;
+  ash.name = "wood-34-ash";
+  ash.bat.knots = FromInches({{0.0, 1.60},
+                              {0.25, 1.75},
+                              {0.55, 1.75},
+                              {0.95, 1.05},
+                              {1.6, 0.93},
+                              {12.0, 0.95},
+                              {15.0, 1.05},
+                              {18.0, 1.28},
+                              {21.0, 1.70},
+                              {23.0, 2.08},
+                              {25.0, 2.42},
+                              {27.0, 2.61},
+                              {33.25, 2.61},
+                              {34.0, 2.35}});
+  ash.bat.material = *FindMaterial("ash");
+  ash.description =
+      "A 34-in solid white-ash bat: 1.75-in knob, 0.93-0.95-in handle, taper from 12 in to "
+      "27 in, 2.61-in barrel, rounded (uncupped) end; 31.5 oz (drop 2.5), balance point 24.0 in.";
+  ash.source =
+      "Profile drawn for this service to the limits of the MLB Official Baseball Rules 3.02 "
+      "(solid wood, at most 2.61 in diameter and 42 in long) with knob, handle and taper "
+      "dimensions typical of turned pro models (not a specific manufacturer's model); "
+      "white ash from the Wood Handbook FPL-GTR-190 (material 'ash').";
+  out.push_back(ash);
+
+  BatPreset bbcor;
+  bbcor.name = "bbcor-33-aluminium";
+  bbcor.bat.knots = FromInches({{0.0, 1.50},
+                                {0.30, 1.55},
+                                {0.60, 1.55},
+                                {1.0, 0.95},
+                                {1.5, 0.875},
+                                {11.0, 0.875},
+                                {13.0, 0.95},
+                                {15.0, 1.20},
+                                {17.0, 1.65},
+                                {19.0, 2.20},
+                                {20.5, 2.625},
+                                {32.75, 2.625},
+                                {33.0, 2.50}});
+  bbcor.bat.material = *FindMaterial("aluminium-7050");
+  bbcor.bat.wall_thickness_m = kBbcorWallM;
+  bbcor.description =
+      "A 33-in hollow 7050-aluminium BBCOR bat: 1.55-in knob, 7/8-in handle, taper from 11 in "
+      "to 20.5 in, 2 5/8-in barrel; open-tube shell of 2.761 mm wall; 30.0 oz (drop 3).";
+  bbcor.source =
+      "NCAA / NFHS BBCOR bat standard: barrel diameter at most 2 5/8 in, length minus weight at "
+      "most 3 (33 in -> 30 oz), ball-bat COR at most 0.50. Profile drawn for this service, "
+      "typical of one-piece alloy BBCOR bats (not a specific model). The uniform wall thickness "
+      "is solved so that the open-tube shell (no end cap, no knob plug; see bat.hpp) weighs "
+      "exactly 30 oz; real bats vary the wall along the barrel.";
+  out.push_back(bbcor);
+  return out;
+}
+
+}  // namespace
+
+ThreeSegmentShape PaperThreeSegmentShape() {
+  ThreeSegmentShape shape;
+  shape.length_m = 0.855;
+  shape.handle_radius_m = 0.0125;
+  shape.barrel_radius_m = 0.035;
+  shape.taper_start_m = 0.3459;
+  shape.taper_end_m = 0.6423;
+  return shape;
+}
+
+const std::vector<BatPreset>& BatPresets() {
+  static const std::vector<BatPreset> presets = BuildPresets();
+  return presets;
+}
+
+std::optional<BatPreset> FindPreset(std::string_view name) {
+  for (const BatPreset& p : BatPresets()) {
+    if (p.name == name) return p;
+  }
+  return std::nullopt;
+}
+
+}  // namespace sweetspot::core

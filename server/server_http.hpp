@@ -1,0 +1,108 @@
+// The httplib side of Server, shared by server.cpp and server_http.cpp: how answers are
+// written (the JSON envelope, streamed and sourced bodies, the design explorer's static
+// files), what is read from a request before routing (the token from the raw head, which
+// path the pre-routing hook takes), httplib's request handling for one request, and the
+// listening socket. Included after Eigen's headers where both are (<httplib.h> pulls in
+// <resolv.h>, whose `_res` macro breaks Eigen: server.cpp).
+#pragma once
+
+#include <httplib.h>
+
+#include <ctime>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "api/error_code.hpp"
+#include "api/response.hpp"
+#include "server/request_stream.hpp"
+#include "server/static_files.hpp"
+
+namespace sweetspot::server::http {
+
+/// One JSON body: never throws on invalid UTF-8 (replaced instead).
+std::string Serialize(const nlohmann::json& body);
+
+/// The text of a caught exception, for the log.
+std::string WhatOf(const std::exception_ptr& caught);
+
+/// Writes an api answer into httplib's: a streamed body chunked (and passed through a proxy's
+/// buffer), a sourced one with Content-Length a piece at a time, a JSON body serialised in
+/// place; Retry-After: 1 on 429 and 503.
+void WriteApiResponse(const api::Response& response, httplib::Response& res);
+
+/// The code of the error envelope for an HTTP status httplib produced itself.
+api::ErrorCode CodeForStatus(int status);
+
+/// The answer of a request the connection loop stopped (its cancel flag set while it
+/// computed), in place of the handler's: 503 for the time budget and for a shutdown; the
+/// handler's own for a client that left.
+void StoppedAnswer(const RequestCancel& cancel, double max_request_time_s,
+                   api::Response* response);
+
+/// Seconds rounded down to whole ones, at least 1 (httplib's keep-alive header).
+time_t WholeSeconds(double s);
+
+/// "Bearer <token>" against the configured token, in constant time; the scheme's name is
+/// case-insensitive, the token compared byte for byte.
+bool TokenMatches(std::string_view header, const std::string& token);
+
+/// The value of header `name` as the client sent it (not percent-decoded), from the raw head
+/// of the request the calling thread answers; "" when absent.
+std::string_view RawHeaderValue(std::string_view name);
+
+/// httplib's setup hook: drops a form-encoded Content-Type (the API reads bodies as JSON).
+void PrepareRequest(httplib::Request& req);
+
+/// The route label of static files in metrics and the access log.
+inline constexpr const char* kStaticRoute = "static";
+
+/// True for requests the design explorer's static files answer (GET or HEAD of "/", or of
+/// an existing file at a path no API route matches).
+bool IsStaticRequest(const httplib::Request& req, const StaticFiles& files);
+
+/// Answers a static request: the file with its headers (304 on a matching If-None-Match), or
+/// a 404 envelope.
+void WriteStaticResponse(const httplib::Request& req, const StaticFiles& files,
+                         httplib::Response& res);
+
+/// The message of the 413 for a body over max_body_bytes (httplib's and the lean path's).
+inline constexpr const char* kBodyTooLargeMessage =
+    "request body exceeds the configured max_body_bytes";
+
+/// How the pre-routing hook answers a request: on httplib's own path (kHttplib), or itself,
+/// with the body the loop received (kWithBody: the methods whose body httplib reads) or
+/// without one (kWithoutBody: GET, HEAD, OPTIONS; httplib ignores their body).
+enum class LeanPath { kHttplib, kWithBody, kWithoutBody };
+
+/// The path `req` takes (kHttplib without the loop's framing).
+LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream);
+
+/// httplib's request handling (parsing, routing, our handlers, writing the answer) for one
+/// request the connection loop has read completely.
+class HttpServer : public httplib::Server {
+ public:
+  /// httplib stops a streamed answer between two chunks once its listening socket is gone
+  /// (svr_sock_ invalid); the connection loop owns the socket, so tell httplib whether the
+  /// server is serving.
+  void SetServing(int listen_fd) { svr_sock_ = listen_fd; }
+  void SetStopping() { svr_sock_ = INVALID_SOCKET; }
+
+  bool ServeOne(httplib::Stream& stream, bool close_connection, bool* connection_closed) {
+    bool closed = false;
+    const bool ok = process_request(stream, close_connection, closed, PrepareRequest);
+    *connection_closed = closed;
+    return ok;
+  }
+};
+
+/// A listening TCP socket on host:port (port 0: any free port), SO_REUSEADDR only, the
+/// kernel's largest backlog. Returns the socket or -1; *bound_port gets the port.
+int Listen(const std::string& host, int port, int* bound_port);
+
+/// The compute pool's size: the configured count, or (0) the CPUs this process may use
+/// (DefaultThreadCount, server/cpu_quota.hpp).
+int ComputeWorkers(int configured);
+
+}  // namespace sweetspot::server::http
