@@ -7,7 +7,9 @@
 #include <cmath>
 
 #include "core/bat/presets.hpp"
+#include "core/collision/free_bat.hpp"
 #include "core/collision/hertz_contact.hpp"
+#include "core/collision/oblique_impact.hpp"
 #include "core/collision/rigid_pivot.hpp"
 #include "core/numerics/nlopt_search.hpp"
 #include "core/scene/collide.hpp"
@@ -158,6 +160,68 @@ void BM_CollideHertzWithRefinement(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_CollideHertzWithRefinement)->Unit(benchmark::kMicrosecond);
+
+// The oblique impact (core/collision/oblique_impact.hpp) next to the normal model it wraps: the
+// free bat's impact at one point (FreeBatImpactAt, with its BBCOR-style block) and the oblique
+// impact with the pair (M_n, e) and with the normal part as a std::function answering the free
+// bat's impulse at v_n (how the scene would wire hertz or flexible; here the cost of the call).
+FreeBatInputs ObliqueBenchBat() {
+  FreeBatInputs in;
+  in.bat_mass_kg = 1.0078;
+  in.balance_point_m = 0.6090;
+  in.moi_centroid_kg_m2 = 0.4122 - 1.0078 * 0.6090 * 0.6090;
+  return in;
+}
+
+ObliqueImpactInputs ObliqueBenchInputs() {
+  ObliqueImpactInputs in;  // 90 mph pitch, 6 degrees down; 70 mph bat, 10 degrees up
+  in.ball_backspin_rad_s = RpmToRadPerSecond(2200.0);
+  in.undercut_m = 0.019;
+  const FreeBatInputs bat = ObliqueBenchBat();
+  const double b = 0.72 - bat.balance_point_m;
+  in.normal.bat_effective_mass_kg =
+      1.0 / (1.0 / bat.bat_mass_kg + b * b / bat.moi_centroid_kg_m2);
+  return in;
+}
+
+void BM_FreeBatImpactNormalModel(benchmark::State& state) {
+  const FreeBatInputs bat = ObliqueBenchBat();
+  for (auto _ : state) {
+    Keep(bat);
+    const FreeBatImpact r = FreeBatImpactAt(bat, 0.72);
+    Keep(r.exit_speed_mps);
+  }
+}
+BENCHMARK(BM_FreeBatImpactNormalModel);
+
+void BM_ObliqueImpact(benchmark::State& state) {
+  ObliqueImpactInputs in = ObliqueBenchInputs();
+  double rpm = 0.0;
+  for (auto _ : state) {
+    Keep(in);
+    const ObliqueImpactResult r = SolveObliqueImpact(in);
+    rpm = r.backspin_rpm;
+    Keep(rpm);
+  }
+  state.counters["backspin_rpm"] = rpm;
+}
+BENCHMARK(BM_ObliqueImpact);
+
+void BM_ObliqueImpactNormalLawCallable(benchmark::State& state) {
+  ObliqueImpactInputs in = ObliqueBenchInputs();
+  const FreeBatInputs bat = ObliqueBenchBat();
+  in.normal.ball_normal_impulse_n_s = [bat](double v_n) {
+    FreeBatInputs at_rest = bat;
+    at_rest.ball_speed_mps = v_n;
+    at_rest.angular_speed_rad_s = 0.0;
+    return FreeBatImpactAt(at_rest, 0.72).ball_impulse_n_s;
+  };
+  for (auto _ : state) {
+    const ObliqueImpactResult r = SolveObliqueImpact(in);
+    Keep(r.backspin_rpm);
+  }
+}
+BENCHMARK(BM_ObliqueImpactNormalLawCallable);
 
 }  // namespace
 }  // namespace bench_core_collision

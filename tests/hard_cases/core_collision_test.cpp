@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "core/bat/presets.hpp"
 #include "core/collision/free_bat.hpp"
 #include "core/collision/hertz_contact.hpp"
+#include "core/collision/oblique_impact.hpp"
 #include "core/collision/rigid_pivot.hpp"
 #include "core/numerics/nlopt_search.hpp"
 #include "core/scene/collide.hpp"
@@ -135,6 +137,129 @@ std::vector<CoreCase> RigidPivotCases() {
 class HardCaseRigidPivot : public testing::TestWithParam<CoreCase> {};
 TEST_P(HardCaseRigidPivot, Holds) { CheckCoreCase(GetParam()); }
 INSTANTIATE_TEST_SUITE_P(Core, HardCaseRigidPivot, testing::ValuesIn(RigidPivotCases()),
+                         RowName<CoreCase>);
+
+// ------------------------------------------------------------------------- oblique impact
+
+// The oblique impact's spin (rpm) in long double for a gripping ball (mu_f = inf), the closed
+// form of oblique_impact.hpp evaluated in extended precision.
+long double ObliqueSpinRpm(const core::ObliqueImpactInputs& in) {
+  using L = long double;
+  const L pi = 3.141592653589793238462643383279502884L;
+  const L d = L(in.descent_angle_deg) * pi / 180, a = L(in.attack_angle_deg) * pi / 180;
+  const L wx = -L(in.ball_speed_mps) * std::cos(d) - L(in.bat_speed_mps) * std::cos(a);
+  const L wy = -L(in.ball_speed_mps) * std::sin(d) - L(in.bat_speed_mps) * std::sin(a);
+  const L speed = std::sqrt(wx * wx + wy * wy);
+  const L m = in.ball_mass_kg, big_r = in.ball_radius_m, r = in.bat_radius_m;
+  const L alpha = in.ball_gyration_ratio;
+  const L sin_psi = L(in.undercut_m) / (big_r + r);
+  const L cos_psi = std::sqrt(1 - sin_psi * sin_psi);
+  const L inv_mn = 1 / L(in.normal.bat_effective_mass_kg);
+  const L j_n = (1 + L(in.normal.cor)) * speed * cos_psi / (1 / m + inv_mn);
+  (void)j_n;
+  const L inv_mu = (1 + alpha) / (alpha * m) + inv_mn + r * r / L(in.bat_roll_moi_kg_m2);
+  const L omega = -L(in.ball_backspin_rad_s);
+  const L slip = speed * sin_psi - big_r * omega;
+  const L j_t = -(1 + L(in.tangential.tangential_cor)) * slip / inv_mu;
+  return (omega - j_t / (alpha * m * big_r)) * 60 / (2 * pi);
+}
+
+core::ObliqueImpactInputs ObliqueInputs(double undercut_fraction) {
+  core::ObliqueImpactInputs in;
+  in.ball_backspin_rad_s = core::RpmToRadPerSecond(2200.0);
+  in.normal.bat_effective_mass_kg = 0.6;
+  in.tangential.friction_coefficient = std::numeric_limits<double>::infinity();
+  in.undercut_m = undercut_fraction * core::MaxUndercutM(in);
+  return in;
+}
+
+// Against the long double form: a few dozen roundings of terms of size |w| / R (~2e3 rad/s,
+// ~2e4 rpm), so 64 eps of 2e4 rpm; the grazing rows (cos psi from (1 - s)(1 + s)) stay there.
+CoreCase ObliqueSpinRow(std::string name, core::ObliqueImpactInputs in) {
+  return {std::move(name),
+          [in] {
+            const core::ObliqueImpactResult r = core::SolveObliqueImpact(in);
+            return FromSummary(r.summary, r.backspin_rpm);
+          },
+          Reference([in] { return ObliqueSpinRpm(in); }, 0, 64 * kEps * 2e4)};
+}
+
+CoreCase ObliqueRefusalRow(std::string name, void (*set)(core::ObliqueImpactInputs*),
+                           std::string phrase) {
+  return {std::move(name),
+          [set] {
+            core::ObliqueImpactInputs in = ObliqueInputs(0.2);
+            set(&in);
+            const core::ObliqueImpactResult r = core::SolveObliqueImpact(in);
+            return FromSummary(r.summary, r.backspin_rpm);
+          },
+          Refused("invalid_input", std::move(phrase))};
+}
+
+std::vector<CoreCase> ObliqueImpactCases() {
+  std::vector<CoreCase> rows = {
+      ObliqueSpinRow("UndercutOfAFifthOfTheReach", ObliqueInputs(0.2)),
+      ObliqueSpinRow("GrazingUndercut", ObliqueInputs(1.0 - 1e-12)),
+      ObliqueSpinRow("GrazingOvercut", ObliqueInputs(-1.0 + 1e-12)),
+      ObliqueSpinRow("TinyUndercut", ObliqueInputs(1e-300)),
+  };
+  {
+    core::ObliqueImpactInputs slow = ObliqueInputs(0.3);
+    slow.ball_speed_mps = 1e-9;
+    slow.bat_speed_mps = 0.0;
+    slow.ball_backspin_rad_s = 0.0;
+    rows.push_back(ObliqueSpinRow("BallAtOneNanometrePerSecond", slow));
+  }
+  // Elastic, frictionless, immovable bat at rest: the ball leaves at its own speed (a mirror),
+  // to a few roundings.
+  rows.push_back({"ElasticFrictionlessMirrorKeepsTheSpeed",
+                  [] {
+                    core::ObliqueImpactInputs in = ObliqueInputs(0.7);
+                    in.bat_speed_mps = 0.0;
+                    in.normal.cor = 1.0;
+                    in.normal.bat_effective_mass_kg = std::numeric_limits<double>::infinity();
+                    in.tangential.friction_coefficient = 0.0;
+                    const core::ObliqueImpactResult r = core::SolveObliqueImpact(in);
+                    return FromSummary(r.summary, r.exit_speed_mps);
+                  },
+                  Exactly(40.2336, 16 * kEps * 40.2336)});
+  rows.push_back(ObliqueRefusalRow(
+      "NaNDescentAngleIsRefused",
+      [](core::ObliqueImpactInputs* in) { in->descent_angle_deg = std::nan(""); },
+      "descent_angle_deg = nan: must be in [-89, 89]"));
+  rows.push_back(ObliqueRefusalRow(
+      "InfiniteBallSpeedIsRefused",
+      [](core::ObliqueImpactInputs* in) {
+        in->ball_speed_mps = std::numeric_limits<double>::infinity();
+      },
+      "ball_speed_mps = inf: must be in [0, 500]"));
+  rows.push_back(ObliqueRefusalRow(
+      "UndercutAtTheReachIsRefused",
+      [](core::ObliqueImpactInputs* in) { in->undercut_m = core::MaxUndercutM(*in); },
+      "the ball misses the bat"));
+  rows.push_back(ObliqueRefusalRow(
+      "SpinOfAMillionRpmIsRefused",
+      [](core::ObliqueImpactInputs* in) {
+        in->ball_backspin_rad_s = core::RpmToRadPerSecond(1e6);
+      },
+      "ball_backspin_rad_s = "));
+  rows.push_back(ObliqueRefusalRow(
+      "NegativeBatRadiusIsRefused", [](core::ObliqueImpactInputs* in) { in->bat_radius_m = -0.01; },
+      "bat_radius_m = -0.01: must be in (0, 1]"));
+  rows.push_back({"NormalLawAnsweringNaNFails",
+                  [] {
+                    core::ObliqueImpactInputs in = ObliqueInputs(0.2);
+                    in.normal.ball_normal_impulse_n_s = [](double) { return std::nan(""); };
+                    const core::ObliqueImpactResult r = core::SolveObliqueImpact(in);
+                    return FromSummary(r.summary, r.backspin_rpm);
+                  },
+                  Refused("failure", "the normal law answered J_n = nan")});
+  return rows;
+}
+
+class HardCaseObliqueImpact : public testing::TestWithParam<CoreCase> {};
+TEST_P(HardCaseObliqueImpact, Holds) { CheckCoreCase(GetParam()); }
+INSTANTIATE_TEST_SUITE_P(Core, HardCaseObliqueImpact, testing::ValuesIn(ObliqueImpactCases()),
                          RowName<CoreCase>);
 
 // ------------------------------------------------------------------------------- free bat
