@@ -64,6 +64,11 @@ struct Context {
   /// then refuses (413) a sweep whose estimated CPU time, wall time or result is over
   /// limits.max_job_cpu_s, max_job_time_s or max_job_result_bytes (api/explore/estimate.hpp).
   bool job = false;
+  /// True when the answer is a job's result, collected by the job service: /v1/explore then
+  /// streams a "json" answer too (Response::stream, content type application/json: the
+  /// compact text the server would send, a row at a time) instead of building it in memory,
+  /// so that the job service can write it to its store as it is produced.
+  bool stream_json = false;
 };
 
 /// What answering a request costs, for the server's choice of worker pool.

@@ -9,11 +9,27 @@
 #      2 replicas on PostgreSQL with --job-workers 1 each (the same 2 workers).
 # Prints a table; the README's "Scaling out" quotes it.
 #
-#   bench/jobs_bench.sh [--build-dir DIR]
+# With --memory "N ...": instead, the server's peak resident memory (VmHWM of
+# /proc/<pid>/status, reset through /proc/<pid>/clear_refs before each phase) while an
+# N-design /v1/explore job (FORMAT: json by default, or csv or ndjson; the closed-form
+# max_exit_speed over a grid of cor x bat speed) runs and while its result is fetched, with
+# SQLite and with PostgreSQL, one job at a time (docs/benchmarks.md, "Issue 38: bounded job
+# memory").
+#
+#   bench/jobs_bench.sh [--build-dir DIR] [--memory "1000000 10000000" [--format FORMAT]]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=build
-[ "${1:-}" = "--build-dir" ] && build="$2"
+memory=""
+format=json
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build-dir) build="$2"; shift 2 ;;
+    --memory) memory="$2"; shift 2 ;;
+    --format) format="$2"; shift 2 ;;
+    *) echo "jobs_bench.sh: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
 server="$PWD/$build/server/sweetspot-server"
 [ -x "$server" ] || { echo "jobs_bench.sh: build $server first" >&2; exit 1; }
 bin=$(ls -d /usr/lib/postgresql/*/bin | head -n1)
@@ -93,6 +109,58 @@ else:
     print(f"{time.perf_counter() - t:.2f} s for 8 sweeps")
 PY
 }
+
+# memory_bench PORT PID DESIGNS: one explore job, its result fetched; prints the table's cells.
+memory_bench() {
+  python3 - "$@" "$format" <<'PY'
+import json, sys, time, urllib.request
+port, pid, n, fmt = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+def peak_mb():
+    for line in open(f"/proc/{pid}/status"):
+        if line.startswith("VmHWM:"): return int(line.split()[1]) / 1024
+def reset():  # the peak back to the current resident memory (Linux >= 4.0)
+    with open(f"/proc/{pid}/clear_refs", "w") as f: f.write("5")
+    return peak_mb()
+def call(method, path, body=None):
+    data = json.dumps(body).encode() if body is not None else None
+    req = urllib.request.Request(f"http://127.0.0.1:{port}{path}", data=data, method=method,
+                                 headers={"Content-Type": "application/json"})
+    with urllib.request.urlopen(req, timeout=3600) as r: return json.load(r)
+side = 1000
+sweep = {"bat": {"preset": "paper-wood"}, "outputs": ["max_exit_speed"], "format": fmt,
+         "parameters": [{"path": "cor", "min": 0.4, "max": 0.6, "count": side},
+                        {"path": "swing.bat_speed_mps", "min": 25, "max": 35, "count": n // side}]}
+idle = reset(); t = time.time()
+job = call("POST", "/v1/jobs", {"path": "/v1/explore", "body": sweep})
+while (state := call("GET", f"/v1/jobs/{job['id']}"))["state"] in ("queued", "running"):
+    time.sleep(0.5)
+assert state["state"] == "done", state
+run_s, run_peak = time.time() - t, peak_mb()
+reset(); t = time.time(); size = 0
+with urllib.request.urlopen(f"http://127.0.0.1:{port}/v1/jobs/{job['id']}/result", timeout=3600) as r:
+    while (piece := r.read(1 << 20)): size += len(piece)
+fetch_s, fetch_peak = time.time() - t, peak_mb()
+call("DELETE", f"/v1/jobs/{job['id']}")
+print(f"{size / 1e6:.0f} MB | {idle:.0f} MB | {run_peak:.0f} MB ({run_s:.1f} s) | "
+      f"{fetch_peak:.0f} MB ({fetch_s:.1f} s)")
+PY
+}
+
+if [ -n "$memory" ]; then
+  echo "| designs ($format) | store | result | VmRSS idle | VmHWM running (time) | VmHWM fetching (time) |"
+  echo "|---|---|---|---|---|---|"
+  for n in $memory; do
+    limits=(--max-batch-samples "$n" --job-max-result-bytes 1000000000000 --job-max-time-s 36000)
+    p=$(start sqlite --jobs-db "$work/jobs.db" --jobs-db-max-bytes 0 "${limits[@]}")
+    echo "| $n | SQLite | $(memory_bench "$p" "$(cat "$work/sqlite.pid")" "$n") |"
+    stop_all; rm -f "$work"/jobs.db*
+    p=$(start pg --jobs-db "$uri" "${limits[@]}")
+    echo "| $n | PostgreSQL | $(memory_bench "$p" "$(cat "$work/pg.pid")" "$n") |"
+    stop_all
+  done
+  echo "(cores: $(nproc); $(date -u +%Y-%m-%d); $(git rev-parse --short HEAD))"
+  exit 0
+fi
 
 echo "| setup | quick job round trip (200 jobs) | 8 slow sweeps posted at once |"
 echo "|---|---|---|"

@@ -161,7 +161,7 @@ const std::vector<Option>& JobOptions() {
        true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          long long n = 0;
-         if (!ParseLong(v, 1024, 1000000000, &n, rule)) return false;
+         if (!ParseLong(v, 1024, 1000000000000LL, &n, rule)) return false;
          c->jobs.max_result_bytes = static_cast<std::size_t>(n);
          return true;
        }},

@@ -115,6 +115,7 @@ void Server::Impl::OpenJobs() {
     api::Context job_context = context;
     job_context.progress = progress;
     job_context.batch = true;  // the rows go to the job's result: --max-batch-samples
+    job_context.stream_json = true;  // a sweep's rows go to the store as they are made
     // Streamed answers (CSV, NDJSON sweeps) are collected by the job service, which stops
     // them at its result limit.
     api::Response response = api::Dispatch(inner, job_context, nullptr, /*allow_stream=*/true);

@@ -14,6 +14,7 @@
 #include "api/explore/engine.hpp"
 #include "api/explore/estimate.hpp"
 #include "api/explore/shards.hpp"
+#include "api/explore/streams.hpp"
 #include "api/handlers/endpoint.hpp"
 #include "api/handlers/handlers.hpp"
 #include "api/json_path.hpp"
@@ -518,51 +519,11 @@ Response HandleExplore(const Request& request, const Context& context) {
   const std::shared_ptr<Sweep>& sweep = parsed->sweep;
   sweep->start = start;
   const std::vector<ExploreColumn> columns = parsed->columns;
-  if (parsed->format == "csv") {
-    // Streamed like NDJSON: the header row, then the rows block by block as they are
-    // evaluated. Only rows: the summary is in the json and ndjson answers (docs/api.md).
-    Response streamed = Response::Text(200, std::string(), "text/csv");
-    core::Progress* progress = context.progress;
-    streamed.stream = [sweep, progress, columns](const ChunkSink& sink) {
-      std::string header;
-      AppendCsvHeader(columns, &header);
-      if (!sink(header)) return false;
-      const SweepOutcome outcome = RunSweep(*sweep, RowFormat::kCsv, columns, progress,
-                                            [&](BlockRows& rows) { return sink(rows.text); });
-      return !outcome.stopped && !outcome.cancelled && !outcome.failed;  // else truncated
-    };
-    return streamed;
-  }
-  // With "columns", a row is the flat object of those columns.
-  if (parsed->format == "ndjson") {
-    // Streamed: the rows block by block as they are evaluated, then the summary line. The
-    // sweep runs while the server writes (after this returns), so it owns copies of
-    // everything; a client that goes away stops it.
-    Response streamed = Response::Text(200, std::string(), "application/x-ndjson");
-    core::Progress* progress = context.progress;
-    streamed.stream = [sweep, progress, columns](const ChunkSink& sink) {
-      const auto line = [&sink](const Json& value) {
-        return sink(value.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n");
-      };
-      const SweepOutcome outcome = RunSweep(*sweep, RowFormat::kNdjson, columns, progress,
-                                            [&](BlockRows& rows) { return sink(rows.text); });
-      if (outcome.stopped) return false;
-      if (outcome.failed) {
-        return line({{"error",
-                      {{"code", ErrorCodeName(ErrorCode::kUnavailable)},
-                       {"message", outcome.message},
-                       {"field", nullptr}}}});
-      }
-      if (outcome.cancelled) {
-        return line({{"error",
-                      {{"code", ErrorCodeName(ErrorCode::kCancelled)},
-                       {"message", outcome.message},
-                       {"field", nullptr}}}});
-      }
-      return line({{"summary", outcome.summary}});
-    };
-    return streamed;
-  }
+  // csv and ndjson are streamed (the sweep runs while the server writes), and so is json for
+  // a job's result (api/explore/streams.hpp).
+  if (parsed->format == "csv") return StreamedCsvAnswer(sweep, columns, context.progress);
+  if (parsed->format == "ndjson") return StreamedNdjsonAnswer(sweep, columns, context.progress);
+  if (context.stream_json) return StreamedJsonAnswer(sweep, columns, context.progress);
   Json rows = Json::array();
   const SweepOutcome outcome =
       RunSweep(*sweep, RowFormat::kJson, columns, context.progress, [&](BlockRows& block) {

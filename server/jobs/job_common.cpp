@@ -17,7 +17,7 @@ constexpr std::size_t kMaxKeptLimit = 1000000;
 constexpr int kMaxResumesLimit = 100;
 constexpr double kMaxLeaseS = 3600.0;
 constexpr std::size_t kMinResultBytes = 1024;
-constexpr std::size_t kMaxResultBytes = 1000000000;  // A PostgreSQL text value holds up to 1 GB.
+constexpr std::size_t kMaxResultBytes = 1000000000000;  // In pieces: no column holds it whole.
 constexpr std::size_t kMaxResultsMemoryBytes = 1000000000000;
 constexpr double kMaxJobTimeS = 1e6;
 
@@ -147,29 +147,84 @@ api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const
                                        ""});
 }
 
-StreamOutcome CollectJobStream(api::Response* response, std::size_t max_bytes,
-                               std::size_t* bytes) {
+CollectedStream CollectJobStream(api::Response* response, std::size_t max_bytes,
+                                 const ResultChunkWriter& write) {
+  CollectedStream out;
   if (!response->stream) {
-    *bytes = response->text.size();
-    return StreamOutcome::kComplete;
+    out.bytes = response->text.size();
+    return out;
   }
   std::string text;
-  std::size_t produced = 0;
   bool over = false;
+  // Hands the full pieces at the front of `text` to the writer, keeping the rest.
+  auto flush_full = [&]() {
+    std::size_t at = 0;
+    while (text.size() - at >= kResultChunkBytes) {
+      if (!write(out.pieces, std::string_view(text).substr(at, kResultChunkBytes),
+                 &out.write_error)) {
+        return false;
+      }
+      ++out.pieces;
+      at += kResultChunkBytes;
+    }
+    text.erase(0, at);
+    return true;
+  };
+  bool write_failed = false;
   const bool complete = response->stream([&](std::string_view chunk) {
-    produced += chunk.size();
-    if (produced > max_bytes) {
+    out.bytes += chunk.size();
+    if (out.bytes > max_bytes) {
       over = true;
       return false;  // Stops the producer.
     }
     text.append(chunk);
+    if (write && text.size() >= kResultChunkBytes && !flush_full()) {
+      write_failed = true;
+      return false;
+    }
     return true;
   });
   response->stream = nullptr;
+  if (!over && !write_failed && complete && out.pieces > 0 && !text.empty()) {
+    if (write(out.pieces, text, &out.write_error)) {
+      ++out.pieces;
+    } else {
+      write_failed = true;
+    }
+  }
+  out.chunked = out.pieces > 0;
+  if (out.chunked) {
+    std::string().swap(text);
+  }
   response->text = std::move(text);
-  *bytes = produced;
-  if (over) return StreamOutcome::kOverLimit;
-  return complete ? StreamOutcome::kComplete : StreamOutcome::kStopped;
+  if (over) {
+    out.outcome = StreamOutcome::kOverLimit;
+  } else if (write_failed) {
+    out.outcome = StreamOutcome::kWriteFailed;
+  } else if (!complete) {
+    out.outcome = StreamOutcome::kStopped;
+  }
+  return out;
+}
+
+bool NormalizeJsonResult(api::Response* response, bool chunked) {
+  if (response->content_type != "application/json") return true;
+  if (chunked) {
+    response->content_type.clear();  // Its pieces are the JSON text, as response_json holds it.
+    return true;
+  }
+  if (response->text.size() > kResultChunkBytes) {
+    // Kept in memory whole (no store keeps pieces): sent as it is, with the newline the server
+    // ends a JSON answer with, rather than parsed into values several times its size.
+    response->text.push_back('\n');
+    return true;
+  }
+  nlohmann::json body = nlohmann::json::parse(response->text, nullptr, false);
+  if (body.is_discarded()) return false;
+  std::string().swap(response->text);
+  response->body = std::move(body);
+  response->content_type.clear();
+  return true;
 }
 
 api::Response JobInterrupted(int resumes, int max_resumes, std::string* message) {

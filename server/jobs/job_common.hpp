@@ -7,13 +7,17 @@
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
+#include <functional>
 #include <optional>
 #include <random>
 #include <string>
+#include <string_view>
 
 #include "api/job_service.hpp"
 #include "api/response.hpp"
 #include "core/refusal.hpp"
+#include "server/jobs/job_store.hpp"
 
 namespace sweetspot::server {
 
@@ -30,10 +34,11 @@ struct JobConfig {
   /// replica running it renews it every lease_s / 4 (at most every 0.5 s); a replica that
   /// died leaves its jobs to the others after this long.
   double lease_s = 10.0;
-  /// The largest result a job may have, bytes, [1024, 1e9] (a PostgreSQL text column holds up
-  /// to 1 GB), with every store (SQLite, PostgreSQL, memory only). A larger result makes the job
-  /// failed (status 413, code TooBig, as the contract pairs them) with its size and this limit
-  /// in the message: never truncated.
+  /// The largest result a job may have, bytes, [1024, 1e12], with every store (SQLite,
+  /// PostgreSQL, memory only; a result over kResultChunkBytes is stored in pieces as it is
+  /// produced, so no column holds it whole). A larger result makes the job failed (status 413,
+  /// code TooBig, as the contract pairs them) with its size and this limit in the message: never
+  /// truncated; a streamed one is stopped as soon as it passes it.
   std::size_t max_result_bytes = 256u << 20;
   /// One process (JobManager): the finished jobs' results held in memory in total, bytes
   /// (serialised size), [1024, 1e12]. With a SQLite store, results larger than
@@ -105,18 +110,42 @@ api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const
 
 /// What CollectJobStream did.
 enum class StreamOutcome {
-  kComplete,   ///< The producer ran to its end: the whole body is in text.
-  kOverLimit,  ///< More than the limit arrived: the producer was told to stop.
-  kStopped,    ///< The producer stopped by itself (cancelled): the body is incomplete.
+  kComplete,     ///< The producer ran to its end: the whole body is in text or written.
+  kOverLimit,    ///< More than the limit arrived: the producer was told to stop.
+  kStopped,      ///< The producer stopped by itself (cancelled): the body is incomplete.
+  kWriteFailed,  ///< A piece could not be written (CollectedStream::write_error): stopped.
 };
 
-/// Runs a streamed answer's producer (Response::stream, e.g. a CSV sweep) into
-/// response->text, at most `max_bytes` of it: the chunk that goes over makes the sink refuse,
-/// which stops the sweep at once instead of after it built the whole body. Clears stream;
-/// *bytes gets the bytes produced (up to the first chunk over the limit). Without a stream:
-/// kComplete and text.size().
-StreamOutcome CollectJobStream(api::Response* response, std::size_t max_bytes,
-                               std::size_t* bytes);
+/// Receives piece `seq` (0, 1, ...; kResultChunkBytes each but the last) of a result as it is
+/// produced; false with *error when it cannot keep it (the producer is then stopped).
+using ResultChunkWriter =
+    std::function<bool(std::uint64_t seq, std::string_view bytes, std::string* error)>;
+
+/// What CollectJobStream produced.
+struct CollectedStream {
+  StreamOutcome outcome = StreamOutcome::kComplete;  ///< How the producer ended.
+  std::size_t bytes = 0;     ///< Bytes produced (up to the first chunk over the limit).
+  bool chunked = false;      ///< The body went to the writer in pieces; text is empty.
+  std::uint64_t pieces = 0;  ///< Pieces written.
+  std::string write_error;   ///< The writer's message (kWriteFailed).
+};
+
+/// Runs a streamed answer's producer (Response::stream, e.g. a sweep) into response->text, at
+/// most `max_bytes` of it: the chunk that goes over makes the sink refuse, which stops the
+/// sweep at once instead of after it built the whole body. With `write`, a body that grows
+/// past kResultChunkBytes is handed to it in pieces of that size as it is produced (text then
+/// holds less than one piece at a time and is empty at the end, `chunked`): never whole in
+/// memory. Clears stream. Without a stream: kComplete and text.size().
+CollectedStream CollectJobStream(api::Response* response, std::size_t max_bytes,
+                                 const ResultChunkWriter& write = nullptr);
+
+/// A result the job services keep, from a streamed JSON answer (content type application/json,
+/// in text): in pieces (`chunked`), its content type becomes "" (the pieces are the JSON text,
+/// as a store keeps a JSON body); whole and at most kResultChunkBytes, it becomes its parsed
+/// body again (stored and sent as any JSON answer: the same bytes); larger (a store without
+/// pieces, or none), it stays text, ended by the newline the server ends JSON answers with.
+/// Returns false (and leaves it) when a text to parse is not JSON.
+bool NormalizeJsonResult(api::Response* response, bool chunked);
 
 /// The quoted id for messages ("\"abc\"", cut when long, control characters escaped).
 std::string QuoteJobId(const std::string& id);

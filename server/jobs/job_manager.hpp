@@ -25,19 +25,23 @@
 // in memory are bounded: with a store, results over kMaxLoadedResultBytes live in the store
 // only and Result() reads them back (as the stored JSON text), and the small ones leave memory,
 // oldest first, once they total more than max_results_memory_bytes; with no store, the oldest
-// finished jobs are dropped (404) instead. A job running longer than max_time_s has its cancel
+// finished jobs are dropped (404) instead. A store that keeps pieces (SQLite) gets a streamed
+// answer (a sweep; /v1/explore's json too, for a job) as it is produced: past kResultChunkBytes
+// it is written in 1 MiB pieces, so a result is never whole in memory, running or read back
+// (a piece at a time, as the client takes it). A job running longer than max_time_s has its cancel
 // flag set (a watchdog thread) and ends failed (408 Timeout) naming the limit.
 #pragma once
 
 #include <chrono>
 #include <condition_variable>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -136,7 +140,27 @@ class JobManager final : public ServerJobService {
   static const char* StateName(State state);
   // 0 while queued, 1 when done, else the runner's last report.
   static double ProgressOf(const Job& job);
+  // What a run produced (RunJob, outside the lock), for FinishRunLocked.
+  struct RunOutcome {
+    api::Response response;     // The answer (or the error it became).
+    bool threw = false;         // The runner threw.
+    bool answered = false;      // A 2xx answer.
+    bool too_big = false;       // Over the result limit: response is the 413.
+    bool memory_bound = false;  // No store: max_results_memory_bytes was the limit.
+    std::size_t bytes = 0;      // The kept answer's bytes; 0 when none is kept.
+    std::string serialized;     // A JSON answer serialised once (for the store), or "".
+    std::uint64_t chunks = 0;   // Result pieces written to the store.
+    std::optional<std::uint64_t> chunked_bytes;  // The answer is in the pieces: its bytes.
+  };
   void WorkerLoop();
+  // Runs the job's request and collects its answer (streamed to the store's pieces when it
+  // keeps them), checked against the result limits. Without the lock.
+  RunOutcome RunJob(Job& job, api::Request inner);
+  // Makes the job cancelled, failed, done or queued again from `run`, saves it and keeps its
+  // result (in memory or the store).
+  void FinishRunLocked(const std::shared_ptr<Job>& job, RunOutcome run);
+  // Deletes the result pieces of job `id` when `chunks` were written (a failure is reported).
+  void DropChunksLocked(const std::string& id, std::uint64_t chunks) const;
   void WatchdogLoop();   // Sets the cancel flag of jobs running longer than max_time_s.
   void LoadFromStore();  // Before the workers start.
   double ToUnixSeconds(Clock::time_point time) const;

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace sweetspot::server {
@@ -34,9 +35,18 @@ struct JobRecord {
   std::string content_type;   ///< The non-JSON body's type; "" for a JSON body.
   std::string error;          ///< The failure's message (failed), else "".
   /// LoadAll left the result (response_json, response_text) out because it is larger than
-  /// kMaxLoadedResultBytes: LoadResult reads it.
+  /// kMaxLoadedResultBytes (or in pieces): LoadResult or OpenResult reads it.
   bool result_in_store = false;
+  /// Set when the result is not in response_json/response_text but in the pieces written by
+  /// JobStore::SaveResultChunk while the job ran: its length, bytes (JSON when content_type is
+  /// empty, as response_json would hold it).
+  std::optional<std::uint64_t> chunked_bytes;
 };
+
+/// A result larger than this is written to the store in pieces of this size as it is produced
+/// (JobStore::SaveResultChunk; the last piece may be shorter), never whole in memory; a smaller
+/// one is saved with its record. Bytes.
+inline constexpr std::size_t kResultChunkBytes = 1u << 20;
 
 /// LoadAll returns results up to this size (bytes of response_json plus response_text); larger
 /// ones stay in the store (JobRecord::result_in_store), so a restart does not load them all.
@@ -48,6 +58,8 @@ struct StoredResult {
   std::string content_type;  ///< The non-JSON body's type; "" for a JSON body.
   std::uint64_t bytes = 0;   ///< The body's length as stored, bytes.
   std::int64_t row = 0;      ///< The store's handle of the record (SQLite: its rowid).
+  std::string id;            ///< The job's id.
+  bool chunked = false;      ///< In pieces of kResultChunkBytes (JobRecord::chunked_bytes).
   /// The body itself, when the store read it whole (JobStore's default OpenResult); else null.
   std::shared_ptr<const std::string> loaded;
 };
@@ -103,6 +115,29 @@ class JobStore {
       return false;
     }
     out->append(result.loaded->substr(offset, max));
+    return true;
+  }
+
+  /// True when SaveResultChunk works (SqliteJobStore); else results are saved whole with their
+  /// records, as Save takes them.
+  virtual bool KeepsResultChunks() const { return false; }
+
+  /// Stores piece `seq` (0, 1, ... in order; kResultChunkBytes each but the last) of job `id`'s
+  /// result while the job runs; the record saved when it finishes names the length
+  /// (JobRecord::chunked_bytes). A piece of the same number is replaced. This default cannot.
+  virtual bool SaveResultChunk(const std::string& id, std::uint64_t seq, std::string_view bytes,
+                               std::string* error) {
+    (void)id;
+    (void)seq;
+    (void)bytes;
+    if (error != nullptr) *error = "this store keeps no result pieces";
+    return false;
+  }
+
+  /// Drops the result pieces of job `id` (none is no error). Delete drops them too.
+  virtual bool DeleteResultChunks(const std::string& id, std::string* error) {
+    (void)id;
+    (void)error;
     return true;
   }
 };

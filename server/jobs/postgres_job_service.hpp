@@ -25,9 +25,13 @@
 //   Unavailable (the server adds Retry-After: 1); connections are re-made on
 //   the next request; a job that finished while the database was away keeps
 //   its result in memory (and its lease renewed) until the commit succeeds.
-// - Results: stored whole (a text value holds up to 1 GB); one larger than
-//   JobConfig::max_result_bytes fails the job with status 413, code TooBig, and
-//   its size in the message: never truncated.
+// - Results: one over kResultChunkBytes (a streamed sweep) is written to
+//   sweetspot_job_result_chunks in 1 MiB pieces as it is produced (only while this
+//   replica holds the job's lease), the job's row naming its length (result_bytes);
+//   smaller ones are stored with the row. Every result is read back as the client
+//   takes it (GET .../result holds a piece at a time, never the whole). One larger
+//   than JobConfig::max_result_bytes fails the job with status 413, code TooBig,
+//   and its size in the message: never truncated.
 // - Shutdown: no new claims; running jobs get the grace period; those still
 //   running then are handed back to the queue (state queued, no resume
 //   counted) for another replica or the next start.

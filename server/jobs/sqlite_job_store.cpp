@@ -20,7 +20,7 @@ constexpr std::size_t kMaxMaxBytes = 1000000000000000;
 constexpr const char* kColumns =
     "id, state, method, path, body, progress, cancel_requested, resumes, created_at, "
     "created_unix_s, started_unix_s, finished_unix_s, status, response_json, response_text, "
-    "content_type, error";
+    "content_type, error, result_bytes";
 
 constexpr const char* kCreateTable =
     "CREATE TABLE IF NOT EXISTS jobs ("
@@ -40,7 +40,18 @@ constexpr const char* kCreateTable =
     " response_json TEXT NOT NULL,"
     " response_text TEXT NOT NULL,"
     " content_type TEXT NOT NULL,"
-    " error TEXT NOT NULL)";
+    " error TEXT NOT NULL,"
+    " result_bytes INTEGER)";
+
+// Version 2: a result over kResultChunkBytes is written in pieces as it is produced
+// (JobRecord::chunked_bytes says how long it is; NULL: in response_json/response_text).
+constexpr const char* kAddResultBytes = "ALTER TABLE jobs ADD COLUMN result_bytes INTEGER";
+constexpr const char* kCreateChunks =
+    "CREATE TABLE IF NOT EXISTS job_result_chunks ("
+    " job_id TEXT NOT NULL,"
+    " seq INTEGER NOT NULL,"
+    " data BLOB NOT NULL,"
+    " PRIMARY KEY (job_id, seq))";
 
 // The text of column `index` (bytes as stored; NULL gives "").
 std::string ColumnText(sqlite3_stmt* statement, int index) {
@@ -165,7 +176,8 @@ bool SqliteJobStore::Initialize(const SqliteJobStoreOptions& options, std::strin
     ok = false;
   }
   if (ok && version < kSchemaVersion) {
-    ok = exec(kCreateTable) &&
+    // 0: a new file; 1: the jobs without result pieces.
+    ok = (version == 0 ? exec(kCreateTable) : exec(kAddResultBytes)) && exec(kCreateChunks) &&
          exec(("PRAGMA user_version = " + std::to_string(kSchemaVersion)).c_str());
   }
   if (!ok) {
@@ -186,10 +198,11 @@ bool SqliteJobStore::Initialize(const SqliteJobStoreOptions& options, std::strin
 
   const std::string save_sql = std::string("INSERT OR REPLACE INTO jobs (") + kColumns +
                                ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, "
-                               "?13, ?14, ?15, ?16, ?17)";
-  // Results over kMaxLoadedResultBytes are left out (sizes in bytes: a BLOB's length).
+                               "?13, ?14, ?15, ?16, ?17, ?18)";
+  // Results over kMaxLoadedResultBytes are left out (sizes in bytes: a BLOB's length), and
+  // results in pieces.
   const std::string big =
-      "(length(CAST(response_json AS BLOB)) + "
+      "(result_bytes IS NOT NULL OR length(CAST(response_json AS BLOB)) + "
       "length(CAST(response_text AS BLOB)) > " +
       std::to_string(kMaxLoadedResultBytes) + ")";
   const std::string load_sql =
@@ -197,13 +210,17 @@ bool SqliteJobStore::Initialize(const SqliteJobStoreOptions& options, std::strin
       "created_unix_s, started_unix_s, finished_unix_s, status, CASE WHEN " +
       big + " THEN '' ELSE response_json END, CASE WHEN " + big +
       " THEN '' ELSE response_text END, content_type, error, " + big +
-      " FROM jobs ORDER BY created_unix_s, id";
+      ", result_bytes FROM jobs ORDER BY created_unix_s, id";
   const char* delete_sql = "DELETE FROM jobs WHERE id = ?1";
+  const char* chunk_sql =
+      "INSERT OR REPLACE INTO job_result_chunks (job_id, seq, data) VALUES (?1, ?2, ?3)";
+  const char* delete_chunks_sql = "DELETE FROM job_result_chunks WHERE job_id = ?1";
   const char* result_sql =
       "SELECT status, response_json, response_text, content_type FROM jobs WHERE id = ?1";
   for (auto [sql, statement] :
        {std::pair{save_sql.c_str(), &save_}, std::pair{load_sql.c_str(), &load_},
-        std::pair{delete_sql, &delete_}, std::pair{result_sql, &result_}}) {
+        std::pair{delete_sql, &delete_}, std::pair{result_sql, &result_},
+        std::pair{chunk_sql, &save_chunk_}, std::pair{delete_chunks_sql, &delete_chunks_}}) {
     if ((code = sqlite3_prepare_v2(db_, sql, -1, statement, nullptr)) != SQLITE_OK) {
       *error = Failure(std::string("prepare ") + sql, code);
       return false;
@@ -215,7 +232,9 @@ bool SqliteJobStore::Initialize(const SqliteJobStoreOptions& options, std::strin
 SqliteJobStore::~SqliteJobStore() {
   std::lock_guard lock(mutex_);
   // sqlite3_finalize returns the statement's last error, already reported.
-  for (sqlite3_stmt* statement : {save_, delete_, load_, result_}) sqlite3_finalize(statement);
+  for (sqlite3_stmt* statement : {save_, delete_, load_, result_, save_chunk_, delete_chunks_}) {
+    sqlite3_finalize(statement);
+  }
   // With every statement finalized, close cannot be SQLITE_BUSY; there is no
   // one left to report another failure to, and the OS releases the lock anyway.
   sqlite3_close(db_);
@@ -257,6 +276,12 @@ bool SqliteJobStore::Save(const JobRecord& record, std::string* error) {
   text(record.response_text);
   text(record.content_type);
   text(record.error);
+  if (code == SQLITE_OK) {
+    ++index;
+    code = record.chunked_bytes
+               ? sqlite3_bind_int64(save_, index, static_cast<sqlite3_int64>(*record.chunked_bytes))
+               : sqlite3_bind_null(save_, index);
+  }
   if (code != SQLITE_OK) {
     if (error != nullptr) *error = Failure("bind parameter " + std::to_string(index), code);
     Rewind(save_);
@@ -271,13 +296,43 @@ bool SqliteJobStore::Save(const JobRecord& record, std::string* error) {
 
 bool SqliteJobStore::Delete(const std::string& id, std::string* error) {
   std::lock_guard lock(mutex_);
-  int code = sqlite3_bind_text64(delete_, 1, id.data(), id.size(), SQLITE_STATIC, SQLITE_UTF8);
+  return DeleteLocked(delete_chunks_, id, "delete the result of job ", error) &&
+         DeleteLocked(delete_, id, "delete job ", error);
+}
+
+bool SqliteJobStore::DeleteResultChunks(const std::string& id, std::string* error) {
+  std::lock_guard lock(mutex_);
+  return DeleteLocked(delete_chunks_, id, "delete the result of job ", error);
+}
+
+bool SqliteJobStore::DeleteLocked(sqlite3_stmt* statement, const std::string& id,
+                                  const std::string& what, std::string* error) {
+  int code = sqlite3_bind_text64(statement, 1, id.data(), id.size(), SQLITE_STATIC, SQLITE_UTF8);
   if (code == SQLITE_OK) {
-    code = sqlite3_step(delete_);
+    code = sqlite3_step(statement);
     if (code == SQLITE_DONE) code = SQLITE_OK;
   }
-  if (code != SQLITE_OK && error != nullptr) *error = Failure("delete job " + id, code);
-  Rewind(delete_);
+  if (code != SQLITE_OK && error != nullptr) *error = Failure(what + id, code);
+  Rewind(statement);
+  return code == SQLITE_OK;
+}
+
+bool SqliteJobStore::SaveResultChunk(const std::string& id, std::uint64_t seq,
+                                     std::string_view bytes, std::string* error) {
+  std::lock_guard lock(mutex_);
+  int code = sqlite3_bind_text64(save_chunk_, 1, id.data(), id.size(), SQLITE_STATIC, SQLITE_UTF8);
+  if (code == SQLITE_OK) code = sqlite3_bind_int64(save_chunk_, 2, static_cast<sqlite3_int64>(seq));
+  if (code == SQLITE_OK) {
+    code = sqlite3_bind_blob64(save_chunk_, 3, bytes.data(), bytes.size(), SQLITE_STATIC);
+  }
+  if (code == SQLITE_OK) {
+    code = sqlite3_step(save_chunk_);
+    if (code == SQLITE_DONE) code = SQLITE_OK;
+  }
+  if (code != SQLITE_OK && error != nullptr) {
+    *error = Failure("save piece " + std::to_string(seq) + " of the result of job " + id, code);
+  }
+  Rewind(save_chunk_);
   return code == SQLITE_OK;
 }
 
@@ -309,6 +364,9 @@ bool SqliteJobStore::LoadAll(std::vector<JobRecord>* records, std::string* error
     record.content_type = ColumnText(load_, 15);
     record.error = ColumnText(load_, 16);
     record.result_in_store = sqlite3_column_int64(load_, 17) != 0;
+    if (sqlite3_column_type(load_, 18) != SQLITE_NULL) {
+      record.chunked_bytes = static_cast<std::uint64_t>(sqlite3_column_int64(load_, 18));
+    }
     records->push_back(std::move(record));
   }
   const bool ok = code == SQLITE_DONE;
@@ -350,8 +408,9 @@ bool SqliteJobStore::OpenResult(const std::string& id, std::optional<StoredResul
   std::lock_guard lock(mutex_);
   result->reset();
   sqlite3_stmt* find = nullptr;
-  int code = sqlite3_prepare_v2(db_, "SELECT rowid, status, content_type FROM jobs WHERE id = ?1",
-                                -1, &find, nullptr);
+  int code = sqlite3_prepare_v2(
+      db_, "SELECT rowid, status, content_type, result_bytes FROM jobs WHERE id = ?1", -1, &find,
+      nullptr);
   if (code == SQLITE_OK) {
     code = sqlite3_bind_text64(find, 1, id.data(), id.size(), SQLITE_STATIC, SQLITE_UTF8);
   }
@@ -363,6 +422,11 @@ bool SqliteJobStore::OpenResult(const std::string& id, std::optional<StoredResul
       found.row = sqlite3_column_int64(find, 0);
       found.status = static_cast<int>(sqlite3_column_int64(find, 1));
       found.content_type = ColumnText(find, 2);
+      found.id = id;
+      if (sqlite3_column_type(find, 3) != SQLITE_NULL) {
+        found.chunked = true;
+        found.bytes = static_cast<std::uint64_t>(sqlite3_column_int64(find, 3));
+      }
       exists = true;
       code = SQLITE_OK;
     } else if (code == SQLITE_DONE) {
@@ -370,7 +434,7 @@ bool SqliteJobStore::OpenResult(const std::string& id, std::optional<StoredResul
     }
   }
   sqlite3_finalize(find);
-  if (code == SQLITE_OK && exists) {
+  if (code == SQLITE_OK && exists && !found.chunked) {
     sqlite3_blob* blob = nullptr;
     code = sqlite3_blob_open(db_, "main", "jobs",
                              found.content_type.empty() ? "response_json" : "response_text",
@@ -391,6 +455,7 @@ bool SqliteJobStore::ReadResult(const StoredResult& result, std::uint64_t offset
   if (offset >= result.bytes || max == 0) return true;
   const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(max, result.bytes - offset));
   std::lock_guard lock(mutex_);
+  if (result.chunked) return ReadChunksLocked(result, offset, n, out, error);
   sqlite3_blob* blob = nullptr;
   int code = sqlite3_blob_open(db_, "main", "jobs",
                                result.content_type.empty() ? "response_json" : "response_text",
@@ -408,6 +473,51 @@ bool SqliteJobStore::ReadResult(const StoredResult& result, std::uint64_t offset
   sqlite3_blob_close(blob);
   if (code != SQLITE_OK) {
     if (error != nullptr) *error = Failure("read the result of row " + std::to_string(result.row), code);
+    return false;
+  }
+  return true;
+}
+
+bool SqliteJobStore::ReadChunksLocked(const StoredResult& result, std::uint64_t offset,
+                                      std::size_t n, std::string* out, std::string* error) {
+  sqlite3_stmt* find = nullptr;
+  int code =
+      sqlite3_prepare_v2(db_, "SELECT rowid FROM job_result_chunks WHERE job_id = ?1 AND seq = ?2",
+                         -1, &find, nullptr);
+  const std::size_t before = out->size();
+  while (code == SQLITE_OK && n > 0) {
+    const std::uint64_t seq = offset / kResultChunkBytes;
+    const auto within = static_cast<int>(offset % kResultChunkBytes);
+    code = sqlite3_bind_text64(find, 1, result.id.data(), result.id.size(), SQLITE_STATIC,
+                               SQLITE_UTF8);
+    if (code == SQLITE_OK) code = sqlite3_bind_int64(find, 2, static_cast<sqlite3_int64>(seq));
+    if (code == SQLITE_OK) code = sqlite3_step(find);
+    const sqlite3_int64 row = code == SQLITE_ROW ? sqlite3_column_int64(find, 0) : 0;
+    if (code == SQLITE_DONE) code = SQLITE_ABORT;  // the piece is gone (job deleted)
+    if (code == SQLITE_ROW) code = SQLITE_OK;
+    Rewind(find);
+    sqlite3_blob* blob = nullptr;
+    if (code == SQLITE_OK)
+      code = sqlite3_blob_open(db_, "main", "job_result_chunks", "data", row, 0, &blob);
+    std::size_t take = 0;
+    if (code == SQLITE_OK) {
+      const int length = sqlite3_blob_bytes(blob);
+      take = std::min<std::size_t>(n, static_cast<std::size_t>(std::max(0, length - within)));
+      if (take == 0) code = SQLITE_ABORT;  // shorter than the record says
+    }
+    if (code == SQLITE_OK) {
+      const std::size_t at = out->size();
+      out->resize(at + take);
+      code = sqlite3_blob_read(blob, out->data() + at, static_cast<int>(take), within);
+      offset += take;
+      n -= take;
+    }
+    sqlite3_blob_close(blob);
+  }
+  sqlite3_finalize(find);
+  if (code != SQLITE_OK) {
+    out->resize(before);
+    if (error != nullptr) *error = Failure("read the result of job " + result.id, code);
     return false;
   }
   return true;

@@ -4,8 +4,9 @@
 // library, like httplib; JobManager only sees the JobStore interface.
 //
 // The database: one table `jobs` (one row per job, the columns of
-// JobRecord), schema version in PRAGMA user_version (kSchemaVersion; a
-// newer version is refused, never rewritten). WAL journal with
+// JobRecord) and `job_result_chunks` (a result over kResultChunkBytes, in pieces written
+// while its job ran: JobStore::SaveResultChunk), schema version in PRAGMA user_version
+// (kSchemaVersion; a newer version is refused, never rewritten). WAL journal with
 // synchronous=NORMAL: a commit survives the process being killed (SIGKILL, a
 // crash), though the last commits may be lost on a power failure. Exclusive
 // locking mode: one server per database file; a second one is refused at Open
@@ -16,6 +17,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/refusal.hpp"
@@ -47,7 +49,7 @@ struct SqliteJobStoreOptions {
 class SqliteJobStore final : public JobStore {
  public:
   /// The schema this code writes (PRAGMA user_version).
-  static constexpr int kSchemaVersion = 1;
+  static constexpr int kSchemaVersion = 2;
 
   /// Opens or creates the database at `path` (":memory:" for a private
   /// in-memory one), sets WAL and exclusive locking, creates or checks the
@@ -77,20 +79,35 @@ class SqliteJobStore final : public JobStore {
   /// One piece of the result, read from its row (a record replaced or deleted since is gone).
   bool ReadResult(const StoredResult& result, std::uint64_t offset, std::size_t max,
                   std::string* out, std::string* error) override;
+  /// True: results over kResultChunkBytes go to the table job_result_chunks as they are made.
+  bool KeepsResultChunks() const override { return true; }
+  /// INSERT OR REPLACE of one piece; committed when it returns true.
+  bool SaveResultChunk(const std::string& id, std::uint64_t seq, std::string_view bytes,
+                       std::string* error) override;
+  /// DELETE of the job's pieces.
+  bool DeleteResultChunks(const std::string& id, std::string* error) override;
 
  private:
   explicit SqliteJobStore(std::string path);
   bool Initialize(const SqliteJobStoreOptions& options, std::string* error);
   // "what: SQLite's message (code N)" for the last failure on the connection.
   std::string Failure(const std::string& what, int code) const;
+  // Runs `statement` (DELETE ... WHERE ... = ?1) for `id`; *error "what id: ..." on failure.
+  bool DeleteLocked(sqlite3_stmt* statement, const std::string& id, const std::string& what,
+                    std::string* error);
+  // Reads `n` bytes from `offset` of a result in pieces (one or two pieces a call).
+  bool ReadChunksLocked(const StoredResult& result, std::uint64_t offset, std::size_t n,
+                        std::string* out, std::string* error);
 
   const std::string path_;
-  std::mutex mutex_;                // Serializes every use of the connection and statements.
-  sqlite3* db_ = nullptr;           // The connection.
-  sqlite3_stmt* save_ = nullptr;    // INSERT OR REPLACE INTO jobs ...
-  sqlite3_stmt* delete_ = nullptr;  // DELETE FROM jobs WHERE id = ?1
-  sqlite3_stmt* load_ = nullptr;    // SELECT ... FROM jobs ORDER BY ...
-  sqlite3_stmt* result_ = nullptr;  // SELECT status, response_json, ... WHERE id = ?1
+  std::mutex mutex_;                       // Serializes every use of the connection and statements.
+  sqlite3* db_ = nullptr;                  // The connection.
+  sqlite3_stmt* save_ = nullptr;           // INSERT OR REPLACE INTO jobs ...
+  sqlite3_stmt* delete_ = nullptr;         // DELETE FROM jobs WHERE id = ?1
+  sqlite3_stmt* load_ = nullptr;           // SELECT ... FROM jobs ORDER BY ...
+  sqlite3_stmt* result_ = nullptr;         // SELECT status, response_json, ... WHERE id = ?1
+  sqlite3_stmt* save_chunk_ = nullptr;     // INSERT OR REPLACE INTO job_result_chunks ...
+  sqlite3_stmt* delete_chunks_ = nullptr;  // DELETE FROM job_result_chunks WHERE job_id = ?1
 };
 
 }  // namespace sweetspot::server

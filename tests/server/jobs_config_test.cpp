@@ -71,7 +71,7 @@ TEST(JobsConfigTest, BadValuesNameFlagValueAndRule) {
   EXPECT_EQ(Parse({"--job-lease-s", "0.5"}).error,
             "option --job-lease-s = \"0.5\": must be in [1, 3600] s");
   EXPECT_EQ(Parse({"--job-max-result-bytes", "100"}).error,
-            "option --job-max-result-bytes = \"100\": must be an integer in [1024, 1000000000]");
+            "option --job-max-result-bytes = \"100\": must be an integer in [1024, 1000000000000]");
   EXPECT_EQ(Parse({"--shutdown-grace-s", "-1"}).error,
             "option --shutdown-grace-s = \"-1\": must be a number of seconds in [0, 3600]");
   EXPECT_EQ(Parse({"--shutdown-grace-s", "nan"}).error,
@@ -98,7 +98,7 @@ TEST(JobsConfigTest, IsValidRefusesOutOfRange) {
   config.jobs.lease_s = 10.0;
   config.jobs.max_result_bytes = 10;
   EXPECT_FALSE(Validates(config.jobs, &why));
-  EXPECT_EQ(why, "max_result_bytes = 10: must be in [1024, 1000000000]");
+  EXPECT_EQ(why, "max_result_bytes = 10: must be in [1024, 1000000000000]");
   config = ServerConfig{};
   config.shutdown_grace_s = -0.5;
   EXPECT_FALSE(Validates(config, &why));

@@ -324,15 +324,19 @@ TEST_F(PostgresJobsTest, ReplicasStartingAtOnceMigrateTheDatabaseOnce) {
     starters.emplace_back([&, i] { replicas[i] = Replica({}, "fresh"); });
   }
   for (std::thread& starter : starters) starter.join();
-  int applied = 0;
+  // Each migration (1: the jobs, 2: result pieces) applied by exactly one replica.
+  int applied_1 = 0;
+  int applied_2 = 0;
   for (auto& replica : replicas) {
     ASSERT_GT(replica->port(), 0) << replica->log();
-    applied += replica->log().find("applied schema migration 1") != std::string::npos ? 1 : 0;
+    applied_1 += replica->log().find("applied schema migration 1") != std::string::npos ? 1 : 0;
+    applied_2 += replica->log().find("applied schema migration 2") != std::string::npos ? 1 : 0;
   }
-  EXPECT_EQ(applied, 1);
+  EXPECT_EQ(applied_1, 1);
+  EXPECT_EQ(applied_2, 1);
   EXPECT_EQ(
       cluster_.Psql("SELECT count(*), max(version) FROM sweetspot_schema_migrations", "fresh"),
-      "1|1");
+      "2|2");
   // And every replica works on it.
   const std::string id = SubmitJob(*replicas[3], "/v1/bat/properties", kQuick);
   WaitForState(*replicas[0], id, "done");
@@ -346,7 +350,7 @@ TEST_F(PostgresJobsTest, ANewerSchemaIsRefusedWithTheReason) {
             "");
   ServerProcess refused;
   EXPECT_FALSE(refused.Start({"--jobs-db", cluster_.Uri()}));
-  EXPECT_NE(refused.log().find("its schema is at version 99, newer than this server's 1"),
+  EXPECT_NE(refused.log().find("its schema is at version 99, newer than this server's 2"),
             std::string::npos)
       << refused.log();
 }

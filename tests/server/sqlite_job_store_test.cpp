@@ -195,14 +195,14 @@ TEST(SqliteJobStoreTest, ANewerSchemaIsRefusedAndLeftAlone) {
   const std::string path = dir.File("jobs.db");
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(db, "PRAGMA user_version = 2", nullptr, nullptr, nullptr), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "PRAGMA user_version = 3", nullptr, nullptr, nullptr), SQLITE_OK);
   ASSERT_EQ(sqlite3_close(db), SQLITE_OK);
   std::string error;
   EXPECT_EQ(SqliteJobStore::Open(path, &error), nullptr);
   EXPECT_EQ(error, "jobs database \"" + path +
-                       "\": its schema version is 2, newer than this server's 1: use a newer "
+                       "\": its schema version is 3, newer than this server's 2: use a newer "
                        "server or another database");
-  // Still version 2 and without a jobs table: nothing was rewritten.
+  // Still version 3 and without a jobs table: nothing was rewritten.
   ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
   sqlite3_stmt* statement = nullptr;
   ASSERT_EQ(sqlite3_prepare_v2(db,
@@ -211,7 +211,7 @@ TEST(SqliteJobStoreTest, ANewerSchemaIsRefusedAndLeftAlone) {
                                -1, &statement, nullptr),
             SQLITE_OK);
   ASSERT_EQ(sqlite3_step(statement), SQLITE_ROW);
-  EXPECT_EQ(sqlite3_column_int(statement, 0), 2);
+  EXPECT_EQ(sqlite3_column_int(statement, 0), 3);
   EXPECT_EQ(sqlite3_column_int(statement, 1), 0);
   sqlite3_finalize(statement);
   sqlite3_close(db);
