@@ -3,6 +3,7 @@
 #include <cmath>
 #include <utility>
 
+#include "api/fields.hpp"
 #include "core/bat/presets.hpp"
 
 namespace sweetspot::api {
@@ -15,11 +16,10 @@ std::optional<core::ThreeSegmentShape> ParseThreeSegment(const Json& value, cons
   ObjectReader reader(value, path, error);
   core::ThreeSegmentShape shape;
   // Presence and types here; the ranges are core's (ThreeSegmentShape::ValidateSize).
-  reader.Number("length_m", AnyNumber(), &shape.length_m);
-  reader.Number("handle_radius_m", AnyNumber(), &shape.handle_radius_m);
-  reader.Number("barrel_radius_m", AnyNumber(), &shape.barrel_radius_m);
-  reader.Number("taper_start_m", AnyNumber(), &shape.taper_start_m);
-  reader.Number("taper_end_m", AnyNumber(), &shape.taper_end_m);
+  // The shape's fields, from the table of fields (api/fields.hpp).
+  FieldHost host;
+  host.shape = &shape;
+  ReadFieldGroup(reader, FieldGroup::kShape, /*required=*/true, host);
   if (!reader.Finish()) return std::nullopt;
   if (core::Refusal refusal; !shape.ValidateSize(&refusal)) {
     CoreRefusal(refusal, path, error);
@@ -80,8 +80,10 @@ std::optional<core::Fill> ParseFill(const Json& value, const std::string& path, 
   auto parsed = ParseMaterial(*material, JoinPath(path, "material"), /*allow_empty=*/true, error);
   if (!parsed) return std::nullopt;
   fill.material = *parsed;
-  reader.Number("diameter_m", AnyNumber(), &fill.diameter_m);  // the ranges: Bat::ValidateSize
-  reader.Number("depth_m", AnyNumber(), &fill.depth_m);
+  // diameter_m, depth_m, from the table of fields; the ranges: Bat::ValidateSize.
+  FieldHost host;
+  host.fill = &fill;
+  ReadFieldGroup(reader, FieldGroup::kFill, /*required=*/true, host);
   if (!reader.Finish()) return std::nullopt;
   return fill;
 }

@@ -125,4 +125,19 @@ bool SetNumberAtPath(nlohmann::json* root, const std::vector<PathStep>& steps, d
   return true;
 }
 
+std::string FormatJsonPath(const std::vector<PathStep>& steps) {
+  std::string out;
+  for (const PathStep& step : steps) {
+    if (const auto* key = std::get_if<std::string>(&step)) {
+      if (!out.empty()) out += '.';
+      out += *key;
+    } else {
+      out += '[';  // appended piece by piece: GCC 12 warns (falsely) on "[" + to_string(i)
+      out += std::to_string(std::get<std::size_t>(step));
+      out += ']';
+    }
+  }
+  return out;
+}
+
 }  // namespace sweetspot::api

@@ -17,6 +17,9 @@ using PathStep = std::variant<std::string, std::size_t>;
 /// Parses "a.b[2].c" into steps; nullopt with the reason in *why on bad syntax.
 std::optional<std::vector<PathStep>> ParseJsonPath(const std::string& path, std::string* why);
 
+/// The path of `steps` written as ParseJsonPath reads it ("a.b[2].c").
+std::string FormatJsonPath(const std::vector<PathStep>& steps);
+
 /// The number at `steps` in `root`, or nullopt (with *why) when the path does
 /// not exist or does not hold a number.
 std::optional<double> NumberAtPath(const nlohmann::json& root, const std::vector<PathStep>& steps,

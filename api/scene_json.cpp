@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "api/bat_json.hpp"
+#include "api/fields.hpp"
 #include "api/router.hpp"
 
 namespace sweetspot::api {
@@ -28,11 +29,10 @@ bool ReadBall(const Json& value, const std::string& path, core::Ball* ball, ApiE
     }
     core::ApplyBallPreset(*found, ball);
   }
-  reader.OptionalNumber("mass_kg", AnyNumber(), &ball->mass_kg);
-  reader.OptionalNumber("radius_m", AnyNumber(), &ball->radius_m);
-  reader.OptionalNumber("speed_mps", AnyNumber(), &ball->speed_mps);
-  reader.OptionalNumber("stiffness_n_m_p", AnyNumber(), &ball->stiffness);
-  reader.OptionalNumber("stiffness_exponent", AnyNumber(), &ball->stiffness_exponent);
+  // mass_kg, radius_m, speed_mps, stiffness_n_m_p, stiffness_exponent: the table of fields.
+  FieldHost host;
+  host.ball = ball;
+  ReadFieldGroup(reader, FieldGroup::kBall, /*required=*/false, host);
   return reader.Finish();
 }
 

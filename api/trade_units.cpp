@@ -5,6 +5,8 @@
 
 #include "api/json_path.hpp"
 #include "api/json_reader.hpp"
+#include "api/response.hpp"
+#include "core/geometry_format.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::api {
@@ -243,6 +245,48 @@ void AppendWarnings(const std::vector<std::string>& warnings, Json* answer) {
   Json& list = (*answer)["warnings"];
   if (!list.is_array()) list = Json::array();
   for (const std::string& w : warnings) list.push_back(w);
+}
+
+void ErrorAsWritten(const Json& request_body, Response* response) {
+  if (response->status < 400 || response->status >= 500 || !response->body.is_object()) return;
+  const auto field = response->body.find("field");
+  const auto message = response->body.find("message");
+  if (field == response->body.end() || !field->is_string() || message == response->body.end() ||
+      !message->is_string()) {
+    return;
+  }
+  const std::string si_field = field->get<std::string>();
+  std::string why;
+  const auto steps = ParseJsonPath(si_field, &why);
+  if (!steps || steps->empty() || !std::holds_alternative<std::string>(steps->back())) return;
+  if (NumberAtPath(request_body, *steps, &why)) return;  // written in SI
+  std::vector<PathStep> written = *steps;
+  for (const TradeForm& form : TradeForms(std::get<std::string>(steps->back()))) {
+    written.back() = form.key;
+    const auto value = NumberAtPath(request_body, written, &why);
+    if (!value) continue;
+    const std::string written_field = FormatJsonPath(written);
+    std::string text = message->get<std::string>();
+    const std::string head = si_field + " = ";
+    if (text.rfind(head, 0) == 0) {
+      // "field = shown: rule" -> "written = value: rule (in SI: field = shown)".
+      const std::size_t colon = text.find(": ", head.size());
+      if (colon == std::string::npos) return;
+      const std::string si_value = text.substr(head.size(), colon - head.size());
+      text = written_field + " = " + core::FormatNumber(*value) + text.substr(colon) + " (in SI: " +
+             si_field + " = " + si_value + ")";
+    } else {
+      // A rule about the field that quotes no value ("... give exactly one of
+      // swing.bat_speed_mps and ..."): the field as written wherever it is named.
+      for (std::size_t at = text.find(si_field); at != std::string::npos;
+           at = text.find(si_field, at + written_field.size())) {
+        text.replace(at, si_field.size(), written_field);
+      }
+    }
+    *message = text;
+    *field = written_field;
+    return;
+  }
 }
 
 }  // namespace sweetspot::api

@@ -88,6 +88,16 @@ struct ImperialSource {
 std::vector<ImperialSource> ImperialSources(std::string_view key);
 
 struct ApiError;
+struct Response;
+
+/// An error answer (a 4xx with "field" and "message") about an SI field the request gave in a
+/// trade form instead, rewritten to name the field as written, with the value as written and
+/// the SI value after it: core checks the ball's speed in SI ("ball.speed_mps =
+/// -4.4703999999999997: must be in [0, 1000]" for "ball": {"speed_mph": -10}), the answer says
+/// "ball.speed_mph = -10: must be in [0, 1000] (in SI: ball.speed_mps = -4.4703999999999997)".
+/// A message that quotes no value names the field as written wherever it names it. Any other
+/// answer is left as it is.
+void ErrorAsWritten(const nlohmann::json& request_body, Response* response);
 
 /// Reads and removes "report_units" ("si", the default, or "imperial") from a request body
 /// (an object), so the endpoint's own reader never sees it. False with the error (field

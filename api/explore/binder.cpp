@@ -17,6 +17,7 @@
 #include <thread>
 #include <utility>
 #include "api/bat_json.hpp"
+#include "api/fields.hpp"
 #include "api/json_reader.hpp"
 #include "api/memory_reserve.hpp"
 #include "api/scene_json.hpp"
@@ -26,33 +27,6 @@
 namespace sweetspot::api {
 
 using Json = nlohmann::json;
-
-enum class DesignBinder::Target {
-  kBallMass,
-  kBallRadius,
-  kBallSpeed,
-  kBallStiffness,
-  kBallExponent,
-  kSwingOmega,
-  kSwingPivot,
-  kSwingHands,
-  kCor,
-  kShapeLength,
-  kShapeHandle,
-  kShapeBarrel,
-  kShapeTaperStart,
-  kShapeTaperEnd,
-  kKnotX,
-  kKnotRadius,
-  kDensity,
-  kYoungs,
-  kShear,
-  kPoisson,
-  kMaterialCor,
-  kWall,
-  kFillDiameter,
-  kFillDepth,
-};
 
 namespace {
 
@@ -82,6 +56,26 @@ bool IsObjectAt(const Json& root, std::initializer_list<const char*> keys) {
   return node->is_object();
 }
 
+// True when the template has the part `group`'s field sits in: a three-segment shape, a
+// profile with that knot, a material or fill given as an object.
+bool HasPart(FieldGroup group, const Json& bat, const BatSpec& spec,
+             const std::vector<std::size_t>& indices) {
+  switch (group) {
+    case FieldGroup::kShape:
+      return spec.three_segment.has_value();
+    case FieldGroup::kKnot:
+      return spec.shape_form == "profile" && indices.size() == 1 &&
+             indices[0] < spec.bat.knots.size();
+    case FieldGroup::kMaterial:
+      return IsObjectAt(bat, {"material"});
+    case FieldGroup::kFill:
+    case FieldGroup::kFillMaterial:
+      return IsObjectAt(bat, {"fill"}) && spec.bat.fill.has_value();
+    default:
+      return true;
+  }
+}
+
 }  // namespace
 
 std::optional<DesignBinder> DesignBinder::Compile(
@@ -98,34 +92,6 @@ std::optional<DesignBinder> DesignBinder::Compile(
   if (!ReadSceneCommon(reader, &binder.scene_)) return std::nullopt;
   binder.scene_.outputs = outputs.scene;
   const Json& bat = base["bat"];
-  using T = Target;
-  static const std::map<std::string_view, T> kScene = {
-      {"ball.mass_kg", T::kBallMass},
-      {"ball.radius_m", T::kBallRadius},
-      {"ball.speed_mps", T::kBallSpeed},
-      {"ball.stiffness_n_m_p", T::kBallStiffness},
-      {"ball.stiffness_exponent", T::kBallExponent},
-      {"swing.angular_speed_rad_s", T::kSwingOmega},
-      {"swing.pivot_from_knob_m", T::kSwingPivot},
-      {"swing.hands_from_knob_m", T::kSwingHands},
-      {"cor", T::kCor},
-      {"bat.wall_thickness_m", T::kWall}};
-  static const std::map<std::string_view, T> kShape = {
-      {"bat.three_segment.length_m", T::kShapeLength},
-      {"bat.three_segment.handle_radius_m", T::kShapeHandle},
-      {"bat.three_segment.barrel_radius_m", T::kShapeBarrel},
-      {"bat.three_segment.taper_start_m", T::kShapeTaperStart},
-      {"bat.three_segment.taper_end_m", T::kShapeTaperEnd}};
-  static const std::map<std::string_view, T> kKnot = {
-      {"bat.profile.knots[].x_m", T::kKnotX}, {"bat.profile.knots[].radius_m", T::kKnotRadius}};
-  static const std::map<std::string_view, T> kMaterial = {
-      {"bat.material.density_kg_m3", T::kDensity},
-      {"bat.material.youngs_modulus_pa", T::kYoungs},
-      {"bat.material.shear_modulus_pa", T::kShear},
-      {"bat.material.poissons_ratio", T::kPoisson},
-      {"bat.material.cor", T::kMaterialCor}};
-  static const std::map<std::string_view, T> kFill = {{"bat.fill.diameter_m", T::kFillDiameter},
-                                                      {"bat.fill.depth_m", T::kFillDepth}};
   binder.parameters_ = parameters;
   for (std::size_t k = 0; k < parameters.size(); ++k) {
     for (std::size_t t = 0; t < parameters[k].targets.size(); ++t) {
@@ -134,59 +100,36 @@ std::optional<DesignBinder> DesignBinder::Compile(
       Binding binding{};
       binding.parameter = k;
       binding.target_index = t;
-      if (const auto it = kScene.find(pattern); it != kScene.end()) {
-        binding.target = it->second;
-      } else if (const auto shape = kShape.find(pattern);
-                 shape != kShape.end() && spec->three_segment) {
-        binding.target = shape->second;
-        binder.shape_ = spec->three_segment;
-      } else if (const auto knot = kKnot.find(pattern);
-                 knot != kKnot.end() && spec->shape_form == "profile" && indices.size() == 1 &&
-                 indices[0] < spec->bat.knots.size()) {
-        binding.target = knot->second;
-        binding.index = indices[0];
-      } else if (const auto material = kMaterial.find(pattern);
-                 material != kMaterial.end() && IsObjectAt(bat, {"material"})) {
-        binding.target = material->second;
-      } else if (const auto fill = kFill.find(pattern);
-                 fill != kFill.end() && IsObjectAt(bat, {"fill"}) && spec->bat.fill) {
-        binding.target = fill->second;
-      } else {
-        return std::nullopt;  // not bound here: the JSON path
+      binding.field = FindField(pattern);
+      // Bound here when the template has the field's part; otherwise the JSON path.
+      if (binding.field == nullptr || !binding.field->swept ||
+          !HasPart(binding.field->group, bat, *spec, indices)) {
+        return std::nullopt;
       }
-      switch (binding.target) {
-        case T::kBallMass:
-        case T::kBallRadius:
-        case T::kBallSpeed:
-        case T::kBallStiffness:
-        case T::kBallExponent:
+      switch (binding.field->group) {
+        case FieldGroup::kBall:
           binder.changes_.ball = true;
           break;
-        case T::kSwingOmega:
-        case T::kSwingPivot:
-        case T::kSwingHands:
+        case FieldGroup::kSwing:
           binder.changes_.swing = true;
           break;
-        case T::kCor:
+        case FieldGroup::kCor:
           binder.changes_.cor = true;
           break;
-        case T::kDensity:
-        case T::kYoungs:
-        case T::kShear:
-        case T::kPoisson:
-        case T::kMaterialCor:
+        case FieldGroup::kMaterial:
+        case FieldGroup::kFillMaterial:
           binder.changes_.bat_materials = true;
           break;
-        case T::kShapeLength:
-        case T::kShapeHandle:
-        case T::kShapeBarrel:
-        case T::kShapeTaperStart:
-        case T::kShapeTaperEnd:
-        case T::kKnotX:
-        case T::kKnotRadius:
-        case T::kWall:
-        case T::kFillDiameter:
-        case T::kFillDepth:
+        case FieldGroup::kShape:
+          binder.shape_ = spec->three_segment;
+          binder.changes_.bat_geometry = true;
+          break;
+        case FieldGroup::kKnot:
+          binding.index = indices[0];
+          binder.changes_.bat_geometry = true;
+          break;
+        case FieldGroup::kWall:
+        case FieldGroup::kFill:
           binder.changes_.bat_geometry = true;
           break;
       }
@@ -200,22 +143,10 @@ std::optional<DesignBinder> DesignBinder::Compile(
   // The bat changes through its three-segment shape only: no knot, material, wall or fill.
   binder.only_shape_swept_ =
       binder.bat_swept_ &&
-      std::none_of(binder.bindings_.begin(), binder.bindings_.end(), [](const Binding& b) {
-        switch (b.target) {
-          case T::kKnotX:
-          case T::kKnotRadius:
-          case T::kDensity:
-          case T::kYoungs:
-          case T::kShear:
-          case T::kPoisson:
-          case T::kMaterialCor:
-          case T::kWall:
-          case T::kFillDiameter:
-          case T::kFillDepth:
-            return true;
-          default:
-            return false;
-        }
+      std::all_of(binder.bindings_.begin(), binder.bindings_.end(), [](const Binding& b) {
+        const FieldGroup g = b.field->group;
+        return g == FieldGroup::kBall || g == FieldGroup::kSwing || g == FieldGroup::kCor ||
+               g == FieldGroup::kShape;
       });
   // Bind gives such a bat the knots of a shape that passed ThreeSegmentShape::ValidateSize.
   binder.changes_.knots_of_valid_shape = binder.only_shape_swept_;
@@ -235,85 +166,10 @@ std::optional<DesignBinder> DesignBinder::Compile(
 bool DesignBinder::Bind(const std::vector<double>& values, core::Scene* scene) const {
   core::Bat& bat = *scene->bat;
   std::optional<core::ThreeSegmentShape> shape = shape_;
-  for (std::size_t k = 0; k < bindings_.size(); ++k) {
-    const Binding& b = bindings_[k];
-    const double v = parameters_[b.parameter].TargetValue(b.target_index, values[b.parameter]);
-    switch (bindings_[k].target) {
-      case Target::kBallMass:
-        scene->ball.mass_kg = v;
-        break;
-      case Target::kBallRadius:
-        scene->ball.radius_m = v;
-        break;
-      case Target::kBallSpeed:
-        scene->ball.speed_mps = v;
-        break;
-      case Target::kBallStiffness:
-        scene->ball.stiffness = v;
-        break;
-      case Target::kBallExponent:
-        scene->ball.stiffness_exponent = v;
-        break;
-      case Target::kSwingOmega:
-        scene->swing.angular_speed_rad_s = v;
-        break;
-      case Target::kSwingPivot:
-        scene->swing.pivot_from_knob_m = v;
-        break;
-      case Target::kSwingHands:
-        scene->swing.hands_from_knob_m = v;
-        break;
-      case Target::kCor:
-        scene->cor = v;
-        break;
-      case Target::kShapeLength:
-        shape->length_m = v;
-        break;
-      case Target::kShapeHandle:
-        shape->handle_radius_m = v;
-        break;
-      case Target::kShapeBarrel:
-        shape->barrel_radius_m = v;
-        break;
-      case Target::kShapeTaperStart:
-        shape->taper_start_m = v;
-        break;
-      case Target::kShapeTaperEnd:
-        shape->taper_end_m = v;
-        break;
-      case Target::kKnotX:
-        bat.knots[bindings_[k].index].x_m = v;
-        break;
-      case Target::kKnotRadius:
-        bat.knots[bindings_[k].index].radius_m = v;
-        break;
-      case Target::kDensity:
-        bat.material.density_kg_m3 = v;
-        break;
-      case Target::kYoungs:
-        bat.material.youngs_modulus_pa = v;
-        break;
-      case Target::kShear:
-        bat.material.shear_modulus_pa = v;
-        bat.material.poissons_ratio_assumed = false;  // given now: no "nu assumed" warning
-        break;
-      case Target::kPoisson:
-        bat.material.poissons_ratio = v;
-        bat.material.poissons_ratio_assumed = false;
-        break;
-      case Target::kMaterialCor:
-        bat.material.cor = v;
-        break;
-      case Target::kWall:
-        bat.wall_thickness_m = v;
-        break;
-      case Target::kFillDiameter:
-        bat.fill->diameter_m = v;
-        break;
-      case Target::kFillDepth:
-        bat.fill->depth_m = v;
-        break;
-    }
+  FieldHost host = FieldHost::Of(scene, shape ? &*shape : nullptr);
+  for (const Binding& b : bindings_) {
+    host.knot = b.index;
+    b.field->set(host, parameters_[b.parameter].TargetValue(b.target_index, values[b.parameter]));
   }
   // The JSON path's checks, in its order (ParseBatGeometry, then the scene's).
   if (shape) {

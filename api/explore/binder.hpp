@@ -19,6 +19,8 @@
 
 namespace sweetspot::api {
 
+struct Field;
+
 /// A swept parameter: its path as written, its steps from the template root.
 struct SweepParameter {
   /// Its name in rows ("parameters.<name>"): "path" as written ("three_segment.taper_start_m"),
@@ -66,9 +68,8 @@ class DesignBinder {
   const core::SceneChanges& changes() const { return changes_; }
 
  private:
-  enum class Target;
   struct Binding {
-    Target target;
+    const Field* field = nullptr;  // its row of the table of fields (api/fields.hpp)
     std::size_t index = 0;         // a knot's
     std::size_t parameter = 0;     // whose value it takes
     std::size_t target_index = 0;  // which of that parameter's targets (SweepParameter)

@@ -1,14 +1,18 @@
 // POST /v1/bat/properties and POST /v1/bat/fit.
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <optional>
 #include <string>
 #include <utility>
 
 #include "api/bat_json.hpp"
+#include "api/fields.hpp"
 #include "api/handlers/endpoint.hpp"
 #include "api/handlers/handlers.hpp"
 #include "api/trade_units.hpp"
 #include "core/bat/presets.hpp"
+#include "core/geometry_format.hpp"
 #include "core/optimize/shape_fit.hpp"
 #include "core/scene/sanity.hpp"
 
@@ -146,11 +150,51 @@ struct FitRequest {
   BatSpec spec;
   core::ShapeFitProblem problem;
   core::ShapeFitOptions options;
+  // Per unknown, its name as the request wrote it ("barrel_diameter_in") and the factor of
+  // its value and bounds to core's SI (0.0127); empty for the default unknowns.
+  std::vector<std::pair<std::string, double>> written;
+
+  // Core's refusal with an unknown named, and its bound given, as the request wrote them.
+  core::Refusal AsWritten(core::Refusal refusal) const {
+    const std::string& field = refusal.field;
+    if (field.rfind("unknowns[", 0) != 0) return refusal;
+    const std::size_t i = std::strtoul(field.c_str() + 9, nullptr, 10);
+    if (i >= written.size()) return refusal;
+    const auto& [name, to_si] = written[i];
+    if (refusal.shown == core::FitVariableName(problem.unknowns[i].variable)) refusal.shown = name;
+    const bool bound = field.size() > 4 && (field.compare(field.size() - 4, 4, ".min") == 0 ||
+                                            field.compare(field.size() - 4, 4, ".max") == 0);
+    if (bound && to_si != 1.0 && std::isfinite(refusal.value) && refusal.QuotesValue()) {
+      refusal.value /= to_si;
+      refusal.shown = core::FormatNumber(refusal.value);
+      refusal.rule += " (in SI: " + core::FormatNumber(refusal.value * to_si) + ")";
+    }
+    return refusal;
+  }
 };
 
 // Reads "unknowns" (default: the paper's question, where the taper starts and ends).
+// The three-segment fit's unknowns by name: the table of fields' fit names (api/fields.hpp), in
+// core's FitVariable order (the order the refusal of an unknown name lists them in).
+const std::vector<std::string>& FitUnknownNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::pair<int, std::string>> ordered;
+    for (const Field& field : Fields()) {
+      if (field.fit_name.empty()) continue;
+      const std::string name(field.fit_name);
+      ordered.emplace_back(static_cast<int>(*core::FitVariableFromName(name)), name);
+    }
+    std::sort(ordered.begin(), ordered.end());
+    std::vector<std::string> out;
+    for (auto& [variable, name] : ordered) out.push_back(std::move(name));
+    return out;
+  }();
+  return names;
+}
+
 bool ReadFitUnknowns(ObjectReader& reader, const core::ThreeSegmentShape& shape,
-                     core::ShapeFitProblem* problem) {
+                     core::ShapeFitProblem* problem,
+                     std::vector<std::pair<std::string, double>>* written) {
   const nlohmann::json* unknowns = reader.Get("unknowns");
   if (unknowns == nullptr) {
     problem->unknowns = {{core::FitVariable::kTaperStart, 0.0, shape.length_m},
@@ -162,17 +206,26 @@ bool ReadFitUnknowns(ObjectReader& reader, const core::ThreeSegmentShape& shape,
   }
   for (std::size_t i = 0; i < unknowns->size(); ++i) {
     ObjectReader u((*unknowns)[i], "unknowns[" + std::to_string(i) + "]", reader.error());
+    // A name of the table of fields (api/fields.hpp), in SI or a trade form
+    // ("barrel_diameter_in", "wall_thickness_in"): the bounds are in its unit.
     std::string name;
-    u.String("name", &name,
-             {"taper_start_m", "taper_end_m", "length_m", "handle_radius_m", "barrel_radius_m",
-              "density_kg_m3", "wall_thickness_m", "fill.diameter_m", "fill.depth_m",
-              "fill.density_kg_m3"});
+    u.String("name", &name);
+    const auto use = u.ok() ? ResolveField(name, FieldScope::kFitName) : std::nullopt;
+    if (u.ok() && !use) {
+      std::string refused;
+      u.String("name", &refused, FitUnknownNames());  // the refusal that lists the names
+      reader.error()->message += DidYouMeanField(name, FieldScope::kFitName);
+      return false;
+    }
     core::FitUnknown unknown;
     u.Number("min", AnyNumber(), &unknown.min);  // the bounds' ranges: core's problem.Validate
     u.Number("max", AnyNumber(), &unknown.max);
     if (!u.Finish()) return false;
-    unknown.variable = *core::FitVariableFromName(name);
+    unknown.variable = *core::FitVariableFromName(use->si);
+    unknown.min *= use->to_si;  // core is SI
+    unknown.max *= use->to_si;
     problem->unknowns.push_back(unknown);
+    written->emplace_back(name, use->to_si);
   }
   return true;
 }
@@ -214,7 +267,7 @@ std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& co
                 "path ({\"path\": \"material.density_kg_m3\", \"min\", \"max\"})");
     return std::nullopt;
   }
-  FitRequest request{std::move(*spec), {}, {}};
+  FitRequest request{std::move(*spec), {}, {}, {}};
   core::ShapeFitProblem& problem = request.problem;
   problem.shape = *shape;
   problem.material = request.spec.bat.material;
@@ -233,12 +286,12 @@ std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& co
              "needs mass_kg, balance_point_m or both");
     return std::nullopt;
   }
-  if (!ReadFitUnknowns(reader, *shape, &problem) ||
+  if (!ReadFitUnknowns(reader, *shape, &problem, &request.written) ||
       !ReadFitOptions(reader, context.limits, &request.options) || !reader.Finish()) {
     return std::nullopt;
   }
   if (core::Refusal why; !problem.ValidateSize(&why)) {
-    CoreRefusal(why, "", error);
+    CoreRefusal(request.AsWritten(why), "", error);
     return std::nullopt;
   }
   if (core::Refusal why; !request.options.Validate(&why)) {
@@ -249,10 +302,14 @@ std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& co
 }
 
 // A refused problem is the client's (400); a failed fit is ours (500).
-std::optional<Response> FitFailure(const FitRequest&, const core::ShapeFitResult& fit) {
+std::optional<Response> FitFailure(const FitRequest& request, const core::ShapeFitResult& fit) {
   if (fit.summary.termination == core::Termination::kInvalidInput) {
     ApiError error;
-    CoreRefusal(fit.summary, "", &error);
+    if (fit.summary.refusal) {
+      CoreRefusal(request.AsWritten(*fit.summary.refusal), "", &error);
+    } else {
+      CoreRefusal(fit.summary, "", &error);
+    }
     return ToResponse(error);
   }
   if (fit.summary.termination == core::Termination::kFailure) {
@@ -265,7 +322,11 @@ nlohmann::json RenderFit(const FitRequest& request, const core::ShapeFitResult& 
   const core::ShapeFitProblem& problem = request.problem;
   nlohmann::json unknown_values = nlohmann::json::object();
   for (std::size_t i = 0; i < problem.unknowns.size() && i < fit.values.size(); ++i) {
-    unknown_values[core::FitVariableName(problem.unknowns[i].variable)] = fit.values[i];
+    if (i < request.written.size()) {  // as the request wrote it, in its unit
+      unknown_values[request.written[i].first] = fit.values[i] / request.written[i].second;
+    } else {
+      unknown_values[core::FitVariableName(problem.unknowns[i].variable)] = fit.values[i];
+    }
   }
   nlohmann::json residuals = nlohmann::json::object();
   if (problem.targets.mass_kg) residuals["mass_kg"] = fit.mass_residual_kg;

@@ -113,7 +113,10 @@ std::optional<Req> ParseRequest(const Request& request, const Context& context, 
     return std::nullopt;
   }
   std::optional<Req> parsed = parse(*body, context, &error);
-  if (!parsed) *failure = ToResponse(error);
+  if (!parsed) {
+    *failure = ToResponse(error);
+    ErrorAsWritten(*body, failure);  // a field given in a trade form: named as written
+  }
   return parsed;
 }
 
@@ -131,11 +134,17 @@ Response ServeEndpoint(const Endpoint<Req, Result>& endpoint, const Request& req
   ReportUnits units = ReportUnits::kSi;
   if (!TakeReportUnits(&*body, &units, &error)) return ToResponse(error);
   const std::optional<Req> parsed = endpoint.parse(*body, context, &error);
-  if (!parsed) return ToResponse(error);
+  if (!parsed) {
+    // A field given in a trade form is named as written, with the value as written.
+    Response answer = ToResponse(error);
+    ErrorAsWritten(*body, &answer);
+    return answer;
+  }
   if (context.validate_only) return ValidRequest();
   const Result result = endpoint.run(*parsed, context);
   if (endpoint.failure) {
     if (std::optional<Response> failed = endpoint.failure(*parsed, result)) {
+      ErrorAsWritten(*body, &*failed);
       return std::move(*failed);
     }
   }

@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 
+#include "api/fields.hpp"
 #include "api/explore/columns.hpp"
 #include "api/explore/design.hpp"
 #include "api/explore/engine.hpp"
@@ -55,6 +56,18 @@ void SweptPathToSi(const Json& base, double min, const ApiLimits& limits,
   if (steps->empty()) return;
   const auto* leaf = std::get_if<std::string>(&steps->back());
   if (leaf == nullptr) return;
+  // A field of the table of fields (api/fields.hpp) in a trade form: its row says which SI field.
+  if (const auto use = ResolveField(FormatJsonPath(*steps), FieldScope::kRequest);
+      use && use->to_si != 1.0) {
+    std::string why;
+    auto si_steps = ParseJsonPath(use->si, &why);
+    if (Json probe = base; si_steps && SetNumberAtPath(&probe, *si_steps, min * use->to_si, &why)) {
+      *steps = std::move(*si_steps);
+      *to_si = use->to_si;
+      return;
+    }
+  }
+  // Any other numeric field the request's parser knows: the first SI spelling it takes.
   for (const TradeForm& si : SiFormsOf(*leaf)) {
     std::vector<PathStep> candidate = *steps;
     candidate.back() = si.key;

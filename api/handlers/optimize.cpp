@@ -15,6 +15,7 @@
 #include "api/bat_json.hpp"
 #include "api/handlers/endpoint.hpp"
 #include "api/handlers/handlers.hpp"
+#include "api/handlers/optimize_variables.hpp"
 #include "api/json_path.hpp"
 #include "api/scene_json.hpp"
 #include "api/trade_units.hpp"
@@ -187,12 +188,35 @@ Json MaterialInRequestForm(const core::Material& m) {
 // The answer's bat in the request's own form: each variable written back at
 // its path; where the request's form lacks the path's parent (a preset), the
 // shape or material block is written out whole.
-Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r) {
+// True when the object at `steps`' parent in `bat` gives the field in any form (SI or trade).
+bool GivesField(const Json& bat, const std::vector<PathStep>& steps) {
+  std::string why;
+  if (NumberAtPath(bat, steps, &why)) return true;
+  std::vector<PathStep> form = steps;
+  for (const TradeForm& trade : TradeForms(std::get<std::string>(steps.back()))) {
+    form.back() = trade.key;
+    if (NumberAtPath(bat, form, &why)) return true;
+  }
+  return false;
+}
+
+Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r,
+                      const VariableNames& names) {
   Json bat = request_bat;
   for (const core::DesignValue& v : r.variables) {
     if (v.scale_factor) continue;  // a factor: its fields follow it in the list
     std::string why;
     const auto steps = ParseJsonPath(v.path, &why);
+    // A field the bat does not give (a preset's wall), of a variable written in a trade form:
+    // written in that form ("wall_thickness_in"), so the bat stays in the request's units.
+    const WrittenVariable* written = names.Find(v.path);
+    if (steps && written != nullptr && !GivesField(bat, *steps)) {
+      if (const auto written_steps = ParseJsonPath(written->written, &why);
+          written_steps &&
+          SetNumberAtPath(&bat, *written_steps, v.value / written->to_si, &why)) {
+        continue;
+      }
+    }
     // In the request's own units: "taper_start_in" stays inches.
     if (steps && SetNumberInRequestForm(&bat, *steps, v.value, &why)) continue;
     if (v.path.rfind("three_segment.", 0) == 0 && r.three_segment) {
@@ -215,16 +239,27 @@ Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r) {
   return bat;
 }
 
-Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
-  Json variables = Json::object();
-  for (const auto& v : r.variables) variables[v.path] = v.value;
+Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
+                  const VariableNames& names) {
+  // Each variable as the request wrote it, in its unit ("wall_thickness_in": inches).
+  Json variables = names.ValuesAsWritten(r.variables);
   Json active = Json::array();
   for (const auto& a : r.active_constraints) {
-    active.push_back({{"name", a.name},
-                      {"unit", a.unit},
-                      {"value", a.value},
-                      {"bound", a.bound},
-                      {"multiplier", Finite(a.multiplier)}});  // null for min_sting
+    // A variable's bound, as the request wrote the variable ("three_segment.
+    // barrel_diameter_in.max", inches, the multiplier per inch).
+    const std::size_t dot = a.name.rfind('.');
+    const WrittenVariable* written =
+        dot == std::string::npos ? nullptr : names.Find(a.name.substr(0, dot));
+    const double f = written != nullptr ? written->to_si : 1.0;
+    active.push_back(
+        {{"name", written != nullptr ? written->written + a.name.substr(dot) : a.name},
+         {"unit", written != nullptr && written->written.size() > 3 &&
+                          written->written.compare(written->written.size() - 3, 3, "_in") == 0
+                      ? std::string("in")
+                      : a.unit},
+         {"value", a.value / f},
+         {"bound", a.bound / f},
+         {"multiplier", Finite(a.multiplier * f)}});  // null for min_sting
   }
   Json runs = Json::array();
   for (const auto& s : r.spread.runs) {
@@ -262,7 +297,7 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat) {
                          {"shortfall", Finite(c.shortfall)},
                          {"message", c.message}});
   }
-  Json out{{"bat", BatInRequestForm(request_bat, r)},
+  Json out{{"bat", BatInRequestForm(request_bat, r, names)},
            {"variables", std::move(variables)},
            {"properties", PropertiesToJson(r.properties, r.bat.LengthM())},
            {"objective_value", Finite(r.objective_value)},
@@ -313,6 +348,8 @@ struct OptimizeRequest {
   core::DesignCorPolicy cor_policy;
   // The base bat's mass properties under problem.inertia_model, computed once (ParseBat).
   core::MassProperties base_properties;
+  // The variables' paths as the request wrote them (trade forms): the answer's names, units.
+  VariableNames variable_names;
 };
 
 // What the optimiser returned: one design, or one per material and the best of them.
@@ -328,120 +365,6 @@ struct OptimizeResult {
     return &choice.per_material[static_cast<std::size_t>(choice.best)].result;
   }
 };
-
-// Reads "variables": continuous design variables into `problem`, a "material" choice into
-// `material_choices`.
-bool ReadVariables(ObjectReader& reader, const ApiLimits& limits, core::DesignProblem* problem,
-                   std::vector<core::Material>* material_choices) {
-  ApiError* error = reader.error();
-  const Json* variables = reader.Get("variables");
-  if (reader.ok() && variables == nullptr) reader.Missing("variables");
-  if (!reader.ok()) return false;
-  const std::size_t max_variables = limits.max_design_variables;
-  if (!variables->is_array() || variables->empty() || variables->size() > max_variables) {
-    return reader.Fail("variables", "must be an array of 1 to " + std::to_string(max_variables) +
-                                        " {\"path\", \"min\", \"max\"}");
-  }
-  std::set<std::string> scale_names;  // the scale variables' names, each once
-  for (std::size_t i = 0; i < variables->size(); ++i) {
-    const std::string where = "variables[" + std::to_string(i) + "]";
-    ObjectReader v((*variables)[i], where, error);
-    core::DesignVariable variable;
-    if (!v.ok()) return false;  // not an object
-    // One field ("path"), several set to the value ("paths"), or several each the base
-    // design's value times it ("scale_paths"): exactly one form, as /v1/explore's parameters.
-    const char* const kForms[] = {"path", "paths", "scale_paths"};
-    std::vector<const char*> given;
-    for (const char* form : kForms) {
-      if (v.Has(form)) given.push_back(form);
-    }
-    if (!v.ok()) return false;
-    if (given.size() != 1) {
-      return v.Fail(given.empty() ? "path" : given[1],
-                    "give exactly one of path, paths (several fields set to one value) and "
-                    "scale_paths (several fields scaled by one value)",
-                    given.empty() ? ErrorCode::kMissingField : ErrorCode::kInvalidValue);
-    }
-    const std::string form = given.front();
-    if (v.Has("name") && form != "scale_paths") {
-      return v.Fail("name",
-                    "names a scale variable: give it with scale_paths only (a path is "
-                    "its own name)");
-    }
-    if (form != "path") {
-      // paths: the first is the variable's path, the rest linked. scale_paths: the fields of a
-      // scale variable named by "name" (default "scale:" and the paths joined with "+").
-      const Json* paths = v.Get(form);
-      if (!paths->is_array() || paths->empty() || paths->size() > 32) {
-        return v.Fail(form, "must be an array of 1 to 32 variable paths");
-      }
-      std::string joined;
-      for (std::size_t k = 0; k < paths->size(); ++k) {
-        const Json& item = (*paths)[k];
-        const std::string field = where + "." + form + "[" + std::to_string(k) + "]";
-        if (!item.is_string() || !core::ParseDesignVariablePath(item.get<std::string>())) {
-          return SetError(error, ErrorCode::kInvalidValue, field, &item,
-                          "is not a design variable path (profile.knots[i].radius_m, ...; "
-                          "material choices cannot be linked or scaled)");
-        }
-        const std::string path = item.get<std::string>();
-        if (form == "scale_paths") {
-          variable.scale_paths.push_back(path);
-          joined += (k == 0 ? "" : "+") + path;
-        } else if (k == 0) {
-          variable.path = path;
-        } else {
-          variable.linked_paths.push_back(path);
-        }
-      }
-      if (form == "scale_paths") {
-        variable.path = "scale:" + joined;
-        v.OptionalString("name", &variable.path);
-        if (!v.ok()) return false;
-        if (variable.path.empty() || variable.path == "material" ||
-            core::ParseDesignVariablePath(variable.path)) {
-          return v.Fail("name",
-                        "must be a non-empty name that is not a design variable path "
-                        "(the answer's variables list the scale under it beside its "
-                        "fields)");
-        }
-        if (!scale_names.insert(variable.path).second) {
-          return v.Fail(v.Has("name") ? "name" : "scale_paths",
-                        "names a scale variable \"" + variable.path +
-                            "\" already given: each needs its own name");
-        }
-      }
-    } else {
-      v.String("path", &variable.path);
-    }
-    if (v.ok() && variable.path == "material") {  // a discrete choice among materials
-      const Json* choices = v.Get("choices");
-      if (choices == nullptr || !choices->is_array() || choices->empty() || choices->size() > 16) {
-        return v.Fail("choices", "must be an array of 1 to 16 material names");
-      }
-      for (std::size_t k = 0; k < choices->size(); ++k) {
-        auto m = ParseMaterial((*choices)[k], where + ".choices[" + std::to_string(k) + "]", false,
-                               error);
-        if (!m) return false;
-        material_choices->push_back(*m);
-      }
-      if (!v.Finish()) return false;
-      continue;
-    }
-    v.Number("min", AnyNumber(), &variable.min);  // the bounds' ranges: core's
-    v.Number("max", AnyNumber(), &variable.max);
-    if (!v.Finish()) return false;
-    if (variable.scale_paths.empty() && !core::ParseDesignVariablePath(variable.path)) {
-      return SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*variables)[i]["path"],
-                      "is not a design variable (profile.knots[i].radius_m, profile.knots[i].x_m, "
-                      "three_segment.<field>, material.density_kg_m3, wall_thickness_m, "
-                      "fill.diameter_m, fill.depth_m, fill.material.density_kg_m3, or material "
-                      "with choices)");
-    }
-    problem->variables.push_back(variable);
-  }
-  return true;
-}
 
 std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& context,
                                              ApiError* error) {
@@ -466,7 +389,8 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
   problem.swing = scene.swing;
   problem.cor = scene.cor;
   problem.inertia_model = scene.inertia_model;
-  if (!ReadVariables(reader, context.limits, &problem, &request.material_choices) ||
+  if (!ReadVariables(reader, context.limits, &problem, &request.material_choices,
+                     &request.variable_names) ||
       !ReadConstraints(reader, &problem.constraints)) {
     return std::nullopt;
   }
@@ -496,7 +420,7 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
     return std::nullopt;
   }
   if (core::Refusal refusal; !problem.Validate(&refusal)) {
-    CoreRefusal(refusal, "", error);
+    CoreRefusal(request.variable_names.AsWritten(refusal), "", error);
     return std::nullopt;
   }
   return request;
@@ -515,7 +439,8 @@ OptimizeResult RunOptimize(const OptimizeRequest& request, const Context& contex
 }
 
 // No usable material (422), or a problem the optimiser refused (400).
-std::optional<Response> OptimizeFailure(const OptimizeRequest&, const OptimizeResult& result) {
+std::optional<Response> OptimizeFailure(const OptimizeRequest& request,
+                                        const OptimizeResult& result) {
   const core::DesignResult* chosen = result.Chosen();
   if (chosen == nullptr) {
     return ErrorResponse(422, ErrorCode::kInfeasible,
@@ -524,14 +449,18 @@ std::optional<Response> OptimizeFailure(const OptimizeRequest&, const OptimizeRe
   }
   if (chosen->summary.termination == core::Termination::kInvalidInput) {
     ApiError error;
-    CoreRefusal(chosen->summary, "", &error);
+    if (chosen->summary.refusal) {
+      CoreRefusal(request.variable_names.AsWritten(*chosen->summary.refusal), "", &error);
+    } else {
+      CoreRefusal(chosen->summary, "", &error);
+    }
     return ToResponse(error);
   }
   return std::nullopt;
 }
 
 Json RenderOptimize(const OptimizeRequest& request, const OptimizeResult& result) {
-  Json out = ResultToJson(*result.Chosen(), request.request_bat);
+  Json out = ResultToJson(*result.Chosen(), request.request_bat, request.variable_names);
   if (result.by_material) {
     Json per_material = Json::array();
     for (const auto& m : result.choice.per_material) {

@@ -287,6 +287,181 @@ bool ShapeFitProblem::ValidateSize(Refusal* why) const {
   return true;
 }
 
+namespace {
+
+// The fit's running state: the best feasible point in s, its metric, the stages' counts.
+struct FitSearch {
+  std::vector<double> best;
+  double best_phi = 0.0;
+  int local_runs = 0;
+  int raw_status = 0;  // of the SLSQP run that produced best (of the last one if none did)
+  int gauss_newton_steps = 0;
+};
+
+// 1. Scan: the start and a Halton set; the feasible points, best first.
+std::vector<std::pair<double, std::vector<double>>> ScanBounds(ShapeFitModel& model,
+                                                               const ShapeFitOptions& options) {
+  constexpr int kPrimes[kNumFitVariables] = {2, 3, 5, 7, 11, 13, 17, 19, 23, 29};
+  const int n = model.n();
+  std::vector<std::pair<double, std::vector<double>>> candidates;
+  std::vector<double> s = model.StartS();
+  for (int k = 0; k <= options.scan_points && options.max_evaluations - model.evaluations() > 0;
+       ++k) {
+    if (k > 0) {
+      for (int j = 0; j < n; ++j) s[static_cast<std::size_t>(j)] = RadicalInverse(k, kPrimes[j]);
+    }
+    if (!model.Feasible(s.data())) continue;
+    candidates.emplace_back(model.Objective(s.data(), nullptr), s);
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  return candidates;
+}
+
+// 2. SLSQP from the best scan points; keeps a feasible improvement in *search.
+template <typename Elapsed>
+void RunLocalStarts(ShapeFitModel& model, const ShapeFitOptions& options,
+                    const std::vector<std::pair<double, std::vector<double>>>& candidates,
+                    const Elapsed& elapsed_s, FitSearch* search, Summary* summary) {
+  const int n = model.n();
+  const auto budget_left = [&] { return options.max_evaluations - model.evaluations(); };
+  bool improved = false;
+  const std::vector<double> lower(static_cast<std::size_t>(n), 0.0);
+  const std::vector<double> upper(static_cast<std::size_t>(n), 1.0);
+  const NloptFunction objective = [&model](const double* x, double* grad) {
+    return model.Objective(x, grad);
+  };
+  std::vector<NloptConstraintFunction> constraints;
+  for (FitConstraint kind : model.constraints()) {
+    constraints.push_back({[&model, kind](const double* x, double* grad) {
+                             return model.Constraint(kind, x, grad);
+                           },
+                           false, 0.0});
+  }
+  for (std::size_t c = 0; c < candidates.size() && search->local_runs < options.local_starts;
+       ++c) {
+    const double time_left = options.max_time_s - elapsed_s();
+    if (budget_left() <= 0 || time_left <= 0.0) break;
+    ++search->local_runs;
+    NloptRunSettings run;
+    run.algorithm = NloptAlgorithm::kLdSlsqp;
+    run.lower = lower;
+    run.upper = upper;
+    run.x_tolerance_rel = 1e-14;
+    run.f_tolerance_abs = 1e-30;
+    run.max_evaluations = budget_left();
+    run.max_time_s = time_left;
+    std::vector<double> x = candidates[c].second;
+    const int status = RunNlopt(objective, constraints, run, &x).raw_status;
+    for (double& xj : x) xj = std::clamp(xj, 0.0, 1.0);
+    if (status > 0 || status == kNloptRoundoffLimited) {  // x holds the best point: keep it
+      const double phi = model.Objective(x.data(), nullptr);
+      if (model.Feasible(x.data()) && phi < search->best_phi) {
+        search->best_phi = phi;
+        search->best = x;
+        search->raw_status = status;
+        improved = true;
+      }
+    }
+    if (!improved) search->raw_status = status;
+  }
+  summary->raw_status = search->raw_status;
+  if (search->raw_status == kNloptRoundoffLimited) {
+    summary->warnings.push_back("NLopt SLSQP stopped round-off limited; its best point is kept");
+  } else if (search->raw_status == kNloptMaxevalReached ||
+             search->raw_status == kNloptMaxtimeReached) {
+    summary->warnings.push_back("NLopt SLSQP stopped at the evaluation or time budget");
+  }
+}
+
+// 3. Gauss-Newton on the residuals (keeps only feasible decreases).
+void PolishGaussNewton(ShapeFitModel& model, const ShapeFitOptions& options, FitSearch* search) {
+  const int n = model.n();
+  std::vector<double>& best = search->best;
+  for (int iter = 0; iter < 50 && options.max_evaluations - model.evaluations() > 0; ++iter) {
+    Eigen::VectorXd r;
+    Eigen::MatrixXd jac;
+    model.Residuals(best.data(), &r, &jac);
+    if (r.lpNorm<Eigen::Infinity>() <= 1e-3 * options.tolerance) break;
+    const Eigen::VectorXd step = jac.completeOrthogonalDecomposition().solve(-r);
+    bool accepted = false;
+    double alpha = 1.0;
+    for (int halving = 0; halving < 30; ++halving, alpha *= 0.5) {
+      std::vector<double> trial = best;
+      for (int j = 0; j < n; ++j) {
+        trial[static_cast<std::size_t>(j)] =
+            std::clamp(best[static_cast<std::size_t>(j)] + alpha * step[j], 0.0, 1.0);
+      }
+      if (!model.Feasible(trial.data())) continue;
+      const double phi = model.Objective(trial.data(), nullptr);
+      if (phi < search->best_phi) {
+        search->best_phi = phi;
+        best = trial;
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) break;
+    ++search->gauss_newton_steps;
+  }
+}
+
+// 4. The metric of the built bat and the termination: targets met, the certified closest bat,
+// or the best found.
+void Classify(const ShapeFitProblem& problem, const ShapeFitOptions& options,
+              ShapeFitModel& model, const std::vector<double>& best, ShapeFitResult* result) {
+  Summary& summary = result->summary;
+  double max_scaled = 0.0;
+  result->metric = 0.0;
+  if (problem.targets.mass_kg.has_value()) {
+    result->mass_residual_kg = result->properties.mass_kg - *problem.targets.mass_kg;
+    const double scaled =
+        result->mass_residual_kg /
+        (options.mass_scale_kg > 0.0 ? options.mass_scale_kg : *problem.targets.mass_kg);
+    max_scaled = std::max(max_scaled, std::abs(scaled));
+    result->metric += scaled * scaled;
+  }
+  if (problem.targets.balance_point_m.has_value()) {
+    result->balance_point_residual_m =
+        result->properties.balance_point_m - *problem.targets.balance_point_m;
+    const double scaled =
+        result->balance_point_residual_m / (options.balance_point_scale_m > 0.0
+                                                ? options.balance_point_scale_m
+                                                : *problem.targets.balance_point_m);
+    max_scaled = std::max(max_scaled, std::abs(scaled));
+    result->metric += scaled * scaled;
+  }
+  summary.objective = result->metric;
+  const std::string achieved =
+      "mass_kg = " + FormatNumber(result->properties.mass_kg) +
+      ", balance_point_m = " + FormatNumber(result->properties.balance_point_m);
+  if (max_scaled <= options.tolerance) {
+    result->targets_met = true;
+    summary.termination = Termination::kConverged;
+    summary.error_estimate = max_scaled;
+    summary.message = "targets met (" + DescribeTargets(problem) + "): " + achieved;
+    return;
+  }
+  result->kkt_error = fit_detail::KktError(model, best);
+  summary.error_estimate = result->kkt_error;
+  const std::string metric = "metric ((M - M*)/s_M)^2 + ((C - C*)/s_C)^2 = " +
+                             FormatNumber(result->metric) + ": " + achieved;
+  if (result->kkt_error <= options.kkt_tolerance) {
+    summary.termination = Termination::kInfeasible;
+    summary.message = "no bat with " + DescribeUnknowns(problem) + " meets " +
+                      DescribeTargets(problem) + "; closest bat in the " + metric;
+  } else {
+    summary.termination = Termination::kNoConvergence;
+    summary.message = "targets " + DescribeTargets(problem) + " not met with " +
+                      DescribeUnknowns(problem) +
+                      "; best bat found (not certified as closest: first-order residual " +
+                      FormatNumber(result->kkt_error) + ") in the " + metric;
+    summary.warnings.push_back("the closest point failed the first-order (KKT) check");
+  }
+}
+
+}  // namespace
+
 ShapeFitResult FitShape(const ShapeFitProblem& problem, const ShapeFitOptions& options) {
   const auto start_time = std::chrono::steady_clock::now();
   const auto elapsed_s = [&start_time] {
@@ -315,20 +490,7 @@ ShapeFitResult FitShape(const ShapeFitProblem& problem, const ShapeFitOptions& o
 
   try {
     ShapeFitModel model(problem, options);
-    const int n = model.n();
-    const auto budget_left = [&] { return options.max_evaluations - model.evaluations(); };
-
-    // 1. Scan: the start and a Halton set; keep the feasible points.
-    constexpr int kPrimes[kNumFitVariables] = {2, 3, 5, 7, 11, 13, 17, 19, 23, 29};
-    std::vector<std::pair<double, std::vector<double>>> candidates;
-    std::vector<double> s = model.StartS();
-    for (int k = 0; k <= options.scan_points && budget_left() > 0; ++k) {
-      if (k > 0) {
-        for (int j = 0; j < n; ++j) s[static_cast<std::size_t>(j)] = RadicalInverse(k, kPrimes[j]);
-      }
-      if (!model.Feasible(s.data())) continue;
-      candidates.emplace_back(model.Objective(s.data(), nullptr), s);
-    }
+    const auto candidates = ScanBounds(model, options);
     if (candidates.empty()) {
       // About the unknowns' bounds together, not one field.
       summary.SetRefusal(TextRefusal("", "the unknowns' bounds (" + DescribeUnknowns(problem) +
@@ -340,154 +502,30 @@ ShapeFitResult FitShape(const ShapeFitProblem& problem, const ShapeFitOptions& o
       summary.solve_time_s = elapsed_s();
       return result;
     }
-    std::stable_sort(candidates.begin(), candidates.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
-    std::vector<double> best = candidates.front().second;
-    double best_phi = candidates.front().first;
+    FitSearch search;
+    search.best = candidates.front().second;
+    search.best_phi = candidates.front().first;
+    RunLocalStarts(model, options, candidates, elapsed_s, &search, &summary);
+    PolishGaussNewton(model, options, &search);
 
-    // 2. SLSQP from the best scan points.
-    int local_runs = 0;
-    int raw_status = 0;  // 0 = no SLSQP run
-    bool improved = false;
-    const std::vector<double> lower(static_cast<std::size_t>(n), 0.0);
-    const std::vector<double> upper(static_cast<std::size_t>(n), 1.0);
-    const NloptFunction objective = [&model](const double* x, double* grad) {
-      return model.Objective(x, grad);
-    };
-    std::vector<NloptConstraintFunction> constraints;
-    for (FitConstraint kind : model.constraints()) {
-      constraints.push_back({[&model, kind](const double* x, double* grad) {
-                               return model.Constraint(kind, x, grad);
-                             },
-                             false, 0.0});
-    }
-    for (std::size_t c = 0; c < candidates.size() && local_runs < options.local_starts; ++c) {
-      const double time_left = options.max_time_s - elapsed_s();
-      if (budget_left() <= 0 || time_left <= 0.0) break;
-      ++local_runs;
-      NloptRunSettings run;
-      run.algorithm = NloptAlgorithm::kLdSlsqp;
-      run.lower = lower;
-      run.upper = upper;
-      run.x_tolerance_rel = 1e-14;
-      run.f_tolerance_abs = 1e-30;
-      run.max_evaluations = budget_left();
-      run.max_time_s = time_left;
-      std::vector<double> x = candidates[c].second;
-      const int status = RunNlopt(objective, constraints, run, &x).raw_status;
-      for (double& xj : x) xj = std::clamp(xj, 0.0, 1.0);
-      if (status > 0 || status == kNloptRoundoffLimited) {  // x holds the best point: keep it
-        const double phi = model.Objective(x.data(), nullptr);
-        if (model.Feasible(x.data()) && phi < best_phi) {
-          best_phi = phi;
-          best = x;
-          raw_status = status;
-          improved = true;
-        }
-      }
-      if (!improved) raw_status = status;
-    }
-    summary.raw_status = raw_status;
-    if (raw_status == kNloptRoundoffLimited) {
-      summary.warnings.push_back("NLopt SLSQP stopped round-off limited; its best point is kept");
-    } else if (raw_status == kNloptMaxevalReached || raw_status == kNloptMaxtimeReached) {
-      summary.warnings.push_back("NLopt SLSQP stopped at the evaluation or time budget");
-    }
-
-    // 3. Gauss-Newton on the residuals (keeps only feasible decreases).
-    int gauss_newton_steps = 0;
-    for (int iter = 0; iter < 50 && budget_left() > 0; ++iter) {
-      Eigen::VectorXd r;
-      Eigen::MatrixXd jac;
-      model.Residuals(best.data(), &r, &jac);
-      if (r.lpNorm<Eigen::Infinity>() <= 1e-3 * options.tolerance) break;
-      const Eigen::VectorXd step = jac.completeOrthogonalDecomposition().solve(-r);
-      bool accepted = false;
-      double alpha = 1.0;
-      for (int halving = 0; halving < 30; ++halving, alpha *= 0.5) {
-        std::vector<double> trial = best;
-        for (int j = 0; j < n; ++j) {
-          trial[static_cast<std::size_t>(j)] =
-              std::clamp(best[static_cast<std::size_t>(j)] + alpha * step[j], 0.0, 1.0);
-        }
-        if (!model.Feasible(trial.data())) continue;
-        const double phi = model.Objective(trial.data(), nullptr);
-        if (phi < best_phi) {
-          best_phi = phi;
-          best = trial;
-          accepted = true;
-          break;
-        }
-      }
-      if (!accepted) break;
-      ++gauss_newton_steps;
-    }
-
-    // 4. The result: repair the ordering round-off, build the bat, classify.
-    std::vector<double> t = model.ToParameters(best.data());
+    // The result: repair the ordering round-off, build the bat, classify.
+    std::vector<double> t = model.ToParameters(search.best.data());
     const ThreeSegmentShape repaired = design_detail::ThreeSegmentShapeAt(t, problem.shape);
     const DesignParameterLayout lay{4};
     t[static_cast<std::size_t>(lay.KnotPosition(1))] = repaired.taper_start_m;
     t[static_cast<std::size_t>(lay.KnotPosition(2))] = repaired.taper_end_m;
     BuildBat(problem, t, &result);
-    summary.iterations = local_runs + gauss_newton_steps;
+    summary.iterations = search.local_runs + search.gauss_newton_steps;
     summary.evaluations = model.evaluations();
-    summary.constraint_violation = std::max(0.0, model.MaxViolationM(best.data()));
+    summary.constraint_violation = std::max(0.0, model.MaxViolationM(search.best.data()));
     if (Refusal bat_why; !result.bat.Validate(&bat_why)) {
       summary.termination = Termination::kFailure;
       summary.message = "the fitted bat is invalid: " + bat_why.Message();
-      summary.objective = best_phi;
+      summary.objective = search.best_phi;
       summary.solve_time_s = elapsed_s();
       return result;
     }
-    double max_scaled = 0.0;
-    result.metric = 0.0;
-    if (problem.targets.mass_kg.has_value()) {
-      result.mass_residual_kg = result.properties.mass_kg - *problem.targets.mass_kg;
-      const double scaled =
-          result.mass_residual_kg /
-          (options.mass_scale_kg > 0.0 ? options.mass_scale_kg : *problem.targets.mass_kg);
-      max_scaled = std::max(max_scaled, std::abs(scaled));
-      result.metric += scaled * scaled;
-    }
-    if (problem.targets.balance_point_m.has_value()) {
-      result.balance_point_residual_m =
-          result.properties.balance_point_m - *problem.targets.balance_point_m;
-      const double scaled =
-          result.balance_point_residual_m / (options.balance_point_scale_m > 0.0
-                                                 ? options.balance_point_scale_m
-                                                 : *problem.targets.balance_point_m);
-      max_scaled = std::max(max_scaled, std::abs(scaled));
-      result.metric += scaled * scaled;
-    }
-    summary.objective = result.metric;
-    const std::string achieved =
-        "mass_kg = " + FormatNumber(result.properties.mass_kg) +
-        ", balance_point_m = " + FormatNumber(result.properties.balance_point_m);
-    if (max_scaled <= options.tolerance) {
-      result.targets_met = true;
-      summary.termination = Termination::kConverged;
-      summary.error_estimate = max_scaled;
-      summary.message = "targets met (" + DescribeTargets(problem) + "): " + achieved;
-    } else {
-      result.kkt_error = fit_detail::KktError(model, best);
-      summary.error_estimate = result.kkt_error;
-      const std::string metric =
-          "metric ((M - M*)/s_M)^2 + ((C - C*)/s_C)^2 = " + FormatNumber(result.metric) + ": " +
-          achieved;
-      if (result.kkt_error <= options.kkt_tolerance) {
-        summary.termination = Termination::kInfeasible;
-        summary.message = "no bat with " + DescribeUnknowns(problem) + " meets " +
-                          DescribeTargets(problem) + "; closest bat in the " + metric;
-      } else {
-        summary.termination = Termination::kNoConvergence;
-        summary.message = "targets " + DescribeTargets(problem) + " not met with " +
-                          DescribeUnknowns(problem) +
-                          "; best bat found (not certified as closest: first-order residual " +
-                          FormatNumber(result.kkt_error) + ") in the " + metric;
-        summary.warnings.push_back("the closest point failed the first-order (KKT) check");
-      }
-    }
+    Classify(problem, options, model, search.best, &result);
   } catch (const std::bad_alloc&) {
     summary.termination = Termination::kFailure;
     summary.message = "out of memory";

@@ -137,7 +137,12 @@ TEST(SwingBatSpeedTest, BatSpeedInMphThroughTheUnitsMechanism) {
                                                 {"swing", {{"bat_speed_mph", 70.0},
                                                            {"angular_speed_rad_s", 17.0}}}});
   EXPECT_EQ(both.status, 400);
-  EXPECT_EQ(both.body["field"], "swing.bat_speed_mps");
+  // Named as written (issue 33, item 2), the SI field after it.
+  EXPECT_EQ(both.body["field"], "swing.bat_speed_mph");
+  EXPECT_NE(both.body["message"].get<std::string>().find(
+                "exactly one of swing.bat_speed_mph and swing.angular_speed_rad_s"),
+            std::string::npos)
+      << both.body.dump();
 }
 
 TEST(SwingBatSpeedTest, BothGivenIsRefused) {

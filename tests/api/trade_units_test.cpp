@@ -159,7 +159,8 @@ TEST(TradeUnitsTest, OneFormPerQuantityAndRulesNameTheFieldAsGiven) {
   EXPECT_EQ(r.status, 400);
   EXPECT_EQ(r.body["field"], "bat.three_segment.barrel_diameter_in");
   // A value outside a range the api checks is refused under the name it was given, with its
-  // SI value; ranges core checks (the ball's) are reported in SI under the SI name.
+  // SI value; so is one outside a range core checks (the ball's; issue 33, item 2: the error
+  // names the field as written, with the value as written, the SI value after it).
   r = Post("/v1/sweet-spot",
            Json{{"bat", SiBat()},
                 {"options", {{"method", "nlopt"}, {"nlopt", {{"x_tolerance_in", -4}}}}}});
@@ -170,8 +171,11 @@ TEST(TradeUnitsTest, OneFormPerQuantityAndRulesNameTheFieldAsGiven) {
       << r.body;
   r = Post("/v1/sweet-spot", Json{{"bat", SiBat()}, {"ball", {{"speed_mph", -10}}}});
   EXPECT_EQ(r.status, 400) << r.body;
-  EXPECT_EQ(r.body["field"], "ball.speed_mps");
-  EXPECT_NE(r.body["message"].get<std::string>().find("= -4.47"), std::string::npos) << r.body;
+  EXPECT_EQ(r.body["field"], "ball.speed_mph");
+  EXPECT_EQ(r.body["message"].get<std::string>().rfind("ball.speed_mph = -10: ", 0), 0u) << r.body;
+  EXPECT_NE(r.body["message"].get<std::string>().find("(in SI: ball.speed_mps = -4.47"),
+            std::string::npos)
+      << r.body;
 }
 
 TEST(TradeUnitsTest, OptimizeConstraintsTakeOunces) {

@@ -1,0 +1,291 @@
+// The table of settable fields (api/fields.hpp) and how a written name finds its row.
+#include "api/fields.hpp"
+
+#include <algorithm>
+
+#include "api/json_path.hpp"
+#include "api/json_reader.hpp"
+#include "api/trade_units.hpp"
+#include "core/bat/material.hpp"
+
+namespace sweetspot::api {
+namespace {
+
+using G = FieldGroup;
+using H = FieldHost;
+
+core::Bat& BatOf(const H& h) { return *h.bat; }
+core::Material& MaterialOf(const H& h) { return h.bat->material; }
+core::Fill& FillOf(const H& h) { return *h.fill; }
+
+// The rows. The ranges are those the request's reader and core's Validate(Size) hold.
+std::vector<Field> MakeFields() {
+  std::vector<Field> f;
+  // The ball, the swing, the COR: explore parameters only.
+  f.push_back({"ball.mass_kg", "kg", G::kBall, core::kMinBallMassKg, core::kMaxBallMassKg, true,
+               false, "", [](const H& h) { return h.ball->mass_kg; },
+               [](const H& h, double v) { h.ball->mass_kg = v; }});
+  f.push_back({"ball.radius_m", "m", G::kBall, core::kMinBallRadiusM, core::kMaxBallRadiusM, true,
+               false, "", [](const H& h) { return h.ball->radius_m; },
+               [](const H& h, double v) { h.ball->radius_m = v; }});
+  f.push_back({"ball.speed_mps", "m/s", G::kBall, 0.0, core::kMaxBallSpeedMps, true, false, "",
+               [](const H& h) { return h.ball->speed_mps; },
+               [](const H& h, double v) { h.ball->speed_mps = v; }});
+  f.push_back({"ball.stiffness_n_m_p", "N/m^p", G::kBall, 0.0, core::kMaxBallStiffness, true,
+               false, "", [](const H& h) { return h.ball->stiffness; },
+               [](const H& h, double v) { h.ball->stiffness = v; }});
+  f.push_back({"ball.stiffness_exponent", "1", G::kBall, 1.0, 3.0, true, false, "",
+               [](const H& h) { return h.ball->stiffness_exponent; },
+               [](const H& h, double v) { h.ball->stiffness_exponent = v; }});
+  f.push_back({"swing.angular_speed_rad_s", "rad/s", G::kSwing, 0.0,
+               core::kMaxSwingAngularSpeedRadS, true, false, "",
+               [](const H& h) { return h.swing->angular_speed_rad_s; },
+               [](const H& h, double v) { h.swing->angular_speed_rad_s = v; }});
+  f.push_back({"swing.pivot_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,
+               core::kMaxSwingOffsetM, true, false, "",
+               [](const H& h) { return h.swing->pivot_from_knob_m; },
+               [](const H& h, double v) { h.swing->pivot_from_knob_m = v; }});
+  f.push_back({"swing.hands_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,
+               core::kMaxSwingOffsetM, true, false, "",
+               [](const H& h) { return h.swing->hands_from_knob_m; },
+               [](const H& h, double v) { h.swing->hands_from_knob_m = v; }});
+  f.push_back({"cor", "1", G::kCor, 0.0, 1.0, true, false, "",
+               [](const H& h) { return h.cor->value_or(0.0); },
+               [](const H& h, double v) { *h.cor = v; }});
+  // The three-segment shape.
+  f.push_back({"bat.three_segment.length_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true, true,
+               "length_m", [](const H& h) { return h.shape->length_m; },
+               [](const H& h, double v) { h.shape->length_m = v; }});
+  f.push_back({"bat.three_segment.handle_radius_m", "m", G::kShape, 0.0, core::kMaxBatRadiusM,
+               true, true, "handle_radius_m", [](const H& h) { return h.shape->handle_radius_m; },
+               [](const H& h, double v) { h.shape->handle_radius_m = v; }});
+  f.push_back({"bat.three_segment.barrel_radius_m", "m", G::kShape, 0.0, core::kMaxBatRadiusM,
+               true, true, "barrel_radius_m", [](const H& h) { return h.shape->barrel_radius_m; },
+               [](const H& h, double v) { h.shape->barrel_radius_m = v; }});
+  f.push_back({"bat.three_segment.taper_start_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true,
+               true, "taper_start_m", [](const H& h) { return h.shape->taper_start_m; },
+               [](const H& h, double v) { h.shape->taper_start_m = v; }});
+  f.push_back({"bat.three_segment.taper_end_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true,
+               true, "taper_end_m", [](const H& h) { return h.shape->taper_end_m; },
+               [](const H& h, double v) { h.shape->taper_end_m = v; }});
+  // A profile's knots.
+  f.push_back({"bat.profile.knots[].x_m", "m", G::kKnot, 0.0, core::kMaxBatLengthM, true, true, "",
+               [](const H& h) { return BatOf(h).knots[h.knot].x_m; },
+               [](const H& h, double v) { BatOf(h).knots[h.knot].x_m = v; }});
+  f.push_back({"bat.profile.knots[].radius_m", "m", G::kKnot, 0.0, core::kMaxBatRadiusM, true,
+               true, "", [](const H& h) { return BatOf(h).knots[h.knot].radius_m; },
+               [](const H& h, double v) { BatOf(h).knots[h.knot].radius_m = v; }});
+  // The material, given as an object.
+  f.push_back({"bat.material.density_kg_m3", "kg/m³", G::kMaterial, 0.0, core::kMaxDensityKgM3,
+               true, true, "density_kg_m3",
+               [](const H& h) { return MaterialOf(h).density_kg_m3; },
+               [](const H& h, double v) { MaterialOf(h).density_kg_m3 = v; }});
+  f.push_back({"bat.material.youngs_modulus_pa", "Pa", G::kMaterial, 0.0, core::kMaxModulusPa,
+               true, false, "", [](const H& h) { return MaterialOf(h).youngs_modulus_pa; },
+               [](const H& h, double v) { MaterialOf(h).youngs_modulus_pa = v; }});
+  f.push_back({"bat.material.shear_modulus_pa", "Pa", G::kMaterial, 0.0, core::kMaxModulusPa,
+               true, false, "", [](const H& h) { return MaterialOf(h).shear_modulus_pa; },
+               [](const H& h, double v) {
+                 MaterialOf(h).shear_modulus_pa = v;
+                 MaterialOf(h).poissons_ratio_assumed = false;  // given: no "nu assumed"
+               }});
+  f.push_back({"bat.material.poissons_ratio", "1", G::kMaterial, -1.0, 0.5, true, false, "",
+               [](const H& h) { return MaterialOf(h).poissons_ratio; },
+               [](const H& h, double v) {
+                 MaterialOf(h).poissons_ratio = v;
+                 MaterialOf(h).poissons_ratio_assumed = false;
+               }});
+  f.push_back({"bat.material.cor", "1", G::kMaterial, 0.0, 1.0, true, false, "",
+               [](const H& h) { return MaterialOf(h).cor.value_or(0.0); },
+               [](const H& h, double v) { MaterialOf(h).cor = v; }});
+  // The wall and the fill.
+  f.push_back({"bat.wall_thickness_m", "m", G::kWall, 0.0, core::kMaxBatRadiusM, true, true,
+               "wall_thickness_m", [](const H& h) { return BatOf(h).wall_thickness_m; },
+               [](const H& h, double v) { BatOf(h).wall_thickness_m = v; }});
+  f.push_back({"bat.fill.diameter_m", "m", G::kFill, 0.0, core::kMaxFillDiameterM, true, true,
+               "fill.diameter_m", [](const H& h) { return FillOf(h).diameter_m; },
+               [](const H& h, double v) { FillOf(h).diameter_m = v; }});
+  f.push_back({"bat.fill.depth_m", "m", G::kFill, 0.0, core::kMaxBatLengthM, true, true,
+               "fill.depth_m", [](const H& h) { return FillOf(h).depth_m; },
+               [](const H& h, double v) { FillOf(h).depth_m = v; }});
+  f.push_back({"bat.fill.material.density_kg_m3", "kg/m³", G::kFillMaterial, 0.0,
+               core::kMaxDensityKgM3, false, true, "fill.density_kg_m3",
+               [](const H& h) { return FillOf(h).material.density_kg_m3; },
+               [](const H& h, double v) { FillOf(h).material.density_kg_m3 = v; }});
+  return f;
+}
+
+constexpr std::string_view kBatPrefix = "bat.";
+
+// The field's name in `scope` (its pattern, with "[]" for a knot's index), or "" when the
+// scope does not take it.
+std::string_view NameIn(const Field& field, FieldScope scope) {
+  switch (scope) {
+    case FieldScope::kRequest:
+      return field.swept ? field.path : std::string_view();
+    case FieldScope::kVariable:
+      return field.variable ? field.path.substr(kBatPrefix.size()) : std::string_view();
+    case FieldScope::kFitName:
+      return field.fit_name;
+  }
+  return {};
+}
+
+// The field named `pattern` in `scope`, or nullptr.
+const Field* FindIn(std::string_view pattern, FieldScope scope) {
+  for (const Field& field : Fields()) {
+    const std::string_view name = NameIn(field, scope);
+    if (!name.empty() && name == pattern) return &field;
+  }
+  return nullptr;
+}
+
+// `written` with its knot indices as "[]" (and the indices), or nullopt for no path.
+std::optional<std::string> PatternOf(std::string_view written,
+                                     std::vector<std::size_t>* indices) {
+  std::string why;
+  const auto steps = ParseJsonPath(std::string(written), &why);
+  if (!steps || steps->empty()) return std::nullopt;
+  std::string pattern;
+  for (const PathStep& step : *steps) {
+    if (const auto* key = std::get_if<std::string>(&step)) {
+      if (!pattern.empty()) pattern += '.';
+      pattern += *key;
+    } else {
+      pattern += "[]";
+      indices->push_back(std::get<std::size_t>(step));
+    }
+  }
+  return pattern;
+}
+
+// `pattern` with its "[]" replaced by `indices` in order.
+std::string WithIndices(std::string_view pattern, const std::vector<std::size_t>& indices) {
+  std::string out;
+  std::size_t next = 0;
+  for (std::size_t k = 0; k < pattern.size(); ++k) {
+    if (pattern.compare(k, 2, "[]") == 0 && next < indices.size()) {
+      out += '[';  // piece by piece: GCC 12 warns (falsely) on "[" + to_string(i)
+      out += std::to_string(indices[next++]);
+      out += ']';
+      ++k;
+    } else {
+      out += pattern[k];
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+FieldHost FieldHost::Of(core::Scene* scene, core::ThreeSegmentShape* shape) {
+  FieldHost host;
+  host.ball = &scene->ball;
+  host.swing = &scene->swing;
+  host.cor = &scene->cor;
+  if (scene->bat.has_value()) {
+    host.bat = &*scene->bat;
+    if (host.bat->fill.has_value()) host.fill = &*host.bat->fill;
+  }
+  host.shape = shape;
+  return host;
+}
+
+std::string_view FieldKey(const Field& field) {
+  return field.path.substr(field.path.rfind('.') + 1);
+}
+
+bool ReadFieldGroup(ObjectReader& reader, FieldGroup group, bool required, const FieldHost& host) {
+  for (const Field& field : Fields()) {
+    if (field.group != group) continue;
+    double value = field.get(host);
+    if (required) {
+      reader.Number(FieldKey(field), AnyNumber(), &value);
+    } else {
+      reader.OptionalNumber(FieldKey(field), AnyNumber(), &value);
+    }
+    if (!reader.ok()) return false;
+    field.set(host, value);
+  }
+  return reader.ok();
+}
+
+const std::vector<Field>& Fields() {
+  static const std::vector<Field> fields = MakeFields();
+  return fields;
+}
+
+const Field* FindField(std::string_view pattern) {
+  for (const Field& field : Fields()) {
+    if (field.path == pattern) return &field;
+  }
+  return nullptr;
+}
+
+std::optional<FieldUse> ResolveField(std::string_view written, FieldScope scope) {
+  std::vector<std::size_t> indices;
+  const auto pattern = PatternOf(written, &indices);
+  if (!pattern) return std::nullopt;
+  const std::size_t dot = pattern->rfind('.');
+  const std::string parent = dot == std::string::npos ? "" : pattern->substr(0, dot + 1);
+  const std::string leaf = dot == std::string::npos ? *pattern : pattern->substr(dot + 1);
+  // The SI name itself, then the SI fields the leaf is a trade spelling of, a radius from a
+  // diameter first ("fill.diameter_in" is the fill's diameter_m: a fill has no radius).
+  std::vector<TradeForm> candidates = {{leaf, 1.0}};
+  for (TradeForm& form : SiFormsOf(leaf)) candidates.push_back(std::move(form));
+  for (const TradeForm& candidate : candidates) {
+    const std::string si_pattern = parent + candidate.key;
+    if (const Field* field = FindIn(si_pattern, scope)) {
+      FieldUse use;
+      use.field = field;
+      use.written = std::string(written);
+      use.si = WithIndices(si_pattern, indices);
+      use.to_si = candidate.to_si;
+      use.indices = std::move(indices);
+      return use;
+    }
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+// Every name of `scope`, SI and trade forms, a knot's index written "[]".
+std::vector<std::string> Patterns(FieldScope scope) {
+  std::vector<std::string> names;
+  for (const Field& field : Fields()) {
+    const std::string name(NameIn(field, scope));
+    if (name.empty()) continue;
+    names.push_back(name);
+    const std::size_t dot = name.rfind('.');
+    const std::string parent = dot == std::string::npos ? "" : name.substr(0, dot + 1);
+    for (const TradeForm& form : TradeForms(name.substr(parent.size()))) {
+      // A fill's diameter is its own field: a radius's forms are no name of it.
+      const auto use = ResolveField(WithIndices(parent + form.key, {0}), scope);
+      if (use && use->field == &field) names.push_back(parent + form.key);
+    }
+  }
+  return names;
+}
+
+}  // namespace
+
+std::vector<std::string> FieldNames(FieldScope scope) {
+  std::vector<std::string> names = Patterns(scope);
+  for (std::string& name : names) {
+    if (const std::size_t at = name.find("[]"); at != std::string::npos) name.replace(at, 2, "[i]");
+  }
+  return names;
+}
+
+std::string DidYouMeanField(std::string_view written, FieldScope scope) {
+  // Compared with a knot's index left out: "profile.knots[3].radus_m".
+  std::vector<std::size_t> indices;
+  std::string typed(written);
+  if (const auto pattern = PatternOf(written, &indices)) typed = *pattern;
+  const std::string nearest = NearestName(typed, Patterns(scope));
+  if (nearest.empty()) return "";
+  return " (did you mean \"" + WithIndices(nearest, indices) + "\"?)";
+}
+
+}  // namespace sweetspot::api
