@@ -79,6 +79,21 @@ enum class LeanPath { kHttplib, kWithBody, kWithoutBody };
 /// The path `req` takes (kHttplib without the loop's framing).
 LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream);
 
+/// The reason phrase httplib 0.11.4 writes after `status` in its status line, for the
+/// statuses this service answers; null for the others (httplib then writes the answer).
+const char* StatusText(int status);
+
+/// The request line and headers of a head the connection loop framed (`head`: up to and
+/// with its blank line), parsed as httplib parses them into *req: method, target, version,
+/// the path percent-decoded, the query's parameters, the headers (values percent-decoded).
+/// False, *req partly filled, for any head where httplib's parsing might differ or fail
+/// (an unusual request line, a method it does not route, a header line without a value):
+/// those take httplib's own path.
+bool ParseFramedHead(std::string_view head, httplib::Request* req);
+
+/// httplib's status line and headers for `res` (headers in its order), blank line included.
+std::string ResponseHead(const httplib::Response& res, const char* status_text);
+
 /// httplib's request handling (parsing, routing, our handlers, writing the answer) for one
 /// request the connection loop has read completely.
 class HttpServer : public httplib::Server {
@@ -88,6 +103,11 @@ class HttpServer : public httplib::Server {
   /// server is serving.
   void SetServing(int listen_fd) { svr_sock_ = listen_fd; }
   void SetStopping() { svr_sock_ = INVALID_SOCKET; }
+  /// The value of the Keep-Alive answer header, as httplib writes it.
+  std::string KeepAliveValue() const {
+    return "timeout=" + std::to_string(keep_alive_timeout_sec_) +
+           ", max=" + std::to_string(keep_alive_max_count_);
+  }
 
   bool ServeOne(httplib::Stream& stream, bool close_connection, bool* connection_closed) {
     bool closed = false;
