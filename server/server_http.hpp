@@ -24,6 +24,12 @@ namespace sweetspot::server::http {
 /// One JSON body: never throws on invalid UTF-8 (replaced instead).
 std::string Serialize(const nlohmann::json& body);
 
+/// `value` appended to *out exactly as Serialize writes it (nlohmann's compact dump, invalid
+/// UTF-8 replaced), without nlohmann's character-at-a-time output for the common case:
+/// objects, arrays, numbers and printable ASCII strings are written here, other strings by
+/// nlohmann's escaping.
+void AppendJson(const nlohmann::json& value, std::string* out);
+
 /// The text of a caught exception, for the log.
 std::string WhatOf(const std::exception_ptr& caught);
 
