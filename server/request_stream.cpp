@@ -3,6 +3,7 @@
 #include <poll.h>
 #include <sys/select.h>
 #include <sys/socket.h>
+#include <sys/uio.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -79,10 +80,29 @@ bool RequestStream::Flush() {
   return sent;
 }
 
+void RequestStream::SetAnswer(std::string head, std::string body) {
+  if (out_.empty()) {
+    out_ = std::move(head);
+  } else {
+    out_ += head;
+  }
+  body_ = std::move(body);
+}
+
 bool RequestStream::SendWithoutWaiting(std::string* unsent) {
+  // out_, then body_ (SetAnswer): one writev for both, no copy of the body.
+  const std::size_t total = out_.size() + body_.size();
   std::size_t at = 0;
-  while (healthy_ && at < out_.size()) {
-    const ssize_t n = ::send(fd_, out_.data() + at, out_.size() - at, MSG_NOSIGNAL | MSG_DONTWAIT);
+  while (healthy_ && at < total) {
+    iovec parts[2];
+    int count = 0;
+    if (at < out_.size()) parts[count++] = {out_.data() + at, out_.size() - at};
+    const std::size_t body_at = at > out_.size() ? at - out_.size() : 0;
+    if (body_at < body_.size()) parts[count++] = {body_.data() + body_at, body_.size() - body_at};
+    msghdr message{};
+    message.msg_iov = parts;
+    message.msg_iovlen = static_cast<std::size_t>(count);
+    const ssize_t n = ::sendmsg(fd_, &message, MSG_NOSIGNAL | MSG_DONTWAIT);
     if (n > 0) {
       at += static_cast<std::size_t>(n);
     } else if (n < 0 && errno == EINTR) {
@@ -93,12 +113,13 @@ bool RequestStream::SendWithoutWaiting(std::string* unsent) {
       healthy_ = false;
     }
   }
-  if (healthy_ && at < out_.size()) {
-    unsent->assign(out_, at, std::string::npos);
-  } else {
-    unsent->clear();
+  unsent->clear();
+  if (healthy_ && at < total) {
+    if (at < out_.size()) unsent->assign(out_, at, std::string::npos);
+    unsent->append(body_, at > out_.size() ? at - out_.size() : 0, std::string::npos);
   }
   out_.clear();
+  body_.clear();
   return healthy_;
 }
 

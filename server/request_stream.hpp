@@ -74,6 +74,9 @@ class RequestStream : public httplib::Stream {
   /// Sends what the socket takes now of the collected answer, without waiting,
   /// and moves the rest to *unsent. False when the socket failed.
   bool SendWithoutWaiting(std::string* unsent);
+  /// The whole answer, written by the caller instead of httplib: its head, then its body
+  /// (kept as it is, not copied: SendWithoutWaiting sends both in one writev).
+  void SetAnswer(std::string head, std::string body);
   /// From now on every write goes out at once (a streamed answer's chunks).
   void WriteThrough();
   /// False once a write failed: the connection must be closed.
@@ -102,6 +105,8 @@ class RequestStream : public httplib::Stream {
   std::string_view body() const {
     return head_bytes_ < request_.size() ? request_.substr(head_bytes_) : std::string_view();
   }
+  /// The bytes of the request's head (the closing blank line included).
+  std::size_t head_bytes() const { return head_bytes_; }
   /// The Content-Length the head declared (0 without one).
   std::uint64_t content_length() const { return content_length_; }
   /// The body as a JSON object, when the choice of pool already parsed it (else null): the
@@ -129,6 +134,7 @@ class RequestStream : public httplib::Stream {
   const std::string& local_ip_;
   int local_port_;
   std::string out_;
+  std::string body_;  // the answer's body after out_ (SetAnswer)
   bool write_through_ = false;
   bool healthy_ = true;
   RequestStream* previous_current_;

@@ -53,6 +53,17 @@ struct Server::Impl {
   void Answer(const httplib::Request& req, std::string_view body, httplib::Response& res);
   /// The pre-routing hook: CORS, the token, refusals, then Answer() with the loop's bytes.
   httplib::Server::HandlerResponse PreRoute(const httplib::Request& req, httplib::Response& res);
+  /// Serves one request the connection loop framed: parsed from the loop's bytes, answered
+  /// by PreRoute, its head and body written here as httplib would write them; httplib's
+  /// own request handling for what this leaves to it (ServeDirect's comment).
+  bool ServeDirect(RequestStream& stream, bool close_connection, bool* connection_closed);
+  /// httplib's error handler: the JSON envelope of a status >= 400 with no body.
+  httplib::Server::HandlerResponse ErrorEnvelope(httplib::Response& res);
+  /// httplib's logger: requests no route answered, counted and logged "unrouted".
+  void LogUnrouted(const httplib::Request& req, const httplib::Response& res);
+  /// httplib's exception handler: a JSON 500, the exception's text in the log only.
+  void OnException(const httplib::Request& req, httplib::Response& res,
+                   const std::exception_ptr& caught);
 
   const ServerConfig& config;  // the Server's, which outlives this
   HttpServer http;
@@ -70,6 +81,7 @@ struct Server::Impl {
   std::unique_ptr<StaticFiles> static_files;  // The explorer's files (web root); never null.
   std::string startup_error;  // Why the jobs database cannot be used; Bind() reports it.
   std::mutex log_mutex;
+  std::string keep_alive_value;  // the Keep-Alive answer header's value (Configure)
   // Created by Bind(); owns the listening socket. Last: its workers use the members above.
   std::unique_ptr<ConnectionLoop> loop;
 };
@@ -79,6 +91,9 @@ namespace {
 // httplib calls on the same thread right after: requests httplib answered
 // itself (413, 411, malformed) are counted there.
 thread_local bool request_was_routed = false;
+// An answer ServeDirect computed but leaves httplib to write (a body from a provider, a
+// status whose reason phrase it does not know): PreRoute hands it to httplib as it is.
+thread_local httplib::Response* computed_answer = nullptr;
 }  // namespace
 
 // httplib's settings that still apply, the static files, and the context every request
@@ -90,6 +105,7 @@ void Server::Impl::Configure() {
   http.set_payload_max_length(config.max_body_bytes);
   http.set_keep_alive_timeout(WholeSeconds(config.keep_alive_timeout_s));
   http.set_keep_alive_max_count(static_cast<size_t>(config.keep_alive_max_requests));
+  keep_alive_value = http.KeepAliveValue();
 
   static_files =
       std::make_unique<StaticFiles>(config.web_root.empty() ? DefaultWebRoot() : config.web_root);
@@ -210,6 +226,11 @@ void Server::Impl::Answer(const httplib::Request& req, std::string_view body,
   // the same handler, as before.
 httplib::Server::HandlerResponse Server::Impl::PreRoute(const httplib::Request& req,
                                                       httplib::Response& res) {
+  if (computed_answer != nullptr) {
+    res = std::move(*computed_answer);
+    computed_answer = nullptr;
+    return httplib::Server::HandlerResponse::Handled;
+  }
   RequestStream* stream = RequestStream::Current();
   if (!config.cors_origin.empty()) {
     const std::string origin = req.get_header_value("Origin");
@@ -287,43 +308,115 @@ void Server::Impl::InstallHandlers() {
   // Statuses httplib produces itself (413, 400 on a malformed request line,
   // ...) get the JSON error envelope; bodies our handlers wrote are kept.
   http.set_error_handler(
-      httplib::Server::HandlerWithResponse([](const httplib::Request&, httplib::Response& res) {
-        if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
-        std::string message = "HTTP status " + std::to_string(res.status);
-        if (res.status == 413) message = kBodyTooLargeMessage;
-        if (res.status == 400) {
-          message =
-              "the request could not be read: malformed, or its body did not arrive within "
-              "the read timeout";
-        }
-        WriteApiResponse(api::ErrorResponse(res.status, CodeForStatus(res.status), message), res);
-        return httplib::Server::HandlerResponse::Handled;
+      httplib::Server::HandlerWithResponse([this](const httplib::Request&, httplib::Response& res) {
+        return ErrorEnvelope(res);
       }));
   http.set_logger([this](const httplib::Request& req, const httplib::Response& res) {
-    if (request_was_routed) {
-      request_was_routed = false;
-      return;
-    }
-    metrics.Begin();
-    metrics.End("unrouted", req.method, res.status, 0.0);
-    if (config.access_log) {
-      const nlohmann::json line{{"method", req.method}, {"path", req.path},
-                                {"route", "unrouted"},  {"status", res.status},
-                                {"duration_s", 0.0},    {"bytes_in", req.body.size()}};
-      std::lock_guard<std::mutex> lock(log_mutex);
-      std::cerr << Serialize(line) << "\n";
-    }
+    LogUnrouted(req, res);
   });
   // Never send an exception's text to the client (pitfalls.md); log it.
   http.set_exception_handler([this](const httplib::Request& req, httplib::Response& res,
                                     std::exception_ptr caught) {
-    WriteApiResponse(api::ErrorResponse(500, api::ErrorCode::kInternalError, "internal error"),
-                     res);
-    const std::string line = AccessLogLine(
-        {req.method, req.path, "unrouted", 500, 0.0, req.body.size(), WhatOf(caught)});
-    std::lock_guard<std::mutex> lock(log_mutex);
-    std::cerr << line << "\n";
+    OnException(req, res, caught);
   });
+}
+
+// Statuses httplib produces itself (413, 400 on a malformed request line,
+// ...) get the JSON error envelope; bodies our handlers wrote are kept.
+httplib::Server::HandlerResponse Server::Impl::ErrorEnvelope(httplib::Response& res) {
+  if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+  std::string message = "HTTP status " + std::to_string(res.status);
+  if (res.status == 413) message = kBodyTooLargeMessage;
+  if (res.status == 400) {
+    message =
+        "the request could not be read: malformed, or its body did not arrive within "
+        "the read timeout";
+  }
+  WriteApiResponse(api::ErrorResponse(res.status, CodeForStatus(res.status), message), res);
+  return httplib::Server::HandlerResponse::Handled;
+}
+
+void Server::Impl::LogUnrouted(const httplib::Request& req, const httplib::Response& res) {
+  if (request_was_routed) {
+    request_was_routed = false;
+    return;
+  }
+  metrics.Begin();
+  metrics.End("unrouted", req.method, res.status, 0.0);
+  if (config.access_log) {
+    const nlohmann::json line{{"method", req.method}, {"path", req.path},
+                              {"route", "unrouted"},  {"status", res.status},
+                              {"duration_s", 0.0},    {"bytes_in", req.body.size()}};
+    std::lock_guard<std::mutex> lock(log_mutex);
+    std::cerr << Serialize(line) << "\n";
+  }
+}
+
+void Server::Impl::OnException(const httplib::Request& req, httplib::Response& res,
+                               const std::exception_ptr& caught) {
+  WriteApiResponse(api::ErrorResponse(500, api::ErrorCode::kInternalError, "internal error"),
+                   res);
+  const std::string line = AccessLogLine(
+      {req.method, req.path, "unrouted", 500, 0.0, req.body.size(), WhatOf(caught)});
+  std::lock_guard<std::mutex> lock(log_mutex);
+  std::cerr << line << "\n";
+}
+
+// A request the loop framed, answered without httplib's request handling: the head is parsed
+// from the loop's bytes (no regex, no line reader), PreRoute answers it, and the answer's
+// head is built here with httplib 0.11.4's rules (write_response_core: the error envelope,
+// Content-Length of the body, Connection: close or Keep-Alive, Content-Type text/plain for
+// an untyped body, Content-Length: 0 for none, Accept-Ranges for HEAD; headers in httplib's
+// order) and handed to the stream with the body, which the loop sends with one writev.
+// httplib's own path stays for what this does not parse (ParseFramedHead), what PreRoute
+// leaves to httplib (LeanPathOf), a client that accepts compressed answers (httplib may
+// compress), and answers it must write itself: a body from a provider (streamed, sourced)
+// or a status without a reason phrase here (then with the answer computed here).
+bool Server::Impl::ServeDirect(RequestStream& stream, bool close_connection,
+                               bool* connection_closed) {
+  httplib::Request req;
+  if (!ParseFramedHead(stream.request().substr(0, stream.head_bytes()), &req) ||
+      req.has_header("Accept-Encoding") || LeanPathOf(req, &stream) == LeanPath::kHttplib) {
+    return http.ServeOne(stream, close_connection, connection_closed);
+  }
+  const std::string connection = req.get_header_value("Connection");
+  const bool closed =
+      connection == "close" || (req.version == "HTTP/1.0" && connection != "Keep-Alive");
+  PrepareRequest(req);
+  httplib::Response res;
+  res.version = "HTTP/1.1";
+  try {
+    PreRoute(req, res);
+  } catch (...) {
+    OnException(req, res, std::current_exception());
+  }
+  if (res.status == -1) res.status = 200;
+  if (res.status >= 400) ErrorEnvelope(res);
+  const char* status_text = StatusText(res.status);
+  if (res.content_provider_ || status_text == nullptr) {
+    computed_answer = &res;
+    const bool ok = http.ServeOne(stream, close_connection, connection_closed);
+    computed_answer = nullptr;
+    return ok;
+  }
+  if (!res.body.empty()) res.set_header("Content-Length", std::to_string(res.body.size()));
+  if (close_connection || connection == "close") {
+    res.set_header("Connection", "close");
+  } else {
+    res.set_header("Keep-Alive", keep_alive_value);
+  }
+  if (!res.body.empty() && !res.has_header("Content-Type")) {
+    res.set_header("Content-Type", "text/plain");
+  }
+  if (res.body.empty() && !res.has_header("Content-Length")) {
+    res.set_header("Content-Length", "0");
+  }
+  const bool head_only = req.method == "HEAD";
+  if (head_only && !res.has_header("Accept-Ranges")) res.set_header("Accept-Ranges", "bytes");
+  stream.SetAnswer(ResponseHead(res, status_text), head_only ? std::string() : std::move(res.body));
+  LogUnrouted(req, res);
+  *connection_closed = closed;
+  return stream.healthy();
 }
 
 Server::Server(ServerConfig config)
@@ -408,7 +501,7 @@ bool Server::Bind(std::string* error) {
   options.compute_budget = impl_->compute_budget.get();
   ConnectionLoopHooks hooks;
   hooks.serve = [impl = impl_.get()](RequestStream& stream, bool close_connection, bool* closed) {
-    return impl->http.ServeOne(stream, close_connection, closed);
+    return impl->ServeDirect(stream, close_connection, closed);
   };
   hooks.classify = [impl = impl_.get()](std::string_view method, std::string_view path,
                                         std::string_view body,

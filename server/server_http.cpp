@@ -7,6 +7,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
 #include <chrono>
 #include <exception>
 #include <memory>
@@ -25,14 +28,101 @@ std::string Serialize(const nlohmann::json& body) {
 
 namespace {
 
-// Serialize(body) appended to *out (the serializer nlohmann::json::dump uses, on a string
-// the caller sized).
-void SerializeInto(const nlohmann::json& body, std::string* out) {
+// One value through nlohmann's own serializer (what dump(-1, ' ', false, replace) writes),
+// appended to *out: for what AppendJson does not write itself.
+void AppendWithNlohmann(const nlohmann::json& value, std::string* out) {
   nlohmann::detail::serializer<nlohmann::json> serializer(
       nlohmann::detail::output_adapter<char, std::string>(*out), ' ',
       nlohmann::json::error_handler_t::replace);
-  serializer.dump(body, /*pretty_print=*/false, /*ensure_ascii=*/false, /*indent_step=*/0);
+  serializer.dump(value, /*pretty_print=*/false, /*ensure_ascii=*/false, /*indent_step=*/0);
 }
+
+// A string as nlohmann writes it: printable ASCII without '"' or '\\' is written as it is
+// (nlohmann's escaping leaves it unchanged); anything else (control characters, UTF-8,
+// invalid bytes) goes through nlohmann's escaping.
+void AppendJsonString(const std::string& text, std::string* out) {
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u >= 0x80 || c == '"' || c == '\\') {
+      AppendWithNlohmann(nlohmann::json(text), out);
+      return;
+    }
+  }
+  out->push_back('"');
+  out->append(text);
+  out->push_back('"');
+}
+
+}  // namespace
+
+void AppendJson(const nlohmann::json& value, std::string* out) {
+  using Type = nlohmann::json::value_t;
+  switch (value.type()) {
+    case Type::null:
+      out->append("null");
+      return;
+    case Type::boolean:
+      out->append(value.get<bool>() ? "true" : "false");
+      return;
+    case Type::number_integer:
+    case Type::number_unsigned: {
+      char digits[24];
+      const auto written =
+          value.type() == Type::number_integer
+              ? std::to_chars(digits, digits + sizeof digits, value.get<std::int64_t>())
+              : std::to_chars(digits, digits + sizeof digits, value.get<std::uint64_t>());
+      out->append(digits, static_cast<std::size_t>(written.ptr - digits));
+      return;
+    }
+    case Type::number_float: {
+      const double x = value.get<double>();
+      if (!std::isfinite(x)) {
+        out->append("null");
+        return;
+      }
+      char digits[64];
+      const char* end = nlohmann::detail::to_chars(digits, digits + sizeof digits, x);
+      out->append(digits, static_cast<std::size_t>(end - digits));
+      return;
+    }
+    case Type::string:
+      AppendJsonString(value.get_ref<const std::string&>(), out);
+      return;
+    case Type::object: {
+      out->push_back('{');
+      bool first = true;
+      for (const auto& [key, item] : value.get_ref<const nlohmann::json::object_t&>()) {
+        if (!first) out->push_back(',');
+        first = false;
+        AppendJsonString(key, out);
+        out->push_back(':');
+        AppendJson(item, out);
+      }
+      out->push_back('}');
+      return;
+    }
+    case Type::array: {
+      out->push_back('[');
+      bool first = true;
+      for (const auto& item : value) {
+        if (!first) out->push_back(',');
+        first = false;
+        AppendJson(item, out);
+      }
+      out->push_back(']');
+      return;
+    }
+    case Type::binary:
+    case Type::discarded:
+      AppendWithNlohmann(value, out);
+      return;
+  }
+}
+
+namespace {
+
+// Serialize(body) appended to *out, on a string the caller sized.
+void SerializeInto(const nlohmann::json& body, std::string* out) { AppendJson(body, out); }
 
 }  // namespace
 
@@ -301,6 +391,119 @@ void WriteStaticResponse(const httplib::Request& req, const StaticFiles& files,
   }
   res.status = 200;
   res.set_content(file->body, file->content_type.c_str());
+}
+
+const char* StatusText(int status) {
+  switch (status) {
+    case 200: return "OK";
+    case 201: return "Created";
+    case 202: return "Accepted";
+    case 204: return "No Content";
+    case 304: return "Not Modified";
+    case 400: return "Bad Request";
+    case 401: return "Unauthorized";
+    case 403: return "Forbidden";
+    case 404: return "Not Found";
+    case 405: return "Method Not Allowed";
+    case 406: return "Not Acceptable";
+    case 408: return "Request Timeout";
+    case 409: return "Conflict";
+    case 410: return "Gone";
+    case 411: return "Length Required";
+    case 412: return "Precondition Failed";
+    case 413: return "Payload Too Large";
+    case 414: return "URI Too Long";
+    case 415: return "Unsupported Media Type";
+    case 422: return "Unprocessable Entity";
+    case 429: return "Too Many Requests";
+    case 500: return "Internal Server Error";
+    case 501: return "Not Implemented";
+    case 502: return "Bad Gateway";
+    case 503: return "Service Unavailable";
+    case 504: return "Gateway Timeout";
+    default: return nullptr;
+  }
+}
+
+namespace {
+
+bool IsSpaceOrTab(char c) { return c == ' ' || c == '\t'; }
+
+std::string Decoded(std::string_view text) {
+  std::string s(text);
+  return text.find('%') == std::string_view::npos ? s : httplib::detail::decode_url(s, false);
+}
+
+}  // namespace
+
+bool ParseFramedHead(std::string_view head, httplib::Request* req) {
+  // The request line: httplib's pattern is "(METHOD) (([^? ]+)(?:\\?([^ ]*?))?) (HTTP/1\\.[01])";
+  // only a plain line of a method this service routes is parsed here.
+  const std::size_t line_end = head.find("\r\n");
+  if (line_end == std::string_view::npos) return false;
+  const std::string_view line = head.substr(0, line_end);
+  const std::size_t sp1 = line.find(' ');
+  if (sp1 == std::string_view::npos) return false;
+  const std::size_t sp2 = line.find(' ', sp1 + 1);
+  if (sp2 == std::string_view::npos) return false;
+  const std::string_view method = line.substr(0, sp1);
+  const std::string_view target = line.substr(sp1 + 1, sp2 - sp1 - 1);
+  const std::string_view version = line.substr(sp2 + 1);
+  if (version != "HTTP/1.1" && version != "HTTP/1.0") return false;
+  if (method != "GET" && method != "POST" && method != "HEAD" && method != "OPTIONS" &&
+      method != "PUT" && method != "DELETE" && method != "PATCH") {
+    return false;
+  }
+  if (target.empty() || target.front() == '?') return false;
+  for (const char c : target) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u <= 0x20 || u >= 0x7f) return false;
+  }
+  req->method = std::string(method);
+  req->version = std::string(version);
+  req->target = std::string(target);
+  const std::size_t query = target.find('?');
+  req->path = Decoded(target.substr(0, query));
+  if (query != std::string_view::npos && query + 1 < target.size()) {
+    httplib::detail::parse_query_text(std::string(target.substr(query + 1)), req->params);
+  }
+  // The headers, as httplib's parse_header reads a line: the name up to the first ':', the
+  // value without the spaces and tabs around it, percent-decoded.
+  std::size_t at = line_end + 2;
+  for (;;) {
+    const std::size_t end = head.find("\r\n", at);
+    if (end == std::string_view::npos) return false;
+    if (end == at) break;  // the blank line
+    std::string_view header = head.substr(at, end - at);
+    at = end + 2;
+    while (!header.empty() && IsSpaceOrTab(header.back())) header.remove_suffix(1);
+    const std::size_t colon = header.find(':');
+    if (colon == std::string_view::npos || colon == 0) return false;
+    std::string_view value = header.substr(colon + 1);
+    while (!value.empty() && IsSpaceOrTab(value.front())) value.remove_prefix(1);
+    if (value.empty()) return false;
+    req->headers.emplace(std::string(header.substr(0, colon)), Decoded(value));
+  }
+  return true;
+}
+
+std::string ResponseHead(const httplib::Response& res, const char* status_text) {
+  std::string head;
+  head.reserve(256);
+  head += "HTTP/1.1 ";
+  head += std::to_string(res.status);
+  head += ' ';
+  head += status_text;
+  head += "\r\n";
+  for (const auto& [name, value] : res.headers) {
+    // httplib writes them with "%s": up to a NUL.
+    head.append(name.c_str());
+    head += ": ";
+    head.append(value.c_str());
+    head += "\r\n";
+  }
+  head += "\r\n";
+  return head;
 }
 
 LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream) {

@@ -24,6 +24,12 @@ namespace sweetspot::server::http {
 /// One JSON body: never throws on invalid UTF-8 (replaced instead).
 std::string Serialize(const nlohmann::json& body);
 
+/// `value` appended to *out exactly as Serialize writes it (nlohmann's compact dump, invalid
+/// UTF-8 replaced), without nlohmann's character-at-a-time output for the common case:
+/// objects, arrays, numbers and printable ASCII strings are written here, other strings by
+/// nlohmann's escaping.
+void AppendJson(const nlohmann::json& value, std::string* out);
+
 /// The text of a caught exception, for the log.
 std::string WhatOf(const std::exception_ptr& caught);
 
@@ -79,6 +85,21 @@ enum class LeanPath { kHttplib, kWithBody, kWithoutBody };
 /// The path `req` takes (kHttplib without the loop's framing).
 LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream);
 
+/// The reason phrase httplib 0.11.4 writes after `status` in its status line, for the
+/// statuses this service answers; null for the others (httplib then writes the answer).
+const char* StatusText(int status);
+
+/// The request line and headers of a head the connection loop framed (`head`: up to and
+/// with its blank line), parsed as httplib parses them into *req: method, target, version,
+/// the path percent-decoded, the query's parameters, the headers (values percent-decoded).
+/// False, *req partly filled, for any head where httplib's parsing might differ or fail
+/// (an unusual request line, a method it does not route, a header line without a value):
+/// those take httplib's own path.
+bool ParseFramedHead(std::string_view head, httplib::Request* req);
+
+/// httplib's status line and headers for `res` (headers in its order), blank line included.
+std::string ResponseHead(const httplib::Response& res, const char* status_text);
+
 /// httplib's request handling (parsing, routing, our handlers, writing the answer) for one
 /// request the connection loop has read completely.
 class HttpServer : public httplib::Server {
@@ -88,6 +109,11 @@ class HttpServer : public httplib::Server {
   /// server is serving.
   void SetServing(int listen_fd) { svr_sock_ = listen_fd; }
   void SetStopping() { svr_sock_ = INVALID_SOCKET; }
+  /// The value of the Keep-Alive answer header, as httplib writes it.
+  std::string KeepAliveValue() const {
+    return "timeout=" + std::to_string(keep_alive_timeout_sec_) +
+           ", max=" + std::to_string(keep_alive_max_count_);
+  }
 
   bool ServeOne(httplib::Stream& stream, bool close_connection, bool* connection_closed) {
     bool closed = false;

@@ -1,6 +1,9 @@
 // Starts the real sweetspot-server executable on 127.0.0.1 with an ephemeral
 // port, talks HTTP to it and stops it with a signal.
 #include <httplib.h>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -38,6 +41,44 @@ TEST(ServerProcessTest, BadFlagExitsWithStatus2AndNamesIt) {
   EXPECT_NE(server.log().find("option --threads = \"0\": must be an integer in [1, 1024]"),
             std::string::npos)
       << server.log();
+}
+
+}  // namespace
+}  // namespace sweetspot
+
+namespace sweetspot {
+namespace {
+
+// The server's environment as the kernel holds it (after its own exec).
+std::string EnvironmentOf(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/environ", std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (char& c : text) {
+    if (c == '\0') c = '\n';
+  }
+  return "\n" + text;
+}
+
+TEST(ServerProcessTest, RunsWithALargerMallocCacheUnlessTheOperatorSetsTunables) {
+  if (std::getenv("GLIBC_TUNABLES") != nullptr) GTEST_SKIP() << "GLIBC_TUNABLES set here";
+  {
+    testing::ServerProcess server;
+    ASSERT_TRUE(server.Start()) << server.log();
+    EXPECT_NE(EnvironmentOf(server.pid()).find("\nGLIBC_TUNABLES=glibc.malloc.tcache_count=64\n"),
+              std::string::npos);
+    httplib::Client client("127.0.0.1", server.port());
+    const auto res = client.Get("/health");
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 200);
+    EXPECT_EQ(server.Stop(), 0);
+  }
+  {
+    testing::ServerProcess server;
+    server.SetEnvironment("GLIBC_TUNABLES", "");
+    ASSERT_TRUE(server.Start()) << server.log();
+    EXPECT_NE(EnvironmentOf(server.pid()).find("\nGLIBC_TUNABLES=\n"), std::string::npos);
+    EXPECT_EQ(server.Stop(), 0);
+  }
 }
 
 }  // namespace
