@@ -281,6 +281,8 @@ TEST(ShapeFitValidity, ProblemRefusals) {
        "targets.balance_point_m = 150: must be in [1e-06, 100]"},
       {[](ShapeFitProblem& p) { p.unknowns.clear(); },
        "unknowns.size() = 0: must be between 1 and 10"},
+      {[](ShapeFitProblem& p) { p.unknowns[1].variable = DesignVariableKind::kKnotRadius; },
+       "unknowns[1].variable = 0: is not a fit unknown (a profile knot's kind)"},
       {[](ShapeFitProblem& p) { p.unknowns[1].variable = DesignVariableKind::kTaperStart; },
        "unknowns[1].variable = taper_start_m: appears more than once"},
       {[](ShapeFitProblem& p) {
