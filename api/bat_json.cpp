@@ -19,7 +19,7 @@ std::optional<core::ThreeSegmentShape> ParseThreeSegment(const Json& value, cons
   // The shape's fields, from the table of fields (api/fields.hpp).
   FieldHost host;
   host.shape = &shape;
-  ReadFieldGroup(reader, FieldGroup::kShape, /*required=*/true, host);
+  ReadFieldGroup(reader, FieldGroup::kShape, host);
   if (!reader.Finish()) return std::nullopt;
   if (core::Refusal refusal; !shape.ValidateSize(&refusal)) {
     CoreRefusal(refusal, path, error);
@@ -55,18 +55,20 @@ std::optional<std::vector<core::ProfileKnot>> ParseProfile(const Json& value,
                  " knots, over the limit max_knots = " + std::to_string(limits.max_knots));
     return std::nullopt;
   }
-  std::vector<core::ProfileKnot> out;
-  out.reserve(knots->size());
+  // Each knot's x_m and radius_m, from the table of fields (api/fields.hpp); the ranges: core's
+  // Bat::ValidateSize.
+  core::Bat knotted;
+  knotted.knots.resize(knots->size());
+  FieldHost host;
+  host.bat = &knotted;
   for (std::size_t i = 0; i < knots->size(); ++i) {
     ObjectReader knot((*knots)[i], knots_path + "[" + std::to_string(i) + "]", error);
-    core::ProfileKnot k;
-    knot.Number("x_m", AnyNumber(), &k.x_m);  // the ranges: core's Bat::ValidateSize
-    knot.Number("radius_m", AnyNumber(), &k.radius_m);
+    host.knot = i;
+    ReadFieldGroup(knot, FieldGroup::kKnot, host);
     if (!knot.Finish()) return std::nullopt;
-    out.push_back(k);
   }
   if (!reader.Finish()) return std::nullopt;
-  return out;
+  return std::move(knotted.knots);
 }
 
 std::optional<core::Fill> ParseFill(const Json& value, const std::string& path, ApiError* error) {
@@ -83,7 +85,7 @@ std::optional<core::Fill> ParseFill(const Json& value, const std::string& path, 
   // diameter_m, depth_m, from the table of fields; the ranges: Bat::ValidateSize.
   FieldHost host;
   host.fill = &fill;
-  ReadFieldGroup(reader, FieldGroup::kFill, /*required=*/true, host);
+  ReadFieldGroup(reader, FieldGroup::kFill, host);
   if (!reader.Finish()) return std::nullopt;
   return fill;
 }
@@ -127,22 +129,17 @@ std::optional<core::Material> ParseMaterial(const Json& value, const std::string
     material.density_min_kg_m3 = material.density_max_kg_m3 = 0.0;
   }
   reader.OptionalString("name", &material.name);
-  // Presence and types here; the ranges are core's (Material::ValidateSize, below).
-  if (has_base) {
-    reader.OptionalNumber("density_kg_m3", AnyNumber(), &material.density_kg_m3);
-    reader.OptionalNumber("youngs_modulus_pa", AnyNumber(), &material.youngs_modulus_pa);
-  } else {
-    reader.Number("density_kg_m3", AnyNumber(), &material.density_kg_m3);
-    reader.Number("youngs_modulus_pa", AnyNumber(), &material.youngs_modulus_pa);
-  }
-  const bool has_shear = reader.ok() && reader.Has("shear_modulus_pa");
-  const bool has_poisson = reader.ok() && reader.Has("poissons_ratio");
-  reader.OptionalNumber("shear_modulus_pa", AnyNumber(), &material.shear_modulus_pa);
-  reader.OptionalNumber("poissons_ratio", AnyNumber(), &material.poissons_ratio);
-  if (auto cor = reader.MaybeNumber("cor", AnyNumber())) material.cor = *cor;
-  if (!reader.Finish()) return std::nullopt;
   // Without a base and without G or nu, nu = 0.3 (as before) but not silently: scenes warn.
-  material.poissons_ratio_assumed = !has_base && !has_shear && !has_poisson;
+  // (The table's setters of G and nu clear it.)
+  material.poissons_ratio_assumed = !has_base;
+  // density_kg_m3, youngs_modulus_pa (required without a base), shear_modulus_pa,
+  // poissons_ratio, cor: the table of fields (api/fields.hpp). Presence and types here; the
+  // ranges are core's (Material::ValidateSize, below).
+  FieldHost host;
+  host.material = &material;
+  ReadFieldGroup(reader, FieldGroup::kMaterial, host,
+                 has_base ? FieldPresence::kAllOptional : FieldPresence::kAsDeclared);
+  if (!reader.Finish()) return std::nullopt;
   if (core::Refusal refusal; !material.ValidateSize(&refusal)) {
     CoreRefusal(refusal, path, error);
     return std::nullopt;
@@ -204,7 +201,9 @@ std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& pa
   } else if (!preset) {
     spec.bat.material = *core::FindMaterial("paper-wood");
   }
-  reader.OptionalNumber("wall_thickness_m", AnyNumber(), &spec.bat.wall_thickness_m);
+  FieldHost host;  // wall_thickness_m: the table of fields
+  host.bat = &spec.bat;
+  ReadFieldGroup(reader, FieldGroup::kWall, host);
   if (const Json* fill = reader.Get("fill")) {
     if (fill->is_null()) {
       spec.bat.fill.reset();

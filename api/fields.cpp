@@ -15,13 +15,14 @@ using G = FieldGroup;
 using H = FieldHost;
 
 core::Bat& BatOf(const H& h) { return *h.bat; }
-core::Material& MaterialOf(const H& h) { return h.bat->material; }
+core::Material& MaterialOf(const H& h) { return *h.material; }
 core::Fill& FillOf(const H& h) { return *h.fill; }
 
 // The rows. The ranges are those the request's reader and core's Validate(Size) hold.
 std::vector<Field> MakeFields() {
   std::vector<Field> f;
-  // The ball, the swing, the COR: explore parameters only.
+  // The ball, the swing, the COR: explore parameters only. Each object's rows in the order
+  // the parser reads them (ReadFieldGroup): the same error for the same request.
   f.push_back({"ball.mass_kg", "kg", G::kBall, core::kMinBallMassKg, core::kMaxBallMassKg, true,
                false, "", [](const H& h) { return h.ball->mass_kg; },
                [](const H& h, double v) { h.ball->mass_kg = v; }});
@@ -41,6 +42,16 @@ std::vector<Field> MakeFields() {
                core::kMaxSwingAngularSpeedRadS, true, false, "",
                [](const H& h) { return h.swing->angular_speed_rad_s; },
                [](const H& h, double v) { h.swing->angular_speed_rad_s = v; }});
+  // The bat's speed: it sets the angular speed once the bat's length is known
+  // (core::ResolveSwing); the parser takes one of it and the angular speed (ReadSwing).
+  // A sweep of it on a template with the angular speed is refused before its first design
+  // (explore's probe of the template), so the binder sets it only where the parser would.
+  f.push_back({"swing.bat_speed_mps", "m/s", G::kSwing, 0.0, core::kMaxBatSpeedMps, true, false,
+               "", [](const H& h) { return h.swing->bat_speed_mps.value_or(0.0); },
+               [](const H& h, double v) { h.swing->bat_speed_mps = v; }});
+  f.push_back({"swing.bat_speed_from_tip_m", "m", G::kSwing, 0.0, core::kMaxSwingOffsetM, true,
+               false, "", [](const H& h) { return h.swing->bat_speed_from_tip_m; },
+               [](const H& h, double v) { h.swing->bat_speed_from_tip_m = v; }});
   f.push_back({"swing.pivot_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,
                core::kMaxSwingOffsetM, true, false, "",
                [](const H& h) { return h.swing->pivot_from_knob_m; },
@@ -55,34 +66,34 @@ std::vector<Field> MakeFields() {
   // The three-segment shape.
   f.push_back({"bat.three_segment.length_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true, true,
                "length_m", [](const H& h) { return h.shape->length_m; },
-               [](const H& h, double v) { h.shape->length_m = v; }});
+               [](const H& h, double v) { h.shape->length_m = v; }, true});
   f.push_back({"bat.three_segment.handle_radius_m", "m", G::kShape, 0.0, core::kMaxBatRadiusM,
                true, true, "handle_radius_m", [](const H& h) { return h.shape->handle_radius_m; },
-               [](const H& h, double v) { h.shape->handle_radius_m = v; }});
+               [](const H& h, double v) { h.shape->handle_radius_m = v; }, true});
   f.push_back({"bat.three_segment.barrel_radius_m", "m", G::kShape, 0.0, core::kMaxBatRadiusM,
                true, true, "barrel_radius_m", [](const H& h) { return h.shape->barrel_radius_m; },
-               [](const H& h, double v) { h.shape->barrel_radius_m = v; }});
+               [](const H& h, double v) { h.shape->barrel_radius_m = v; }, true});
   f.push_back({"bat.three_segment.taper_start_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true,
                true, "taper_start_m", [](const H& h) { return h.shape->taper_start_m; },
-               [](const H& h, double v) { h.shape->taper_start_m = v; }});
+               [](const H& h, double v) { h.shape->taper_start_m = v; }, true});
   f.push_back({"bat.three_segment.taper_end_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true,
                true, "taper_end_m", [](const H& h) { return h.shape->taper_end_m; },
-               [](const H& h, double v) { h.shape->taper_end_m = v; }});
+               [](const H& h, double v) { h.shape->taper_end_m = v; }, true});
   // A profile's knots.
   f.push_back({"bat.profile.knots[].x_m", "m", G::kKnot, 0.0, core::kMaxBatLengthM, true, true, "",
                [](const H& h) { return BatOf(h).knots[h.knot].x_m; },
-               [](const H& h, double v) { BatOf(h).knots[h.knot].x_m = v; }});
+               [](const H& h, double v) { BatOf(h).knots[h.knot].x_m = v; }, true});
   f.push_back({"bat.profile.knots[].radius_m", "m", G::kKnot, 0.0, core::kMaxBatRadiusM, true,
                true, "", [](const H& h) { return BatOf(h).knots[h.knot].radius_m; },
-               [](const H& h, double v) { BatOf(h).knots[h.knot].radius_m = v; }});
+               [](const H& h, double v) { BatOf(h).knots[h.knot].radius_m = v; }, true});
   // The material, given as an object.
   f.push_back({"bat.material.density_kg_m3", "kg/m³", G::kMaterial, 0.0, core::kMaxDensityKgM3,
                true, true, "density_kg_m3",
                [](const H& h) { return MaterialOf(h).density_kg_m3; },
-               [](const H& h, double v) { MaterialOf(h).density_kg_m3 = v; }});
+               [](const H& h, double v) { MaterialOf(h).density_kg_m3 = v; }, true});
   f.push_back({"bat.material.youngs_modulus_pa", "Pa", G::kMaterial, 0.0, core::kMaxModulusPa,
                true, false, "", [](const H& h) { return MaterialOf(h).youngs_modulus_pa; },
-               [](const H& h, double v) { MaterialOf(h).youngs_modulus_pa = v; }});
+               [](const H& h, double v) { MaterialOf(h).youngs_modulus_pa = v; }, true});
   f.push_back({"bat.material.shear_modulus_pa", "Pa", G::kMaterial, 0.0, core::kMaxModulusPa,
                true, false, "", [](const H& h) { return MaterialOf(h).shear_modulus_pa; },
                [](const H& h, double v) {
@@ -104,10 +115,10 @@ std::vector<Field> MakeFields() {
                [](const H& h, double v) { BatOf(h).wall_thickness_m = v; }});
   f.push_back({"bat.fill.diameter_m", "m", G::kFill, 0.0, core::kMaxFillDiameterM, true, true,
                "fill.diameter_m", [](const H& h) { return FillOf(h).diameter_m; },
-               [](const H& h, double v) { FillOf(h).diameter_m = v; }});
+               [](const H& h, double v) { FillOf(h).diameter_m = v; }, true});
   f.push_back({"bat.fill.depth_m", "m", G::kFill, 0.0, core::kMaxBatLengthM, true, true,
                "fill.depth_m", [](const H& h) { return FillOf(h).depth_m; },
-               [](const H& h, double v) { FillOf(h).depth_m = v; }});
+               [](const H& h, double v) { FillOf(h).depth_m = v; }, true});
   f.push_back({"bat.fill.material.density_kg_m3", "kg/m³", G::kFillMaterial, 0.0,
                core::kMaxDensityKgM3, false, true, "fill.density_kg_m3",
                [](const H& h) { return FillOf(h).material.density_kg_m3; },
@@ -185,6 +196,7 @@ FieldHost FieldHost::Of(core::Scene* scene, core::ThreeSegmentShape* shape) {
   host.cor = &scene->cor;
   if (scene->bat.has_value()) {
     host.bat = &*scene->bat;
+    host.material = &host.bat->material;
     if (host.bat->fill.has_value()) host.fill = &*host.bat->fill;
   }
   host.shape = shape;
@@ -195,17 +207,22 @@ std::string_view FieldKey(const Field& field) {
   return field.path.substr(field.path.rfind('.') + 1);
 }
 
-bool ReadFieldGroup(ObjectReader& reader, FieldGroup group, bool required, const FieldHost& host) {
+bool ReadFieldGroup(ObjectReader& reader, FieldGroup group, const FieldHost& host,
+                    FieldPresence presence, std::vector<const Field*>* given) {
   for (const Field& field : Fields()) {
     if (field.group != group) continue;
-    double value = field.get(host);
-    if (required) {
-      reader.Number(FieldKey(field), AnyNumber(), &value);
+    const std::string_view key = FieldKey(field);
+    std::optional<double> value;
+    if (field.required && presence == FieldPresence::kAsDeclared) {
+      double number = 0.0;
+      if (reader.Number(key, AnyNumber(), &number)) value = number;
     } else {
-      reader.OptionalNumber(FieldKey(field), AnyNumber(), &value);
+      value = reader.MaybeNumber(key, AnyNumber());
     }
     if (!reader.ok()) return false;
-    field.set(host, value);
+    if (!value) continue;
+    field.set(host, *value);
+    if (given != nullptr) given->push_back(&field);
   }
   return reader.ok();
 }

@@ -6,10 +6,11 @@
 // its SI name, so a path is accepted in every form wherever the field is, and an answer or an
 // error names it as the user wrote it. Core stays SI: the conversion happens here only.
 //
-// Adding a field: a row of Fields() (fields.cpp) with its accessor; core's own name for it
-// (DesignVariableKind for an optimiser variable, FitVariable for a fit unknown) when those take
-// it; the parser's reading of it (bat_json.cpp / scene_json.cpp). FieldsTest round-trips every
-// row through the parser, the binder and the optimiser's variables.
+// Adding a field: a row of Fields() (fields.cpp) with its accessor, in its object's reading
+// order (the request's parser reads each object's numbers with ReadFieldGroup, in the table's
+// order); core's own name for it (DesignVariableKind for an optimiser variable, FitVariable for
+// a fit unknown) when those take it. FieldsTest round-trips every row through the parser, the
+// binder and the optimiser's variables.
 #pragma once
 
 #include <cstddef>
@@ -44,12 +45,13 @@ struct FieldHost {
   core::Ball* ball = nullptr;
   core::Swing* swing = nullptr;
   std::optional<double>* cor = nullptr;
-  core::Bat* bat = nullptr;                   ///< Knots, material, wall.
-  core::ThreeSegmentShape* shape = nullptr;   ///< A three-segment bat's shape.
-  core::Fill* fill = nullptr;                 ///< The bat's fill.
+  core::Bat* bat = nullptr;                  ///< Knots, wall.
+  core::Material* material = nullptr;        ///< The bat's material (a material object's rows).
+  core::ThreeSegmentShape* shape = nullptr;  ///< A three-segment bat's shape.
+  core::Fill* fill = nullptr;                ///< The bat's fill.
   std::size_t knot = 0;
 
-  /// Every part of `scene` (its bat's fill when it has one), and `shape`.
+  /// Every part of `scene` (its bat's material, and fill when it has one), and `shape`.
   static FieldHost Of(core::Scene* scene, core::ThreeSegmentShape* shape = nullptr);
 };
 
@@ -74,6 +76,9 @@ struct Field {
   /// a material's shear modulus or Poisson's ratio given is no longer assumed).
   double (*get)(const FieldHost& host) = nullptr;
   void (*set)(const FieldHost& host, double value_si) = nullptr;
+  /// Required in its object when the parser reads its group (ReadFieldGroup, FieldPresence::
+  /// kAsDeclared): a shape's, a knot's, a fill's size, a material's density and Young's.
+  bool required = false;
 };
 
 /// Every settable field, once.
@@ -82,12 +87,27 @@ const std::vector<Field>& Fields();
 /// The field's key in its object: the last key of its path ("taper_start_m").
 std::string_view FieldKey(const Field& field);
 
+/// Whether ReadFieldGroup requires a field.
+enum class FieldPresence {
+  kAsDeclared,   ///< Its row's `required`.
+  kAllOptional,  ///< None (a material over a catalogue "base": each field overrides the base's).
+};
+
 /// Reads the fields of `group` from `reader`'s object by their keys (each also in its trade
-/// forms, as ObjectReader reads a number), in the table's order, into `host`: each required
-/// (ObjectReader::Number) or optional (OptionalNumber: an absent one keeps the host's value).
-/// False when the reader has an error. The request's parser reads the three-segment shape,
-/// the fill's size and the ball this way.
-bool ReadFieldGroup(ObjectReader& reader, FieldGroup group, bool required, const FieldHost& host);
+/// forms, as ObjectReader reads a number), in the table's order, into `host`: a required one
+/// with ObjectReader::Number, an optional one with MaybeNumber (an absent one leaves the host's
+/// value as it is). `given`, when not null, gets each field the object gave. False when the
+/// reader has an error. The request's parser reads every object's numbers this way: the
+/// three-segment shape, a profile's knots, a material, the wall, the fill's size, the ball, the
+/// swing and the COR.
+bool ReadFieldGroup(ObjectReader& reader, FieldGroup group, const FieldHost& host,
+                    FieldPresence presence = FieldPresence::kAsDeclared,
+                    std::vector<const Field*>* given = nullptr);
+
+/// True when `field`'s path is `pattern` (SI, a knot's index as "[]").
+inline bool IsField(const Field* field, std::string_view pattern) {
+  return field != nullptr && field->path == pattern;
+}
 
 /// The field whose path (SI, indices as "[]") is `pattern`, or nullptr.
 const Field* FindField(std::string_view pattern);

@@ -18,6 +18,7 @@ bool ApiLimits::Validate(core::Refusal* refusal) const {
       {"max_string_length", max_string_length},
       {"max_knots", max_knots},
       {"max_variants", max_variants},
+      {"max_launches", max_launches},
       {"max_curve_samples", max_curve_samples},
       {"max_samples", max_samples},
       {"max_batch_samples", max_batch_samples},

@@ -8,6 +8,7 @@
 #include "api/bat_json.hpp"
 #include "api/fields.hpp"
 #include "api/router.hpp"
+#include "core/scene/output_registry.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -32,33 +33,35 @@ bool ReadBall(const Json& value, const std::string& path, core::Ball* ball, ApiE
   // mass_kg, radius_m, speed_mps, stiffness_n_m_p, stiffness_exponent: the table of fields.
   FieldHost host;
   host.ball = ball;
-  ReadFieldGroup(reader, FieldGroup::kBall, /*required=*/false, host);
+  ReadFieldGroup(reader, FieldGroup::kBall, host);
   return reader.Finish();
 }
 
-// Exactly one of angular_speed_rad_s and bat_speed_mps (which core turns into the angular speed
-// once the bat's length is known: core::ResolveSwing). NaN marks "not given": JSON has none.
+// angular_speed_rad_s, bat_speed_mps, bat_speed_from_tip_m, pivot_from_knob_m,
+// hands_from_knob_m: the table of fields (api/fields.hpp). Exactly one of angular_speed_rad_s
+// and bat_speed_mps (which core turns into the angular speed once the bat's length is known:
+// core::ResolveSwing), read into a copy so that the swing changes only when they are one.
 bool ReadSwing(const Json& value, const std::string& path, core::Swing* swing, ApiError* error) {
   ObjectReader reader(value, path, error);
-  constexpr double kNotGiven = std::numeric_limits<double>::quiet_NaN();
-  double angular_speed_rad_s = kNotGiven;
-  double bat_speed_mps = kNotGiven;
-  reader.OptionalNumber("angular_speed_rad_s", AnyNumber(), &angular_speed_rad_s);
-  reader.OptionalNumber("bat_speed_mps", AnyNumber(), &bat_speed_mps);
-  reader.OptionalNumber("bat_speed_from_tip_m", AnyNumber(), &swing->bat_speed_from_tip_m);
-  reader.OptionalNumber("pivot_from_knob_m", AnyNumber(), &swing->pivot_from_knob_m);
-  reader.OptionalNumber("hands_from_knob_m", AnyNumber(), &swing->hands_from_knob_m);
-  if (!reader.ok()) return false;
-  if (!std::isnan(angular_speed_rad_s) && !std::isnan(bat_speed_mps)) {
+  core::Swing read = *swing;
+  FieldHost host;
+  host.swing = &read;
+  std::vector<const Field*> given;
+  if (!ReadFieldGroup(reader, FieldGroup::kSwing, host, FieldPresence::kAsDeclared, &given)) {
+    return false;
+  }
+  const auto has = [&given](std::string_view pattern) {
+    return std::any_of(given.begin(), given.end(),
+                       [pattern](const Field* field) { return IsField(field, pattern); });
+  };
+  const bool angular = has("swing.angular_speed_rad_s");
+  if (angular && has("swing.bat_speed_mps")) {
     return reader.Fail("bat_speed_mps",
                        "give exactly one of swing.bat_speed_mps and swing.angular_speed_rad_s "
                        "(both are given; the bat speed sets the angular speed)");
   }
-  if (!std::isnan(angular_speed_rad_s)) {
-    swing->angular_speed_rad_s = angular_speed_rad_s;
-    swing->bat_speed_mps.reset();
-  }
-  if (!std::isnan(bat_speed_mps)) swing->bat_speed_mps = bat_speed_mps;
+  if (angular) read.bat_speed_mps.reset();
+  *swing = read;
   return reader.Finish();
 }
 
@@ -71,7 +74,9 @@ bool ReadSceneCommon(ObjectReader& reader, core::Scene* scene) {
   if (const Json* swing = reader.Get("swing")) {
     if (!ReadSwing(*swing, reader.PathOf("swing"), &scene->swing, reader.error())) return false;
   }
-  if (auto cor = reader.MaybeNumber("cor", AnyNumber())) scene->cor = *cor;
+  FieldHost host;  // "cor": the table of fields
+  host.cor = &scene->cor;
+  ReadFieldGroup(reader, FieldGroup::kCor, host);
   std::string inertia = "rigid_body";
   reader.OptionalString("inertia_model", &inertia, {"rigid_body", "slender_rod"});
   scene->inertia_model =
@@ -91,11 +96,8 @@ bool ReadOutputs(ObjectReader& reader, core::Scene* scene) {
     const auto parsed =
         item.is_string() ? core::ParseSceneOutput(item.get<std::string>()) : std::nullopt;
     if (!parsed) {
-      return reader.Fail(
-          "outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
-                         " is not one of max_exit_speed, center_of_percussion, "
-                         "vibration_node, sweet_zone, exit_speed_curve, least_sting_zone, barrel, "
-                         "bbcor, bbcor_scan");
+      return reader.Fail("outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
+                                        " is not one of " + core::SceneOutputNameList());
     }
     if (std::find(scene->outputs.begin(), scene->outputs.end(), *parsed) == scene->outputs.end()) {
       scene->outputs.push_back(*parsed);

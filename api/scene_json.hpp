@@ -68,9 +68,6 @@ Response SceneFailure(const core::Summary& summary, const std::string& missing_m
 /// evaluations, error_estimate, solve_time_s, models_used, warnings}.
 nlohmann::json SummaryToJson(const core::Summary& summary);
 
-/// The outputs of a scene result, by output name, plus models_used,
-/// error_estimate, timings, cor and properties.
-nlohmann::json SceneResultToJson(const core::SceneResult& result);
 /// The `barrel` output (hoop mode, stiffness, effective COR along the barrel); null hoop fields
 /// for a solid bat.
 nlohmann::json BarrelOutputToJson(const core::BarrelOutput& barrel);

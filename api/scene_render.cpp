@@ -1,5 +1,6 @@
-// Renders core's scene results as JSON: the Summary, the outputs of /v1/sweet-spot and
-// /v1/collision, the barrel and BBCOR blocks (the reading side is scene_json.cpp).
+// Renders core's scene results as JSON: the Summary, /v1/collision's result, and the blocks the
+// outputs' declarations render (api/outputs/: vibration node, least sting, barrel, BBCOR; the
+// reading side is scene_json.cpp).
 #include <cmath>
 #include <cstddef>
 
@@ -9,8 +10,6 @@ namespace sweetspot::api {
 namespace {
 
 using Json = nlohmann::json;
-
-Json PlacementJson(core::Placement placement) { return core::PlacementName(placement); }
 
 }  // namespace
 
@@ -112,93 +111,6 @@ Json BbcorScanToJson(const core::BbcorScan& s) {
            "from the flexible free-free bat (barrel spring in series for a hollow bat), BBCOR = "
            "e_A (1 + r) + r, r = m z^2 / I_pivot about the 6-in pivot; the maximum refined by a "
            "parabola"}};
-}
-
-Json SceneResultToJson(const core::SceneResult& r) {
-  Json out = Json::object();
-  Json errors = Json::object();
-  if (r.max_exit_speed) {
-    const auto& m = *r.max_exit_speed;
-    out["max_exit_speed"] = {
-        {"position_from_knob_m", m.position_from_knob_m},
-        {"exit_speed_mps", m.exit_speed_mps},
-        {"placement", PlacementJson(m.placement)},
-        {"unconstrained_position_from_knob_m", m.unconstrained_position_from_knob_m},
-        {"model", m.model},
-        {"method", m.method}};
-    if (m.method != "closed_form") out["max_exit_speed"]["summary"] = SummaryToJson(m.summary);
-    errors["max_exit_speed"] = {{"position_m", m.error_estimate_m},
-                                {"exit_speed_mps", m.error_estimate_mps}};
-  }
-  if (r.center_of_percussion) {
-    const auto& c = *r.center_of_percussion;
-    out["center_of_percussion"] = {{"position_from_knob_m", c.position_from_knob_m},
-                                   {"hands_from_knob_m", c.hands_from_knob_m},
-                                   {"moi_hands_kg_m2", c.moi_hands_kg_m2},
-                                   {"placement", PlacementJson(c.placement)}};
-    errors["center_of_percussion"] = {{"position_m", c.error_estimate_m}};
-  }
-  if (r.sweet_zone) {
-    const auto& z = *r.sweet_zone;
-    out["sweet_zone"] = {{"from_knob_m", z.from_knob_m},
-                         {"to_knob_m", z.to_knob_m},
-                         {"tolerance_mps", z.tolerance_mps},
-                         {"threshold_mps", z.threshold_mps},
-                         {"clipped_at_knob", z.clipped_at_knob},
-                         {"clipped_at_tip", z.clipped_at_tip},
-                         {"method", z.method}};
-    errors["sweet_zone"] = {{"ends_m", z.error_estimate_m}};
-  }
-  if (r.exit_speed_curve) {
-    Json points = Json::array();
-    for (const auto& p : r.exit_speed_curve->points) {
-      points.push_back(
-          {{"position_from_knob_m", p.position_from_knob_m}, {"exit_speed_mps", p.exit_speed_mps}});
-    }
-    out["exit_speed_curve"] = std::move(points);
-    errors["exit_speed_curve"] = {{"exit_speed_mps", r.exit_speed_curve->error_estimate_mps}};
-  }
-  if (r.vibration_node) {
-    const auto& v = *r.vibration_node;
-    out["vibration_node"] = VibrationNodeToJson(v);
-    errors["vibration_node"] = {{"position_m", v.error_estimate_m},
-                                {"frequency_hz", v.error_estimate_hz},
-                                {"second_mode_frequency_hz", v.second_mode_error_estimate_hz}};
-  }
-  if (r.least_sting_zone) {
-    const auto& z = *r.least_sting_zone;
-    out["least_sting_zone"] = LeastStingZoneToJson(z);
-    double speed_err = 0.0, energy_err = 0.0;
-    for (const auto& p : z.curve) {
-      speed_err = std::max(speed_err, p.error_estimate_exit_speed_mps);
-      energy_err = std::max(energy_err, p.error_estimate_hands_energy_j);
-    }
-    errors["least_sting_zone"] = {{"ends_m", z.error_estimate_m},
-                                  {"exit_speed_mps", speed_err},
-                                  {"hands_energy_j", energy_err}};
-  }
-  if (r.barrel) out["barrel"] = BarrelOutputToJson(*r.barrel);
-  if (r.bbcor) out["bbcor"] = BbcorToJson(*r.bbcor);
-  if (r.bbcor_scan) {
-    out["bbcor_scan"] = BbcorScanToJson(*r.bbcor_scan);
-    errors["bbcor_scan"] = {{"value", r.bbcor_scan->error_estimate}};
-  }
-  out["error_estimate"] = std::move(errors);
-  out["models_used"] = r.summary.models_used;
-  out["exit_speed_model"] = r.exit_speed_model.empty() ? Json(nullptr) : Json(r.exit_speed_model);
-  if (!r.model_reason.empty()) out["model_reason"] = r.model_reason;
-  if (r.cor.has_value()) {  // absent when no requested output uses a COR
-    out["cor"] = *r.cor;
-    out["cor_source"] = r.cor_source;
-    if (r.cor_impact_speed_mps) out["cor_impact_speed_mps"] = *r.cor_impact_speed_mps;
-  }
-  Json timings = Json::array();
-  for (const auto& t : r.timings) {
-    timings.push_back({{"model", t.model}, {"time_s", t.time_s}, {"calls", t.calls}});
-  }
-  out["timings"] = std::move(timings);
-  if (!r.summary.warnings.empty()) out["warnings"] = r.summary.warnings;
-  return out;
 }
 
 Json CollisionResultToJson(const core::CollisionResult& r) {

@@ -60,9 +60,13 @@ std::optional<double> LengthOf(const Json& object) {
   return std::nullopt;
 }
 
-void AddImperialTo(Json* node, std::optional<double> length_m) {
+// A flight's lengths are read in feet too (/v1/flight: "distance_m" -> "distance_ft", and every
+// length of its "landing" and "trajectory"); nothing else in an answer has these keys.
+bool IsFlightLength(std::string_view base) { return base == "distance" || base == "apex"; }
+
+void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false) {
   if (node->is_array()) {
-    for (Json& item : *node) AddImperialTo(&item, length_m);
+    for (Json& item : *node) AddImperialTo(&item, length_m, feet);
     return;
   }
   if (!node->is_object()) return;
@@ -72,7 +76,9 @@ void AddImperialTo(Json* node, std::optional<double> length_m) {
     if (value.is_structured()) {
       // A "bat" is the request's own form (optimize, fit): a request again as it stands, so
       // one form per quantity, as the request gave it.
-      if (key != "bat") AddImperialTo(&value, length_m);
+      if (key != "bat") {
+        AddImperialTo(&value, length_m, key == "landing" || key == "trajectory");
+      }
       continue;
     }
     if (!value.is_number()) continue;
@@ -81,6 +87,9 @@ void AddImperialTo(Json* node, std::optional<double> length_m) {
     const std::string base = key.substr(0, key.size() - rule->si.size());
     const double si = value.get<double>();
     added.emplace_back(base + std::string(rule->trade), si / rule->to_si);
+    if (rule->trade == "_in" && (feet || IsFlightLength(base))) {
+      added.emplace_back(base + "_ft", si / (12.0 * core::kMetresPerInch));
+    }
     if (rule->trade == "_in" && EndsWith(base, "_from_knob") && length_m) {
       const std::string stem = base.substr(0, base.size() - std::string_view("_from_knob").size());
       added.emplace_back(stem + "_from_tip_in", (*length_m - si) / core::kMetresPerInch);

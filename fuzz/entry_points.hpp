@@ -41,6 +41,7 @@ inline api::ApiLimits FuzzLimits() {
   limits.max_iterations = 200;
   limits.max_time_s = 0.05;
   limits.max_integration_steps = 200000;
+  limits.max_launches = 8;
   return limits;
 }
 
@@ -65,6 +66,7 @@ inline const std::vector<FuzzRoute>& PostRoutes() {
       {'p', "/v1/bat/properties"}, {'f', "/v1/bat/fit"}, {'s', "/v1/sweet-spot"},
       {'c', "/v1/collision"},      {'m', "/v1/compare"}, {'o', "/v1/optimize"},
       {'x', "/v1/explore"},        {'j', "/v1/jobs"},    {'b', "/v1/bat/modes"},
+      {'l', "/v1/flight"},
   };
   return routes;
 }
@@ -349,6 +351,7 @@ inline const std::vector<Target>& Targets() {
       {"collision", [](std::string_view in) { return RunPost("/v1/collision", in); }},
       {"compare", [](std::string_view in) { return RunPost("/v1/compare", in); }},
       {"explore", [](std::string_view in) { return RunPost("/v1/explore", in); }},
+      {"flight", [](std::string_view in) { return RunPost("/v1/flight", in); }},
   };
   return targets;
 }

@@ -22,7 +22,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/stages.sh
 seconds="${SWEETSPOT_FUZZ_SECONDS:-6}"
-targets="${SWEETSPOT_FUZZ_TARGETS:-parse_body parse_bat dispatch bat_fit sweet_spot collision compare explore}"
+targets="${SWEETSPOT_FUZZ_TARGETS:-parse_body parse_bat dispatch bat_fit sweet_spot collision compare explore flight}"
 jobs="${SWEETSPOT_JOBS:-$(nproc)}"
 build="${SWEETSPOT_FUZZ_BUILD:-build-fuzz}"
 

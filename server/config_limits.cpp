@@ -36,6 +36,11 @@ const std::vector<Option>& LimitOptions() {
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->limits.max_variants, v, rule);
        }},
+      {"--max-launches", "SWEETSPOT_MAX_LAUNCHES", "launches in one /v1/flight request (default 4096)",
+       true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_launches, v, rule);
+       }},
       {"--max-jobs-page", "SWEETSPOT_MAX_JOBS_PAGE",
        "jobs on one page of GET /v1/jobs: the largest `limit` (default 1000)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {

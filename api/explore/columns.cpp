@@ -8,6 +8,7 @@
 #include "api/bat_json.hpp"
 #include "api/explore/shards.hpp"
 #include "api/json_reader.hpp"
+#include "api/outputs/scene_outputs.hpp"
 #include "api/scene_json.hpp"
 
 namespace sweetspot::api {
@@ -32,52 +33,6 @@ const char* KindOf(const Json& value) {
   if (value.is_string()) return "a string";
   if (value.is_boolean()) return "a boolean";
   return "a value";
-}
-
-// The result of every requested scene output, with placeholder values and one element in
-// each array, so that rendering it shows every field a row of that output can have.
-core::SceneResult ProbeResult(const std::vector<core::SceneOutput>& outputs) {
-  core::SceneResult r;
-  for (const core::SceneOutput output : outputs) {
-    switch (output) {
-      case core::SceneOutput::kMaxExitSpeed:
-        r.max_exit_speed.emplace();  // method "" != closed_form: its summary is shown too
-        break;
-      case core::SceneOutput::kCenterOfPercussion:
-        r.center_of_percussion.emplace();
-        break;
-      case core::SceneOutput::kVibrationNode:
-        r.vibration_node.emplace();
-        r.vibration_node->second_mode_nodes_from_knob_m = {0.0};
-        r.vibration_node->refinement_elements = {0};
-        break;
-      case core::SceneOutput::kSweetZone:
-        r.sweet_zone.emplace();
-        break;
-      case core::SceneOutput::kExitSpeedCurve:
-        r.exit_speed_curve.emplace();
-        r.exit_speed_curve->points.emplace_back();
-        break;
-      case core::SceneOutput::kLeastStingZone:
-        r.least_sting_zone.emplace();
-        r.least_sting_zone->curve.emplace_back();
-        break;
-      case core::SceneOutput::kBarrel:
-        r.barrel.emplace();
-        r.barrel->hollow = true;  // every field a number
-        r.barrel->effective_cor_curve.emplace_back();
-        break;
-      case core::SceneOutput::kBbcor:
-        r.bbcor.emplace();
-        r.bbcor->method = "trampoline_quasi_static";
-        break;
-      case core::SceneOutput::kBbcorScan:
-        r.bbcor_scan.emplace();
-        r.bbcor_scan->points.emplace_back();
-        break;
-    }
-  }
-  return r;
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include "api/bat_json.hpp"
 #include "api/json_reader.hpp"
+#include "api/outputs/scene_outputs.hpp"
 #include "api/scene_json.hpp"
 #include "api/trade_units.hpp"
 #include "core/scene/collide.hpp"

@@ -28,16 +28,13 @@ std::optional<DirectAccessor> CompileSiAccessor(const std::vector<std::string>& 
                                                 const std::vector<SweepParameter>& parameters,
                                                 const RowOutputs& outputs);
 
-bool IsNumberSource(Source s) {
-  switch (s) {
+bool IsNumberSource(const DirectAccessor& a) {
+  if (a.source == Source::kOutputField) return a.field->number;
+  switch (a.source) {
     case Source::kIndex:
     case Source::kFeasible:
     case Source::kParameter:
     case Source::kMissing:
-    case Source::kMaxPlacement:
-    case Source::kMaxModel:
-    case Source::kMaxMethod:
-    case Source::kCopPlacement:
     case Source::kInertiaModel:
       return false;
     default:
@@ -58,7 +55,7 @@ std::optional<DirectAccessor> CompileAccessor(const std::vector<std::string>& to
     std::vector<std::string> si = tokens;
     si.back() = source.si_key;
     auto accessor = CompileSiAccessor(si, parameters, outputs);
-    if (!accessor || !IsNumberSource(accessor->source)) continue;
+    if (!accessor || !IsNumberSource(*accessor)) continue;
     accessor->convert = source.from_tip ? DirectConvert::kFromTip : DirectConvert::kDivide;
     accessor->factor = source.to_si;
     return accessor;
@@ -97,18 +94,18 @@ std::optional<DirectAccessor> CompileSiAccessor(const std::vector<std::string>& 
     source = S::kMissing;  // a feasible row has no error
   } else if (tokens.size() == 1 && head == "collision_efficiency" && outputs.collision_efficiency) {
     source = S::kCollisionEfficiency;
-  } else if (head == "max_exit_speed" && has(core::SceneOutput::kMaxExitSpeed)) {
-    source = field({{"position_from_knob_m", S::kMaxPosition},
-                    {"exit_speed_mps", S::kMaxSpeed},
-                    {"unconstrained_position_from_knob_m", S::kMaxUnconstrained},
-                    {"placement", S::kMaxPlacement},
-                    {"model", S::kMaxModel},
-                    {"method", S::kMaxMethod}});
-  } else if (head == "center_of_percussion" && has(core::SceneOutput::kCenterOfPercussion)) {
-    source = field({{"position_from_knob_m", S::kCopPosition},
-                    {"hands_from_knob_m", S::kCopHands},
-                    {"moi_hands_kg_m2", S::kCopMoiHands},
-                    {"placement", S::kCopPlacement}});
+  } else if (const auto output = core::ParseSceneOutput(head); output && has(*output)) {
+    // A field of a requested output's block that its declaration reads directly.
+    if (tokens.size() != 2) return std::nullopt;
+    const ApiOutputDecl& decl = ApiOutputDeclaration(*output);
+    for (const DirectField* f = decl.direct_begin; f != decl.direct_end; ++f) {
+      if (tokens[1] == f->name) {
+        DirectAccessor accessor{S::kOutputField, 0};
+        accessor.field = f;
+        return accessor;
+      }
+    }
+    return std::nullopt;
   } else if (head == "properties" && outputs.properties) {
     if (tokens.size() == 3 && tokens[1] == "imperial") {
       static const std::map<std::string_view, S> kImperial = {
@@ -135,37 +132,13 @@ std::optional<DirectAccessor> CompileSiAccessor(const std::vector<std::string>& 
   return DirectAccessor{*source, 0};
 }
 
-DirectValue Number(double v) {
-  DirectValue d;
-  d.kind = DirectValue::kNumber;
-  d.number = v;
-  return d;
-}
-
-DirectValue Text(std::string_view v) {
-  DirectValue d;
-  d.kind = DirectValue::kString;
-  d.text = v;
-  return d;
-}
-
 DirectView ViewOf(const DesignOutcome& o) {
   const core::SceneResult& r = o.result;
   DirectView v;
   v.properties = &r.mass_properties;
   v.length_m = r.length_m;
   v.collision_efficiency = &o.collision_efficiency;
-  if (r.max_exit_speed) {
-    const core::MaxExitSpeedResult& m = *r.max_exit_speed;
-    v.has_max = true;
-    v.max_position = m.position_from_knob_m;
-    v.max_speed = m.exit_speed_mps;
-    v.max_unconstrained = m.unconstrained_position_from_knob_m;
-    v.max_placement = m.placement;
-    v.max_model = m.model;
-    v.max_method = m.method;
-  }
-  if (r.center_of_percussion) v.cop = &*r.center_of_percussion;
+  v.outputs.result = &r;
   return v;
 }
 
@@ -174,13 +147,8 @@ DirectView ViewOf(const core::ClosedFormDesign& d, std::string_view model_name) 
   DirectView v;
   v.properties = &d.mass_properties;
   v.length_m = d.length_m;
-  v.has_max = true;
-  v.max_position = d.max_exit_speed.position_from_knob_m;
-  v.max_speed = d.max_exit_speed.exit_speed_mps;
-  v.max_unconstrained = d.max_exit_speed.unconstrained_position_from_knob_m;
-  v.max_placement = d.max_exit_speed.placement;
-  v.max_model = model_name;
-  v.max_method = "closed_form";  // ClosedFormMaxExitSpeed's
+  v.outputs.lean = &d;
+  v.outputs.lean_model = model_name;
   return v;
 }
 
@@ -206,8 +174,6 @@ DirectValue ReadSiDirect(const DirectAccessor& a, std::uint64_t index,
                          const core::ImperialProperties& imperial) {
   using S = Source;
   const core::MassProperties& p = *o.properties;
-  const bool m = o.has_max;
-  const core::CenterOfPercussionResult* c = o.cop;
   switch (a.source) {
     case S::kIndex: {
       DirectValue d;
@@ -229,26 +195,8 @@ DirectValue ReadSiDirect(const DirectAccessor& a, std::uint64_t index,
       return o.collision_efficiency != nullptr && o.collision_efficiency->has_value()
                  ? Number(**o.collision_efficiency)
                  : DirectValue{};
-    case S::kMaxPosition:
-      return m ? Number(o.max_position) : DirectValue{};
-    case S::kMaxSpeed:
-      return m ? Number(o.max_speed) : DirectValue{};
-    case S::kMaxUnconstrained:
-      return m ? Number(o.max_unconstrained) : DirectValue{};
-    case S::kMaxPlacement:
-      return m ? Text(core::PlacementName(o.max_placement)) : DirectValue{};
-    case S::kMaxModel:
-      return m ? Text(o.max_model) : DirectValue{};
-    case S::kMaxMethod:
-      return m ? Text(o.max_method) : DirectValue{};
-    case S::kCopPosition:
-      return c ? Number(c->position_from_knob_m) : DirectValue{};
-    case S::kCopHands:
-      return c ? Number(c->hands_from_knob_m) : DirectValue{};
-    case S::kCopMoiHands:
-      return c ? Number(c->moi_hands_kg_m2) : DirectValue{};
-    case S::kCopPlacement:
-      return c ? Text(core::PlacementName(c->placement)) : DirectValue{};
+    case S::kOutputField:
+      return a.field->read(o.outputs);
     case S::kMass:
       return Number(p.mass_kg);
     case S::kBalance:

@@ -17,20 +17,17 @@
 #include "api/explore/binder.hpp"
 #include "api/explore/columns.hpp"
 #include "api/explore/engine.hpp"
+#include "api/outputs/scene_outputs.hpp"
 #include "core/scene/closed_form_designs.hpp"
 
 namespace sweetspot::api::explore_direct {
 
 using Json = nlohmann::json;
 
-// A value a column reads from a design's outcome without a JSON row.
-struct DirectValue {
-  enum Kind { kMissing, kNumber, kUnsigned, kBool, kString } kind = kMissing;
-  double number = 0.0;
-  std::uint64_t count = 0;
-  bool flag = false;
-  std::string_view text;
-};
+// A value a column reads from a design's outcome without a JSON row (api/outputs/).
+using ::sweetspot::api::DirectValue;
+using ::sweetspot::api::Number;
+using ::sweetspot::api::Text;
 
 // Where a direct column's value comes from.
 enum class Source {
@@ -39,16 +36,7 @@ enum class Source {
   kParameter,
   kMissing,
   kCollisionEfficiency,
-  kMaxPosition,
-  kMaxSpeed,
-  kMaxUnconstrained,
-  kMaxPlacement,
-  kMaxModel,
-  kMaxMethod,
-  kCopPosition,
-  kCopHands,
-  kCopMoiHands,
-  kCopPlacement,
+  kOutputField,  // a field of a scene output's block: its declaration's DirectField
   kMass,
   kBalance,
   kMoiKnob,
@@ -76,6 +64,7 @@ enum class DirectConvert {
 struct DirectAccessor {
   Source source = Source::kMissing;
   std::size_t parameter = 0;
+  const DirectField* field = nullptr;  // kOutputField: the output's field
   DirectConvert convert = DirectConvert::kNone;
   double factor = 1.0;  // kDivide's divisor
 };
@@ -88,23 +77,13 @@ std::optional<DirectAccessor> CompileAccessor(const std::vector<std::string>& to
                                               const std::vector<SweepParameter>& parameters,
                                               const RowOutputs& outputs);
 
-// A number value.
-DirectValue Number(double v);
-
-// A text value (the view must outlive the row).
-DirectValue Text(std::string_view v);
-
 // What a direct column reads of a feasible design: a DesignOutcome's result, or the lean
 // path's numbers (core::ClosedFormDesign), the same fields under the same names.
 struct DirectView {
   const core::MassProperties* properties = nullptr;
   double length_m = 0.0;
   const std::optional<double>* collision_efficiency = nullptr;  // null: none
-  bool has_max = false;                                         // max_exit_speed was computed
-  double max_position = 0.0, max_speed = 0.0, max_unconstrained = 0.0;
-  core::Placement max_placement = core::Placement::kOnBat;
-  std::string_view max_model, max_method;
-  const core::CenterOfPercussionResult* cop = nullptr;  // null: none
+  OutputView outputs;  // what the scene outputs' direct fields read
 };
 
 // What a direct column reads of a design evaluated in full.

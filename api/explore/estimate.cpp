@@ -7,6 +7,7 @@
 #include "api/explore/columns.hpp"
 #include "api/explore/design.hpp"
 #include "core/geometry_format.hpp"
+#include "core/scene/output_registry.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -177,9 +178,10 @@ SweepEstimate EstimateSweep(const Sweep& sweep, const std::string& format,
   // The per-design CPU: the row, then each model the outputs need.
   double cost = kClosedFormRowS;
   std::string basis = "closed forms";
-  const bool exit_speed = Asks(sweep, core::SceneOutput::kMaxExitSpeed) ||
-                          Asks(sweep, core::SceneOutput::kSweetZone) ||
-                          Asks(sweep, core::SceneOutput::kExitSpeedCurve);
+  // The outputs of the scene's exit-speed model (their declarations' uses_exit_model).
+  const bool exit_speed = std::any_of(
+      sweep.outputs.scene.begin(), sweep.outputs.scene.end(),
+      [](core::SceneOutput o) { return core::SceneOutputDeclaration(o).uses_exit_model; });
   const auto add = [&](double seconds, const std::string& what) {
     cost += seconds;
     basis = basis == "closed forms" ? what : basis + " + " + what;

@@ -23,6 +23,7 @@
 #include "api/scene_json.hpp"
 #include "api/trade_units.hpp"
 #include "core/explore/sampling.hpp"
+#include "core/scene/output_registry.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -370,10 +371,8 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
         outputs.scene.push_back(*output);
       } else {
         reader.Fail("outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
-                                   " is not one of properties, max_exit_speed, "
-                                   "center_of_percussion, vibration_node, sweet_zone, "
-                                   "exit_speed_curve, least_sting_zone, barrel, bbcor, bbcor_scan, "
-                                   "collision_efficiency");
+                                   " is not one of properties, " + core::SceneOutputNameList() +
+                                   ", collision_efficiency");
         return std::nullopt;
       }
     }

@@ -37,6 +37,9 @@ Response HandleBatFit(const Request& request, const Context& context);
 Response HandleSweetSpot(const Request& request, const Context& context);
 /// POST /v1/collision: one impact with a chosen model.
 Response HandleCollision(const Request& request, const Context& context);
+/// POST /v1/flight: batted-ball flight from launch conditions to the landing point
+/// (core/flight), for one launch or many.
+Response HandleFlight(const Request& request, const Context& context);
 /// POST /v1/compare: a baseline bat against variants in one scene.
 Response HandleCompare(const Request& request, const Context& context);
 /// POST /v1/optimize: Ipopt bat design (501 until the optimisation issue lands).

@@ -30,11 +30,10 @@ void ReplaceAll(std::string* text, const std::string& from, const std::string& t
   }
 }
 
-// The variable path `item` as core takes it: SI as written, or a trade form of a table field
-// converted ("three_segment.barrel_diameter_in" -> "three_segment.barrel_radius_m", 0.0127).
-// Nullopt when it names no design variable.
+// The variable path `item` as core takes it: a variable row of the table of fields
+// (api/fields.hpp), SI as written, or a trade form converted ("three_segment.barrel_diameter_in"
+// -> "three_segment.barrel_radius_m", 0.0127). Nullopt when it names no design variable.
 std::optional<WrittenVariable> VariablePath(const std::string& item) {
-  if (core::ParseDesignVariablePath(item)) return WrittenVariable{item, item, 1.0};
   const auto use = ResolveField(item, FieldScope::kVariable);
   if (!use || !core::ParseDesignVariablePath(use->si)) return std::nullopt;
   return WrittenVariable{use->si, item, use->to_si};

@@ -71,6 +71,10 @@ const std::vector<Route>& Routes() {
       {"POST", "/v1/collision",
        "One impact with a chosen model (auto, rigid_pivot, free_bat, hertz).", HandleCollision,
        true, RouteWorkload::kScene},
+      {"POST", "/v1/flight",
+       "Batted-ball flight (Nathan's calculator): distance, hang time, apex, landing point, "
+       "Statcast labels, for one launch or many.",
+       HandleFlight, true},
       {"POST", "/v1/compare", "A baseline bat against variants: properties, sweet spot, deltas.",
        HandleCompare, true, RouteWorkload::kScene},
       {"POST", "/v1/optimize",

@@ -3,6 +3,7 @@
 // Each is a typed endpoint (api/handlers/endpoint.hpp): parse -> core call -> render.
 #include "api/handlers/endpoint.hpp"
 #include "api/handlers/handlers.hpp"
+#include "api/outputs/scene_outputs.hpp"
 #include "api/scene_json.hpp"
 #include "core/scene/sanity.hpp"
 

@@ -7,21 +7,12 @@
 
 #include "api/handlers/handlers.hpp"
 #include "api/router.hpp"
-#include "core/scene/evaluate_scene.hpp"
+#include "core/scene/output_registry.hpp"
 
 namespace sweetspot::api {
 namespace {
 
 using Json = nlohmann::json;
-
-// True when a model of `models` is not a closed form (hertz integrates an ODE,
-// flexible_beam builds finite elements, flexible does both).
-bool NeedsIterativeModel(const std::vector<std::string>& models) {
-  for (const std::string& model : models) {
-    if (model != "mass_properties" && model != "rigid_pivot" && model != "free_bat") return true;
-  }
-  return false;
-}
 
 // The collision model named by `object[key]`, or `fallback` when it is absent
 // or not a known name (the handler refuses such a body at once).
@@ -31,25 +22,19 @@ core::CollisionModel ModelAt(const Json& object, const char* key, core::Collisio
   return core::ParseCollisionModel(it->get_ref<const std::string&>()).value_or(fallback);
 }
 
-// The names that can make a scene body need an iterative model: the outputs
-// that need one with the default model, and the models that are iterative.
+// The names that can make a scene body need an iterative model: the outputs whose declaration
+// says compute (core/scene/output_registry.hpp), and the exit-speed models that are not
+// closed forms (an output of class kAsExitModel is then compute).
 const std::vector<std::string>& IterativeNames() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> out;
-    using core::SceneOutput;
-    for (const SceneOutput output :
-         {SceneOutput::kMaxExitSpeed, SceneOutput::kCenterOfPercussion, SceneOutput::kVibrationNode,
-          SceneOutput::kSweetZone, SceneOutput::kExitSpeedCurve, SceneOutput::kLeastStingZone}) {
-      if (NeedsIterativeModel(core::ModelsFor(output, core::CollisionModel::kRigidPivot))) {
-        out.emplace_back(core::SceneOutputName(output));
-      }
+    for (const core::SceneOutputDecl* output : core::SceneOutputTable()) {
+      if (output->workload == core::OutputWorkload::kCompute) out.emplace_back(output->name);
     }
     for (const core::CollisionModel model :
          {core::CollisionModel::kRigidPivot, core::CollisionModel::kFreeBat,
           core::CollisionModel::kHertz, core::CollisionModel::kFlexible}) {
-      if (NeedsIterativeModel(core::ModelsFor(SceneOutput::kMaxExitSpeed, model))) {
-        out.emplace_back(core::CollisionModelName(model));
-      }
+      if (!core::IsClosedFormModel(model)) out.emplace_back(core::CollisionModelName(model));
     }
     return out;
   }();
@@ -100,7 +85,8 @@ double CurvePoints(const Json& body, const std::vector<core::SceneOutput>& outpu
 Workload SceneWorkload(const Request& request, const Json& body) {
   if (request.path == "/v1/collision") {
     const core::CollisionModel model = ModelAt(body, "model", core::CollisionModel::kAuto);
-    return NeedsIterativeModel(core::ModelsFor(core::SceneOutput::kMaxExitSpeed, model))
+    return core::WorkloadOf(core::SceneOutput::kMaxExitSpeed, model) ==
+                   core::OutputWorkload::kCompute
                ? Workload::kCompute
                : Workload::kLight;
   }
@@ -119,7 +105,9 @@ Workload SceneWorkload(const Request& request, const Json& body) {
     }
   }
   for (const core::SceneOutput output : outputs) {
-    if (NeedsIterativeModel(core::ModelsFor(output, model))) return Workload::kCompute;
+    if (core::WorkloadOf(output, model) == core::OutputWorkload::kCompute) {
+      return Workload::kCompute;
+    }
   }
   return CurvePoints(body, outputs) > kLightCurvePoints ? Workload::kCompute : Workload::kLight;
 }

@@ -50,4 +50,15 @@ bool ShiftInvertLanczos(const Eigen::SparseMatrix<double>& k, const Eigen::Spars
                         const Eigen::VectorXd& start, Eigen::VectorXd* values,
                         Eigen::MatrixXd* vectors, int* steps);
 
+/// The lowest `num_modes` flexible eigenpairs of (K, M) by ShiftInvertLanczos (shift sigma,
+/// `extra` more Ritz vectors, `rigid` deflated, from `start`), accepted only when the Sturm
+/// count (ModesBelowCount) confirms that no mode below the last wanted one was missed, and
+/// polished by a Rayleigh-Ritz step of (K, M): true with the eigenpairs, the two rigid modes
+/// first (eigenvalue 0), in *lambda and *vectors and the Lanczos steps in *iterations;
+/// otherwise false, the outputs untouched.
+bool ConfirmedLanczos(const Eigen::SparseMatrix<double>& k, const Eigen::SparseMatrix<double>& m,
+                      const Eigen::MatrixXd& rigid, int num_modes, int extra, double sigma,
+                      const Eigen::VectorXd& start, Eigen::VectorXd* lambda,
+                      Eigen::MatrixXd* vectors, int* iterations);
+
 }  // namespace sweetspot::core

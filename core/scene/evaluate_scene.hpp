@@ -21,18 +21,29 @@ namespace sweetspot::core {
 /// The models an output needs with `exit_model` as the exit-speed model, in run order
 /// (e.g. {"mass_properties", "rigid_pivot"}; vibration_node: {"flexible_beam"};
 /// least_sting_zone, or any exit output with model flexible: {"mass_properties",
-/// "flexible_beam", "flexible"}).
+/// "flexible_beam", "flexible"}): its declaration's (core/scene/output_registry.hpp).
 std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model);
 
 /// The name of the barrel model (in models_used and timings).
 inline constexpr char kBarrelModel[] = "barrel";
-/// The size the barrel outputs added to SceneResult (Reset's size check).
-inline constexpr size_t kBarrelFieldsSize = sizeof(std::optional<BarrelOutput>) +
-                                            sizeof(std::optional<BbcorResult>) +
-                                            sizeof(std::optional<BbcorScan>);
 
-/// The answer of EvaluateScene. Outputs not requested (or not computed) are empty.
-struct SceneResult {
+/// One slot per output: its result, empty when not requested (or not computed). An output's
+/// declaration names its slot (core/scene/output_registry.hpp), which resets it.
+struct SceneOutputResults {
+  std::optional<MaxExitSpeedResult> max_exit_speed;              ///< max_exit_speed.
+  std::optional<CenterOfPercussionResult> center_of_percussion;  ///< center_of_percussion.
+  std::optional<SweetZoneResult> sweet_zone;                     ///< sweet_zone.
+  std::optional<ExitSpeedCurveResult> exit_speed_curve;          ///< exit_speed_curve.
+  std::optional<VibrationNodeResult> vibration_node;             ///< vibration_node.
+  std::optional<LeastStingZoneResult> least_sting_zone;          ///< least_sting_zone.
+  std::optional<BarrelOutput> barrel;                            ///< barrel.
+  std::optional<BbcorResult> bbcor;                              ///< bbcor.
+  std::optional<BbcorScan> bbcor_scan;                           ///< bbcor_scan.
+};
+
+/// The answer of EvaluateScene: what every evaluation reports, and the outputs' slots
+/// (SceneOutputResults). Outputs not requested (or not computed) are empty.
+struct SceneResult : SceneOutputResults {
   Summary summary;            ///< Overall: termination, message, models_used, total time.
   std::string missing_model;  ///< Set (e.g. "flexible_beam") when refused for a missing model.
   std::string refused_field;  ///< The request field the refusal is about (e.g. "outputs").
@@ -48,19 +59,11 @@ struct SceneResult {
   Swing swing;
   std::string exit_speed_model;  ///< The exit-speed model used ("" when none was needed).
   std::string model_reason;      ///< Why that model (auto).
-  std::optional<MaxExitSpeedResult> max_exit_speed;              ///< max_exit_speed.
-  std::optional<CenterOfPercussionResult> center_of_percussion;  ///< center_of_percussion.
-  std::optional<SweetZoneResult> sweet_zone;                     ///< sweet_zone.
-  std::optional<ExitSpeedCurveResult> exit_speed_curve;          ///< exit_speed_curve.
-  std::optional<VibrationNodeResult> vibration_node;             ///< vibration_node.
-  std::optional<LeastStingZoneResult> least_sting_zone;          ///< least_sting_zone.
-  std::optional<BarrelOutput> barrel;                            ///< barrel.
-  std::optional<BbcorResult> bbcor;                              ///< bbcor.
-  std::optional<BbcorScan> bbcor_scan;                           ///< bbcor_scan.
   std::vector<ModelTiming> timings;  ///< Time per model, in first-use order.
 
   /// Every field as a default-constructed result has it, the strings and vectors keeping their
-  /// buffers (a sweep writes each design's result over the previous one's).
+  /// buffers (a sweep writes each design's result over the previous one's); each output's slot
+  /// by its declaration.
   void Reset();
 };
 
@@ -78,10 +81,13 @@ class SceneEvaluator {
   const SceneOptions& options() const { return options_; }
 
  private:
+  // Evaluate's work inside its frame: the outputs the scene asks for, one loop over the table.
+  void EvaluateOutputs(const Scene& scene, SceneResult* out);
   SceneOptions options_;
   std::optional<Refusal> options_refusal_;  // set when the options are invalid
   TimingBook book_;
   std::vector<SceneOutput> wanted_;  // the scene's outputs without duplicates (scratch)
+  std::vector<std::string> messages_;  // the outputs' failure messages (scratch)
 };
 
 /// Computes the requested outputs (SceneEvaluator(options).Evaluate). Never throws.

@@ -22,6 +22,7 @@
 #include "core/numerics/nlopt_search.hpp"
 #include "core/progress.hpp"
 #include "core/refusal.hpp"
+#include "core/scene/output_id.hpp"
 #include "core/sweet_spot/numeric.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 

@@ -10,23 +10,6 @@
 namespace sweetspot::core {
 namespace {
 
-struct OutputName {
-  SceneOutput output;
-  const char* name;
-};
-
-constexpr OutputName kOutputNames[] = {
-    {SceneOutput::kMaxExitSpeed, "max_exit_speed"},
-    {SceneOutput::kCenterOfPercussion, "center_of_percussion"},
-    {SceneOutput::kVibrationNode, "vibration_node"},
-    {SceneOutput::kSweetZone, "sweet_zone"},
-    {SceneOutput::kExitSpeedCurve, "exit_speed_curve"},
-    {SceneOutput::kLeastStingZone, "least_sting_zone"},
-    {SceneOutput::kBarrel, "barrel"},
-    {SceneOutput::kBbcor, "bbcor"},
-    {SceneOutput::kBbcorScan, "bbcor_scan"},
-};
-
 // A position x in a profile's coordinate (origin o from the knob) as metres from the knob, for
 // x in [lo, hi] = [-o, L - o]: the ends map to 0 and L exactly, the rest is clamped to [0, L].
 double FromProfile(double x, double o, double lo, double hi, double length_m) {
@@ -36,20 +19,6 @@ double FromProfile(double x, double o, double lo, double hi, double length_m) {
 }
 
 }  // namespace
-
-const char* SceneOutputName(SceneOutput output) {
-  for (const auto& o : kOutputNames) {
-    if (o.output == output) return o.name;
-  }
-  return "max_exit_speed";
-}
-
-std::optional<SceneOutput> ParseSceneOutput(std::string_view name) {
-  for (const auto& o : kOutputNames) {
-    if (name == o.name) return o.output;
-  }
-  return std::nullopt;
-}
 
 const char* PlacementName(Placement placement) {
   switch (placement) {

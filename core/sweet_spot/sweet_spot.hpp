@@ -16,26 +16,6 @@
 
 namespace sweetspot::core {
 
-/// What a scene can be asked for.
-enum class SceneOutput {
-  kMaxExitSpeed,        ///< The impact position of maximum exit speed, and that speed.
-  kCenterOfPercussion,  ///< The impact position leaving no reaction impulse at the hands.
-  kVibrationNode,   ///< The node of the fundamental bending mode (needs the flexible beam model).
-  kSweetZone,       ///< Positions whose exit speed is within a tolerance of the maximum.
-  kExitSpeedCurve,  ///< Exit speed along the bat.
-  kLeastStingZone,  ///< Flexible impacts swept along the bat: where the hands get least vibration.
-  kBarrel,          ///< A hollow barrel's hoop mode, stiffness and effective COR (trampoline).
-  kBbcor,           ///< BBCOR by the NCAA protocol (core/collision/barrel.hpp).
-  /// BBCOR along the barrel by the flexible model and its maximum (core/collision/bbcor_scan.hpp).
-  kBbcorScan,
-};
-
-/// Stable name: "max_exit_speed", "center_of_percussion", "vibration_node", "sweet_zone",
-/// "exit_speed_curve", "least_sting_zone", "barrel", "bbcor", "bbcor_scan".
-const char* SceneOutputName(SceneOutput output);
-/// The output called `name`, or nullopt.
-std::optional<SceneOutput> ParseSceneOutput(std::string_view name);
-
 /// The former refusal of vibration_node (kept for callers that quote it; no longer returned).
 inline constexpr char kVibrationNodeRefusal[] =
     "vibration_node needs the flexible beam model, which is not available yet";

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "api/explore/engine.hpp"
+#include "api/outputs/scene_outputs.hpp"
 #include "api/router.hpp"
 #include "api/thread_budget.hpp"
 #include "core/explore/sampling.hpp"
@@ -563,6 +564,32 @@ TEST(ExploreEngineTest, LeanPathRowsMatchTheJsonPath) {
       EXPECT_NE(rows.find("\"feasible\":true"), std::string::npos) << model << " sweep " << k;
     }
   }
+}
+
+// Every field an output's api declaration reads directly (api/outputs/: DirectField), as a column
+// of a sweep asking for that output alone (max_exit_speed alone goes the lean path), is the
+// JSON path's: a new output's direct fields are checked without listing them here.
+TEST(ExploreEngineTest, EveryDirectFieldOfEveryOutputMatchesTheJsonPath) {
+  int checked = 0;
+  for (const ApiOutputDecl* output : ApiOutputTable()) {
+    if (output->direct_begin == output->direct_end) continue;
+    const std::string name = core::SceneOutputName(output->id);
+    Json body = Json::parse(R"({
+      "bat": {"three_segment": {"length_m": 0.8636, "handle_radius_m": 0.0125,
+              "barrel_radius_m": 0.033, "taper_start_m": 0.30, "taper_end_m": 0.55},
+              "material": "ash"},
+      "cor": 0.5,
+      "parameters": [{"path": "three_segment.taper_start_m", "min": 0.2, "max": 0.6,
+                      "count": 12}]})");
+    body["outputs"] = Json::array({name});
+    Json columns = Json::array({"index"});
+    for (const DirectField* f = output->direct_begin; f != output->direct_end; ++f) {
+      columns.push_back(name + "." + f->name);
+      ++checked;
+    }
+    ExpectSameRows(body, /*expect_bound=*/true, columns);
+  }
+  EXPECT_GT(checked, 0);
 }
 
 }  // namespace

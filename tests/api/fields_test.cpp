@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -31,8 +32,10 @@ Response Post(const std::string& path, const Json& body) {
   return Dispatch({"POST", path, body.dump()}, Context{});
 }
 
-// A request with every part a field can sit in: the three-segment form, or a profile.
-Json Template(bool profile) {
+// A request with every part a field can sit in: the three-segment form, or a profile; the
+// swing by its bat speed for a field of the bat speed (the parser takes one of it and the
+// angular speed).
+Json Template(bool profile, bool bat_speed = false) {
   Json bat = profile ? Json::parse(R"({"profile": {"knots": [{"x_m": 0, "radius_m": 0.012},
                          {"x_m": 0.3, "radius_m": 0.013}, {"x_m": 0.6, "radius_m": 0.033},
                          {"x_m": 0.84, "radius_m": 0.033}]}})")
@@ -44,11 +47,17 @@ Json Template(bool profile) {
   bat["wall_thickness_m"] = 0.003;
   bat["fill"] = Json::parse(R"({"material": {"density_kg_m3": 200, "youngs_modulus_pa": 2e7},
       "diameter_m": 0.02, "depth_m": 0.1})");
+  Json swing = {{"angular_speed_rad_s", 40.0}, {"pivot_from_knob_m", 0.01},
+                {"hands_from_knob_m", 0.15}};
+  if (bat_speed) {
+    swing.erase("angular_speed_rad_s");
+    swing["bat_speed_mps"] = 31.0;
+    swing["bat_speed_from_tip_m"] = 0.16;
+  }
   return Json{{"bat", bat},
               {"ball", {{"mass_kg", 0.145}, {"radius_m", 0.0366}, {"speed_mps", 30.0},
                         {"stiffness_n_m_p", 1e7}, {"stiffness_exponent", 1.5}}},
-              {"swing", {{"angular_speed_rad_s", 40.0}, {"pivot_from_knob_m", 0.01},
-                         {"hands_from_knob_m", 0.15}}},
+              {"swing", swing},
               {"cor", 0.5}};
 }
 
@@ -89,15 +98,18 @@ std::string Concrete(std::string_view pattern) {
 }
 
 bool IsProfileField(const Field& field) { return field.group == FieldGroup::kKnot; }
+bool IsBatSpeedField(const Field& field) {
+  return field.path.rfind("swing.bat_speed", 0) == 0;
+}
 
 // Every field: set in SI and in each trade form through the parser, read back through its
 // accessor; bound by the sweep's binder to the same scene the parser gives; and, when a
 // variable, named by core's variable path in every form.
 TEST(FieldsTest, EveryFieldRoundTripsThroughParserBinderAndOptimizeVariable) {
-  ASSERT_EQ(Fields().size(), 25u);
+  ASSERT_EQ(Fields().size(), 27u);
   for (const Field& field : Fields()) {
     SCOPED_TRACE(std::string(field.path));
-    const Json base = Template(IsProfileField(field));
+    const Json base = Template(IsProfileField(field), IsBatSpeedField(field));
     std::string why;
     auto parsed_base = Parse(base, &why);
     ASSERT_TRUE(parsed_base) << why;
@@ -180,6 +192,8 @@ TEST(FieldsTest, EveryFieldRoundTripsThroughParserBinderAndOptimizeVariable) {
       EXPECT_EQ(bound.swing.angular_speed_rad_s, parsed->scene.swing.angular_speed_rad_s);
       EXPECT_EQ(bound.swing.pivot_from_knob_m, parsed->scene.swing.pivot_from_knob_m);
       EXPECT_EQ(bound.swing.hands_from_knob_m, parsed->scene.swing.hands_from_knob_m);
+      EXPECT_EQ(bound.swing.bat_speed_mps, parsed->scene.swing.bat_speed_mps);
+      EXPECT_EQ(bound.swing.bat_speed_from_tip_m, parsed->scene.swing.bat_speed_from_tip_m);
       EXPECT_EQ(bound.cor, parsed->scene.cor);
     }
 
@@ -225,12 +239,119 @@ TEST(FieldsTest, TradeFormsResolveToTheirField) {
   const auto speed = ResolveField("ball.speed_mph", FieldScope::kRequest);
   ASSERT_TRUE(speed);
   EXPECT_EQ(speed->si, "ball.speed_mps");
+  const auto bat_speed = ResolveField("swing.bat_speed_mph", FieldScope::kRequest);
+  ASSERT_TRUE(bat_speed);  // bound by the sweep's binder since it is a row
+  EXPECT_EQ(bat_speed->si, "swing.bat_speed_mps");
+  EXPECT_TRUE(bat_speed->field->swept);
+  // A knot's index as the JSON path reads it: the variable is core's, named as written.
+  const auto padded = ResolveField("profile.knots[02].radius_m", FieldScope::kVariable);
+  ASSERT_TRUE(padded);
+  EXPECT_EQ(padded->si, "profile.knots[2].radius_m");
   EXPECT_FALSE(ResolveField("wall_thickness_oz", FieldScope::kVariable));
   EXPECT_FALSE(ResolveField("ball.speed_mps", FieldScope::kVariable));
   EXPECT_EQ(DidYouMeanField("three_segment.taper_strat_in", FieldScope::kVariable),
             " (did you mean \"three_segment.taper_start_in\"?)");
   EXPECT_EQ(DidYouMeanField("profile.knots[4].radus_m", FieldScope::kVariable),
             " (did you mean \"profile.knots[4].radius_m\"?)");
+}
+
+// Every variable core's optimiser knows is a variable row of the table (and the reverse is
+// the round trip's): /v1/optimize takes its variables from the table only.
+TEST(FieldsTest, EveryCoreDesignVariableIsAVariableRow) {
+  for (int kind = 0; kind <= static_cast<int>(core::DesignVariableKind::kFillDensity); ++kind) {
+    core::DesignVariableRef ref;
+    ref.kind = static_cast<core::DesignVariableKind>(kind);
+    const bool knot = ref.kind == core::DesignVariableKind::kKnotRadius ||
+                      ref.kind == core::DesignVariableKind::kKnotPosition;
+    ref.knot = knot ? 2 : -1;
+    const std::string path = core::DesignVariablePath(ref);
+    SCOPED_TRACE(path);
+    const auto use = ResolveField(path, FieldScope::kVariable);
+    ASSERT_TRUE(use.has_value());
+    EXPECT_EQ(use->si, path);
+    EXPECT_TRUE(use->field->variable);
+  }
+}
+
+// The swing's numbers come from the table: each in its trade form, and exactly one of the
+// angular speed and the bat speed, refused as before.
+TEST(FieldsTest, SwingFromTheTableInTradeForms) {
+  Json request = Template(false);
+  request["swing"] = {{"bat_speed_mph", 70.0}, {"bat_speed_from_tip_in", 6.0},
+                      {"pivot_from_knob_in", -1.0}, {"hands_from_knob_in", 5.0}};
+  std::string why;
+  const auto parsed = Parse(request, &why);
+  ASSERT_TRUE(parsed) << why;
+  const core::Swing& swing = parsed->scene.swing;
+  ASSERT_TRUE(swing.bat_speed_mps.has_value());
+  EXPECT_DOUBLE_EQ(*swing.bat_speed_mps, 70.0 * 0.44704);
+  EXPECT_DOUBLE_EQ(swing.bat_speed_from_tip_m, 6.0 * 0.0254);
+  EXPECT_DOUBLE_EQ(swing.pivot_from_knob_m, -0.0254);
+  EXPECT_DOUBLE_EQ(swing.hands_from_knob_m, 5.0 * 0.0254);
+  request["swing"] = {{"angular_speed_rad_s", 30.0}, {"bat_speed_mps", 31.0}};
+  EXPECT_FALSE(Parse(request, &why));
+  EXPECT_EQ(why,
+            "swing.bat_speed_mps = 31.0: give exactly one of swing.bat_speed_mps and "
+            "swing.angular_speed_rad_s (both are given; the bat speed sets the angular speed)");
+}
+
+// A material object's numbers come from the table: density and Young's modulus required
+// without a base (the first missing one named), any of them over a base; G or nu given means
+// nu is not assumed.
+TEST(FieldsTest, MaterialFromTheTable) {
+  Json request = Template(false);
+  request["bat"]["material"] = {{"youngs_modulus_pa", 1e10}};
+  std::string why;
+  EXPECT_FALSE(Parse(request, &why));
+  EXPECT_EQ(why, "bat.material.density_kg_m3 is required");
+  request["bat"]["material"] = {{"density_kg_m3", 700.0}};
+  EXPECT_FALSE(Parse(request, &why));
+  EXPECT_EQ(why, "bat.material.youngs_modulus_pa is required");
+  request["bat"]["material"] = {{"density_kg_m3", 700.0}, {"youngs_modulus_pa", 1e10}};
+  auto parsed = Parse(request, &why);
+  ASSERT_TRUE(parsed) << why;
+  EXPECT_TRUE(parsed->scene.bat->material.poissons_ratio_assumed);
+  EXPECT_FALSE(parsed->scene.bat->material.cor.has_value());
+  request["bat"]["material"]["poissons_ratio"] = 0.3;
+  parsed = Parse(request, &why);
+  ASSERT_TRUE(parsed) << why;
+  EXPECT_FALSE(parsed->scene.bat->material.poissons_ratio_assumed);
+  request["bat"]["material"] = {{"base", "ash"}, {"cor", 0.55}};
+  parsed = Parse(request, &why);
+  ASSERT_TRUE(parsed) << why;
+  EXPECT_EQ(parsed->scene.bat->material.cor, 0.55);
+  EXPECT_FALSE(parsed->scene.bat->material.poissons_ratio_assumed);
+}
+
+// An explore column of a parameter named in a trade form ("parameters.swing.hands_from_knob_in")
+// holds the swept value as written; the design is the SI sweep's (the table's row, bound by
+// the binder: the same exit speeds as the sweep written in SI).
+TEST(FieldsTest, ExploreColumnsOfTradeFormParameters) {
+  const auto use = ResolveField("swing.hands_from_knob_in", FieldScope::kRequest);
+  ASSERT_TRUE(use);
+  EXPECT_EQ(use->field, FindField("swing.hands_from_knob_m"));
+  const auto sweep = [](const std::string& path, double min, double max) {
+    Json body = Json::parse(R"({"bat": {"preset": "wood-34-ash"}, "outputs": ["max_exit_speed"],
+        "format": "csv"})");
+    body["columns"] = {"parameters." + path, "max_exit_speed.exit_speed_mps"};
+    body["parameters"] = Json::array({{{"path", path}, {"min", min}, {"max", max}, {"count", 2}}});
+    return Post("/v1/explore", body);
+  };
+  const Response in = sweep("swing.hands_from_knob_in", 4.0, 8.0);
+  const Response si = sweep("swing.hands_from_knob_m", 4.0 * 0.0254, 8.0 * 0.0254);
+  ASSERT_EQ(in.status, 200) << in.text << in.body.dump();
+  ASSERT_EQ(si.status, 200) << si.text << si.body.dump();
+  std::istringstream a(in.text), b(si.text);
+  std::string line_in, line_si;
+  std::getline(a, line_in);
+  std::getline(b, line_si);
+  EXPECT_EQ(line_in, "parameters.swing.hands_from_knob_in,max_exit_speed.exit_speed_mps");
+  for (double hands_in : {4.0, 8.0}) {
+    ASSERT_TRUE(std::getline(a, line_in));
+    ASSERT_TRUE(std::getline(b, line_si));
+    EXPECT_EQ(std::stod(line_in.substr(0, line_in.find(','))), hands_in);
+    EXPECT_EQ(line_in.substr(line_in.find(',')), line_si.substr(line_si.find(',')));
+  }
 }
 
 Json Optimize(const Json& variable) {

@@ -7,7 +7,7 @@
 #include <utility>
 
 #include "api/router.hpp"
-#include "core/sweet_spot/sweet_spot.hpp"
+#include "core/scene/output_registry.hpp"
 
 namespace sweetspot::api {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -47,8 +47,8 @@ TEST(OpenApiTest, PathsMatchTheRouterBothWays) {
   }
 }
 
-// The outputs an endpoint's schema lists are the ones its parser takes: every scene output of
-// core (SceneOutput, kMaxExitSpeed..kBbcorScan: extend the range with the enum) for
+// The outputs an endpoint's schema lists are the ones its parser takes: every registered scene
+// output (core's table, core/scene/output_registry.hpp) for
 // /v1/sweet-spot and /v1/compare, and with properties and collision_efficiency for /v1/explore.
 // The explore and compare lists had fallen behind the parser (least_sting_zone; barrel, bbcor,
 // bbcor_scan).
@@ -56,9 +56,9 @@ TEST(OpenApiTest, OutputEnumsAreTheOutputsTheParsersTake) {
   const Response r = Dispatch({"GET", "/openapi.json", ""}, Context{});
   ASSERT_EQ(r.status, 200);
   std::set<std::string> scene;
-  for (int i = 0; i <= static_cast<int>(core::SceneOutput::kBbcorScan); ++i) {
-    const std::string name = core::SceneOutputName(static_cast<core::SceneOutput>(i));
-    EXPECT_TRUE(core::ParseSceneOutput(name).has_value()) << name;
+  for (const core::SceneOutputDecl* output : core::SceneOutputTable()) {
+    const std::string name = output->name;
+    EXPECT_EQ(core::ParseSceneOutput(name), output->id) << name;
     scene.insert(name);
   }
   std::set<std::string> explore = scene;

@@ -76,7 +76,7 @@ const std::vector<std::string> kCoreFolders = {
     "core/collision", "core/sweet_spot", "core/scene", "core/optimize", "core/explore"};
 const std::vector<std::string> kApiFolders = {
     "api",  // JSON reading and rendering, limits, errors, the route types
-    "api/explore", "api/handlers"};
+    "api/outputs", "api/explore", "api/handlers"};
 
 // Rank of a "core/..." or "api/..." header or file's folder in `folders`; -1 when unplaced.
 int FolderRank(const std::vector<std::string>& folders, const std::string& path) {

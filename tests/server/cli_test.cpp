@@ -108,5 +108,20 @@ TEST(CliTest, ShardsMergeIntoTheUnshardedSweep) {
   std::system(("rm -rf " + dir).c_str());
 }
 
+// `sweetspot flight`: the /v1/flight handler without a network (issue 34). Nathan's sheet case
+// in mph: 422.18 ft converged (421.49 ft by the sheet's 0.01 s steps; docs/validation.md).
+TEST(CliTest, FlightAnswersAndRefusesLikeTheEndpoint) {
+  CliResult result = RunCli(
+      "flight -", R"({"launch": {"exit_speed_mph": 103, "launch_angle_deg": 27.5,
+      "backspin_rpm": 2500, "sidespin_rpm": 0}, "environment": {"elevation_ft": 15}})");
+  ASSERT_EQ(result.exit_code, 0) << result.out;
+  const auto body = nlohmann::json::parse(result.out);
+  EXPECT_NEAR(body["distance_m"].get<double>() / 0.3048, 422.18, 0.01);
+  EXPECT_EQ(body["spin_source"], "given");
+  result = RunCli("flight -", R"({"launch": {"exit_speed_mph": 100, "launch_angle_deg": 120}})");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_EQ(nlohmann::json::parse(result.out)["field"], "launch.launch_angle_deg");
+}
+
 }  // namespace
 }  // namespace sweetspot
