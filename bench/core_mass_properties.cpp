@@ -52,7 +52,8 @@ void BM_ShapeFitTable2(benchmark::State& state) {
   ShapeFitProblem problem;
   problem.shape = PaperThreeSegmentShape();
   problem.material = *FindMaterial("paper-wood");
-  problem.unknowns = {{FitVariable::kTaperStart, 0.0, 0.855}, {FitVariable::kTaperEnd, 0.0, 0.855}};
+  problem.unknowns = {{DesignVariableKind::kTaperStart, 0.0, 0.855},
+                      {DesignVariableKind::kTaperEnd, 0.0, 0.855}};
   problem.targets.mass_kg = 0.885;
   problem.targets.balance_point_m = 0.564;
   for (auto _ : state) {

@@ -161,7 +161,7 @@ struct FitRequest {
     const std::size_t i = std::strtoul(field.c_str() + 9, nullptr, 10);
     if (i >= written.size()) return refusal;
     const auto& [name, to_si] = written[i];
-    if (refusal.shown == core::FitVariableName(problem.unknowns[i].variable)) refusal.shown = name;
+    if (refusal.shown == core::FitUnknownName(problem.unknowns[i].variable)) refusal.shown = name;
     const bool bound = field.size() > 4 && (field.compare(field.size() - 4, 4, ".min") == 0 ||
                                             field.compare(field.size() - 4, 4, ".max") == 0);
     if (bound && to_si != 1.0 && std::isfinite(refusal.value) && refusal.QuotesValue()) {
@@ -175,14 +175,14 @@ struct FitRequest {
 
 // Reads "unknowns" (default: the paper's question, where the taper starts and ends).
 // The three-segment fit's unknowns by name: the table of fields' fit names (api/fields.hpp), in
-// core's FitVariable order (the order the refusal of an unknown name lists them in).
+// core's kFitUnknownKinds order (the order the refusal of an unknown name lists them in).
 const std::vector<std::string>& FitUnknownNames() {
   static const std::vector<std::string> names = [] {
     std::vector<std::pair<int, std::string>> ordered;
     for (const Field& field : Fields()) {
       if (field.fit_name.empty()) continue;
       const std::string name(field.fit_name);
-      ordered.emplace_back(static_cast<int>(*core::FitVariableFromName(name)), name);
+      ordered.emplace_back(core::FitUnknownIndex(*core::FitUnknownFromName(name)), name);
     }
     std::sort(ordered.begin(), ordered.end());
     std::vector<std::string> out;
@@ -197,8 +197,8 @@ bool ReadFitUnknowns(ObjectReader& reader, const core::ThreeSegmentShape& shape,
                      std::vector<std::pair<std::string, double>>* written) {
   const nlohmann::json* unknowns = reader.Get("unknowns");
   if (unknowns == nullptr) {
-    problem->unknowns = {{core::FitVariable::kTaperStart, 0.0, shape.length_m},
-                         {core::FitVariable::kTaperEnd, 0.0, shape.length_m}};
+    problem->unknowns = {{core::DesignVariableKind::kTaperStart, 0.0, shape.length_m},
+                         {core::DesignVariableKind::kTaperEnd, 0.0, shape.length_m}};
     return reader.ok();
   }
   if (!unknowns->is_array() || unknowns->empty() || unknowns->size() > 10) {
@@ -221,7 +221,7 @@ bool ReadFitUnknowns(ObjectReader& reader, const core::ThreeSegmentShape& shape,
     u.Number("min", AnyNumber(), &unknown.min);  // the bounds' ranges: core's problem.Validate
     u.Number("max", AnyNumber(), &unknown.max);
     if (!u.Finish()) return false;
-    unknown.variable = *core::FitVariableFromName(use->si);
+    unknown.variable = *core::FitUnknownFromName(use->si);
     unknown.min *= use->to_si;  // core is SI
     unknown.max *= use->to_si;
     problem->unknowns.push_back(unknown);
@@ -325,7 +325,7 @@ nlohmann::json RenderFit(const FitRequest& request, const core::ShapeFitResult& 
     if (i < request.written.size()) {  // as the request wrote it, in its unit
       unknown_values[request.written[i].first] = fit.values[i] / request.written[i].second;
     } else {
-      unknown_values[core::FitVariableName(problem.unknowns[i].variable)] = fit.values[i];
+      unknown_values[core::FitUnknownName(problem.unknowns[i].variable)] = fit.values[i];
     }
   }
   nlohmann::json residuals = nlohmann::json::object();

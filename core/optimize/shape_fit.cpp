@@ -36,20 +36,20 @@ constexpr const char* kVariableName[kNumFitVariables] = {
 
 // Builds the bat of the family at parameters t (DesignParameterLayout{4}).
 void BuildBat(const ShapeFitProblem& problem, const std::vector<double>& t, ShapeFitResult* out) {
-  const auto value = [&t](FitVariable v) { return fit_detail::FitValue(t, v); };
-  out->shape.taper_start_m = value(FitVariable::kTaperStart);
-  out->shape.taper_end_m = value(FitVariable::kTaperEnd);
-  out->shape.length_m = value(FitVariable::kLength);
-  out->shape.handle_radius_m = value(FitVariable::kHandleRadius);
-  out->shape.barrel_radius_m = value(FitVariable::kBarrelRadius);
+  const auto value = [&t](DesignVariableKind v) { return fit_detail::FitValue(t, v); };
+  out->shape.taper_start_m = value(DesignVariableKind::kTaperStart);
+  out->shape.taper_end_m = value(DesignVariableKind::kTaperEnd);
+  out->shape.length_m = value(DesignVariableKind::kLength);
+  out->shape.handle_radius_m = value(DesignVariableKind::kHandleRadius);
+  out->shape.barrel_radius_m = value(DesignVariableKind::kBarrelRadius);
   out->material = problem.material;
-  out->material.density_kg_m3 = value(FitVariable::kDensity);
-  out->wall_thickness_m = value(FitVariable::kWallThickness);
+  out->material.density_kg_m3 = value(DesignVariableKind::kDensity);
+  out->wall_thickness_m = value(DesignVariableKind::kWallThickness);
   out->fill = problem.fill;
   if (out->fill.has_value()) {
-    out->fill->diameter_m = value(FitVariable::kFillDiameter);
-    out->fill->depth_m = value(FitVariable::kFillDepth);
-    out->fill->material.density_kg_m3 = value(FitVariable::kFillDensity);
+    out->fill->diameter_m = value(DesignVariableKind::kFillDiameter);
+    out->fill->depth_m = value(DesignVariableKind::kFillDepth);
+    out->fill->material.density_kg_m3 = value(DesignVariableKind::kFillDensity);
   }
   out->bat = MakeThreeSegmentBat(out->shape, out->material);
   out->bat.wall_thickness_m = out->wall_thickness_m;
@@ -87,7 +87,7 @@ std::string DescribeUnknowns(const ShapeFitProblem& problem) {
   std::string out;
   for (const FitUnknown& u : problem.unknowns) {
     if (!out.empty()) out += ", ";
-    out += std::string(FitVariableName(u.variable)) + " in [" + FormatNumber(u.min) + ", " +
+    out += std::string(FitUnknownName(u.variable)) + " in [" + FormatNumber(u.min) + ", " +
            FormatNumber(u.max) + "]";
   }
   return out;
@@ -99,14 +99,21 @@ constexpr double kMinMetricScale = 1e-6;
 
 }  // namespace
 
-const char* FitVariableName(FitVariable variable) {
-  const int i = static_cast<int>(variable);
-  return (i >= 0 && i < kNumFitVariables) ? kVariableName[i] : "unknown";
+int FitUnknownIndex(DesignVariableKind kind) {
+  for (int i = 0; i < kNumFitUnknowns; ++i) {
+    if (kFitUnknownKinds[i] == kind) return i;
+  }
+  return -1;
 }
 
-std::optional<FitVariable> FitVariableFromName(std::string_view name) {
-  for (int i = 0; i < kNumFitVariables; ++i) {
-    if (name == kVariableName[i]) return static_cast<FitVariable>(i);
+const char* FitUnknownName(DesignVariableKind kind) {
+  const int i = FitUnknownIndex(kind);
+  return i >= 0 ? kVariableName[i] : "unknown";
+}
+
+std::optional<DesignVariableKind> FitUnknownFromName(std::string_view name) {
+  for (int i = 0; i < kNumFitUnknowns; ++i) {
+    if (name == kVariableName[i]) return kFitUnknownKinds[i];
   }
   return std::nullopt;
 }
@@ -186,9 +193,10 @@ bool ShapeFitProblem::Validate(Refusal* why) const {
   std::vector<bool> unknown(static_cast<std::size_t>(kNumFitVariables), false);
   for (std::size_t i = 0; i < unknowns.size(); ++i) {
     const FitUnknown& u = unknowns[i];
-    const int idx = static_cast<int>(u.variable);
-    if (idx < 0 || idx >= kNumFitVariables) {
-      return Refuse(why, IndexedField("unknowns", i, "variable"), idx, "is not a FitVariable");
+    const int idx = FitUnknownIndex(u.variable);
+    if (idx < 0) {
+      return Refuse(why, IndexedField("unknowns", i, "variable"), static_cast<int>(u.variable),
+                    "is not a fit unknown (a profile knot's kind)");
     }
     const char* name = kVariableName[idx];
     if (unknown[static_cast<std::size_t>(idx)]) {
@@ -216,16 +224,18 @@ bool ShapeFitProblem::Validate(Refusal* why) const {
                                      "must be greater than " + IndexedField("unknowns", i, "min") +
                                          " = " + FormatNumber(u.min));
     }
-    const FitVariable v = u.variable;
-    const bool must_be_positive = v == FitVariable::kLength || v == FitVariable::kHandleRadius ||
-                                  v == FitVariable::kBarrelRadius || v == FitVariable::kDensity ||
-                                  v == FitVariable::kWallThickness;
+    const DesignVariableKind v = u.variable;
+    const bool must_be_positive =
+        v == DesignVariableKind::kLength || v == DesignVariableKind::kHandleRadius ||
+        v == DesignVariableKind::kBarrelRadius || v == DesignVariableKind::kDensity ||
+        v == DesignVariableKind::kWallThickness;
     if (must_be_positive && !(u.min > 0.0)) {
       return why == nullptr
                  ? false
                  : Refuse(why, IndexedField("unknowns", i, "min"), u.min,
                           std::string("must be positive for ") + name +
-                              (v == FitVariable::kWallThickness ? " (the bat stays hollow)" : ""));
+                              (v == DesignVariableKind::kWallThickness ? " (the bat stays hollow)"
+                                                                       : ""));
     }
     if (!must_be_positive && u.min < 0.0) {
       return why == nullptr ? false
@@ -236,28 +246,29 @@ bool ShapeFitProblem::Validate(Refusal* why) const {
   // The fixed values.
   const std::vector<double> t = fit_detail::StartParameters(*this);
   for (int i = 0; i < kNumFitVariables; ++i) {
-    const FitVariable v = static_cast<FitVariable>(i);
+    const DesignVariableKind v = kFitUnknownKinds[i];
     if (unknown[static_cast<std::size_t>(i)] ||
         (fit_detail::IsFillVariable(v) && !fill.has_value()))
       continue;
     const double value = fit_detail::FitValue(t, v);
-    const char* field = fit_detail::FitVariableField(v);
+    const char* field = fit_detail::FitUnknownField(v);
     if (!std::isfinite(value)) return Refuse(why, field, value, "must be finite");
-    const bool must_be_positive = v == FitVariable::kLength || v == FitVariable::kHandleRadius ||
-                                  v == FitVariable::kBarrelRadius || v == FitVariable::kDensity;
+    const bool must_be_positive =
+        v == DesignVariableKind::kLength || v == DesignVariableKind::kHandleRadius ||
+        v == DesignVariableKind::kBarrelRadius || v == DesignVariableKind::kDensity;
     if (must_be_positive && !(value > 0.0)) return Refuse(why, field, value, "must be positive");
     if (value < 0.0) return Refuse(why, field, value, "must be non-negative");
   }
   Material m = material;
-  m.density_kg_m3 = fit_detail::FitValue(t, FitVariable::kDensity);
+  m.density_kg_m3 = fit_detail::FitValue(t, DesignVariableKind::kDensity);
   Refusal inner;
   if (!m.Validate(why != nullptr ? &inner : nullptr))
     return Refuse(why, Prefixed("material.", inner));
   if (fill.has_value()) {
     Material f = fill->material;
-    if (unknown[static_cast<std::size_t>(FitVariable::kFillDensity)]) {
+    if (unknown[static_cast<std::size_t>(FitUnknownIndex(DesignVariableKind::kFillDensity))]) {
       // check the other fields
-      f.density_kg_m3 = std::max(fit_detail::FitValue(t, FitVariable::kFillDensity), 1.0);
+      f.density_kg_m3 = std::max(fit_detail::FitValue(t, DesignVariableKind::kFillDensity), 1.0);
     }
     if (f.density_kg_m3 != 0.0 && !f.Validate(why != nullptr ? &inner : nullptr)) {
       return Refuse(why, Prefixed("fill.material.", inner));
@@ -333,13 +344,11 @@ void RunLocalStarts(ShapeFitModel& model, const ShapeFitOptions& options,
   };
   std::vector<NloptConstraintFunction> constraints;
   for (FitConstraint kind : model.constraints()) {
-    constraints.push_back({[&model, kind](const double* x, double* grad) {
-                             return model.Constraint(kind, x, grad);
-                           },
-                           false, 0.0});
+    constraints.push_back(
+        {[&model, kind](const double* x, double* grad) { return model.Constraint(kind, x, grad); },
+         false, 0.0});
   }
-  for (std::size_t c = 0; c < candidates.size() && search->local_runs < options.local_starts;
-       ++c) {
+  for (std::size_t c = 0; c < candidates.size() && search->local_runs < options.local_starts; ++c) {
     const double time_left = options.max_time_s - elapsed_s();
     if (budget_left() <= 0 || time_left <= 0.0) break;
     ++search->local_runs;
@@ -408,8 +417,8 @@ void PolishGaussNewton(ShapeFitModel& model, const ShapeFitOptions& options, Fit
 
 // 4. The metric of the built bat and the termination: targets met, the certified closest bat,
 // or the best found.
-void Classify(const ShapeFitProblem& problem, const ShapeFitOptions& options,
-              ShapeFitModel& model, const std::vector<double>& best, ShapeFitResult* result) {
+void Classify(const ShapeFitProblem& problem, const ShapeFitOptions& options, ShapeFitModel& model,
+              const std::vector<double>& best, ShapeFitResult* result) {
   Summary& summary = result->summary;
   double max_scaled = 0.0;
   result->metric = 0.0;
@@ -424,10 +433,9 @@ void Classify(const ShapeFitProblem& problem, const ShapeFitOptions& options,
   if (problem.targets.balance_point_m.has_value()) {
     result->balance_point_residual_m =
         result->properties.balance_point_m - *problem.targets.balance_point_m;
-    const double scaled =
-        result->balance_point_residual_m / (options.balance_point_scale_m > 0.0
-                                                ? options.balance_point_scale_m
-                                                : *problem.targets.balance_point_m);
+    const double scaled = result->balance_point_residual_m /
+                          (options.balance_point_scale_m > 0.0 ? options.balance_point_scale_m
+                                                               : *problem.targets.balance_point_m);
     max_scaled = std::max(max_scaled, std::abs(scaled));
     result->metric += scaled * scaled;
   }
@@ -444,8 +452,9 @@ void Classify(const ShapeFitProblem& problem, const ShapeFitOptions& options,
   }
   result->kkt_error = fit_detail::KktError(model, best);
   summary.error_estimate = result->kkt_error;
-  const std::string metric = "metric ((M - M*)/s_M)^2 + ((C - C*)/s_C)^2 = " +
-                             FormatNumber(result->metric) + ": " + achieved;
+  const std::string metric =
+      "metric ((M - M*)/s_M)^2 + ((C - C*)/s_C)^2 = " + FormatNumber(result->metric) + ": " +
+      achieved;
   if (result->kkt_error <= options.kkt_tolerance) {
     summary.termination = Termination::kInfeasible;
     summary.message = "no bat with " + DescribeUnknowns(problem) + " meets " +

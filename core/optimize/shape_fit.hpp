@@ -31,6 +31,7 @@
 #include "core/bat/bat.hpp"
 #include "core/bat/mass_properties.hpp"
 #include "core/bat/material.hpp"
+#include "core/optimize/design_problem.hpp"
 #include "core/summary.hpp"
 
 namespace sweetspot::core {
@@ -45,28 +46,31 @@ inline constexpr double kMinFitTolerance = 1e-15;
 /// Largest tolerance of a fit's targets (scaled residual, dimensionless).
 inline constexpr double kMaxFitTolerance = 0.1;
 
-/// A dimension of a three-segment bat that the fit may change.
-enum class FitVariable {
-  kTaperStart,     ///< "taper_start_m": x1, m.
-  kTaperEnd,       ///< "taper_end_m": x2, m.
-  kLength,         ///< "length_m": L, m.
-  kHandleRadius,   ///< "handle_radius_m": r1, m.
-  kBarrelRadius,   ///< "barrel_radius_m": r2, m.
-  kDensity,        ///< "density_kg_m3": the bat material's density, kg/m³.
-  kWallThickness,  ///< "wall_thickness_m": m (the bat stays hollow: min > 0).
-  kFillDiameter,   ///< "fill.diameter_m": m (needs a fill).
-  kFillDepth,      ///< "fill.depth_m": m (needs a fill).
-  kFillDensity,    ///< "fill.density_kg_m3": kg/m³ (needs a fill).
-};
+/// The fit's unknowns: the design variables (DesignVariableKind) of a three-segment bat's ten
+/// fields (every kind but the profile's knots), in the order their names are listed.
+inline constexpr int kNumFitUnknowns = 10;
+/// The kinds a fit unknown may be, in the order of FitUnknownName's names.
+inline constexpr DesignVariableKind kFitUnknownKinds[kNumFitUnknowns] = {
+    DesignVariableKind::kTaperStart,    DesignVariableKind::kTaperEnd,
+    DesignVariableKind::kLength,        DesignVariableKind::kHandleRadius,
+    DesignVariableKind::kBarrelRadius,  DesignVariableKind::kDensity,
+    DesignVariableKind::kWallThickness, DesignVariableKind::kFillDiameter,
+    DesignVariableKind::kFillDepth,     DesignVariableKind::kFillDensity};
 
-/// Stable name of a variable (the quoted names above).
-const char* FitVariableName(FitVariable variable);
-/// The variable called `name`, or nullopt.
-std::optional<FitVariable> FitVariableFromName(std::string_view name);
+/// Position of `kind` in kFitUnknownKinds, or -1 (a profile knot's kind is no fit unknown).
+int FitUnknownIndex(DesignVariableKind kind);
+/// The fit's name of a kind: "taper_start_m", "taper_end_m", "length_m", "handle_radius_m",
+/// "barrel_radius_m", "density_kg_m3", "wall_thickness_m" (the bat stays hollow: min > 0),
+/// "fill.diameter_m", "fill.depth_m", "fill.density_kg_m3" (the fill's need a fill);
+/// "unknown" for a knot's kind.
+const char* FitUnknownName(DesignVariableKind kind);
+/// The kind the fit calls `name`, or nullopt.
+std::optional<DesignVariableKind> FitUnknownFromName(std::string_view name);
 
 /// One unknown and its bounds, in the variable's unit.
 struct FitUnknown {
-  FitVariable variable = FitVariable::kTaperStart;  ///< What is unknown.
+  /// What is unknown: one of kFitUnknownKinds.
+  DesignVariableKind variable = DesignVariableKind::kTaperStart;
   /// Lower bound (unit of the variable), >= 0 (ShapeFitProblem::ValidateSize: <= kMaxFitBound).
   double min = 0.0;
   /// Upper bound (unit of the variable; > min; ShapeFitProblem::ValidateSize: <= kMaxFitBound).

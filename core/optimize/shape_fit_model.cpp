@@ -44,14 +44,7 @@ constexpr const char* kField[kNumFitVariables] = {
     "wall_thickness_m",           "fill.diameter_m",       "fill.depth_m",
     "fill.material.density_kg_m3"};
 
-constexpr DesignVariableKind kKind[kNumFitVariables] = {
-    DesignVariableKind::kTaperStart,    DesignVariableKind::kTaperEnd,
-    DesignVariableKind::kLength,        DesignVariableKind::kHandleRadius,
-    DesignVariableKind::kBarrelRadius,  DesignVariableKind::kDensity,
-    DesignVariableKind::kWallThickness, DesignVariableKind::kFillDiameter,
-    DesignVariableKind::kFillDepth,     DesignVariableKind::kFillDensity};
-
-std::vector<int> ParametersOf(FitVariable variable) {
+std::vector<int> ParametersOf(DesignVariableKind variable) {
   return design_detail::DesignParametersOf(DesignVariableOf(variable), kLayout);
 }
 
@@ -130,21 +123,20 @@ bool Involves(FitConstraint kind, const std::vector<int>& parameters) {
 
 }  // namespace
 
-DesignVariableRef DesignVariableOf(FitVariable variable) {
-  const int i = static_cast<int>(variable);
+DesignVariableRef DesignVariableOf(DesignVariableKind variable) {
   DesignVariableRef ref;
-  ref.kind = (i >= 0 && i < kNumFitVariables) ? kKind[i] : DesignVariableKind::kTaperStart;
+  ref.kind = FitUnknownIndex(variable) >= 0 ? variable : DesignVariableKind::kTaperStart;
   return ref;
 }
 
-const char* FitVariableField(FitVariable variable) {
-  const int i = static_cast<int>(variable);
-  return (i >= 0 && i < kNumFitVariables) ? kField[i] : "";
+const char* FitUnknownField(DesignVariableKind variable) {
+  const int i = FitUnknownIndex(variable);
+  return i >= 0 ? kField[i] : "";
 }
 
-bool IsFillVariable(FitVariable variable) {
-  return variable == FitVariable::kFillDiameter || variable == FitVariable::kFillDepth ||
-         variable == FitVariable::kFillDensity;
+bool IsFillVariable(DesignVariableKind variable) {
+  return variable == DesignVariableKind::kFillDiameter ||
+         variable == DesignVariableKind::kFillDepth || variable == DesignVariableKind::kFillDensity;
 }
 
 std::vector<double> BaseParameters(const ShapeFitProblem& problem) {
@@ -166,14 +158,14 @@ std::vector<double> StartParameters(const ShapeFitProblem& problem) {
   return t;
 }
 
-double FitValue(const std::vector<double>& t, FitVariable variable) {
+double FitValue(const std::vector<double>& t, DesignVariableKind variable) {
   return At(t, ParametersOf(variable).front());
 }
 
 bool HollowOf(const ShapeFitProblem& problem) {
   if (problem.wall_thickness_m > 0.0) return true;
   for (const FitUnknown& u : problem.unknowns) {
-    if (u.variable == FitVariable::kWallThickness) return true;
+    if (u.variable == DesignVariableKind::kWallThickness) return true;
   }
   return false;
 }
@@ -195,8 +187,7 @@ std::vector<FitConstraint> ApplicableConstraints(bool hollow, bool has_fill) {
 
 bool ConstraintInvolves(FitConstraint kind, const std::vector<bool>& unknown) {
   for (int i = 0; i < kNumFitVariables && i < static_cast<int>(unknown.size()); ++i) {
-    if (unknown[static_cast<std::size_t>(i)] &&
-        Involves(kind, ParametersOf(static_cast<FitVariable>(i)))) {
+    if (unknown[static_cast<std::size_t>(i)] && Involves(kind, ParametersOf(kFitUnknownKinds[i]))) {
       return true;
     }
   }
@@ -208,7 +199,7 @@ double ConstraintValue(FitConstraint kind, const std::vector<double>& t, bool ho
 }
 
 Refusal ConstraintRefusal(FitConstraint kind, const std::vector<double>& t, bool hollow) {
-  const auto field = [](FitVariable v) { return FitVariableField(v); };
+  const auto field = [](DesignVariableKind v) { return FitUnknownField(v); };
   const double x1 = At(t, kIndex.x1);
   const double x2 = At(t, kIndex.x2);
   const double length = At(t, kIndex.length);
@@ -217,29 +208,29 @@ Refusal ConstraintRefusal(FitConstraint kind, const std::vector<double>& t, bool
   const double depth = At(t, kIndex.depth);
   switch (kind) {
     case FitConstraint::kStart:
-      return NumberRefusal(field(FitVariable::kTaperStart), x1, "must be non-negative");
+      return NumberRefusal(field(DesignVariableKind::kTaperStart), x1, "must be non-negative");
     case FitConstraint::kOrder:
-      return NumberRefusal(field(FitVariable::kTaperStart), x1,
+      return NumberRefusal(field(DesignVariableKind::kTaperStart), x1,
                            std::string("must not exceed shape.taper_end_m = ") + FormatNumber(x2));
     case FitConstraint::kEnd:
-      return NumberRefusal(field(FitVariable::kTaperEnd), x2,
+      return NumberRefusal(field(DesignVariableKind::kTaperEnd), x2,
                            "must not exceed shape.length_m = " + FormatNumber(length));
     case FitConstraint::kWallHandle:
       return NumberRefusal(
-          field(FitVariable::kWallThickness), wall,
+          field(DesignVariableKind::kWallThickness), wall,
           "must be less than shape.handle_radius_m = " + FormatNumber(At(t, kIndex.r1)));
     case FitConstraint::kWallBarrel:
       return NumberRefusal(
-          field(FitVariable::kWallThickness), wall,
+          field(DesignVariableKind::kWallThickness), wall,
           "must be less than shape.barrel_radius_m = " + FormatNumber(At(t, kIndex.r2)));
     case FitConstraint::kFillDepth:
-      return NumberRefusal(field(FitVariable::kFillDepth), depth,
+      return NumberRefusal(field(DesignVariableKind::kFillDepth), depth,
                            "must not exceed shape.length_m = " + FormatNumber(length));
     case FitConstraint::kBoreBottom:
     case FitConstraint::kBoreTip: {
       const double y = kind == FitConstraint::kBoreTip ? length : length - depth;
       const double around = FamilyRadiusAt<double>(t.data(), y) - (hollow ? wall : 0.0);
-      return NumberRefusal(field(FitVariable::kFillDiameter), diameter,
+      return NumberRefusal(field(DesignVariableKind::kFillDiameter), diameter,
                            "the bore radius " + FormatNumber(0.5 * diameter) +
                                " must be less than the " + (hollow ? "inner" : "outer") +
                                " radius " + FormatNumber(around) + " at x_m = " + FormatNumber(y) +
@@ -286,7 +277,7 @@ ShapeFitModel::ShapeFitModel(const ShapeFitProblem& problem, const ShapeFitOptio
   // values (ShapeFitProblem::IsValid checked them).
   double length_scale = At(base_, kIndex.length);
   for (const FitUnknown& u : problem.unknowns) {
-    if (u.variable == FitVariable::kLength) length_scale = std::max(length_scale, u.max);
+    if (u.variable == DesignVariableKind::kLength) length_scale = std::max(length_scale, u.max);
   }
   length_scale_ = length_scale > 0.0 ? length_scale : 1.0;
   for (FitConstraint kind : ApplicableConstraints(hollow_, has_fill_)) {

@@ -22,24 +22,24 @@
 
 namespace sweetspot::core::fit_detail {
 
-/// Number of FitVariable values.
-inline constexpr int kNumFitVariables = 10;
+/// Number of kinds a fit unknown may be.
+inline constexpr int kNumFitVariables = kNumFitUnknowns;
 /// Length of the parameter vector t: DesignParameterLayout{4}.Size().
 inline constexpr int kNumFitParameters = 2 * 4 + 5;
 
 /// The design variable that the fit variable `variable` is.
-DesignVariableRef DesignVariableOf(FitVariable variable);
+DesignVariableRef DesignVariableOf(DesignVariableKind variable);
 /// The field of a fit variable in refusals ("shape.taper_start_m", ...; "" if out of range).
-const char* FitVariableField(FitVariable variable);
+const char* FitUnknownField(DesignVariableKind variable);
 /// True for the fill's variables (they need a fill).
-bool IsFillVariable(FitVariable variable);
+bool IsFillVariable(DesignVariableKind variable);
 
 /// The problem's bat as parameters t (DesignParameterLayout{4}; fill entries 0 without a fill).
 std::vector<double> BaseParameters(const ShapeFitProblem& problem);
 /// The starting parameters: unknowns clamped into their bounds (the middle when not finite).
 std::vector<double> StartParameters(const ShapeFitProblem& problem);
 /// The value of `variable` in the parameters t, in its unit.
-double FitValue(const std::vector<double>& t, FitVariable variable);
+double FitValue(const std::vector<double>& t, DesignVariableKind variable);
 /// True when the bat is hollow (a wall, or the wall is an unknown).
 bool HollowOf(const ShapeFitProblem& problem);
 
@@ -57,7 +57,7 @@ enum class FitConstraint {
 
 /// The constraints that apply to a bat (hollow, with a fill).
 std::vector<FitConstraint> ApplicableConstraints(bool hollow, bool has_fill);
-/// True when an unknown among `unknown` (indexed by FitVariable) can change the constraint.
+/// True when an unknown among `unknown` (indexed by FitUnknownIndex) can change the constraint.
 bool ConstraintInvolves(FitConstraint kind, const std::vector<bool>& unknown);
 /// g(t), m (<= 0 when it holds).
 double ConstraintValue(FitConstraint kind, const std::vector<double>& t, bool hollow);

@@ -29,16 +29,16 @@ ShapeFitProblem EveryUnknown() {
   problem.material = *FindMaterial("aluminium-7050");
   problem.wall_thickness_m = 0.002;
   problem.fill = Fill{*FindMaterial("cork"), 0.02, 0.1};
-  problem.unknowns = {{FitVariable::kTaperStart, 0.1, 0.4},
-                      {FitVariable::kTaperEnd, 0.42, 0.7},
-                      {FitVariable::kLength, 0.8, 0.9},
-                      {FitVariable::kHandleRadius, 0.011, 0.014},
-                      {FitVariable::kBarrelRadius, 0.03, 0.034},
-                      {FitVariable::kDensity, 2000.0, 3000.0},
-                      {FitVariable::kWallThickness, 0.001, 0.003},
-                      {FitVariable::kFillDiameter, 0.01, 0.03},
-                      {FitVariable::kFillDepth, 0.05, 0.2},
-                      {FitVariable::kFillDensity, 100.0, 400.0}};
+  problem.unknowns = {{DesignVariableKind::kTaperStart, 0.1, 0.4},
+                      {DesignVariableKind::kTaperEnd, 0.42, 0.7},
+                      {DesignVariableKind::kLength, 0.8, 0.9},
+                      {DesignVariableKind::kHandleRadius, 0.011, 0.014},
+                      {DesignVariableKind::kBarrelRadius, 0.03, 0.034},
+                      {DesignVariableKind::kDensity, 2000.0, 3000.0},
+                      {DesignVariableKind::kWallThickness, 0.001, 0.003},
+                      {DesignVariableKind::kFillDiameter, 0.01, 0.03},
+                      {DesignVariableKind::kFillDepth, 0.05, 0.2},
+                      {DesignVariableKind::kFillDensity, 100.0, 400.0}};
   problem.targets.mass_kg = 0.9;
   problem.targets.balance_point_m = 0.55;
   return problem;
@@ -50,13 +50,13 @@ std::vector<double> InteriorPoint() {
 }
 
 TEST(ShapeFitModelTest, UnknownsAreTheDesignVariablesOfTheSameFields) {
-  EXPECT_EQ(DesignVariablePath(fit_detail::DesignVariableOf(FitVariable::kTaperStart)),
+  EXPECT_EQ(DesignVariablePath(fit_detail::DesignVariableOf(DesignVariableKind::kTaperStart)),
             "three_segment.taper_start_m");
-  EXPECT_EQ(DesignVariablePath(fit_detail::DesignVariableOf(FitVariable::kBarrelRadius)),
+  EXPECT_EQ(DesignVariablePath(fit_detail::DesignVariableOf(DesignVariableKind::kBarrelRadius)),
             "three_segment.barrel_radius_m");
-  EXPECT_EQ(DesignVariablePath(fit_detail::DesignVariableOf(FitVariable::kDensity)),
+  EXPECT_EQ(DesignVariablePath(fit_detail::DesignVariableOf(DesignVariableKind::kDensity)),
             "material.density_kg_m3");
-  EXPECT_EQ(DesignVariablePath(fit_detail::DesignVariableOf(FitVariable::kFillDensity)),
+  EXPECT_EQ(DesignVariablePath(fit_detail::DesignVariableOf(DesignVariableKind::kFillDensity)),
             "fill.material.density_kg_m3");
 }
 
@@ -69,18 +69,19 @@ TEST(ShapeFitModelTest, ResidualsAreThePublicMassProperties) {
   Eigen::VectorXd r;
   model.Residuals(s.data(), &r, nullptr);
   const std::vector<double> t = model.ToParameters(s.data());
-  const auto value = [&t](FitVariable v) { return fit_detail::FitValue(t, v); };
-  ThreeSegmentShape shape{value(FitVariable::kLength), value(FitVariable::kHandleRadius),
-                          value(FitVariable::kBarrelRadius), value(FitVariable::kTaperStart),
-                          value(FitVariable::kTaperEnd)};
+  const auto value = [&t](DesignVariableKind v) { return fit_detail::FitValue(t, v); };
+  ThreeSegmentShape shape{
+      value(DesignVariableKind::kLength), value(DesignVariableKind::kHandleRadius),
+      value(DesignVariableKind::kBarrelRadius), value(DesignVariableKind::kTaperStart),
+      value(DesignVariableKind::kTaperEnd)};
   Material material = problem.material;
-  material.density_kg_m3 = value(FitVariable::kDensity);
+  material.density_kg_m3 = value(DesignVariableKind::kDensity);
   Bat bat = MakeThreeSegmentBat(shape, material);
-  bat.wall_thickness_m = value(FitVariable::kWallThickness);
+  bat.wall_thickness_m = value(DesignVariableKind::kWallThickness);
   bat.fill = problem.fill;
-  bat.fill->diameter_m = value(FitVariable::kFillDiameter);
-  bat.fill->depth_m = value(FitVariable::kFillDepth);
-  bat.fill->material.density_kg_m3 = value(FitVariable::kFillDensity);
+  bat.fill->diameter_m = value(DesignVariableKind::kFillDiameter);
+  bat.fill->depth_m = value(DesignVariableKind::kFillDepth);
+  bat.fill->material.density_kg_m3 = value(DesignVariableKind::kFillDensity);
   std::string why;
   ASSERT_TRUE(Validates(bat, &why)) << why;
   const MassProperties p = ComputeMassProperties(bat);

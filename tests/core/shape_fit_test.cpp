@@ -24,7 +24,8 @@ ShapeFitProblem Table2Problem() {
   ShapeFitProblem problem;
   problem.shape = PaperThreeSegmentShape();
   problem.material = *FindMaterial("paper-wood");
-  problem.unknowns = {{FitVariable::kTaperStart, 0.0, kL}, {FitVariable::kTaperEnd, 0.0, kL}};
+  problem.unknowns = {{DesignVariableKind::kTaperStart, 0.0, kL},
+                      {DesignVariableKind::kTaperEnd, 0.0, kL}};
   problem.targets.mass_kg = 0.885;
   problem.targets.balance_point_m = 0.564;
   return problem;
@@ -137,7 +138,7 @@ TEST(ShapeFitPaper, ExactFitRecoversATaper) {
 
 TEST(ShapeFitPaper, DensityFromTheMass) {
   ShapeFitProblem problem = Table2Problem();
-  problem.unknowns = {{FitVariable::kDensity, 100.0, 2000.0}};
+  problem.unknowns = {{DesignVariableKind::kDensity, 100.0, 2000.0}};
   problem.targets.balance_point_m.reset();
   const ShapeFitResult fit = FitShape(problem);
   ASSERT_EQ(fit.summary.termination, Termination::kConverged) << fit.summary.FullReport();
@@ -152,7 +153,7 @@ TEST(ShapeFitPaper, DensityCannotMoveTheBalancePoint) {
   // One unknown, two targets: C does not depend on rho, so the closest bat
   // meets the mass exactly and misses C by 0.6090 - 0.564.
   ShapeFitProblem problem = Table2Problem();
-  problem.unknowns = {{FitVariable::kDensity, 100.0, 2000.0}};
+  problem.unknowns = {{DesignVariableKind::kDensity, 100.0, 2000.0}};
   const ShapeFitResult fit = FitShape(problem);
   ASSERT_EQ(fit.summary.termination, Termination::kInfeasible) << fit.summary.FullReport();
   // The mass residual is driven to round-off by Gauss-Newton (1e-9: the
@@ -167,7 +168,7 @@ TEST(ShapeFitHollow, WallThicknessFromTheMass) {
   problem.shape = {0.8382, 0.0115, 0.0333375, 0.28, 0.52};
   problem.material = *FindMaterial("aluminium-7050");
   problem.wall_thickness_m = 0.002;
-  problem.unknowns = {{FitVariable::kWallThickness, 0.0005, 0.01}};
+  problem.unknowns = {{DesignVariableKind::kWallThickness, 0.0005, 0.01}};
   problem.targets.mass_kg = 0.850485694;  // 30 oz
   const ShapeFitResult fit = FitShape(problem);
   ASSERT_EQ(fit.summary.termination, Termination::kConverged) << fit.summary.FullReport();
@@ -182,7 +183,7 @@ TEST(ShapeFitFill, CorkDepthFromTheMass) {
   Fill fill{*FindMaterial("cork"), 0.0254, 0.1};
   fill.material.density_kg_m3 = 320.0;
   problem.fill = fill;
-  problem.unknowns = {{FitVariable::kFillDepth, 0.0, kL}};
+  problem.unknowns = {{DesignVariableKind::kFillDepth, 0.0, kL}};
   problem.targets.balance_point_m.reset();
   problem.targets.mass_kg = 1.0078187508438627 - 0.0423;  // paper-notes: 42.3 g less at 25.4 cm
   const ShapeFitResult fit = FitShape(problem);
@@ -196,7 +197,7 @@ TEST(ShapeFitFill, BoreMustStayInsideTheWood) {
   // taper): a target that needs a deeper bore stops at the constraint.
   ShapeFitProblem problem = Table2Problem();
   problem.fill = Fill{EmptyFillMaterial(), 0.05, 0.1};
-  problem.unknowns = {{FitVariable::kFillDepth, 0.0, kL}};
+  problem.unknowns = {{DesignVariableKind::kFillDepth, 0.0, kL}};
   problem.targets.balance_point_m.reset();
   problem.targets.mass_kg = 0.5;
   const ShapeFitResult fit = FitShape(problem);
@@ -280,10 +281,12 @@ TEST(ShapeFitValidity, ProblemRefusals) {
        "targets.balance_point_m = 150: must be in [1e-06, 100]"},
       {[](ShapeFitProblem& p) { p.unknowns.clear(); },
        "unknowns.size() = 0: must be between 1 and 10"},
-      {[](ShapeFitProblem& p) { p.unknowns[1].variable = FitVariable::kTaperStart; },
+      {[](ShapeFitProblem& p) { p.unknowns[1].variable = DesignVariableKind::kKnotRadius; },
+       "unknowns[1].variable = 0: is not a fit unknown (a profile knot's kind)"},
+      {[](ShapeFitProblem& p) { p.unknowns[1].variable = DesignVariableKind::kTaperStart; },
        "unknowns[1].variable = taper_start_m: appears more than once"},
       {[](ShapeFitProblem& p) {
-         p.unknowns[1] = {FitVariable::kFillDepth, 0.0, 0.3};
+         p.unknowns[1] = {DesignVariableKind::kFillDepth, 0.0, 0.3};
        },
        "unknowns[1].variable = fill.depth_m: the bat has no fill"},
       {[](ShapeFitProblem& p) { p.unknowns[0].max = 0.0; },
@@ -291,19 +294,19 @@ TEST(ShapeFitValidity, ProblemRefusals) {
       {[](ShapeFitProblem& p) { p.unknowns[0].min = -0.1; },
        "unknowns[0].min = -0.1: must be non-negative for taper_start_m"},
       {[](ShapeFitProblem& p) {
-         p.unknowns[1] = {FitVariable::kWallThickness, 0.0, 0.01};
+         p.unknowns[1] = {DesignVariableKind::kWallThickness, 0.0, 0.01};
        },
        "unknowns[1].min = 0: must be positive for wall_thickness_m (the bat stays hollow)"},
       {[](ShapeFitProblem& p) { p.shape.length_m = 0.0; }, "shape.length_m = 0: must be positive"},
       {[](ShapeFitProblem& p) { p.material.youngs_modulus_pa = -1.0; },
        "material.youngs_modulus_pa = -1: must be positive"},
       {[](ShapeFitProblem& p) {
-         p.unknowns = {{FitVariable::kDensity, 100.0, 1000.0}};
+         p.unknowns = {{DesignVariableKind::kDensity, 100.0, 1000.0}};
          p.shape.taper_start_m = 0.7;
        },
        "shape.taper_start_m = 0.7: must not exceed shape.taper_end_m = 0.6423"},
       {[](ShapeFitProblem& p) {
-         p.unknowns = {{FitVariable::kDensity, 100.0, 1000.0}};
+         p.unknowns = {{DesignVariableKind::kDensity, 100.0, 1000.0}};
          p.wall_thickness_m = 0.02;
        },
        "wall_thickness_m = 0.02: must be less than shape.handle_radius_m = 0.0125"},
@@ -322,7 +325,7 @@ TEST(ShapeFitValidity, ProblemRefusals) {
 
 TEST(ShapeFitValidity, BoundsWithoutAnyValidBat) {
   ShapeFitProblem problem = Table2Problem();
-  problem.unknowns = {{FitVariable::kTaperStart, 0.7, 0.8}};  // x2 stays 0.6423 < x1
+  problem.unknowns = {{DesignVariableKind::kTaperStart, 0.7, 0.8}};  // x2 stays 0.6423 < x1
   const ShapeFitResult fit = FitShape(problem);
   EXPECT_EQ(fit.summary.termination, Termination::kInvalidInput);
   EXPECT_NE(fit.summary.message.find("admit no valid bat"), std::string::npos)
@@ -330,13 +333,17 @@ TEST(ShapeFitValidity, BoundsWithoutAnyValidBat) {
 }
 
 TEST(ShapeFitValidity, VariableNames) {
-  for (int i = 0; i < 10; ++i) {
-    const auto v = static_cast<FitVariable>(i);
-    EXPECT_EQ(FitVariableFromName(FitVariableName(v)), v);
+  for (int i = 0; i < kNumFitUnknowns; ++i) {
+    const DesignVariableKind v = kFitUnknownKinds[i];
+    EXPECT_EQ(FitUnknownIndex(v), i);
+    EXPECT_EQ(FitUnknownFromName(FitUnknownName(v)), v);
   }
-  EXPECT_STREQ(FitVariableName(FitVariable::kTaperStart), "taper_start_m");
-  EXPECT_STREQ(FitVariableName(FitVariable::kFillDensity), "fill.density_kg_m3");
-  EXPECT_FALSE(FitVariableFromName("x1").has_value());
+  // A profile knot's kind is a design variable but no fit unknown.
+  EXPECT_EQ(FitUnknownIndex(DesignVariableKind::kKnotRadius), -1);
+  EXPECT_STREQ(FitUnknownName(DesignVariableKind::kKnotPosition), "unknown");
+  EXPECT_STREQ(FitUnknownName(DesignVariableKind::kTaperStart), "taper_start_m");
+  EXPECT_STREQ(FitUnknownName(DesignVariableKind::kFillDensity), "fill.density_kg_m3");
+  EXPECT_FALSE(FitUnknownFromName("x1").has_value());
 }
 
 TEST(ShapeFitThreads, ParallelFitsAgreeWithTheSerialOne) {

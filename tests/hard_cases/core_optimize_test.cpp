@@ -35,7 +35,7 @@ CoreCase DensityFitRow(std::string name, double mass_kg) {
   return {std::move(name),
           [mass_kg] {
             core::ShapeFitProblem p = PaperFit();
-            p.unknowns = {{core::FitVariable::kDensity, 1e-6, 1e6}};
+            p.unknowns = {{core::DesignVariableKind::kDensity, 1e-6, 1e6}};
             p.targets.mass_kg = mass_kg;
             const core::ShapeFitResult r = core::FitShape(p);
             return FromSummary(r.summary, r.material.density_kg_m3);
@@ -61,8 +61,8 @@ std::vector<CoreCase> ShapeFitCases() {
       {"PaperTable2TargetsAreInfeasible",
        [] {
          core::ShapeFitProblem p = PaperFit();
-         p.unknowns = {{core::FitVariable::kTaperStart, 0.0, 0.855},
-                       {core::FitVariable::kTaperEnd, 0.0, 0.855}};
+         p.unknowns = {{core::DesignVariableKind::kTaperStart, 0.0, 0.855},
+                       {core::DesignVariableKind::kTaperEnd, 0.0, 0.855}};
          p.targets.mass_kg = 0.885;
          p.targets.balance_point_m = 0.564;
          return FromSummary(core::FitShape(p).summary, kNaN);
@@ -74,7 +74,7 @@ std::vector<CoreCase> ShapeFitCases() {
        [] {
          core::ShapeFitProblem p = PaperFit();
          p.wall_thickness_m = 0.002;
-         p.unknowns = {{core::FitVariable::kWallThickness, 1e-12, 0.0125 * (1 - 1e-12)}};
+         p.unknowns = {{core::DesignVariableKind::kWallThickness, 1e-12, 0.0125 * (1 - 1e-12)}};
          p.targets.mass_kg = 0.3;
          const core::ShapeFitResult r = core::FitShape(p);
          return FromSummary(r.summary, std::abs(r.properties.mass_kg - 0.3) / 0.3);
@@ -83,7 +83,7 @@ std::vector<CoreCase> ShapeFitCases() {
       {"EqualBoundsAreRefused",
        [] {
          core::ShapeFitProblem p = PaperFit();
-         p.unknowns = {{core::FitVariable::kDensity, 600.0, 600.0}};
+         p.unknowns = {{core::DesignVariableKind::kDensity, 600.0, 600.0}};
          p.targets.mass_kg = 0.95;
          return FromSummary(core::FitShape(p).summary, kNaN);
        },
