@@ -8,7 +8,7 @@
 //
 // Adding a field: a row of Fields() (fields.cpp) with its accessor, in its object's reading
 // order (the request's parser reads each object's numbers with ReadFieldGroup, in the table's
-// order); core's own name for it (DesignVariableKind for an optimiser variable, FitVariable for
+// order); core's own name for it (DesignVariableKind, for an optimiser variable and for
 // a fit unknown) when those take it. FieldsTest round-trips every row through the parser, the
 // binder and the optimiser's variables.
 #pragma once
