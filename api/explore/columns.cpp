@@ -54,6 +54,11 @@ Json RowShape(const std::vector<std::string>& parameter_paths, const RowOutputs&
   }
   if (outputs.properties) shape["properties"] = PropertiesToJson(core::MassProperties{}, 0.0);
   if (outputs.collision_efficiency) shape["collision_efficiency"] = 0.0;
+  if (outputs.swing) {
+    core::Swing swing;
+    swing.bat_speed_mps = 0.0;
+    shape["swing"] = SwingToJson(swing);
+  }
   return shape;
 }
 

@@ -22,6 +22,8 @@ struct RowOutputs {
   bool properties = false;            ///< The bat's mass properties ("properties").
   bool collision_efficiency = false;  ///< q at the sweet spot (rigid pivot; needs max_exit_speed).
   std::vector<core::SceneOutput> scene;  ///< The scene outputs.
+  /// Each design has its own swing (a bat speed given or swept): rows carry "swing".
+  bool swing = false;
 };
 
 /// A design's row and what computing it took.

@@ -9,13 +9,13 @@
 #include <functional>
 #include <memory>
 
-#include "api/fields.hpp"
 #include "api/explore/columns.hpp"
 #include "api/explore/design.hpp"
 #include "api/explore/engine.hpp"
 #include "api/explore/estimate.hpp"
 #include "api/explore/shards.hpp"
 #include "api/explore/streams.hpp"
+#include "api/fields.hpp"
 #include "api/handlers/endpoint.hpp"
 #include "api/handlers/handlers.hpp"
 #include "api/json_path.hpp"
@@ -380,6 +380,22 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
         std::find(outputs.scene.begin(), outputs.scene.end(), core::SceneOutput::kMaxExitSpeed) ==
             outputs.scene.end()) {
       outputs.scene.push_back(core::SceneOutput::kMaxExitSpeed);
+    }
+  }
+  // A bat speed, in the template or swept, gives each design its own swing, which its row
+  // reports (RenderDesignRow): the row's shape says so for the columns and the estimate.
+  if (const auto swing = base.find("swing"); swing != base.end() && swing->is_object()) {
+    for (const auto& item : swing->items()) {
+      if (item.key().rfind("bat_speed_m", 0) == 0) outputs.swing = true;
+    }
+  }
+  for (const SweepParameter& parameter : parameters) {
+    for (const auto& target : parameter.targets) {
+      const auto* head = target.size() >= 2 ? std::get_if<std::string>(&target[0]) : nullptr;
+      const auto* field = head != nullptr ? std::get_if<std::string>(&target[1]) : nullptr;
+      if (field != nullptr && *head == "swing" && field->rfind("bat_speed_m", 0) == 0) {
+        outputs.swing = true;
+      }
     }
   }
   core::SceneOptions options;

@@ -77,8 +77,16 @@ TEST(ExploreEstimateTest, EstimateIsWithinAQuarterOfTheAnswer) {
   defaults.erase("options");
   Json imperial = defaults;
   imperial["report_units"] = "imperial";
+  // A bat speed gives every row its own "swing" block (5 numbers); the estimate counts it
+  // (SwingOfABatSpeedSweepCanBeAColumn checks the block's bytes are in the row's estimate).
+  Json bat_speed = defaults;
+  bat_speed["swing"] = {{"bat_speed_mph", 70}};
+  Json bat_speed_swept = defaults;
+  bat_speed_swept["parameters"].push_back(
+      {{"path", "swing.bat_speed_mph"}, {"min", 60}, {"max", 80}, {"count", 3}});
   for (const Case& c : {Case{CurveSweep(40, 300), "curve of 300"}, Case{defaults, "defaults"},
-                        Case{imperial, "imperial"}}) {
+                        Case{imperial, "imperial"}, Case{bat_speed, "bat speed"},
+                        Case{bat_speed_swept, "bat speed swept"}}) {
     ApiError error;
     const auto parsed = ParseExploreRequest(c.body, Context{}, &error);
     ASSERT_TRUE(parsed) << c.what << ": " << error.message;
@@ -89,6 +97,38 @@ TEST(ExploreEstimateTest, EstimateIsWithinAQuarterOfTheAnswer) {
     EXPECT_NEAR(static_cast<double>(estimate.AnswerBytes()) / actual, 1.0, 0.25)
         << c.what << ": estimate " << estimate.AnswerBytes() << ", answer " << actual;
   }
+}
+
+// A row's "swing" block (a bat speed given or swept) can be named as columns.
+TEST(ExploreEstimateTest, SwingOfABatSpeedSweepCanBeAColumn) {
+  Json body = CurveSweep(3, 2);
+  body.erase("outputs");
+  body.erase("options");
+  body["parameters"] = {{{"path", "swing.bat_speed_mph"}, {"min", 60}, {"max", 80}, {"count", 3}}};
+  body["format"] = "csv";
+  body["columns"] = {"index", "swing.bat_speed_mps", "swing.bat_speed_mph"};
+  const Response r = Explore(body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  Json without_speed = CurveSweep(3, 2);
+  without_speed["columns"] = {"index", "swing.bat_speed_mps"};
+  const Response refused = Explore(without_speed);
+  EXPECT_EQ(refused.status, 400) << refused.body.dump();  // no bat speed: rows have no swing
+  // The estimate of a row counts the block: 5 numbers and their names, over 100 bytes (the
+  // estimate missed them: 329 bytes of a 488-byte max_exit_speed row with a bat speed).
+  Json plain = body;
+  plain.erase("columns");
+  plain.erase("format");
+  Json same_without = plain;
+  same_without["parameters"] = {{{"path", "cor"}, {"min", 0.4}, {"max", 0.6}, {"count", 3}}};
+  ApiError error;
+  const auto with_swing = ParseExploreRequest(plain, Context{}, &error);
+  ASSERT_TRUE(with_swing) << error.message;
+  const auto no_swing = ParseExploreRequest(same_without, Context{}, &error);
+  ASSERT_TRUE(no_swing) << error.message;
+  const auto bytes = [](const auto& parsed) {
+    return EstimateSweep(*parsed->sweep, parsed->format, parsed->columns).bytes_per_row;
+  };
+  EXPECT_GT(bytes(with_swing), bytes(no_swing) + 100);
 }
 
 // The limit is configuration: just above the estimate the answer is computed, below it 413.
