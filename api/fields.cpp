@@ -38,6 +38,14 @@ std::vector<Field> MakeFields() {
   f.push_back({"ball.stiffness_exponent", "1", G::kBall, 1.0, 3.0, true, false, "",
                [](const H& h) { return h.ball->stiffness_exponent; },
                [](const H& h, double v) { h.ball->stiffness_exponent = v; }});
+  // The oblique impact's (batted_ball): the pitch's path and spin at the plate.
+  f.push_back({"ball.descent_angle_deg", "deg", G::kBall, -core::kMaxPathAngleDeg,
+               core::kMaxPathAngleDeg, true, false, "",
+               [](const H& h) { return h.ball->descent_angle_deg; },
+               [](const H& h, double v) { h.ball->descent_angle_deg = v; }});
+  f.push_back({"ball.spin_rpm", "rpm", G::kBall, -core::kMaxPitchSpinRpm, core::kMaxPitchSpinRpm,
+               true, false, "", [](const H& h) { return h.ball->spin_rpm; },
+               [](const H& h, double v) { h.ball->spin_rpm = v; }});
   f.push_back({"swing.angular_speed_rad_s", "rad/s", G::kSwing, 0.0,
                core::kMaxSwingAngularSpeedRadS, true, false, "",
                [](const H& h) { return h.swing->angular_speed_rad_s; },
@@ -60,6 +68,14 @@ std::vector<Field> MakeFields() {
                core::kMaxSwingOffsetM, true, false, "",
                [](const H& h) { return h.swing->hands_from_knob_m; },
                [](const H& h, double v) { h.swing->hands_from_knob_m = v; }});
+  f.push_back({"swing.attack_angle_deg", "deg", G::kSwing, -core::kMaxPathAngleDeg,
+               core::kMaxPathAngleDeg, true, false, "",
+               [](const H& h) { return h.swing->attack_angle_deg; },
+               [](const H& h, double v) { h.swing->attack_angle_deg = v; }});
+  // Where across the bat the ball meets it (batted_ball).
+  f.push_back({"contact.undercut_m", "m", G::kContact, -core::kMaxUndercutM, core::kMaxUndercutM,
+               true, false, "", [](const H& h) { return h.contact->undercut_m; },
+               [](const H& h, double v) { h.contact->undercut_m = v; }});
   f.push_back({"cor", "1", G::kCor, 0.0, 1.0, true, false, "",
                [](const H& h) { return h.cor->value_or(0.0); },
                [](const H& h, double v) { *h.cor = v; }});
@@ -194,6 +210,7 @@ FieldHost FieldHost::Of(core::Scene* scene, core::ThreeSegmentShape* shape) {
   host.ball = &scene->ball;
   host.swing = &scene->swing;
   host.cor = &scene->cor;
+  host.contact = &scene->contact;
   if (scene->bat.has_value()) {
     host.bat = &*scene->bat;
     host.material = &host.bat->material;

@@ -30,6 +30,7 @@ enum class FieldGroup {
   kBall,          ///< "ball.*": the pitched ball.
   kSwing,         ///< "swing.*".
   kCor,           ///< "cor".
+  kContact,       ///< "contact.*": where across the bat the ball meets it.
   kShape,         ///< "bat.three_segment.*": a three-segment bat's shape.
   kKnot,          ///< "bat.profile.knots[i].*": a profile bat's knot.
   kMaterial,      ///< "bat.material.*": a material given as an object.
@@ -45,6 +46,7 @@ struct FieldHost {
   core::Ball* ball = nullptr;
   core::Swing* swing = nullptr;
   std::optional<double>* cor = nullptr;
+  core::Contact* contact = nullptr;
   core::Bat* bat = nullptr;                  ///< Knots, wall.
   core::Material* material = nullptr;        ///< The bat's material (a material object's rows).
   core::ThreeSegmentShape* shape = nullptr;  ///< A three-segment bat's shape.

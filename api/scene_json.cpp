@@ -77,6 +77,15 @@ bool ReadSceneCommon(ObjectReader& reader, core::Scene* scene) {
   FieldHost host;  // "cor": the table of fields
   host.cor = &scene->cor;
   ReadFieldGroup(reader, FieldGroup::kCor, host);
+  if (const Json* contact = reader.Get("contact")) {  // "contact": its object's rows
+    ObjectReader contact_reader(*contact, reader.PathOf("contact"), reader.error());
+    FieldHost contact_host;
+    contact_host.contact = &scene->contact;
+    if (!ReadFieldGroup(contact_reader, FieldGroup::kContact, contact_host) ||
+        !contact_reader.Finish()) {
+      return false;
+    }
+  }
   std::string inertia = "rigid_body";
   reader.OptionalString("inertia_model", &inertia, {"rigid_body", "slender_rod"});
   scene->inertia_model =

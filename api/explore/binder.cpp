@@ -116,6 +116,8 @@ std::optional<DesignBinder> DesignBinder::Compile(
         case FieldGroup::kCor:
           binder.changes_.cor = true;
           break;
+        case FieldGroup::kContact:  // read by batted_ball only: nothing resolved changes
+          break;
         case FieldGroup::kMaterial:
         case FieldGroup::kFillMaterial:
           binder.changes_.bat_materials = true;

@@ -178,7 +178,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
 
   // The design template: the bat and the scene fields, as written.
   Json base = Json::object();
-  for (const char* key : {"bat", "ball", "swing", "cor", "inertia_model"}) {
+  for (const char* key : {"bat", "ball", "swing", "cor", "inertia_model", "contact"}) {
     if (const Json* value = reader.Get(key)) base[key] = *value;
   }
   if (!base.contains("bat")) {

@@ -23,14 +23,18 @@ enum class SceneOutput {
   kBbcor,           ///< BBCOR by the NCAA protocol (core/collision/barrel.hpp).
   /// BBCOR along the barrel by the flexible model and its maximum (core/collision/bbcor_scan.hpp).
   kBbcorScan,
+  /// The batted ball at the max-exit-speed point: the oblique impact, then its flight
+  /// (core/collision/oblique_impact.hpp, core/flight/flight.hpp).
+  kBattedBall,
 };
 
 /// The number of outputs (ids run from 0 to kSceneOutputCount - 1).
 inline constexpr std::size_t kSceneOutputCount =
-    static_cast<std::size_t>(SceneOutput::kBbcorScan) + 1;
+    static_cast<std::size_t>(SceneOutput::kBattedBall) + 1;
 
 /// Stable name, the declaration's: "max_exit_speed", "center_of_percussion", "vibration_node",
-/// "sweet_zone", "exit_speed_curve", "least_sting_zone", "barrel", "bbcor", "bbcor_scan".
+/// "sweet_zone", "exit_speed_curve", "least_sting_zone", "barrel", "bbcor", "bbcor_scan",
+/// "batted_ball".
 const char* SceneOutputName(SceneOutput output);
 /// The output called `name`, or nullopt.
 std::optional<SceneOutput> ParseSceneOutput(std::string_view name);

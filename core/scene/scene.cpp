@@ -35,6 +35,11 @@ bool Ball::Validate(Refusal* why) const {
   if (!(std::isfinite(stiffness_exponent) && stiffness_exponent >= 1.0 &&
         stiffness_exponent <= 3.0))
     return Refuse17(why, "ball.stiffness_exponent", stiffness_exponent, "must be in [1, 3]");
+  if (!CheckRange(why, "ball.descent_angle_deg", descent_angle_deg, -kMaxPathAngleDeg,
+                  kMaxPathAngleDeg) ||
+      !CheckRange(why, "ball.spin_rpm", spin_rpm, -kMaxPitchSpinRpm, kMaxPitchSpinRpm)) {
+    return false;
+  }
   return !cor_law.has_value() || cor_law->Validate(why);
 }
 
@@ -57,7 +62,13 @@ bool Swing::Validate(Refusal* why) const {
          (!bat_speed_mps.has_value() ||
           CheckRange(why, "swing.bat_speed_mps", *bat_speed_mps, 0.0, kMaxBatSpeedMps)) &&
          CheckRange(why, "swing.bat_speed_from_tip_m", bat_speed_from_tip_m, 0.0,
-                    kMaxSwingOffsetM);
+                    kMaxSwingOffsetM) &&
+         CheckRange(why, "swing.attack_angle_deg", attack_angle_deg, -kMaxPathAngleDeg,
+                    kMaxPathAngleDeg);
+}
+
+bool Contact::Validate(Refusal* why) const {
+  return CheckRange(why, "contact.undercut_m", undercut_m, -kMaxUndercutM, kMaxUndercutM);
 }
 
 bool ResolveSwing(const Swing& swing, double length_m, Swing* resolved, Refusal* refusal) {
@@ -114,7 +125,7 @@ bool Scene::Validate(Refusal* why) const {
     if (!std::isfinite(mp.moi_knob_kg_m2))
       return Refuse17(why, "mass_properties.moi_knob_kg_m2", mp.moi_knob_kg_m2, "must be finite");
   }
-  if (!ball.Validate(why) || !swing.Validate(why)) return false;
+  if (!ball.Validate(why) || !swing.Validate(why) || !contact.Validate(why)) return false;
   if (!ValidateCor(why)) return false;
   if (outputs.empty())
     return Refuse(why, TextRefusal("outputs", "empty: name at least one output"));

@@ -50,6 +50,14 @@ inline constexpr double kMaxSwingAngularSpeedRadS = 1e4;
 inline constexpr double kMaxSwingOffsetM = 100.0;
 /// Largest bat speed (swing.bat_speed_mps) a scene accepts, m/s.
 inline constexpr double kMaxBatSpeedMps = 1e3;
+/// Largest |angle| of a path (swing.attack_angle_deg, ball.descent_angle_deg), deg: the
+/// oblique impact's own bound (ObliqueImpactInputs).
+inline constexpr double kMaxPathAngleDeg = 89.0;
+/// Largest |ball.spin_rpm| a scene accepts (the flight's spin bound).
+inline constexpr double kMaxPitchSpinRpm = 10000.0;
+/// Largest |contact.undercut_m| a scene accepts, m (4 in; the oblique impact refuses beyond
+/// ball radius + bat radius at the point).
+inline constexpr double kMaxUndercutM = 0.1016;
 
 /// The ball. Defaults: a regulation baseball and the paper's Table 3 speed.
 struct Ball {
@@ -59,6 +67,11 @@ struct Ball {
   /// Contact models: k in F = k delta^p, N/m^p, in (0, kMaxBallStiffness].
   double stiffness = kDefaultBallStiffness;
   double stiffness_exponent = kDefaultBallStiffnessExponent;  ///< Contact models: p, in [1, 3].
+  /// The pitch's path at the plate below horizontal, deg (+ down), in [-kMaxPathAngleDeg,
+  /// kMaxPathAngleDeg]; the oblique impact's (batted_ball) only.
+  double descent_angle_deg = 0.0;
+  /// The pitch's spin, rpm (+ backspin), |value| <= kMaxPitchSpinRpm; batted_ball only.
+  double spin_rpm = 0.0;
   /// The catalogue entry this ball came from ("" = none: today's default ball).
   std::string preset;
   /// The ball's COR against solid wood by impact speed (set by a preset). When set and the scene
@@ -93,6 +106,8 @@ struct Swing {
   /// Where bat_speed_mps is measured, m from the tip (the barrel end), in [0, kMaxSwingOffsetM];
   /// the default is 6 in, as swing sensors report.
   double bat_speed_from_tip_m = kCorReferenceFromTipM;
+  /// The bat's path above horizontal, deg (+ up), within +-kMaxPathAngleDeg; batted_ball only.
+  double attack_angle_deg = 0.0;
 
   /// True when every field is finite and in range; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "swing.field = value: rule".
@@ -105,6 +120,16 @@ struct Swing {
 /// pivot, or the omega it gives is over kMaxSwingAngularSpeedRadS. `swing` must be valid.
 bool ResolveSwing(const Swing& swing, double length_m, Swing* resolved, Refusal* refusal);
 
+/// Where the ball meets the bat across the bat's axis (the oblique impact, batted_ball).
+struct Contact {
+  /// The ball's centre above the bat's axis across the approach line, m (+ gives backspin),
+  /// within +-kMaxUndercutM.
+  double undercut_m = 0.0;
+
+  /// True when in range; otherwise the refusal "contact.undercut_m = ...: ...".
+  bool Validate(Refusal* refusal) const;
+};
+
 /// A scene: what is hit, how, and what is wanted.
 struct Scene {
   std::optional<Bat> bat;  ///< The bat (needed for the contact model's surface stiffness).
@@ -114,6 +139,7 @@ struct Scene {
   InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< When computing from `bat`.
   Ball ball;                                              ///< The ball.
   Swing swing;                                            ///< The swing.
+  Contact contact;  ///< Where across the bat the ball meets it (batted_ball).
   /// COR in [0, 1]; unset = the ball's COR law (a preset's) for a solid bat, else the bat
   /// material's default (ResolveScene).
   std::optional<double> cor;
