@@ -48,7 +48,7 @@ Json Template(bool profile, bool bat_speed = false) {
   bat["fill"] = Json::parse(R"({"material": {"density_kg_m3": 200, "youngs_modulus_pa": 2e7},
       "diameter_m": 0.02, "depth_m": 0.1})");
   Json swing = {{"angular_speed_rad_s", 40.0}, {"pivot_from_knob_m", 0.01},
-                {"hands_from_knob_m", 0.15}};
+                {"hands_from_knob_m", 0.15}, {"attack_angle_deg", 8.0}};
   if (bat_speed) {
     swing.erase("angular_speed_rad_s");
     swing["bat_speed_mps"] = 31.0;
@@ -56,9 +56,11 @@ Json Template(bool profile, bool bat_speed = false) {
   }
   return Json{{"bat", bat},
               {"ball", {{"mass_kg", 0.145}, {"radius_m", 0.0366}, {"speed_mps", 30.0},
-                        {"stiffness_n_m_p", 1e7}, {"stiffness_exponent", 1.5}}},
+                        {"stiffness_n_m_p", 1e7}, {"stiffness_exponent", 1.5},
+                        {"descent_angle_deg", 6.0}, {"spin_rpm", 1500.0}}},
               {"swing", swing},
-              {"cor", 0.5}};
+              {"cor", 0.5},
+              {"contact", {{"undercut_m", 0.01}}}};
 }
 
 // The request parsed as a sweep's template is (ParseBatGeometry, ReadSceneCommon).
@@ -106,7 +108,7 @@ bool IsBatSpeedField(const Field& field) {
 // accessor; bound by the sweep's binder to the same scene the parser gives; and, when a
 // variable, named by core's variable path in every form.
 TEST(FieldsTest, EveryFieldRoundTripsThroughParserBinderAndOptimizeVariable) {
-  ASSERT_EQ(Fields().size(), 27u);
+  ASSERT_EQ(Fields().size(), 31u);
   for (const Field& field : Fields()) {
     SCOPED_TRACE(std::string(field.path));
     const Json base = Template(IsProfileField(field), IsBatSpeedField(field));

@@ -35,7 +35,7 @@ TEST(OutputRegistryTest, EveryIdHasOneDeclarationWhoseNameParsesBack) {
   EXPECT_FALSE(ParseSceneOutput("sweetspot").has_value());
   EXPECT_EQ(SceneOutputNameList(),
             "max_exit_speed, center_of_percussion, vibration_node, sweet_zone, exit_speed_curve, "
-            "least_sting_zone, barrel, bbcor, bbcor_scan");
+            "least_sting_zone, barrel, bbcor, bbcor_scan, batted_ball");
 }
 
 // An output another reads (needs_output) is computed first: the loop runs in table order.
