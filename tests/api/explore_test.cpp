@@ -296,8 +296,9 @@ TEST(ExploreTest, AnUnknownLastKeyIsRefusedBeforeTheFirstDesign) {
        "parameters[0].path = \"fill.depht_m\": bat.fill.depht_m is not a known field; did you "
        "mean depth_m? (known: depth_m, diameter_m, material)"},
       {CorkSweep()["bat"], "ball.speed",
-       "parameters[0].path = \"ball.speed\": ball.speed is not a known field (known: mass_kg, "
-       "preset, radius_m, speed_mps, stiffness_exponent, stiffness_n_m_p)"},
+       "parameters[0].path = \"ball.speed\": ball.speed is not a known field (known: "
+       "descent_angle_deg, mass_kg, preset, radius_m, speed_mps, spin_rpm, stiffness_exponent, "
+       "stiffness_n_m_p)"},
   };
   for (const Case& c : cases) {
     Json body = CorkSweep();
