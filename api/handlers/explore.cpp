@@ -297,9 +297,12 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
       const Json* path_json = written[j].second;
       std::string path = written[j].first;
       const std::string head = path.substr(0, path.find_first_of(".["));
-      if (head != "bat" && head != "ball" && head != "swing" && head != "cor") path = "bat." + path;
+      if (head != "bat" && head != "ball" && head != "swing" && head != "cor" &&
+          head != "contact") path = "bat." + path;
       // A scene object the request left to its defaults can still be swept.
-      if ((head == "ball" || head == "swing") && !base.contains(head)) base[head] = Json::object();
+      if ((head == "ball" || head == "swing" || head == "contact") && !base.contains(head)) {
+        base[head] = Json::object();
+      }
       std::string why;
       // A preset (bat.preset, ball.preset) is a catalogue name: every design would fail alike.
       if (path.size() >= 7 && path.compare(path.size() - 7, 7, ".preset") == 0) {

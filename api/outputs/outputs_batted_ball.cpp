@@ -14,7 +14,7 @@ void RenderBattedBall(const core::SceneResult& r, Json* out, Json* errors) {
   (*out)["batted_ball"] = {
       {"exit_speed_mps", i.exit_speed_mps},
       {"launch_angle_deg", i.launch_angle_deg},
-      {"backspin_rpm", i.backspin_rpm},
+      {"backspin_rpm", i.backspin_rpm + 0.0},  // + 0.0: head-on writes 0, not -0
       {"sidespin_rpm", 0.0},
       {"spin_source", "oblique_impact"},
       {"distance_m", f.distance_m},

@@ -89,6 +89,25 @@ TEST(BattedBallApiTest, RefusesAModelItCannotFeed) {
   EXPECT_NE(r.body.dump().find("options.model"), std::string::npos) << r.body.dump();
 }
 
+TEST(BattedBallApiTest, ExploreSweepsTheUndercut) {
+  const Response r = Dispatch(
+      {"POST", "/v1/explore",
+       R"({"bat": {"preset": "wood-34-ash"}, "ball": {"speed_mph": 90},
+           "swing": {"bat_speed_mph": 70}, "options": {"model": "free_bat"},
+           "outputs": ["batted_ball"],
+           "parameters": [{"path": "contact.undercut_in", "min": 0, "max": 1, "count": 3}]})"},
+      Context{});
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const auto& rows = r.body["rows"];
+  ASSERT_EQ(rows.size(), 3u) << r.body.dump();
+  double previous = -1.0;
+  for (const auto& row : rows) {  // backspin grows with the undercut
+    const double spin = row["batted_ball"]["backspin_rpm"].get<double>();
+    EXPECT_GT(spin, previous) << row.dump();
+    previous = spin;
+  }
+}
+
 }  // namespace
 }  // namespace batted_ball_api_test
 }  // namespace sweetspot::api
