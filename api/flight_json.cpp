@@ -59,8 +59,8 @@ bool Refused(const core::Refusal& refusal, const std::string& prefix,
     if (written_key == core_key) break;
     // "path = written: rule as core_key (SI value)", the number as the request wrote it.
     return SetError(error, ErrorCode::kInvalidValue, g.path, nullptr,
-                    "= " + core::FormatNumber(g.written) + ": " + refusal.rule + " as " +
-                        core_key + " (" + refusal.shown + ")");
+                    "= " + core::FormatNumber(g.written) + ": " + refusal.rule + " as " + core_key +
+                        " (" + refusal.shown + ")");
   }
   return CoreRefusal(refusal, prefix, error);
 }
@@ -137,9 +137,10 @@ bool ReadEnvironment(ObjectReader& parent, core::flight::Environment* environmen
                &environment->elevation_m, &given);
   ReadQuantity(reader, "relative_humidity_pct", {{"relative_humidity_pct"}},
                &environment->relative_humidity_pct, &given);
-  ReadQuantity(reader, "sea_level_pressure_pa",
-               {{"pressure_hpa", flight_json::kPaPerHpa}, {"pressure_inhg", flight_json::kPaPerInHg}},
-               &environment->sea_level_pressure_pa, &given);
+  ReadQuantity(
+      reader, "sea_level_pressure_pa",
+      {{"pressure_hpa", flight_json::kPaPerHpa}, {"pressure_inhg", flight_json::kPaPerInHg}},
+      &environment->sea_level_pressure_pa, &given);
   flight_json::ReadWind(reader, &environment->wind, &given);
   if (!reader.Finish()) return false;
   if (core::Refusal refusal; !environment->Validate(&refusal)) {
@@ -165,12 +166,10 @@ bool ReadAero(ObjectReader& parent, core::flight::AeroOptions* aero) {
     const char* key;
     double* out;
   };
-  const Coefficient coefficients[] = {{"cd0", &aero->cd0},
-                                      {"cd_spin_per_krpm", &aero->cd_spin_per_krpm},
-                                      {"cl0", &aero->cl0},
-                                      {"cl1", &aero->cl1},
-                                      {"cl2", &aero->cl2},
-                                      {"cl_per_spin_factor", &aero->cl_per_spin_factor}};
+  const Coefficient coefficients[] = {
+      {"cd0", &aero->cd0}, {"cd_spin_per_krpm", &aero->cd_spin_per_krpm},
+      {"cl0", &aero->cl0}, {"cl1", &aero->cl1},
+      {"cl2", &aero->cl2}, {"cl_per_spin_factor", &aero->cl_per_spin_factor}};
   for (const Coefficient& c : coefficients) {
     if (!reader.ok()) break;
     if (reader.Has(c.key) && !custom) {
@@ -232,11 +231,11 @@ std::optional<FlightRequest> ParseFlight(const nlohmann::json& body, const ApiLi
       return std::nullopt;
     }
     if (many->size() > limits.max_launches) {
-      reader.Fail("launches",
-                  "has " + std::to_string(many->size()) +
-                      " launches, over the limit max_launches = " +
-                      std::to_string(limits.max_launches),
-                  ErrorCode::kTooBig);
+      reader.Fail(
+          "launches",
+          "has " + std::to_string(many->size()) +
+              " launches, over the limit max_launches = " + std::to_string(limits.max_launches),
+          ErrorCode::kTooBig);
       return std::nullopt;
     }
     request.launches.resize(many->size());
@@ -292,7 +291,8 @@ std::optional<FlightRequest> ParseFlight(const nlohmann::json& body, const ApiLi
       SetError(error, ErrorCode::kTooBig, "outputs", nullptr,
                "asks for up to " + core::FormatNumber(total) +
                    " trajectory samples (launches x (max_flight_time_s / trajectory_interval_s "
-                   "+ 2)), over the limit of " + core::FormatNumber(kMaxTrajectorySamples) +
+                   "+ 2)), over the limit of " +
+                   core::FormatNumber(kMaxTrajectorySamples) +
                    ": fewer launches, a longer options.trajectory_interval_s or a shorter "
                    "options.max_flight_time_s");
       return std::nullopt;
@@ -324,21 +324,21 @@ nlohmann::json FlightToJson(const core::flight::FlightResult& r,
                             const std::vector<core::flight::TrajectoryPoint>* trajectory) {
   using core::flight::FlightTerminationName;
   nlohmann::json numerics = {{"method", "dormand_prince_5_4"},
-                   {"termination", FlightTerminationName(r.termination)},
-                   {"error_estimate_m", r.error_estimate_m},
-                   {"steps", r.steps},
-                   {"rejected_steps", r.rejected_steps},
-                   {"evaluations", r.evaluations}};
+                             {"termination", FlightTerminationName(r.termination)},
+                             {"error_estimate_m", r.error_estimate_m},
+                             {"steps", r.steps},
+                             {"rejected_steps", r.rejected_steps},
+                             {"evaluations", r.evaluations}};
   nlohmann::json out = {{"aero_model", core::flight::AeroModelName(aero.model)},
-              {"spin_source", core::flight::SpinSourceName(r.spin_source)},
-              {"backspin_rpm", r.spin.backspin_rpm},
-              {"sidespin_rpm", r.spin.sidespin_rpm},
-              {"air_density_kg_m3", r.air_density_kg_m3},
-              {"classification",
-               {{"barrel", r.classification.barrel},
-                {"hard_hit", r.classification.hard_hit},
-                {"sweet_spot_launch", r.classification.sweet_spot_launch}}},
-              {"numerics", std::move(numerics)}};
+                        {"spin_source", core::flight::SpinSourceName(r.spin_source)},
+                        {"backspin_rpm", r.spin.backspin_rpm},
+                        {"sidespin_rpm", r.spin.sidespin_rpm},
+                        {"air_density_kg_m3", r.air_density_kg_m3},
+                        {"classification",
+                         {{"barrel", r.classification.barrel},
+                          {"hard_hit", r.classification.hard_hit},
+                          {"sweet_spot_launch", r.classification.sweet_spot_launch}}},
+                        {"numerics", std::move(numerics)}};
   if (r.Landed()) {
     out["distance_m"] = r.distance_m;
     out["hang_time_s"] = r.hang_time_s;
@@ -348,6 +348,14 @@ nlohmann::json FlightToJson(const core::flight::FlightResult& r,
     out["bearing_deg"] = r.bearing_deg;
     out["landing_speed_mps"] = r.landing_speed_mps;
     out["landing_angle_deg"] = r.landing_angle_deg;
+  }
+  if (aero.model == core::flight::AeroModel::kSawicki2003) {
+    // Its drag curve is this service's reading of the paper's description, not the paper's
+    // numbers (core/flight/flight.cpp, SawickiDrag): the answer says so.
+    out["warnings"] = nlohmann::json::array(
+        {"aero.model sawicki-2003: the lift law is the paper's fit; the drag curve is an "
+         "approximation of the paper's description of the drag crisis (0.5 to 0.2 around "
+         "30 m/s), not values read from its figure, and is not validated (docs/flight.md)"});
   }
   if (trajectory != nullptr) {
     nlohmann::json points = nlohmann::json::array();

@@ -88,6 +88,11 @@ TEST(FlightApiTest, CustomAndSawickiModels) {
       "aero": {"model": "sawicki-2003"}})");
   ASSERT_EQ(r.status, 200) << r.body.dump();
   EXPECT_EQ(r.body["models_used"], nlohmann::json::array({"flight:sawicki-2003"}));
+  // Its drag curve is not the paper's numbers: the answer warns (the other models do not).
+  ASSERT_TRUE(r.body.contains("warnings")) << r.body.dump();
+  EXPECT_NE(r.body["warnings"][0].get<std::string>().find("not validated"), std::string::npos);
+  r = Post(R"({"launch": {"exit_speed_mph": 100, "launch_angle_deg": 28}})");
+  EXPECT_FALSE(r.body.contains("warnings")) << r.body.dump();
   // A custom coefficient with another model would be ignored: refused.
   r = Post(R"({"launch": {"exit_speed_mph": 100, "launch_angle_deg": 28},
       "aero": {"model": "nathan-2016", "cd0": 0.35}})");
@@ -105,8 +110,8 @@ TEST(FlightApiTest, BadInputIsRefusedNamingTheField) {
   const Bad cases[] = {
       // NaN is no JSON: the parser refuses it.
       {R"({"launch": {"exit_speed_mph": NaN, "launch_angle_deg": 20}})", "", 400},
-      {R"({"launch": {"exit_speed_mph": 100, "launch_angle_deg": 120}})",
-       "launch.launch_angle_deg", 400},
+      {R"({"launch": {"exit_speed_mph": 100, "launch_angle_deg": 120}})", "launch.launch_angle_deg",
+       400},
       {R"({"launch": {"exit_speed_mph": 100, "launch_angle_deg": 20, "backspin_rpm": 1e6,
           "sidespin_rpm": 0}})",
        "launch.backspin_rpm", 400},
@@ -116,15 +121,15 @@ TEST(FlightApiTest, BadInputIsRefusedNamingTheField) {
       {R"({"launch": {"exit_speed_mph": 100, "launch_angle_deg": 20},
           "environment": {"relative_humidity_pct": 150}})",
        "environment.relative_humidity_pct", 400},
-      {R"({"launch": {"exit_speed_mph": 1000, "launch_angle_deg": 20}})",
-       "launch.exit_speed_mph", 400},
+      {R"({"launch": {"exit_speed_mph": 1000, "launch_angle_deg": 20}})", "launch.exit_speed_mph",
+       400},
       {R"({"launch": {"launch_angle_deg": 20}})", "launch.exit_speed_mps", 400},
       {R"({"launch": {"exit_speed_mps": 40, "exit_speed_mph": 90, "launch_angle_deg": 20}})",
        "launch.exit_speed_mph", 400},
       {R"({"launch": {"exit_speed_mps": 40, "launch_angle_deg": 20, "backspin_rpm": 2000}})",
        "launch.sidespin_rpm", 400},
-      {R"({"launch": {"exit_speed_mps": 40, "launch_angle_deg": 20, "spin": 2000}})",
-       "launch.spin", 400},
+      {R"({"launch": {"exit_speed_mps": 40, "launch_angle_deg": 20, "spin": 2000}})", "launch.spin",
+       400},
       {R"({"launches": []})", "launches", 400},
       {R"({"launch": {"exit_speed_mps": 40, "launch_angle_deg": 20},
           "environment": {"temperature_f": 500}})",
