@@ -19,6 +19,7 @@ bool ApiLimits::Validate(core::Refusal* refusal) const {
       {"max_knots", max_knots},
       {"max_variants", max_variants},
       {"max_launches", max_launches},
+      {"max_frontier_values", max_frontier_values},
       {"max_curve_samples", max_curve_samples},
       {"max_samples", max_samples},
       {"max_batch_samples", max_batch_samples},

@@ -17,6 +17,8 @@ struct ApiLimits {
   std::size_t max_knots = 256;            ///< Knots of a profile.
   std::size_t max_variants = 64;          ///< Variants in /v1/compare.
   std::size_t max_launches = 4096;        ///< Launches in one /v1/flight request.
+  /// Values of one /v1/optimize frontier (`frontier.values`, or `count`).
+  std::size_t max_frontier_values = 1000;
   std::size_t max_curve_samples = 10000;  ///< Points of an exit-speed curve (>= 2).
   std::size_t max_samples = 100000;       ///< Designs in one synchronous /v1/explore request.
   /// Designs in one /v1/explore run as a batch (a job, the CLI: Context::batch), whose rows

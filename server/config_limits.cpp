@@ -41,6 +41,11 @@ const std::vector<Option>& LimitOptions() {
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->limits.max_launches, v, rule);
        }},
+      {"--max-frontier-values", "SWEETSPOT_MAX_FRONTIER_VALUES",
+       "values of one /v1/optimize frontier (default 1000)", true,
+       [](ServerConfig* c, const std::string& v, std::string* rule) {
+         return SetSize(&c->limits.max_frontier_values, v, rule);
+       }},
       {"--max-jobs-page", "SWEETSPOT_MAX_JOBS_PAGE",
        "jobs on one page of GET /v1/jobs: the largest `limit` (default 1000)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <memory>
 #include <set>
 #include <string>
 #include <utility>
@@ -15,6 +16,7 @@
 #include "api/bat_json.hpp"
 #include "api/handlers/endpoint.hpp"
 #include "api/handlers/handlers.hpp"
+#include "api/handlers/optimize_request.hpp"
 #include "api/handlers/optimize_variables.hpp"
 #include "api/json_path.hpp"
 #include "api/scene_json.hpp"
@@ -239,6 +241,10 @@ Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r,
   return bat;
 }
 
+}  // namespace
+
+namespace optimize_detail {
+
 Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
                   const VariableNames& names) {
   // Each variable as the request wrote it, in its unit ("wall_thickness_in": inches).
@@ -334,38 +340,6 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
   return out;
 }
 
-// A parsed /v1/optimize request: the problem, the solver's options, the materials to choose
-// among (empty = no choice), the objective's name and the bat as written (the answer's bat
-// is given back in its form).
-struct OptimizeRequest {
-  core::DesignProblem problem;
-  std::string model_reason;  // why problem.model (core::ResolveExitModel)
-  core::DesignOptions options;
-  std::vector<core::Material> material_choices;
-  std::string objective;
-  Json request_bat;
-  // Where the COR comes from (core::ResolveDesignCor): the answer's "cor_source".
-  core::DesignCorPolicy cor_policy;
-  // The base bat's mass properties under problem.inertia_model, computed once (ParseBat).
-  core::MassProperties base_properties;
-  // The variables' paths as the request wrote them (trade forms): the answer's names, units.
-  VariableNames variable_names;
-};
-
-// What the optimiser returned: one design, or one per material and the best of them.
-struct OptimizeResult {
-  bool by_material = false;
-  core::MaterialChoiceResult choice;  // by_material
-  core::DesignResult single;          // otherwise
-
-  // The design answered with; null when no material gives a usable design.
-  const core::DesignResult* Chosen() const {
-    if (!by_material) return &single;
-    if (choice.best < 0) return nullptr;
-    return &choice.per_material[static_cast<std::size_t>(choice.best)].result;
-  }
-};
-
 std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& context,
                                              ApiError* error) {
   ObjectReader reader(body, "", error);
@@ -425,6 +399,28 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
   }
   return request;
 }
+
+}  // namespace optimize_detail
+
+namespace {
+
+using optimize_detail::OptimizeRequest;
+using optimize_detail::ParseOptimize;
+using optimize_detail::ResultToJson;
+
+// What the optimiser returned: one design, or one per material and the best of them.
+struct OptimizeResult {
+  bool by_material = false;
+  core::MaterialChoiceResult choice;  // by_material
+  core::DesignResult single;          // otherwise
+
+  // The design answered with; null when no material gives a usable design.
+  const core::DesignResult* Chosen() const {
+    if (!by_material) return &single;
+    if (choice.best < 0) return nullptr;
+    return &choice.per_material[static_cast<std::size_t>(choice.best)].result;
+  }
+};
 
 OptimizeResult RunOptimize(const OptimizeRequest& request, const Context& context) {
   OptimizeResult result;
@@ -527,7 +523,16 @@ const Endpoint<OptimizeRequest, OptimizeResult>& OptimizeEndpoint() {
 }  // namespace
 
 Response HandleOptimize(const Request& request, const Context& context) {
-  return ServeEndpoint(OptimizeEndpoint(), request, context);
+  const auto start = std::chrono::steady_clock::now();
+  Response refused;
+  std::optional<Json> body = ParseObjectBody(request, context, &refused);
+  if (!body) return refused;
+  if (body->contains("frontier")) {
+    return optimize_detail::HandleFrontier(std::move(*body), context, start);
+  }
+  Request parsed = request;  // the body parsed once: ServeEndpoint takes it from here
+  parsed.parsed_body = std::make_shared<Json>(std::move(*body));
+  return ServeEndpoint(OptimizeEndpoint(), parsed, context);
 }
 
 }  // namespace sweetspot::api
