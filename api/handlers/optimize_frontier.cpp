@@ -293,8 +293,9 @@ std::vector<std::string> CsvColumns(const FrontierRequest& r) {
                                    "properties.length_m",
                                    "sweet_spot.position_from_knob_m",
                                    "sweet_spot.exit_speed_mps"};
-  for (const WrittenVariable& v : r.base.variable_names.paths) {
-    columns.push_back("variables." + v.written);
+  for (const core::DesignVariable& v : r.base.problem.variables) {
+    const WrittenVariable* written = r.base.variable_names.Find(v.path);
+    columns.push_back("variables." + (written != nullptr ? written->written : v.path));
   }
   return columns;
 }
