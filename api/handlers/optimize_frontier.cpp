@@ -29,6 +29,7 @@ struct FrontierRequest {
   core::FrontierSpec spec;
   std::string written;  // the constraint as the request wrote it ("mass_oz")
   double to_si = 1.0;   // SI = written value * to_si
+  std::vector<double> written_values;  // the shard's values as written (the rows give these)
   bool prefer_smaller = true;
   std::string format = "json";
   std::size_t first_index = 0;  // the shard's first value's index among all values
@@ -100,6 +101,7 @@ bool ReadValues(ObjectReader& reader, const ApiLimits& limits, FrontierRequest* 
       values.push_back(i + 1 == count ? to : from + (to - from) * i / (count - 1.0));
     }
   }
+  out->written_values = values;
   for (double& v : values) v *= out->to_si;
   out->spec.values = std::move(values);
   return true;
@@ -199,8 +201,12 @@ std::optional<FrontierRequest> ParseFrontierRequest(Json body, const Context& co
   const std::size_t from = static_cast<std::size_t>(shard.index * n / shard.count);
   const std::size_t to = static_cast<std::size_t>((shard.index + 1) * n / shard.count);
   r.first_index = from;
-  r.spec.values = std::vector<double>(r.spec.values.begin() + static_cast<std::ptrdiff_t>(from),
-                                      r.spec.values.begin() + static_cast<std::ptrdiff_t>(to));
+  const auto block = [from, to](const std::vector<double>& all) {
+    return std::vector<double>(all.begin() + static_cast<std::ptrdiff_t>(from),
+                               all.begin() + static_cast<std::ptrdiff_t>(to));
+  };
+  r.spec.values = block(r.spec.values);
+  r.written_values = block(r.written_values);
   if (r.spec.values.empty()) {
     SetError(error, ErrorCode::kInvalidValue, "shard.count", nullptr,
              "leaves shard " + std::to_string(shard.index) + " no value (" +
@@ -217,7 +223,7 @@ Json Finite(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 Json RowOf(const FrontierRequest& r, const core::FrontierPoint& point) {
   Json row = ResultToJson(point.result, r.base.request_bat, r.base.variable_names);
   Json out{{"index", r.first_index + static_cast<std::size_t>(point.index)},
-           {r.written, point.value / r.to_si},
+           {r.written, r.written_values[static_cast<std::size_t>(point.index)]},
            {"start",
             {{"warm_started", point.warm_started},
              {"predicted", point.predicted},
