@@ -48,17 +48,20 @@ def sweep(client):
 
 
 def frontier(client):
-    """The best bat at every weight: one optimisation per weight, swing speed falling with the
-    swing weight (objective max_exit_speed_swing_weight), MLB wood-bat rules."""
+    """The best bat at every weight: one frontier request (each weight started from its
+    neighbour's answer), the swing slowing with the swing weight (objective
+    max_exit_speed_swing_weight), MLB wood-bat rules; rows streamed as each weight is solved."""
     designs = {}
-    for ounces in (29, 30, 31, 32):
-        design = client.optimize(
-            bat=BAT, **SCENE, objective="max_exit_speed_swing_weight",
-            variables=[{"scale_paths": ["three_segment.handle_radius_m",
-                                        "three_segment.barrel_radius_m"],
-                        "name": "girth", "min": 0.85, "max": 1.05},
-                       {"path": "three_segment.taper_start_m", "min": 0.2, "max": 0.45}],
-            constraints={"mass_oz": ounces, "rules": "mlb-wood"}, report_units="imperial")
+    rows = client.frontier(
+        bat=BAT, **SCENE, objective="max_exit_speed_swing_weight",
+        variables=[{"scale_paths": ["three_segment.handle_radius_m",
+                                    "three_segment.barrel_radius_m"],
+                    "name": "girth", "min": 0.85, "max": 1.05},
+                   {"path": "three_segment.taper_start_m", "min": 0.2, "max": 0.45}],
+        constraints={"rules": "mlb-wood"}, report_units="imperial",
+        frontier={"constraint": "mass_oz", "values": [29, 30, 31, 32]})
+    for design in rows:
+        ounces = design["mass_oz"]
         designs[ounces] = design
         shape = design["bat"]["three_segment"]
         print("frontier %d oz: %.1f mph at %.1f in from the tip; barrel %.3f in, handle %.3f in, "
@@ -67,6 +70,7 @@ def frontier(client):
                   design["sweet_spot"]["position_from_tip_in"], shape["barrel_diameter_in"],
                   shape["handle_diameter_in"], shape["taper_start_in"],
                   design["summary"]["termination"]))
+    print("frontier: Pareto front %s" % rows.summary["pareto"])
     return designs
 
 

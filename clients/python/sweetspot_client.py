@@ -508,6 +508,17 @@ class Client:
         """``POST /v1/optimize``: the best bat under constraints."""
         return self._post("/v1/optimize", request, fields)
 
+    def frontier(self, request: Optional[JsonDict] = None, **fields: Any) -> RowStream:
+        """``POST /v1/optimize`` with ``frontier`` (the best design at every value of one
+        constraint) as NDJSON: a :class:`RowStream` of one row per value as the server solves it
+        (its ``summary``, with the Pareto front, once read). ``frontier`` is e.g.
+        ``{"constraint": "mass_oz", "from": 29, "to": 32, "count": 7}``."""
+        body = _merge(request, fields)
+        if "frontier" not in body:
+            raise ValueError("frontier() needs a frontier: {\"constraint\": ..., \"values\": [...]}")
+        body["format"] = "ndjson"
+        return self.stream("POST", "/v1/optimize", body, kind="ndjson")
+
     def flight(self, request: Optional[JsonDict] = None, **fields: Any) -> JsonDict:
         """``POST /v1/flight``: batted-ball flight from ``launch`` (or ``launches``) (needs a
         server with /v1/flight)."""

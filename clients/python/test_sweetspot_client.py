@@ -242,6 +242,23 @@ class EndpointsTest(unittest.TestCase):
         self.same(answer, "/v1/optimize", body)
         self.assertEqual(answer["summary"]["termination"], "converged")
 
+    def test_frontier_streams_one_row_per_value(self):
+        body = {"bat": {"preset": "wood-34-ash"}, "ball": {"preset": "mlb", "speed_mph": 90},
+                "swing": {"bat_speed_mph": 70},
+                "variables": [{"path": "material.density_kg_m3", "min": 500, "max": 800}],
+                "frontier": {"constraint": "mass_oz", "values": [30, 31, 32]}}
+        rows = self.client.frontier(body)
+        designs = list(rows)
+        self.assertEqual([d["mass_oz"] for d in designs], [30, 31, 32])
+        self.assertEqual([d["summary"]["termination"] for d in designs], ["converged"] * 3)
+        self.assertEqual(rows.summary["pareto"], [0, 1, 2])
+        # The same designs as the JSON answer.
+        answer = self.client.optimize(body)
+        self.assertEqual([d["objective_value"] for d in designs],
+                         [r["objective_value"] for r in answer["rows"]])
+        with self.assertRaises(ValueError):
+            self.client.frontier({"bat": {"preset": "wood-34-ash"}})
+
     def test_explore_json_ndjson_csv_agree(self):
         body = {"bat": {"preset": "paper-wood"},
                 "parameters": [{"path": "ball.speed_mph", "min": 50, "max": 100, "count": 6}],
