@@ -96,6 +96,51 @@ void BM_OptimizeSixteenKnotsNlopt(benchmark::State& state) {
 }
 BENCHMARK(BM_OptimizeSixteenKnotsNlopt)->Unit(benchmark::kMillisecond);
 
+// The 16-knot problem generalised to n knots (knots 1..n-2 free; bench/scipy_peers.py's
+// `design --knots n`), for the scaling table of issue 36 (bench/optimize_scaling.sh).
+DesignProblem KnotProblem(int n) {
+  DesignProblem p;
+  const double length = 0.86;
+  for (int i = 0; i < n; ++i) {
+    const double x = length * i / (n - 1);
+    const double s = x / length;
+    p.bat.knots.push_back({x, 0.0125 + 0.020 / (1.0 + std::exp(-14.0 * (s - 0.55)))});
+  }
+  p.bat.material = *FindMaterial("ash");
+  for (int i = 1; i <= n - 2; ++i) {
+    p.variables.push_back({"profile.knots[" + std::to_string(i) + "].radius_m", 0.0110, 0.0332});
+  }
+  p.constraints.mass_kg = DesignRange::Equal(ComputeMassProperties(p.bat).mass_kg);
+  p.constraints.balance_point_m = DesignRange::AtMost(0.60);
+  p.constraints.max_barrel_diameter_m = InchesToMetres(2.61);
+  p.constraints.min_handle_diameter_m = InchesToMetres(0.9);
+  p.constraints.taper = TaperRule::kNonDecreasing;
+  return p;
+}
+
+// backend: 0 Ipopt exact Hessian, 1 Ipopt limited memory, 2 NLopt SLSQP. A problem the service
+// refuses (over 200 variables) reports refused = 1 and no time of a solve.
+void BM_OptimizeKnots(benchmark::State& state) {
+  const DesignProblem p = KnotProblem(static_cast<int>(state.range(0)));
+  DesignOptions o;
+  o.backend = state.range(1) == 2 ? DesignBackend::kNloptSlsqp : DesignBackend::kIpopt;
+  o.hessian = state.range(1) == 0 ? HessianMode::kExact : HessianMode::kLimitedMemory;
+  o.max_variables = 100000;  // the service's cap is --max-design-variables; measure past it
+  DesignResult r;
+  for (auto _ : state) {
+    r = OptimizeDesign(p, o);
+    benchmark::DoNotOptimize(r);
+  }
+  Report(state, r);
+  state.counters["refused"] = r.summary.termination == Termination::kInvalidInput ? 1 : 0;
+  state.SetLabel(r.summary.termination == Termination::kInvalidInput ? r.summary.message
+                                                                     : r.summary.backend);
+}
+BENCHMARK(BM_OptimizeKnots)
+    ->ArgsProduct({{16, 32, 64, 128, 256}, {0, 1, 2}})
+    ->ArgNames({"knots", "backend"})
+    ->Unit(benchmark::kMillisecond);
+
 void BM_OptimizeThreeSegment(benchmark::State& state) {
   const DesignProblem p = ThreeSegmentProblem();
   DesignOptions o;

@@ -4,7 +4,8 @@
 Run by bench/peers.sh with Debian's interpreter, /usr/bin/python3 (numpy and SciPy from
 `apt-get install python3-scipy`). Never needed by the service, the tests or CI.
 
-  design16 [--repeat N]
+  design16 [--repeat N]    (= design --knots 16)
+  design [--knots N] [--repeat R]   (the same family with N knots, N - 2 free)
       The 16-knot design of bench/core_optimize.cpp (SixteenKnotProblem): the radii of knots
       1..14 of a solid ash bat in [0.0110, 0.0332] m, maximising the rigid-pivot exit speed
       (closed form) with the mass equal to the base bat's, the balance point at most 0.60 m,
@@ -97,8 +98,8 @@ def max_exit_speed_closed_form(moi_pivot, length, cor):
 # ------------------------------------------------------------------------------------------
 # The 16-knot design.
 
-def sixteen_knot_bat():
-    n, length = 16, 0.86
+def knot_bat(n=16):
+    length = 0.86
     xs, rs = [], []
     for i in range(n):
         x = length * i / (n - 1)
@@ -108,8 +109,9 @@ def sixteen_knot_bat():
     return np.array(xs), np.array(rs)
 
 
-def design16(repeat):
-    xs, r_base = sixteen_knot_bat()
+def design(n, repeat):
+    """The n-knot design (design16 generalised: knots 1..n-2 free)."""
+    xs, r_base = knot_bat(n)
     length = xs[-1]
     lo, hi = 0.0110, 0.0332
     max_r = 0.5 * 2.61 * 0.0254
@@ -118,7 +120,7 @@ def design16(repeat):
 
     def radii(v):
         r = r_base.copy()
-        r[1:15] = v
+        r[1:n - 1] = v
         return r
 
     def objective(v):
@@ -134,9 +136,9 @@ def design16(repeat):
         balance = mass_properties(xs, r, ASH_DENSITY_KG_M3)[1]
         return np.concatenate(([0.60 - balance], max_r - r, r - min_r, r[1:] - r[:-1]))
 
-    v0 = r_base[1:15].copy()
+    v0 = r_base[1:n - 1].copy()
     constraints = [{"type": "eq", "fun": equality}, {"type": "ineq", "fun": inequalities}]
-    bounds = [(lo, hi)] * 14
+    bounds = [(lo, hi)] * (n - 2)
     best = best_cpu = math.inf
     result = None
     for _ in range(repeat):
@@ -153,7 +155,7 @@ def design16(repeat):
                                       for x, r in zip(xs, r_base)]},
                 "material": "ash"},
         "variables": [{"path": f"profile.knots[{i}].radius_m", "min": lo, "max": hi}
-                      for i in range(1, 15)],
+                      for i in range(1, n - 1)],
         "constraints": {"mass_kg": float(mass0), "balance_point_m": {"max": 0.60},
                         "max_barrel_diameter_m": 2.61 * 0.0254,
                         "min_handle_diameter_m": 0.9 * 0.0254, "taper": "non_decreasing"},
@@ -161,6 +163,7 @@ def design16(repeat):
     }
     return {
         "peer": "scipy.optimize.minimize SLSQP, finite-difference gradients, ftol 1e-10",
+        "knots": n,
         "time_s": best,
         "cpu_s": best_cpu,
         "repeat": repeat,
@@ -257,9 +260,10 @@ def sweep(request_path, rows_path, limit, variant):
 
 
 def main(argv):
-    if len(argv) >= 2 and argv[1] == "design16":
+    if len(argv) >= 2 and argv[1] in ("design16", "design"):
         repeat = int(argv[argv.index("--repeat") + 1]) if "--repeat" in argv else 5
-        print(json.dumps(design16(repeat)))
+        n = int(argv[argv.index("--knots") + 1]) if "--knots" in argv else 16
+        print(json.dumps(design(n, repeat)))
         return 0
     if len(argv) >= 4 and argv[1] == "sweep":
         limit = int(argv[argv.index("--limit") + 1]) if "--limit" in argv else 0
