@@ -1,0 +1,465 @@
+#include "api/explore/flight_sweep.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <system_error>
+#include <thread>
+#include <utility>
+
+#include "api/error_code.hpp"
+#include "api/flight_json.hpp"
+#include "api/json_reader.hpp"
+#include "api/thread_budget.hpp"
+#include "core/explore/sampling.hpp"
+#include "core/flight/flight.hpp"
+#include "core/progress.hpp"
+
+namespace sweetspot::api {
+namespace flight_sweep {
+namespace {
+
+using Json = nlohmann::json;
+namespace flight = core::flight;
+
+// What a swept path sets.
+enum class Target {
+  kExitSpeed,
+  kLaunchAngle,
+  kSprayAngle,
+  kBackspin,
+  kSidespin,
+  kHeight,
+  kTemperature,
+  kElevation,
+  kHumidity,
+  kPressure,
+  kWindSpeed,
+  kWindDirection,
+};
+
+// A path as a request writes it, and its SI value: written * scale + offset (api/flight_json's
+// spellings of the same fields).
+struct PathSpec {
+  const char* path;
+  Target target;
+  double scale = 1.0;
+  double offset = 0.0;
+};
+
+constexpr double kPaPerInHg = 3386.389;  // as api/flight_json.cpp
+constexpr PathSpec kPaths[] = {
+    {"launch.exit_speed_mps", Target::kExitSpeed},
+    {"launch.exit_speed_mph", Target::kExitSpeed, flight::kMpsPerMph},
+    {"launch.launch_angle_deg", Target::kLaunchAngle},
+    {"launch.spray_angle_deg", Target::kSprayAngle},
+    {"launch.backspin_rpm", Target::kBackspin},
+    {"launch.sidespin_rpm", Target::kSidespin},
+    {"launch.height_m", Target::kHeight},
+    {"launch.height_ft", Target::kHeight, flight::kMetresPerFoot},
+    {"environment.temperature_c", Target::kTemperature},
+    {"environment.temperature_f", Target::kTemperature, 5.0 / 9.0, -32.0 * 5.0 / 9.0},
+    {"environment.elevation_m", Target::kElevation},
+    {"environment.elevation_ft", Target::kElevation, flight::kMetresPerFoot},
+    {"environment.relative_humidity_pct", Target::kHumidity},
+    {"environment.pressure_hpa", Target::kPressure, 100.0},
+    {"environment.pressure_inhg", Target::kPressure, kPaPerInHg},
+    {"environment.wind.speed_mps", Target::kWindSpeed},
+    {"environment.wind.speed_mph", Target::kWindSpeed, flight::kMpsPerMph},
+    {"environment.wind.direction_deg", Target::kWindDirection},
+};
+
+const PathSpec* FindPath(const std::string& path) {
+  for (const PathSpec& spec : kPaths) {
+    if (path == spec.path) return &spec;
+  }
+  return nullptr;
+}
+
+void Apply(const PathSpec& spec, double written, flight::Launch* launch,
+           flight::Environment* environment) {
+  const double si = written * spec.scale + spec.offset;
+  switch (spec.target) {
+    case Target::kExitSpeed: launch->exit_speed_mps = si; break;
+    case Target::kLaunchAngle: launch->launch_angle_deg = si; break;
+    case Target::kSprayAngle: launch->spray_angle_deg = si; break;
+    case Target::kBackspin: launch->backspin_rpm = si; break;
+    case Target::kSidespin: launch->sidespin_rpm = si; break;
+    case Target::kHeight: launch->height_m = si; break;
+    case Target::kTemperature: environment->temperature_c = si; break;
+    case Target::kElevation: environment->elevation_m = si; break;
+    case Target::kHumidity: environment->relative_humidity_pct = si; break;
+    case Target::kPressure: environment->sea_level_pressure_pa = si; break;
+    case Target::kWindSpeed: environment->wind.speed_mps = si; break;
+    case Target::kWindDirection: environment->wind.direction_deg = si; break;
+  }
+}
+
+// A parsed flight sweep, owned by its (maybe streamed) answer.
+struct FlightSweep {
+  FlightRequest base;                    // launches[0] is the template
+  std::vector<std::string> paths;        // as written
+  std::vector<const PathSpec*> specs;    // per path
+  core::SweepPlan plan;                  // dimensions in the order of `paths`
+  std::uint64_t total = 0;               // designs
+  int threads = 1;                       // wanted (the extra ones from `budget`)
+  ThreadBudget* budget = nullptr;        // or none
+  core::Progress* progress = nullptr;    // cancel flag (a job's), or none
+  std::chrono::steady_clock::time_point start;
+};
+
+// Flies design `i` (its swept values in `point`).
+flight::FlightResult FlyDesign(const FlightSweep& sweep, const std::vector<double>& point) {
+  flight::Launch launch = sweep.base.launches.front();
+  flight::Environment environment = sweep.base.environment;
+  for (std::size_t d = 0; d < sweep.specs.size(); ++d) {
+    Apply(*sweep.specs[d], point[d], &launch, &environment);
+  }
+  return flight::Fly(launch, environment, sweep.base.aero, sweep.base.options);
+}
+
+// Shortest round-trip text of a finite number ("" for a non-finite one: never written).
+void AppendNumber(double value, std::string* out) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  if (result.ec == std::errc()) out->append(buffer, result.ptr);
+}
+
+void AppendQuoted(const std::string& text, std::string* out) {
+  out->push_back('"');
+  for (char c : text) {
+    if (c == '"') out->push_back('"');
+    out->push_back(c);
+  }
+  out->push_back('"');
+}
+
+constexpr const char* kCsvColumns =
+    "termination,distance_m,hang_time_s,apex_m,landing_x_m,landing_y_m,bearing_deg,"
+    "landing_speed_mps,landing_angle_deg,backspin_rpm,sidespin_rpm,spin_source,barrel,hard_hit,"
+    "sweet_spot_launch,error_estimate_m,steps,message";
+
+std::string CsvHeader(const FlightSweep& sweep) {
+  std::string header = "index";
+  for (const std::string& path : sweep.paths) header += ",parameters." + path;
+  header += ",";
+  header += kCsvColumns;
+  header += "\n";
+  return header;
+}
+
+void AppendCsvRow(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
+                  const flight::FlightResult& r, std::string* out) {
+  AppendNumber(static_cast<double>(index), out);
+  for (double value : point) {
+    out->push_back(',');
+    AppendNumber(value, out);
+  }
+  out->push_back(',');
+  out->append(flight::FlightTerminationName(r.termination));
+  const bool landed = r.Landed();
+  for (double value : {r.distance_m, r.hang_time_s, r.apex_m, r.landing_x_m, r.landing_y_m,
+                       r.bearing_deg, r.landing_speed_mps, r.landing_angle_deg}) {
+    out->push_back(',');
+    if (landed) AppendNumber(value, out);
+  }
+  const bool flown = r.termination != flight::FlightTermination::kInvalidInput;
+  out->push_back(',');
+  if (flown) AppendNumber(r.spin.backspin_rpm, out);
+  out->push_back(',');
+  if (flown) AppendNumber(r.spin.sidespin_rpm, out);
+  out->push_back(',');
+  if (flown) out->append(flight::SpinSourceName(r.spin_source));
+  for (bool label : {r.classification.barrel, r.classification.hard_hit,
+                     r.classification.sweet_spot_launch}) {
+    out->push_back(',');
+    if (flown) out->append(label ? "true" : "false");
+  }
+  out->push_back(',');
+  if (landed) AppendNumber(r.error_estimate_m, out);
+  out->push_back(',');
+  AppendNumber(r.steps, out);
+  out->push_back(',');
+  if (!landed) AppendQuoted(NotLandedMessage(r, sweep.base.options), out);
+  out->push_back('\n');
+}
+
+Json JsonRow(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
+             const flight::FlightResult& r) {
+  Json parameters = Json::object();
+  for (std::size_t d = 0; d < sweep.paths.size(); ++d) parameters[sweep.paths[d]] = point[d];
+  Json out = FlightToJson(r, sweep.base.aero, nullptr);
+  if (!r.Landed()) out["message"] = NotLandedMessage(r, sweep.base.options);
+  return {{"index", index}, {"parameters", std::move(parameters)}, {"flight", std::move(out)}};
+}
+
+// Runs the sweep's designs in waves of one block per thread (blocks of kBlock designs), hands
+// the blocks to `consume` in design order; false when cancelled or when `consume` refused.
+// `make(first, last, sequence)` evaluates designs [first, last) into a block. Threads that
+// cannot be started leave their block to the calling thread (nothing throws).
+constexpr std::uint64_t kBlock = 1024;
+
+template <class Block, class Make, class Consume>
+bool RunWaves(const FlightSweep& sweep, Make make, Consume consume, int* lanes_used) {
+  int extra = std::max(0, sweep.threads - 1);
+  if (extra > 0 && sweep.budget != nullptr) extra = sweep.budget->TryTake(extra);
+  struct GiveBack {
+    ThreadBudget* budget;
+    int threads;
+    ~GiveBack() {
+      if (budget != nullptr && threads > 0) budget->Give(threads);
+    }
+  } give_back{sweep.budget, sweep.budget != nullptr ? extra : 0};
+  const int lanes = 1 + extra;
+  *lanes_used = lanes;
+  std::vector<core::DesignSequence> sequences(static_cast<std::size_t>(lanes),
+                                              core::DesignSequence(sweep.plan));
+  std::vector<Block> blocks(static_cast<std::size_t>(lanes));
+  for (std::uint64_t first = 0; first < sweep.total; first += kBlock * lanes) {
+    if (core::IsCancelled(sweep.progress)) return false;
+    std::vector<std::thread> workers;
+    for (int k = 1; k < lanes; ++k) {
+      const std::uint64_t lo = first + kBlock * k;
+      if (lo >= sweep.total) break;
+      const std::uint64_t hi = std::min(lo + kBlock, sweep.total);
+      try {
+        workers.emplace_back([&, k, lo, hi] { blocks[k] = make(lo, hi, &sequences[k]); });
+      } catch (const std::system_error&) {
+        blocks[k] = make(lo, hi, &sequences[k]);  // no thread: this one does it
+      }
+    }
+    blocks[0] = make(first, std::min(first + kBlock, sweep.total), &sequences[0]);
+    for (std::thread& worker : workers) worker.join();
+    for (int k = 0; k < lanes && first + kBlock * k < sweep.total; ++k) {
+      if (!consume(std::move(blocks[k]))) return false;
+    }
+    if (sweep.progress != nullptr) {
+      sweep.progress->Report(static_cast<double>(std::min(first + kBlock * lanes, sweep.total)) /
+                             static_cast<double>(sweep.total));
+    }
+  }
+  return true;
+}
+
+// Prefixes an error of the template's parser with "flight.".
+void PrefixFlight(ApiError* error) {
+  if (error->field.empty()) return;
+  if (error->message.rfind(error->field, 0) == 0) error->message = "flight." + error->message;
+  error->field = "flight." + error->field;
+}
+
+std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::string* format,
+                                 ApiError* error) {
+  ObjectReader reader(body, "", error);
+  const Json* template_json = reader.Get("flight");
+  if (!reader.ok()) return std::nullopt;
+  if (!template_json->is_object()) {
+    reader.Fail("flight", "must be an object: a /v1/flight request with one \"launch\"");
+    return std::nullopt;
+  }
+  if (template_json->contains("launches")) {
+    SetError(error, ErrorCode::kInvalidValue, "flight.launches", nullptr,
+             "a sweep's template has one \"launch\"; sweep its fields with \"parameters\"");
+    return std::nullopt;
+  }
+  FlightSweep sweep;
+  {
+    ApiError inner;
+    std::optional<FlightRequest> request = ParseFlight(*template_json, context.limits, &inner);
+    if (!request) {
+      *error = std::move(inner);
+      PrefixFlight(error);
+      return std::nullopt;
+    }
+    if (request->trajectory) {
+      SetError(error, ErrorCode::kInvalidValue, "flight.outputs", nullptr,
+               "a sweep's rows carry no trajectory (POST /v1/flight gives one)");
+      return std::nullopt;
+    }
+    sweep.base = std::move(*request);
+  }
+
+  const std::size_t limit =
+      context.batch ? context.limits.max_batch_samples : context.limits.max_samples;
+  const char* limit_name = context.batch ? "max_batch_samples" : "max_samples";
+  std::string sampling = "grid";
+  reader.OptionalString("sampling", &sampling, {"grid", "lhs", "sobol"});
+  if (!reader.ok()) return std::nullopt;
+  sweep.plan.method = *core::ParseSamplingMethod(sampling);
+  long long samples = 0, seed = 0;
+  reader.OptionalInteger("samples", 1,
+                         static_cast<long long>(std::min<std::size_t>(limit, 1ULL << 53)),
+                         &samples);
+  reader.OptionalInteger("seed", 0, 1LL << 53, &seed);
+  sweep.plan.samples = static_cast<std::uint64_t>(samples);
+  sweep.plan.seed = static_cast<std::uint64_t>(seed);
+  if (reader.ok() && sweep.plan.method != core::SamplingMethod::kGrid && samples == 0) {
+    reader.Missing("samples");
+  }
+  *format = "json";  // as a bat sweep's
+  reader.OptionalString("format", format, {"json", "csv"});
+  const Json* params = reader.Get("parameters");
+  if (reader.ok() && params == nullptr) reader.Missing("parameters");
+  if (!reader.ok()) return std::nullopt;
+  if (!params->is_array() || params->empty() || params->size() > 32) {
+    reader.Fail("parameters", "must be an array of 1 to 32 {\"path\", \"min\", \"max\"}");
+    return std::nullopt;
+  }
+  bool swept[12] = {};
+  for (std::size_t i = 0; i < params->size(); ++i) {
+    const std::string where = "parameters[" + std::to_string(i) + "]";
+    if (!(*params)[i].is_object()) {
+      SetError(error, ErrorCode::kInvalidValue, where, &(*params)[i],
+               "must be an object {\"path\", \"min\", \"max\"}");
+      return std::nullopt;
+    }
+    ObjectReader p((*params)[i], where, error);
+    std::string path;
+    core::SweepDimension dimension;
+    NumberRule finite;
+    finite.min = -1e12;
+    finite.max = 1e12;
+    p.String("path", &path);
+    p.Number("min", finite, &dimension.min);
+    p.Number("max", finite, &dimension.max);
+    long long count = sweep.plan.method == core::SamplingMethod::kGrid ? 2 : 1;
+    p.OptionalInteger("count", 1, 1000000000, &count);  // the total is checked below
+    dimension.count = static_cast<int>(count);
+    if (!p.Finish()) return std::nullopt;
+    const PathSpec* spec = FindPath(path);
+    if (spec == nullptr) {
+      std::string known;
+      for (const PathSpec& s : kPaths) known += (known.empty() ? "" : ", ") + std::string(s.path);
+      SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
+               "is not a field a flight sweep can sweep (one of: " + known + ")");
+      return std::nullopt;
+    }
+    if (swept[static_cast<int>(spec->target)]) {
+      SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
+               "sweeps a quantity another parameter already sweeps");
+      return std::nullopt;
+    }
+    swept[static_cast<int>(spec->target)] = true;
+    if (dimension.max < dimension.min) {
+      SetError(error, ErrorCode::kInvalidValue, where + ".max", &(*params)[i]["max"],
+               "must be >= min");
+      return std::nullopt;
+    }
+    sweep.paths.push_back(path);
+    sweep.specs.push_back(spec);
+    sweep.plan.dimensions.push_back(dimension);
+  }
+  // Both spins or neither (Launch::Validate): one swept spin needs the other in the template.
+  const bool back = swept[static_cast<int>(Target::kBackspin)];
+  const bool side = swept[static_cast<int>(Target::kSidespin)];
+  if (back != side && !sweep.base.launches.front().backspin_rpm) {
+    SetError(error, ErrorCode::kInvalidValue, "flight.launch", nullptr,
+             std::string("gives no spin, and the sweep sets only ") +
+                 (back ? "backspin_rpm" : "sidespin_rpm") +
+                 ": give both spins in the launch, or sweep both");
+    return std::nullopt;
+  }
+  if (!reader.Finish()) return std::nullopt;
+  if (core::Refusal refusal; !sweep.plan.Validate(&refusal)) {
+    CoreRefusal(refusal, "", error);
+    return std::nullopt;
+  }
+  sweep.total = sweep.plan.DesignCount();
+  if (sweep.total > limit) {
+    SetError(error, ErrorCode::kTooBig, "parameters", nullptr,
+             "describe " + std::to_string(sweep.total) + " launches, over the limit " +
+                 limit_name + " = " + std::to_string(limit));
+    return std::nullopt;
+  }
+  sweep.threads = std::max(1, context.explore_threads);
+  sweep.budget = context.thread_budget;
+  sweep.progress = context.progress;
+  return sweep;
+}
+
+}  // namespace
+}  // namespace flight_sweep
+
+bool IsFlightSweep(const nlohmann::json& body) {
+  return body.is_object() && body.contains("flight");
+}
+
+std::vector<std::string> FlightSweepPaths() {
+  std::vector<std::string> paths;
+  for (const flight_sweep::PathSpec& spec : flight_sweep::kPaths) paths.emplace_back(spec.path);
+  return paths;
+}
+
+Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
+  using flight_sweep::FlightSweep;
+  const auto start = std::chrono::steady_clock::now();
+  ApiError error;
+  std::string format;
+  std::optional<FlightSweep> parsed = flight_sweep::Parse(body, context, &format, &error);
+  if (!parsed) return ToResponse(error);
+  if (context.validate_only) return {200, nlohmann::json{{"valid", true}}};
+  auto sweep = std::make_shared<FlightSweep>(std::move(*parsed));
+  sweep->start = start;
+  if (format == "csv") {
+    Response streamed = Response::Text(200, std::string(), "text/csv");
+    streamed.stream = [sweep](const ChunkSink& sink) {
+      if (!sink(flight_sweep::CsvHeader(*sweep))) return false;
+      int lanes = 1;
+      return flight_sweep::RunWaves<std::string>(
+          *sweep,
+          [&](std::uint64_t first, std::uint64_t last, core::DesignSequence* sequence) {
+            std::string text;
+            text.reserve(static_cast<std::size_t>(last - first) * 256);
+            for (std::uint64_t i = first; i < last; ++i) {
+              const std::vector<double>& point = sequence->Design(i);
+              flight_sweep::AppendCsvRow(*sweep, i, point, flight_sweep::FlyDesign(*sweep, point),
+                                         &text);
+            }
+            return text;
+          },
+          [&](std::string&& text) { return sink(text); }, &lanes);
+    };
+    return streamed;
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  std::uint64_t landed = 0;
+  int lanes = 1;
+  const bool complete = flight_sweep::RunWaves<std::vector<nlohmann::json>>(
+      *sweep,
+      [&](std::uint64_t first, std::uint64_t last, core::DesignSequence* sequence) {
+        std::vector<nlohmann::json> block;
+        block.reserve(static_cast<std::size_t>(last - first));
+        for (std::uint64_t i = first; i < last; ++i) {
+          const std::vector<double>& point = sequence->Design(i);
+          block.push_back(
+              flight_sweep::JsonRow(*sweep, i, point, flight_sweep::FlyDesign(*sweep, point)));
+        }
+        return block;
+      },
+      [&](std::vector<nlohmann::json>&& block) {
+        for (nlohmann::json& row : block) {
+          if (row["flight"].contains("distance_m")) ++landed;
+          rows.push_back(std::move(row));
+        }
+        return true;
+      },
+      &lanes);
+  if (!complete) {
+    return ErrorResponse(409, ErrorCode::kCancelled, "the flight sweep was cancelled");
+  }
+  const double timing_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  nlohmann::json summary = {
+      {"designs", sweep->total},
+      {"landed", landed},
+      {"threads", lanes},
+      {"timing_s", timing_s},
+      {"models_used",
+       {std::string("flight:") + core::flight::AeroModelName(sweep->base.aero.model)}}};
+  return {200, {{"rows", std::move(rows)}, {"summary", std::move(summary)}}};
+}
+
+}  // namespace sweetspot::api
