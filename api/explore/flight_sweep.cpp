@@ -111,14 +111,50 @@ struct FlightSweep {
   std::chrono::steady_clock::time_point start;
 };
 
-// Flies design `i` (its swept values in `point`).
-flight::FlightResult FlyDesign(const FlightSweep& sweep, const std::vector<double>& point) {
+// The integrator steps one block of kBlock launches may take (accepted and rejected): ~1000 a
+// launch, against ~10 for an ordinary flight at the default tolerance and a few hundred at
+// 1e-13, so that launches that never come down (a custom lift holding them up runs each to the
+// 20,000-step limit, ~6 ms) cost a block at most ~0.3 s. A block's launches fly in order on one
+// thread, so the budget gives the same rows on any number of threads. Once it is spent, each
+// later launch of the block flies with the smallest step limit (10).
+constexpr std::uint64_t kBlock = 1024;  // launches a block (one thread's turn)
+constexpr long long kBlockStepBudget = static_cast<long long>(kBlock) * 1000;
+constexpr int kMinSteps = 10;  // FlightOptions::max_steps's lower bound
+
+// One launch's flight and the step limit it flew with.
+struct Flown {
+  flight::FlightResult result;
+  int max_steps = 0;
+};
+
+// Flies a design (its swept values in `point`) within what is left of its block's budget.
+Flown FlyDesign(const FlightSweep& sweep, const std::vector<double>& point,
+                long long* block_budget) {
   flight::Launch launch = sweep.base.launches.front();
   flight::Environment environment = sweep.base.environment;
   for (std::size_t d = 0; d < sweep.specs.size(); ++d) {
     Apply(*sweep.specs[d], point[d], &launch, &environment);
   }
-  return flight::Fly(launch, environment, sweep.base.aero, sweep.base.options);
+  flight::FlightOptions options = sweep.base.options;
+  options.max_steps = static_cast<int>(std::max<long long>(
+      kMinSteps, std::min<long long>(options.max_steps, *block_budget)));
+  Flown flown{flight::Fly(launch, environment, sweep.base.aero, options), options.max_steps};
+  *block_budget -= flown.result.steps + flown.result.rejected_steps;
+  return flown;
+}
+
+// Why a launch did not land (NotLandedMessage, and the block's budget when it cut the limit).
+std::string Message(const FlightSweep& sweep, const Flown& flown) {
+  flight::FlightOptions options = sweep.base.options;
+  options.max_steps = flown.max_steps;
+  std::string message = NotLandedMessage(flown.result, options);
+  if (flown.result.termination == flight::FlightTermination::kStepLimit &&
+      flown.max_steps < sweep.base.options.max_steps) {
+    message += " (the sweep's budget of " + std::to_string(kBlockStepBudget) +
+               " integrator steps per block of " + std::to_string(kBlock) +
+               " launches was spent by the block's launches before it)";
+  }
+  return message;
 }
 
 // Shortest round-trip text of a finite number ("" for a non-finite one: never written).
@@ -152,7 +188,8 @@ std::string CsvHeader(const FlightSweep& sweep) {
 }
 
 void AppendCsvRow(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
-                  const flight::FlightResult& r, std::string* out) {
+                  const Flown& flown, std::string* out) {
+  const flight::FlightResult& r = flown.result;
   AppendNumber(static_cast<double>(index), out);
   for (double value : point) {
     out->push_back(',');
@@ -166,33 +203,34 @@ void AppendCsvRow(const FlightSweep& sweep, std::uint64_t index, const std::vect
     out->push_back(',');
     if (landed) AppendNumber(value, out);
   }
-  const bool flown = r.termination != flight::FlightTermination::kInvalidInput;
+  const bool ran = r.termination != flight::FlightTermination::kInvalidInput;
   out->push_back(',');
-  if (flown) AppendNumber(r.spin.backspin_rpm, out);
+  if (ran) AppendNumber(r.spin.backspin_rpm, out);
   out->push_back(',');
-  if (flown) AppendNumber(r.spin.sidespin_rpm, out);
+  if (ran) AppendNumber(r.spin.sidespin_rpm, out);
   out->push_back(',');
-  if (flown) out->append(flight::SpinSourceName(r.spin_source));
+  if (ran) out->append(flight::SpinSourceName(r.spin_source));
   for (bool label : {r.classification.barrel, r.classification.hard_hit,
                      r.classification.sweet_spot_launch}) {
     out->push_back(',');
-    if (flown) out->append(label ? "true" : "false");
+    if (ran) out->append(label ? "true" : "false");
   }
   out->push_back(',');
   if (landed) AppendNumber(r.error_estimate_m, out);
   out->push_back(',');
   AppendNumber(r.steps, out);
   out->push_back(',');
-  if (!landed) AppendQuoted(NotLandedMessage(r, sweep.base.options), out);
+  if (!landed) AppendQuoted(Message(sweep, flown), out);
   out->push_back('\n');
 }
 
 Json JsonRow(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
-             const flight::FlightResult& r) {
+             const Flown& flown) {
+  const flight::FlightResult& r = flown.result;
   Json parameters = Json::object();
   for (std::size_t d = 0; d < sweep.paths.size(); ++d) parameters[sweep.paths[d]] = point[d];
   Json out = FlightToJson(r, sweep.base.aero, nullptr);
-  if (!r.Landed()) out["message"] = NotLandedMessage(r, sweep.base.options);
+  if (!r.Landed()) out["message"] = Message(sweep, flown);
   return {{"index", index}, {"parameters", std::move(parameters)}, {"flight", std::move(out)}};
 }
 
@@ -200,7 +238,6 @@ Json JsonRow(const FlightSweep& sweep, std::uint64_t index, const std::vector<do
 // the blocks to `consume` in design order; false when cancelled or when `consume` refused.
 // `make(first, last, sequence)` evaluates designs [first, last) into a block. Threads that
 // cannot be started leave their block to the calling thread (nothing throws).
-constexpr std::uint64_t kBlock = 1024;
 
 template <class Block, class Make, class Consume>
 bool RunWaves(const FlightSweep& sweep, Make make, Consume consume, int* lanes_used) {
@@ -413,10 +450,11 @@ Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
           [&](std::uint64_t first, std::uint64_t last, core::DesignSequence* sequence) {
             std::string text;
             text.reserve(static_cast<std::size_t>(last - first) * 256);
+            long long budget = flight_sweep::kBlockStepBudget;
             for (std::uint64_t i = first; i < last; ++i) {
               const std::vector<double>& point = sequence->Design(i);
-              flight_sweep::AppendCsvRow(*sweep, i, point, flight_sweep::FlyDesign(*sweep, point),
-                                         &text);
+              flight_sweep::AppendCsvRow(*sweep, i, point,
+                                         flight_sweep::FlyDesign(*sweep, point, &budget), &text);
             }
             return text;
           },
@@ -432,10 +470,11 @@ Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
       [&](std::uint64_t first, std::uint64_t last, core::DesignSequence* sequence) {
         std::vector<nlohmann::json> block;
         block.reserve(static_cast<std::size_t>(last - first));
+        long long budget = flight_sweep::kBlockStepBudget;
         for (std::uint64_t i = first; i < last; ++i) {
           const std::vector<double>& point = sequence->Design(i);
-          block.push_back(
-              flight_sweep::JsonRow(*sweep, i, point, flight_sweep::FlyDesign(*sweep, point)));
+          block.push_back(flight_sweep::JsonRow(*sweep, i, point,
+                                                flight_sweep::FlyDesign(*sweep, point, &budget)));
         }
         return block;
       },

@@ -127,6 +127,41 @@ TEST(FlightSweepTest, ARefusedDesignIsARow) {
   EXPECT_NE(refused.back().find("launch.launch_angle_deg"), std::string::npos) << lines[3];
 }
 
+// Launches that never come down (a custom lift holds them up to max_flight_time_s = 600 s,
+// thousands of steps each): a block's budget of 1,024,000 steps bounds the work; later launches
+// of the block fly with the 10-step minimum and say why. The same rows on 1 and 2 threads.
+TEST(FlightSweepTest, LaunchesThatNeverLandStopAtTheBlocksStepBudget) {
+  const std::string body = R"({"flight": {"launch": {"exit_speed_mps": 20, "launch_angle_deg": 0,
+        "backspin_rpm": 10000, "sidespin_rpm": 0},
+      "aero": {"model": "custom", "cd0": 0, "cd_spin_per_krpm": 0, "lift_law": "linear",
+               "cl_per_spin_factor": 10, "spin_decay_s": 1e6},
+      "options": {"max_flight_time_s": 600}},
+    "parameters": [{"path": "launch.exit_speed_mps", "min": 5, "max": 20, "count": 300}],
+    "format": "csv"})";
+  Context two;
+  two.explore_threads = 2;
+  const Response r = Explore(body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  EXPECT_EQ(Explore(body, two).text, r.text);
+  const std::vector<std::string> lines = Lines(r.text);
+  ASSERT_EQ(lines.size(), 301u);
+  long long steps = 0;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const std::vector<std::string> row = Cells(lines[i]);
+    EXPECT_NE(row[2], "landed") << lines[i];
+    steps += std::stoll(row[row.size() - 2]);
+  }
+  // Accepted steps only (the budget also counts rejected ones): at most the budget plus the
+  // 10-step minimum of each later launch.
+  EXPECT_LE(steps, 1024000 + 10 * 300);
+  const std::vector<std::string> last = Cells(lines.back());
+  EXPECT_EQ(last[2], "step_limit");
+  EXPECT_EQ(last.back(),
+            "the integrator took max_steps = 10 steps before the ball landed (the sweep's budget "
+            "of 1024000 integrator steps per block of 1024 launches was spent by the block's "
+            "launches before it)");
+}
+
 struct Bad {
   const char* body;
   const char* field;
