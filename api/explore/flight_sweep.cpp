@@ -411,6 +411,18 @@ std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::
                  limit_name + " = " + std::to_string(limit));
     return std::nullopt;
   }
+  // A JSON answer is built in memory (a CSV one streams): a row is about 1 kB (the /v1/flight
+  // answer with its parameters; 0.7 kB compact), so its size is bounded like a bat sweep's.
+  constexpr std::uint64_t kJsonRowBytes = 1000;
+  if (*format == "json" && sweep.total > context.limits.max_response_bytes / kJsonRowBytes) {
+    SetError(error, ErrorCode::kTooBig, "format", nullptr,
+             "\"json\" for " + std::to_string(sweep.total) + " launches is about " +
+                 std::to_string(sweep.total * kJsonRowBytes / 1000000) +
+                 " MB in memory, over max_response_bytes = " +
+                 std::to_string(context.limits.max_response_bytes) +
+                 "; ask for \"format\": \"csv\" (streamed)");
+    return std::nullopt;
+  }
   sweep.threads = std::max(1, context.explore_threads);
   sweep.budget = context.thread_budget;
   sweep.progress = context.progress;

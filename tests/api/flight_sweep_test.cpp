@@ -190,6 +190,11 @@ TEST(FlightSweepTest, RefusalsNameTheField) {
           "parameters": [{"path": "launch.exit_speed_mph", "min": 90, "max": 100, "count": 1000},
                          {"path": "launch.launch_angle_deg", "min": 0, "max": 50, "count": 1000}]})",
        "parameters", 413},
+      // 90,000 rows of JSON (~90 MB) are over max_response_bytes (64 MiB): csv streams.
+      {R"({"flight": {"launch": {"exit_speed_mph": 100, "launch_angle_deg": 28}},
+          "parameters": [{"path": "launch.exit_speed_mph", "min": 90, "max": 100, "count": 300},
+                         {"path": "launch.launch_angle_deg", "min": 0, "max": 50, "count": 300}]})",
+       "format", 413},
       {R"({"flight": {"launch": {"exit_speed_mph": 100, "launch_angle_deg": 28}},
           "parameters": [{"path": "launch.exit_speed_mph", "min": 90, "max": 100}],
           "format": "ndjson"})",
