@@ -100,7 +100,8 @@ void Apply(const PathSpec& spec, double written, flight::Launch* launch,
 
 // A parsed flight sweep, owned by its (maybe streamed) answer.
 struct FlightSweep {
-  FlightRequest base;                    // launches[0] is the template
+  FlightRequest base;                    // launches[0] is the template, or the list
+  bool list = false;                     // fly base.launches as given (no parameters)
   std::vector<std::string> paths;        // as written
   std::vector<const PathSpec*> specs;    // per path
   core::SweepPlan plan;                  // dimensions in the order of `paths`
@@ -121,16 +122,20 @@ constexpr std::uint64_t kBlock = 1024;  // launches a block (one thread's turn)
 constexpr long long kBlockStepBudget = static_cast<long long>(kBlock) * 1000;
 constexpr int kMinSteps = 10;  // FlightOptions::max_steps's lower bound
 
+// The swept values of a list's launch: none.
+const std::vector<double> kNoPoint;
+
 // One launch's flight and the step limit it flew with.
 struct Flown {
   flight::FlightResult result;
   int max_steps = 0;
 };
 
-// Flies a design (its swept values in `point`) within what is left of its block's budget.
-Flown FlyDesign(const FlightSweep& sweep, const std::vector<double>& point,
+// Flies design `index` (its swept values in `point`; a list's launch `index`) within what is
+// left of its block's budget.
+Flown FlyDesign(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
                 long long* block_budget) {
-  flight::Launch launch = sweep.base.launches.front();
+  flight::Launch launch = sweep.base.launches[sweep.list ? index : 0];
   flight::Environment environment = sweep.base.environment;
   for (std::size_t d = 0; d < sweep.specs.size(); ++d) {
     Apply(*sweep.specs[d], point[d], &launch, &environment);
@@ -227,10 +232,11 @@ void AppendCsvRow(const FlightSweep& sweep, std::uint64_t index, const std::vect
 Json JsonRow(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
              const Flown& flown) {
   const flight::FlightResult& r = flown.result;
-  Json parameters = Json::object();
-  for (std::size_t d = 0; d < sweep.paths.size(); ++d) parameters[sweep.paths[d]] = point[d];
   Json out = FlightToJson(r, sweep.base.aero, nullptr);
   if (!r.Landed()) out["message"] = Message(sweep, flown);
+  if (sweep.list) return {{"index", index}, {"flight", std::move(out)}};
+  Json parameters = Json::object();
+  for (std::size_t d = 0; d < sweep.paths.size(); ++d) parameters[sweep.paths[d]] = point[d];
   return {{"index", index}, {"parameters", std::move(parameters)}, {"flight", std::move(out)}};
 }
 
@@ -252,8 +258,11 @@ bool RunWaves(const FlightSweep& sweep, Make make, Consume consume, int* lanes_u
   } give_back{sweep.budget, sweep.budget != nullptr ? extra : 0};
   const int lanes = 1 + extra;
   *lanes_used = lanes;
-  std::vector<core::DesignSequence> sequences(static_cast<std::size_t>(lanes),
-                                              core::DesignSequence(sweep.plan));
+  std::vector<core::DesignSequence> sequences;  // none for a list
+  if (!sweep.list) {
+    sequences.assign(static_cast<std::size_t>(lanes), core::DesignSequence(sweep.plan));
+  }
+  const auto sequence = [&](int k) { return sequences.empty() ? nullptr : &sequences[k]; };
   std::vector<Block> blocks(static_cast<std::size_t>(lanes));
   for (std::uint64_t first = 0; first < sweep.total; first += kBlock * lanes) {
     if (core::IsCancelled(sweep.progress)) return false;
@@ -263,12 +272,12 @@ bool RunWaves(const FlightSweep& sweep, Make make, Consume consume, int* lanes_u
       if (lo >= sweep.total) break;
       const std::uint64_t hi = std::min(lo + kBlock, sweep.total);
       try {
-        workers.emplace_back([&, k, lo, hi] { blocks[k] = make(lo, hi, &sequences[k]); });
+        workers.emplace_back([&, k, lo, hi] { blocks[k] = make(lo, hi, sequence(k)); });
       } catch (const std::system_error&) {
-        blocks[k] = make(lo, hi, &sequences[k]);  // no thread: this one does it
+        blocks[k] = make(lo, hi, sequence(k));  // no thread: this one does it
       }
     }
-    blocks[0] = make(first, std::min(first + kBlock, sweep.total), &sequences[0]);
+    blocks[0] = make(first, std::min(first + kBlock, sweep.total), sequence(0));
     for (std::thread& worker : workers) worker.join();
     for (int k = 0; k < lanes && first + kBlock * k < sweep.total; ++k) {
       if (!consume(std::move(blocks[k]))) return false;
@@ -288,6 +297,11 @@ void PrefixFlight(ApiError* error) {
   error->field = "flight." + error->field;
 }
 
+bool ParseSweptTemplate(ObjectReader& reader, std::size_t limit, const char* limit_name,
+                        FlightSweep* out, std::string* format, ApiError* error);
+std::optional<FlightSweep> Finish(FlightSweep sweep, const Context& context,
+                                  const std::string& format, ApiError* error);
+
 std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::string* format,
                                  ApiError* error) {
   ObjectReader reader(body, "", error);
@@ -297,15 +311,17 @@ std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::
     reader.Fail("flight", "must be an object: a /v1/flight request with one \"launch\"");
     return std::nullopt;
   }
-  if (template_json->contains("launches")) {
-    SetError(error, ErrorCode::kInvalidValue, "flight.launches", nullptr,
-             "a sweep's template has one \"launch\"; sweep its fields with \"parameters\"");
-    return std::nullopt;
-  }
+  const std::size_t limit =
+      context.batch ? context.limits.max_batch_samples : context.limits.max_samples;
+  const char* limit_name = context.batch ? "max_batch_samples" : "max_samples";
   FlightSweep sweep;
+  // "launches": a list flown as given (a season's batted balls), up to the sweep's limit.
+  sweep.list = template_json->contains("launches");
   {
     ApiError inner;
-    std::optional<FlightRequest> request = ParseFlight(*template_json, context.limits, &inner);
+    ApiLimits limits = context.limits;
+    if (sweep.list) limits.max_launches = limit;
+    std::optional<FlightRequest> request = ParseFlight(*template_json, limits, &inner);
     if (!request) {
       *error = std::move(inner);
       PrefixFlight(error);
@@ -319,12 +335,31 @@ std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::
     sweep.base = std::move(*request);
   }
 
-  const std::size_t limit =
-      context.batch ? context.limits.max_batch_samples : context.limits.max_samples;
-  const char* limit_name = context.batch ? "max_batch_samples" : "max_samples";
+  if (sweep.list) {
+    for (const char* key : {"parameters", "sampling", "samples", "seed"}) {
+      if (reader.Has(key)) {
+        reader.Fail(key, "applies to a swept \"launch\"; a list of \"launches\" is flown as "
+                         "given");
+        return std::nullopt;
+      }
+    }
+    *format = "json";  // as a bat sweep's
+    reader.OptionalString("format", format, {"json", "csv"});
+    if (!reader.Finish()) return std::nullopt;
+    sweep.total = sweep.base.launches.size();  // <= limit: ParseFlight's max_launches
+  } else if (!ParseSweptTemplate(reader, limit, limit_name, &sweep, format, error)) {
+    return std::nullopt;
+  }
+  return Finish(std::move(sweep), context, *format, error);
+}
+
+// The "parameters", "sampling", "samples", "seed" and "format" of a swept template.
+bool ParseSweptTemplate(ObjectReader& reader, std::size_t limit, const char* limit_name,
+                        FlightSweep* out, std::string* format, ApiError* error) {
+  FlightSweep& sweep = *out;
   std::string sampling = "grid";
   reader.OptionalString("sampling", &sampling, {"grid", "lhs", "sobol"});
-  if (!reader.ok()) return std::nullopt;
+  if (!reader.ok()) return false;
   sweep.plan.method = *core::ParseSamplingMethod(sampling);
   long long samples = 0, seed = 0;
   reader.OptionalInteger("samples", 1,
@@ -340,10 +375,10 @@ std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::
   reader.OptionalString("format", format, {"json", "csv"});
   const Json* params = reader.Get("parameters");
   if (reader.ok() && params == nullptr) reader.Missing("parameters");
-  if (!reader.ok()) return std::nullopt;
+  if (!reader.ok()) return false;
   if (!params->is_array() || params->empty() || params->size() > 32) {
     reader.Fail("parameters", "must be an array of 1 to 32 {\"path\", \"min\", \"max\"}");
-    return std::nullopt;
+    return false;
   }
   bool swept[12] = {};
   for (std::size_t i = 0; i < params->size(); ++i) {
@@ -351,7 +386,7 @@ std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::
     if (!(*params)[i].is_object()) {
       SetError(error, ErrorCode::kInvalidValue, where, &(*params)[i],
                "must be an object {\"path\", \"min\", \"max\"}");
-      return std::nullopt;
+      return false;
     }
     ObjectReader p((*params)[i], where, error);
     std::string path;
@@ -365,25 +400,25 @@ std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::
     long long count = sweep.plan.method == core::SamplingMethod::kGrid ? 2 : 1;
     p.OptionalInteger("count", 1, 1000000000, &count);  // the total is checked below
     dimension.count = static_cast<int>(count);
-    if (!p.Finish()) return std::nullopt;
+    if (!p.Finish()) return false;
     const PathSpec* spec = FindPath(path);
     if (spec == nullptr) {
       std::string known;
       for (const PathSpec& s : kPaths) known += (known.empty() ? "" : ", ") + std::string(s.path);
       SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
                "is not a field a flight sweep can sweep (one of: " + known + ")");
-      return std::nullopt;
+      return false;
     }
     if (swept[static_cast<int>(spec->target)]) {
       SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
                "sweeps a quantity another parameter already sweeps");
-      return std::nullopt;
+      return false;
     }
     swept[static_cast<int>(spec->target)] = true;
     if (dimension.max < dimension.min) {
       SetError(error, ErrorCode::kInvalidValue, where + ".max", &(*params)[i]["max"],
                "must be >= min");
-      return std::nullopt;
+      return false;
     }
     sweep.paths.push_back(path);
     sweep.specs.push_back(spec);
@@ -397,24 +432,30 @@ std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::
              std::string("gives no spin, and the sweep sets only ") +
                  (back ? "backspin_rpm" : "sidespin_rpm") +
                  ": give both spins in the launch, or sweep both");
-    return std::nullopt;
+    return false;
   }
-  if (!reader.Finish()) return std::nullopt;
+  if (!reader.Finish()) return false;
   if (core::Refusal refusal; !sweep.plan.Validate(&refusal)) {
     CoreRefusal(refusal, "", error);
-    return std::nullopt;
+    return false;
   }
   sweep.total = sweep.plan.DesignCount();
   if (sweep.total > limit) {
     SetError(error, ErrorCode::kTooBig, "parameters", nullptr,
              "describe " + std::to_string(sweep.total) + " launches, over the limit " +
                  limit_name + " = " + std::to_string(limit));
-    return std::nullopt;
+    return false;
   }
+  return true;
+}
+
+// The checks and settings every flight sweep shares: the size of a JSON answer, the threads.
+std::optional<FlightSweep> Finish(FlightSweep sweep, const Context& context,
+                                  const std::string& format, ApiError* error) {
   // A JSON answer is built in memory (a CSV one streams): a row is about 1 kB (the /v1/flight
   // answer with its parameters; 0.7 kB compact), so its size is bounded like a bat sweep's.
   constexpr std::uint64_t kJsonRowBytes = 1000;
-  if (*format == "json" && sweep.total > context.limits.max_response_bytes / kJsonRowBytes) {
+  if (format == "json" && sweep.total > context.limits.max_response_bytes / kJsonRowBytes) {
     SetError(error, ErrorCode::kTooBig, "format", nullptr,
              "\"json\" for " + std::to_string(sweep.total) + " launches is about " +
                  std::to_string(sweep.total * kJsonRowBytes / 1000000) +
@@ -464,9 +505,11 @@ Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
             text.reserve(static_cast<std::size_t>(last - first) * 256);
             long long budget = flight_sweep::kBlockStepBudget;
             for (std::uint64_t i = first; i < last; ++i) {
-              const std::vector<double>& point = sequence->Design(i);
+              const std::vector<double>& point =
+                  sequence != nullptr ? sequence->Design(i) : flight_sweep::kNoPoint;
               flight_sweep::AppendCsvRow(*sweep, i, point,
-                                         flight_sweep::FlyDesign(*sweep, point, &budget), &text);
+                                         flight_sweep::FlyDesign(*sweep, i, point, &budget),
+                                         &text);
             }
             return text;
           },
@@ -484,9 +527,10 @@ Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
         block.reserve(static_cast<std::size_t>(last - first));
         long long budget = flight_sweep::kBlockStepBudget;
         for (std::uint64_t i = first; i < last; ++i) {
-          const std::vector<double>& point = sequence->Design(i);
-          block.push_back(flight_sweep::JsonRow(*sweep, i, point,
-                                                flight_sweep::FlyDesign(*sweep, point, &budget)));
+          const std::vector<double>& point =
+              sequence != nullptr ? sequence->Design(i) : flight_sweep::kNoPoint;
+          block.push_back(flight_sweep::JsonRow(
+              *sweep, i, point, flight_sweep::FlyDesign(*sweep, i, point, &budget)));
         }
         return block;
       },
