@@ -1,12 +1,12 @@
 #include "api/explore/flight_sweep.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
-#include <system_error>
 #include <thread>
 #include <utility>
 
@@ -241,12 +241,15 @@ Json JsonRow(const FlightSweep& sweep, std::uint64_t index, const std::vector<do
 }
 
 // Runs the sweep's designs in waves of one block per thread (blocks of kBlock designs), hands
-// the blocks to `consume` in design order; false when cancelled or when `consume` refused.
+// the blocks to `consume` in design order; false when cancelled, when `consume` refused, or
+// when a block threw (*out_of_memory: std::bad_alloc is all a block can throw).
 // `make(first, last, sequence)` evaluates designs [first, last) into a block. Threads that
 // cannot be started leave their block to the calling thread (nothing throws).
 
 template <class Block, class Make, class Consume>
-bool RunWaves(const FlightSweep& sweep, Make make, Consume consume, int* lanes_used) {
+bool RunWaves(const FlightSweep& sweep, Make make, Consume consume, int* lanes_used,
+              bool* out_of_memory) {
+  *out_of_memory = false;
   int extra = std::max(0, sweep.threads - 1);
   if (extra > 0 && sweep.budget != nullptr) extra = sweep.budget->TryTake(extra);
   struct GiveBack {
@@ -264,6 +267,15 @@ bool RunWaves(const FlightSweep& sweep, Make make, Consume consume, int* lanes_u
   }
   const auto sequence = [&](int k) { return sequences.empty() ? nullptr : &sequences[k]; };
   std::vector<Block> blocks(static_cast<std::size_t>(lanes));
+  // A block that throws (out of memory) fails the sweep; nothing escapes a thread.
+  std::atomic<bool> failed{false};
+  const auto run = [&](int k, std::uint64_t lo, std::uint64_t hi) noexcept {
+    try {
+      blocks[k] = make(lo, hi, sequence(k));
+    } catch (...) {
+      failed.store(true);
+    }
+  };
   for (std::uint64_t first = 0; first < sweep.total; first += kBlock * lanes) {
     if (core::IsCancelled(sweep.progress)) return false;
     std::vector<std::thread> workers;
@@ -272,13 +284,17 @@ bool RunWaves(const FlightSweep& sweep, Make make, Consume consume, int* lanes_u
       if (lo >= sweep.total) break;
       const std::uint64_t hi = std::min(lo + kBlock, sweep.total);
       try {
-        workers.emplace_back([&, k, lo, hi] { blocks[k] = make(lo, hi, sequence(k)); });
-      } catch (const std::system_error&) {
-        blocks[k] = make(lo, hi, sequence(k));  // no thread: this one does it
+        workers.emplace_back(run, k, lo, hi);
+      } catch (...) {
+        run(k, lo, hi);  // no thread: this one does it
       }
     }
-    blocks[0] = make(first, std::min(first + kBlock, sweep.total), sequence(0));
+    run(0, first, std::min(first + kBlock, sweep.total));
     for (std::thread& worker : workers) worker.join();
+    if (failed.load()) {
+      *out_of_memory = true;
+      return false;
+    }
     for (int k = 0; k < lanes && first + kBlock * k < sweep.total; ++k) {
       if (!consume(std::move(blocks[k]))) return false;
     }
@@ -498,6 +514,7 @@ Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
     streamed.stream = [sweep](const ChunkSink& sink) {
       if (!sink(flight_sweep::CsvHeader(*sweep))) return false;
       int lanes = 1;
+      bool out_of_memory = false;  // a cut CSV: the stream ends early
       return flight_sweep::RunWaves<std::string>(
           *sweep,
           [&](std::uint64_t first, std::uint64_t last, core::DesignSequence* sequence) {
@@ -513,13 +530,14 @@ Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
             }
             return text;
           },
-          [&](std::string&& text) { return sink(text); }, &lanes);
+          [&](std::string&& text) { return sink(text); }, &lanes, &out_of_memory);
     };
     return streamed;
   }
   nlohmann::json rows = nlohmann::json::array();
   std::uint64_t landed = 0;
   int lanes = 1;
+  bool out_of_memory = false;
   const bool complete = flight_sweep::RunWaves<std::vector<nlohmann::json>>(
       *sweep,
       [&](std::uint64_t first, std::uint64_t last, core::DesignSequence* sequence) {
@@ -541,7 +559,13 @@ Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
         }
         return true;
       },
-      &lanes);
+      &lanes, &out_of_memory);
+  if (out_of_memory) {
+    rows = nlohmann::json();
+    return ErrorResponse(503, ErrorCode::kUnavailable,
+                         "the flight sweep ran out of memory; retry later, or ask for "
+                         "\"format\": \"csv\" (streamed)");
+  }
   if (!complete) {
     return ErrorResponse(409, ErrorCode::kCancelled, "the flight sweep was cancelled");
   }
