@@ -341,6 +341,11 @@ std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::
     if (!request) {
       *error = std::move(inner);
       PrefixFlight(error);
+      if (sweep.list && error->code == ErrorCode::kTooBig && error->field == "flight.launches") {
+        error->message = "flight.launches: has " +
+                         std::to_string(template_json->at("launches").size()) +
+                         " launches, over the limit " + limit_name + " = " + std::to_string(limit);
+      }
       return std::nullopt;
     }
     if (request->trajectory) {

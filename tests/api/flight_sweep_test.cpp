@@ -191,6 +191,13 @@ TEST(FlightSweepTest, AListOfLaunchesIsFlownAsGiven) {
                     R"(}, "parameters": [{"path": "launch.exit_speed_mph", "min": 1, "max": 2}]})")
                 .body["field"],
             "parameters");
+  Context small;
+  small.limits.max_samples = 2;
+  const Response too_many = Explore(R"({"flight": {"launches": )" + launches + "}}", small);
+  EXPECT_EQ(too_many.status, 413);
+  EXPECT_EQ(too_many.body["field"], "flight.launches");
+  EXPECT_EQ(too_many.body["message"],
+            "flight.launches: has 3 launches, over the limit max_samples = 2");
   EXPECT_EQ(Explore(R"({"flight": {"launches": [{"exit_speed_mph": 100, "launch_angle_deg": 28},
                 {"exit_speed_mph": 100, "launch_angle_deg": 120}]}})")
                 .body["field"],
