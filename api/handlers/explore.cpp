@@ -13,6 +13,7 @@
 #include "api/explore/design.hpp"
 #include "api/explore/engine.hpp"
 #include "api/explore/estimate.hpp"
+#include "api/explore/flight_sweep.hpp"
 #include "api/explore/shards.hpp"
 #include "api/explore/streams.hpp"
 #include "api/fields.hpp"
@@ -542,6 +543,8 @@ Response HandleExplore(const Request& request, const Context& context) {
   // Not ParseRequest: "report_units" is this endpoint's own field (ParseExploreRequest).
   const std::optional<Json> body = ParseObjectBody(request, context, &failure);
   if (!body) return failure;
+  // A sweep of batted-ball launches ("flight" instead of a bat): api/explore/flight_sweep.hpp.
+  if (IsFlightSweep(*body)) return HandleFlightSweep(*body, context);
   ApiError error;
   const auto parsed = ParseExploreRequest(*body, context, &error);
   if (!parsed) return ToResponse(error);

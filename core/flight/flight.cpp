@@ -56,6 +56,20 @@ struct Model {
   LiftLaw lift = LiftLaw::kSaturating;
   double cl0 = 0, cl1 = 0, cl2 = 0, cl_slope = 0;
   double wind_x = 0, wind_y = 0;  // wind velocity, m/s.
+  // Products of the above, computed once per flight (Prepare) so that a right-hand side needs
+  // one division: k·cd0, k·cd_spin·spin_krpm (1/m), Rω (m/s), k·cl2·Rω and k·slope·Rω (1/s),
+  // cl1·Rω (m/s).
+  double k_cd0 = 0, k_cd_spin = 0, spin_speed_mps = 0, k_cl2_spin = 0, k_slope_spin = 0,
+         cl1_spin = 0;
+
+  void Prepare() {
+    k_cd0 = k_per_m * cd0;
+    k_cd_spin = k_per_m * cd_spin * spin_krpm;
+    spin_speed_mps = radius_m * omega_rad_s;
+    k_cl2_spin = k_per_m * cl2 * spin_speed_mps;
+    k_slope_spin = k_per_m * cl_slope * spin_speed_mps;
+    cl1_spin = cl1 * spin_speed_mps;
+  }
 };
 
 // Sawicki et al. (2003)'s drag coefficient against air speed, as this file approximates it: 0.5
@@ -71,26 +85,30 @@ double SawickiDrag(double v) {
 
 double SawickiLift(double s) { return s < 0.1 ? 1.5 * s : 0.09 + 0.6 * s; }
 
-// Inlined into the stepper: called 6 times a step, it is most of a flight's time.
+// Inlined into the stepper: called 6 times a step, it is most of a flight's time. Its cost is
+// the latency of one chain (sqrt, exp, one division), so the constants are folded (Model::
+// Prepare) and Nathan's lift k·CL·v with CL = cl2·S/(cl0 + cl1·S), S = Rω·decay/v, is written
+// with one division: k·cl2·Rω·decay·v / (cl0·v + cl1·Rω·decay) (the same number to rounding).
 [[gnu::always_inline]] inline State Derivative(const Model& m, double t, const State& s) {
   State d{s.vx, s.vy, s.vz, 0.0, 0.0, -kGravityMps2};
   if (!m.air) return d;
   const double rx = s.vx - m.wind_x, ry = s.vy - m.wind_y, rz = s.vz;
   const double v = std::sqrt(rx * rx + ry * ry + rz * rz);
-  const double decay = m.decay ? std::exp(-t * v * m.decay_rate_per_m) : 1.0;
-  double cd = 0.0, cl = 0.0;
-  const double spin_factor = v > 0.0 ? m.radius_m * m.omega_rad_s / v * decay : 0.0;
+  double drag = 0.0, lift = 0.0;  // drag: −k·CD·v; lift: k·CL·v (1/s)
   if (m.model == AeroModel::kSawicki2003) {
-    cd = SawickiDrag(v);
-    cl = SawickiLift(spin_factor);
+    const double spin_factor = v > 0.0 ? m.spin_speed_mps / v : 0.0;
+    drag = -m.k_per_m * SawickiDrag(v) * v;
+    lift = m.k_per_m * SawickiLift(spin_factor) * v;
   } else {
-    cd = m.cd0 + m.cd_spin * m.spin_krpm * decay;
-    cl = m.lift == LiftLaw::kLinear ? m.cl_slope * spin_factor
-                                    : m.cl2 * spin_factor / (m.cl0 + m.cl1 * spin_factor);
+    const double decay = m.decay ? std::exp(-t * v * m.decay_rate_per_m) : 1.0;
+    drag = -(m.k_cd0 + m.k_cd_spin * decay) * v;
+    if (m.lift == LiftLaw::kLinear) {
+      lift = m.k_slope_spin * decay;  // k·slope·S·v: v cancels
+    } else if (v > 0.0) {
+      lift = m.k_cl2_spin * decay * v / (m.cl0 * v + m.cl1_spin * decay);
+    }
   }
-  const double drag = -m.k_per_m * cd * v;
   // Magnus: k·CL·v·(û × v_rel), û the (fixed) spin axis, as the calculator writes it.
-  const double lift = m.k_per_m * cl * v;
   d.vx += drag * rx + lift * (m.uy * rz - m.uz * ry);
   d.vy += drag * ry + lift * (m.uz * rx - m.ux * rz);
   d.vz += drag * rz + lift * (m.ux * ry - m.uy * rx);
@@ -130,13 +148,38 @@ struct Dense {
 
 const double* Array(const State& s) { return &s.x; }
 
+// The step controller's floors, as logarithms: err is taken as at least 1e-10, and the memory
+// of the last step's err as at least 1e-4 (Hairer's DOPRI5).
+constexpr double kLogMinError = -23.025850929940457;       // ln 1e-10
+constexpr double kLogMinErrorMemory = -9.210340371976182;  // ln 1e-4
+
 // The θ in [0, 1] where component `i` of the dense output crosses zero, given its signs at
-// the ends differ (Illinois regula falsi, to 1e-11 in θ: 1e-10 m on a step of tens of metres).
+// the ends differ: Newton's method on the dense polynomial from the secant's guess (three or
+// four iterations to 1e-13 in θ), and if it leaves [0, 1] or does not settle, an Illinois
+// regula falsi to 1e-11 in θ (1e-10 m on a step of tens of metres).
 double RootOf(const Dense& dense, int i, double f0, double f1) {
+  double theta = f0 / (f0 - f1);
+  for (int iter = 0; iter < 8; ++iter) {
+    // y = r1 + θ·Q, Q = r2 + u·P, P = r3 + θ·(r4 + u·r5), u = 1 − θ; dy/dθ by the product rule.
+    const double u = 1.0 - theta;
+    const double inner = dense.r4[i] + u * dense.r5[i];
+    const double p = dense.r3[i] + theta * inner;
+    const double q = dense.r2[i] + u * p;
+    const double dp = inner - theta * dense.r5[i];
+    const double dq = -p + u * dp;
+    const double f = dense.r1[i] + theta * q;
+    const double df = q + theta * dq;
+    if (f == 0.0) return theta;
+    if (!(df != 0.0)) break;
+    const double step = f / df;
+    theta -= step;
+    if (!(theta >= 0.0 && theta <= 1.0)) break;
+    if (std::abs(step) < 1e-13) return theta;
+  }
   double a = 0.0, b = 1.0, fa = f0, fb = f1;
   int side = 0;
   for (int iter = 0; iter < 60 && b - a > 1e-11; ++iter) {
-    const double theta = (a * fb - b * fa) / (fb - fa);
+    theta = (a * fb - b * fa) / (fb - fa);
     const double f = dense.Component(i, theta);
     if (f == 0.0) return theta;
     if ((f > 0.0) == (fa > 0.0)) {
@@ -387,6 +430,7 @@ FlightResult Fly(const Launch& launch, const Environment& environment, const Aer
       break;
   }
   m.decay_rate_per_m = 1.0 / (aero.spin_decay_s * kDecayReferenceSpeedMps);
+  m.Prepare();
   const double wind_dir = environment.wind.direction_deg * kDegToRad;
   m.wind_x = environment.wind.speed_mps * std::sin(wind_dir);
   m.wind_y = environment.wind.speed_mps * std::cos(wind_dir);
@@ -408,7 +452,9 @@ FlightResult Fly(const Launch& launch, const Environment& environment, const Aer
   // The error estimate: the local position errors, plus each step's local velocity error
   // carried to the landing (δv · (T − t_i), T the hang time): Σ|δx_i| + T·Σ|δv_i| − Σ|δv_i|·t_i.
   double error_sum = 0.0, velocity_error_sum = 0.0, velocity_error_time_sum = 0.0;
-  double previous_error_ratio = 1e-4;  // PI controller memory (Hairer's DOPRI5 "facold").
+  // PI controller memory (Hairer's DOPRI5 "facold", 1e-4 at first), kept as its logarithm: the
+  // controller's err^0.17 · facold^−0.04 is one exp of logarithms (two pow calls cost more).
+  double log_previous_error_ratio = std::log(1e-4);
 
   while (true) {
     // Rejected steps count too: a step size shrinking forever must end as well.
@@ -479,8 +525,9 @@ FlightResult Fly(const Launch& launch, const Environment& environment, const Aer
       return r;
     }
     const double err = std::sqrt(err2 / 6.0);
+    const double log_err = std::log(err);  // −inf for a zero error: the clamps below hold
     if (err > 1.0) {
-      h *= std::max(0.2, 0.9 * std::pow(err, -0.2));
+      h *= std::max(0.2, 0.9 * std::exp(-0.2 * log_err));
       ++r.rejected_steps;
       continue;
     }
@@ -555,9 +602,10 @@ FlightResult Fly(const Launch& launch, const Environment& environment, const Aer
     k1 = k7;  // first same as last
     t += h;
     // Step-size control (Hairer's DOPRI5: PI control with β = 0.04).
-    const double fac = std::pow(std::max(err, 1e-10), 0.2 - 0.04 * 0.75) *
-                       std::pow(previous_error_ratio, -0.04);
-    previous_error_ratio = std::max(err, 1e-4);
+    // fac = max(err, 1e-10)^0.17 · facold^−0.04, facold = max(err, 1e-4) of the last step.
+    const double fac = std::exp((0.2 - 0.04 * 0.75) * std::max(log_err, kLogMinError) -
+                                0.04 * log_previous_error_ratio);
+    log_previous_error_ratio = std::max(log_err, kLogMinErrorMemory);
     h = h * std::clamp(0.9 / fac, 0.2, 10.0);
   }
 }

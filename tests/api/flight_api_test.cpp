@@ -193,6 +193,42 @@ TEST(FlightApiTest, ABallStillUpAtTheTimeLimitIsAnError) {
   EXPECT_TRUE(r.body["flights"][1].contains("distance_m"));
 }
 
+// Many balls that never come down: a custom lift with no drag and no spin decay holds each one
+// up (it drifts sideways on a looping path) until max_flight_time_s = 600 s, ~6,700 steps
+// (~3 ms) each. The request's budget of 2,000,000 steps over all its launches bounds the work:
+// once it is spent, each later launch flies with the smallest step limit (10) and its row says
+// why it did not land. Without the budget, 4096 such launches would take ~25 s of CPU.
+TEST(FlightApiTest, BallsThatNeverLandStopAtTheRequestsStepBudget) {
+  constexpr int kLaunches = 400;  // ~6,700 steps each: the budget is spent after ~300
+  std::string launches;
+  for (int i = 0; i < kLaunches; ++i) {
+    launches += std::string(i ? "," : "") +
+                R"({"exit_speed_mps": 20, "launch_angle_deg": 0, "backspin_rpm": 10000,
+                    "sidespin_rpm": 0})";
+  }
+  const Response r = Post(R"({"launches": [)" + launches + R"(],
+      "aero": {"model": "custom", "cd0": 0, "cd_spin_per_krpm": 0, "lift_law": "linear",
+               "cl_per_spin_factor": 10, "spin_decay_s": 1e6},
+      "options": {"max_flight_time_s": 600}})");
+  ASSERT_EQ(r.status, 200) << r.body.dump().substr(0, 500);
+  const auto& flights = r.body["flights"];
+  ASSERT_EQ(flights.size(), static_cast<std::size_t>(kLaunches));
+  long long total = 0;
+  for (const auto& f : flights) {
+    total += f["numerics"]["steps"].get<long long>() + f["numerics"]["rejected_steps"].get<long long>();
+    EXPECT_FALSE(f.contains("distance_m"));
+  }
+  // The budget, plus at most the 10-step minimum for each launch after it was spent.
+  EXPECT_LE(total, 2000000 + 10LL * kLaunches);
+  EXPECT_GT(total, 2000000 - 20000);  // it was spent (the last full flight took < 20,000)
+  EXPECT_EQ(flights[0]["numerics"]["termination"], "time_limit");
+  EXPECT_EQ(flights[kLaunches - 1]["numerics"]["termination"], "step_limit");
+  EXPECT_EQ(flights[kLaunches - 1]["message"],
+            "the integrator took max_steps = 10 steps before the ball landed (the request's "
+            "budget of 2000000 integrator steps over all its launches was spent by the launches "
+            "before it)");
+}
+
 }  // namespace
 }  // namespace flight_api_test
 }  // namespace sweetspot::api

@@ -1,0 +1,589 @@
+#include "api/explore/flight_sweep.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <charconv>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <thread>
+#include <utility>
+
+#include "api/error_code.hpp"
+#include "api/flight_json.hpp"
+#include "api/json_reader.hpp"
+#include "api/thread_budget.hpp"
+#include "core/explore/sampling.hpp"
+#include "core/flight/flight.hpp"
+#include "core/progress.hpp"
+
+namespace sweetspot::api {
+namespace flight_sweep {
+namespace {
+
+using Json = nlohmann::json;
+namespace flight = core::flight;
+
+// What a swept path sets.
+enum class Target {
+  kExitSpeed,
+  kLaunchAngle,
+  kSprayAngle,
+  kBackspin,
+  kSidespin,
+  kHeight,
+  kTemperature,
+  kElevation,
+  kHumidity,
+  kPressure,
+  kWindSpeed,
+  kWindDirection,
+};
+
+// A path as a request writes it, and its SI value: written * scale + offset (api/flight_json's
+// spellings of the same fields).
+struct PathSpec {
+  const char* path;
+  Target target;
+  double scale = 1.0;
+  double offset = 0.0;
+};
+
+constexpr double kPaPerInHg = 3386.389;  // as api/flight_json.cpp
+constexpr PathSpec kPaths[] = {
+    {"launch.exit_speed_mps", Target::kExitSpeed},
+    {"launch.exit_speed_mph", Target::kExitSpeed, flight::kMpsPerMph},
+    {"launch.launch_angle_deg", Target::kLaunchAngle},
+    {"launch.spray_angle_deg", Target::kSprayAngle},
+    {"launch.backspin_rpm", Target::kBackspin},
+    {"launch.sidespin_rpm", Target::kSidespin},
+    {"launch.height_m", Target::kHeight},
+    {"launch.height_ft", Target::kHeight, flight::kMetresPerFoot},
+    {"environment.temperature_c", Target::kTemperature},
+    {"environment.temperature_f", Target::kTemperature, 5.0 / 9.0, -32.0 * 5.0 / 9.0},
+    {"environment.elevation_m", Target::kElevation},
+    {"environment.elevation_ft", Target::kElevation, flight::kMetresPerFoot},
+    {"environment.relative_humidity_pct", Target::kHumidity},
+    {"environment.pressure_hpa", Target::kPressure, 100.0},
+    {"environment.pressure_inhg", Target::kPressure, kPaPerInHg},
+    {"environment.wind.speed_mps", Target::kWindSpeed},
+    {"environment.wind.speed_mph", Target::kWindSpeed, flight::kMpsPerMph},
+    {"environment.wind.direction_deg", Target::kWindDirection},
+};
+
+const PathSpec* FindPath(const std::string& path) {
+  for (const PathSpec& spec : kPaths) {
+    if (path == spec.path) return &spec;
+  }
+  return nullptr;
+}
+
+void Apply(const PathSpec& spec, double written, flight::Launch* launch,
+           flight::Environment* environment) {
+  const double si = written * spec.scale + spec.offset;
+  switch (spec.target) {
+    case Target::kExitSpeed: launch->exit_speed_mps = si; break;
+    case Target::kLaunchAngle: launch->launch_angle_deg = si; break;
+    case Target::kSprayAngle: launch->spray_angle_deg = si; break;
+    case Target::kBackspin: launch->backspin_rpm = si; break;
+    case Target::kSidespin: launch->sidespin_rpm = si; break;
+    case Target::kHeight: launch->height_m = si; break;
+    case Target::kTemperature: environment->temperature_c = si; break;
+    case Target::kElevation: environment->elevation_m = si; break;
+    case Target::kHumidity: environment->relative_humidity_pct = si; break;
+    case Target::kPressure: environment->sea_level_pressure_pa = si; break;
+    case Target::kWindSpeed: environment->wind.speed_mps = si; break;
+    case Target::kWindDirection: environment->wind.direction_deg = si; break;
+  }
+}
+
+// A parsed flight sweep, owned by its (maybe streamed) answer.
+struct FlightSweep {
+  FlightRequest base;                    // launches[0] is the template, or the list
+  bool list = false;                     // fly base.launches as given (no parameters)
+  std::vector<std::string> paths;        // as written
+  std::vector<const PathSpec*> specs;    // per path
+  core::SweepPlan plan;                  // dimensions in the order of `paths`
+  std::uint64_t total = 0;               // designs
+  int threads = 1;                       // wanted (the extra ones from `budget`)
+  ThreadBudget* budget = nullptr;        // or none
+  core::Progress* progress = nullptr;    // cancel flag (a job's), or none
+  std::chrono::steady_clock::time_point start;
+};
+
+// The integrator steps one block of kBlock launches may take (accepted and rejected): ~1000 a
+// launch, against ~10 for an ordinary flight at the default tolerance and a few hundred at
+// 1e-13, so that launches that never come down (a custom lift holding them up runs each to the
+// 20,000-step limit, ~6 ms) cost a block at most ~0.3 s. A block's launches fly in order on one
+// thread, so the budget gives the same rows on any number of threads. Once it is spent, each
+// later launch of the block flies with the smallest step limit (10).
+constexpr std::uint64_t kBlock = 1024;  // launches a block (one thread's turn)
+constexpr long long kBlockStepBudget = static_cast<long long>(kBlock) * 1000;
+constexpr int kMinSteps = 10;  // FlightOptions::max_steps's lower bound
+
+// The swept values of a list's launch: none.
+const std::vector<double> kNoPoint;
+
+// One launch's flight and the step limit it flew with.
+struct Flown {
+  flight::FlightResult result;
+  int max_steps = 0;
+};
+
+// Flies design `index` (its swept values in `point`; a list's launch `index`) within what is
+// left of its block's budget.
+Flown FlyDesign(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
+                long long* block_budget) {
+  flight::Launch launch = sweep.base.launches[sweep.list ? index : 0];
+  flight::Environment environment = sweep.base.environment;
+  for (std::size_t d = 0; d < sweep.specs.size(); ++d) {
+    Apply(*sweep.specs[d], point[d], &launch, &environment);
+  }
+  flight::FlightOptions options = sweep.base.options;
+  options.max_steps = static_cast<int>(std::max<long long>(
+      kMinSteps, std::min<long long>(options.max_steps, *block_budget)));
+  Flown flown{flight::Fly(launch, environment, sweep.base.aero, options), options.max_steps};
+  *block_budget -= flown.result.steps + flown.result.rejected_steps;
+  return flown;
+}
+
+// Why a launch did not land (NotLandedMessage, and the block's budget when it cut the limit).
+std::string Message(const FlightSweep& sweep, const Flown& flown) {
+  flight::FlightOptions options = sweep.base.options;
+  options.max_steps = flown.max_steps;
+  std::string message = NotLandedMessage(flown.result, options);
+  if (flown.result.termination == flight::FlightTermination::kStepLimit &&
+      flown.max_steps < sweep.base.options.max_steps) {
+    message += " (the sweep's budget of " + std::to_string(kBlockStepBudget) +
+               " integrator steps per block of " + std::to_string(kBlock) +
+               " launches was spent by the block's launches before it)";
+  }
+  return message;
+}
+
+// Shortest round-trip text of a finite number ("" for a non-finite one: never written).
+void AppendNumber(double value, std::string* out) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  if (result.ec == std::errc()) out->append(buffer, result.ptr);
+}
+
+void AppendQuoted(const std::string& text, std::string* out) {
+  out->push_back('"');
+  for (char c : text) {
+    if (c == '"') out->push_back('"');
+    out->push_back(c);
+  }
+  out->push_back('"');
+}
+
+constexpr const char* kCsvColumns =
+    "termination,distance_m,hang_time_s,apex_m,landing_x_m,landing_y_m,bearing_deg,"
+    "landing_speed_mps,landing_angle_deg,backspin_rpm,sidespin_rpm,spin_source,barrel,hard_hit,"
+    "sweet_spot_launch,error_estimate_m,steps,message";
+
+std::string CsvHeader(const FlightSweep& sweep) {
+  std::string header = "index";
+  for (const std::string& path : sweep.paths) header += ",parameters." + path;
+  header += ",";
+  header += kCsvColumns;
+  header += "\n";
+  return header;
+}
+
+void AppendCsvRow(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
+                  const Flown& flown, std::string* out) {
+  const flight::FlightResult& r = flown.result;
+  AppendNumber(static_cast<double>(index), out);
+  for (double value : point) {
+    out->push_back(',');
+    AppendNumber(value, out);
+  }
+  out->push_back(',');
+  out->append(flight::FlightTerminationName(r.termination));
+  const bool landed = r.Landed();
+  for (double value : {r.distance_m, r.hang_time_s, r.apex_m, r.landing_x_m, r.landing_y_m,
+                       r.bearing_deg, r.landing_speed_mps, r.landing_angle_deg}) {
+    out->push_back(',');
+    if (landed) AppendNumber(value, out);
+  }
+  const bool ran = r.termination != flight::FlightTermination::kInvalidInput;
+  out->push_back(',');
+  if (ran) AppendNumber(r.spin.backspin_rpm, out);
+  out->push_back(',');
+  if (ran) AppendNumber(r.spin.sidespin_rpm, out);
+  out->push_back(',');
+  if (ran) out->append(flight::SpinSourceName(r.spin_source));
+  for (bool label : {r.classification.barrel, r.classification.hard_hit,
+                     r.classification.sweet_spot_launch}) {
+    out->push_back(',');
+    if (ran) out->append(label ? "true" : "false");
+  }
+  out->push_back(',');
+  if (landed) AppendNumber(r.error_estimate_m, out);
+  out->push_back(',');
+  AppendNumber(r.steps, out);
+  out->push_back(',');
+  if (!landed) AppendQuoted(Message(sweep, flown), out);
+  out->push_back('\n');
+}
+
+Json JsonRow(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
+             const Flown& flown) {
+  const flight::FlightResult& r = flown.result;
+  Json out = FlightToJson(r, sweep.base.aero, nullptr);
+  if (!r.Landed()) out["message"] = Message(sweep, flown);
+  if (sweep.list) return {{"index", index}, {"flight", std::move(out)}};
+  Json parameters = Json::object();
+  for (std::size_t d = 0; d < sweep.paths.size(); ++d) parameters[sweep.paths[d]] = point[d];
+  return {{"index", index}, {"parameters", std::move(parameters)}, {"flight", std::move(out)}};
+}
+
+// Runs the sweep's designs in waves of one block per thread (blocks of kBlock designs), hands
+// the blocks to `consume` in design order; false when cancelled, when `consume` refused, or
+// when a block threw (*out_of_memory: std::bad_alloc is all a block can throw).
+// `make(first, last, sequence)` evaluates designs [first, last) into a block. Threads that
+// cannot be started leave their block to the calling thread (nothing throws).
+
+template <class Block, class Make, class Consume>
+bool RunWaves(const FlightSweep& sweep, Make make, Consume consume, int* lanes_used,
+              bool* out_of_memory) {
+  *out_of_memory = false;
+  int extra = std::max(0, sweep.threads - 1);
+  if (extra > 0 && sweep.budget != nullptr) extra = sweep.budget->TryTake(extra);
+  struct GiveBack {
+    ThreadBudget* budget;
+    int threads;
+    ~GiveBack() {
+      if (budget != nullptr && threads > 0) budget->Give(threads);
+    }
+  } give_back{sweep.budget, sweep.budget != nullptr ? extra : 0};
+  const int lanes = 1 + extra;
+  *lanes_used = lanes;
+  std::vector<core::DesignSequence> sequences;  // none for a list
+  if (!sweep.list) {
+    sequences.assign(static_cast<std::size_t>(lanes), core::DesignSequence(sweep.plan));
+  }
+  const auto sequence = [&](int k) { return sequences.empty() ? nullptr : &sequences[k]; };
+  std::vector<Block> blocks(static_cast<std::size_t>(lanes));
+  // A block that throws (out of memory) fails the sweep; nothing escapes a thread.
+  std::atomic<bool> failed{false};
+  const auto run = [&](int k, std::uint64_t lo, std::uint64_t hi) noexcept {
+    try {
+      blocks[k] = make(lo, hi, sequence(k));
+    } catch (...) {
+      failed.store(true);
+    }
+  };
+  for (std::uint64_t first = 0; first < sweep.total; first += kBlock * lanes) {
+    if (core::IsCancelled(sweep.progress)) return false;
+    std::vector<std::thread> workers;
+    for (int k = 1; k < lanes; ++k) {
+      const std::uint64_t lo = first + kBlock * k;
+      if (lo >= sweep.total) break;
+      const std::uint64_t hi = std::min(lo + kBlock, sweep.total);
+      try {
+        workers.emplace_back(run, k, lo, hi);
+      } catch (...) {
+        run(k, lo, hi);  // no thread: this one does it
+      }
+    }
+    run(0, first, std::min(first + kBlock, sweep.total));
+    for (std::thread& worker : workers) worker.join();
+    if (failed.load()) {
+      *out_of_memory = true;
+      return false;
+    }
+    for (int k = 0; k < lanes && first + kBlock * k < sweep.total; ++k) {
+      if (!consume(std::move(blocks[k]))) return false;
+    }
+    if (sweep.progress != nullptr) {
+      sweep.progress->Report(static_cast<double>(std::min(first + kBlock * lanes, sweep.total)) /
+                             static_cast<double>(sweep.total));
+    }
+  }
+  return true;
+}
+
+// Prefixes an error of the template's parser with "flight.".
+void PrefixFlight(ApiError* error) {
+  if (error->field.empty()) return;
+  if (error->message.rfind(error->field, 0) == 0) error->message = "flight." + error->message;
+  error->field = "flight." + error->field;
+}
+
+bool ParseSweptTemplate(ObjectReader& reader, std::size_t limit, const char* limit_name,
+                        FlightSweep* out, std::string* format, ApiError* error);
+std::optional<FlightSweep> Finish(FlightSweep sweep, const Context& context,
+                                  const std::string& format, ApiError* error);
+
+std::optional<FlightSweep> Parse(const Json& body, const Context& context, std::string* format,
+                                 ApiError* error) {
+  ObjectReader reader(body, "", error);
+  const Json* template_json = reader.Get("flight");
+  if (!reader.ok()) return std::nullopt;
+  if (!template_json->is_object()) {
+    reader.Fail("flight", "must be an object: a /v1/flight request with one \"launch\"");
+    return std::nullopt;
+  }
+  const std::size_t limit =
+      context.batch ? context.limits.max_batch_samples : context.limits.max_samples;
+  const char* limit_name = context.batch ? "max_batch_samples" : "max_samples";
+  FlightSweep sweep;
+  // "launches": a list flown as given (a season's batted balls), up to the sweep's limit.
+  sweep.list = template_json->contains("launches");
+  {
+    ApiError inner;
+    ApiLimits limits = context.limits;
+    if (sweep.list) limits.max_launches = limit;
+    std::optional<FlightRequest> request = ParseFlight(*template_json, limits, &inner);
+    if (!request) {
+      *error = std::move(inner);
+      PrefixFlight(error);
+      if (sweep.list && error->code == ErrorCode::kTooBig && error->field == "flight.launches") {
+        error->message = "flight.launches: has " +
+                         std::to_string(template_json->at("launches").size()) +
+                         " launches, over the limit " + limit_name + " = " + std::to_string(limit);
+      }
+      return std::nullopt;
+    }
+    if (request->trajectory) {
+      SetError(error, ErrorCode::kInvalidValue, "flight.outputs", nullptr,
+               "a sweep's rows carry no trajectory (POST /v1/flight gives one)");
+      return std::nullopt;
+    }
+    sweep.base = std::move(*request);
+  }
+
+  if (sweep.list) {
+    for (const char* key : {"parameters", "sampling", "samples", "seed"}) {
+      if (reader.Has(key)) {
+        reader.Fail(key, "applies to a swept \"launch\"; a list of \"launches\" is flown as "
+                         "given");
+        return std::nullopt;
+      }
+    }
+    *format = "json";  // as a bat sweep's
+    reader.OptionalString("format", format, {"json", "csv"});
+    if (!reader.Finish()) return std::nullopt;
+    sweep.total = sweep.base.launches.size();  // <= limit: ParseFlight's max_launches
+  } else if (!ParseSweptTemplate(reader, limit, limit_name, &sweep, format, error)) {
+    return std::nullopt;
+  }
+  return Finish(std::move(sweep), context, *format, error);
+}
+
+// The "parameters", "sampling", "samples", "seed" and "format" of a swept template.
+bool ParseSweptTemplate(ObjectReader& reader, std::size_t limit, const char* limit_name,
+                        FlightSweep* out, std::string* format, ApiError* error) {
+  FlightSweep& sweep = *out;
+  std::string sampling = "grid";
+  reader.OptionalString("sampling", &sampling, {"grid", "lhs", "sobol"});
+  if (!reader.ok()) return false;
+  sweep.plan.method = *core::ParseSamplingMethod(sampling);
+  long long samples = 0, seed = 0;
+  reader.OptionalInteger("samples", 1,
+                         static_cast<long long>(std::min<std::size_t>(limit, 1ULL << 53)),
+                         &samples);
+  reader.OptionalInteger("seed", 0, 1LL << 53, &seed);
+  sweep.plan.samples = static_cast<std::uint64_t>(samples);
+  sweep.plan.seed = static_cast<std::uint64_t>(seed);
+  if (reader.ok() && sweep.plan.method != core::SamplingMethod::kGrid && samples == 0) {
+    reader.Missing("samples");
+  }
+  *format = "json";  // as a bat sweep's
+  reader.OptionalString("format", format, {"json", "csv"});
+  const Json* params = reader.Get("parameters");
+  if (reader.ok() && params == nullptr) reader.Missing("parameters");
+  if (!reader.ok()) return false;
+  if (!params->is_array() || params->empty() || params->size() > 32) {
+    reader.Fail("parameters", "must be an array of 1 to 32 {\"path\", \"min\", \"max\"}");
+    return false;
+  }
+  bool swept[12] = {};
+  for (std::size_t i = 0; i < params->size(); ++i) {
+    const std::string where = "parameters[" + std::to_string(i) + "]";
+    if (!(*params)[i].is_object()) {
+      SetError(error, ErrorCode::kInvalidValue, where, &(*params)[i],
+               "must be an object {\"path\", \"min\", \"max\"}");
+      return false;
+    }
+    ObjectReader p((*params)[i], where, error);
+    std::string path;
+    core::SweepDimension dimension;
+    NumberRule finite;
+    finite.min = -1e12;
+    finite.max = 1e12;
+    p.String("path", &path);
+    p.Number("min", finite, &dimension.min);
+    p.Number("max", finite, &dimension.max);
+    long long count = sweep.plan.method == core::SamplingMethod::kGrid ? 2 : 1;
+    p.OptionalInteger("count", 1, 1000000000, &count);  // the total is checked below
+    dimension.count = static_cast<int>(count);
+    if (!p.Finish()) return false;
+    const PathSpec* spec = FindPath(path);
+    if (spec == nullptr) {
+      std::string known;
+      for (const PathSpec& s : kPaths) known += (known.empty() ? "" : ", ") + std::string(s.path);
+      SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
+               "is not a field a flight sweep can sweep (one of: " + known + ")");
+      return false;
+    }
+    if (swept[static_cast<int>(spec->target)]) {
+      SetError(error, ErrorCode::kInvalidValue, where + ".path", &(*params)[i]["path"],
+               "sweeps a quantity another parameter already sweeps");
+      return false;
+    }
+    swept[static_cast<int>(spec->target)] = true;
+    if (dimension.max < dimension.min) {
+      SetError(error, ErrorCode::kInvalidValue, where + ".max", &(*params)[i]["max"],
+               "must be >= min");
+      return false;
+    }
+    sweep.paths.push_back(path);
+    sweep.specs.push_back(spec);
+    sweep.plan.dimensions.push_back(dimension);
+  }
+  // Both spins or neither (Launch::Validate): one swept spin needs the other in the template.
+  const bool back = swept[static_cast<int>(Target::kBackspin)];
+  const bool side = swept[static_cast<int>(Target::kSidespin)];
+  if (back != side && !sweep.base.launches.front().backspin_rpm) {
+    SetError(error, ErrorCode::kInvalidValue, "flight.launch", nullptr,
+             std::string("gives no spin, and the sweep sets only ") +
+                 (back ? "backspin_rpm" : "sidespin_rpm") +
+                 ": give both spins in the launch, or sweep both");
+    return false;
+  }
+  if (!reader.Finish()) return false;
+  if (core::Refusal refusal; !sweep.plan.Validate(&refusal)) {
+    CoreRefusal(refusal, "", error);
+    return false;
+  }
+  sweep.total = sweep.plan.DesignCount();
+  if (sweep.total > limit) {
+    SetError(error, ErrorCode::kTooBig, "parameters", nullptr,
+             "describe " + std::to_string(sweep.total) + " launches, over the limit " +
+                 limit_name + " = " + std::to_string(limit));
+    return false;
+  }
+  return true;
+}
+
+// The checks and settings every flight sweep shares: the size of a JSON answer, the threads.
+std::optional<FlightSweep> Finish(FlightSweep sweep, const Context& context,
+                                  const std::string& format, ApiError* error) {
+  // A JSON answer is built in memory (a CSV one streams): a row is about 1 kB (the /v1/flight
+  // answer with its parameters; 0.7 kB compact), so its size is bounded like a bat sweep's.
+  constexpr std::uint64_t kJsonRowBytes = 1000;
+  if (format == "json" && sweep.total > context.limits.max_response_bytes / kJsonRowBytes) {
+    SetError(error, ErrorCode::kTooBig, "format", nullptr,
+             "\"json\" for " + std::to_string(sweep.total) + " launches is about " +
+                 std::to_string(sweep.total * kJsonRowBytes / 1000000) +
+                 " MB in memory, over max_response_bytes = " +
+                 std::to_string(context.limits.max_response_bytes) +
+                 "; ask for \"format\": \"csv\" (streamed)");
+    return std::nullopt;
+  }
+  sweep.threads = std::max(1, context.explore_threads);
+  sweep.budget = context.thread_budget;
+  sweep.progress = context.progress;
+  return sweep;
+}
+
+}  // namespace
+}  // namespace flight_sweep
+
+bool IsFlightSweep(const nlohmann::json& body) {
+  return body.is_object() && body.contains("flight");
+}
+
+std::vector<std::string> FlightSweepPaths() {
+  std::vector<std::string> paths;
+  for (const flight_sweep::PathSpec& spec : flight_sweep::kPaths) paths.emplace_back(spec.path);
+  return paths;
+}
+
+Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
+  using flight_sweep::FlightSweep;
+  const auto start = std::chrono::steady_clock::now();
+  ApiError error;
+  std::string format;
+  std::optional<FlightSweep> parsed = flight_sweep::Parse(body, context, &format, &error);
+  if (!parsed) return ToResponse(error);
+  if (context.validate_only) return {200, nlohmann::json{{"valid", true}}};
+  auto sweep = std::make_shared<FlightSweep>(std::move(*parsed));
+  sweep->start = start;
+  if (format == "csv") {
+    Response streamed = Response::Text(200, std::string(), "text/csv");
+    streamed.stream = [sweep](const ChunkSink& sink) {
+      if (!sink(flight_sweep::CsvHeader(*sweep))) return false;
+      int lanes = 1;
+      bool out_of_memory = false;  // a cut CSV: the stream ends early
+      return flight_sweep::RunWaves<std::string>(
+          *sweep,
+          [&](std::uint64_t first, std::uint64_t last, core::DesignSequence* sequence) {
+            std::string text;
+            text.reserve(static_cast<std::size_t>(last - first) * 256);
+            long long budget = flight_sweep::kBlockStepBudget;
+            for (std::uint64_t i = first; i < last; ++i) {
+              const std::vector<double>& point =
+                  sequence != nullptr ? sequence->Design(i) : flight_sweep::kNoPoint;
+              flight_sweep::AppendCsvRow(*sweep, i, point,
+                                         flight_sweep::FlyDesign(*sweep, i, point, &budget),
+                                         &text);
+            }
+            return text;
+          },
+          [&](std::string&& text) { return sink(text); }, &lanes, &out_of_memory);
+    };
+    return streamed;
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  std::uint64_t landed = 0;
+  int lanes = 1;
+  bool out_of_memory = false;
+  const bool complete = flight_sweep::RunWaves<std::vector<nlohmann::json>>(
+      *sweep,
+      [&](std::uint64_t first, std::uint64_t last, core::DesignSequence* sequence) {
+        std::vector<nlohmann::json> block;
+        block.reserve(static_cast<std::size_t>(last - first));
+        long long budget = flight_sweep::kBlockStepBudget;
+        for (std::uint64_t i = first; i < last; ++i) {
+          const std::vector<double>& point =
+              sequence != nullptr ? sequence->Design(i) : flight_sweep::kNoPoint;
+          block.push_back(flight_sweep::JsonRow(
+              *sweep, i, point, flight_sweep::FlyDesign(*sweep, i, point, &budget)));
+        }
+        return block;
+      },
+      [&](std::vector<nlohmann::json>&& block) {
+        for (nlohmann::json& row : block) {
+          if (row["flight"].contains("distance_m")) ++landed;
+          rows.push_back(std::move(row));
+        }
+        return true;
+      },
+      &lanes, &out_of_memory);
+  if (out_of_memory) {
+    rows = nlohmann::json();
+    return ErrorResponse(503, ErrorCode::kUnavailable,
+                         "the flight sweep ran out of memory; retry later, or ask for "
+                         "\"format\": \"csv\" (streamed)");
+  }
+  if (!complete) {
+    return ErrorResponse(409, ErrorCode::kCancelled, "the flight sweep was cancelled");
+  }
+  const double timing_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  nlohmann::json summary = {
+      {"designs", sweep->total},
+      {"landed", landed},
+      {"threads", lanes},
+      {"timing_s", timing_s},
+      {"models_used",
+       {std::string("flight:") + core::flight::AeroModelName(sweep->base.aero.model)}}};
+  return {200, {{"rows", std::move(rows)}, {"summary", std::move(summary)}}};
+}
+
+}  // namespace sweetspot::api
