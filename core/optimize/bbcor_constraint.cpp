@@ -49,9 +49,15 @@ DesignResult OptimizeWithCertifiedBbcor(const DesignProblem& problem, const Opti
   double prev_offset = 0.0, prev_g = 0.0;
   bool have_prev = false;
   DesignResult r;
+  int iterations = 0, evaluations = 0;
   for (int round = 1; round <= kMaxRounds; ++round) {
     p.constraints.bbcor_estimate_offset = offset;
     r = once(p);
+    // The work of every round (the last round's alone otherwise).
+    iterations += std::max(r.summary.iterations, 0);
+    evaluations += std::max(r.summary.evaluations, 0);
+    if (r.summary.iterations >= 0) r.summary.iterations = iterations;
+    if (r.summary.evaluations >= 0) r.summary.evaluations = evaluations;
     r.bbcor_rounds = round;
     r.bbcor_estimate_offset = offset;
     // The active BBCOR constraint reported in THE BBCOR's terms: the certified value and the

@@ -155,6 +155,21 @@ TEST(BarrelApiTest, OptimizeHoldsTheBbcorAtTheLimitWithTheWallAsAVariable) {
   EXPECT_EQ(s.body["bbcor"]["value"], b["value"]);
 }
 
+// constraints.bbcor_max out of (0, 1] or on a solid design: a 400 naming the field.
+TEST(BarrelApiTest, BbcorMaxIsRefusedWithItsField) {
+  const Response high = Post("/v1/optimize", R"({"bat": {"preset": "bbcor-33-aluminium"},
+      "variables": [{"path": "wall_thickness_m", "min": 0.0015, "max": 0.004}],
+      "objective": "min_moi", "constraints": {"bbcor_max": 1.5}})");
+  EXPECT_EQ(high.status, 400) << high.body.dump();
+  EXPECT_NE(high.body.dump().find("constraints.bbcor_max"), std::string::npos) << high.body.dump();
+  const Response solid = Post("/v1/optimize", R"({"bat": {"preset": "wood-34-ash"},
+      "variables": [{"path": "profile.knots[12].radius_m", "min": 0.030, "max": 0.0331}],
+      "objective": "min_moi", "constraints": {"bbcor_max": 0.49}})");
+  EXPECT_EQ(solid.status, 400) << solid.body.dump();
+  EXPECT_NE(solid.body.dump().find("applies to a hollow design"), std::string::npos)
+      << solid.body.dump();
+}
+
 // A hollow bat's scene COR is the trampoline's at the scene's ball and speed: 0.516 for the
 // preset, 0.514 for the answer (an MLB ball at 90 mph, a 70 mph bat speed), above 0.50 for a
 // legal bat. The bbcor rule constrains the
