@@ -7,6 +7,7 @@
 
 #include "core/collision/barrel.hpp"
 #include "core/geometry_format.hpp"
+#include "core/optimize/design_public.hpp"
 #include "core/optimize/rules.hpp"
 #include "core/scene/scene_barrel.hpp"
 
@@ -43,7 +44,14 @@ DesignResult OptimizeWithCertifiedBbcor(const DesignProblem& problem, const Opti
   // The first offset: the base bat's, when it is hollow and both values exist.
   double offset = 0.0;
   if (problem.bat.IsHollow()) {
-    const BbcorResult c = ComputeCertifiedBbcor(problem.bat);
+    // The base design's mass properties when the request has them (the rigid body's: the
+    // protocol's I_pivot), not computed again.
+    const MassProperties* base =
+        problem.base_mass_properties.has_value()
+            ? design_detail::RigidBodyPropertiesOrNull(*problem.base_mass_properties)
+            : nullptr;
+    const BbcorResult c =
+        ComputeCertifiedBbcor(problem.bat, FlexibleOptions{}, BarrelOptions{}, base);
     if (c.ok) offset = c.value - c.estimate_value;
   }
   double prev_offset = 0.0, prev_g = 0.0;
