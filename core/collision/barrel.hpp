@@ -176,9 +176,9 @@ struct BbcorResult {
   double hoop_frequency_hz = 0.0;     ///< At the impact point (0 for a solid bat), Hz.
   double barrel_stiffness_n_m = 0.0;  ///< k_b at the impact point (0 for a solid bat), N/m.
   // Certified only (method "flexible_scan_max"):
-  double impact_from_tip_m = 0.0;  ///< The maximum's location, m from the barrel end.
-  std::string refinement;          ///< The scan's ("polished" or "none").
-  double error_estimate = 0.0;     ///< The scan's impact error estimate (dimensionless).
+  double impact_from_tip_m = 0.0;     ///< The maximum's location, m from the barrel end.
+  std::string refinement;             ///< The scan's ("polished" or "none").
+  double error_estimate = 0.0;        ///< The scan's impact error estimate (dimensionless).
   std::vector<std::string> warnings;  ///< The scan's warnings.
   double estimate_value = 0.0;        ///< ComputeBbcor's fixed-point value (dimensionless).
   double estimate_from_tip_m = 0.0;   ///< Its point, m from the barrel end.

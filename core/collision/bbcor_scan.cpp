@@ -173,8 +173,7 @@ BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes, const BbcorPro
                      xc = c.position_from_tip_m;
         const double num = (xb - xa) * (xb - xa) * (b.value - c.value) -
                            (xb - xc) * (xb - xc) * (b.value - a.value);
-        const double den =
-            (xb - xa) * (b.value - c.value) - (xb - xc) * (b.value - a.value);
+        const double den = (xb - xa) * (b.value - c.value) - (xb - xc) * (b.value - a.value);
         if (!(den != 0.0)) break;
         const double v = xb - 0.5 * num / den;
         if (!(v > xa && v < xc) || std::abs(v - xb) < kPolishTolM) break;

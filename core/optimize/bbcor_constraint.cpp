@@ -31,8 +31,8 @@ std::optional<double> BbcorBoundOf(const DesignProblem& problem) {
     bound = *LimitsOf(RuleSet::kBbcor).max_bbcor;
   }
   if (problem.constraints.bbcor_max.has_value()) {
-    bound = std::min(bound.value_or(*problem.constraints.bbcor_max),
-                     *problem.constraints.bbcor_max);
+    bound =
+        std::min(bound.value_or(*problem.constraints.bbcor_max), *problem.constraints.bbcor_max);
   }
   return bound;
 }

@@ -10,8 +10,10 @@
 // the answer's scan value is in [bound - 2.5e-7, bound] (the constraint active; never above the
 // bound, and within half the feasibility tolerance 1e-6 of 0.5) or below the bound with the
 // constraint inactive; d by the secant on g(d) = B_scan(answer(d)) - (bound - 1.25e-7) after
-// the first step (the first is the fixed-point step d' = B_scan - B_est). At most 8 rounds; the last answer is certified by BbcorRuleHolds
-// whatever happens (over the bound: infeasible, the value in the message).
+// the first step (the first is the fixed-point step d' = B_scan - B_est). At most 8 rounds; the
+// last answer is certified by BbcorRuleHolds whatever happens (over the bound: infeasible, the
+// value in the message).
+//
 // What this is NOT: the NLP's gradient is the estimate's, not the scan maximum's (the offset's
 // own gradient is left out), so at an active bound the answer is feasible for THE BBCOR to the
 // tolerance, but its optimality is that of the estimate's constraint surface shifted to pass

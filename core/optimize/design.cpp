@@ -378,9 +378,8 @@ void CheckBbcorRule(const DesignProblem& problem, const PublicEvaluation& pub,
   std::string bbcor_why;
   // The constraint's own acceptance: kFeasibleRelative of the limit (the re-check above).
   const double limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
-  if (!BbcorRuleHolds(result->bat, &result->bbcor.emplace(), &bbcor_why,
-                      kFeasibleRelative * limit, RigidBodyPropertiesOrNull(pub.properties),
-                      *bound)) {
+  if (!BbcorRuleHolds(result->bat, &result->bbcor.emplace(), &bbcor_why, kFeasibleRelative * limit,
+                      RigidBodyPropertiesOrNull(pub.properties), *bound)) {
     result->summary.termination = Termination::kInfeasible;
     result->summary.message = bbcor_why;
     result->message_kind = DesignMessageKind::kInfeasible;
@@ -505,9 +504,8 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
   const Clock::time_point start = Clock::now();
   const Clock::time_point deadline = shared_deadline.value_or(
       start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
-                  std::isfinite(options.max_time_s) && options.max_time_s > 0.0
-                      ? options.max_time_s
-                      : 0.0)));
+                  std::isfinite(options.max_time_s) && options.max_time_s > 0.0 ? options.max_time_s
+                                                                                : 0.0)));
   DesignResult r = OptimizeWithCertifiedBbcor(problem, [&](const DesignProblem& p) {
     return OptimizeOnce(p, options, progress, progress_from, progress_to, deadline);
   });

@@ -1,9 +1,8 @@
 #include "core/optimize/rules.hpp"
 
-#include "core/scene/scene_barrel.hpp"
-
 #include "core/geometry_format.hpp"
 #include "core/refusal.hpp"
+#include "core/scene/scene_barrel.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -151,8 +150,8 @@ bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why, double
   }
   if (!(bbcor->value <= limit + tolerance)) {
     if (why != nullptr) {
-      *why = name + ": the design's BBCOR = " + FormatNumber(bbcor->value) +
-             " exceeds the limit " + FormatNumber(limit) +
+      *why = name + ": the design's BBCOR = " + FormatNumber(bbcor->value) + " exceeds the limit " +
+             FormatNumber(limit) +
              " (NCAA protocol, the flexible scan's maximum, recomputed on the answer: the "
              "optimiser found no design within the variables' bounds and the other constraints "
              "that meets it; raise the wall's upper bound or free the variables that lower the "

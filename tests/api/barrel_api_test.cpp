@@ -45,8 +45,8 @@ TEST(BarrelApiTest, AluminiumPresetHasAHoopModeAndABbcorAtTheLimit) {
   EXPECT_EQ(c["ball"], "ncaa-nfhs");
   EXPECT_NEAR(c["ball_speed_mps"].get<double>(), 60.79744, 1e-9);
   EXPECT_NEAR(c["pivot_from_knob_m"].get<double>(), 0.1524, 1e-15);
-  EXPECT_EQ(r.body["models_used"], nlohmann::json::array({"mass_properties", "barrel",
-                                                          "flexible_beam", "flexible"}))
+  EXPECT_EQ(r.body["models_used"],
+            nlohmann::json::array({"mass_properties", "barrel", "flexible_beam", "flexible"}))
       << r.body["models_used"].dump();
 }
 

@@ -95,8 +95,8 @@ TEST(BbcorVerdict, NoDesignChangesVerdictBetweenOutputRuleAndScan) {
   }
   EXPECT_EQ(designs, 112);
   // The sweep straddles the limit (both verdicts occur) and the estimate disagrees with the
-  // scan on many designs (measured: 38 of 112; estimate - scan 0.0030 to 0.0247, mean 0.0119), so a verdict taken from the estimate would fail
-  // the checks above.
+  // scan on many designs (measured: 38 of 112; estimate - scan 0.0030 to 0.0247, mean 0.0119), so a
+  // verdict taken from the estimate would fail the checks above.
   EXPECT_GT(legal, 0);
   EXPECT_LT(legal, designs);
   EXPECT_GE(estimate_disagrees, 10);
@@ -128,8 +128,8 @@ double BbcorAtFromTip(const Bat& bat, double from_tip_m) {
 TEST(BbcorVerdict, EnvelopeTheoremGradientAgainstFiniteDifferencesAndTheEstimates) {
   const Bat base = FindPreset("bbcor-33-aluminium")->bat;
   BbcorScan scan;
-  const BbcorResult c = ComputeCertifiedBbcor(base, FlexibleOptions{}, BarrelOptions{}, nullptr,
-                                              nullptr, &scan);
+  const BbcorResult c =
+      ComputeCertifiedBbcor(base, FlexibleOptions{}, BarrelOptions{}, nullptr, nullptr, &scan);
   ASSERT_TRUE(c.ok) << c.message;
   const double at = c.impact_from_tip_m;
   struct Direction {
@@ -151,10 +151,8 @@ TEST(BbcorVerdict, EnvelopeTheoremGradientAgainstFiniteDifferencesAndTheEstimate
     d.apply(&minus, -d.step);
     const double total =
         (ComputeCertifiedBbcor(plus).value - ComputeCertifiedBbcor(minus).value) / (2 * d.step);
-    const double envelope =
-        (BbcorAtFromTip(plus, at) - BbcorAtFromTip(minus, at)) / (2 * d.step);
-    const double estimate =
-        (ComputeBbcor(plus).value - ComputeBbcor(minus).value) / (2 * d.step);
+    const double envelope = (BbcorAtFromTip(plus, at) - BbcorAtFromTip(minus, at)) / (2 * d.step);
+    const double estimate = (ComputeBbcor(plus).value - ComputeBbcor(minus).value) / (2 * d.step);
     EXPECT_NEAR(envelope, total, 0.03 * std::abs(total)) << d.name;
     // Measured: the estimate's slope is 1.28x the scan's in the wall (-18.2 against -14.2 per
     // m) and of the OPPOSITE sign in the density (+2.9e-7 against -5.5e-6 per kg/m^3: a
@@ -165,9 +163,10 @@ TEST(BbcorVerdict, EnvelopeTheoremGradientAgainstFiniteDifferencesAndTheEstimate
     } else {
       EXPECT_LT(estimate * envelope, 0.0) << d.name;
     }
-    std::printf("d BBCOR / d %s: total (max re-located) %.6g, envelope (at x* = %.4f in) %.6g, "
-                "estimate's %.6g (ratio %.3f)\n",
-                d.name, total, at / kInch, envelope, estimate, estimate / envelope);
+    std::printf(
+        "d BBCOR / d %s: total (max re-located) %.6g, envelope (at x* = %.4f in) %.6g, "
+        "estimate's %.6g (ratio %.3f)\n",
+        d.name, total, at / kInch, envelope, estimate, estimate / envelope);
   }
 }
 

@@ -292,8 +292,8 @@ TEST(OptimizeBarrelCor, TheIssuesRequestIsHeldByTheMassNotTheBbcor) {
 
 // With the alloy's density free as well, the weight no longer fixes the wall: the design's COR
 // pushes the wall down to the BBCOR limit (rules.bbcor.bbcor active: THE BBCOR at 0.50), thinner
-// than the preset's; with the COR held fixed the wall goes the other way, to its 4 mm bound, where the
-// held COR overstates the exit speed.
+// than the preset's; with the COR held fixed the wall goes the other way, to its 4 mm bound, where
+// the held COR overstates the exit speed.
 TEST(OptimizeBarrelCor, WithTheDensityFreeTheWallThinsToTheBbcorLimit) {
   const DesignProblem p = PresetRequestWithDensity();
   for (const HessianMode hessian : {HessianMode::kLimitedMemory, HessianMode::kExact}) {
