@@ -35,22 +35,6 @@ Bat DenseAlloyBat() {
   return bat;
 }
 
-double BbcorWithWall(Bat bat, double wall_m) {
-  bat.wall_thickness_m = wall_m;
-  return ComputeBbcor(bat).value;
-}
-
-// The reference: the thinnest wall with BBCOR <= 0.50, by bisection to 1e-12 m (BBCOR falls
-// monotonically with the wall here: docs/models.md's table).
-double ThinnestLegalWall(const Bat& bat) {
-  double thin = 0.001, thick = 0.008;
-  while (thick - thin > 1e-12) {
-    const double mid = 0.5 * (thin + thick);
-    (BbcorWithWall(bat, mid) > 0.5 ? thin : thick) = mid;
-  }
-  return thick;
-}
-
 DesignProblem ThinWall(const Bat& bat, double min_wall_m) {
   DesignProblem p;
   p.bat = bat;
