@@ -80,8 +80,14 @@ DesignResult OptimizeWithCertifiedBbcor(const DesignProblem& problem, const Opti
       }
     }
     // No certified value (no BBCOR constraint on a solid design, a refusal, a failure): the
-    // rounds have nothing to correct.
+    // rounds have nothing to correct. Nor after a round that did not finish (cancelled, out of
+    // time, no convergence): its answer stands with its termination. An infeasible round goes
+    // on when the scan's check made it so (the estimate's constraint held: `held` below).
     if (!r.bbcor.has_value() || !r.bbcor->ok) return r;
+    if (r.summary.termination != Termination::kConverged &&
+        r.summary.termination != Termination::kInfeasible) {
+      return r;
+    }
     const double g = r.bbcor->value - (*bound - 0.5 * kCertifiedTolerance);
     const bool active = r.bbcor->estimate_value >= *bound - offset - kActiveTolerance;
     // The estimate's own constraint not met: the design problem is infeasible as it stands.
