@@ -65,19 +65,46 @@ Json BarrelOutputToJson(const core::BarrelOutput& b) {
 }
 
 Json BbcorToJson(const core::BbcorResult& b) {
-  const bool hollow = b.method != "rigid";
+  const bool certified = b.method == core::kCertifiedBbcorMethod;
+  if (!certified) {  // the fixed-point estimate alone
+    const bool hollow = b.method != "rigid";
+    return {{"value", b.value},
+            {"ball", b.ball},
+            {"ball_speed_mps", b.ball_speed_mps},
+            {"ball_cor", b.ball_cor},
+            {"impact_from_knob_m", b.impact_from_knob_m},
+            {"pivot_from_knob_m", b.pivot_from_knob_m},
+            {"method", b.method},
+            {"hoop_frequency_hz", hollow ? Json(b.hoop_frequency_hz) : Json(nullptr)},
+            {"barrel_stiffness_n_m", hollow ? Json(b.barrel_stiffness_n_m) : Json(nullptr)},
+            {"protocol",
+             "NCAA BBCOR fast estimate: the bat at rest on a pivot 6 in from the knob, the ball "
+             "fired at 136 mph at 6 in from the barrel end; BBCOR = e_A (1 + r) + r, "
+             "r = m z^2 / I_pivot"}};
+  }
+  const bool hollow = b.barrel_stiffness_n_m > 0.0;
   return {{"value", b.value},
+          {"method", b.method},
+          {"impact_from_knob_m", b.impact_from_knob_m},
+          {"impact_from_tip_m", b.impact_from_tip_m},
+          {"refinement", b.refinement},
           {"ball", b.ball},
           {"ball_speed_mps", b.ball_speed_mps},
           {"ball_cor", b.ball_cor},
-          {"impact_from_knob_m", b.impact_from_knob_m},
           {"pivot_from_knob_m", b.pivot_from_knob_m},
-          {"method", b.method},
-          {"hoop_frequency_hz", hollow ? Json(b.hoop_frequency_hz) : Json(nullptr)},
           {"barrel_stiffness_n_m", hollow ? Json(b.barrel_stiffness_n_m) : Json(nullptr)},
+          {"estimate",
+           {{"value", b.estimate_value},
+            {"method", b.estimate_method},
+            {"impact_from_tip_m", b.estimate_from_tip_m},
+            {"error", b.estimate_error}}},
           {"protocol",
-           "NCAA BBCOR: the bat at rest on a pivot 6 in from the knob, the ball fired at 136 mph "
-           "at 6 in from the barrel end; BBCOR = e_A (1 + r) + r, r = m z^2 / I_pivot"}};
+           "NCAA BBCOR at the maximum-BBCOR location: the bat at rest on a pivot 6 in from the "
+           "knob, the ball fired at 136 mph; e_A = rebound / incoming speed of the flexible "
+           "free-free bat, BBCOR = e_A (1 + r) + r, r = m z^2 / I_pivot; the maximum over 4.0 to "
+           "8.0 in from the barrel end (every 0.5 in, then polished on the model). estimate: the "
+           "fast fixed-point approximation (rigid pivoted bat 6 in from the tip), error = "
+           "estimate - value"}};
 }
 
 Json BbcorScanToJson(const core::BbcorScan& s) {
@@ -95,6 +122,7 @@ Json BbcorScanToJson(const core::BbcorScan& s) {
           {"max_from_tip_m", s.max_from_tip_m},
           {"max_from_knob_m", s.max_from_knob_m},
           {"refinement", s.refinement},
+          {"polish_impacts", s.polish_impacts},
           {"fixed_point_value", s.fixed_point_value},
           {"fixed_point_from_tip_m", s.fixed_point_from_tip_m},
           {"fixed_point_method", s.fixed_point_method},
@@ -109,8 +137,8 @@ Json BbcorScanToJson(const core::BbcorScan& s) {
            "NCAA BBCOR at every point of the scan range (4.0 to 8.0 in from the barrel end every "
            "0.5 in: this service's choice): the ball fired at 136 mph onto the bat at rest, e_A "
            "from the flexible free-free bat (barrel spring in series for a hollow bat), BBCOR = "
-           "e_A (1 + r) + r, r = m z^2 / I_pivot about the 6-in pivot; the maximum refined by a "
-           "parabola"}};
+           "e_A (1 + r) + r, r = m z^2 / I_pivot about the 6-in pivot; the maximum polished on the "
+           "model by successive parabolic interpolation"}};
 }
 
 Json CollisionResultToJson(const core::CollisionResult& r) {

@@ -14,6 +14,7 @@
 #include "core/numerics/nlopt_search.hpp"
 #include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
+#include "core/scene/scene_barrel.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
 namespace sweetspot::core {
@@ -222,6 +223,45 @@ void BM_ObliqueImpactNormalLawCallable(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ObliqueImpactNormalLawCallable);
+
+// Issue 35: THE BBCOR (the flexible scan's maximum) against its fixed-point estimate, per
+// design, for the aluminium preset: the estimate (ComputeBbcor), the certified value with the
+// bat's modes computed (ComputeCertifiedBbcor, no cache: what rules: bbcor pays per answer) and
+// with the modes given (the scan alone).
+//   sweetspot_bench_core --benchmark_filter='Bbcor'
+void BM_BbcorEstimate(benchmark::State& state) {
+  const Bat bat = FindPreset("bbcor-33-aluminium")->bat;
+  for (auto _ : state) {
+    const BbcorResult r = ComputeBbcor(bat);
+    Keep(r.value);
+  }
+}
+BENCHMARK(BM_BbcorEstimate)->Unit(benchmark::kMicrosecond);
+
+void BM_BbcorCertifiedWithModes(benchmark::State& state) {
+  const Bat bat = FindPreset("bbcor-33-aluminium")->bat;
+  int impacts = 0;
+  for (auto _ : state) {
+    BbcorScan scan;
+    const BbcorResult r =
+        ComputeCertifiedBbcor(bat, FlexibleOptions{}, BarrelOptions{}, nullptr, nullptr, &scan);
+    impacts = static_cast<int>(scan.points.size()) + scan.polish_impacts;
+    Keep(r.value);
+  }
+  state.counters["impacts"] = impacts;
+}
+BENCHMARK(BM_BbcorCertifiedWithModes)->Unit(benchmark::kMillisecond);
+
+void BM_BbcorCertifiedScanOnly(benchmark::State& state) {
+  const Bat bat = FindPreset("bbcor-33-aluminium")->bat;
+  const BatModes modes = ComputeBatModes(bat, FlexibleOptions{}.ImpactModes());
+  for (auto _ : state) {
+    const BbcorResult r =
+        ComputeCertifiedBbcor(bat, FlexibleOptions{}, BarrelOptions{}, nullptr, &modes);
+    Keep(r.value);
+  }
+}
+BENCHMARK(BM_BbcorCertifiedScanOnly)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace bench_core_collision

@@ -84,6 +84,7 @@ bool ReadConstraints(ObjectReader& top, core::DesignConstraints* c) {
         std::pair{(*region)[0].get<double>(), (*region)[1].get<double>()};
   }
   c->min_frequency_hz = reader.MaybeNumber("min_frequency_hz", AnyNumber());
+  c->bbcor_max = reader.MaybeNumber("bbcor_max", AnyNumber());
   if (const Json* taper = reader.Get("taper")) {
     if (taper->is_string() && taper->get<std::string>() == "non_decreasing") {
       c->taper = core::TaperRule::kNonDecreasing;
@@ -322,7 +323,12 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
     out["cor_impact_speed_mps"] = Finite(r.cor_impact_speed_mps);
     out["cor_ball"] = Finite(r.cor_ball);
   }
-  if (r.bbcor) out["bbcor"] = BbcorToJson(*r.bbcor);
+  if (r.bbcor) {
+    out["bbcor"] = BbcorToJson(*r.bbcor);
+    // The certification rounds (core/optimize/bbcor_constraint.hpp).
+    out["bbcor"]["rounds"] = r.bbcor_rounds;
+    out["bbcor"]["estimate_offset"] = r.bbcor_estimate_offset;
+  }
   if (r.first_bending_mode) {
     const core::DesignFrequency& f = *r.first_bending_mode;
     out["first_bending_mode"] = {{"frequency_hz", Finite(f.frequency_hz)},

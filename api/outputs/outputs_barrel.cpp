@@ -19,13 +19,15 @@ void ProbeBarrel(core::SceneResult* r) {
   r->barrel->effective_cor_curve.emplace_back();
 }
 
-void RenderBbcor(const core::SceneResult& r, Json* out, Json*) {
+void RenderBbcor(const core::SceneResult& r, Json* out, Json* errors) {
   (*out)["bbcor"] = BbcorToJson(*r.bbcor);
+  (*errors)["bbcor"] = {{"value", r.bbcor->error_estimate}};
 }
 
 void ProbeBbcor(core::SceneResult* r) {
   r->bbcor.emplace();
-  r->bbcor->method = "trampoline_quasi_static";
+  r->bbcor->method = core::kCertifiedBbcorMethod;
+  r->bbcor->barrel_stiffness_n_m = 1.0;  // every field a number
 }
 
 void RenderBbcorScan(const core::SceneResult& r, Json* out, Json* errors) {

@@ -155,11 +155,18 @@ struct BbcorProtocol {
   double scan_step_m = 0.5 * 0.0254;           ///< m.
 };
 
-/// The BBCOR of a bat by the protocol.
+/// The method of the certified BBCOR (CertifiedBbcorOf, bbcor_scan.hpp): the flexible scan's
+/// maximum over the barrel.
+inline constexpr const char* kCertifiedBbcorMethod = "flexible_scan_max";
+
+/// The BBCOR of a bat by the protocol: ComputeBbcor's fixed-point estimate (method "rigid" or
+/// "trampoline_quasi_static"), or the certified value (method "flexible_scan_max",
+/// CertifiedBbcorOf in bbcor_scan.hpp) with that estimate beside it.
 struct BbcorResult {
   bool ok = false;                    ///< False: a model failure or invalid input (message).
   std::string message;                ///< Why not.
-  double value = 0.0;                 ///< BBCOR at the protocol's impact point.
+  /// BBCOR at the impact point: the fixed point's (estimate) or the scan's maximum (certified).
+  double value = 0.0;
   std::string ball;                   ///< Ball used.
   double ball_speed_mps = 0.0;        ///< m/s.
   double ball_cor = 0.0;              ///< The ball's COR against solid wood at that speed.
@@ -168,9 +175,21 @@ struct BbcorResult {
   std::string method;                 ///< "rigid" (solid bat) or "trampoline_quasi_static".
   double hoop_frequency_hz = 0.0;     ///< At the impact point (0 for a solid bat), Hz.
   double barrel_stiffness_n_m = 0.0;  ///< k_b at the impact point (0 for a solid bat), N/m.
+  // Certified only (method "flexible_scan_max"):
+  double impact_from_tip_m = 0.0;     ///< The maximum's location, m from the barrel end.
+  std::string refinement;             ///< The scan's ("polished" or "none").
+  double error_estimate = 0.0;        ///< The scan's impact error estimate (dimensionless).
+  std::vector<std::string> warnings;  ///< The scan's warnings.
+  double estimate_value = 0.0;        ///< ComputeBbcor's fixed-point value (dimensionless).
+  double estimate_from_tip_m = 0.0;   ///< Its point, m from the barrel end.
+  std::string estimate_method;        ///< Its method ("rigid", "trampoline_quasi_static").
+  double estimate_error = 0.0;        ///< estimate_value - value (dimensionless).
+  double solve_time_s = 0.0;          ///< The scan's wall time, s.
 };
 
-/// BBCOR of `bat` by `protocol`. A solid bat gives the ball's COR at the protocol's speed (a
+/// The FAST ESTIMATE of the BBCOR of `bat` by `protocol` (the certified value is the flexible
+/// scan's maximum, CertifiedBbcorOf in bbcor_scan.hpp; docs/validation.md gives this estimate's
+/// measured error against it). A solid bat gives the ball's COR at the protocol's speed (a
 /// rigid bat's BBCOR is e by construction); a hollow one the trampoline's e_eff for the bat
 /// pivoted at the protocol's pivot (M_e = I_pivot / z^2) at the protocol's impact point.
 /// `rigid_body_properties`: the bat's mass properties under InertiaModel::kRigidBody when the

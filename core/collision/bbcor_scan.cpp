@@ -16,6 +16,10 @@ namespace sweetspot::core {
 namespace {
 
 constexpr int kMaxScanPoints = 201;
+// The polish: at most this many impacts, stopped when the vertex moves less than 0.002 in
+// (the value's error there, curvature ~40 per m^2 on the presets, is ~1e-7).
+constexpr int kMaxPolishImpacts = 6;
+constexpr double kPolishTolM = 0.002 * 0.0254;
 
 // The scan's positions from the tip: first, first + step, ... up to last (inclusive within a
 // millionth of a step).
@@ -96,13 +100,14 @@ BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes, const BbcorPro
     const double i_pivot = properties.MoiAboutKgM2(protocol.pivot_from_knob_m);
     FlexibleImpactOptions o = impact;
     o.hands_loads = false;  // only the exit speed is read
-    for (double from_tip : ScanPositionsFromTip(protocol)) {
+    // One protocol impact `from_tip` m from the barrel end: false (out.message) on a failure.
+    auto strike = [&](double from_tip, BbcorScanPoint* p) {
       const double x = length - from_tip;
       const double z = x - protocol.pivot_from_knob_m;
       if (!(x >= 0.0 && z > 0.0)) {
         out.message = "bbcor_scan: the scan point " + FormatNumber17(from_tip) +
                       " m from the tip is not on the bat beyond the pivot";
-        return;
+        return false;
       }
       const BarrelWall wall = BarrelWallAt(bat, x, barrel);
       FlexibleImpactInputs in;
@@ -129,19 +134,23 @@ BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes, const BbcorPro
       if (!fr.summary.IsSolutionUsable()) {
         out.message = "bbcor_scan: the impact " + FormatNumber17(from_tip) +
                       " m from the tip: " + fr.summary.message;
-        return;
+        return false;
       }
       const double r = m * z * z / i_pivot;
+      p->position_from_tip_m = from_tip;
+      p->position_from_knob_m = x;
+      p->apparent_cor = fr.exit_speed_mps / u;
+      p->value = p->apparent_cor * (1.0 + r) + r;
+      p->rigid_value = fr.rigid_exit_speed_mps / u * (1.0 + r) + r;
+      p->barrel_stiffness_n_m = wall.hollow ? wall.stiffness_n_m : 0.0;
+      p->error_estimate = fr.error_estimate_exit_speed_mps / u * (1.0 + r);
+      p->modes_used = fr.modes_used;
+      out.error_estimate = std::max(out.error_estimate, p->error_estimate);
+      return true;
+    };
+    for (double from_tip : ScanPositionsFromTip(protocol)) {
       BbcorScanPoint p;
-      p.position_from_tip_m = from_tip;
-      p.position_from_knob_m = x;
-      p.apparent_cor = fr.exit_speed_mps / u;
-      p.value = p.apparent_cor * (1.0 + r) + r;
-      p.rigid_value = fr.rigid_exit_speed_mps / u * (1.0 + r) + r;
-      p.barrel_stiffness_n_m = wall.hollow ? wall.stiffness_n_m : 0.0;
-      p.error_estimate = fr.error_estimate_exit_speed_mps / u * (1.0 + r);
-      p.modes_used = fr.modes_used;
-      out.error_estimate = std::max(out.error_estimate, p.error_estimate);
+      if (!strike(from_tip, &p)) return;
       out.points.push_back(p);
     }
     const auto& pts = out.points;
@@ -150,34 +159,86 @@ BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes, const BbcorPro
       if (pts[i].value > pts[best].value) best = i;
     }
     out.max_index = static_cast<int>(best);
-    out.max_value = pts[best].value;
-    out.max_from_tip_m = pts[best].position_from_tip_m;
+    out.max_point = pts[best];
     out.refinement = "none";
-    if (best > 0 && best + 1 < pts.size()) {
-      // The parabola through the three points (equal spacing h): its vertex lies within
-      // +-h/2 of the middle one, since the middle value is the largest.
-      const double ym = pts[best - 1].value, y0 = pts[best].value, yp = pts[best + 1].value;
-      const double curvature = ym - 2.0 * y0 + yp;
-      if (curvature < 0.0) {
-        const double h = protocol.scan_step_m;
-        out.max_from_tip_m += 0.5 * h * (ym - yp) / curvature;
-        out.max_value = y0 - (ym - yp) * (ym - yp) / (8.0 * curvature);
-        out.refinement = "parabola";
+    if (best > 0 && best + 1 < pts.size() &&
+        pts[best - 1].value - 2.0 * pts[best].value + pts[best + 1].value < 0.0) {
+      // Successive parabolic interpolation on the model inside the grid's bracket (a, b, c),
+      // b the largest: strike at the vertex of the parabola through the three, keep the
+      // bracket around the largest, until the vertex moves less than kPolishTolM. Every value
+      // reported is a struck point's, never an interpolation.
+      BbcorScanPoint a = pts[best - 1], b = pts[best], c = pts[best + 1];
+      for (int it = 0; it < kMaxPolishImpacts; ++it) {
+        const double xa = a.position_from_tip_m, xb = b.position_from_tip_m,
+                     xc = c.position_from_tip_m;
+        const double num = (xb - xa) * (xb - xa) * (b.value - c.value) -
+                           (xb - xc) * (xb - xc) * (b.value - a.value);
+        const double den = (xb - xa) * (b.value - c.value) - (xb - xc) * (b.value - a.value);
+        if (!(den != 0.0)) break;
+        const double v = xb - 0.5 * num / den;
+        if (!(v > xa && v < xc) || std::abs(v - xb) < kPolishTolM) break;
+        BbcorScanPoint pv;
+        if (!strike(v, &pv)) return;
+        ++out.polish_impacts;
+        if (pv.value > b.value) {
+          if (v < xb) {
+            c = b;
+          } else {
+            a = b;
+          }
+          b = pv;
+        } else if (v < xb) {
+          a = pv;
+        } else {
+          c = pv;
+        }
       }
-    } else {
+      out.max_point = b;
+      out.refinement = "polished";
+    } else if (best == 0 || best + 1 == pts.size()) {
       out.warnings.push_back("the largest BBCOR is at an end of the scan range (" +
-                             FormatNumber17(out.max_from_tip_m) +
+                             FormatNumber17(pts[best].position_from_tip_m) +
                              " m from the tip): the maximum may lie outside it");
     }
+    out.max_value = out.max_point.value;
+    out.max_from_tip_m = out.max_point.position_from_tip_m;
     out.max_from_knob_m = length - out.max_from_tip_m;
     out.ok = true;
-    out.message = "scanned " + std::to_string(pts.size()) + " points";
+    out.message = "scanned " + std::to_string(pts.size()) + " points, " +
+                  std::to_string(out.polish_impacts) + " polishing impacts";
   });
   if (!guard.message.empty()) {
     out.ok = false;
     out.message = "bbcor_scan: " + guard.message;
   }
   out.solve_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+BbcorResult CertifiedBbcorOf(const BbcorScan& scan) {
+  BbcorResult out;
+  out.ball = scan.ball;
+  out.ball_speed_mps = scan.ball_speed_mps;
+  out.ball_cor = scan.ball_cor;
+  out.pivot_from_knob_m = scan.pivot_from_knob_m;
+  out.method = kCertifiedBbcorMethod;
+  out.warnings = scan.warnings;
+  if (!scan.ok) {
+    out.message = scan.message;
+    return out;
+  }
+  out.ok = true;
+  out.value = scan.max_value;
+  out.impact_from_knob_m = scan.max_from_knob_m;
+  out.impact_from_tip_m = scan.max_from_tip_m;
+  out.refinement = scan.refinement;
+  out.error_estimate = scan.error_estimate;
+  out.barrel_stiffness_n_m = scan.max_point.barrel_stiffness_n_m;
+  out.estimate_value = scan.fixed_point_value;
+  out.estimate_from_tip_m = scan.fixed_point_from_tip_m;
+  out.estimate_method = scan.fixed_point_method;
+  out.estimate_error = scan.fixed_point_value - scan.max_value;
+  out.solve_time_s = scan.solve_time_s;
   return out;
 }
 

@@ -17,8 +17,17 @@
 //   same way does not give the ball's COR exactly: each point also reports that rigid free-bat
 //   value (rigid_value) so the bending loss can be told from the free/pivoted difference.
 // - The range (default 4.0 to 8.0 in from the tip every 0.5 in) is this service's choice; no
-//   source gives it. The maximum is the largest sampled point, refined by the parabola through
-//   it and its two neighbours when it is interior (never outside them).
+//   source gives it (the standard certifies "at the maximum BBCOR location", found by testing
+//   along the barrel; its own search is not reproduced). The maximum is found on that grid, then
+//   POLISHED on the model: when the largest point is interior, successive parabolic
+//   interpolation strikes the bat at the vertex of the parabola through the bracket (the
+//   largest point and its neighbours), keeps the bracket around the largest struck point, and
+//   stops when the vertex moves less than 0.002 in (at most 6 impacts). The maximum reported is
+//   a struck point's value, never an interpolation.
+// - CertifiedBbcorOf: that maximum is THE BBCOR of this service (issue 35): the `bbcor` output,
+//   `rules: bbcor` and the optimiser's BBCOR constraints; ComputeBbcor's fixed point (rigid
+//   pivoted bat 6 in from the tip, quasi-static trampoline) is kept beside it as the labelled
+//   fast estimate, with its error against the scan.
 // The bat's modes are computed once by the caller and reused for every point.
 #pragma once
 
@@ -57,20 +66,24 @@ struct BbcorScan {
   double ball_cor = 0.0;                      ///< The ball's COR at that speed.
   double pivot_from_knob_m = 0.0;             ///< m.
   std::vector<BbcorScanPoint> points;  ///< Every point, from the tip end of the range inwards.
-  int max_index = -1;                  ///< The point with the largest BBCOR.
-  double max_value = 0.0;              ///< The maximum BBCOR (refined), dimensionless.
-  double max_from_tip_m = 0.0;         ///< Its location, m from the barrel end (refined).
+  int max_index = -1;                  ///< The grid point with the largest BBCOR.
+  /// The struck point with the largest BBCOR (a grid point or a polishing impact).
+  BbcorScanPoint max_point;
+  double max_value = 0.0;              ///< The maximum BBCOR (max_point's value), dimensionless.
+  double max_from_tip_m = 0.0;         ///< Its location, m from the barrel end.
   double max_from_knob_m = 0.0;        ///< The same, m from the knob.
-  /// "parabola" (through the largest point and its neighbours) or "none" (largest point at
-  /// an end of the range: a warning says so).
+  /// "polished" (the grid's largest point refined by successive parabolic interpolation on the
+  /// model, the file comment) or "none" (the largest grid point at an end of the range: a
+  /// warning says so; or no curvature to polish on).
   std::string refinement;
+  int polish_impacts = 0;  ///< Impacts of the polish (beyond the grid's points).
   /// ComputeBbcor's value (rigid pivoted bat at the fixed point), beside it.
   double fixed_point_value = 0.0;
   double fixed_point_from_tip_m = 0.0;  ///< Its point, m from the barrel end.
   std::string fixed_point_method;       ///< ComputeBbcor's method.
   double error_estimate = 0.0;          ///< Largest point error estimate (dimensionless).
   int elements = 0;                     ///< Beam mesh elements.
-  int steps = 0;                        ///< Integrator steps over all impacts.
+  int steps = 0;                        ///< Integrator steps over all impacts (polish included).
   double solve_time_s = 0.0;            ///< Wall time, s.
 };
 
@@ -88,5 +101,10 @@ BbcorScan ComputeBbcorScan(const Bat& bat, const BatModes& modes,
                            const FlexibleImpactOptions& impact = {},
                            const BarrelOptions& barrel = {},
                            const MassProperties* rigid_body_properties = nullptr);
+
+/// THE BBCOR of `scan` (ok): value = scan.max_value (method "flexible_scan_max", the impact
+/// point the maximum's), the fixed-point estimate beside it (estimate_value,
+/// estimate_error = estimate - value). A failed scan gives ok = false with its message.
+BbcorResult CertifiedBbcorOf(const BbcorScan& scan);
 
 }  // namespace sweetspot::core

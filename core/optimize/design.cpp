@@ -18,6 +18,7 @@
 #include "core/flexible/modes.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/limits.hpp"
+#include "core/optimize/bbcor_constraint.hpp"
 #include "core/optimize/design_backends.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
@@ -372,16 +373,13 @@ void MarkCancelledMultiStart(const DesignOptions& options, const std::vector<Run
 // infeasible.
 void CheckBbcorRule(const DesignProblem& problem, const PublicEvaluation& pub,
                     DesignResult* result) {
-  const auto& rules = problem.constraints.rules;
-  if (!result->bat.IsHollow() ||
-      std::find(rules.begin(), rules.end(), RuleSet::kBbcor) == rules.end()) {
-    return;
-  }
+  const std::optional<double> bound = BbcorBoundOf(problem);  // bbcor_constraint.hpp
+  if (!result->bat.IsHollow() || !bound.has_value()) return;
   std::string bbcor_why;
   // The constraint's own acceptance: kFeasibleRelative of the limit (the re-check above).
   const double limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
-  if (!BbcorRuleHolds(result->bat, &result->bbcor.emplace(), &bbcor_why,
-                      kFeasibleRelative * limit, RigidBodyPropertiesOrNull(pub.properties))) {
+  if (!BbcorRuleHolds(result->bat, &result->bbcor.emplace(), &bbcor_why, kFeasibleRelative * limit,
+                      RigidBodyPropertiesOrNull(pub.properties), *bound)) {
     result->summary.termination = Termination::kInfeasible;
     result->summary.message = bbcor_why;
     result->message_kind = DesignMessageKind::kInfeasible;
@@ -390,9 +388,9 @@ void CheckBbcorRule(const DesignProblem& problem, const PublicEvaluation& pub,
 
 // The optimisation, with the progress it reports mapped into [progress_from, progress_to]
 // and an overall deadline (OptimizeOverMaterials shares one budget between materials).
-DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options,
-                      Progress* progress, double progress_from, double progress_to,
-                      std::optional<Clock::time_point> shared_deadline) {
+DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& options,
+                          Progress* progress, double progress_from, double progress_to,
+                          std::optional<Clock::time_point> shared_deadline) {
   const Clock::time_point start = Clock::now();
   const auto elapsed_s = [&start] {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -493,6 +491,26 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
   }
   summary.solve_time_s = elapsed_s();
   return result;
+}
+
+// The optimisation, in certification rounds when the problem bounds the BBCOR
+// (bbcor_constraint.hpp): the rounds share one deadline.
+DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options,
+                      Progress* progress, double progress_from, double progress_to,
+                      std::optional<Clock::time_point> shared_deadline) {
+  if (!BbcorBoundOf(problem).has_value()) {
+    return OptimizeOnce(problem, options, progress, progress_from, progress_to, shared_deadline);
+  }
+  const Clock::time_point start = Clock::now();
+  const Clock::time_point deadline = shared_deadline.value_or(
+      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                  std::isfinite(options.max_time_s) && options.max_time_s > 0.0 ? options.max_time_s
+                                                                                : 0.0)));
+  DesignResult r = OptimizeWithCertifiedBbcor(problem, [&](const DesignProblem& p) {
+    return OptimizeOnce(p, options, progress, progress_from, progress_to, deadline);
+  });
+  r.summary.solve_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return r;
 }
 
 }  // namespace

@@ -127,9 +127,26 @@ bool ModelBuilder::BarrelCor() {
 // A solid design keeps the check of the scene's COR before solving (Rules()).
 bool ModelBuilder::BbcorConstraint() {
   const auto& rules = cons.rules;
-  if (!model.hollow_ || std::find(rules.begin(), rules.end(), RuleSet::kBbcor) == rules.end()) {
-    return true;
+  const bool rule = std::find(rules.begin(), rules.end(), RuleSet::kBbcor) != rules.end();
+  if (cons.bbcor_max.has_value()) {
+    if (!CheckInRange(why, "constraints.bbcor_max", *cons.bbcor_max, 0.0, 1.0,
+                      /*lo_open=*/true)) {
+      return false;
+    }
+    if (!model.hollow_) {
+      return Refuse(why, TextRefusal("constraints.bbcor_max",
+                                     "applies to a hollow design (a wall_thickness_m on the "
+                                     "bat or as a variable); a solid bat's BBCOR is the "
+                                     "ball's COR less its bending loss, which no variable "
+                                     "here sets"));
+    }
   }
+  if (!model.hollow_ || (!rule && !cons.bbcor_max.has_value())) return true;
+  // THE BBCOR's bound (bbcor_constraint.hpp): the estimate held below it less the offset the
+  // certification rounds set (0 on the first round without a hollow base).
+  const double rule_limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
+  const bool margin = cons.bbcor_max.has_value() && (!rule || *cons.bbcor_max < rule_limit);
+  const double bound = margin ? *cons.bbcor_max : rule_limit;
   const BbcorProtocol protocol;
   const BarrelOptions barrel;
   const std::optional<BallPreset> ball = FindBallPreset(protocol.ball);
@@ -162,10 +179,10 @@ bool ModelBuilder::BbcorConstraint() {
                                    "variables' bounds) cannot be computed"));
   }
   DesignConstraintSpec c;
-  c.name = c.min_name = c.max_name = "rules.bbcor.bbcor";
+  c.name = c.min_name = c.max_name = margin ? "bbcor_max" : "rules.bbcor.bbcor";
   c.unit = "";
   c.f.function = DesignFunction::kBbcor;
-  c.upper = *LimitsOf(RuleSet::kBbcor).max_bbcor;
+  c.upper = bound - cons.bbcor_estimate_offset;
   c.property = true;  // analysed for conflicts (its reach within the bounds)
   model.constraints_.push_back(std::move(c));
   return true;

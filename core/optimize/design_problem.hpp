@@ -149,6 +149,14 @@ struct DesignConstraints {
   int taper_first_knot = 0;    ///< Profile: the taper rule starts at this knot (>= 0).
   int taper_last_knot = -1;    ///< Profile: ... and ends at this knot (-1 = the last).
   std::vector<RuleSet> rules;  ///< League rule sets ("rules.<name>.<limit>").
+  /// "bbcor_max": THE BBCOR (the flexible scan's maximum, bbcor_constraint.hpp) at most this,
+  /// dimensionless, in (0, 1]: a margin below the rule's 0.50 (e.g. 0.49). Hollow designs only
+  /// (the base bat hollow or wall_thickness_m a variable).
+  std::optional<double> bbcor_max;
+  /// Internal (set by OptimizeDesign's certification rounds, bbcor_constraint.hpp; 0 from a
+  /// request): the scan's maximum minus the fixed-point estimate, subtracted from the BBCOR
+  /// bound of the estimate the design model constrains.
+  double bbcor_estimate_offset = 0.0;
 };
 
 /// What to improve.
@@ -464,10 +472,14 @@ struct DesignResult {
   std::optional<DesignSting> sting;  ///< min_sting: the answer's impact (else empty).
   /// constraints.min_frequency_hz: the answer's first bending mode (else empty).
   std::optional<DesignFrequency> first_bending_mode;
-  /// rules bbcor on a hollow answer: its BBCOR by the NCAA protocol, a constraint of the design
-  /// problem (rules.bbcor.bbcor) recomputed on the answer by ComputeBbcor (BbcorRuleHolds; above
-  /// the limit by more than the feasibility tolerance the termination is infeasible).
+  /// rules bbcor or constraints.bbcor_max on a hollow answer: THE BBCOR (the flexible scan's
+  /// maximum, its fixed-point estimate beside it) recomputed on the answer (BbcorRuleHolds; above
+  /// the bound by more than the feasibility tolerance the termination is infeasible).
   std::optional<BbcorResult> bbcor;
+  /// The certification rounds (bbcor_constraint.hpp): optimisations run (0 without a BBCOR
+  /// bound) and the last one's estimate offset (scan maximum - estimate, dimensionless).
+  int bbcor_rounds = 0;
+  double bbcor_estimate_offset = 0.0;  ///< Dimensionless.
   /// Errors reported by Ipopt's derivative checker (-1 = not run).
   int derivative_check_errors = -1;
   std::string derivative_check_report;  ///< The checker's output (empty if not run).

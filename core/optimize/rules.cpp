@@ -2,6 +2,7 @@
 
 #include "core/geometry_format.hpp"
 #include "core/refusal.hpp"
+#include "core/scene/scene_barrel.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -137,20 +138,24 @@ bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why) {
 }
 
 bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why, double tolerance,
-                    const MassProperties* rigid_body_properties) {
-  *bbcor = ComputeBbcor(bat, BbcorProtocol{}, BarrelOptions{}, rigid_body_properties);
-  const double limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
+                    const MassProperties* rigid_body_properties, std::optional<double> bound) {
+  // THE BBCOR (issue 35): the flexible scan's maximum, the fixed-point estimate beside it.
+  *bbcor = ComputeCertifiedBbcor(bat, FlexibleOptions{}, BarrelOptions{}, rigid_body_properties);
+  const double rule_limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
+  const double limit = bound.value_or(rule_limit);
+  const std::string name = limit < rule_limit ? "constraints.bbcor_max" : "rules.bbcor";
   if (!bbcor->ok) {
-    if (why != nullptr) *why = "rules.bbcor: the BBCOR could not be computed: " + bbcor->message;
+    if (why != nullptr) *why = name + ": the BBCOR could not be computed: " + bbcor->message;
     return false;
   }
   if (!(bbcor->value <= limit + tolerance)) {
     if (why != nullptr) {
-      *why = "rules.bbcor: the design's BBCOR = " + FormatNumber(bbcor->value) +
-             " exceeds the limit " + FormatNumber(limit) +
-             " (NCAA protocol with the barrel model, recomputed on the answer: the optimiser "
-             "found no design within the variables' bounds and the other constraints that meets "
-             "it; raise the wall's upper bound or free the variables that lower the BBCOR)";
+      *why = name + ": the design's BBCOR = " + FormatNumber(bbcor->value) + " exceeds the limit " +
+             FormatNumber(limit) +
+             " (NCAA protocol, the flexible scan's maximum, recomputed on the answer: the "
+             "optimiser found no design within the variables' bounds and the other constraints "
+             "that meets it; raise the wall's upper bound or free the variables that lower the "
+             "BBCOR)";
     }
     return false;
   }

@@ -69,13 +69,17 @@ struct RuleFacts {
 /// problem).
 bool RuleAllowsDesign(RuleSet rule, const RuleFacts& facts, Refusal* why);
 
-/// The `bbcor` rule's check of a finished hollow design, by recomputing: *bbcor = ComputeBbcor(bat)
-/// (the NCAA protocol, default barrel options). The design model holds BBCOR <= 0.50 as a
-/// constraint; this is the independent check of its answer. False, with "rules.bbcor: ..." in
-/// *why, when the value exceeds the limit by more than tolerance (>= 0; the optimiser passes its
-/// feasibility tolerance) or the model fails. `rigid_body_properties`: the bat's mass properties
-/// under InertiaModel::kRigidBody when the caller has them (null: computed, ComputeBbcor's).
+/// The `bbcor` rule's check of a finished hollow design, by recomputing THE BBCOR (issue 35):
+/// *bbcor = ComputeCertifiedBbcor(bat) (scene_barrel.hpp: the flexible scan's maximum by the NCAA
+/// protocol, default flexible and barrel options, the fixed-point estimate beside it). The design
+/// model holds the BBCOR as a constraint (bbcor_constraint.hpp); this is the independent check of
+/// its answer. False, with "rules.bbcor: ..." (or "constraints.bbcor_max: ..." when `bound` is
+/// below the rule's 0.50) in *why, when the value exceeds `bound` (default: the rule's limit)
+/// by more than tolerance (>= 0; the optimiser passes its feasibility tolerance) or the model
+/// fails. `rigid_body_properties`: the bat's mass properties under InertiaModel::kRigidBody when
+/// the caller has them (null: computed).
 bool BbcorRuleHolds(const Bat& bat, BbcorResult* bbcor, std::string* why, double tolerance = 0.0,
-                    const MassProperties* rigid_body_properties = nullptr);
+                    const MassProperties* rigid_body_properties = nullptr,
+                    std::optional<double> bound = std::nullopt);
 
 }  // namespace sweetspot::core

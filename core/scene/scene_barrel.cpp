@@ -2,8 +2,12 @@
 #include "core/scene/scene_barrel.hpp"
 
 #include <algorithm>
+#include <memory>
+#include <utility>
 
 #include "core/collision/contact_law.hpp"
+#include "core/flexible/modes.hpp"
+#include "core/flexible/modes_cache.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -51,6 +55,22 @@ bool SceneBarrel(const Scene& scene, const ResolvedScene& r, const BarrelOptions
     out->effective_cor_curve.push_back(p);
   }
   return true;
+}
+
+BbcorResult ComputeCertifiedBbcor(const Bat& bat, const FlexibleOptions& flexible,
+                                  const BarrelOptions& barrel,
+                                  const MassProperties* rigid_body_properties,
+                                  const BatModes* modes, BbcorScan* scan) {
+  std::shared_ptr<const BatModes> own;
+  if (modes == nullptr) {
+    own = CachedBatModes(bat, flexible.ImpactModes(), flexible.modes_cache);
+    modes = own.get();
+  }
+  BbcorScan s = ComputeBbcorScan(bat, *modes, BbcorProtocol{}, flexible.impact, barrel,
+                                 rigid_body_properties);
+  BbcorResult out = CertifiedBbcorOf(s);
+  if (scan != nullptr) *scan = std::move(s);
+  return out;
 }
 
 }  // namespace sweetspot::core

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/collision/barrel.hpp"
+#include "core/collision/bbcor_scan.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/scene/scene.hpp"
 
@@ -17,5 +18,16 @@ namespace sweetspot::core {
 /// *error when the model fails.
 bool SceneBarrel(const Scene& scene, const ResolvedScene& resolved, const BarrelOptions& options,
                  BarrelOutput* out, std::string* error);
+
+/// THE BBCOR of `bat` (issue 35; bbcor_scan.hpp): the flexible scan's maximum over the barrel
+/// by the NCAA protocol with `flexible`'s impact options and modes (`modes`: the bat's impact
+/// modes when the caller has them, else computed here with flexible.ImpactModes() and its
+/// cache), `barrel`'s wall, the fixed-point estimate beside it. `rigid_body_properties` as
+/// ComputeBbcorScan's. `scan` (optional): the whole scan. Never throws; ok = false with the
+/// message on a failure (the modes' included).
+BbcorResult ComputeCertifiedBbcor(const Bat& bat, const FlexibleOptions& flexible = {},
+                                  const BarrelOptions& barrel = {},
+                                  const MassProperties* rigid_body_properties = nullptr,
+                                  const BatModes* modes = nullptr, BbcorScan* scan = nullptr);
 
 }  // namespace sweetspot::core

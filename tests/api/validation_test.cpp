@@ -124,11 +124,16 @@ TEST(ValidationTest, SolidWoodBbcorIsJustBelowTheLimit) {
   for (const char* preset : {"wood-34-ash", "paper-wood"}) {
     const Json r = Post("/v1/sweet-spot", Json{{"bat", {{"preset", preset}}},
                                               {"outputs", {"bbcor"}}});
+    // THE BBCOR (issue 35): the flexible scan's maximum, below the rigid estimate (bending
+    // takes energy); the estimate is the NCAA ball's COR.
     const double bbcor = r["bbcor"]["value"].get<double>();
-    EXPECT_EQ(r["bbcor"]["method"], "rigid") << preset;
+    EXPECT_EQ(r["bbcor"]["method"], "flexible_scan_max") << preset;
+    EXPECT_EQ(r["bbcor"]["estimate"]["method"], "rigid") << preset;
     EXPECT_LE(bbcor, 0.50) << preset;
     EXPECT_GE(bbcor, 0.45) << preset;
-    EXPECT_NEAR(bbcor, 0.479, 1e-12) << preset;  // pinned: 0.555 - 0.001 (136 - 60)
+    EXPECT_LT(bbcor, r["bbcor"]["estimate"]["value"].get<double>()) << preset;
+    // pinned: 0.555 - 0.001 (136 - 60)
+    EXPECT_NEAR(r["bbcor"]["estimate"]["value"].get<double>(), 0.479, 1e-12) << preset;
   }
 }
 
@@ -173,14 +178,18 @@ TEST(ValidationTest, HoopFrequencyOfHollowBatsAndItsLinkToBbcor) {
 // BBCOR of a legal hollow bat: at most 0.500 (the NCAA limit; legal bats are designed up to it).
 // For the model this is the CALIBRATION (the shell factor c = 7 is fitted so this preset gives
 // 0.500, docs/models.md "Barrel"), not a prediction: the test pins that the calibration holds
-// with the catalogue's NCAA ball (0.479 at 136 mph), to the 0.0001 the fit was rounded to.
+// with the catalogue's NCAA ball (0.479 at 136 mph), to the 0.0001 the fit was rounded to. The
+// calibration is of the fixed-point ESTIMATE; THE BBCOR (the flexible scan's maximum, issue 35)
+// of the preset is 0.4867 (tolerance 5e-4: three times the scan's error estimate, 1.5e-4).
 TEST(ValidationTest, HollowBbcorPresetSitsAtTheLimitByCalibration) {
   const Json r = Post("/v1/sweet-spot", Json{{"bat", {{"preset", "bbcor-33-aluminium"}}},
                                             {"outputs", {"bbcor"}}});
-  EXPECT_EQ(r["bbcor"]["method"], "trampoline_quasi_static");
+  EXPECT_EQ(r["bbcor"]["method"], "flexible_scan_max");
+  EXPECT_EQ(r["bbcor"]["estimate"]["method"], "trampoline_quasi_static");
   EXPECT_NEAR(r["bbcor"]["ball_cor"].get<double>(), 0.479, 1e-12);
+  EXPECT_NEAR(r["bbcor"]["estimate"]["value"].get<double>(), 0.50, 1e-4);
   EXPECT_LE(r["bbcor"]["value"].get<double>(), 0.50);
-  EXPECT_NEAR(r["bbcor"]["value"].get<double>(), 0.50, 1e-4);
+  EXPECT_NEAR(r["bbcor"]["value"].get<double>(), 0.4867, 5e-4);
 }
 
 }  // namespace

@@ -217,7 +217,8 @@ TEST(BarrelScene, OutputsNeedTheBatsGeometryAndSolidBatsKeepTheirCor) {
   EXPECT_FALSE(with.barrel->hollow);
   EXPECT_EQ(with.barrel->effective_cor, *with.cor);
   ASSERT_TRUE(with.bbcor.has_value());
-  EXPECT_EQ(with.bbcor->method, "rigid");
+  EXPECT_EQ(with.bbcor->method, "flexible_scan_max");
+  EXPECT_EQ(with.bbcor->estimate_method, "rigid");
   // Only mass properties: refused, naming the bat.
   Scene no_bat = s;
   no_bat.mass_properties = ComputeMassProperties(*s.bat);
