@@ -97,9 +97,10 @@ void SceneResult::Reset() {
   // A field added to SceneResult must be reset here too: on x86-64 (the size this list was
   // written for) the size check says so. The outputs' slots are reset by their declarations.
   // A new slot can move this difference too (the base's tail padding: 600 -> 608 with
-  // batted_ball's slot, SceneResult's own fields unchanged).
+  // batted_ball's slot, SceneResult's own fields unchanged). 608 -> 736: Swing gained the
+  // speed model's settings and its resolution (reset with `swing` below).
 #if defined(__x86_64__)
-  static_assert(sizeof(SceneResult) - sizeof(SceneOutputResults) == 608,
+  static_assert(sizeof(SceneResult) - sizeof(SceneOutputResults) == 736,
                 "SceneResult gained a field: reset it in Reset");
 #endif
   summary.Reset();
@@ -173,7 +174,7 @@ void SceneEvaluator::EvaluateOutputs(const Scene& scene, SceneResult* out_ptr) {
   const bool flexible_exit = needs_exit && options.model == CollisionModel::kFlexible;
   if (!scene.bat.has_value() && RefuseMissingGeometry(run, flexible_exit, &out)) return;
   ResolvedScene r;
-  const bool resolved = ResolveScene(scene, needs_cor, &book_, &r, &s);
+  const bool resolved = ResolveScene(scene, needs_cor, &book_, &r, &s, std::nullopt, options.model);
   // Also when refused: the caller can then tell properties that are not usable (the bat's).
   out.mass_properties = r.mass_properties;
   if (!resolved) return;
