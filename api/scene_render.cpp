@@ -26,7 +26,13 @@ Json SwingToJson(const core::Swing& swing) {
         swing.resolution.has_value() ? &*swing.resolution : nullptr;
     if (swing.bat_speed_point == core::BatSpeedPoint::kSweetSpot) {
       out["bat_speed_point"] = core::BatSpeedPointName(swing.bat_speed_point);
-      if (how != nullptr) out["bat_speed_point_model"] = how->point_model;
+      if (how != nullptr) {
+        out["bat_speed_point_model"] = how->point_model;
+        if (how->iterations > 0) {  // hertz, flexible: iterated to the model's own maximum
+          out["bat_speed_point_iterations"] = how->iterations;
+          out["bat_speed_point_error_mps"] = how->speed_error_mps;
+        }
+      }
     }
     if (swing.speed_model == core::SwingSpeedModel::kSwingWeight) {
       out["speed_model"] = core::SwingSpeedModelName(swing.speed_model);

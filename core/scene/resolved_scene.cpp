@@ -186,18 +186,11 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
     return false;
   }
   // The bat-speed point "sweet_spot" is a closed form's maximum: the exit model's, or for the
-  // ODE models (hertz, flexible) free_bat's, said so in a warning.
+  // ODE models (hertz, flexible) free_bat's (EvaluateScene then iterates to the model's own:
+  // SolveSweetSpotSwing; the resolution's point_model says which).
   std::string reason;
   CollisionModel point_model = ResolveExitModel(exit_model, scene, &reason);
   if (point_model != CollisionModel::kRigidPivot && point_model != CollisionModel::kFreeBat) {
-    if (scene.swing.bat_speed_mps.has_value() &&
-        scene.swing.bat_speed_point == BatSpeedPoint::kSweetSpot) {
-      s->warnings.push_back(std::string("swing.bat_speed_from_tip_m = sweet_spot: the bat-speed "
-                                        "point is free_bat's closed-form max-exit-speed point; "
-                                        "model ") +
-                            CollisionModelName(point_model) +
-                            "'s own maximum may lie elsewhere (max_exit_speed reports it)");
-    }
     point_model = CollisionModel::kFreeBat;
   }
   if (Refusal refusal; !ResolveSceneSwing(scene.ball, scene.swing, r->mass_properties, r->length_m,

@@ -124,6 +124,11 @@ struct SwingResolution {
   double moi_hands_kg_m2 = 0.0;      ///< The bat's MOI about the hands, kg·m².
   double reference_moi_kg_m2 = 0.0;  ///< kSwingWeight: the reference swing weight, kg·m².
   double swing_weight_factor = 1.0;  ///< (moi_hands / reference)^-n; 1 for kFixed.
+  /// kSweetSpot with hertz or flexible: the fixed-point iterations to the model's own maximum
+  /// (SolveSweetSpotSwing); 0 for a closed form (solved exactly).
+  int iterations = 0;
+  /// ... and the speed at that maximum minus bat_speed_mps when they stopped, m/s.
+  double speed_error_mps = 0.0;
 };
 
 /// The swing just before impact. Defaults: the paper's Table 3 and the standard grip.
