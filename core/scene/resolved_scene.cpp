@@ -82,8 +82,9 @@ bool ResolveSceneSwing(const Ball& ball, const Swing& swing, const MassPropertie
       x = mx.position_from_knob_m;  // an end of the bat
       if (!(x - pivot > 0.0)) {
         return Refuse17(refusal, "swing.pivot_from_knob_m", pivot,
-                        "the max-exit-speed point for swing.bat_speed_from_tip_m = sweet_spot is "
-                        "the knob, not beyond the pivot");
+                        "the max-exit-speed point for swing.bat_speed_from_tip_m = sweet_spot "
+                        "(an end of the bat, " + FormatNumber17(x) +
+                            " m from the knob) must lie beyond the pivot");
       }
       omega = v / (x - pivot);
     } else if (v > 0.0) {
