@@ -60,6 +60,17 @@ std::vector<Field> MakeFields() {
   f.push_back({"swing.bat_speed_from_tip_m", "m", G::kSwing, 0.0, core::kMaxSwingOffsetM, true,
                false, "", [](const H& h) { return h.swing->bat_speed_from_tip_m; },
                [](const H& h, double v) { h.swing->bat_speed_from_tip_m = v; }});
+  // swing.speed_model "swing_weight"'s settings (core/scene/swing_speed.hpp); the parser reads
+  // the model's name and bat_speed_from_tip_m's "sweet_spot" itself (ReadSwing).
+  f.push_back({"swing.reference_moi_kg_m2", "kg·m²", G::kSwing, 0.0, core::kMaxSwingMoiKgM2, true,
+               false, "",
+               [](const H& h) {
+                 return h.swing->reference_moi_kg_m2.value_or(core::kSwingWeightReferenceMoiKgM2);
+               },
+               [](const H& h, double v) { h.swing->reference_moi_kg_m2 = v; }});
+  f.push_back({"swing.swing_weight_exponent", "1", G::kSwing, 0.0, core::kMaxSwingWeightExponent,
+               true, false, "", [](const H& h) { return h.swing->swing_weight_exponent; },
+               [](const H& h, double v) { h.swing->swing_weight_exponent = v; }});
   f.push_back({"swing.pivot_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,
                core::kMaxSwingOffsetM, true, false, "",
                [](const H& h) { return h.swing->pivot_from_knob_m; },

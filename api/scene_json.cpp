@@ -41,9 +41,33 @@ bool ReadBall(const Json& value, const std::string& path, core::Ball* ball, ApiE
 // hands_from_knob_m: the table of fields (api/fields.hpp). Exactly one of angular_speed_rad_s
 // and bat_speed_mps (which core turns into the angular speed once the bat's length is known:
 // core::ResolveSwing), read into a copy so that the swing changes only when they are one.
+// swing.speed_model ("fixed" or "swing_weight") and bat_speed_from_tip_m (or _in) given as
+// "sweet_spot" are read here; the numbers by the table.
 bool ReadSwing(const Json& value, const std::string& path, core::Swing* swing, ApiError* error) {
-  ObjectReader reader(value, path, error);
   core::Swing read = *swing;
+  // "sweet_spot" in place of the bat-speed point's distance: taken out of a copy of the object
+  // before the table reads its numbers.
+  std::optional<Json> without_point;
+  if (value.is_object()) {
+    for (const char* key : {"bat_speed_from_tip_m", "bat_speed_from_tip_in"}) {
+      const auto it = value.find(key);
+      if (it == value.end() || !it->is_string()) continue;
+      if (it->get<std::string>() != "sweet_spot") {
+        ObjectReader point_reader(value, path, error);
+        return point_reader.Fail(key, "must be a number or \"sweet_spot\" (the bat's own "
+                                      "max-exit-speed point)");
+      }
+      if (!without_point.has_value()) without_point = value;
+      without_point->erase(key);
+      read.bat_speed_point = core::BatSpeedPoint::kSweetSpot;
+    }
+  }
+  ObjectReader reader(without_point.has_value() ? *without_point : value, path, error);
+  if (std::string model; reader.OptionalString("speed_model", &model, {"fixed", "swing_weight"}) &&
+                         reader.Has("speed_model")) {
+    read.speed_model = *core::ParseSwingSpeedModel(model);
+  }
+  if (!reader.ok()) return false;
   FieldHost host;
   host.swing = &read;
   std::vector<const Field*> given;
@@ -61,6 +85,11 @@ bool ReadSwing(const Json& value, const std::string& path, core::Swing* swing, A
                        "(both are given; the bat speed sets the angular speed)");
   }
   if (angular) read.bat_speed_mps.reset();
+  if (read.bat_speed_point == core::BatSpeedPoint::kSweetSpot &&
+      has("swing.bat_speed_from_tip_m")) {
+    return reader.Fail("bat_speed_from_tip_m",
+                       "give either a distance or \"sweet_spot\" (both are given)");
+  }
   *swing = read;
   return reader.Finish();
 }

@@ -20,6 +20,34 @@ Json SwingToJson(const core::Swing& swing) {
   if (swing.bat_speed_mps.has_value()) {
     out["bat_speed_mps"] = *swing.bat_speed_mps;
     out["bat_speed_from_tip_m"] = swing.bat_speed_from_tip_m;
+    // A resolved swing that is not the plain fixed speed at a distance says how it was
+    // resolved (an answer's swing without these is a fixed speed at bat_speed_from_tip_m).
+    const core::SwingResolution* how =
+        swing.resolution.has_value() ? &*swing.resolution : nullptr;
+    if (swing.bat_speed_point == core::BatSpeedPoint::kSweetSpot) {
+      out["bat_speed_point"] = core::BatSpeedPointName(swing.bat_speed_point);
+      if (how != nullptr) {
+        out["bat_speed_point_model"] = how->point_model;
+        if (how->iterations > 0) {  // hertz, flexible: iterated to the model's own maximum
+          out["bat_speed_point_iterations"] = how->iterations;
+          out["bat_speed_point_error_mps"] = how->speed_error_mps;
+        }
+      }
+    }
+    if (swing.speed_model == core::SwingSpeedModel::kSwingWeight) {
+      out["speed_model"] = core::SwingSpeedModelName(swing.speed_model);
+      if (how != nullptr) {
+        out["swing_weight"] = {{"given_bat_speed_mps", how->given_bat_speed_mps},
+                               {"moi_hands_kg_m2", how->moi_hands_kg_m2},
+                               {"reference_moi_kg_m2", how->reference_moi_kg_m2},
+                               {"exponent", swing.swing_weight_exponent},
+                               {"factor", how->swing_weight_factor},
+                               {"source", core::kSwingWeightSource}};
+        if (!swing.reference_moi_kg_m2.has_value()) {
+          out["swing_weight"]["reference_bat"] = core::kSwingWeightReferenceBat;
+        }
+      }
+    }
   }
   return out;
 }

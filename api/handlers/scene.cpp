@@ -287,6 +287,15 @@ Json CompareDeltas(const core::SceneResult& variant, const core::SceneResult& ba
     deltas["max_exit_speed_mps"] =
         variant.max_exit_speed->exit_speed_mps - base.max_exit_speed->exit_speed_mps;
   }
+  // A swing whose speed depends on the bat (swing.speed_model swing_weight, or the bat-speed
+  // point at each bat's sweet spot): how much faster the variant is swung.
+  const core::Swing& vs = variant.swing;
+  if (vs.resolution.has_value() && base.swing.resolution.has_value() &&
+      (vs.speed_model == core::SwingSpeedModel::kSwingWeight ||
+       vs.bat_speed_point == core::BatSpeedPoint::kSweetSpot)) {
+    deltas["bat_speed_mps"] = vs.resolution->bat_speed_mps - base.swing.resolution->bat_speed_mps;
+    deltas["angular_speed_rad_s"] = vs.angular_speed_rad_s - base.swing.angular_speed_rad_s;
+  }
   if (variant.center_of_percussion && base.center_of_percussion) {
     deltas["center_of_percussion_m"] = variant.center_of_percussion->position_from_knob_m -
                                        base.center_of_percussion->position_from_knob_m;

@@ -19,6 +19,7 @@
 #include "core/optimize/design_integrals.hpp"
 #include "core/scene/collide.hpp"
 #include "core/scene/resolved_scene.hpp"
+#include "core/scene/swing_speed.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 #include "core/units.hpp"
 
@@ -59,8 +60,8 @@ T DesignModel::AngularSpeedOf(const T* p) const {
   const T omega0 = SwingAngularSpeedAt(p[3]);
   if (objective_kind_ == DesignObjective::kMaxExitSpeedSwingWeight && jet::Value(omega0) > 0.0 &&
       swing_weight_exponent_ != 0.0) {
-    return omega0 *
-           jet::Pow(MoiAbout(p, c0_, kSixInchPivotM) * (1.0 / i6_ref_), -swing_weight_exponent_);
+    return omega0 * SwingWeightSpeedFactor(MoiAbout(p, c0_, kSixInchPivotM), i6_ref_,
+                                           swing_weight_exponent_);
   }
   return omega0;
 }
@@ -143,7 +144,7 @@ double DesignModel::AngularSpeedFor(double i6_kg_m2, double length_m) const {
       swing_weight_exponent_ == 0.0) {
     return omega0;
   }
-  return omega0 * std::pow(i6_kg_m2 / i6_ref_, -swing_weight_exponent_);
+  return omega0 * SwingWeightSpeedFactor(i6_kg_m2, i6_ref_, swing_weight_exponent_);
 }
 
 std::vector<double> DesignModel::BaseX() const {

@@ -308,7 +308,7 @@ class DesignModel {
   double pivot_from_knob_m_ = 0.0;
   double cor_ = 0.5;
   bool free_bat_ = false;  // the exit-speed model: free_bat (else rigid_pivot)
-  double swing_weight_exponent_ = 0.27;
+  double swing_weight_exponent_ = kSwingWeightExponent;
   double zone_tolerance_mps_ = 1.0;
   double i6_ref_ = 1.0;
   // min_sting: the scene of the flexible impact and a per-solve cache of modes (shared by the

@@ -20,10 +20,21 @@ bool ModelBuilder::CheckScene() {
     return Refuse(why, TextRefusal("objective", "not a known objective"));
   }
   if (!problem.ball.Validate(why) || !problem.swing.Validate(why)) return false;
+  // The scenes' swing settings the optimiser does not take (its swing weight is the objective
+  // max_exit_speed_swing_weight's): refused, not ignored.
+  if (problem.swing.bat_speed_point != BatSpeedPoint::kFromTip) {
+    return Refuse(why, QuotedRefusal("swing.bat_speed_from_tip_m", "sweet_spot",
+                                     "is not taken by the optimiser: give a distance"));
+  }
+  if (problem.swing.speed_model != SwingSpeedModel::kFixed) {
+    return Refuse(why, QuotedRefusal("swing.speed_model", "swing_weight",
+                                     "is not taken by the optimiser: use objective "
+                                     "max_exit_speed_swing_weight"));
+  }
   if (!(std::isfinite(problem.swing_weight_exponent) && problem.swing_weight_exponent >= 0.0 &&
-        problem.swing_weight_exponent <= 0.5)) {
+        problem.swing_weight_exponent <= kMaxSwingWeightExponent)) {
     return Refuse(why, "swing_weight_exponent", problem.swing_weight_exponent,
-                  "must be in [0, 0.5]");
+                  "must be in [0, " + FormatNumber(kMaxSwingWeightExponent) + "]");
   }
   if (problem.swing_weight_reference_kg_m2.has_value()) {
     if (problem.objective != DesignObjective::kMaxExitSpeedSwingWeight) {

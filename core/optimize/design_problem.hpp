@@ -192,10 +192,11 @@ struct DesignProblem {
   std::vector<DesignVariable> variables;                       ///< 1 to 200 distinct variables.
   DesignConstraints constraints;                               ///< What must hold.
   DesignObjective objective = DesignObjective::kMaxExitSpeed;  ///< What to improve.
-  /// kMaxExitSpeedSwingWeight: n in omega = omega0 (I6 / I6_ref)^-n, in [0, 0.5]; I6_ref is
+  /// kMaxExitSpeedSwingWeight: n in omega = omega0 (I6 / I6_ref)^-n (SwingWeightSpeedFactor,
+  /// core/scene/swing_speed.hpp: Cross & Bower 2006), in [0, kMaxSwingWeightExponent]; I6_ref is
   /// swing_weight_reference_kg_m2 when set, else the base design's MOI about the 6-in point (so
   /// the base design swings at omega0).
-  double swing_weight_exponent = 0.27;
+  double swing_weight_exponent = kSwingWeightExponent;
   /// kMaxExitSpeedSwingWeight: I6_ref, the MOI about the 6-in point that swings at omega0,
   /// kg·m², in (0, kMaxDesignMoiKgM2]; unset = the base design's. Refused with any other
   /// objective (it would have no effect).

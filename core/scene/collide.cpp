@@ -34,7 +34,7 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
     ResolvedScene r;
     // A ball's COR law is evaluated at this impact's own normal speed.
     const bool resolved =
-        ResolveScene(scene, /*needs_cor=*/true, &book, &r, &s, impact_from_knob_m);
+        ResolveScene(scene, /*needs_cor=*/true, &book, &r, &s, impact_from_knob_m, model);
     // Also when refused: the caller can then tell properties that are not usable (the bat's).
     out.mass_properties = r.mass_properties;
     if (!resolved) return;

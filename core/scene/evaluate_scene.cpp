@@ -9,6 +9,7 @@
 #include "core/scene/output_registry.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/scene/scene_models.hpp"
+#include "core/scene/sweet_spot_swing.hpp"
 
 namespace sweetspot::core {
 namespace evaluate_scene {
@@ -97,9 +98,10 @@ void SceneResult::Reset() {
   // A field added to SceneResult must be reset here too: on x86-64 (the size this list was
   // written for) the size check says so. The outputs' slots are reset by their declarations.
   // A new slot can move this difference too (the base's tail padding: 600 -> 608 with
-  // batted_ball's slot, SceneResult's own fields unchanged).
+  // batted_ball's slot, SceneResult's own fields unchanged). 608 -> 752: Swing gained the
+  // speed model's settings and its resolution (reset with `swing` below).
 #if defined(__x86_64__)
-  static_assert(sizeof(SceneResult) - sizeof(SceneOutputResults) == 608,
+  static_assert(sizeof(SceneResult) - sizeof(SceneOutputResults) == 752,
                 "SceneResult gained a field: reset it in Reset");
 #endif
   summary.Reset();
@@ -173,7 +175,7 @@ void SceneEvaluator::EvaluateOutputs(const Scene& scene, SceneResult* out_ptr) {
   const bool flexible_exit = needs_exit && options.model == CollisionModel::kFlexible;
   if (!scene.bat.has_value() && RefuseMissingGeometry(run, flexible_exit, &out)) return;
   ResolvedScene r;
-  const bool resolved = ResolveScene(scene, needs_cor, &book_, &r, &s);
+  const bool resolved = ResolveScene(scene, needs_cor, &book_, &r, &s, std::nullopt, options.model);
   // Also when refused: the caller can then tell properties that are not usable (the bat's).
   out.mass_properties = r.mass_properties;
   if (!resolved) return;
@@ -193,9 +195,11 @@ void SceneEvaluator::EvaluateOutputs(const Scene& scene, SceneResult* out_ptr) {
 
   FlexibleModes flexible_modes(scene, options.flexible, &book_);
   std::optional<ExitSpeedModel> exit_model;
+  std::shared_ptr<const BatModes> impact_modes;  // flexible: the exit model's modes
   if (needs_exit) {
     if (model == CollisionModel::kFlexible) {
       const auto& modes = flexible_modes.Impact();
+      impact_modes = modes;
       if (FlexibleModesRefused(*modes, &s)) {
         if (s.termination == Termination::kInvalidInput) out.refused_field = "bat";
         return;
@@ -209,6 +213,16 @@ void SceneEvaluator::EvaluateOutputs(const Scene& scene, SceneResult* out_ptr) {
     context.exit_model = &*exit_model;
     context.closed_form =
         exit_model->profile().has_value() && options.method == SweetSpotMethod::kClosedForm;
+    // A swing at its sweet spot with hertz or flexible: the point moved to the model's own
+    // maximum (the swing and a ball-law COR re-resolved).
+    if (!SolveSweetSpotSwing(scene, options, model, needs_cor, &book_, impact_modes, &r,
+                             &exit_model, &s)) {
+      return;
+    }
+    out.cor = r.cor;
+    out.cor_source = r.cor_source;
+    out.cor_impact_speed_mps = r.cor_impact_speed_mps;
+    out.swing = r.swing;
   }
   for (const SceneOutputDecl* d : SceneOutputTable()) {
     if (!run[static_cast<std::size_t>(d->id)]) continue;

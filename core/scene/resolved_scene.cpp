@@ -17,8 +17,103 @@ bool BallCorApplies(const Scene& scene) {
   return scene.bat->wall_thickness_m <= 0.0 || !scene.bat->material.cor.has_value();
 }
 
+namespace resolved_scene {
+namespace {
+
+// The refusal of `field` = `value` as the scene writes it (17 significant digits).
+bool Refuse17(Refusal* out, std::string_view field, double value, std::string_view rule) {
+  return out == nullptr ? false : Refuse(out, Number17Refusal(field, value, rule));
+}
+
+// The angular speed at which the max-exit-speed point of `profile` (its own omega ignored) moves
+// at `v` m/s about `pivot`, rad/s, on the unbounded bat. With d = origin - pivot, K = J / m and
+// the approach speed w = u + omega d, the maximiser is x* = (-w + sqrt(w^2 + omega^2 K)) / omega
+// (ExitSpeedProfile::Maximum), so omega (d + x*) = -u + sqrt((u + omega d)^2 + omega^2 K) = v
+// is the quadratic (d^2 + K) omega^2 + 2 u d omega - v (v + 2u) = 0, whose positive root is
+// taken in the form that does not cancel. Exact: the COR (the gain) does not enter.
+double SweetSpotAngularSpeed(const ExitSpeedProfile& profile, double pivot, double v) {
+  const double u = profile.ball_speed_mps;
+  const double d = profile.origin_from_knob_m - pivot;
+  const double a = d * d + profile.inertia_kg_m2 / profile.ball_mass_kg;
+  const double c = v * (v + 2.0 * u);
+  const double ud = u * d;
+  const double root = std::sqrt(ud * ud + a * c);
+  return ud >= 0.0 ? c / (ud + root) : (root - ud) / a;
+}
+
+}  // namespace
+}  // namespace resolved_scene
+
+bool ResolveSceneSwing(const Ball& ball, const Swing& swing, const MassProperties& mp,
+                       double length_m, CollisionModel point_model, Swing* resolved,
+                       Refusal* refusal) {
+  using resolved_scene::Refuse17;
+  if (!swing.bat_speed_mps.has_value()) return ResolveSwing(swing, length_m, resolved, refusal);
+  SwingResolution how;
+  how.given_bat_speed_mps = *swing.bat_speed_mps;
+  how.moi_hands_kg_m2 = mp.MoiAboutKgM2(swing.hands_from_knob_m);
+  if (swing.speed_model == SwingSpeedModel::kSwingWeight) {
+    how.reference_moi_kg_m2 = swing.reference_moi_kg_m2.value_or(kSwingWeightReferenceMoiKgM2);
+    if (!(how.moi_hands_kg_m2 > 0.0)) {
+      return Refuse17(refusal, "swing.hands_from_knob_m", swing.hands_from_knob_m,
+                      "swing.speed_model = swing_weight needs the bat's MOI about the hands > 0 "
+                      "(it is " + FormatNumber17(how.moi_hands_kg_m2) + " kg·m²)");
+    }
+    how.swing_weight_factor = SwingWeightSpeedFactor(how.moi_hands_kg_m2, how.reference_moi_kg_m2,
+                                                     swing.swing_weight_exponent);
+  }
+  const double v = how.given_bat_speed_mps * how.swing_weight_factor;
+  how.bat_speed_mps = v;
+  Swing at_point = swing;
+  at_point.bat_speed_mps = v;
+  if (swing.bat_speed_point == BatSpeedPoint::kSweetSpot) {
+    // The closed form's max-exit-speed point at the angular speed that point moves at v:
+    // exact (SweetSpotAngularSpeed); when that point is off the bat, the end the maximum on the
+    // bat lies at, the speed given there.
+    how.point_model = CollisionModelName(point_model);
+    const double pivot = swing.pivot_from_knob_m;
+    ExitSpeedProfile profile = ClosedFormProfileFor(point_model, mp, ball, swing, /*cor=*/0.0);
+    double omega = v > 0.0 ? resolved_scene::SweetSpotAngularSpeed(profile, pivot, v) : 0.0;
+    double x = pivot + (omega > 0.0 ? v / omega : 0.0);
+    profile.angular_speed_rad_s = omega;
+    profile.approach_mps = profile.ball_speed_mps + omega * (profile.origin_from_knob_m - pivot);
+    ClosedFormMaximum mx = ClosedFormMaximumOnBat(profile, length_m);
+    if (v > 0.0 && mx.placement != Placement::kOnBat) {
+      x = mx.position_from_knob_m;  // an end of the bat
+      if (!(x - pivot > 0.0)) {
+        return Refuse17(refusal, "swing.pivot_from_knob_m", pivot,
+                        "the max-exit-speed point for swing.bat_speed_from_tip_m = sweet_spot "
+                        "(an end of the bat, " + FormatNumber17(x) +
+                            " m from the knob) must lie beyond the pivot");
+      }
+      omega = v / (x - pivot);
+    } else if (v > 0.0) {
+      x = std::clamp(x, 0.0, length_m);
+    } else {
+      x = mx.position_from_knob_m;  // no bat speed: the profile's own maximum
+    }
+    at_point.bat_speed_from_tip_m = std::max(0.0, length_m - x);
+    if (!(omega <= kMaxSwingAngularSpeedRadS)) {
+      return Refuse17(refusal, "swing.bat_speed_mps", *swing.bat_speed_mps,
+                      "gives angular_speed_rad_s = " + FormatNumber17(omega) + " over " +
+                          FormatNumber17(kMaxSwingAngularSpeedRadS) +
+                          " at the sweet spot (" + FormatNumber17(x) + " m from the knob)");
+    }
+    *resolved = at_point;
+    resolved->angular_speed_rad_s = omega;
+    how.position_from_knob_m = x;
+  } else {
+    if (!ResolveSwing(at_point, length_m, resolved, refusal)) return false;
+    how.position_from_knob_m = length_m - swing.bat_speed_from_tip_m;
+  }
+  how.from_tip_m = resolved->bat_speed_from_tip_m;
+  resolved->resolution = std::move(how);
+  return true;
+}
+
 bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, ResolvedScene* r,
-                  Summary* s, std::optional<double> cor_impact_from_knob_m) {
+                  Summary* s, std::optional<double> cor_impact_from_knob_m,
+                  CollisionModel exit_model) {
   if (Refusal refusal; !scene.Validate(&refusal)) {
     s->SetRefusal(std::move(refusal));
     return false;
@@ -91,7 +186,16 @@ bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, Resolved
                         "must be within the bat [0, " + FormatNumber17(r->length_m) + "]"));
     return false;
   }
-  if (Refusal refusal; !ResolveSwing(scene.swing, r->length_m, &r->swing, &refusal)) {
+  // The bat-speed point "sweet_spot" is a closed form's maximum: the exit model's, or for the
+  // ODE models (hertz, flexible) free_bat's (EvaluateScene then iterates to the model's own:
+  // SolveSweetSpotSwing; the resolution's point_model says which).
+  std::string reason;
+  CollisionModel point_model = ResolveExitModel(exit_model, scene, &reason);
+  if (point_model != CollisionModel::kRigidPivot && point_model != CollisionModel::kFreeBat) {
+    point_model = CollisionModel::kFreeBat;
+  }
+  if (Refusal refusal; !ResolveSceneSwing(scene.ball, scene.swing, r->mass_properties, r->length_m,
+                                          point_model, &r->swing, &refusal)) {
     s->SetRefusal(std::move(refusal));
     return false;
   }

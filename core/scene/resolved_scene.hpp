@@ -57,8 +57,26 @@ bool BallCorApplies(const Scene& scene);
 /// the barrel model (EffectiveCorAt, default BarrelOptions) at the same point and speed
 /// ("barrel:<ball>"); else the bat material's. False with the
 /// termination and message in *summary otherwise. Never throws.
+/// `exit_model` is the model the answer's exit speeds come from (kAuto: ResolveExitModel's
+/// choice): a swing given at its "sweet_spot" is solved at that model's closed-form maximum
+/// (free_bat's for hertz and flexible, with a warning).
 bool ResolveScene(const Scene& scene, bool needs_cor, TimingBook* book, ResolvedScene* resolved,
-                  Summary* summary, std::optional<double> cor_impact_from_knob_m = std::nullopt);
+                  Summary* summary, std::optional<double> cor_impact_from_knob_m = std::nullopt,
+                  CollisionModel exit_model = CollisionModel::kAuto);
+
+/// `swing` resolved for a bat with `mass_properties`, `length_m` long, hit by `ball`, into
+/// *resolved (`swing` must be valid). Without a bat speed: ResolveSwing. With one, v = the given
+/// speed times SwingWeightSpeedFactor(MOI about the hands, reference, n) when speed_model is
+/// kSwingWeight (else 1); then at bat_speed_point kFromTip ResolveSwing at v, and at kSweetSpot
+/// the angular speed at which the max-exit-speed point of `point_model`'s closed form
+/// (kRigidPivot or kFreeBat) moves at v: solved exactly (the quadratic in docs/models.md, "Bat
+/// speed"; the COR does not move that point), or, when the maximum on the bat is an end of it,
+/// v at that end. resolved->resolution says how; bat_speed_mps and bat_speed_from_tip_m become
+/// this bat's speed and point. False with the refusal (ResolveSwing's, or the sweet spot's)
+/// otherwise.
+bool ResolveSceneSwing(const Ball& ball, const Swing& swing, const MassProperties& mass_properties,
+                       double length_m, CollisionModel point_model, Swing* resolved,
+                       Refusal* refusal);
 
 /// The rigid-pivot inputs of a bat with `mass_properties` hit by `ball` in `swing` with `cor`.
 RigidPivotInputs RigidPivotInputsFor(const MassProperties& mass_properties, const Ball& ball,

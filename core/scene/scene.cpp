@@ -64,7 +64,60 @@ bool Swing::Validate(Refusal* why) const {
          CheckRange(why, "swing.bat_speed_from_tip_m", bat_speed_from_tip_m, 0.0,
                     kMaxSwingOffsetM) &&
          CheckRange(why, "swing.attack_angle_deg", attack_angle_deg, -kMaxPathAngleDeg,
-                    kMaxPathAngleDeg);
+                    kMaxPathAngleDeg) &&
+         ValidateSpeedModel(why);
+}
+
+bool Swing::ValidateSpeedModel(Refusal* why) const {
+  if (reference_moi_kg_m2.has_value() &&
+      !(std::isfinite(*reference_moi_kg_m2) && *reference_moi_kg_m2 > 0.0 &&
+        *reference_moi_kg_m2 <= kMaxSwingMoiKgM2)) {
+    return Refuse17(why, "swing.reference_moi_kg_m2", *reference_moi_kg_m2,
+                    "must be in (0, " + FormatNumber(kMaxSwingMoiKgM2) + "]");
+  }
+  if (!CheckRange(why, "swing.swing_weight_exponent", swing_weight_exponent, 0.0,
+                  kMaxSwingWeightExponent)) {
+    return false;
+  }
+  if (bat_speed_point == BatSpeedPoint::kSweetSpot && !bat_speed_mps.has_value()) {
+    return why == nullptr ? false
+                          : Refuse(why, QuotedRefusal("swing.bat_speed_from_tip_m", "sweet_spot",
+                                                      "needs swing.bat_speed_mps (the speed "
+                                                      "measured at the sweet spot)"));
+  }
+  if (speed_model == SwingSpeedModel::kSwingWeight && !bat_speed_mps.has_value()) {
+    return why == nullptr ? false
+                          : Refuse(why, QuotedRefusal("swing.speed_model", "swing_weight",
+                                                      "needs swing.bat_speed_mps (the reference "
+                                                      "bat's speed)"));
+  }
+  if (speed_model != SwingSpeedModel::kSwingWeight) {
+    // Settings of the swing-weight model without it would have no effect.
+    if (reference_moi_kg_m2.has_value()) {
+      return Refuse17(why, "swing.reference_moi_kg_m2", *reference_moi_kg_m2,
+                      "applies only with swing.speed_model = swing_weight");
+    }
+    if (swing_weight_exponent != kSwingWeightExponent) {
+      return Refuse17(why, "swing.swing_weight_exponent", swing_weight_exponent,
+                      "applies only with swing.speed_model = swing_weight");
+    }
+  }
+  return true;
+}
+
+const char* BatSpeedPointName(BatSpeedPoint point) {
+  return point == BatSpeedPoint::kSweetSpot ? "sweet_spot" : "distance";
+}
+
+const char* SwingSpeedModelName(SwingSpeedModel model) {
+  return model == SwingSpeedModel::kSwingWeight ? "swing_weight" : "fixed";
+}
+
+std::optional<SwingSpeedModel> ParseSwingSpeedModel(std::string_view name) {
+  for (SwingSpeedModel m : {SwingSpeedModel::kFixed, SwingSpeedModel::kSwingWeight}) {
+    if (name == SwingSpeedModelName(m)) return m;
+  }
+  return std::nullopt;
 }
 
 bool Contact::Validate(Refusal* why) const {

@@ -23,6 +23,7 @@
 #include "core/progress.hpp"
 #include "core/refusal.hpp"
 #include "core/scene/output_id.hpp"
+#include "core/scene/swing_speed.hpp"
 #include "core/sweet_spot/numeric.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
@@ -50,6 +51,8 @@ inline constexpr double kMaxSwingAngularSpeedRadS = 1e4;
 inline constexpr double kMaxSwingOffsetM = 100.0;
 /// Largest bat speed (swing.bat_speed_mps) a scene accepts, m/s.
 inline constexpr double kMaxBatSpeedMps = 1e3;
+/// Largest reference swing weight (swing.reference_moi_kg_m2) a scene accepts, kg·m².
+inline constexpr double kMaxSwingMoiKgM2 = 1e4;
 /// Largest |angle| of a path (swing.attack_angle_deg, ball.descent_angle_deg), deg: the
 /// oblique impact's own bound (ObliqueImpactInputs).
 inline constexpr double kMaxPathAngleDeg = 89.0;
@@ -92,6 +95,42 @@ void ApplyBallPreset(const BallPreset& preset, Ball* ball);
 /// from the tip, the standard bat-speed point, near every model's sweet spot.
 inline constexpr double kCorReferenceFromTipM = 0.1524;
 
+/// Where swing.bat_speed_mps is measured.
+enum class BatSpeedPoint {
+  kFromTip,    ///< "distance": swing.bat_speed_from_tip_m from the tip (default 6 in).
+  kSweetSpot,  ///< "sweet_spot": the bat's own max-exit-speed point, solved with the swing.
+};
+/// How the bat speed depends on the bat.
+enum class SwingSpeedModel {
+  kFixed,        ///< "fixed": every bat at the given speed (default).
+  kSwingWeight,  ///< "swing_weight": the given speed is the reference bat's (swing_speed.hpp).
+};
+/// Stable names (quoted above).
+const char* BatSpeedPointName(BatSpeedPoint point);
+const char* SwingSpeedModelName(SwingSpeedModel model);
+/// The speed model called `name`, or nullopt.
+std::optional<SwingSpeedModel> ParseSwingSpeedModel(std::string_view name);
+
+/// How a swing given by its bat speed was resolved for one bat (ResolveSceneSwing).
+struct SwingResolution {
+  double given_bat_speed_mps = 0.0;  ///< The request's bat speed (the reference bat's), m/s.
+  /// This bat's speed at its bat-speed point, m/s: the given one times swing_weight_factor.
+  double bat_speed_mps = 0.0;
+  double position_from_knob_m = 0.0;  ///< The bat-speed point, m from the knob.
+  double from_tip_m = 0.0;            ///< The same, m from the tip.
+  /// kSweetSpot: the closed form whose max-exit-speed point it is ("rigid_pivot" or
+  /// "free_bat"); "" for kFromTip.
+  std::string point_model;
+  double moi_hands_kg_m2 = 0.0;      ///< The bat's MOI about the hands, kg·m².
+  double reference_moi_kg_m2 = 0.0;  ///< kSwingWeight: the reference swing weight, kg·m².
+  double swing_weight_factor = 1.0;  ///< (moi_hands / reference)^-n; 1 for kFixed.
+  /// kSweetSpot with hertz or flexible: the fixed-point iterations to the model's own maximum
+  /// (SolveSweetSpotSwing); 0 for a closed form (solved exactly).
+  int iterations = 0;
+  /// ... and the speed at that maximum minus bat_speed_mps when they stopped, m/s.
+  double speed_error_mps = 0.0;
+};
+
 /// The swing just before impact. Defaults: the paper's Table 3 and the standard grip.
 struct Swing {
   /// Angular speed about the pivot, rad/s, in [0, kMaxSwingAngularSpeedRadS].
@@ -106,12 +145,30 @@ struct Swing {
   /// Where bat_speed_mps is measured, m from the tip (the barrel end), in [0, kMaxSwingOffsetM];
   /// the default is 6 in, as swing sensors report.
   double bat_speed_from_tip_m = kCorReferenceFromTipM;
+  /// Where bat_speed_mps is measured: bat_speed_from_tip_m, or the bat's own max-exit-speed
+  /// point ("sweet_spot"; needs bat_speed_mps).
+  BatSpeedPoint bat_speed_point = BatSpeedPoint::kFromTip;
+  /// kSwingWeight (needs bat_speed_mps): bat_speed_mps is the speed of a bat whose MOI about
+  /// the hands is reference_moi_kg_m2, and each bat is swung at bat_speed_mps (I_hands /
+  /// reference)^-swing_weight_exponent (core/scene/swing_speed.hpp, Cross & Bower 2006).
+  SwingSpeedModel speed_model = SwingSpeedModel::kFixed;
+  /// kSwingWeight: the reference bat's MOI about the hands, kg·m², in (0, kMaxSwingMoiKgM2];
+  /// unset = kSwingWeightReferenceMoiKgM2 (wood-34-ash about the 6-in point).
+  std::optional<double> reference_moi_kg_m2;
+  /// kSwingWeight: n in V = C / I^n, in [0, kMaxSwingWeightExponent] (default Cross & Bower's).
+  double swing_weight_exponent = kSwingWeightExponent;
   /// The bat's path above horizontal, deg (+ up), within +-kMaxPathAngleDeg; batted_ball only.
   double attack_angle_deg = 0.0;
+  /// Set on a resolved swing given by its bat speed (ResolveSceneSwing): how it was resolved.
+  std::optional<SwingResolution> resolution;
 
   /// True when every field is finite and in range; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "swing.field = value: rule".
   bool Validate(Refusal* refusal) const;
+  /// Validate's rules for bat_speed_point, speed_model, reference_moi_kg_m2 and
+  /// swing_weight_exponent: each new setting needs bat_speed_mps, and the swing-weight settings
+  /// need speed_model kSwingWeight (they would have no effect).
+  bool ValidateSpeedModel(Refusal* refusal) const;
 };
 
 /// `swing` for a bat `length_m` long, into *resolved: a copy, with angular_speed_rad_s set from

@@ -108,7 +108,7 @@ bool IsBatSpeedField(const Field& field) {
 // accessor; bound by the sweep's binder to the same scene the parser gives; and, when a
 // variable, named by core's variable path in every form.
 TEST(FieldsTest, EveryFieldRoundTripsThroughParserBinderAndOptimizeVariable) {
-  ASSERT_EQ(Fields().size(), 31u);
+  ASSERT_EQ(Fields().size(), 33u);
   for (const Field& field : Fields()) {
     SCOPED_TRACE(std::string(field.path));
     const Json base = Template(IsProfileField(field), IsBatSpeedField(field));
@@ -196,6 +196,8 @@ TEST(FieldsTest, EveryFieldRoundTripsThroughParserBinderAndOptimizeVariable) {
       EXPECT_EQ(bound.swing.hands_from_knob_m, parsed->scene.swing.hands_from_knob_m);
       EXPECT_EQ(bound.swing.bat_speed_mps, parsed->scene.swing.bat_speed_mps);
       EXPECT_EQ(bound.swing.bat_speed_from_tip_m, parsed->scene.swing.bat_speed_from_tip_m);
+      EXPECT_EQ(bound.swing.reference_moi_kg_m2, parsed->scene.swing.reference_moi_kg_m2);
+      EXPECT_EQ(bound.swing.swing_weight_exponent, parsed->scene.swing.swing_weight_exponent);
       EXPECT_EQ(bound.cor, parsed->scene.cor);
     }
 

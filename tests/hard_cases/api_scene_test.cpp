@@ -94,6 +94,32 @@ std::vector<ApiCase> SweetSpotCases() {
           Between("/sweet_zone/to_knob_m", 0, 0.855)}),
       Refusal("SwingAbove1e4", p, Paper(R"(, "swing": {"angular_speed_rad_s": 1e5})"), 400,
               "InvalidValue", "swing.angular_speed_rad_s"),
+      // The bat speed at the sweet spot (issue 35): no speed gives omega 0; the largest speed a
+      // finite omega; a pivot beyond the tip has no point beyond it (refused, not NaN).
+      Ok("SweetSpotZeroBatSpeed", p,
+         Paper(R"(, "swing": {"bat_speed_mps": 0, "bat_speed_from_tip_m": "sweet_spot"})"),
+         {Near("/swing/angular_speed_rad_s", 0, 0),
+          Between("/max_exit_speed/position_from_knob_m", 0, 0.855)}),
+      Ok("SweetSpotLargestBatSpeed", p,
+         Paper(R"(, "swing": {"bat_speed_mps": 1000, "bat_speed_from_tip_m": "sweet_spot"},
+                  "outputs": ["max_exit_speed", "sweet_zone"])"),
+         {Between("/swing/angular_speed_rad_s", 1000, 1e4),
+          Between("/max_exit_speed/position_from_knob_m", 0, 0.855)}),
+      Refusal("SweetSpotPivotBeyondTheTip", p,
+              Paper(R"(, "swing": {"bat_speed_mps": 30, "bat_speed_from_tip_m": "sweet_spot",
+                       "pivot_from_knob_m": 100})"),
+              400, "InvalidValue", "swing.pivot_from_knob_m"),
+      // The swing-weight law at its extremes: a reference of 1e-300 kg m^2 swings the bat at
+      // ~1e-80 of the given speed (finite); the largest reference and exponent give 200 times the
+      // speed, over the omega limit: refused on the bat speed.
+      Ok("SwingWeightTinyReference", p,
+         Paper(R"(, "swing": {"bat_speed_mps": 30, "speed_model": "swing_weight",
+                  "reference_moi_kg_m2": 1e-300})"),
+         {Between("/swing/bat_speed_mps", 0, 1e-70)}),
+      Refusal("SwingWeightOverTheOmegaLimit", p,
+              Paper(R"(, "swing": {"bat_speed_mps": 1000, "speed_model": "swing_weight",
+                       "reference_moi_kg_m2": 1e4, "swing_weight_exponent": 0.5})"),
+              400, "InvalidValue", "swing.bat_speed_mps"),
       // NLopt on flat objectives (the core table runs every algorithm).
       Ok("GnAgsOnNoMotion", p,
          Paper(R"(, "ball": {"speed_mps": 0}, "swing": {"angular_speed_rad_s": 0},
