@@ -165,6 +165,7 @@ bool BattedBallModel::Evaluate(double x, double undercut_m, BattedBallResult* ou
       return j;
     };
   }
+  // (A closed form's model is listed by its caller: max_exit_speed, Collide.)
   const auto ti = book_ != nullptr ? book_->Now() : std::chrono::steady_clock::time_point{};
   out->impact = SolveObliqueImpact(in);
   if (book_ != nullptr) book_->Add("oblique_impact", book_->Since(ti), 1);
@@ -309,6 +310,8 @@ double BattedBallModel::CarryAt(double x, double undercut_m,
       return (1.0 + e) * v_n / inv_reduced;
     };
   }
+  // A closed form's normal part is computed inside the oblique impact: listed, not timed.
+  if (!integrated_ && book_ != nullptr) book_->Add(CollisionModelName(model_), 0.0, 1);
   const auto ti = book_ != nullptr ? book_->Now() : std::chrono::steady_clock::time_point{};
   ObliqueImpactResult impact = SolveObliqueImpact(in);
   if (book_ != nullptr) book_->Add("oblique_impact", book_->Since(ti), 1);

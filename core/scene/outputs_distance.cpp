@@ -74,7 +74,7 @@ extern const SceneOutputDecl kDistanceSweetSpotOutput{
     OutputModes::kNone,
     "",
     /*needs_output=*/SceneOutput::kDistanceSweetSpot,
-    OutputWorkload::kAsExitModel,
+    OutputWorkload::kCompute,  // hundreds of flights (and, hertz/flexible, a table of impacts)
     outputs_distance::ComputeDistanceSweetSpot,
     SlotPresent<&SceneOutputResults::distance_sweet_spot>,
     ResetSlot<&SceneOutputResults::distance_sweet_spot>,
@@ -91,7 +91,7 @@ extern const SceneOutputDecl kCarryMapOutput{
     OutputModes::kNone,
     "",
     /*needs_output=*/SceneOutput::kCarryMap,
-    OutputWorkload::kAsExitModel,
+    OutputWorkload::kCompute,  // hundreds of flights (and, hertz/flexible, a table of impacts)
     outputs_distance::ComputeCarryMap,
     SlotPresent<&SceneOutputResults::carry_map>,
     ResetSlot<&SceneOutputResults::carry_map>,
