@@ -231,6 +231,39 @@ TEST(BattedBallApiTest, ExploreSweepsTheUndercut) {
   }
 }
 
+TEST(BattedBallApiTest, ExploreColumnsOfTheBattedBallOutputs) {
+  nlohmann::json body = nlohmann::json::parse(
+      R"({"bat": {"preset": "wood-34-ash"}, "ball": {"speed_mph": 90, "descent_angle_deg": 6},
+          "swing": {"bat_speed_mph": 70, "attack_angle_deg": 10},
+          "contact": {"undercut_in": 0.5}, "options": {"model": "free_bat"},
+          "outputs": ["batted_ball", "distance_sweet_spot"],
+          "parameters": [{"path": "swing.attack_angle_deg", "min": 5, "max": 15, "count": 3}]})");
+  const Response full = Dispatch({"POST", "/v1/explore", body.dump()}, Context{});
+  ASSERT_EQ(full.status, 200) << full.body.dump();
+  body["columns"] = {"batted_ball.distance_m", "batted_ball.launch_angle_deg",
+                     "distance_sweet_spot.position_from_knob_m", "distance_sweet_spot.undercut_in",
+                     "distance_sweet_spot.search.evaluations"};
+  const Response cols = Dispatch({"POST", "/v1/explore", body.dump()}, Context{});
+  ASSERT_EQ(cols.status, 200) << cols.body.dump();
+  ASSERT_EQ(cols.body["rows"].size(), 3u);
+  double previous_launch = -90.0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& row = full.body["rows"][i];
+    const auto& flat = cols.body["rows"][i];
+    EXPECT_EQ(flat["batted_ball.distance_m"], row["batted_ball"]["distance_m"]) << i;
+    EXPECT_EQ(flat["distance_sweet_spot.position_from_knob_m"],
+              row["distance_sweet_spot"]["position_from_knob_m"])
+        << i;
+    EXPECT_NEAR(flat["distance_sweet_spot.undercut_in"].get<double>(),
+                row["distance_sweet_spot"]["undercut_m"].get<double>() / 0.0254, 1e-12);
+    EXPECT_EQ(flat["distance_sweet_spot.search.evaluations"],
+              row["distance_sweet_spot"]["search"]["evaluations"]);
+    // A steeper swing launches the same contact higher.
+    EXPECT_GT(flat["batted_ball.launch_angle_deg"].get<double>(), previous_launch) << i;
+    previous_launch = flat["batted_ball.launch_angle_deg"].get<double>();
+  }
+}
+
 }  // namespace
 }  // namespace batted_ball_api_test
 }  // namespace sweetspot::api
