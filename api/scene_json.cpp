@@ -203,8 +203,8 @@ bool ReadHertzOptions(const Json& value, const std::string& path, const ApiLimit
   return reader.Finish();
 }
 
-bool ReadDistanceOptions(const Json& value, const std::string& path,
-                         core::DistanceOptions* options, ApiError* error) {
+bool ReadDistanceOptions(const Json& value, const std::string& path, core::DistanceOptions* options,
+                         ApiError* error) {
   // Ranges are core's (DistanceOptions::Validate, named "distance.<field>"), checked with the
   // options.
   ObjectReader reader(value, path, error);

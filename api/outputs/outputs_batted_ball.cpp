@@ -87,8 +87,8 @@ const DirectField kBattedBallFields[] = {
 
 namespace obb = outputs_batted_ball_api;
 
-extern const ApiOutputDecl kBattedBallApi{
-    core::SceneOutput::kBattedBall, obb::RenderBattedBall, obb::ProbeBattedBall,
-    std::begin(obb::kBattedBallFields), std::end(obb::kBattedBallFields)};
+extern const ApiOutputDecl kBattedBallApi{core::SceneOutput::kBattedBall, obb::RenderBattedBall,
+                                          obb::ProbeBattedBall, std::begin(obb::kBattedBallFields),
+                                          std::end(obb::kBattedBallFields)};
 
 }  // namespace sweetspot::api

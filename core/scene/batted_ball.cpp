@@ -47,7 +47,6 @@ bool IsDefault(const flight::Environment& e) {
          e.wind.speed_mps == d.wind.speed_mps && e.wind.direction_deg == d.wind.direction_deg;
 }
 
-
 }  // namespace
 }  // namespace batted_ball
 
@@ -117,10 +116,12 @@ bool BattedBallModel::ModelImpulse(double x, double v_n, double* j_n, std::strin
     if (fast) solver.refine_check = false;
     const HertzImpact hi = SolveHertzImpact(p, solver);
     ok = hi.summary.IsSolutionUsable();
-    if (ok) *j_n = hi.ball_impulse_n_s;
-    else if (failure != nullptr)
+    if (ok) {
+      *j_n = hi.ball_impulse_n_s;
+    } else if (failure != nullptr) {
       *failure = "hertz at " + FormatNumber17(x) + " m from the knob, normal approach speed " +
                  FormatNumber17(v_n) + " m/s: " + hi.summary.message;
+    }
   } else if (modes_ != nullptr && scene_.bat.has_value()) {
     FlexibleImpactInputs in = FlexibleImpactInputsFor(scene_, r_, x, hertz_);
     in.approach_speed_mps = v_n;
@@ -131,10 +132,12 @@ bool BattedBallModel::ModelImpulse(double x, double v_n, double* j_n, std::strin
     }
     const FlexibleImpactResult fr = SolveFlexibleImpact(*scene_.bat, *modes_, in, o);
     ok = fr.summary.IsSolutionUsable();
-    if (ok) *j_n = fr.ball_impulse_n_s;
-    else if (failure != nullptr)
+    if (ok) {
+      *j_n = fr.ball_impulse_n_s;
+    } else if (failure != nullptr) {
       *failure = "flexible at " + FormatNumber17(x) + " m from the knob, normal approach speed " +
                  FormatNumber17(v_n) + " m/s: " + fr.summary.message;
+    }
   } else if (failure != nullptr) {
     *failure = "flexible: no modes (internal error)";
   }
@@ -142,9 +145,8 @@ bool BattedBallModel::ModelImpulse(double x, double v_n, double* j_n, std::strin
   return ok;
 }
 
-bool BattedBallModel::Evaluate(double x, double undercut_m, BattedBallResult* out,
-                               Refusal* refusal, std::string* failure,
-                               const flight::FlightOptions& flight_options) {
+bool BattedBallModel::Evaluate(double x, double undercut_m, BattedBallResult* out, Refusal* refusal,
+                               std::string* failure, const flight::FlightOptions& flight_options) {
   using namespace batted_ball;
   *out = BattedBallResult{};
   ObliqueImpactInputs in = InputsAt(x, undercut_m);
@@ -182,8 +184,7 @@ bool BattedBallModel::Evaluate(double x, double undercut_m, BattedBallResult* ou
   }
   if (integrated_) out->normal_cor = out->impact.normal_cor;
   const auto tf = book_ != nullptr ? book_->Now() : std::chrono::steady_clock::time_point{};
-  out->flight =
-      flight::Fly(LaunchOf(out->impact), scene_.environment, scene_.aero, flight_options);
+  out->flight = flight::Fly(LaunchOf(out->impact), scene_.environment, scene_.aero, flight_options);
   if (book_ != nullptr) book_->Add("flight", book_->Since(tf), 1);
   if (!out->flight.Landed()) {
     if (failure != nullptr) {
@@ -219,8 +220,8 @@ bool BattedBallModel::TabulateNormalLaw(double x_lo, double x_hi, int positions,
     const double w = std::hypot(wx, wy);
     const double reach = scene_.ball.radius_m + in.bat_radius_m;
     const double d_far = std::min(std::max(std::abs(d_lo), std::abs(d_hi)), kGrazeFraction * reach);
-    const double d_near = (d_lo <= 0.0 && d_hi >= 0.0) ? 0.0
-                          : std::min(std::abs(d_lo), std::abs(d_hi));
+    const double d_near =
+        (d_lo <= 0.0 && d_hi >= 0.0) ? 0.0 : std::min(std::abs(d_lo), std::abs(d_hi));
     const auto cos_of = [reach](double d) {
       const double s = std::min(1.0, d / reach);
       return std::sqrt((1.0 - s) * (1.0 + s));
@@ -284,8 +285,7 @@ double BattedBallModel::TableCor(double x, double v_n) const {
   // shifted inward at the ends): Lagrange on the uniform grid, in grid units.
   const double u = (x - table_x0_) / table_dx_;
   const int window = std::min(4, table_positions_);
-  const int first =
-      std::clamp(static_cast<int>(std::floor(u)) - 1, 0, table_positions_ - window);
+  const int first = std::clamp(static_cast<int>(std::floor(u)) - 1, 0, table_positions_ - window);
   double value = 0.0;
   for (int a = 0; a < window; ++a) {
     double basis = 1.0;
@@ -505,8 +505,8 @@ DistanceSweetSpotResult DistanceSweetSpot(BattedBallModel& model, double length_
     out.backspin_rpm = out.ball.impact.backspin_rpm;
     out.normal_table_error_m = model.integrated() ? out.distance_m - table_carry : 0.0;
     const double reach = model.UndercutReachAtM(x);
-    out.at_position_bound = x - lo <= options.position_tolerance_m ||
-                            hi - x <= options.position_tolerance_m;
+    out.at_position_bound =
+        x - lo <= options.position_tolerance_m || hi - x <= options.position_tolerance_m;
     out.at_undercut_bound = d - std::max(d_lo, -reach) <= options.undercut_tolerance_m ||
                             std::min(d_hi, reach) - d <= options.undercut_tolerance_m;
     s.evaluations = out.evaluations;
@@ -573,8 +573,9 @@ CarryMapResult CarryMap(BattedBallModel& model, double length_m, const DistanceO
     s.evaluations = np * nu;
     if (!(best > -kInf)) {
       s.termination = Termination::kFailure;
-      s.message = "carry_map: no point of the grid carries (every ball misses the bat, is "
-                  "driven back or does not land): widen options.distance's ranges";
+      s.message =
+          "carry_map: no point of the grid carries (every ball misses the bat, is "
+          "driven back or does not land): widen options.distance's ranges";
       return;
     }
     s.termination = Termination::kConverged;

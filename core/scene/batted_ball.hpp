@@ -50,19 +50,19 @@ inline constexpr double kGrazeFraction = 0.9;
 
 /// The batted ball at one impact point and undercut: the oblique impact, then its flight.
 struct BattedBallResult {
-  double impact_from_knob_m = 0.0;     ///< Where the bat met the ball, m from the knob.
-  double undercut_m = 0.0;             ///< The undercut, m (+ backspin).
+  double impact_from_knob_m = 0.0;       ///< Where the bat met the ball, m from the knob.
+  double undercut_m = 0.0;               ///< The undercut, m (+ backspin).
   double bat_speed_at_impact_mps = 0.0;  ///< The bat's axis speed there, m/s.
-  double bat_radius_m = 0.0;           ///< The bat's radius there (the default without a bat), m.
-  double bat_effective_mass_kg = 0.0;  ///< M_n of the normal model there, kg.
+  double bat_radius_m = 0.0;             ///< The bat's radius there (the default without a bat), m.
+  double bat_effective_mass_kg = 0.0;    ///< M_n of the normal model there, kg.
   double normal_cor = 0.0;  ///< e of the normal model: the scene's COR (closed forms), or the
                             ///< COR the ODE model's impulse implies at this v_n (hertz, flexible).
   /// hertz or flexible: the model whose own impulse gave the normal part; null for a closed form.
   const char* normal_model = nullptr;
   flight::AeroModel aero_model = flight::AeroModel::kNathan2016;  ///< The scene's aero model.
   bool default_environment = true;  ///< The scene's environment is the flight's default.
-  ObliqueImpactResult impact;   ///< The oblique impact (SolveObliqueImpact).
-  flight::FlightResult flight;  ///< Its flight (Fly, the scene's environment and aero).
+  ObliqueImpactResult impact;       ///< The oblique impact (SolveObliqueImpact).
+  flight::FlightResult flight;      ///< Its flight (Fly, the scene's environment and aero).
 };
 
 /// The batted ball of a resolved scene under one collision model, at any (x, D). Not
@@ -73,8 +73,8 @@ class BattedBallModel {
   /// (needed for kFlexible, else ignored). Every reference must outlive this object; `book`
   /// books "oblique_impact", "flight" and the normal model's impacts (may be null).
   BattedBallModel(const Scene& scene, const ResolvedScene& resolved, CollisionModel model,
-                  const HertzOptions& hertz, const FlexibleOptions& flexible,
-                  const BatModes* modes, TimingBook* book);
+                  const HertzOptions& hertz, const FlexibleOptions& flexible, const BatModes* modes,
+                  TimingBook* book);
 
   /// The collision model of the normal part.
   CollisionModel model() const { return model_; }
@@ -149,25 +149,25 @@ class BattedBallModel {
 /// distance_sweet_spot: where along the bat, and how far under the ball's centre, the ball
 /// carries farthest.
 struct DistanceSweetSpotResult {
-  double position_from_knob_m = 0.0;  ///< The impact position, m from the knob.
-  double undercut_m = 0.0;            ///< The undercut, m.
-  double distance_m = 0.0;            ///< The carry there, m (the model's own normal law).
-  double exit_speed_mps = 0.0;        ///< The exit speed there, m/s.
-  double launch_angle_deg = 0.0;      ///< The launch angle there, deg.
-  double backspin_rpm = 0.0;          ///< The backspin there, rpm.
-  BattedBallResult ball;              ///< The batted ball at the optimum (exact normal law).
+  double position_from_knob_m = 0.0;      ///< The impact position, m from the knob.
+  double undercut_m = 0.0;                ///< The undercut, m.
+  double distance_m = 0.0;                ///< The carry there, m (the model's own normal law).
+  double exit_speed_mps = 0.0;            ///< The exit speed there, m/s.
+  double launch_angle_deg = 0.0;          ///< The launch angle there, deg.
+  double backspin_rpm = 0.0;              ///< The backspin there, rpm.
+  BattedBallResult ball;                  ///< The batted ball at the optimum (exact normal law).
   double position_min_from_knob_m = 0.0;  ///< The position range searched, m from the knob.
   double position_max_from_knob_m = 0.0;  ///< Its upper end, m.
   double undercut_min_m = 0.0;            ///< The undercut range searched, m.
   double undercut_max_m = 0.0;            ///< Its upper end, m.
   double position_tolerance_m = 0.0;      ///< The local search's tolerance on x, m.
   double undercut_tolerance_m = 0.0;      ///< Its tolerance on D, m.
-  bool at_position_bound = false;  ///< The optimum is at an end of the position range.
-  bool at_undercut_bound = false;  ///< The optimum is at an end of the undercut range (or at
-                                   ///< the graze limit).
-  int coarse_positions = 0;        ///< The coarse scan's grid.
-  int coarse_undercuts = 0;        ///< Its undercuts.
-  int evaluations = 0;             ///< Carries computed (scan + local search).
+  bool at_position_bound = false;         ///< The optimum is at an end of the position range.
+  bool at_undercut_bound = false;         ///< The optimum is at an end of the undercut range (or at
+                                          ///< the graze limit).
+  int coarse_positions = 0;               ///< The coarse scan's grid.
+  int coarse_undercuts = 0;               ///< Its undercuts.
+  int evaluations = 0;                    ///< Carries computed (scan + local search).
   /// "closed_form", or "tabulated" (hertz, flexible: the table's effective COR).
   std::string normal_law;
   int normal_table_positions = 0;  ///< The table's positions (0 for a closed form).
@@ -192,12 +192,12 @@ struct CarryMapResult {
   /// distance_m[i * undercuts + j] at (positions[i], undercuts[j]), m; NaN where the ball has
   /// no carry (beyond the graze limit, driven back, or not landing).
   std::vector<double> distance_m;
-  double best_distance_m = 0.0;         ///< The largest carry of the grid, m.
+  double best_distance_m = 0.0;            ///< The largest carry of the grid, m.
   double best_position_from_knob_m = 0.0;  ///< Where, m from the knob.
-  double best_undercut_m = 0.0;         ///< With which undercut, m.
-  std::string normal_law;               ///< "closed_form" or "tabulated".
-  int normal_table_speeds = 0;          ///< Tabulated: speeds per grid position.
-  Summary summary;                      ///< termination, evaluations, message.
+  double best_undercut_m = 0.0;            ///< With which undercut, m.
+  std::string normal_law;                  ///< "closed_form" or "tabulated".
+  int normal_table_speeds = 0;             ///< Tabulated: speeds per grid position.
+  Summary summary;                         ///< termination, evaluations, message.
 };
 
 /// The carry over map_positions x map_undercuts evenly spaced over `options`' region (hertz,
@@ -206,7 +206,6 @@ CarryMapResult CarryMap(BattedBallModel& model, double length_m, const DistanceO
                         const Progress* progress = nullptr);
 
 /// The position range of `options` on a bat `length_m` long: [min or L/2, max or L].
-void DistancePositionRange(const DistanceOptions& options, double length_m, double* lo,
-                           double* hi);
+void DistancePositionRange(const DistanceOptions& options, double length_m, double* lo, double* hi);
 
 }  // namespace sweetspot::core

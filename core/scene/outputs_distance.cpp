@@ -14,8 +14,8 @@ namespace {
 // The batted-ball model of the context (the exit-speed model's collision model and modes).
 BattedBallModel ModelOf(OutputContext& c) {
   const BatModes* modes = c.exit_model != nullptr ? c.exit_model->modes() : nullptr;
-  return BattedBallModel(c.scene, c.resolved, c.model, c.options.hertz, c.options.flexible,
-                         modes, &c.book);
+  return BattedBallModel(c.scene, c.resolved, c.model, c.options.hertz, c.options.flexible, modes,
+                         &c.book);
 }
 
 // A search's summary into the context: a refusal, a failure, or a termination short of

@@ -188,14 +188,13 @@ bool DistanceOptions::Validate(Refusal* why) const {
                     "must be greater than distance.position_min_from_knob_m = " +
                         FormatNumber17(*position_min_from_knob_m));
   }
-  if (!CheckRange(why, "distance.undercut_min_m", undercut_min_m, -kMaxUndercutM,
-                  kMaxUndercutM) ||
+  if (!CheckRange(why, "distance.undercut_min_m", undercut_min_m, -kMaxUndercutM, kMaxUndercutM) ||
       !CheckRange(why, "distance.undercut_max_m", undercut_max_m, -kMaxUndercutM, kMaxUndercutM))
     return false;
   if (!(undercut_min_m < undercut_max_m))
-    return Refuse17(why, "distance.undercut_max_m", undercut_max_m,
-                    "must be greater than distance.undercut_min_m = " +
-                        FormatNumber17(undercut_min_m));
+    return Refuse17(
+        why, "distance.undercut_max_m", undercut_max_m,
+        "must be greater than distance.undercut_min_m = " + FormatNumber17(undercut_min_m));
   const struct {
     const char* field;
     int value, lo, hi;

@@ -72,8 +72,7 @@ TEST(BattedBallApiTest, RefusesOutOfRangeNamingTheFieldAsWritten) {
       {R"(, "contact": {"undercut_m": -0.2})", "contact.undercut_m"},
       {R"(, "ball": {"spin_rpm": 1e6})", "ball.spin_rpm"},
       {R"(, "ball": {"descent_angle_deg": 95})", "ball.descent_angle_deg"},
-      {R"(, "swing": {"bat_speed_mph": 70, "attack_angle_deg": -120})",
-       "swing.attack_angle_deg"},
+      {R"(, "swing": {"bat_speed_mph": 70, "attack_angle_deg": -120})", "swing.attack_angle_deg"},
       {R"(, "contact": {"undercut_m": "x"})", "contact.undercut_m"},
   };
   for (const auto& c : cases) {
@@ -91,13 +90,12 @@ TEST(BattedBallApiTest, HertzAndFlexibleGiveTheirOwnNormalImpulse) {
     EXPECT_EQ(b["impact"]["normal_model"], model);
     // Head-on: the model's own exit speed at max_exit_speed's point (the same ODE at the same
     // approach speed; 1e-6 m/s covers max_exit_speed's own evaluation being a search's).
-    const Response c = Dispatch(
-        {"POST", "/v1/collision",
-         R"({"bat": {"preset": "wood-34-ash"}, "ball": {"speed_mph": 90},
+    const Response c = Dispatch({"POST", "/v1/collision",
+                                 R"({"bat": {"preset": "wood-34-ash"}, "ball": {"speed_mph": 90},
              "swing": {"bat_speed_mph": 70}, "model": ")" +
-             std::string(model) + R"(", "impact_from_knob_m": )" +
-             b["impact_from_knob_m"].dump() + "}"},
-        Context{});
+                                     std::string(model) + R"(", "impact_from_knob_m": )" +
+                                     b["impact_from_knob_m"].dump() + "}"},
+                                Context{});
     ASSERT_EQ(c.status, 200) << c.body.dump();
     EXPECT_NEAR(b["exit_speed_mps"].get<double>(), c.body["exit_speed_mps"].get<double>(), 1e-9)
         << model;
@@ -107,8 +105,8 @@ TEST(BattedBallApiTest, HertzAndFlexibleGiveTheirOwnNormalImpulse) {
 
 TEST(BattedBallApiTest, TheScenesEnvironmentAndAero) {
   const Response sea = Post(Scene("free_bat", R"(, "contact": {"undercut_in": 0.75})"));
-  const Response coors = Post(Scene(
-      "free_bat", R"(, "contact": {"undercut_in": 0.75}, "environment": {"elevation_ft": 5200,
+  const Response coors = Post(
+      Scene("free_bat", R"(, "contact": {"undercut_in": 0.75}, "environment": {"elevation_ft": 5200,
                      "temperature_f": 85}, "aero": {"model": "nathan-2016"})"));
   ASSERT_EQ(sea.status, 200) << sea.body.dump();
   ASSERT_EQ(coors.status, 200) << coors.body.dump();
@@ -177,10 +175,9 @@ TEST(BattedBallApiTest, DistanceSweetSpotAndCarryMap) {
       "outputs": ["distance_sweet_spot", "carry_map"], "report_units": "imperial"})");
   ASSERT_EQ(r.status, 200) << r.body.dump();
   const auto& d = r.body["distance_sweet_spot"];
-  for (const char* key :
-       {"position_from_knob_m", "position_from_knob_in", "position_from_tip_in", "undercut_m",
-        "undercut_in", "distance_m", "distance_ft", "exit_speed_mps", "exit_speed_mph",
-        "launch_angle_deg", "backspin_rpm"}) {
+  for (const char* key : {"position_from_knob_m", "position_from_knob_in", "position_from_tip_in",
+                          "undercut_m", "undercut_in", "distance_m", "distance_ft",
+                          "exit_speed_mps", "exit_speed_mph", "launch_angle_deg", "backspin_rpm"}) {
     EXPECT_TRUE(d.contains(key)) << key << d.dump();
   }
   EXPECT_EQ(d["search"]["normal_law"], "closed_form");
@@ -206,20 +203,20 @@ TEST(BattedBallApiTest, DistanceSweetSpotAndCarryMap) {
   };
   for (const auto& c : cases) {
     const Response bad = Post(std::string(R"({"bat": {"preset": "wood-34-ash"},
-        "outputs": ["carry_map"], "options": {"distance": )") + c.distance + "}}");
+        "outputs": ["carry_map"], "options": {"distance": )") +
+                              c.distance + "}}");
     EXPECT_EQ(bad.status, 400) << c.distance << bad.body.dump();
     EXPECT_EQ(bad.body["field"], c.field) << c.distance << bad.body.dump();
   }
 }
 
 TEST(BattedBallApiTest, ExploreSweepsTheUndercut) {
-  const Response r = Dispatch(
-      {"POST", "/v1/explore",
-       R"({"bat": {"preset": "wood-34-ash"}, "ball": {"speed_mph": 90},
+  const Response r = Dispatch({"POST", "/v1/explore",
+                               R"({"bat": {"preset": "wood-34-ash"}, "ball": {"speed_mph": 90},
            "swing": {"bat_speed_mph": 70}, "options": {"model": "free_bat"},
            "outputs": ["batted_ball"],
            "parameters": [{"path": "contact.undercut_in", "min": 0, "max": 1, "count": 3}]})"},
-      Context{});
+                              Context{});
   ASSERT_EQ(r.status, 200) << r.body.dump();
   const auto& rows = r.body["rows"];
   ASSERT_EQ(rows.size(), 3u) << r.body.dump();

@@ -127,8 +127,8 @@ TEST(BattedBall, TabulatedNormalLawMatchesTheModel) {
         ASSERT_TRUE(model.Evaluate(x, d, &exact, &why, &failure)) << failure;
         const double c = model.CarryAt(x, d, fo, &table);
         ASSERT_TRUE(std::isfinite(c)) << x << " " << d;
-        worst = std::max(worst, std::abs(table.impact.exit_speed_mps -
-                                         exact.impact.exit_speed_mps));
+        worst =
+            std::max(worst, std::abs(table.impact.exit_speed_mps - exact.impact.exit_speed_mps));
       }
     }
     std::cout << CollisionModelName(m) << ": worst |exit speed (table) - exact| = " << worst
