@@ -304,8 +304,8 @@ bool CoreRefusal(const core::Summary& summary, const std::string& prefix, ApiErr
 
 bool IsSceneField(std::string_view core_field) {
   // The heads of core::Scene's fields; every other core field of a scene request is an option.
-  constexpr std::string_view kSceneHeads[] = {"bat",     "ball",          "swing",  "cor",
-                                              "outputs", "inertia_model", "contact"};
+  constexpr std::string_view kSceneHeads[] = {
+      "bat", "ball", "swing", "cor", "outputs", "inertia_model", "contact", "environment", "aero"};
   const std::string_view head = core_field.substr(0, core_field.find_first_of(".["));
   for (const std::string_view h : kSceneHeads) {
     if (head == h) return true;

@@ -7,6 +7,7 @@
 
 #include "api/bat_json.hpp"
 #include "api/fields.hpp"
+#include "api/flight_json.hpp"
 #include "api/router.hpp"
 #include "core/scene/output_registry.hpp"
 
@@ -114,6 +115,10 @@ bool ReadSceneCommon(ObjectReader& reader, core::Scene* scene) {
         !contact_reader.Finish()) {
       return false;
     }
+  }
+  // "environment" and "aero": the batted ball's flight, read as /v1/flight reads them.
+  if (!ReadEnvironment(reader, &scene->environment) || !ReadAero(reader, &scene->aero)) {
+    return false;
   }
   std::string inertia = "rigid_body";
   reader.OptionalString("inertia_model", &inertia, {"rigid_body", "slender_rod"});
@@ -227,6 +232,42 @@ bool ReadHertzOptions(const Json& value, const std::string& path, const ApiLimit
   return reader.Finish();
 }
 
+bool ReadDistanceOptions(const Json& value, const std::string& path, core::DistanceOptions* options,
+                         ApiError* error) {
+  // Ranges are core's (DistanceOptions::Validate, named "distance.<field>"), checked with the
+  // options.
+  ObjectReader reader(value, path, error);
+  const auto optional_position = [&reader](const char* key, std::optional<double>* out) {
+    if (!reader.ok() || !reader.Has(key)) return;
+    double v = 0.0;
+    reader.OptionalNumber(key, AnyNumber(), &v);
+    *out = v;
+  };
+  optional_position("position_min_from_knob_m", &options->position_min_from_knob_m);
+  optional_position("position_max_from_knob_m", &options->position_max_from_knob_m);
+  reader.OptionalNumber("undercut_min_m", AnyNumber(), &options->undercut_min_m);
+  reader.OptionalNumber("undercut_max_m", AnyNumber(), &options->undercut_max_m);
+  reader.OptionalNumber("position_tolerance_m", AnyNumber(), &options->position_tolerance_m);
+  reader.OptionalNumber("undercut_tolerance_m", AnyNumber(), &options->undercut_tolerance_m);
+  const struct {
+    const char* key;
+    int* out;
+    long long lo, hi;
+  } counts[] = {{"coarse_positions", &options->coarse_positions, 2, 201},
+                {"coarse_undercuts", &options->coarse_undercuts, 2, 201},
+                {"max_evaluations", &options->max_evaluations, 10, 100000},
+                {"map_positions", &options->map_positions, 2, 401},
+                {"map_undercuts", &options->map_undercuts, 2, 401},
+                {"normal_table_speeds", &options->normal_table_speeds, 2, 16},
+                {"normal_table_positions", &options->normal_table_positions, 3, 401}};
+  for (const auto& c : counts) {
+    long long v = *c.out;
+    reader.OptionalInteger(c.key, c.lo, c.hi, &v);
+    *c.out = static_cast<int>(v);
+  }
+  return reader.Finish();
+}
+
 bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOptions* options) {
   ClampToLimits(limits, options);
   const Json* value = top.Get("options");
@@ -308,6 +349,12 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
   }
   if (const Json* hertz = reader.Get("hertz")) {
     if (!ReadHertzOptions(*hertz, reader.PathOf("hertz"), limits, &options->hertz, top.error())) {
+      return false;
+    }
+  }
+  if (const Json* distance = reader.Get("distance")) {
+    if (!ReadDistanceOptions(*distance, reader.PathOf("distance"), &options->distance,
+                             top.error())) {
       return false;
     }
   }

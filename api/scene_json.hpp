@@ -36,6 +36,12 @@ bool ReadSceneOptions(ObjectReader& reader, const ApiLimits& limits, core::Scene
 bool ReadFlexibleOptions(const nlohmann::json& value, const std::string& path,
                          const ApiLimits& limits, core::FlexibleOptions* options, ApiError* error);
 
+/// Reads options.distance at `path` (distance_sweet_spot and carry_map: the region, the
+/// searches' grids, tolerances and budget, the normal-law table); the ranges are core's
+/// (DistanceOptions::Validate, checked with the scene's options).
+bool ReadDistanceOptions(const nlohmann::json& value, const std::string& path,
+                         core::DistanceOptions* options, ApiError* error);
+
 /// Reads a "hertz" options object at `path`.
 bool ReadHertzOptions(const nlohmann::json& value, const std::string& path, const ApiLimits& limits,
                       core::HertzOptions* options, ApiError* error);

@@ -44,6 +44,13 @@ constexpr double kLeastStingZoneS = 24.5e-3;
 // - bbcor_scan: 9 flexible impacts plus the design's modes (docs/api.md: "~10 ms plus the
 //   design's modes"); bbcor and barrel: the trampoline model's closed forms, counted as a row.
 constexpr double kBbcorScanS = 10e-3 + kModesS;
+// - distance_sweet_spot and carry_map (docs/benchmarks.md, "Issue 34: the batted-ball scene
+//   outputs", BM_DistanceSweetSpot, BM_CarryMap, CPU): 0.37 ms for the free bat's search (163
+//   carries: 2.3 us each), 1.65 ms for a 41 x 21 free-bat map (1.9 us per carry); hertz and
+//   flexible add their table's impacts (positions x speeds: 6.1 us, 0.23 ms each).
+constexpr double kSearchCarryS = 2.3e-6;
+constexpr double kSearchCarries = 170.0;
+constexpr double kMapCarryS = 1.9e-6;
 
 // The elements an array of a row has: the shape holds one of each (RowShape).
 std::uint64_t ArrayCount(const std::string& key, const Json& array, const Sweep& sweep,
@@ -52,6 +59,11 @@ std::uint64_t ArrayCount(const std::string& key, const Json& array, const Sweep&
   if (key == "curve") return static_cast<std::uint64_t>(sweep.options.flexible.sting_samples);
   if (key == "effective_cor_curve") return 10;  // 1 to 10 in from the tip (core/scene_barrel)
   if (key == "points") return 9;                // every 0.5 in from 4 to 8 in from the tip
+  // carry_map: a row per position, each with a carry per undercut.
+  if (key == "positions") return static_cast<std::uint64_t>(sweep.options.distance.map_positions);
+  if (key == "undercuts_m" || key == "distance_m") {
+    return static_cast<std::uint64_t>(sweep.options.distance.map_undercuts);
+  }
   return array.size();
 }
 
@@ -199,6 +211,21 @@ SweepEstimate EstimateSweep(const Sweep& sweep, const std::string& format,
         "least_sting_zone");
   }
   if (Asks(sweep, core::SceneOutput::kBbcorScan)) add(kBbcorScanS, "bbcor_scan");
+  // The distance outputs: their carries, and the normal law's table for hertz and flexible.
+  const double table_impact_s = sweep.exit_speed_model == "hertz"      ? kHertzImpactS
+                                : sweep.exit_speed_model == "flexible" ? kFlexibleImpactS
+                                                                       : 0.0;
+  const core::DistanceOptions& distance = sweep.options.distance;
+  if (Asks(sweep, core::SceneOutput::kDistanceSweetSpot)) {
+    add(kSearchCarries * kSearchCarryS +
+            table_impact_s * distance.normal_table_positions * distance.normal_table_speeds,
+        "distance_sweet_spot");
+  }
+  if (Asks(sweep, core::SceneOutput::kCarryMap)) {
+    add(static_cast<double>(distance.map_positions) * distance.map_undercuts * kMapCarryS +
+            table_impact_s * distance.map_positions * distance.normal_table_speeds,
+        "carry_map");
+  }
   estimate.cpu_s_per_design = cost;
   estimate.cost_basis = basis;
   return estimate;

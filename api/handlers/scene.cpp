@@ -121,6 +121,23 @@ std::optional<CollisionRequest> ParseCollision(const Json& body, const Context& 
   ClampToLimits(context.limits, &options.hertz);
   ClampToLimits(context.limits, &options.flexible);
   reader.OptionalBool("contact_details", &options.want_contact_details);
+  // "outputs": ["batted_ball"], the one scene output an impact point answers (its block beside
+  // the impact's).
+  if (const Json* outputs = reader.Get("outputs"); outputs != nullptr && reader.ok()) {
+    if (!outputs->is_array()) {
+      reader.Fail("outputs", "must be an array of output names (\"batted_ball\")");
+    } else {
+      for (std::size_t i = 0; i < outputs->size() && reader.ok(); ++i) {
+        const Json& item = (*outputs)[i];
+        if (!item.is_string() || item.get<std::string>() != "batted_ball") {
+          reader.Fail("outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
+                                     " is not one of batted_ball (the scene outputs /v1/collision "
+                                     "answers at impact_from_knob_m)");
+        }
+      }
+      options.want_batted_ball = reader.ok();
+    }
+  }
   if (const Json* hertz = reader.Get("hertz")) {
     ReadHertzOptions(*hertz, reader.PathOf("hertz"), context.limits, &options.hertz, error);
   }
@@ -149,7 +166,17 @@ const Endpoint<CollisionRequest, core::CollisionResult>& CollisionEndpoint() {
                           "model");
     };
     e.render = [](const CollisionRequest&, const core::CollisionResult& result) {
-      return CollisionResultToJson(result);
+      Json out = CollisionResultToJson(result);
+      if (result.batted_ball.has_value()) {
+        // The block as /v1/sweet-spot writes it (its api declaration), its error beside the
+        // impact's.
+        core::SceneResult ball;
+        ball.batted_ball = result.batted_ball;
+        Json errors = Json::object();
+        ApiOutputDeclaration(core::SceneOutput::kBattedBall).render(ball, &out, &errors);
+        out["error_estimate"]["batted_ball"] = errors["batted_ball"];
+      }
+      return out;
     };
     e.summary = [](const core::CollisionResult& result) -> const core::Summary& {
       return result.summary;

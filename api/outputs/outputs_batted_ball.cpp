@@ -1,4 +1,6 @@
 // The api's half of batted_ball (core's: core/scene/outputs_batted_ball.cpp).
+#include <iterator>
+
 #include "api/outputs/scene_outputs.hpp"
 
 namespace sweetspot::api {
@@ -33,20 +35,60 @@ void RenderBattedBall(const core::SceneResult& r, Json* out, Json* errors) {
         {"tangential_cor", core::kDefaultTangentialCor},
         {"friction_coefficient", core::kDefaultBallBatFriction}}},
       {"flight",
-       {{"aero_model", core::flight::AeroModelName(core::flight::AeroOptions{}.model)},
-        {"environment", "default"},
+       {{"aero_model", core::flight::AeroModelName(b.aero_model)},
+        {"environment", b.default_environment ? "default" : "scene"},
         {"air_density_kg_m3", f.air_density_kg_m3}}},
   };
+  // hertz and flexible: the normal impulse is the model's own at the normal approach speed.
+  if (b.normal_model != nullptr) {
+    (*out)["batted_ball"]["impact"]["normal_model"] = b.normal_model;
+  }
   (*errors)["batted_ball"] = {{"distance_m", f.error_estimate_m}};
 }
 
 void ProbeBattedBall(core::SceneResult* r) { r->batted_ball.emplace(); }
 
+// batted_ball's numbers a sweep reads without rendering (its explore columns).
+template <typename F>
+DirectValue FromBall(const OutputView& v, F number) {
+  return v.result != nullptr && v.result->batted_ball ? number(*v.result->batted_ball)
+                                                      : DirectValue{};
+}
+
+const DirectField kBattedBallFields[] = {
+    {"exit_speed_mps", true,
+     [](const OutputView& v) {
+       return FromBall(v, [](const auto& b) { return Number(b.impact.exit_speed_mps); });
+     }},
+    {"launch_angle_deg", true,
+     [](const OutputView& v) {
+       return FromBall(v, [](const auto& b) { return Number(b.impact.launch_angle_deg); });
+     }},
+    {"backspin_rpm", true,
+     [](const OutputView& v) {
+       return FromBall(v, [](const auto& b) { return Number(b.impact.backspin_rpm + 0.0); });
+     }},
+    {"distance_m", true,
+     [](const OutputView& v) {
+       return FromBall(v, [](const auto& b) { return Number(b.flight.distance_m); });
+     }},
+    {"hang_time_s", true,
+     [](const OutputView& v) {
+       return FromBall(v, [](const auto& b) { return Number(b.flight.hang_time_s); });
+     }},
+    {"apex_m", true,
+     [](const OutputView& v) {
+       return FromBall(v, [](const auto& b) { return Number(b.flight.apex_m); });
+     }},
+};
+
 }  // namespace
 }  // namespace outputs_batted_ball_api
 
-extern const ApiOutputDecl kBattedBallApi{core::SceneOutput::kBattedBall,
-                                          outputs_batted_ball_api::RenderBattedBall,
-                                          outputs_batted_ball_api::ProbeBattedBall};
+namespace obb = outputs_batted_ball_api;
+
+extern const ApiOutputDecl kBattedBallApi{core::SceneOutput::kBattedBall, obb::RenderBattedBall,
+                                          obb::ProbeBattedBall, std::begin(obb::kBattedBallFields),
+                                          std::end(obb::kBattedBallFields)};
 
 }  // namespace sweetspot::api

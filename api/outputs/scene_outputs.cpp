@@ -13,7 +13,7 @@ using Json = nlohmann::json;
 // Each output's api declaration (api/outputs/outputs_*.cpp).
 extern const ApiOutputDecl kMaxExitSpeedApi, kSweetZoneApi, kExitSpeedCurveApi,
     kCenterOfPercussionApi, kVibrationNodeApi, kLeastStingZoneApi, kBarrelApi, kBbcorApi,
-    kBbcorScanApi, kBattedBallApi;
+    kBbcorScanApi, kBattedBallApi, kDistanceSweetSpotApi, kCarryMapApi;
 
 namespace {
 
@@ -25,7 +25,7 @@ const std::array<const ApiOutputDecl*, core::kSceneOutputCount>& ApiById() {
     for (const ApiOutputDecl* d :
          {&kMaxExitSpeedApi, &kSweetZoneApi, &kExitSpeedCurveApi, &kCenterOfPercussionApi,
           &kVibrationNodeApi, &kLeastStingZoneApi, &kBarrelApi, &kBbcorApi, &kBbcorScanApi,
-          &kBattedBallApi}) {
+          &kBattedBallApi, &kDistanceSweetSpotApi, &kCarryMapApi}) {
       const auto i = static_cast<std::size_t>(d->id);
       if (i >= out.size() || out[i] != nullptr) {
         throw std::logic_error("api output table: a duplicate or out-of-range id");

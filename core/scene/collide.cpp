@@ -83,6 +83,7 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
       out.error_estimate_mps = impact.error_estimate_exit_speed_mps;
     };
     auto tm = std::chrono::steady_clock::now();
+    std::shared_ptr<const BatModes> impact_modes;  // model = flexible: for the batted ball too
     switch (model) {
       case CollisionModel::kRigidPivot:
         out.rigid_pivot = RigidPivotImpactAt(RigidPivotInputsFor(scene, r), impact_from_knob_m);
@@ -105,6 +106,7 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
       case CollisionModel::kFlexible: {
         FlexibleModes flexible_modes(scene, options.flexible, &book);
         const auto& modes = flexible_modes.Impact();
+        impact_modes = modes;
         out.modes_cache_hit = flexible_modes.impact_hit();
         if (FlexibleModesRefused(*modes, &s)) return;
         tm = std::chrono::steady_clock::now();  // the modes have their own timing
@@ -128,6 +130,22 @@ CollisionResult Collide(const Scene& scene, double impact_from_knob_m, Collision
     book.Add(CollisionModelName(model), SecondsSince(tm), 1);
     s.objective = out.exit_speed_mps;
     s.error_estimate = out.error_estimate_mps;
+    if (options.want_batted_ball && s.IsSolutionUsable()) {
+      BattedBallModel batted(scene, r, model, options.hertz, options.flexible, impact_modes.get(),
+                             &book);
+      BattedBallResult ball;
+      Refusal refusal;
+      std::string failure;
+      if (batted.Evaluate(impact_from_knob_m, scene.contact.undercut_m, &ball, &refusal,
+                          &failure)) {
+        out.batted_ball = std::move(ball);
+      } else if (!refusal.field.empty() || !refusal.rule.empty()) {
+        s.SetRefusal(std::move(refusal));
+      } else {
+        s.termination = Termination::kFailure;
+        s.message = "batted_ball: " + failure;
+      }
+    }
   });
 }
 

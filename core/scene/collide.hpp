@@ -13,6 +13,7 @@
 #include "core/collision/hertz_contact.hpp"
 #include "core/collision/rigid_pivot.hpp"
 #include "core/numerics/timing_book.hpp"
+#include "core/scene/batted_ball.hpp"
 #include "core/scene/scene.hpp"
 #include "core/summary.hpp"
 
@@ -24,6 +25,10 @@ struct CollisionOptions {
   HertzOptions hertz;                 ///< Contact-model settings (the flexible model uses its
                                       ///< bat_surface_compliance too).
   FlexibleOptions flexible;           ///< Flexible-beam settings (model = kFlexible).
+  /// Also the batted ball at the impact point (CollisionResult::batted_ball): the oblique impact
+  /// with the scene's contact.undercut_m, its normal part by the model that ran, then the flight
+  /// with the scene's environment and aero (core/scene/batted_ball.hpp).
+  bool want_batted_ball = false;
 
   /// True when every field is in range; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "field = value: rule".
@@ -51,6 +56,8 @@ struct CollisionResult {
   std::optional<FreeBatImpact> free_bat;         ///< Details when model = free_bat.
   std::optional<HertzImpact> hertz;              ///< Details when model = hertz.
   std::optional<FlexibleImpactResult> flexible;  ///< Details when model = flexible.
+  /// With CollisionOptions::want_batted_ball, when the impact ran: the batted ball.
+  std::optional<BattedBallResult> batted_ball;
   bool modes_cache_hit = false;      ///< model = flexible: the modes came from the cache.
   std::vector<ModelTiming> timings;  ///< Time per model.
 };

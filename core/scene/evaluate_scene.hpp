@@ -14,6 +14,7 @@
 #include "core/collision/oblique_impact.hpp"
 #include "core/flight/flight.hpp"
 #include "core/numerics/timing_book.hpp"
+#include "core/scene/batted_ball.hpp"
 #include "core/scene/scene.hpp"
 #include "core/summary.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
@@ -29,18 +30,6 @@ std::vector<std::string> ModelsFor(SceneOutput output, CollisionModel exit_model
 /// The name of the barrel model (in models_used and timings).
 inline constexpr char kBarrelModel[] = "barrel";
 
-/// The batted_ball output: the oblique impact at the max-exit-speed point, then the flight.
-struct BattedBallResult {
-  double impact_from_knob_m = 0.0;     ///< Where the bat met the ball (max_exit_speed's), m.
-  double undercut_m = 0.0;             ///< The scene's contact.undercut_m, m.
-  double bat_speed_at_impact_mps = 0.0;  ///< The bat's axis speed there, m/s.
-  double bat_radius_m = 0.0;           ///< The bat's radius there (the default without a bat), m.
-  double bat_effective_mass_kg = 0.0;  ///< M_n of the normal model there, kg.
-  double normal_cor = 0.0;             ///< e of the normal model (the scene's COR).
-  ObliqueImpactResult impact;          ///< The oblique impact (SolveObliqueImpact).
-  flight::FlightResult flight;         ///< Its flight (Fly, default environment and aero).
-};
-
 /// One slot per output: its result, empty when not requested (or not computed). An output's
 /// declaration names its slot (core/scene/output_registry.hpp), which resets it.
 struct SceneOutputResults {
@@ -54,6 +43,8 @@ struct SceneOutputResults {
   std::optional<BbcorResult> bbcor;                              ///< bbcor.
   std::optional<BbcorScan> bbcor_scan;                           ///< bbcor_scan.
   std::optional<BattedBallResult> batted_ball;                   ///< batted_ball.
+  std::optional<DistanceSweetSpotResult> distance_sweet_spot;    ///< distance_sweet_spot.
+  std::optional<CarryMapResult> carry_map;                       ///< carry_map.
 };
 
 /// The answer of EvaluateScene: what every evaluation reports, and the outputs' slots

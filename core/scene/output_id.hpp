@@ -26,15 +26,19 @@ enum class SceneOutput {
   /// The batted ball at the max-exit-speed point: the oblique impact, then its flight
   /// (core/collision/oblique_impact.hpp, core/flight/flight.hpp).
   kBattedBall,
+  /// The impact position and undercut that carry the ball farthest (core/scene/batted_ball.hpp).
+  kDistanceSweetSpot,
+  /// The carry over a grid of impact positions x undercuts (core/scene/batted_ball.hpp).
+  kCarryMap,
 };
 
 /// The number of outputs (ids run from 0 to kSceneOutputCount - 1).
 inline constexpr std::size_t kSceneOutputCount =
-    static_cast<std::size_t>(SceneOutput::kBattedBall) + 1;
+    static_cast<std::size_t>(SceneOutput::kCarryMap) + 1;
 
 /// Stable name, the declaration's: "max_exit_speed", "center_of_percussion", "vibration_node",
 /// "sweet_zone", "exit_speed_curve", "least_sting_zone", "barrel", "bbcor", "bbcor_scan",
-/// "batted_ball".
+/// "batted_ball", "distance_sweet_spot", "carry_map".
 const char* SceneOutputName(SceneOutput output);
 /// The output called `name`, or nullopt.
 std::optional<SceneOutput> ParseSceneOutput(std::string_view name);

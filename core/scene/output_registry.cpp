@@ -8,7 +8,7 @@ namespace sweetspot::core {
 // Each output's declaration (core/scene/outputs_*.cpp).
 extern const SceneOutputDecl kMaxExitSpeedOutput, kSweetZoneOutput, kExitSpeedCurveOutput,
     kCenterOfPercussionOutput, kVibrationNodeOutput, kLeastStingZoneOutput, kBarrelOutput,
-    kBbcorOutput, kBbcorScanOutput, kBattedBallOutput;
+    kBbcorOutput, kBbcorScanOutput, kBattedBallOutput, kDistanceSweetSpotOutput, kCarryMapOutput;
 
 const std::vector<const SceneOutputDecl*>& SceneOutputTable() {
   // THE table: one row per output, in the order they are computed (an output another reads,
@@ -17,7 +17,7 @@ const std::vector<const SceneOutputDecl*>& SceneOutputTable() {
       &kMaxExitSpeedOutput,  &kSweetZoneOutput,      &kCenterOfPercussionOutput,
       &kVibrationNodeOutput, &kLeastStingZoneOutput, &kBarrelOutput,
       &kBbcorOutput,         &kBbcorScanOutput,      &kExitSpeedCurveOutput,
-      &kBattedBallOutput,
+      &kBattedBallOutput,    &kDistanceSweetSpotOutput, &kCarryMapOutput,
   };
   return table;
 }

@@ -179,6 +179,11 @@ bool Scene::Validate(Refusal* why) const {
       return Refuse17(why, "mass_properties.moi_knob_kg_m2", mp.moi_knob_kg_m2, "must be finite");
   }
   if (!ball.Validate(why) || !swing.Validate(why) || !contact.Validate(why)) return false;
+  // The flight's own validators, their fields under the scene's objects ("environment.").
+  if (Refusal inner; !environment.Validate(why == nullptr ? nullptr : &inner))
+    return why == nullptr ? false : Refuse(why, Prefixed("environment.", std::move(inner)));
+  if (Refusal inner; !aero.Validate(why == nullptr ? nullptr : &inner))
+    return why == nullptr ? false : Refuse(why, Prefixed("aero.", std::move(inner)));
   if (!ValidateCor(why)) return false;
   if (outputs.empty())
     return Refuse(why, TextRefusal("outputs", "empty: name at least one output"));
@@ -215,9 +220,49 @@ bool SceneOptions::Validate(Refusal* why) const {
                       curve_positions_from_knob_m[i], "must be finite");
   }
   if (!hertz.Validate(why)) return false;
+  if (!distance.Validate(why)) return false;
   if (Refusal barrel_why; !barrel.Validate(&barrel_why))
     return Refuse(why, TextRefusal("barrel", barrel_why.Message()));
   return flexible.Validate(why);
+}
+
+bool DistanceOptions::Validate(Refusal* why) const {
+  for (const auto* bound : {&position_min_from_knob_m, &position_max_from_knob_m}) {
+    if (bound->has_value() && !(std::isfinite(**bound) && std::abs(**bound) <= kMaxSwingOffsetM)) {
+      return Refuse17(why,
+                      bound == &position_min_from_knob_m ? "distance.position_min_from_knob_m"
+                                                         : "distance.position_max_from_knob_m",
+                      **bound, "must be finite and within the bat");
+    }
+  }
+  if (position_min_from_knob_m.has_value() && position_max_from_knob_m.has_value() &&
+      !(*position_min_from_knob_m < *position_max_from_knob_m)) {
+    return Refuse17(why, "distance.position_max_from_knob_m", *position_max_from_knob_m,
+                    "must be greater than distance.position_min_from_knob_m = " +
+                        FormatNumber17(*position_min_from_knob_m));
+  }
+  if (!CheckRange(why, "distance.undercut_min_m", undercut_min_m, -kMaxUndercutM, kMaxUndercutM) ||
+      !CheckRange(why, "distance.undercut_max_m", undercut_max_m, -kMaxUndercutM, kMaxUndercutM))
+    return false;
+  if (!(undercut_min_m < undercut_max_m))
+    return Refuse17(
+        why, "distance.undercut_max_m", undercut_max_m,
+        "must be greater than distance.undercut_min_m = " + FormatNumber17(undercut_min_m));
+  const struct {
+    const char* field;
+    int value, lo, hi;
+  } counts[] = {{"distance.coarse_positions", coarse_positions, 2, 201},
+                {"distance.coarse_undercuts", coarse_undercuts, 2, 201},
+                {"distance.max_evaluations", max_evaluations, 10, 100000},
+                {"distance.map_positions", map_positions, 2, 401},
+                {"distance.map_undercuts", map_undercuts, 2, 401},
+                {"distance.normal_table_speeds", normal_table_speeds, 2, 16},
+                {"distance.normal_table_positions", normal_table_positions, 3, 401}};
+  for (const auto& c : counts) {
+    if (!CheckIntegerInRange(why, c.field, c.value, c.lo, c.hi)) return false;
+  }
+  return CheckRange(why, "distance.position_tolerance_m", position_tolerance_m, 1e-7, 0.01) &&
+         CheckRange(why, "distance.undercut_tolerance_m", undercut_tolerance_m, 1e-8, 0.01);
 }
 
 bool FlexibleOptions::Validate(Refusal* why) const {

@@ -19,6 +19,7 @@
 #include "core/flexible/beam_model.hpp"
 #include "core/flexible/modes.hpp"
 #include "core/flexible/modes_cache.hpp"
+#include "core/flight/flight.hpp"
 #include "core/numerics/nlopt_search.hpp"
 #include "core/progress.hpp"
 #include "core/refusal.hpp"
@@ -197,6 +198,11 @@ struct Scene {
   Ball ball;                                              ///< The ball.
   Swing swing;                                            ///< The swing.
   Contact contact;  ///< Where across the bat the ball meets it (batted_ball).
+  /// The air the batted ball flies through (batted_ball, distance_sweet_spot, carry_map); the
+  /// flight's defaults (70 F, sea level, 50 %, 29.92 inHg, calm).
+  flight::Environment environment;
+  /// The batted ball's aerodynamic model (the flight's; default nathan-2016).
+  flight::AeroOptions aero;
   /// COR in [0, 1]; unset = the ball's COR law (a preset's) for a solid bat, else the bat
   /// material's default (ResolveScene).
   std::optional<double> cor;
@@ -274,6 +280,44 @@ struct FlexibleOptions {
   BeamModesOptions ImpactModes() const;
 };
 
+/// Settings of distance_sweet_spot and carry_map: the region of impact positions x undercuts
+/// searched or mapped, the searches' tolerances and the map's grid.
+struct DistanceOptions {
+  /// Lowest impact position searched or mapped, m from the knob; unset = half the bat length.
+  std::optional<double> position_min_from_knob_m;
+  /// Highest impact position, m from the knob; unset = the tip (the bat length).
+  std::optional<double> position_max_from_knob_m;
+  /// Lowest undercut, m (- = overcut: topspin), in [-kMaxUndercutM, kMaxUndercutM].
+  double undercut_min_m = -0.0254;
+  /// Highest undercut, m, in (undercut_min_m, kMaxUndercutM].
+  double undercut_max_m = 0.0508;
+  /// distance_sweet_spot's coarse scan: positions, in [2, 201].
+  int coarse_positions = 13;
+  /// distance_sweet_spot's coarse scan: undercuts, in [2, 201].
+  int coarse_undercuts = 11;
+  /// distance_sweet_spot's local search (NLopt LN_BOBYQA around the best coarse point): its
+  /// absolute tolerance on the position, m, in [1e-7, 0.01].
+  double position_tolerance_m = 1e-4;
+  /// Its absolute tolerance on the undercut, m, in [1e-8, 0.01].
+  double undercut_tolerance_m = 1e-5;
+  /// Its evaluation budget, in [10, 100000].
+  int max_evaluations = 400;
+  /// carry_map: positions of the grid (evenly spaced over the position range), in [2, 401].
+  int map_positions = 41;
+  /// carry_map: undercuts of the grid (evenly spaced over the undercut range), in [2, 401].
+  int map_undercuts = 21;
+  /// hertz and flexible: the normal impulse J_n(v_n) is tabulated per position at this many
+  /// normal approach speeds (Chebyshev nodes) and interpolated, in [2, 16].
+  int normal_table_speeds = 5;
+  /// distance_sweet_spot with hertz or flexible: the positions of that table over the position
+  /// range (the map uses its own grid's), in [3, 401].
+  int normal_table_positions = 41;
+
+  /// True when every field is in range; otherwise the refusal ("distance.coarse_positions =
+  /// 1: must be in [2, 201]").
+  bool Validate(Refusal* refusal) const;
+};
+
 /// Options of EvaluateScene.
 struct SceneOptions {
   /// Exit-speed model for max/zone/curve: kAuto = free_bat (rigid_pivot for a paper bat);
@@ -293,6 +337,7 @@ struct SceneOptions {
   HertzOptions hertz;        ///< Contact-model settings (model = kHertz).
   FlexibleOptions flexible;  ///< Flexible-beam settings (vibration_node, flexible, sting).
   BarrelOptions barrel;      ///< Barrel-model settings (barrel, bbcor).
+  DistanceOptions distance;  ///< distance_sweet_spot and carry_map settings.
   /// True (the default): the result's timings and solve_time_s are measured. False: the
   /// closed forms and the mass properties read no clock (their timings are 0 s; the models
   /// and calls are still listed): /v1/explore's sweeps, whose rows report no timings.

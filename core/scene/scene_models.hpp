@@ -64,6 +64,8 @@ class ExitSpeedModel : public ExitSpeedFunction {
   bool EvalFast(double s, double* v, double* noise, std::string* why) override;
   /// The closed-form profile (rigid_pivot, free_bat), or nullopt.
   const std::optional<ExitSpeedProfile>& profile() const { return profile_; }
+  /// The flexible impact modes (kFlexible), or null.
+  const BatModes* modes() const { return modes_.get(); }
   /// The models' warnings so far, each once.
   const std::vector<std::string>& warnings() const { return warnings_; }
 

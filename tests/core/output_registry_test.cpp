@@ -35,7 +35,8 @@ TEST(OutputRegistryTest, EveryIdHasOneDeclarationWhoseNameParsesBack) {
   EXPECT_FALSE(ParseSceneOutput("sweetspot").has_value());
   EXPECT_EQ(SceneOutputNameList(),
             "max_exit_speed, center_of_percussion, vibration_node, sweet_zone, exit_speed_curve, "
-            "least_sting_zone, barrel, bbcor, bbcor_scan, batted_ball");
+            "least_sting_zone, barrel, bbcor, bbcor_scan, batted_ball, distance_sweet_spot, "
+            "carry_map");
 }
 
 // An output another reads (needs_output) is computed first: the loop runs in table order.
@@ -57,7 +58,8 @@ TEST(OutputRegistryTest, WorkloadClassFollowsTheModels) {
     for (const CollisionModel m :
          {CollisionModel::kAuto, CollisionModel::kRigidPivot, CollisionModel::kFreeBat,
           CollisionModel::kHertz, CollisionModel::kFlexible}) {
-      bool iterative = false;
+      // The distance searches fly hundreds of balls whatever the model: compute too.
+      bool iterative = d->id == SceneOutput::kDistanceSweetSpot || d->id == SceneOutput::kCarryMap;
       for (const std::string& model : ModelsFor(d->id, m)) {
         iterative =
             iterative || model == kFlexibleBeamModel || model == "flexible" || model == "hertz";
