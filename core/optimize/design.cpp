@@ -18,6 +18,7 @@
 #include "core/flexible/modes.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/limits.hpp"
+#include "core/optimize/certificate_runs.hpp"
 #include "core/optimize/design_backends.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
@@ -437,6 +438,8 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     summary.solve_time_s = elapsed_s();
     return result;
   }
+  // Constraints that repeat another are merged before the solve (certificate.hpp).
+  result.merged_constraints = design_detail::MergeDuplicateConstraints(&model);
   const bool cor_known =
       problem.cor.has_value() || problem.bat.material.cor.has_value() || model.cor_from_barrel();
   result.cor = cor_known ? model.cor() : kNaN;
@@ -452,10 +455,11 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     const Clock::time_point deadline =
         shared_deadline.value_or(start + std::chrono::duration_cast<Clock::duration>(
                                              std::chrono::duration<double>(options.max_time_s)));
-    const std::vector<Run> runs = model.fixed_violations().empty()
-                                      ? RunStarts(model, options, backend, deadline, progress,
-                                                  progress_from, progress_to, &result)
-                                      : std::vector<Run>{};
+    std::vector<Run> runs = model.fixed_violations().empty()
+                                ? RunStarts(model, options, backend, deadline, progress,
+                                            progress_from, progress_to, &result)
+                                : std::vector<Run>{};
+    design_detail::CertifyRuns(model, options, &runs);
     FillSpread(runs, &result.spread);
 
     // The answer.
@@ -479,7 +483,10 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     const Run& chosen = runs[static_cast<std::size_t>(best)];
     ClassifyChosen(options, backend, chosen, pub, result.bat, &result);
     ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, &result);
-    ReportActiveConstraints(model, x, chosen.outcome, &result);
+    ReportActiveConstraints(
+        model, x, design_detail::WithCertifiedMultipliers(model, options, x, chosen.outcome, &result),
+        &result);
+    design_detail::FinishCertificate(chosen, &result);
     MarkCancelledMultiStart(options, runs, progress, &result);
     CheckBbcorRule(problem, pub, &result);
   } catch (const std::bad_alloc&) {

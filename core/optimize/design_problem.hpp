@@ -19,6 +19,7 @@
 #include "core/bat/bat.hpp"
 #include "core/bat/mass_properties.hpp"
 #include "core/bat/material.hpp"
+#include "core/optimize/certificate.hpp"
 #include "core/optimize/rules.hpp"
 #include "core/progress.hpp"
 #include "core/scene/collide.hpp"
@@ -291,6 +292,14 @@ struct DesignOptions {
   /// Most continuous variables a problem may have (>= 1). The api sets it from its configured
   /// limit (ApiLimits::max_design_variables, server flag --max-design-variables).
   int max_variables = 200;
+  /// The answer's certificate (DesignCertificate): largest relative stationarity residual of a
+  /// certified answer, in (0, 1). A solve whose backend reports convergence is converged only
+  /// when its certificate holds.
+  double stationarity_tolerance = kDefaultStationarityTolerance;
+  /// The certificate's largest violation, relative to each constraint's scale, in (0, 1).
+  double feasibility_tolerance = kDefaultFeasibilityTolerance;
+  /// The certificate's largest complementarity product (relative), in (0, 1).
+  double complementarity_tolerance = kDefaultComplementarityTolerance;
 
   /// True when every field is in range; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "field = value: rule".
@@ -357,6 +366,9 @@ enum class DesignMessageKind {
   kStingFailed,  ///< "the sting of the optimised bat cannot be computed: ...".
   kInfeasible,   ///< "infeasible: ..." (the conflicts), or the BBCOR rule's refusal of the answer.
   kNoDesign,     ///< "no local solve returned a design (...)".
+  /// The backend reported convergence but the certificate failed: "not certified: <status>
+  /// reported convergence but <what failed>; ...".
+  kNotCertified,
   kFailure,      ///< An internal failure ("out of memory", "failure: ...").
 };
 
@@ -468,6 +480,12 @@ struct DesignResult {
   /// problem (rules.bbcor.bbcor) recomputed on the answer by ComputeBbcor (BbcorRuleHolds; above
   /// the limit by more than the feasibility tolerance the termination is infeasible).
   std::optional<BbcorResult> bbcor;
+  /// The service's own first-order optimality check of the answer (not checked for min_sting,
+  /// refused input or no design). active_constraints' multipliers are its estimates, NaN when
+  /// certificate.multipliers_unique is false.
+  DesignCertificate certificate;
+  /// Constraints found before the solve to repeat another (or a variable's bounds) and merged.
+  std::vector<MergedConstraint> merged_constraints;
   /// Errors reported by Ipopt's derivative checker (-1 = not run).
   int derivative_check_errors = -1;
   std::string derivative_check_report;  ///< The checker's output (empty if not run).
