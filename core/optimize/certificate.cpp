@@ -295,7 +295,14 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
     Eigen::VectorXd probe(n);
     for (int j = 0; j < n; ++j) probe(j) = 1.0 + 0.5 * std::sin(1.0 + 0.7 * j);
     std::vector<std::pair<double, int>> signature;
+    // The model's own guards ("validity.*": a wall within every knot's radius, knots in order)
+    // are not the request's constraints: they are neither merged nor reported.
+    const auto& cs = model->constraints();
+    auto guard = [&cs](int k) {
+      return cs[static_cast<std::size_t>(k)].name.rfind("validity.", 0) == 0;
+    };
     for (int k = 0; k < m; ++k) {
+      if (guard(k)) continue;
       Eigen::VectorXd row = j0.row(k).transpose();
       const double norm = row.norm();
       if (!(norm > 0.0) || !row.allFinite()) continue;  // fixed: no variable changes it
@@ -331,7 +338,6 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
       return std::isfinite(*a) && *a != 0.0 && std::isfinite(*b);
     };
 
-    const auto& cs = model->constraints();
     std::vector<bool> removed(static_cast<std::size_t>(m), false);
     for (std::size_t p = 0; p < signature.size(); ++p) {
       for (std::size_t q = p + 1; q < signature.size(); ++q) {
@@ -385,7 +391,7 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
     // A constraint on one variable alone whose limit is one of the variable's bounds and whose
     // range contains them: both would be active together.
     for (int k = 0; k < m; ++k) {
-      if (removed[static_cast<std::size_t>(k)]) continue;
+      if (removed[static_cast<std::size_t>(k)] || guard(k)) continue;
       int var = -1;
       bool single = true;
       for (const DesignPoint& pt : points) {

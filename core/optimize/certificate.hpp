@@ -94,7 +94,8 @@ DesignCertificate Certify(const DesignModel& model, const std::vector<double>& x
 
 /// Finds the constraints of `model` that repeat another one (the same function up to an affine
 /// map, checked on the exact gradients and values at three points of the box: the base design,
-/// the middle, and 0.3 of the way) or a variable's bounds, and removes each one whose range (in
+/// the middle, and 0.3 of the way) or a variable's bounds (the model's own "validity.*" guards
+/// aside), and removes each one whose range (in
 /// the other's quantity) contains the other's: *model becomes the model without them. A pair whose
 /// ranges cross is kept (the certificate's uniqueness check reports the multipliers). Returns
 /// what was removed. Never throws.
