@@ -189,6 +189,25 @@ TEST(CertificateMerge, DropInsideTheWeightRangeOrWithAVariableLengthStays) {
   EXPECT_EQ(variable.m(), m);
 }
 
+// A barrel limit of exactly twice every radius's upper bound repeats the bounds: each knot's
+// limit is merged into its variable's bounds (both would be active together); a limit 1e-6 m
+// inside them is a constraint of its own and stays.
+TEST(CertificateMerge, DiameterLimitRepeatingTheBoundsIsMergedIntoThem) {
+  DesignProblem p = Knots(0.86);
+  p.constraints.rules.clear();
+  p.constraints.max_barrel_diameter_m = 2.0 * 0.0332;
+  DesignModel model;
+  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, nullptr));
+  const std::vector<MergedConstraint> merged = MergeDuplicateConstraints(&model);
+  ASSERT_EQ(merged.size(), 14u);  // knots 1..14 (0 and 15 are fixed: no variable moves them)
+  EXPECT_EQ(merged[0].name, "max_barrel_diameter_m.knots[1]");
+  EXPECT_EQ(merged[0].into, "profile.knots[1].radius_m");
+  p.constraints.max_barrel_diameter_m = 2.0 * 0.0332 - 1e-6;
+  DesignModel inside;
+  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &inside, nullptr));
+  EXPECT_TRUE(MergeDuplicateConstraints(&inside).empty());
+}
+
 TEST(CertificateOptions, TolerancesAreValidated) {
   for (const char* field :
        {"stationarity_tolerance", "feasibility_tolerance", "complementarity_tolerance"}) {
