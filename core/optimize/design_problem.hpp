@@ -330,9 +330,10 @@ struct DesignActiveConstraint {
   double value = 0.0;  ///< The constrained quantity at the optimum.
   double bound = 0.0;  ///< The limit it sits on.
   /// Sensitivity of the optimal objective to the bound: objective unit per constraint unit
-  /// (first order, from the solver's multiplier). Positive: raising the bound raises the
-  /// objective value (better when maximising, worse when minimising). NaN for min_sting (the
-  /// sting has no derivative, so no multiplier can be estimated).
+  /// (first order, the certificate's own multiplier estimate, never the backend's). Positive:
+  /// raising the bound raises the objective value (better when maximising, worse when
+  /// minimising). NaN for min_sting (the sting has no derivative, so no multiplier can be
+  /// estimated) and when the active gradients are dependent (no unique multiplier).
   double multiplier = 0.0;
 };
 
@@ -429,8 +430,8 @@ struct DesignFrequency {
 };
 
 /// The answer of OptimizeDesign. The summary is always filled:
-/// - termination: converged (Ipopt converged and the design meets every constraint when
-///   re-checked through ComputeMassProperties), no_convergence (stopped by iterations, time,
+/// - termination: converged (the backend converged, its answer's certificate holds and the
+///   design meets every constraint when re-checked through ComputeMassProperties), no_convergence (stopped by iterations, time,
 ///   cancellation or round-off; best design kept), infeasible (no design meets the
 ///   constraints: `conflicts` says why; the least-violating design is returned), failure,
 ///   invalid_input (message names the field; the bat is the base design);
@@ -438,8 +439,9 @@ struct DesignFrequency {
 ///   of the chosen start (Ipopt ApplicationReturnStatus, NLopt result); iterations and
 ///   evaluations summed over all solves; objective = objective_value; constraint_violation =
 ///   the largest violation of a constraint or bound, each in its own unit, re-checked through
-///   the public mass properties; error_estimate = the relative first-order optimality (KKT)
-///   residual of the scaled problem at the answer (NaN for min_sting: no derivative);
+///   the public mass properties; error_estimate = certificate.stationarity, the relative
+///   first-order optimality (KKT) residual of the scaled problem at the answer (NaN for
+///   min_sting: no derivative);
 ///   solve_time_s = wall time of the call.
 struct DesignResult {
   Summary summary;  ///< How it went (see above).
