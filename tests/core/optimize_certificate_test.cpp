@@ -12,8 +12,10 @@
 #include <Eigen/Dense>
 
 #include "core/bat/material.hpp"
+#include "core/optimize/certificate_runs.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
+#include "core/optimize/design_runs.hpp"
 #include "core/units.hpp"
 
 namespace sweetspot::core {
@@ -139,6 +141,41 @@ TEST(Certificate, HoldsAtTheOptimumAndNotAtTheStart) {
     EXPECT_FALSE(tight.certified);
     EXPECT_NE(tight.failed.find("stationarity"), std::string::npos) << tight.failed;
   }
+}
+
+// The multi-start's choice: a start that reported convergence where the certificate fails is
+// no_convergence after CertifyRuns, so a certified start is chosen over it even with a worse
+// objective (here the uncertified start's objective is set above every design's).
+TEST(Certificate, MultiStartPrefersACertifiedStart) {
+  const DesignProblem p = Family();
+  const DesignResult answer = OptimizeDesign(p);
+  ASSERT_TRUE(answer.certificate.certified);
+  DesignModel model;
+  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, nullptr));
+  std::vector<double> optimum;
+  for (const DesignValue& v : answer.variables) optimum.push_back(v.value);
+  // Start 0: 1 mm off the optimum in the taper start, claimed converged, feasible and with an
+  // objective above every design's; start 1: the optimum, converged.
+  std::vector<design_detail::Run> runs(2);
+  runs[0].x = optimum;
+  runs[0].x[0] -= 1e-3;  // off the mass, not stationary (inward: the optimum may sit at 0.5)
+  ASSERT_GE(runs[0].x[0], 0.1);  // still inside the taper start's bounds (else clamped back)
+  runs[0].outcome.termination = Termination::kConverged;
+  runs[0].feasible = true;  // as claimed: the choice is under test, not Finish
+  runs[0].violation = 0.0;
+  runs[0].objective = 1e3;  // better than any design
+  runs[1].x = optimum;
+  runs[1].outcome.termination = Termination::kConverged;
+  runs[1].feasible = true;
+  runs[1].violation = 0.0;
+  runs[1].objective = answer.objective_value;
+  design_detail::CertifyRuns(model, DesignOptions{}, &runs);
+  EXPECT_TRUE(runs[0].uncertified);
+  EXPECT_EQ(runs[0].outcome.termination, Termination::kNoConvergence);
+  EXPECT_NE(runs[0].outcome.message.find("first-order conditions do not hold"), std::string::npos);
+  EXPECT_FALSE(runs[1].uncertified);
+  EXPECT_EQ(runs[1].outcome.termination, Termination::kConverged);
+  EXPECT_EQ(design_detail::ChooseRun(model, runs), 1);
 }
 
 // A 16-knot solid bat at 33 in: the bbcor drop (length_in - weight_oz <= 3) is the weight's
