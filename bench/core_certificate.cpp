@@ -2,7 +2,7 @@
 // of duplicated constraints (once per request, before the solve) and the certificate with its
 // uniqueness check (at the answer), on the n-knot problem of bench/scipy_peers.py's design16
 // (Ipopt, exact Hessian). Arg: knots.
-// Run: build/bench/sweetspot_bench_core --benchmark_filter='Certif|MergeDuplicate' 
+// Run: build/bench/sweetspot_bench_core --benchmark_filter='Certif|MergeDuplicate'
 #include <benchmark/benchmark.h>
 
 #include <cmath>

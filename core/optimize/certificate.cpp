@@ -91,7 +91,8 @@ Eigen::VectorXd NonNegativeLeastSquares(const Eigen::MatrixXd& a, const Eigen::V
     Eigen::VectorXd z = Eigen::VectorXd::Zero(k);
     if (idx.empty()) return z;
     Eigen::MatrixXd ap(a.rows(), static_cast<Eigen::Index>(idx.size()));
-    for (std::size_t q = 0; q < idx.size(); ++q) ap.col(static_cast<Eigen::Index>(q)) = a.col(idx[q]);
+    for (std::size_t q = 0; q < idx.size(); ++q)
+      ap.col(static_cast<Eigen::Index>(q)) = a.col(idx[q]);
     const Eigen::VectorXd zp = ap.completeOrthogonalDecomposition().solve(b);
     for (std::size_t q = 0; q < idx.size(); ++q) z(idx[q]) = zp(static_cast<Eigen::Index>(q));
     return z;
@@ -101,12 +102,13 @@ Eigen::VectorXd NonNegativeLeastSquares(const Eigen::MatrixXd& a, const Eigen::V
     const std::vector<bool> all(static_cast<std::size_t>(k), true);
     const Eigen::VectorXd z = solve_passive(all);
     bool ok = true;
-    for (Eigen::Index i = 0; i < k; ++i) ok = ok && (free[static_cast<std::size_t>(i)] || z(i) >= 0.0);
+    for (Eigen::Index i = 0; i < k; ++i)
+      ok = ok && (free[static_cast<std::size_t>(i)] || z(i) >= 0.0);
     if (ok) return z;
   }
   c = solve_passive(passive);  // the free columns alone
-  const double scale = std::max(1.0, b.lpNorm<Eigen::Infinity>()) *
-                       std::max(1.0, a.cwiseAbs().maxCoeff());
+  const double scale =
+      std::max(1.0, b.lpNorm<Eigen::Infinity>()) * std::max(1.0, a.cwiseAbs().maxCoeff());
   const double tol = 1e-13 * scale;
   std::vector<bool> excluded(static_cast<std::size_t>(k), false);
   for (int outer = 0; outer < 3 * static_cast<int>(k) + 10; ++outer) {
@@ -360,8 +362,8 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
         // limit strictly inside the other's range never binds and changes nothing.
         const bool shares = (std::isfinite(lo) && (std::abs(lo - cl.lower) <= slop ||
                                                    std::abs(lo - cl.upper) <= slop)) ||
-                            (std::isfinite(hi) && (std::abs(hi - cl.lower) <= slop ||
-                                                   std::abs(hi - cl.upper) <= slop));
+                            (std::isfinite(hi) &&
+                             (std::abs(hi - cl.lower) <= slop || std::abs(hi - cl.upper) <= slop));
         if (!shares) continue;
         int drop = -1, keep = -1;
         if (Contains(lo, hi, cl.lower, cl.upper, slop)) {
@@ -380,8 +382,10 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
         mc.into = kept.name;
         mc.message = d.name + " (" + RangeText(d.lower, d.upper, d.unit) + ") and " + kept.name +
                      " (" + RangeText(kept.lower, kept.upper, kept.unit) +
-                     ") constrain the same quantity (" + relation + " for every design the "
-                     "variables give) and share a limit: " + kept.name + " implies " + d.name +
+                     ") constrain the same quantity (" + relation +
+                     " for every design the "
+                     "variables give) and share a limit: " +
+                     kept.name + " implies " + d.name +
                      ", which is merged into it (its multiplier would not be unique)";
         merged.push_back(std::move(mc));
         removed[static_cast<std::size_t>(drop)] = true;
@@ -419,10 +423,11 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
       MergedConstraint mc;
       mc.name = c.name;
       mc.into = v.path;
-      mc.message = c.name + " (" + RangeText(c.lower, c.upper, c.unit) + ") repeats a bound of " +
-                   v.path + " (in [" + FormatNumber(v.lower) + ", " + FormatNumber(v.upper) +
-                   "]) and shares a limit with them: the bounds imply it, so it is merged into them (its "
-                   "multiplier would not be unique)";
+      mc.message =
+          c.name + " (" + RangeText(c.lower, c.upper, c.unit) + ") repeats a bound of " + v.path +
+          " (in [" + FormatNumber(v.lower) + ", " + FormatNumber(v.upper) +
+          "]) and shares a limit with them: the bounds imply it, so it is merged into them (its "
+          "multiplier would not be unique)";
       merged.push_back(std::move(mc));
       removed[static_cast<std::size_t>(k)] = true;
     }

@@ -46,11 +46,11 @@ struct DesignCertificate {
   /// False when no check was made (the input was refused, no design was returned, or the
   /// objective has no derivative: min_sting); the numbers are then NaN and certified false.
   bool checked = false;
-  double stationarity = std::numeric_limits<double>::quiet_NaN();     ///< See above.
-  double feasibility = std::numeric_limits<double>::quiet_NaN();      ///< See above.
-  double complementarity = std::numeric_limits<double>::quiet_NaN();  ///< See above.
-  double stationarity_tolerance = kDefaultStationarityTolerance;      ///< Its limit.
-  double feasibility_tolerance = kDefaultFeasibilityTolerance;        ///< Its limit.
+  double stationarity = std::numeric_limits<double>::quiet_NaN();       ///< See above.
+  double feasibility = std::numeric_limits<double>::quiet_NaN();        ///< See above.
+  double complementarity = std::numeric_limits<double>::quiet_NaN();    ///< See above.
+  double stationarity_tolerance = kDefaultStationarityTolerance;        ///< Its limit.
+  double feasibility_tolerance = kDefaultFeasibilityTolerance;          ///< Its limit.
   double complementarity_tolerance = kDefaultComplementarityTolerance;  ///< Its limit.
   bool certified = false;  ///< Every condition within its tolerance.
   /// The active constraints' and bounds' gradients are linearly independent (LICQ), so the

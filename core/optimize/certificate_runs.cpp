@@ -26,15 +26,15 @@ void CertifyRuns(const DesignModel& model, const DesignOptions& options, std::ve
     if (!cert.checked || cert.certified) continue;
     run.uncertified = true;
     run.outcome.termination = Termination::kNoConvergence;
-    run.outcome.message = (run.outcome.message.empty() ? "" : run.outcome.message + "; ") +
-                          "reported convergence, but the first-order conditions do not hold: " +
-                          cert.failed;
+    run.outcome.message =
+        (run.outcome.message.empty() ? "" : run.outcome.message + "; ") +
+        "reported convergence, but the first-order conditions do not hold: " + cert.failed;
   }
 }
 
 LocalSolveOutcome WithCertifiedMultipliers(const DesignModel& model, const DesignOptions& options,
-                                           const std::vector<double>& x,
-                                           const LocalSolveOutcome& o, DesignResult* result) {
+                                           const std::vector<double>& x, const LocalSolveOutcome& o,
+                                           DesignResult* result) {
   result->certificate = Certify(model, x, TolerancesFrom(options), true);
   LocalSolveOutcome out = o;
   const DesignCertificate& c = result->certificate;
@@ -63,7 +63,8 @@ void FinishCertificate(const Run& chosen, DesignResult* result) {
       result->summary.termination == Termination::kNoConvergence) {
     result->summary.message = "not certified: " + chosen.outcome.status_name +
                               " reported convergence, but the first-order conditions do not "
-                              "hold at its design (" + c.failed + "); the design is kept";
+                              "hold at its design (" +
+                              c.failed + "); the design is kept";
     result->message_kind = DesignMessageKind::kNotCertified;
   }
 }

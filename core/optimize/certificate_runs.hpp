@@ -24,8 +24,8 @@ void CertifyRuns(const DesignModel& model, const DesignOptions& options, std::ve
 /// solve `o` with the certificate's multipliers in place of the backend's (for
 /// ReportActiveConstraints); `o` unchanged when no certificate could be made (min_sting).
 LocalSolveOutcome WithCertifiedMultipliers(const DesignModel& model, const DesignOptions& options,
-                                           const std::vector<double>& x,
-                                           const LocalSolveOutcome& o, DesignResult* result);
+                                           const std::vector<double>& x, const LocalSolveOutcome& o,
+                                           DesignResult* result);
 
 /// After ReportActiveConstraints: error_estimate is the certificate's stationarity; multipliers
 /// that are not unique become NaN (with a warning); the message of a chosen run that reported

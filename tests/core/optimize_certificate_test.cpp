@@ -23,8 +23,8 @@ namespace sweetspot::core {
 namespace optimize_certificate_test {
 namespace {
 
-using design_detail::Certify;
 using design_detail::CertificateTolerances;
+using design_detail::Certify;
 using design_detail::MergeDuplicateConstraints;
 using design_detail::NonNegativeLeastSquares;
 
@@ -42,9 +42,11 @@ double BruteForceResidual(const Eigen::MatrixXd& a, const Eigen::VectorXd& b,
     for (int i = 0; i < k; ++i)
       if (mask >> i & 1) idx.push_back(i);
     Eigen::MatrixXd ap(a.rows(), static_cast<Eigen::Index>(idx.size()));
-    for (std::size_t q = 0; q < idx.size(); ++q) ap.col(static_cast<Eigen::Index>(q)) = a.col(idx[q]);
-    const Eigen::VectorXd z =
-        idx.empty() ? Eigen::VectorXd() : Eigen::VectorXd(ap.completeOrthogonalDecomposition().solve(b));
+    for (std::size_t q = 0; q < idx.size(); ++q)
+      ap.col(static_cast<Eigen::Index>(q)) = a.col(idx[q]);
+    const Eigen::VectorXd z = idx.empty()
+                                  ? Eigen::VectorXd()
+                                  : Eigen::VectorXd(ap.completeOrthogonalDecomposition().solve(b));
     bool ok = true;
     for (std::size_t q = 0; q < idx.size(); ++q) ok = ok && (free[idx[q]] || z(q) >= 0.0);
     if (!ok) continue;

@@ -122,7 +122,8 @@ std::vector<CoreCase> CertificateCases() {
        },
        Reference(
            [] {
-             const long double v0 = IpoptOptimum(BbcorAtThirtyOunces(core::DesignRange::Equal(30.0)));
+             const long double v0 =
+                 IpoptOptimum(BbcorAtThirtyOunces(core::DesignRange::Equal(30.0)));
              const long double v1 =
                  IpoptOptimum(BbcorAtThirtyOunces(core::DesignRange::Equal(30.001)));
              return (v1 - v0) / core::OuncesToKilograms(0.001);
