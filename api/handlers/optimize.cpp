@@ -166,6 +166,9 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
   reader.OptionalNumber("tolerance", AnyNumber(), &o->tolerance);
   reader.OptionalNumber("constraint_tolerance", AnyNumber(), &o->constraint_tolerance);
   reader.OptionalBool("explain_infeasibility", &o->explain_infeasibility);
+  reader.OptionalNumber("stationarity_tolerance", AnyNumber(), &o->stationarity_tolerance);
+  reader.OptionalNumber("feasibility_tolerance", AnyNumber(), &o->feasibility_tolerance);
+  reader.OptionalNumber("complementarity_tolerance", AnyNumber(), &o->complementarity_tolerance);
   if (const Json* f = reader.Get("flexible")) {
     if (!ReadFlexibleOptions(*f, reader.PathOf("flexible"), limits, flexible, top.error())) {
       return false;
@@ -289,6 +292,26 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
                        {"objective_max", Finite(r.spread.objective_max)},
                        {"objective_median", Finite(r.spread.objective_median)},
                        {"runs", std::move(runs)}};
+  // The service's own first-order check of the answer (core/optimize/certificate.hpp).
+  const core::DesignCertificate& cert = r.certificate;
+  summary["certificate"] = {{"checked", cert.checked},
+                            {"certified", cert.certified},
+                            {"stationarity", Finite(cert.stationarity)},
+                            {"feasibility", Finite(cert.feasibility)},
+                            {"complementarity", Finite(cert.complementarity)},
+                            {"stationarity_tolerance", cert.stationarity_tolerance},
+                            {"feasibility_tolerance", cert.feasibility_tolerance},
+                            {"complementarity_tolerance", cert.complementarity_tolerance},
+                            {"multipliers_unique", cert.multipliers_unique},
+                            {"active", cert.active},
+                            {"failed", cert.failed}};
+  if (!r.merged_constraints.empty()) {
+    Json merged = Json::array();
+    for (const core::MergedConstraint& m : r.merged_constraints) {
+      merged.push_back({{"name", m.name}, {"into", m.into}, {"message", m.message}});
+    }
+    summary["merged_constraints"] = std::move(merged);
+  }
   if (r.derivative_check_errors >= 0) {
     summary["derivative_check"] = {{"errors", r.derivative_check_errors},
                                    {"report", r.derivative_check_report}};

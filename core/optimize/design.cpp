@@ -19,6 +19,7 @@
 #include "core/geometry_format.hpp"
 #include "core/numerics/limits.hpp"
 #include "core/optimize/bbcor_constraint.hpp"
+#include "core/optimize/certificate_runs.hpp"
 #include "core/optimize/design_backends.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
@@ -435,6 +436,8 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
     summary.solve_time_s = elapsed_s();
     return result;
   }
+  // Constraints that repeat another are merged before the solve (certificate.hpp).
+  result.merged_constraints = design_detail::MergeDuplicateConstraints(&model);
   const bool cor_known =
       problem.cor.has_value() || problem.bat.material.cor.has_value() || model.cor_from_barrel();
   result.cor = cor_known ? model.cor() : kNaN;
@@ -450,10 +453,11 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
     const Clock::time_point deadline =
         shared_deadline.value_or(start + std::chrono::duration_cast<Clock::duration>(
                                              std::chrono::duration<double>(options.max_time_s)));
-    const std::vector<Run> runs = model.fixed_violations().empty()
-                                      ? RunStarts(model, options, backend, deadline, progress,
-                                                  progress_from, progress_to, &result)
-                                      : std::vector<Run>{};
+    std::vector<Run> runs = model.fixed_violations().empty()
+                                ? RunStarts(model, options, backend, deadline, progress,
+                                            progress_from, progress_to, &result)
+                                : std::vector<Run>{};
+    design_detail::CertifyRuns(model, options, &runs);
     FillSpread(runs, &result.spread);
 
     // The answer.
@@ -477,7 +481,10 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
     const Run& chosen = runs[static_cast<std::size_t>(best)];
     ClassifyChosen(options, backend, chosen, pub, result.bat, &result);
     ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, &result);
-    ReportActiveConstraints(model, x, chosen.outcome, &result);
+    ReportActiveConstraints(
+        model, x, design_detail::WithCertifiedMultipliers(model, options, x, chosen.outcome, &result),
+        &result);
+    design_detail::FinishCertificate(chosen, &result);
     MarkCancelledMultiStart(options, runs, progress, &result);
     CheckBbcorRule(problem, pub, &result);
   } catch (const std::bad_alloc&) {

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "core/geometry_format.hpp"
 #include "core/optimize/design_model.hpp"
@@ -115,6 +116,15 @@ bool DesignOptions::Validate(Refusal* why) const {
   if (!std::isfinite(constraint_tolerance) || !(constraint_tolerance > 0.0) ||
       !(constraint_tolerance < 1.0)) {
     return Refuse(why, "constraint_tolerance", constraint_tolerance, "must be in (0, 1)");
+  }
+  const std::pair<const char*, double> certificate[] = {
+      {"stationarity_tolerance", stationarity_tolerance},
+      {"feasibility_tolerance", feasibility_tolerance},
+      {"complementarity_tolerance", complementarity_tolerance}};
+  for (const auto& [name, value] : certificate) {
+    if (!std::isfinite(value) || !(value > 0.0) || !(value < 1.0)) {
+      return Refuse(why, name, value, "must be in (0, 1)");
+    }
   }
   if (starts < 1 || starts > 64) return Refuse(why, "starts", starts, "must be between 1 and 64");
   if (!std::isfinite(min_knot_gap_m) || !(min_knot_gap_m > 0.0) || min_knot_gap_m > 0.1) {

@@ -19,6 +19,7 @@
 #include "core/bat/bat.hpp"
 #include "core/bat/mass_properties.hpp"
 #include "core/bat/material.hpp"
+#include "core/optimize/certificate.hpp"
 #include "core/optimize/rules.hpp"
 #include "core/progress.hpp"
 #include "core/scene/collide.hpp"
@@ -300,6 +301,14 @@ struct DesignOptions {
   /// Most continuous variables a problem may have (>= 1). The api sets it from its configured
   /// limit (ApiLimits::max_design_variables, server flag --max-design-variables).
   int max_variables = 200;
+  /// The answer's certificate (DesignCertificate): largest relative stationarity residual of a
+  /// certified answer, in (0, 1). A solve whose backend reports convergence is converged only
+  /// when its certificate holds.
+  double stationarity_tolerance = kDefaultStationarityTolerance;
+  /// The certificate's largest violation, relative to each constraint's scale, in (0, 1).
+  double feasibility_tolerance = kDefaultFeasibilityTolerance;
+  /// The certificate's largest complementarity product (relative), in (0, 1).
+  double complementarity_tolerance = kDefaultComplementarityTolerance;
 
   /// True when every field is in range; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "field = value: rule".
@@ -330,9 +339,10 @@ struct DesignActiveConstraint {
   double value = 0.0;  ///< The constrained quantity at the optimum.
   double bound = 0.0;  ///< The limit it sits on.
   /// Sensitivity of the optimal objective to the bound: objective unit per constraint unit
-  /// (first order, from the solver's multiplier). Positive: raising the bound raises the
-  /// objective value (better when maximising, worse when minimising). NaN for min_sting (the
-  /// sting has no derivative, so no multiplier can be estimated).
+  /// (first order, the certificate's own multiplier estimate, never the backend's). Positive:
+  /// raising the bound raises the objective value (better when maximising, worse when
+  /// minimising). NaN for min_sting (the sting has no derivative, so no multiplier can be
+  /// estimated) and when the active gradients are dependent (no unique multiplier).
   double multiplier = 0.0;
 };
 
@@ -366,6 +376,9 @@ enum class DesignMessageKind {
   kStingFailed,  ///< "the sting of the optimised bat cannot be computed: ...".
   kInfeasible,   ///< "infeasible: ..." (the conflicts), or the BBCOR rule's refusal of the answer.
   kNoDesign,     ///< "no local solve returned a design (...)".
+  /// The backend reported convergence but the certificate failed: "not certified: <status>
+  /// reported convergence but <what failed>; ...".
+  kNotCertified,
   kFailure,      ///< An internal failure ("out of memory", "failure: ...").
 };
 
@@ -426,8 +439,8 @@ struct DesignFrequency {
 };
 
 /// The answer of OptimizeDesign. The summary is always filled:
-/// - termination: converged (Ipopt converged and the design meets every constraint when
-///   re-checked through ComputeMassProperties), no_convergence (stopped by iterations, time,
+/// - termination: converged (the backend converged, its answer's certificate holds and the
+///   design meets every constraint when re-checked through ComputeMassProperties), no_convergence (stopped by iterations, time,
 ///   cancellation or round-off; best design kept), infeasible (no design meets the
 ///   constraints: `conflicts` says why; the least-violating design is returned), failure,
 ///   invalid_input (message names the field; the bat is the base design);
@@ -435,8 +448,9 @@ struct DesignFrequency {
 ///   of the chosen start (Ipopt ApplicationReturnStatus, NLopt result); iterations and
 ///   evaluations summed over all solves; objective = objective_value; constraint_violation =
 ///   the largest violation of a constraint or bound, each in its own unit, re-checked through
-///   the public mass properties; error_estimate = the relative first-order optimality (KKT)
-///   residual of the scaled problem at the answer (NaN for min_sting: no derivative);
+///   the public mass properties; error_estimate = certificate.stationarity, the relative
+///   first-order optimality (KKT) residual of the scaled problem at the answer (NaN for
+///   min_sting: no derivative);
 ///   solve_time_s = wall time of the call.
 struct DesignResult {
   Summary summary;  ///< How it went (see above).
@@ -481,6 +495,12 @@ struct DesignResult {
   /// bound) and the last one's estimate offset (scan maximum - estimate, dimensionless).
   int bbcor_rounds = 0;
   double bbcor_estimate_offset = 0.0;  ///< Dimensionless.
+  /// The service's own first-order optimality check of the answer (not checked for min_sting,
+  /// refused input or no design). active_constraints' multipliers are its estimates, NaN when
+  /// certificate.multipliers_unique is false.
+  DesignCertificate certificate;
+  /// Constraints found before the solve to repeat another (or a variable's bounds) and merged.
+  std::vector<MergedConstraint> merged_constraints;
   /// Errors reported by Ipopt's derivative checker (-1 = not run).
   int derivative_check_errors = -1;
   std::string derivative_check_report;  ///< The checker's output (empty if not run).

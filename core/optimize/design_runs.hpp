@@ -25,6 +25,9 @@ struct Run {
   double objective = std::numeric_limits<double>::quiet_NaN();  ///< Model objective at x.
   double violation = std::numeric_limits<double>::infinity();   ///< Largest scaled violation.
   bool feasible = false;  ///< violation <= kFeasibleRelative.
+  /// The solver reported convergence but the certificate failed (its termination is then
+  /// no_convergence, its message what failed).
+  bool uncertified = false;
 };
 
 /// Evaluates the end of a local solve (clamped into the bounds, objective, violation).

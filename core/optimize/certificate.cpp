@@ -1,0 +1,446 @@
+// The certificate of a design answer and the merge of duplicated constraints. See
+// certificate.hpp.
+#include "core/optimize/certificate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "core/geometry_format.hpp"
+#include "core/numerics/limits.hpp"
+#include "core/optimize/design_model.hpp"
+
+namespace sweetspot::core::design_detail {
+namespace {
+
+// Columns whose smallest singular value (unit columns, column-pivoted QR) is below this are
+// dependent: the multipliers are then not unique. An exact duplicate (a drop limit with the
+// length fixed beside a mass limit) gives ~1e-16; independent active sets of the design problems
+// give >= 1e-4 (taper chains, bounds, mass and balance).
+constexpr double kDependentColumns = 1e-9;
+
+// Two constraints are the same function up to c_k = a c_l + b when, at every test point, the
+// gradients agree to this (relative, max norm) and a and b stay the same to it: exact gradients
+// of the same integrals agree to rounding (~1e-15).
+constexpr double kDuplicateRelative = 1e-9;
+
+// A column of the fit: a constraint's or a bound's gradient with the sign its multiplier has.
+struct Column {
+  enum Kind { kConstraint, kLower, kUpper } kind = kConstraint;
+  int index = 0;       // constraint or variable index
+  double sign = 1.0;   // +1: upper side (or an equality), -1: lower side
+  double slack = 0.0;  // scaled distance to the limit (>= 0)
+  bool free = false;   // equality: either sign
+};
+
+std::string RangeText(double lo, double hi, const std::string& unit) {
+  const std::string u = unit.empty() ? "" : " " + unit;
+  if (lo == hi) return "= " + FormatNumber(lo) + u;
+  if (std::isfinite(lo) && std::isfinite(hi))
+    return "in [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]" + u;
+  if (std::isfinite(hi)) return "<= " + FormatNumber(hi) + u;
+  return ">= " + FormatNumber(lo) + u;
+}
+
+// Six significant digits (the relations of merged constraints).
+std::string Short(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", v);
+  return buffer;
+}
+
+// [lo, hi] contains [a, b] (to rounding of the affine map: `slop`).
+bool Contains(double lo, double hi, double a, double b, double slop) {
+  return lo <= a + slop && hi >= b - slop;
+}
+
+// The test points: the base design, the box's middle and 0.3 of the way across it.
+std::vector<std::vector<double>> TestPoints(const DesignModel& model) {
+  std::vector<std::vector<double>> points = {model.BaseX()};
+  for (double t : {0.5, 0.3}) {
+    std::vector<double> x(static_cast<std::size_t>(model.n()));
+    for (std::size_t j = 0; j < x.size(); ++j) {
+      const DesignVariableSpec& v = model.variables()[j];
+      x[j] = v.lower + t * (v.upper - v.lower);
+    }
+    points.push_back(std::move(x));
+  }
+  return points;
+}
+
+}  // namespace
+
+Eigen::VectorXd NonNegativeLeastSquares(const Eigen::MatrixXd& a, const Eigen::VectorXd& b,
+                                        const std::vector<bool>& free) {
+  const Eigen::Index k = a.cols();
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(k);
+  if (k == 0) return c;
+  std::vector<bool> passive(free.begin(), free.end());
+  // Least squares over the passive columns (minimum norm when they are dependent).
+  auto solve_passive = [&](const std::vector<bool>& p) {
+    std::vector<Eigen::Index> idx;
+    for (Eigen::Index i = 0; i < k; ++i)
+      if (p[static_cast<std::size_t>(i)]) idx.push_back(i);
+    Eigen::VectorXd z = Eigen::VectorXd::Zero(k);
+    if (idx.empty()) return z;
+    Eigen::MatrixXd ap(a.rows(), static_cast<Eigen::Index>(idx.size()));
+    for (std::size_t q = 0; q < idx.size(); ++q)
+      ap.col(static_cast<Eigen::Index>(q)) = a.col(idx[q]);
+    const Eigen::VectorXd zp = ap.completeOrthogonalDecomposition().solve(b);
+    for (std::size_t q = 0; q < idx.size(); ++q) z(idx[q]) = zp(static_cast<Eigen::Index>(q));
+    return z;
+  };
+  // Most answers: every column's least-squares coefficient already has its sign.
+  {
+    const std::vector<bool> all(static_cast<std::size_t>(k), true);
+    const Eigen::VectorXd z = solve_passive(all);
+    bool ok = true;
+    for (Eigen::Index i = 0; i < k; ++i)
+      ok = ok && (free[static_cast<std::size_t>(i)] || z(i) >= 0.0);
+    if (ok) return z;
+  }
+  c = solve_passive(passive);  // the free columns alone
+  const double scale =
+      std::max(1.0, b.lpNorm<Eigen::Infinity>()) * std::max(1.0, a.cwiseAbs().maxCoeff());
+  const double tol = 1e-13 * scale;
+  std::vector<bool> excluded(static_cast<std::size_t>(k), false);
+  for (int outer = 0; outer < 3 * static_cast<int>(k) + 10; ++outer) {
+    const Eigen::VectorXd w = a.transpose() * (b - a * c);
+    Eigen::Index j = -1;
+    double best = tol;
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const auto ii = static_cast<std::size_t>(i);
+      if (passive[ii] || excluded[ii]) continue;
+      if (w(i) > best) {
+        best = w(i);
+        j = i;
+      }
+    }
+    if (j < 0) break;
+    passive[static_cast<std::size_t>(j)] = true;
+    for (int inner = 0; inner < 3 * static_cast<int>(k) + 10; ++inner) {
+      const Eigen::VectorXd z = solve_passive(passive);
+      bool feasible = true;
+      double alpha = 1.0;
+      for (Eigen::Index i = 0; i < k; ++i) {
+        const auto ii = static_cast<std::size_t>(i);
+        if (!passive[ii] || free[ii] || z(i) > 0.0) continue;
+        feasible = false;
+        const double denom = c(i) - z(i);
+        alpha = std::min(alpha, denom > 0.0 ? c(i) / denom : 0.0);
+      }
+      if (feasible) {
+        c = z;
+        break;
+      }
+      c += alpha * (z - c);
+      bool dropped = false;
+      for (Eigen::Index i = 0; i < k; ++i) {
+        const auto ii = static_cast<std::size_t>(i);
+        if (passive[ii] && !free[ii] && c(i) <= 0.0) {
+          passive[ii] = false;
+          c(i) = 0.0;
+          dropped = true;
+          // A column that leaves at once adds nothing (dependent on the passive ones): not
+          // tried again this round.
+          if (i == j) excluded[ii] = true;
+        }
+      }
+      if (!dropped) break;
+    }
+    for (Eigen::Index i = 0; i < k; ++i)
+      if (passive[static_cast<std::size_t>(i)]) excluded[static_cast<std::size_t>(i)] = false;
+  }
+  return c;
+}
+
+DesignCertificate Certify(const DesignModel& model, const std::vector<double>& x,
+                          const CertificateTolerances& tolerances, bool check_uniqueness) {
+  DesignCertificate cert;
+  cert.stationarity_tolerance = tolerances.stationarity;
+  cert.feasibility_tolerance = tolerances.feasibility;
+  cert.complementarity_tolerance = tolerances.complementarity;
+  if (model.derivative_free() || x.size() != static_cast<std::size_t>(model.n())) return cert;
+  try {
+    ScaledDesignNlp nlp(model);
+    std::vector<double> s = nlp.ToScaled(x);
+    for (double& v : s) v = std::clamp(v, 0.0, 1.0);
+    if (!nlp.Evaluate(s.data(), true)) return cert;
+    const int n = nlp.n(), m = nlp.m();
+    std::vector<double> lower, upper;
+    nlp.ConstraintBounds(&lower, &upper);
+    const Eigen::VectorXd grad = nlp.grad_f();
+    const double g_norm = std::max(1.0, grad.lpNorm<Eigen::Infinity>());
+    const double act = kCertificateActiveTolerance;
+
+    std::vector<Column> columns;
+    for (int k = 0; k < m; ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      const double g = nlp.g()[kk];
+      const bool equality = lower[kk] == upper[kk];
+      const bool at_upper = std::isfinite(upper[kk]) && upper[kk] - g <= act;
+      const bool at_lower = std::isfinite(lower[kk]) && g - lower[kk] <= act;
+      if (equality || (at_upper && at_lower)) {
+        columns.push_back({Column::kConstraint, k, 1.0, 0.0, true});
+      } else if (at_upper) {
+        columns.push_back({Column::kConstraint, k, 1.0, std::max(0.0, upper[kk] - g), false});
+      } else if (at_lower) {
+        columns.push_back({Column::kConstraint, k, -1.0, std::max(0.0, g - lower[kk]), false});
+      }
+    }
+    for (int j = 0; j < n; ++j) {
+      const double v = s[static_cast<std::size_t>(j)];
+      if (v <= act) columns.push_back({Column::kLower, j, -1.0, v, false});
+      if (v >= 1.0 - act) columns.push_back({Column::kUpper, j, 1.0, 1.0 - v, false});
+    }
+    const auto a_count = static_cast<Eigen::Index>(columns.size());
+    Eigen::MatrixXd a(n, a_count);
+    std::vector<bool> free(columns.size());
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+      const Column& col = columns[c];
+      const auto cc = static_cast<Eigen::Index>(c);
+      if (col.kind == Column::kConstraint) {
+        a.col(cc) = col.sign * nlp.jacobian().row(col.index).transpose();
+      } else {
+        a.col(cc) = col.sign * Eigen::VectorXd::Unit(n, col.index);
+      }
+      free[c] = col.free;
+    }
+    const Eigen::VectorXd mu = NonNegativeLeastSquares(a, -grad, free);
+    const Eigen::VectorXd r = grad + a * mu;
+
+    cert.checked = true;
+    cert.active = static_cast<int>(columns.size());
+    cert.stationarity = r.lpNorm<Eigen::Infinity>() / g_norm;
+    cert.feasibility = std::max(0.0, nlp.Violation());
+    cert.complementarity = 0.0;
+    cert.lambda.assign(static_cast<std::size_t>(m), 0.0);
+    cert.z_lower.assign(static_cast<std::size_t>(n), 0.0);
+    cert.z_upper.assign(static_cast<std::size_t>(n), 0.0);
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+      const Column& col = columns[c];
+      const double v = mu(static_cast<Eigen::Index>(c));
+      if (!col.free) cert.complementarity = std::max(cert.complementarity, v * col.slack / g_norm);
+      const auto idx = static_cast<std::size_t>(col.index);
+      if (col.kind == Column::kConstraint) cert.lambda[idx] = col.sign * v;
+      if (col.kind == Column::kLower) cert.z_lower[idx] = v;
+      if (col.kind == Column::kUpper) cert.z_upper[idx] = v;
+    }
+    if (!std::isfinite(cert.stationarity)) cert.stationarity = kInf;
+
+    if (check_uniqueness) {
+      if (a_count == 0) {
+        cert.multipliers_unique = true;
+      } else if (a_count <= n) {
+        Eigen::MatrixXd unit = a;
+        bool zero = false;
+        for (Eigen::Index c = 0; c < a_count; ++c) {
+          const double norm = unit.col(c).norm();
+          zero = zero || !(norm > 0.0);
+          if (norm > 0.0) unit.col(c) /= norm;
+        }
+        if (!zero) {
+          Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(unit);
+          qr.setThreshold(kDependentColumns);
+          cert.multipliers_unique = qr.rank() == a_count;
+        }
+      }
+    }
+
+    auto fail = [&cert](const char* what, double value, double tolerance) {
+      cert.failed += (cert.failed.empty() ? "" : "; ") + std::string(what) + " " +
+                     FormatNumber(value) + " > " + FormatNumber(tolerance);
+    };
+    if (!(cert.stationarity <= tolerances.stationarity))
+      fail("stationarity", cert.stationarity, tolerances.stationarity);
+    if (!(cert.feasibility <= tolerances.feasibility))
+      fail("feasibility", cert.feasibility, tolerances.feasibility);
+    if (!(cert.complementarity <= tolerances.complementarity))
+      fail("complementarity", cert.complementarity, tolerances.complementarity);
+    cert.certified = cert.failed.empty();
+  } catch (const std::exception&) {
+    cert = DesignCertificate{};
+    cert.stationarity_tolerance = tolerances.stationarity;
+    cert.feasibility_tolerance = tolerances.feasibility;
+    cert.complementarity_tolerance = tolerances.complementarity;
+  }
+  return cert;
+}
+
+std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
+  std::vector<MergedConstraint> merged;
+  const int m = model->m(), n = model->n();
+  if (m == 0 || n == 0) return merged;
+  try {
+    const std::vector<std::vector<double>> xs = TestPoints(*model);
+    std::vector<DesignPoint> points;
+    std::vector<const std::vector<double>*> at;  // the x of each evaluated point
+    for (const std::vector<double>& x : xs) {
+      DesignPoint p;
+      if (!model->Evaluate(x.data(), true, &p)) continue;
+      points.push_back(std::move(p));
+      at.push_back(&x);
+    }
+    if (points.size() < 2) return merged;
+    const Eigen::MatrixXd& j0 = points.front().jacobian;
+
+    // A signature of each constraint's gradient direction at the first point (unit length, the
+    // largest entry positive, projected on a fixed vector), so that only neighbours in it are
+    // compared in full.
+    Eigen::VectorXd probe(n);
+    for (int j = 0; j < n; ++j) probe(j) = 1.0 + 0.5 * std::sin(1.0 + 0.7 * j);
+    std::vector<std::pair<double, int>> signature;
+    // The model's own guards ("validity.*": a wall within every knot's radius, knots in order)
+    // are not the request's constraints: they are neither merged nor reported.
+    const auto& cs = model->constraints();
+    auto guard = [&cs](int k) {
+      return cs[static_cast<std::size_t>(k)].name.rfind("validity.", 0) == 0;
+    };
+    for (int k = 0; k < m; ++k) {
+      if (guard(k)) continue;
+      Eigen::VectorXd row = j0.row(k).transpose();
+      const double norm = row.norm();
+      if (!(norm > 0.0) || !row.allFinite()) continue;  // fixed: no variable changes it
+      Eigen::Index big = 0;
+      row.cwiseAbs().maxCoeff(&big);
+      row /= row(big) > 0 ? norm : -norm;
+      signature.push_back({row.dot(probe) / probe.norm(), k});
+    }
+    std::sort(signature.begin(), signature.end());
+
+    // c_k = a c_l + b at every test point: *a, *b.
+    auto affine = [&points](int k, int l, double* a, double* b) {
+      for (std::size_t p = 0; p < points.size(); ++p) {
+        const Eigen::VectorXd gk = points[p].jacobian.row(k).transpose();
+        const Eigen::VectorXd gl = points[p].jacobian.row(l).transpose();
+        const double nl = gl.squaredNorm();
+        if (!(nl > 0.0)) return false;
+        const double ap = gk.dot(gl) / nl;
+        if ((gk - ap * gl).lpNorm<Eigen::Infinity>() >
+            kDuplicateRelative * gk.lpNorm<Eigen::Infinity>())
+          return false;
+        const double ck = points[p].constraints[static_cast<std::size_t>(k)];
+        const double cl = points[p].constraints[static_cast<std::size_t>(l)];
+        const double bp = ck - ap * cl;
+        if (p == 0) {
+          *a = ap;
+          *b = bp;
+        } else if (std::abs(ap - *a) > kDuplicateRelative * std::abs(*a) ||
+                   std::abs(bp - *b) > kDuplicateRelative * (std::abs(ck) + std::abs(ap * cl))) {
+          return false;
+        }
+      }
+      return std::isfinite(*a) && *a != 0.0 && std::isfinite(*b);
+    };
+
+    std::vector<bool> removed(static_cast<std::size_t>(m), false);
+    for (std::size_t p = 0; p < signature.size(); ++p) {
+      for (std::size_t q = p + 1; q < signature.size(); ++q) {
+        if (signature[q].first - signature[p].first > 1e-7) break;
+        int k = signature[q].second, l = signature[p].second;
+        if (k < l) std::swap(k, l);  // k the later constraint (removed on a tie)
+        if (removed[static_cast<std::size_t>(k)] || removed[static_cast<std::size_t>(l)]) continue;
+        double a = 0.0, b = 0.0;
+        if (!affine(k, l, &a, &b)) continue;
+        const DesignConstraintSpec& ck = cs[static_cast<std::size_t>(k)];
+        const DesignConstraintSpec& cl = cs[static_cast<std::size_t>(l)];
+        // c_k's range in c_l's quantity.
+        double lo = (ck.lower - b) / a, hi = (ck.upper - b) / a;
+        if (a < 0) std::swap(lo, hi);
+        const double slop = 1e-12 * std::max({1.0, std::abs(cl.lower) * std::isfinite(cl.lower),
+                                              std::abs(cl.upper) * std::isfinite(cl.upper)});
+        const std::string relation = ck.name + " = " + Short(a) + " " + cl.name +
+                                     (b < 0 ? " - " : " + ") + Short(std::abs(b));
+        // Only a pair that can be active together (a shared limit) is merged: a redundant
+        // limit strictly inside the other's range never binds and changes nothing.
+        const bool shares = (std::isfinite(lo) && (std::abs(lo - cl.lower) <= slop ||
+                                                   std::abs(lo - cl.upper) <= slop)) ||
+                            (std::isfinite(hi) &&
+                             (std::abs(hi - cl.lower) <= slop || std::abs(hi - cl.upper) <= slop));
+        if (!shares) continue;
+        int drop = -1, keep = -1;
+        if (Contains(lo, hi, cl.lower, cl.upper, slop)) {
+          drop = k;
+          keep = l;
+        } else if (Contains(cl.lower, cl.upper, lo, hi, slop)) {
+          drop = l;
+          keep = k;
+        } else {
+          continue;  // the ranges cross: both stay
+        }
+        const DesignConstraintSpec& d = cs[static_cast<std::size_t>(drop)];
+        const DesignConstraintSpec& kept = cs[static_cast<std::size_t>(keep)];
+        MergedConstraint mc;
+        mc.name = d.name;
+        mc.into = kept.name;
+        mc.message = d.name + " (" + RangeText(d.lower, d.upper, d.unit) + ") and " + kept.name +
+                     " (" + RangeText(kept.lower, kept.upper, kept.unit) +
+                     ") constrain the same quantity (" + relation +
+                     " for every design the "
+                     "variables give) and share a limit: " +
+                     kept.name + " implies " + d.name +
+                     ", which is merged into it (its multiplier would not be unique)";
+        merged.push_back(std::move(mc));
+        removed[static_cast<std::size_t>(drop)] = true;
+      }
+    }
+
+    // A constraint on one variable alone whose limit is one of the variable's bounds and whose
+    // range contains them: both would be active together.
+    for (int k = 0; k < m; ++k) {
+      if (removed[static_cast<std::size_t>(k)] || guard(k)) continue;
+      int var = -1;
+      bool single = true;
+      for (const DesignPoint& pt : points) {
+        for (int j = 0; j < n && single; ++j) {
+          if (pt.jacobian(k, j) == 0.0) continue;
+          if (var >= 0 && var != j) single = false;
+          var = j;
+        }
+      }
+      if (!single || var < 0) continue;
+      const double a = points.front().jacobian(k, var);
+      bool linear = true;
+      for (const DesignPoint& pt : points)
+        linear = linear && std::abs(pt.jacobian(k, var) - a) <= kDuplicateRelative * std::abs(a);
+      if (!linear) continue;
+      const DesignConstraintSpec& c = model->constraints()[static_cast<std::size_t>(k)];
+      const DesignVariableSpec& v = model->variables()[static_cast<std::size_t>(var)];
+      const double b = points.front().constraints[static_cast<std::size_t>(k)] -
+                       a * (*at.front())[static_cast<std::size_t>(var)];
+      double lo = (c.lower - b) / a, hi = (c.upper - b) / a;
+      if (a < 0) std::swap(lo, hi);
+      const double slop = 1e-12 * std::max({1.0, std::abs(v.lower), std::abs(v.upper)});
+      const bool shares = std::abs(lo - v.lower) <= slop || std::abs(hi - v.upper) <= slop;
+      if (!shares || !Contains(lo, hi, v.lower, v.upper, slop)) continue;
+      MergedConstraint mc;
+      mc.name = c.name;
+      mc.into = v.path;
+      mc.message =
+          c.name + " (" + RangeText(c.lower, c.upper, c.unit) + ") repeats a bound of " + v.path +
+          " (in [" + FormatNumber(v.lower) + ", " + FormatNumber(v.upper) +
+          "]) and shares a limit with them: the bounds imply it, so it is merged into them (its "
+          "multiplier would not be unique)";
+      merged.push_back(std::move(mc));
+      removed[static_cast<std::size_t>(k)] = true;
+    }
+
+    if (merged.empty()) return merged;
+    std::vector<int> keep;
+    for (int k = 0; k < m; ++k)
+      if (!removed[static_cast<std::size_t>(k)]) keep.push_back(k);
+    *model = model->WithConstraints(keep);
+  } catch (const std::exception&) {
+    merged.clear();
+  }
+  return merged;
+}
+
+}  // namespace sweetspot::core::design_detail
