@@ -23,6 +23,7 @@
 #include "core/optimize/design_problem.hpp"
 #include "core/optimize/design_public.hpp"
 #include "core/optimize/design_runs.hpp"
+#include "core/optimize/least_squares_polish.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
@@ -125,6 +126,8 @@ const char* ObjectiveUnit(DesignObjective objective) {
       return "m";
     case DesignObjective::kMinSting:
       return "j";
+    case DesignObjective::kLeastSquares:
+      return "";
     default:
       return "mps";
   }
@@ -142,7 +145,10 @@ std::vector<Run> RunStarts(const DesignModel& model, const DesignOptions& option
   for (int i = 0; i < options.starts; ++i) {
     // Draw every start's point whether or not it runs, so start i is the same design for
     // any budget (reproducible).
-    const std::vector<double> x = i == 0 ? x0 : RandomStart(model, rng, options.min_knot_gap_m);
+    std::vector<double> x = i == 0 ? x0 : RandomStart(model, rng, options.min_knot_gap_m);
+    if (i > 0 && static_cast<std::size_t>(i) <= options.start_points.size()) {
+      x = design_detail::ClampedStart(model, options.start_points[static_cast<std::size_t>(i - 1)]);
+    }
     if (i > 0 && (Clock::now() >= deadline || IsCancelled(progress))) {
       result->summary.warnings.push_back(
           std::string(IsCancelled(progress) ? "cancelled" : "time budget reached") + " after " +
@@ -402,7 +408,8 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
   const DesignBackend backend = MainBackend(problem, options);
   summary.backend = BackendName(backend);
   summary.models_used = {"mass_properties"};
-  if (problem.objective != DesignObjective::kMinMoi) {
+  if (problem.objective != DesignObjective::kMinMoi &&
+      problem.objective != DesignObjective::kLeastSquares) {
     summary.models_used.push_back(CollisionModelName(problem.model));
   }
   const bool sting = problem.objective == DesignObjective::kMinSting;
@@ -462,6 +469,10 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     const int best = ChooseRun(model, runs);
     result.spread.best_start = best;
     std::vector<double> x = best >= 0 ? runs[static_cast<std::size_t>(best)].x : model.BaseX();
+    // The least-squares objective (the shape fit's): Gauss-Newton to round-off from the stop.
+    if (best >= 0 && problem.objective == DesignObjective::kLeastSquares) {
+      design_detail::PolishLeastSquares(model, &x, &summary);
+    }
     const PublicEvaluation pub = AnswerAt(problem, model, x, cor_known, &result);
     // Independent re-check of every constraint (public mass properties).
     double worst = 0.0, worst_relative = 0.0;
@@ -521,7 +532,8 @@ MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,
     return out;
   }
   const bool maximize = problem.objective != DesignObjective::kMinMoi &&
-                        problem.objective != DesignObjective::kMinSting;
+                        problem.objective != DesignObjective::kMinSting &&
+                        problem.objective != DesignObjective::kLeastSquares;
   for (std::size_t i = 0; i < materials.size(); ++i) {
     if (IsCancelled(progress)) {
       out.summary.warnings.push_back("cancelled after " + std::to_string(i) + " materials");

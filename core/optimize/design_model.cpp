@@ -17,6 +17,7 @@
 #include "core/numerics/limits.hpp"
 #include "core/optimize/design_bbcor.hpp"
 #include "core/optimize/design_integrals.hpp"
+#include "core/optimize/least_squares_objective.hpp"
 #include "core/scene/collide.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
@@ -68,6 +69,9 @@ T DesignModel::AngularSpeedOf(const T* p) const {
 template <typename T, typename E>
 T DesignModel::ObjectiveOf(const T* p, const E& e) const {
   if (objective_kind_ == DesignObjective::kMinMoi) return MoiAbout(p, c0_, kSixInchPivotM);
+  if (objective_kind_ == DesignObjective::kLeastSquares) {
+    return design_detail::LeastSquaresOf(p, c0_, *least_squares_);
+  }
   const double m = ball_mass_kg_;
   const double u = ball_speed_mps_;
   const double pivot = pivot_from_knob_m_;

@@ -190,6 +190,15 @@ class DesignModel {
   bool Hessian(const double* x, double objective_weight, const double* constraint_weights,
                Eigen::MatrixXd* out) const;
 
+  /// kLeastSquares: the scaled residuals r = ((M - M*) / s_M, (C - C*) / s_C) of the targets
+  /// given (phi = |r|^2) and, if `jacobian`, dr/dx (one row per residual, n columns); false
+  /// without the objective or when not finite (least_squares_objective.cpp).
+  bool LeastSquaresResiduals(const double* x, Eigen::VectorXd* r, Eigen::MatrixXd* jacobian) const;
+  /// kLeastSquares: the targets' tolerance (LeastSquaresTargets::tolerance; 1e-9 without).
+  double least_squares_tolerance() const {
+    return least_squares_.has_value() ? least_squares_->tolerance : 1e-9;
+  }
+
   /// The bat at x (a three-segment design goes through ThreeSegmentShape::Knots()).
   Bat BatAt(const double* x) const;
   /// The three-segment shape at x (nullopt for a profile design).
@@ -282,6 +291,8 @@ class DesignModel {
   double objective_scale_ = 1.0;
   std::string objective_unit_;
   DesignObjective objective_kind_ = DesignObjective::kMaxExitSpeed;
+  // kLeastSquares: the targets and scales (least_squares_objective.hpp).
+  std::optional<LeastSquaresTargets> least_squares_;
 
   Bat base_bat_;                                 // material, wall, fill, profile knots
   std::optional<ThreeSegmentShape> base_shape_;  // three-segment designs

@@ -171,6 +171,9 @@ struct ModelBuilder {
   void CupConstraints();
   // Validity of the bat (only where a variable can break it; the base bat is valid).
   void ValidityConstraints();
+  // The least-squares objective's targets (least_squares_objective.cpp): required with
+  // kLeastSquares, refused with any other objective.
+  bool LeastSquaresObjective();
   // Validity of the fill: its depth and its bore inside the material.
   void FillValidityConstraints(double keep);
   // Objective and the scales.

@@ -76,6 +76,9 @@ PublicEvaluation EvaluatePublic(const DesignProblem& problem, const DesignModel&
     case DesignObjective::kMinMoi:
       out.objective = p.MoiSixInchKgM2();
       break;
+    case DesignObjective::kLeastSquares:
+      out.objective = problem.least_squares->Value(p.mass_kg, p.balance_point_m);
+      break;
     case DesignObjective::kMinSting:
       out.sting = model.StingOf(bat, true);
       out.objective = out.sting->sting_j;
