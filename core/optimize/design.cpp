@@ -145,10 +145,9 @@ std::vector<Run> RunStarts(const DesignModel& model, const DesignOptions& option
   for (int i = 0; i < options.starts; ++i) {
     // Draw every start's point whether or not it runs, so start i is the same design for
     // any budget (reproducible).
-    std::vector<double> x = i == 0 ? x0 : RandomStart(model, rng, options.min_knot_gap_m);
-    if (i > 0 && static_cast<std::size_t>(i) <= options.start_points.size()) {
-      x = design_detail::ClampedStart(model, options.start_points[static_cast<std::size_t>(i - 1)]);
-    }
+    const std::vector<double> x =
+        design_detail::GivenStartOr(model, options.start_points, i,
+                                    i == 0 ? x0 : RandomStart(model, rng, options.min_knot_gap_m));
     if (i > 0 && (Clock::now() >= deadline || IsCancelled(progress))) {
       result->summary.warnings.push_back(
           std::string(IsCancelled(progress) ? "cancelled" : "time budget reached") + " after " +
@@ -469,10 +468,7 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     const int best = ChooseRun(model, runs);
     result.spread.best_start = best;
     std::vector<double> x = best >= 0 ? runs[static_cast<std::size_t>(best)].x : model.BaseX();
-    // The least-squares objective (the shape fit's): Gauss-Newton to round-off from the stop.
-    if (best >= 0 && problem.objective == DesignObjective::kLeastSquares) {
-      design_detail::PolishLeastSquares(model, &x, &summary);
-    }
+    if (best >= 0) design_detail::PolishLeastSquares(model, &x, &summary);  // least squares only
     const PublicEvaluation pub = AnswerAt(problem, model, x, cor_known, &result);
     // Independent re-check of every constraint (public mass properties).
     double worst = 0.0, worst_relative = 0.0;

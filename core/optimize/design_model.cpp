@@ -129,6 +129,7 @@ T DesignModel::FunctionOf(DesignFunction f, const T* p) const {
     case DesignFunction::kLinear:
     case DesignFunction::kFirstFrequency:  // not a function of P (FrequencyOf)
     case DesignFunction::kBbcor:           // nor this (BbcorOf)
+    case DesignFunction::kBoreBottom:      // nor this (BoreBottomOf)
       break;
   }
   return T(kNaN);
@@ -369,6 +370,10 @@ double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
   }
   if (f.function == DesignFunction::kFirstFrequency) return FirstFrequencyAt(x);
   const std::vector<double> t = ParametersAt(x);
+  if (f.function == DesignFunction::kBoreBottom) {
+    double v = kNaN;
+    return BoreBottomOf(t, &v, nullptr, 1) ? v : kNaN;
+  }
   if (IsWallFunction(f.function)) {
     double v = kNaN;
     if (!WallFunctionOf(f.function, t, &v, nullptr, 1)) return kNaN;
@@ -418,6 +423,9 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
     }
     if (f.function == DesignFunction::kFirstFrequency) {
       return FrequencyOf(t, value, gradient_row, stride);
+    }
+    if (f.function == DesignFunction::kBoreBottom) {
+      return BoreBottomOf(t, value, gradient_row, stride);
     }
     if (IsWallFunction(f.function)) {
       return WallFunctionOf(f.function, t, value, gradient_row, stride);
@@ -481,8 +489,13 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   bool available = true;
   double bbcor_weight = 0.0;
   double wall_objective_weight = 0.0;
+  double bore_weight = 0.0;
   auto add = [&](const DesignFunctionSpec& f, double weight) {
     if (f.function == DesignFunction::kLinear || weight == 0.0) return;
+    if (f.function == DesignFunction::kBoreBottom) {
+      bore_weight += weight;  // a function of the parameters (AddBoreBottomHessian)
+      return;
+    }
     if (f.function == DesignFunction::kFirstFrequency) {
       available = false;  // no second derivatives of the eigenvalue (Build refuses kExact)
       return;
@@ -513,6 +526,7 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   *out = in.dp.transpose() * big_w * in.dp;
   // L is linear in x: only M, S1 and S2 have second derivatives.
   design_detail::AddIntegralHessian(context, {w[0], w[1], w[2]}, out);
+  if (bore_weight != 0.0) AddBoreBottomHessian(t, bore_weight, out);
   if (bbcor_weight != 0.0 &&
       !AddWallFunctionHessian(DesignFunction::kBbcor, t, bbcor_weight, out)) {
     return false;

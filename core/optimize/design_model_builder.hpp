@@ -174,6 +174,10 @@ struct ModelBuilder {
   // The least-squares objective's targets (least_squares_objective.cpp): required with
   // kLeastSquares, refused with any other objective.
   bool LeastSquaresObjective();
+  // The shape fit's exact bore rules on a three-segment design with the least-squares
+  // objective (design_bore.cpp): the bore inside the material at its bottom (kBoreBottom) and
+  // at the tip; true when they replace the knots' conservative ones.
+  bool BoreConstraints(double keep);
   // Validity of the fill: its depth and its bore inside the material.
   void FillValidityConstraints(double keep);
   // Objective and the scales.

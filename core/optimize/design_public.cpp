@@ -109,6 +109,7 @@ double PublicConstraintValue(const DesignModel& model, const DesignConstraintSpe
     case DesignFunction::kLinear:
     case DesignFunction::kObjective:
     case DesignFunction::kFirstFrequency:  // the fixed mesh the constraint is defined on
+    case DesignFunction::kBoreBottom:      // a closed form of the shape's own numbers
       break;
   }
   return model.Value(c.f, x);

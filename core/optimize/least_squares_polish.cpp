@@ -102,11 +102,29 @@ Eigen::VectorXd ProjectedStep(const DesignModel& model, const std::vector<double
   return step;
 }
 
+// |2 J_s^T r| over the components a move inside the bounds can follow (a variable at a bound
+// whose descent direction leaves the bounds is left out): the first-order residual on the box.
+double ProjectedGradientNorm(const DesignModel& model, const std::vector<double>& x,
+                             const Eigen::MatrixXd& jac_s, const Eigen::VectorXd& r) {
+  const Eigen::VectorXd g = 2.0 * jac_s.transpose() * r;
+  double sum = 0.0;
+  for (int j = 0; j < model.n(); ++j) {
+    const DesignVariableSpec& v = model.variables()[static_cast<std::size_t>(j)];
+    const double xj = x[static_cast<std::size_t>(j)];
+    if ((xj <= v.lower && g[j] > 0.0) || (xj >= v.upper && g[j] < 0.0)) continue;
+    sum += g[j] * g[j];
+  }
+  return std::sqrt(sum);
+}
+
 }  // namespace
 
-std::vector<double> ClampedStart(const DesignModel& model, const std::vector<double>& values) {
-  if (values.size() != model.variables().size()) return model.BaseX();
-  std::vector<double> x = values;
+std::vector<double> GivenStartOr(const DesignModel& model,
+                                 const std::vector<std::vector<double>>& given, int i,
+                                 std::vector<double> otherwise) {
+  if (i < 1 || static_cast<std::size_t>(i) > given.size()) return otherwise;
+  std::vector<double> x = given[static_cast<std::size_t>(i - 1)];
+  if (x.size() != model.variables().size()) return otherwise;
   for (std::size_t j = 0; j < x.size(); ++j) {
     x[j] = std::clamp(x[j], model.variables()[j].lower, model.variables()[j].upper);
   }
@@ -114,6 +132,7 @@ std::vector<double> ClampedStart(const DesignModel& model, const std::vector<dou
 }
 
 void PolishLeastSquares(const DesignModel& model, std::vector<double>* x, Summary* summary) {
+  if (!model.least_squares()) return;
   const int n = model.n();
   const Eigen::VectorXd width = Widths(model);
   const double tolerance = 1e-3 * model.least_squares_tolerance();
@@ -133,6 +152,7 @@ void PolishLeastSquares(const DesignModel& model, std::vector<double>* x, Summar
     if (r.lpNorm<Eigen::Infinity>() <= tolerance) break;
     const Eigen::MatrixXd jac_s = jac * width.asDiagonal();  // d r / d s
     const Eigen::VectorXd step = ProjectedStep(model, *x, jac_s, r);
+    const double gradient = ProjectedGradientNorm(model, *x, jac_s, r);
     bool accepted = false;
     double alpha = 1.0;
     for (int halving = 0; halving < 30; ++halving, alpha *= 0.5) {
@@ -143,11 +163,26 @@ void PolishLeastSquares(const DesignModel& model, std::vector<double>* x, Summar
         trial[static_cast<std::size_t>(j)] =
             v.lower + width[j] * std::clamp(s + alpha * step[j], 0.0, 1.0);
       }
+      if (trial == *x) break;  // the step is below the variables' resolution
       DesignPoint q;
       ++evaluations;
       if (!model.Evaluate(trial.data(), false, &q) || !MeetsConstraints(model, q)) continue;
-      if (q.objective < best_phi) {
-        best_phi = q.objective;
+      // A decrease of phi beyond its rounding; or, where phi is flat to its rounding (near a
+      // closest point that no target meets: phi changes by ~|dx|^2 there), a step that halves
+      // the first-order residual, which locates the stationary point to the gradient's
+      // rounding instead. phi's rounding: 2 |r|_1 times the residuals' (a few eps of values of
+      // size 1), with a margin of 8.
+      const double noise = 16.0 * kEps * r.lpNorm<1>();
+      bool better = q.objective < best_phi - noise;
+      if (!better && q.objective <= best_phi + noise) {
+        Eigen::VectorXd rq;
+        Eigen::MatrixXd jq;
+        ++evaluations;
+        better = model.LeastSquaresResiduals(trial.data(), &rq, &jq) &&
+                 ProjectedGradientNorm(model, trial, jq * width.asDiagonal(), rq) < 0.5 * gradient;
+      }
+      if (better) {
+        best_phi = std::min(best_phi, q.objective);
         *x = std::move(trial);
         accepted = true;
         break;

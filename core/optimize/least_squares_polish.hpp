@@ -12,7 +12,8 @@
 
 namespace sweetspot::core::design_detail {
 
-/// Gauss-Newton on the model's residuals from x (in place): minimum-norm steps in s, clamped
+/// With the least-squares objective (else nothing), Gauss-Newton on the model's residuals
+/// from x (in place): minimum-norm steps in s, clamped
 /// into the bounds, halved until phi decreases at a point that meets every constraint; ends
 /// when every scaled residual is at most 1e-3 of the targets' tolerance, no step is accepted,
 /// or after 50 steps. Adds the accepted steps to summary->iterations and the evaluations to
@@ -24,8 +25,11 @@ void PolishLeastSquares(const DesignModel& model, std::vector<double>* x, Summar
 /// where phi is flat to rounding over the bounds. NaN when the residuals are not finite.
 double LeastSquaresKktError(const DesignModel& model, const std::vector<double>& x);
 
-/// The start `values` (one per variable, field units) clamped into the bounds; the base design
-/// (BaseX) when their number is not the model's.
-std::vector<double> ClampedStart(const DesignModel& model, const std::vector<double>& values);
+/// Start i of a multi-start: given[i - 1] (one value per variable, field units) clamped into
+/// the bounds when i >= 1 and there is one of the model's size (DesignOptions::start_points),
+/// else `otherwise`.
+std::vector<double> GivenStartOr(const DesignModel& model,
+                                 const std::vector<std::vector<double>>& given, int i,
+                                 std::vector<double> otherwise);
 
 }  // namespace sweetspot::core::design_detail
