@@ -289,9 +289,10 @@ struct DesignOptions {
   double constraint_tolerance = 1e-10;
   int starts = 1;          ///< Local solves (1..64): the base design, then seeded random designs.
   std::uint64_t seed = 1;  ///< Seed of the random starts (std::mt19937_64).
-  /// Given starts: start i >= 1 is start_points[i - 1] (the variables' values, field units,
-  /// clamped into their bounds) while there is one, then the random designs (the random design
-  /// of start i stays the same). The shape fit's scan gives its best points here.
+  /// Given starts: start i is start_points[i] (the variables' values, field units, clamped into
+  /// their bounds) while there is one, start 0 included (the base design then supplies only the
+  /// fixed fields), then the base design or the random designs (the random design of start i
+  /// stays the same). The shape fit's scan gives its best points here.
   std::vector<std::vector<double>> start_points;
   /// Smallest gap between neighbouring knots when knot positions are variables, m (> 0).
   double min_knot_gap_m = 1e-4;

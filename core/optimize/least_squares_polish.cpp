@@ -122,8 +122,8 @@ double ProjectedGradientNorm(const DesignModel& model, const std::vector<double>
 std::vector<double> GivenStartOr(const DesignModel& model,
                                  const std::vector<std::vector<double>>& given, int i,
                                  std::vector<double> otherwise) {
-  if (i < 1 || static_cast<std::size_t>(i) > given.size()) return otherwise;
-  std::vector<double> x = given[static_cast<std::size_t>(i - 1)];
+  if (i < 0 || static_cast<std::size_t>(i) >= given.size()) return otherwise;
+  std::vector<double> x = given[static_cast<std::size_t>(i)];
   if (x.size() != model.variables().size()) return otherwise;
   for (std::size_t j = 0; j < x.size(); ++j) {
     x[j] = std::clamp(x[j], model.variables()[j].lower, model.variables()[j].upper);

@@ -25,9 +25,8 @@ void PolishLeastSquares(const DesignModel& model, std::vector<double>* x, Summar
 /// where phi is flat to rounding over the bounds. NaN when the residuals are not finite.
 double LeastSquaresKktError(const DesignModel& model, const std::vector<double>& x);
 
-/// Start i of a multi-start: given[i - 1] (one value per variable, field units) clamped into
-/// the bounds when i >= 1 and there is one of the model's size (DesignOptions::start_points),
-/// else `otherwise`.
+/// Start i of a multi-start: given[i] (one value per variable, field units) clamped into the
+/// bounds when there is one of the model's size (DesignOptions::start_points), else `otherwise`.
 std::vector<double> GivenStartOr(const DesignModel& model,
                                  const std::vector<std::vector<double>>& given, int i,
                                  std::vector<double> otherwise);

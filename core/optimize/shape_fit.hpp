@@ -96,6 +96,10 @@ struct ShapeFitProblem {
   std::optional<Fill> fill;          ///< Optional fill.
   std::vector<FitUnknown> unknowns;  ///< 1 to 10 distinct unknowns.
   FitTargets targets;                ///< What to meet.
+  /// The rigid-body mass properties of the bat as given (shape, material, wall, fill) when the
+  /// caller has computed them (the api's ParseBat): used for the fit's design problem when its
+  /// start is that bat (no unknown clamped), instead of computing them again. Unset = computed.
+  std::optional<MassProperties> bat_mass_properties;
 
   /// True when the problem can be solved; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "field = value: rule".

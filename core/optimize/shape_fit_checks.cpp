@@ -5,10 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <string_view>
 
 #include "core/geometry_format.hpp"
 #include "core/numerics/limits.hpp"
 #include "core/optimize/design_integrals.hpp"
+#include "core/refusal.hpp"
 
 namespace sweetspot::core::fit_detail {
 namespace {
@@ -285,3 +288,224 @@ std::vector<double> UnknownValues(const ShapeFitProblem& problem, const std::vec
 }
 
 }  // namespace sweetspot::core::fit_detail
+
+// ---------------------------------------------------------------------------------------------
+// The fit's names and the checks of its problem and options (shape_fit.hpp).
+
+namespace sweetspot::core {
+namespace {
+
+using fit_detail::FitConstraint;
+using fit_detail::kNumFitVariables;
+
+constexpr const char* kVariableName[kNumFitVariables] = {
+    "taper_start_m",   "taper_end_m",       "length_m",         "handle_radius_m",
+    "barrel_radius_m", "density_kg_m3",     "wall_thickness_m", "fill.diameter_m",
+    "fill.depth_m",    "fill.density_kg_m3"};
+
+// Smallest target or scale of the fit's metric, kg or m: residuals divided by
+// less than this can overflow to inf.
+constexpr double kMinMetricScale = 1e-6;
+
+}  // namespace
+
+int FitUnknownIndex(DesignVariableKind kind) {
+  for (int i = 0; i < kNumFitUnknowns; ++i) {
+    if (kFitUnknownKinds[i] == kind) return i;
+  }
+  return -1;
+}
+
+const char* FitUnknownName(DesignVariableKind kind) {
+  const int i = FitUnknownIndex(kind);
+  return i >= 0 ? kVariableName[i] : "unknown";
+}
+
+std::optional<DesignVariableKind> FitUnknownFromName(std::string_view name) {
+  for (int i = 0; i < kNumFitUnknowns; ++i) {
+    if (name == kVariableName[i]) return kFitUnknownKinds[i];
+  }
+  return std::nullopt;
+}
+
+bool ShapeFitOptions::Validate(Refusal* why) const {
+  if (!std::isfinite(mass_scale_kg) || mass_scale_kg < 0.0) {
+    return Refuse(why, "mass_scale_kg", mass_scale_kg,
+                  "must be finite and non-negative (0 = the target)");
+  }
+  if (!std::isfinite(balance_point_scale_m) || balance_point_scale_m < 0.0) {
+    return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
+                  "must be finite and non-negative (0 = the target)");
+  }
+  if (mass_scale_kg > kMaxFitMassKg) {
+    return Refuse(why, "mass_scale_kg", mass_scale_kg,
+                  RangeRule(0.0, kMaxFitMassKg) + " (0 = the target)");
+  }
+  if (balance_point_scale_m > kMaxBatLengthM) {
+    return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
+                  RangeRule(0.0, kMaxBatLengthM) + " (0 = the target)");
+  }
+  // Smaller scales overflow the scaled residuals to inf (found by fuzzing).
+  if (mass_scale_kg > 0.0 && mass_scale_kg < kMinMetricScale) {
+    return Refuse(why, "mass_scale_kg", mass_scale_kg, "must be 0 (the target) or at least 1e-06");
+  }
+  if (balance_point_scale_m > 0.0 && balance_point_scale_m < kMinMetricScale) {
+    return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
+                  "must be 0 (the target) or at least 1e-06");
+  }
+  if (!CheckInRange(why, "tolerance", tolerance, kMinFitTolerance, kMaxFitTolerance)) return false;
+  if (!std::isfinite(kkt_tolerance) || !(kkt_tolerance > 0.0)) {
+    return Refuse(why, "kkt_tolerance", kkt_tolerance, "must be finite and positive");
+  }
+  if (scan_points < 1) return Refuse(why, "scan_points", scan_points, "must be at least 1");
+  if (local_starts < 1) return Refuse(why, "local_starts", local_starts, "must be at least 1");
+  if (max_evaluations < 1) {
+    return Refuse(why, "max_evaluations", max_evaluations, "must be at least 1");
+  }
+  if (!std::isfinite(max_time_s) || !(max_time_s > 0.0)) {
+    return Refuse(why, "max_time_s", max_time_s, "must be finite and positive");
+  }
+  return true;
+}
+
+bool ShapeFitProblem::Validate(Refusal* why) const {
+  if (!targets.mass_kg.has_value() && !targets.balance_point_m.has_value()) {
+    return Refuse(why, TextRefusal("targets", "must give mass_kg, balance_point_m or both"));
+  }
+  if (targets.mass_kg.has_value() && !(std::isfinite(*targets.mass_kg) && *targets.mass_kg > 0.0)) {
+    return Refuse(why, "targets.mass_kg", *targets.mass_kg, "must be finite and positive");
+  }
+  if (targets.balance_point_m.has_value() &&
+      !(std::isfinite(*targets.balance_point_m) && *targets.balance_point_m > 0.0)) {
+    return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
+                  "must be finite and positive");
+  }
+  // A target is the metric's default scale: a smaller one overflows it (found by fuzzing).
+  if (targets.mass_kg.has_value() && *targets.mass_kg < kMinMetricScale) {
+    return Refuse(why, "targets.mass_kg", *targets.mass_kg, "must be at least 1e-06");
+  }
+  if (targets.balance_point_m.has_value() && *targets.balance_point_m < kMinMetricScale) {
+    return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
+                  "must be at least 1e-06");
+  }
+  if (targets.mass_kg.has_value() && *targets.mass_kg > kMaxFitMassKg) {
+    return Refuse(why, "targets.mass_kg", *targets.mass_kg,
+                  RangeRule(kMinMetricScale, kMaxFitMassKg));
+  }
+  if (targets.balance_point_m.has_value() && *targets.balance_point_m > kMaxBatLengthM) {
+    return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
+                  RangeRule(kMinMetricScale, kMaxBatLengthM));
+  }
+  if (unknowns.empty() || unknowns.size() > static_cast<std::size_t>(kNumFitVariables)) {
+    return Refuse(why, "unknowns.size()", static_cast<double>(unknowns.size()),
+                  "must be between 1 and 10");
+  }
+  std::vector<bool> unknown(static_cast<std::size_t>(kNumFitVariables), false);
+  for (std::size_t i = 0; i < unknowns.size(); ++i) {
+    const FitUnknown& u = unknowns[i];
+    const int idx = FitUnknownIndex(u.variable);
+    if (idx < 0) {
+      return Refuse(why, IndexedField("unknowns", i, "variable"), static_cast<int>(u.variable),
+                    "is not a fit unknown (a profile knot's kind)");
+    }
+    const char* name = kVariableName[idx];
+    if (unknown[static_cast<std::size_t>(idx)]) {
+      return Refuse(why, QuotedRefusal(IndexedField("unknowns", i, "variable"), name,
+                                       "appears more than once"));
+    }
+    unknown[static_cast<std::size_t>(idx)] = true;
+    if (fit_detail::IsFillVariable(u.variable) && !fill.has_value()) {
+      return Refuse(
+          why, QuotedRefusal(IndexedField("unknowns", i, "variable"), name, "the bat has no fill"));
+    }
+    if (!std::isfinite(u.min)) {
+      return why == nullptr
+                 ? false
+                 : Refuse(why, IndexedField("unknowns", i, "min"), u.min, "must be finite");
+    }
+    if (!std::isfinite(u.max)) {
+      return why == nullptr
+                 ? false
+                 : Refuse(why, IndexedField("unknowns", i, "max"), u.max, "must be finite");
+    }
+    if (!(u.max > u.min)) {
+      return why == nullptr ? false
+                            : Refuse(why, IndexedField("unknowns", i, "max"), u.max,
+                                     "must be greater than " + IndexedField("unknowns", i, "min") +
+                                         " = " + FormatNumber(u.min));
+    }
+    const DesignVariableKind v = u.variable;
+    const bool must_be_positive =
+        v == DesignVariableKind::kLength || v == DesignVariableKind::kHandleRadius ||
+        v == DesignVariableKind::kBarrelRadius || v == DesignVariableKind::kDensity ||
+        v == DesignVariableKind::kWallThickness;
+    if (must_be_positive && !(u.min > 0.0)) {
+      return why == nullptr
+                 ? false
+                 : Refuse(why, IndexedField("unknowns", i, "min"), u.min,
+                          std::string("must be positive for ") + name +
+                              (v == DesignVariableKind::kWallThickness ? " (the bat stays hollow)"
+                                                                       : ""));
+    }
+    if (!must_be_positive && u.min < 0.0) {
+      return why == nullptr ? false
+                            : Refuse(why, IndexedField("unknowns", i, "min"), u.min,
+                                     std::string("must be non-negative for ") + name);
+    }
+  }
+  // The fixed values.
+  const std::vector<double> t = fit_detail::StartParameters(*this);
+  for (int i = 0; i < kNumFitVariables; ++i) {
+    const DesignVariableKind v = kFitUnknownKinds[i];
+    if (unknown[static_cast<std::size_t>(i)] ||
+        (fit_detail::IsFillVariable(v) && !fill.has_value()))
+      continue;
+    const double value = fit_detail::FitValue(t, v);
+    const char* field = fit_detail::FitUnknownField(v);
+    if (!std::isfinite(value)) return Refuse(why, field, value, "must be finite");
+    const bool must_be_positive =
+        v == DesignVariableKind::kLength || v == DesignVariableKind::kHandleRadius ||
+        v == DesignVariableKind::kBarrelRadius || v == DesignVariableKind::kDensity;
+    if (must_be_positive && !(value > 0.0)) return Refuse(why, field, value, "must be positive");
+    if (value < 0.0) return Refuse(why, field, value, "must be non-negative");
+  }
+  Material m = material;
+  m.density_kg_m3 = fit_detail::FitValue(t, DesignVariableKind::kDensity);
+  Refusal inner;
+  if (!m.Validate(why != nullptr ? &inner : nullptr))
+    return Refuse(why, Prefixed("material.", inner));
+  if (fill.has_value()) {
+    Material f = fill->material;
+    if (unknown[static_cast<std::size_t>(FitUnknownIndex(DesignVariableKind::kFillDensity))]) {
+      // check the other fields
+      f.density_kg_m3 = std::max(fit_detail::FitValue(t, DesignVariableKind::kFillDensity), 1.0);
+    }
+    if (f.density_kg_m3 != 0.0 && !f.Validate(why != nullptr ? &inner : nullptr)) {
+      return Refuse(why, Prefixed("fill.material.", inner));
+    }
+  }
+  const bool hollow = fit_detail::HollowOf(*this);
+  for (FitConstraint kind : fit_detail::ApplicableConstraints(hollow, fill.has_value())) {
+    if (!fit_detail::ConstraintInvolves(kind, unknown) &&
+        fit_detail::ConstraintValue(kind, t, hollow) > 0.0) {
+      return Refuse(why, fit_detail::ConstraintRefusal(kind, t, hollow));
+    }
+  }
+  return true;
+}
+
+bool ShapeFitProblem::ValidateSize(Refusal* why) const {
+  if (!Validate(why)) return false;
+  for (std::size_t i = 0; i < unknowns.size(); ++i) {
+    const FitUnknown& u = unknowns[i];
+    if (u.min > kMaxFitBound || u.max > kMaxFitBound) {
+      const bool min = u.min > kMaxFitBound;
+      return why == nullptr ? false
+                            : Refuse(why, IndexedField("unknowns", i, min ? "min" : "max"),
+                                     min ? u.min : u.max, RangeRule(0.0, kMaxFitBound));
+    }
+  }
+  return true;
+}
+
+}  // namespace sweetspot::core

@@ -1,5 +1,6 @@
-// Internal to core (public only so that tests can check it): the shape fit's checks and its
-// problem as a design problem (core/optimize/shape_fit.hpp). No solver headers here.
+// Internal to core (public only so that tests can check it): the shape fit's checks (its names,
+// ShapeFitProblem::Validate and ShapeFitOptions::Validate are defined in shape_fit_checks.cpp)
+// and its problem as a design problem (core/optimize/shape_fit.hpp). No solver headers here.
 //
 // One parametrisation: the design code's (design_integrals.hpp). A fit unknown is the design
 // variable of the same field ("three_segment.taper_start_m", "material.density_kg_m3", ...);
