@@ -63,6 +63,23 @@ void BM_ShapeFitTable2(benchmark::State& state) {
 }
 BENCHMARK(BM_ShapeFitTable2)->Unit(benchmark::kMicrosecond);
 
+// An attainable fit: the taper of the paper's bat from M* = 0.95 kg, C* = 0.6 m (the api's
+// golden fit_taper request), met to round-off.
+void BM_ShapeFitTaper(benchmark::State& state) {
+  ShapeFitProblem problem;
+  problem.shape = PaperThreeSegmentShape();
+  problem.material = *FindMaterial("paper-wood");
+  problem.unknowns = {{DesignVariableKind::kTaperStart, 0.0, 0.855},
+                      {DesignVariableKind::kTaperEnd, 0.0, 0.855}};
+  problem.targets.mass_kg = 0.95;
+  problem.targets.balance_point_m = 0.6;
+  for (auto _ : state) {
+    ShapeFitResult r = FitShape(problem);
+    benchmark::DoNotOptimize(r);
+  }
+}
+BENCHMARK(BM_ShapeFitTaper)->Unit(benchmark::kMicrosecond);
+
 }  // namespace
 }  // namespace bench_core_mass_properties
 }  // namespace sweetspot::core

@@ -273,6 +273,9 @@ std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& co
   problem.material = request.spec.bat.material;
   problem.wall_thickness_m = request.spec.bat.wall_thickness_m;
   problem.fill = request.spec.bat.fill;
+  if (request.spec.properties) {  // computed once, by ParseBat
+    problem.bat_mass_properties = request.spec.properties->rigid_body;
+  }
 
   const nlohmann::json* targets = reader.Get("targets");
   if (reader.ok() && targets == nullptr) reader.Missing("targets");

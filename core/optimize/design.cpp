@@ -25,6 +25,7 @@
 #include "core/optimize/design_problem.hpp"
 #include "core/optimize/design_public.hpp"
 #include "core/optimize/design_runs.hpp"
+#include "core/optimize/least_squares_polish.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/sweet_spot/sweet_spot.hpp"
 
@@ -127,6 +128,8 @@ const char* ObjectiveUnit(DesignObjective objective) {
       return "m";
     case DesignObjective::kMinSting:
       return "j";
+    case DesignObjective::kLeastSquares:
+      return "";
     default:
       return "mps";
   }
@@ -144,7 +147,9 @@ std::vector<Run> RunStarts(const DesignModel& model, const DesignOptions& option
   for (int i = 0; i < options.starts; ++i) {
     // Draw every start's point whether or not it runs, so start i is the same design for
     // any budget (reproducible).
-    const std::vector<double> x = i == 0 ? x0 : RandomStart(model, rng, options.min_knot_gap_m);
+    const std::vector<double> x =
+        design_detail::GivenStartOr(model, options.start_points, i,
+                                    i == 0 ? x0 : RandomStart(model, rng, options.min_knot_gap_m));
     if (i > 0 && (Clock::now() >= deadline || IsCancelled(progress))) {
       result->summary.warnings.push_back(
           std::string(IsCancelled(progress) ? "cancelled" : "time budget reached") + " after " +
@@ -401,7 +406,8 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
   const DesignBackend backend = MainBackend(problem, options);
   summary.backend = BackendName(backend);
   summary.models_used = {"mass_properties"};
-  if (problem.objective != DesignObjective::kMinMoi) {
+  if (problem.objective != DesignObjective::kMinMoi &&
+      problem.objective != DesignObjective::kLeastSquares) {
     summary.models_used.push_back(CollisionModelName(problem.model));
   }
   const bool sting = problem.objective == DesignObjective::kMinSting;
@@ -464,6 +470,7 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
     const int best = ChooseRun(model, runs);
     result.spread.best_start = best;
     std::vector<double> x = best >= 0 ? runs[static_cast<std::size_t>(best)].x : model.BaseX();
+    if (best >= 0) design_detail::PolishLeastSquares(model, &x, &summary);  // least squares only
     const PublicEvaluation pub = AnswerAt(problem, model, x, cor_known, &result);
     // Independent re-check of every constraint (public mass properties).
     double worst = 0.0, worst_relative = 0.0;
@@ -546,7 +553,8 @@ MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,
     return out;
   }
   const bool maximize = problem.objective != DesignObjective::kMinMoi &&
-                        problem.objective != DesignObjective::kMinSting;
+                        problem.objective != DesignObjective::kMinSting &&
+                        problem.objective != DesignObjective::kLeastSquares;
   for (std::size_t i = 0; i < materials.size(); ++i) {
     if (IsCancelled(progress)) {
       out.summary.warnings.push_back("cancelled after " + std::to_string(i) + " materials");

@@ -1,5 +1,5 @@
 // Internal to core: the design code's one parametrisation of a bat and its mass integrals,
-// shared by the design model (design_model.cpp) and the shape fit (shape_fit_model.cpp).
+// of the design model (design_model.cpp), whose problems the shape fit's are (shape_fit.cpp).
 //
 // Parameters: DesignParameterLayout order (core/bat/mass_properties.hpp): the knots' radii and
 // positions, then density, wall, fill diameter, depth and density. A three-segment shape is

@@ -17,6 +17,7 @@
 #include "core/numerics/limits.hpp"
 #include "core/optimize/design_bbcor.hpp"
 #include "core/optimize/design_integrals.hpp"
+#include "core/optimize/least_squares_objective.hpp"
 #include "core/scene/collide.hpp"
 #include "core/scene/resolved_scene.hpp"
 #include "core/scene/swing_speed.hpp"
@@ -69,6 +70,9 @@ T DesignModel::AngularSpeedOf(const T* p) const {
 template <typename T, typename E>
 T DesignModel::ObjectiveOf(const T* p, const E& e) const {
   if (objective_kind_ == DesignObjective::kMinMoi) return MoiAbout(p, c0_, kSixInchPivotM);
+  if (objective_kind_ == DesignObjective::kLeastSquares) {
+    return design_detail::LeastSquaresOf(p, c0_, *least_squares_);
+  }
   const double m = ball_mass_kg_;
   const double u = ball_speed_mps_;
   const double pivot = pivot_from_knob_m_;
@@ -126,6 +130,7 @@ T DesignModel::FunctionOf(DesignFunction f, const T* p) const {
     case DesignFunction::kLinear:
     case DesignFunction::kFirstFrequency:  // not a function of P (FrequencyOf)
     case DesignFunction::kBbcor:           // nor this (BbcorOf)
+    case DesignFunction::kBoreBottom:      // nor this (BoreBottomOf)
       break;
   }
   return T(kNaN);
@@ -366,6 +371,10 @@ double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
   }
   if (f.function == DesignFunction::kFirstFrequency) return FirstFrequencyAt(x);
   const std::vector<double> t = ParametersAt(x);
+  if (f.function == DesignFunction::kBoreBottom) {
+    double v = kNaN;
+    return BoreBottomOf(t, &v, nullptr, 1) ? v : kNaN;
+  }
   if (IsWallFunction(f.function)) {
     double v = kNaN;
     if (!WallFunctionOf(f.function, t, &v, nullptr, 1)) return kNaN;
@@ -415,6 +424,9 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
     }
     if (f.function == DesignFunction::kFirstFrequency) {
       return FrequencyOf(t, value, gradient_row, stride);
+    }
+    if (f.function == DesignFunction::kBoreBottom) {
+      return BoreBottomOf(t, value, gradient_row, stride);
     }
     if (IsWallFunction(f.function)) {
       return WallFunctionOf(f.function, t, value, gradient_row, stride);
@@ -478,8 +490,13 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   bool available = true;
   double bbcor_weight = 0.0;
   double wall_objective_weight = 0.0;
+  double bore_weight = 0.0;
   auto add = [&](const DesignFunctionSpec& f, double weight) {
     if (f.function == DesignFunction::kLinear || weight == 0.0) return;
+    if (f.function == DesignFunction::kBoreBottom) {
+      bore_weight += weight;  // a function of the parameters (AddBoreBottomHessian)
+      return;
+    }
     if (f.function == DesignFunction::kFirstFrequency) {
       available = false;  // no second derivatives of the eigenvalue (Build refuses kExact)
       return;
@@ -510,6 +527,7 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   *out = in.dp.transpose() * big_w * in.dp;
   // L is linear in x: only M, S1 and S2 have second derivatives.
   design_detail::AddIntegralHessian(context, {w[0], w[1], w[2]}, out);
+  if (bore_weight != 0.0) AddBoreBottomHessian(t, bore_weight, out);
   if (bbcor_weight != 0.0 &&
       !AddWallFunctionHessian(DesignFunction::kBbcor, t, bbcor_weight, out)) {
     return false;

@@ -58,6 +58,10 @@ enum class DesignFunction {
   /// The BBCOR by the NCAA protocol (ComputeBbcor's quasi-static trampoline, design_bbcor.hpp):
   /// the `bbcor` rule's constraint on a hollow design (dimensionless).
   kBbcor,
+  /// The bore's clearance at its bottom on a three-segment design, m: keep (R(L - d) - wall) -
+  /// diameter / 2, R the outer radius, keep = 1 - kStrictMargin (>= 0: the bore inside the
+  /// material there; the shape fit's exact rule, design_bore.cpp).
+  kBoreBottom,
   kObjective,  ///< The problem's objective, in its unit.
 };
 
@@ -190,6 +194,17 @@ class DesignModel {
   bool Hessian(const double* x, double objective_weight, const double* constraint_weights,
                Eigen::MatrixXd* out) const;
 
+  /// kLeastSquares: the scaled residuals r = ((M - M*) / s_M, (C - C*) / s_C) of the targets
+  /// given (phi = |r|^2) and, if `jacobian`, dr/dx (one row per residual, n columns); false
+  /// without the objective or when not finite (least_squares_objective.cpp).
+  bool LeastSquaresResiduals(const double* x, Eigen::VectorXd* r, Eigen::MatrixXd* jacobian) const;
+  /// True with the least-squares objective (DesignObjective::kLeastSquares).
+  bool least_squares() const { return least_squares_.has_value(); }
+  /// kLeastSquares: the targets' tolerance (LeastSquaresTargets::tolerance; 1e-9 without).
+  double least_squares_tolerance() const {
+    return least_squares_.has_value() ? least_squares_->tolerance : 1e-9;
+  }
+
   /// The bat at x (a three-segment design goes through ThreeSegmentShape::Knots()).
   Bat BatAt(const double* x) const;
   /// The three-segment shape at x (nullopt for a profile design).
@@ -254,6 +269,12 @@ class DesignModel {
   // mass is not positive.
   bool WallIntegrals(DesignFunction f, const std::vector<double>& t, bool derivatives,
                      design_detail::Integrals* in) const;
+  // kBoreBottom (design_bore.cpp): its value at parameters t and (when gradient_row) its
+  // gradient added into gradient_row[j * stride]; false when not finite.
+  bool BoreBottomOf(const std::vector<double>& t, double* value, double* gradient_row,
+                    int stride) const;
+  // Adds weight times kBoreBottom's Hessian at parameters t into *h.
+  void AddBoreBottomHessian(const std::vector<double>& t, double weight, Eigen::MatrixXd* h) const;
   // True when `f` is a function of the wall (WallFunctionOf), not of P alone.
   bool IsWallFunction(DesignFunction f) const {
     return f == DesignFunction::kBbcor || (f == DesignFunction::kObjective && barrel_cor_);
@@ -282,6 +303,8 @@ class DesignModel {
   double objective_scale_ = 1.0;
   std::string objective_unit_;
   DesignObjective objective_kind_ = DesignObjective::kMaxExitSpeed;
+  // kLeastSquares: the targets and scales (least_squares_objective.hpp).
+  std::optional<LeastSquaresTargets> least_squares_;
 
   Bat base_bat_;                                 // material, wall, fill, profile knots
   std::optional<ThreeSegmentShape> base_shape_;  // three-segment designs

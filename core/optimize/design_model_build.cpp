@@ -16,9 +16,11 @@ namespace design_detail {
 
 // Scene and objective.
 bool ModelBuilder::CheckScene() {
-  if (ParseDesignObjective(DesignObjectiveName(problem.objective)) != problem.objective) {
+  if (problem.objective != DesignObjective::kLeastSquares &&
+      ParseDesignObjective(DesignObjectiveName(problem.objective)) != problem.objective) {
     return Refuse(why, TextRefusal("objective", "not a known objective"));
   }
+  if (!LeastSquaresObjective()) return false;
   if (!problem.ball.Validate(why) || !problem.swing.Validate(why)) return false;
   // The scenes' swing settings the optimiser does not take (its swing weight is the objective
   // max_exit_speed_swing_weight's): refused, not ignored.
@@ -51,7 +53,8 @@ bool ModelBuilder::CheckScene() {
                     kMaxDesignZoneToleranceMps, /*lo_open=*/true)) {
     return false;
   }
-  exit_speed_objective = problem.objective != DesignObjective::kMinMoi;
+  exit_speed_objective = problem.objective != DesignObjective::kMinMoi &&
+                         problem.objective != DesignObjective::kLeastSquares;
   const bool by_bat_speed = problem.swing.bat_speed_mps.has_value();
   if (exit_speed_objective && problem.ball.speed_mps == 0.0 &&
       (by_bat_speed ? *problem.swing.bat_speed_mps : problem.swing.angular_speed_rad_s) == 0.0) {
@@ -440,10 +443,12 @@ bool ModelBuilder::SwingByBatSpeed() {
 bool ModelBuilder::Objective() {
   model.objective_.function = DesignFunction::kObjective;
   model.maximize_ = problem.objective != DesignObjective::kMinMoi &&
-                    problem.objective != DesignObjective::kMinSting;
+                    problem.objective != DesignObjective::kMinSting &&
+                    problem.objective != DesignObjective::kLeastSquares;
   model.objective_unit_ = problem.objective == DesignObjective::kMinMoi            ? "kg_m2"
                           : problem.objective == DesignObjective::kWidestSweetZone ? "m"
                           : problem.objective == DesignObjective::kMinSting        ? "j"
+                          : problem.objective == DesignObjective::kLeastSquares    ? ""
                                                                                    : "mps";
   const std::vector<double> x0 = model.BaseX();
   double f0 = kNaN;
@@ -466,6 +471,8 @@ bool ModelBuilder::Objective() {
                                    "clamped into the variables' bounds)"));
   }
   model.objective_scale_ = std::abs(f0) > 0.0 ? std::abs(f0) : 1.0;
+  // The least-squares metric is already scaled (0 at a root, which the start may be).
+  if (problem.objective == DesignObjective::kLeastSquares) model.objective_scale_ = 1.0;
   for (DesignConstraintSpec& c : model.constraints_) {
     double s = std::abs(model.Value(c.f, x0.data()));
     if (!std::isfinite(s)) s = 0.0;

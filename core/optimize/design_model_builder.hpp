@@ -171,6 +171,13 @@ struct ModelBuilder {
   void CupConstraints();
   // Validity of the bat (only where a variable can break it; the base bat is valid).
   void ValidityConstraints();
+  // The least-squares objective's targets (least_squares_objective.cpp): required with
+  // kLeastSquares, refused with any other objective.
+  bool LeastSquaresObjective();
+  // The shape fit's exact bore rules on a three-segment design with the least-squares
+  // objective (design_bore.cpp): the bore inside the material at its bottom (kBoreBottom) and
+  // at the tip; true when they replace the knots' conservative ones.
+  bool BoreConstraints(double keep);
   // Validity of the fill: its depth and its bore inside the material.
   void FillValidityConstraints(double keep);
   // Objective and the scales.

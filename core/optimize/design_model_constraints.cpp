@@ -433,6 +433,7 @@ void ModelBuilder::FillValidityConstraints(double keep) {
   const int last = lay.KnotPosition(model.num_knots_ - 1);
   AddLinear("validity.fill.depth_m", "validity.fill.depth_m", "validity.fill.depth_m", "m",
             {{last, 1.0}, {lay.FillDepth(), -1.0}}, 0.0, 0.0, kInf, false, true);
+  if (BoreConstraints(keep)) return;  // the shape fit's exact rules (design_bore.cpp)
   // The bore must stay inside the material over its depth. The profile is piecewise linear,
   // so its least radius over [L - d, L] is at a knot inside or at the bore's bottom, which
   // lies on the segment of the last knot at or before it: constrain every knot that can be

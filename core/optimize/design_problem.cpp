@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <utility>
+#include <string>
 
 #include "core/geometry_format.hpp"
 #include "core/optimize/design_model.hpp"
@@ -82,6 +83,8 @@ std::string DesignVariablePath(const DesignVariableRef& ref) {
 }
 
 const char* DesignObjectiveName(DesignObjective objective) {
+  // The shape fit's objective: a name, not one ParseDesignObjective accepts from a request.
+  if (objective == DesignObjective::kLeastSquares) return "least_squares";
   for (const auto& o : kObjectiveNames) {
     if (o.objective == objective) return o.name;
   }
@@ -127,6 +130,13 @@ bool DesignOptions::Validate(Refusal* why) const {
     }
   }
   if (starts < 1 || starts > 64) return Refuse(why, "starts", starts, "must be between 1 and 64");
+  for (std::size_t i = 0; i < start_points.size(); ++i) {
+    for (double v : start_points[i]) {
+      if (!std::isfinite(v)) {
+        return Refuse(why, "start_points[" + std::to_string(i) + "]", v, "must be finite");
+      }
+    }
+  }
   if (!std::isfinite(min_knot_gap_m) || !(min_knot_gap_m > 0.0) || min_knot_gap_m > 0.1) {
     return Refuse(why, "min_knot_gap_m", min_knot_gap_m, "must be in (0, 0.1]");
   }

@@ -20,6 +20,7 @@
 #include "core/bat/mass_properties.hpp"
 #include "core/bat/material.hpp"
 #include "core/optimize/certificate.hpp"
+#include "core/optimize/least_squares_objective.hpp"
 #include "core/optimize/rules.hpp"
 #include "core/progress.hpp"
 #include "core/scene/collide.hpp"
@@ -175,6 +176,10 @@ enum class DesignObjective {
   /// max-exit-speed point (the flexible beam, as least_sting_zone measures sting), J
   /// (minimise). No derivative exists (adaptive mesh and integration): solved by NLopt COBYLA.
   kMinSting,
+  /// "least_squares" (the shape fit's, FitShape; not a request objective): the metric
+  /// ((M - M*)/s_M)^2 + ((C - C*)/s_C)^2 of DesignProblem::least_squares, dimensionless
+  /// (minimise).
+  kLeastSquares,
 };
 
 /// Stable name (quoted above).
@@ -240,6 +245,8 @@ struct DesignProblem {
   /// three_segment's knots when given); unset = computed. OptimizeOverMaterials drops them (each
   /// material is another bat).
   std::optional<MassProperties> base_mass_properties;
+  /// kLeastSquares: its targets and scales (required then, refused with any other objective).
+  std::optional<LeastSquaresTargets> least_squares;
 
   /// True when the problem is well formed (variables parse and apply to this design, bounds
   /// finite and ordered, constraints finite, the base bat valid, the rules' discrete limits
@@ -292,6 +299,11 @@ struct DesignOptions {
   double constraint_tolerance = 1e-10;
   int starts = 1;          ///< Local solves (1..64): the base design, then seeded random designs.
   std::uint64_t seed = 1;  ///< Seed of the random starts (std::mt19937_64).
+  /// Given starts: start i is start_points[i] (the variables' values, field units, clamped into
+  /// their bounds) while there is one, start 0 included (the base design then supplies only the
+  /// fixed fields), then the base design or the random designs (the random design of start i
+  /// stays the same). The shape fit's scan gives its best points here.
+  std::vector<std::vector<double>> start_points;
   /// Smallest gap between neighbouring knots when knot positions are variables, m (> 0).
   double min_knot_gap_m = 1e-4;
   /// On an infeasible result, find which constraints conflict and by how much (a few small

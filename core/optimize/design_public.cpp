@@ -76,6 +76,9 @@ PublicEvaluation EvaluatePublic(const DesignProblem& problem, const DesignModel&
     case DesignObjective::kMinMoi:
       out.objective = p.MoiSixInchKgM2();
       break;
+    case DesignObjective::kLeastSquares:
+      out.objective = problem.least_squares->Value(p.mass_kg, p.balance_point_m);
+      break;
     case DesignObjective::kMinSting:
       out.sting = model.StingOf(bat, true);
       out.objective = out.sting->sting_j;
@@ -106,6 +109,7 @@ double PublicConstraintValue(const DesignModel& model, const DesignConstraintSpe
     case DesignFunction::kLinear:
     case DesignFunction::kObjective:
     case DesignFunction::kFirstFrequency:  // the fixed mesh the constraint is defined on
+    case DesignFunction::kBoreBottom:      // a closed form of the shape's own numbers
       break;
   }
   return model.Value(c.f, x);

@@ -1,6 +1,6 @@
-// The shape fit: its checks, and the scan, SLSQP and Gauss-Newton stages over the least-squares
-// design problem of core/optimize/shape_fit_model.hpp (the design code's parametrisation and AD,
-// the one NLopt trampoline). See shape_fit.hpp.
+// The shape fit: its checks, a scan of the bounds, then the fit as a design problem solved by the
+// one solver layer (OptimizeDesign with the least-squares objective, NLopt SLSQP from the best
+// scan points and the layer's Gauss-Newton polish), and its certification. See shape_fit.hpp.
 #include "core/optimize/shape_fit.hpp"
 
 #include <algorithm>
@@ -9,33 +9,52 @@
 #include <exception>
 #include <limits>
 #include <new>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <Eigen/Dense>
-
 #include "core/geometry_format.hpp"
 #include "core/numerics/limits.hpp"
-#include "core/numerics/nlopt_run.hpp"
-#include "core/numerics/termination.hpp"
 #include "core/optimize/design_integrals.hpp"
-#include "core/optimize/shape_fit_model.hpp"
+#include "core/optimize/design_model.hpp"
+#include "core/optimize/least_squares_polish.hpp"
+#include "core/optimize/shape_fit_checks.hpp"
 
 namespace sweetspot::core {
 namespace {
 
 using fit_detail::FitConstraint;
 using fit_detail::kNumFitVariables;
-using fit_detail::ShapeFitModel;
 
-constexpr const char* kVariableName[kNumFitVariables] = {
-    "taper_start_m",   "taper_end_m",       "length_m",         "handle_radius_m",
-    "barrel_radius_m", "density_kg_m3",     "wall_thickness_m", "fill.diameter_m",
-    "fill.depth_m",    "fill.density_kg_m3"};
+// The fit's backend: NLopt SLSQP through the design optimiser, then its Gauss-Newton polish.
+constexpr const char* kFitBackend = "nlopt:slsqp+gauss_newton";
+// The design optimiser's tolerance for the fit (SLSQP's ftol_rel and xtol_rel): the fit's
+// SLSQP ran to x within 1e-14 relative, so a closest bat on a bound (which the polish cannot
+// improve) is placed to round-off.
+constexpr double kFitSolverTolerance = 1e-14;
 
-// Builds the bat of the family at parameters t (DesignParameterLayout{4}).
-void BuildBat(const ShapeFitProblem& problem, const std::vector<double>& t, ShapeFitResult* out) {
+// True when two bats have the same knots, densities, wall and fill (the same mass properties).
+bool SameBat(const Bat& a, const Bat& b) {
+  const auto same_fill = [](const std::optional<Fill>& f, const std::optional<Fill>& g) {
+    return f.has_value() == g.has_value() &&
+           (!f.has_value() || (f->diameter_m == g->diameter_m && f->depth_m == g->depth_m &&
+                               f->material.density_kg_m3 == g->material.density_kg_m3));
+  };
+  if (a.knots.size() != b.knots.size()) return false;
+  for (std::size_t i = 0; i < a.knots.size(); ++i) {
+    if (a.knots[i].x_m != b.knots[i].x_m || a.knots[i].radius_m != b.knots[i].radius_m) {
+      return false;
+    }
+  }
+  return a.material.density_kg_m3 == b.material.density_kg_m3 &&
+         a.wall_thickness_m == b.wall_thickness_m && same_fill(a.fill, b.fill);
+}
+
+// Builds the bat of the family at parameters t (DesignParameterLayout{4}); its mass properties
+// are `known`'s when that is the same bat (computed once), else computed.
+void BuildBat(const ShapeFitProblem& problem, const std::vector<double>& t, ShapeFitResult* out,
+              const std::optional<std::pair<Bat, MassProperties>>& known = std::nullopt) {
   const auto value = [&t](DesignVariableKind v) { return fit_detail::FitValue(t, v); };
   out->shape.taper_start_m = value(DesignVariableKind::kTaperStart);
   out->shape.taper_end_m = value(DesignVariableKind::kTaperEnd);
@@ -54,7 +73,9 @@ void BuildBat(const ShapeFitProblem& problem, const std::vector<double>& t, Shap
   out->bat = MakeThreeSegmentBat(out->shape, out->material);
   out->bat.wall_thickness_m = out->wall_thickness_m;
   out->bat.fill = out->fill;
-  out->properties = ComputeMassProperties(out->bat, InertiaModel::kRigidBody);
+  out->properties = known.has_value() && SameBat(known->first, out->bat)
+                        ? known->second
+                        : ComputeMassProperties(out->bat, InertiaModel::kRigidBody);
   out->values.clear();
   for (const FitUnknown& u : problem.unknowns) out->values.push_back(value(u.variable));
 }
@@ -93,332 +114,96 @@ std::string DescribeUnknowns(const ShapeFitProblem& problem) {
   return out;
 }
 
-// Smallest target or scale of the fit's metric, kg or m: residuals divided by
-// less than this can overflow to inf.
-constexpr double kMinMetricScale = 1e-6;
-
 }  // namespace
-
-int FitUnknownIndex(DesignVariableKind kind) {
-  for (int i = 0; i < kNumFitUnknowns; ++i) {
-    if (kFitUnknownKinds[i] == kind) return i;
-  }
-  return -1;
-}
-
-const char* FitUnknownName(DesignVariableKind kind) {
-  const int i = FitUnknownIndex(kind);
-  return i >= 0 ? kVariableName[i] : "unknown";
-}
-
-std::optional<DesignVariableKind> FitUnknownFromName(std::string_view name) {
-  for (int i = 0; i < kNumFitUnknowns; ++i) {
-    if (name == kVariableName[i]) return kFitUnknownKinds[i];
-  }
-  return std::nullopt;
-}
-
-bool ShapeFitOptions::Validate(Refusal* why) const {
-  if (!std::isfinite(mass_scale_kg) || mass_scale_kg < 0.0) {
-    return Refuse(why, "mass_scale_kg", mass_scale_kg,
-                  "must be finite and non-negative (0 = the target)");
-  }
-  if (!std::isfinite(balance_point_scale_m) || balance_point_scale_m < 0.0) {
-    return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
-                  "must be finite and non-negative (0 = the target)");
-  }
-  if (mass_scale_kg > kMaxFitMassKg) {
-    return Refuse(why, "mass_scale_kg", mass_scale_kg,
-                  RangeRule(0.0, kMaxFitMassKg) + " (0 = the target)");
-  }
-  if (balance_point_scale_m > kMaxBatLengthM) {
-    return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
-                  RangeRule(0.0, kMaxBatLengthM) + " (0 = the target)");
-  }
-  // Smaller scales overflow the scaled residuals to inf (found by fuzzing).
-  if (mass_scale_kg > 0.0 && mass_scale_kg < kMinMetricScale) {
-    return Refuse(why, "mass_scale_kg", mass_scale_kg, "must be 0 (the target) or at least 1e-06");
-  }
-  if (balance_point_scale_m > 0.0 && balance_point_scale_m < kMinMetricScale) {
-    return Refuse(why, "balance_point_scale_m", balance_point_scale_m,
-                  "must be 0 (the target) or at least 1e-06");
-  }
-  if (!CheckInRange(why, "tolerance", tolerance, kMinFitTolerance, kMaxFitTolerance)) return false;
-  if (!std::isfinite(kkt_tolerance) || !(kkt_tolerance > 0.0)) {
-    return Refuse(why, "kkt_tolerance", kkt_tolerance, "must be finite and positive");
-  }
-  if (scan_points < 1) return Refuse(why, "scan_points", scan_points, "must be at least 1");
-  if (local_starts < 1) return Refuse(why, "local_starts", local_starts, "must be at least 1");
-  if (max_evaluations < 1) {
-    return Refuse(why, "max_evaluations", max_evaluations, "must be at least 1");
-  }
-  if (!std::isfinite(max_time_s) || !(max_time_s > 0.0)) {
-    return Refuse(why, "max_time_s", max_time_s, "must be finite and positive");
-  }
-  return true;
-}
-
-bool ShapeFitProblem::Validate(Refusal* why) const {
-  if (!targets.mass_kg.has_value() && !targets.balance_point_m.has_value()) {
-    return Refuse(why, TextRefusal("targets", "must give mass_kg, balance_point_m or both"));
-  }
-  if (targets.mass_kg.has_value() && !(std::isfinite(*targets.mass_kg) && *targets.mass_kg > 0.0)) {
-    return Refuse(why, "targets.mass_kg", *targets.mass_kg, "must be finite and positive");
-  }
-  if (targets.balance_point_m.has_value() &&
-      !(std::isfinite(*targets.balance_point_m) && *targets.balance_point_m > 0.0)) {
-    return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
-                  "must be finite and positive");
-  }
-  // A target is the metric's default scale: a smaller one overflows it (found by fuzzing).
-  if (targets.mass_kg.has_value() && *targets.mass_kg < kMinMetricScale) {
-    return Refuse(why, "targets.mass_kg", *targets.mass_kg, "must be at least 1e-06");
-  }
-  if (targets.balance_point_m.has_value() && *targets.balance_point_m < kMinMetricScale) {
-    return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
-                  "must be at least 1e-06");
-  }
-  if (targets.mass_kg.has_value() && *targets.mass_kg > kMaxFitMassKg) {
-    return Refuse(why, "targets.mass_kg", *targets.mass_kg,
-                  RangeRule(kMinMetricScale, kMaxFitMassKg));
-  }
-  if (targets.balance_point_m.has_value() && *targets.balance_point_m > kMaxBatLengthM) {
-    return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
-                  RangeRule(kMinMetricScale, kMaxBatLengthM));
-  }
-  if (unknowns.empty() || unknowns.size() > static_cast<std::size_t>(kNumFitVariables)) {
-    return Refuse(why, "unknowns.size()", static_cast<double>(unknowns.size()),
-                  "must be between 1 and 10");
-  }
-  std::vector<bool> unknown(static_cast<std::size_t>(kNumFitVariables), false);
-  for (std::size_t i = 0; i < unknowns.size(); ++i) {
-    const FitUnknown& u = unknowns[i];
-    const int idx = FitUnknownIndex(u.variable);
-    if (idx < 0) {
-      return Refuse(why, IndexedField("unknowns", i, "variable"), static_cast<int>(u.variable),
-                    "is not a fit unknown (a profile knot's kind)");
-    }
-    const char* name = kVariableName[idx];
-    if (unknown[static_cast<std::size_t>(idx)]) {
-      return Refuse(why, QuotedRefusal(IndexedField("unknowns", i, "variable"), name,
-                                       "appears more than once"));
-    }
-    unknown[static_cast<std::size_t>(idx)] = true;
-    if (fit_detail::IsFillVariable(u.variable) && !fill.has_value()) {
-      return Refuse(
-          why, QuotedRefusal(IndexedField("unknowns", i, "variable"), name, "the bat has no fill"));
-    }
-    if (!std::isfinite(u.min)) {
-      return why == nullptr
-                 ? false
-                 : Refuse(why, IndexedField("unknowns", i, "min"), u.min, "must be finite");
-    }
-    if (!std::isfinite(u.max)) {
-      return why == nullptr
-                 ? false
-                 : Refuse(why, IndexedField("unknowns", i, "max"), u.max, "must be finite");
-    }
-    if (!(u.max > u.min)) {
-      return why == nullptr ? false
-                            : Refuse(why, IndexedField("unknowns", i, "max"), u.max,
-                                     "must be greater than " + IndexedField("unknowns", i, "min") +
-                                         " = " + FormatNumber(u.min));
-    }
-    const DesignVariableKind v = u.variable;
-    const bool must_be_positive =
-        v == DesignVariableKind::kLength || v == DesignVariableKind::kHandleRadius ||
-        v == DesignVariableKind::kBarrelRadius || v == DesignVariableKind::kDensity ||
-        v == DesignVariableKind::kWallThickness;
-    if (must_be_positive && !(u.min > 0.0)) {
-      return why == nullptr
-                 ? false
-                 : Refuse(why, IndexedField("unknowns", i, "min"), u.min,
-                          std::string("must be positive for ") + name +
-                              (v == DesignVariableKind::kWallThickness ? " (the bat stays hollow)"
-                                                                       : ""));
-    }
-    if (!must_be_positive && u.min < 0.0) {
-      return why == nullptr ? false
-                            : Refuse(why, IndexedField("unknowns", i, "min"), u.min,
-                                     std::string("must be non-negative for ") + name);
-    }
-  }
-  // The fixed values.
-  const std::vector<double> t = fit_detail::StartParameters(*this);
-  for (int i = 0; i < kNumFitVariables; ++i) {
-    const DesignVariableKind v = kFitUnknownKinds[i];
-    if (unknown[static_cast<std::size_t>(i)] ||
-        (fit_detail::IsFillVariable(v) && !fill.has_value()))
-      continue;
-    const double value = fit_detail::FitValue(t, v);
-    const char* field = fit_detail::FitUnknownField(v);
-    if (!std::isfinite(value)) return Refuse(why, field, value, "must be finite");
-    const bool must_be_positive =
-        v == DesignVariableKind::kLength || v == DesignVariableKind::kHandleRadius ||
-        v == DesignVariableKind::kBarrelRadius || v == DesignVariableKind::kDensity;
-    if (must_be_positive && !(value > 0.0)) return Refuse(why, field, value, "must be positive");
-    if (value < 0.0) return Refuse(why, field, value, "must be non-negative");
-  }
-  Material m = material;
-  m.density_kg_m3 = fit_detail::FitValue(t, DesignVariableKind::kDensity);
-  Refusal inner;
-  if (!m.Validate(why != nullptr ? &inner : nullptr))
-    return Refuse(why, Prefixed("material.", inner));
-  if (fill.has_value()) {
-    Material f = fill->material;
-    if (unknown[static_cast<std::size_t>(FitUnknownIndex(DesignVariableKind::kFillDensity))]) {
-      // check the other fields
-      f.density_kg_m3 = std::max(fit_detail::FitValue(t, DesignVariableKind::kFillDensity), 1.0);
-    }
-    if (f.density_kg_m3 != 0.0 && !f.Validate(why != nullptr ? &inner : nullptr)) {
-      return Refuse(why, Prefixed("fill.material.", inner));
-    }
-  }
-  const bool hollow = fit_detail::HollowOf(*this);
-  for (FitConstraint kind : fit_detail::ApplicableConstraints(hollow, fill.has_value())) {
-    if (!fit_detail::ConstraintInvolves(kind, unknown) &&
-        fit_detail::ConstraintValue(kind, t, hollow) > 0.0) {
-      return Refuse(why, fit_detail::ConstraintRefusal(kind, t, hollow));
-    }
-  }
-  return true;
-}
-
-bool ShapeFitProblem::ValidateSize(Refusal* why) const {
-  if (!Validate(why)) return false;
-  for (std::size_t i = 0; i < unknowns.size(); ++i) {
-    const FitUnknown& u = unknowns[i];
-    if (u.min > kMaxFitBound || u.max > kMaxFitBound) {
-      const bool min = u.min > kMaxFitBound;
-      return why == nullptr ? false
-                            : Refuse(why, IndexedField("unknowns", i, min ? "min" : "max"),
-                                     min ? u.min : u.max, RangeRule(0.0, kMaxFitBound));
-    }
-  }
-  return true;
-}
 
 namespace {
 
-// The fit's running state: the best feasible point in s, its metric, the stages' counts.
-struct FitSearch {
-  std::vector<double> best;
-  double best_phi = 0.0;
-  int local_runs = 0;
-  int raw_status = 0;  // of the SLSQP run that produced best (of the last one if none did)
-  int gauss_newton_steps = 0;
+// A valid point of the scan: the unknowns' values there and the metric.
+struct ScanPoint {
+  double phi = 0.0;
+  std::vector<double> x;
+  bool start = false;  // the problem's start (its unknowns clamped into their bounds)
 };
 
-// 1. Scan: the start and a Halton set; the feasible points, best first.
-std::vector<std::pair<double, std::vector<double>>> ScanBounds(ShapeFitModel& model,
-                                                               const ShapeFitOptions& options) {
+// The parameters each unknown sets (DesignParameterLayout{4}; two for a radius).
+std::vector<std::vector<int>> UnknownParameters(const ShapeFitProblem& problem) {
+  std::vector<std::vector<int>> out;
+  for (const FitUnknown& u : problem.unknowns) {
+    out.push_back(design_detail::DesignParametersOf(fit_detail::DesignVariableOf(u.variable),
+                                                    DesignParameterLayout{4}));
+  }
+  return out;
+}
+
+// The parameters t with the unknowns' values x set in the problem's start.
+std::vector<double> ParametersAtX(const ShapeFitProblem& problem, const std::vector<double>& x) {
+  std::vector<double> t = fit_detail::StartParameters(problem);
+  const std::vector<std::vector<int>> parameters = UnknownParameters(problem);
+  for (std::size_t j = 0; j < x.size(); ++j) {
+    for (int p : parameters[j]) t[static_cast<std::size_t>(p)] = x[j];
+  }
+  return t;
+}
+
+// 1. Scan: the start and a Halton set of the bounds (x_j = lo (1 - s) + hi s); the points where
+// every validity rule that an unknown can break holds (the others were checked by Validate),
+// in scan order.
+std::vector<ScanPoint> ScanBounds(const ShapeFitProblem& problem, const ShapeFitOptions& options) {
   constexpr int kPrimes[kNumFitVariables] = {2, 3, 5, 7, 11, 13, 17, 19, 23, 29};
-  const int n = model.n();
-  std::vector<std::pair<double, std::vector<double>>> candidates;
-  std::vector<double> s = model.StartS();
-  for (int k = 0; k <= options.scan_points && options.max_evaluations - model.evaluations() > 0;
-       ++k) {
-    if (k > 0) {
-      for (int j = 0; j < n; ++j) s[static_cast<std::size_t>(j)] = RadicalInverse(k, kPrimes[j]);
-    }
-    if (!model.Feasible(s.data())) continue;
-    candidates.emplace_back(model.Objective(s.data(), nullptr), s);
+  const bool hollow = fit_detail::HollowOf(problem);
+  std::vector<bool> unknown(static_cast<std::size_t>(kNumFitVariables), false);
+  for (const FitUnknown& u : problem.unknowns) {
+    unknown[static_cast<std::size_t>(FitUnknownIndex(u.variable))] = true;
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
-  return candidates;
+  std::vector<FitConstraint> constraints;
+  for (FitConstraint kind : fit_detail::ApplicableConstraints(hollow, problem.fill.has_value())) {
+    if (fit_detail::ConstraintInvolves(kind, unknown)) constraints.push_back(kind);
+  }
+  const std::vector<std::vector<int>> parameters = UnknownParameters(problem);
+  std::vector<double> t = fit_detail::StartParameters(problem);
+  const std::size_t n = problem.unknowns.size();
+  std::vector<double> s(n), x(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    const FitUnknown& u = problem.unknowns[j];
+    s[j] = (t[static_cast<std::size_t>(parameters[j].front())] - u.min) / (u.max - u.min);
+  }
+  std::vector<ScanPoint> points;
+  for (int k = 0; k <= options.scan_points; ++k) {
+    for (std::size_t j = 0; j < n; ++j) {
+      // The start itself, then x_j = lo (1 - s) + hi s.
+      if (k > 0) s[j] = RadicalInverse(k, kPrimes[j]);
+      x[j] = k == 0 ? t[static_cast<std::size_t>(parameters[j].front())]
+                    : problem.unknowns[j].min * (1.0 - s[j]) + problem.unknowns[j].max * s[j];
+      for (int p : parameters[j]) t[static_cast<std::size_t>(p)] = x[j];
+    }
+    const bool valid = std::all_of(constraints.begin(), constraints.end(), [&](FitConstraint c) {
+      return fit_detail::ConstraintValue(c, t, hollow) <= 0.0;
+    });
+    if (valid) points.push_back({0.0, x, k == 0});
+  }
+  return points;
 }
 
-// 2. SLSQP from the best scan points; keeps a feasible improvement in *search.
-template <typename Elapsed>
-void RunLocalStarts(ShapeFitModel& model, const ShapeFitOptions& options,
-                    const std::vector<std::pair<double, std::vector<double>>>& candidates,
-                    const Elapsed& elapsed_s, FitSearch* search, Summary* summary) {
-  const int n = model.n();
-  const auto budget_left = [&] { return options.max_evaluations - model.evaluations(); };
-  bool improved = false;
-  const std::vector<double> lower(static_cast<std::size_t>(n), 0.0);
-  const std::vector<double> upper(static_cast<std::size_t>(n), 1.0);
-  const NloptFunction objective = [&model](const double* x, double* grad) {
-    return model.Objective(x, grad);
-  };
-  std::vector<NloptConstraintFunction> constraints;
-  for (FitConstraint kind : model.constraints()) {
-    constraints.push_back(
-        {[&model, kind](const double* x, double* grad) { return model.Constraint(kind, x, grad); },
-         false, 0.0});
+// 2. phi at the scan's points by the fit's design model (within the evaluation budget), best
+// first; *evaluations counts them.
+void RankScan(const DesignModel& model, const ShapeFitOptions& options,
+              std::vector<ScanPoint>* points, int* evaluations) {
+  std::vector<ScanPoint> ranked;
+  for (ScanPoint& point : *points) {
+    if (*evaluations >= options.max_evaluations) break;
+    ++*evaluations;
+    point.phi = model.Value(model.objective(), point.x.data());
+    if (std::isfinite(point.phi)) ranked.push_back(std::move(point));
   }
-  for (std::size_t c = 0; c < candidates.size() && search->local_runs < options.local_starts; ++c) {
-    const double time_left = options.max_time_s - elapsed_s();
-    if (budget_left() <= 0 || time_left <= 0.0) break;
-    ++search->local_runs;
-    NloptRunSettings run;
-    run.algorithm = NloptAlgorithm::kLdSlsqp;
-    run.lower = lower;
-    run.upper = upper;
-    run.x_tolerance_rel = 1e-14;
-    run.f_tolerance_abs = 1e-30;
-    run.max_evaluations = budget_left();
-    run.max_time_s = time_left;
-    std::vector<double> x = candidates[c].second;
-    const int status = RunNlopt(objective, constraints, run, &x).raw_status;
-    for (double& xj : x) xj = std::clamp(xj, 0.0, 1.0);
-    if (status > 0 || status == kNloptRoundoffLimited) {  // x holds the best point: keep it
-      const double phi = model.Objective(x.data(), nullptr);
-      if (model.Feasible(x.data()) && phi < search->best_phi) {
-        search->best_phi = phi;
-        search->best = x;
-        search->raw_status = status;
-        improved = true;
-      }
-    }
-    if (!improved) search->raw_status = status;
-  }
-  summary->raw_status = search->raw_status;
-  if (search->raw_status == kNloptRoundoffLimited) {
-    summary->warnings.push_back("NLopt SLSQP stopped round-off limited; its best point is kept");
-  } else if (search->raw_status == kNloptMaxevalReached ||
-             search->raw_status == kNloptMaxtimeReached) {
-    summary->warnings.push_back("NLopt SLSQP stopped at the evaluation or time budget");
-  }
-}
-
-// 3. Gauss-Newton on the residuals (keeps only feasible decreases).
-void PolishGaussNewton(ShapeFitModel& model, const ShapeFitOptions& options, FitSearch* search) {
-  const int n = model.n();
-  std::vector<double>& best = search->best;
-  for (int iter = 0; iter < 50 && options.max_evaluations - model.evaluations() > 0; ++iter) {
-    Eigen::VectorXd r;
-    Eigen::MatrixXd jac;
-    model.Residuals(best.data(), &r, &jac);
-    if (r.lpNorm<Eigen::Infinity>() <= 1e-3 * options.tolerance) break;
-    const Eigen::VectorXd step = jac.completeOrthogonalDecomposition().solve(-r);
-    bool accepted = false;
-    double alpha = 1.0;
-    for (int halving = 0; halving < 30; ++halving, alpha *= 0.5) {
-      std::vector<double> trial = best;
-      for (int j = 0; j < n; ++j) {
-        trial[static_cast<std::size_t>(j)] =
-            std::clamp(best[static_cast<std::size_t>(j)] + alpha * step[j], 0.0, 1.0);
-      }
-      if (!model.Feasible(trial.data())) continue;
-      const double phi = model.Objective(trial.data(), nullptr);
-      if (phi < search->best_phi) {
-        search->best_phi = phi;
-        best = trial;
-        accepted = true;
-        break;
-      }
-    }
-    if (!accepted) break;
-    ++search->gauss_newton_steps;
-  }
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const ScanPoint& a, const ScanPoint& b) { return a.phi < b.phi; });
+  *points = std::move(ranked);
 }
 
 // 4. The metric of the built bat and the termination: targets met, the certified closest bat,
 // or the best found.
-void Classify(const ShapeFitProblem& problem, const ShapeFitOptions& options, ShapeFitModel& model,
-              const std::vector<double>& best, ShapeFitResult* result) {
+void Classify(const ShapeFitProblem& problem, const ShapeFitOptions& options,
+              const DesignModel& model, const std::vector<double>& x, ShapeFitResult* result) {
   Summary& summary = result->summary;
   double max_scaled = 0.0;
   result->metric = 0.0;
@@ -450,7 +235,7 @@ void Classify(const ShapeFitProblem& problem, const ShapeFitOptions& options, Sh
     summary.message = "targets met (" + DescribeTargets(problem) + "): " + achieved;
     return;
   }
-  result->kkt_error = fit_detail::KktError(model, best);
+  result->kkt_error = design_detail::LeastSquaresKktError(model, x);
   summary.error_estimate = result->kkt_error;
   const std::string metric =
       "metric ((M - M*)/s_M)^2 + ((C - C*)/s_C)^2 = " + FormatNumber(result->metric) + ": " +
@@ -469,6 +254,97 @@ void Classify(const ShapeFitProblem& problem, const ShapeFitOptions& options, Sh
   }
 }
 
+// The design optimiser's options for the fit: NLopt SLSQP from the best scan points, to the
+// fit's own tolerances (x to 1e-14 relative), within what is left of its budgets.
+DesignOptions SolveOptions(const ShapeFitOptions& options, const std::vector<ScanPoint>& ranked,
+                           int evaluations, double time_left_s) {
+  DesignOptions o;
+  o.backend = DesignBackend::kNloptSlsqp;
+  o.tolerance = kFitSolverTolerance;
+  o.starts = static_cast<int>(
+      std::min<std::size_t>({static_cast<std::size_t>(options.local_starts), ranked.size(), 64}));
+  for (int i = 0; i < o.starts; ++i) {
+    o.start_points.push_back(ranked[static_cast<std::size_t>(i)].x);
+  }
+  // SLSQP runs at most 20 evaluations per "iteration" (nlopt_design.cpp): the budget left,
+  // shared by the starts.
+  const int left = std::max(1, options.max_evaluations - evaluations);
+  o.max_iterations = std::clamp(left / (20 * o.starts), 1, 100000);
+  o.max_time_s = std::max(time_left_s, 1e-6);
+  o.explain_infeasibility = false;  // no property constraints: the metric says how far
+  return o;
+}
+
+// The design optimiser's answer: the unknowns' values, and its bat with their mass properties.
+struct FitSolve {
+  std::vector<double> x;
+  std::optional<std::pair<Bat, MassProperties>> bat;
+};
+
+// 3. OptimizeDesign on the fit's problem from the best scan points with its polish to round-off,
+// within what is left of the budgets: the values it ends at, or the best scan point's when the
+// budget is spent or the solve gives no usable design. Sets the summary's counts, raw status,
+// constraint violation and warnings.
+FitSolve SolveFromScan(const ShapeFitProblem& problem, const DesignProblem& fit_problem,
+                       const ShapeFitOptions& options, const std::vector<ScanPoint>& ranked,
+                       int scan_evaluations, double time_left_s, Summary* summary) {
+  summary->evaluations = scan_evaluations;
+  summary->iterations = 0;
+  summary->constraint_violation = 0.0;
+  if (scan_evaluations >= options.max_evaluations || !(time_left_s > 0.0)) {
+    return {ranked.front().x, std::nullopt};
+  }
+  const DesignResult design =
+      OptimizeDesign(fit_problem, SolveOptions(options, ranked, scan_evaluations, time_left_s));
+  // iterations: the local solves run plus the polish's accepted steps (the iterations the
+  // design layer adds beyond its starts' own).
+  int solver_iterations = 0;
+  for (const DesignStart& run : design.spread.runs) solver_iterations += run.iterations;
+  summary->iterations =
+      design.spread.starts + std::max(design.summary.iterations - solver_iterations, 0);
+  summary->evaluations += std::max(design.summary.evaluations, 0);
+  summary->raw_status = design.summary.raw_status;
+  summary->warnings = design.summary.warnings;
+  // The design's point, unless it has none or is worse than the scan's best (a solver's
+  // failure keeps its best point when that is feasible: NLopt SLSQP may stop with "more than
+  // iter SQP iterations" at a root).
+  const bool failed = design.summary.termination == Termination::kFailure;
+  const bool usable = design.summary.termination != Termination::kInvalidInput &&
+                      design.message_kind != DesignMessageKind::kNoDesign &&
+                      design.variables.size() == problem.unknowns.size() &&
+                      std::isfinite(design.objective_value) &&
+                      design.objective_value <= ranked.front().phi &&
+                      std::isfinite(design.summary.constraint_violation) &&
+                      (!failed || design.summary.constraint_violation <= 0.0);
+  if (!usable) {
+    summary->warnings.push_back("the design optimiser's solve gave no usable design (" +
+                                design.summary.message + "); the best scan point is kept");
+    return {ranked.front().x, std::nullopt};
+  }
+  if (failed) {
+    summary->warnings.push_back("the local solve stopped with " + design.summary.message +
+                                "; its best point is kept");
+  }
+  summary->constraint_violation = std::max(0.0, design.summary.constraint_violation);
+  FitSolve out;
+  for (const DesignValue& v : design.variables) out.x.push_back(v.value);
+  out.bat.emplace(design.bat, design.properties);
+  return out;
+}
+
+// The rigid-body mass properties of the fit problem's base design: the caller's when it is
+// the problem's bat (its start, nothing clamped), else computed.
+MassProperties BaseProperties(const ShapeFitProblem& problem, const ScanPoint& base,
+                              const DesignProblem& fit_problem) {
+  if (base.start && problem.bat_mass_properties.has_value() &&
+      fit_detail::StartParameters(problem) == fit_detail::BaseParameters(problem)) {
+    return *problem.bat_mass_properties;
+  }
+  Bat bat = fit_problem.bat;
+  bat.knots = fit_problem.three_segment->Knots();
+  return ComputeMassProperties(bat, InertiaModel::kRigidBody);
+}
+
 }  // namespace
 
 ShapeFitResult FitShape(const ShapeFitProblem& problem, const ShapeFitOptions& options) {
@@ -479,7 +355,7 @@ ShapeFitResult FitShape(const ShapeFitProblem& problem, const ShapeFitOptions& o
   ShapeFitResult result;
   Summary& summary = result.summary;
   summary.models_used = {"mass_properties"};
-  summary.backend = "nlopt:slsqp+gauss_newton";
+  summary.backend = kFitBackend;
   Refusal why;
   bool invalid = false;
   if (!options.Validate(&why)) {
@@ -498,43 +374,55 @@ ShapeFitResult FitShape(const ShapeFitProblem& problem, const ShapeFitOptions& o
   }
 
   try {
-    ShapeFitModel model(problem, options);
-    const auto candidates = ScanBounds(model, options);
-    if (candidates.empty()) {
+    std::vector<ScanPoint> ranked = ScanBounds(problem, options);
+    if (ranked.empty()) {
       // About the unknowns' bounds together, not one field.
       summary.SetRefusal(TextRefusal("", "the unknowns' bounds (" + DescribeUnknowns(problem) +
                                              ") admit no valid bat: every one of " +
                                              std::to_string(options.scan_points + 1) +
                                              " points tried is invalid"));
       BuildBat(problem, fit_detail::BaseParameters(problem), &result);
-      summary.evaluations = model.evaluations();
+      summary.evaluations = 0;
       summary.solve_time_s = elapsed_s();
       return result;
     }
-    FitSearch search;
-    search.best = candidates.front().second;
-    search.best_phi = candidates.front().first;
-    RunLocalStarts(model, options, candidates, elapsed_s, &search, &summary);
-    PolishGaussNewton(model, options, &search);
+    // The fit's design problem (its base the first valid point: the start, when valid), whose
+    // model ranks the scan.
+    DesignProblem fit_problem =
+        fit_detail::FitDesignProblem(problem, options, ParametersAtX(problem, ranked.front().x));
+    fit_problem.base_mass_properties = BaseProperties(problem, ranked.front(), fit_problem);
+    DesignModel model;
+    Refusal model_why;
+    if (!DesignModel::Build(fit_problem, DesignOptions{}, &model, &model_why)) {
+      summary.termination = Termination::kFailure;
+      summary.message = "the fit's design problem is refused: " + model_why.Message();
+      BuildBat(problem, ParametersAtX(problem, ranked.front().x), &result);
+      summary.solve_time_s = elapsed_s();
+      return result;
+    }
+    int evaluations = 0;
+    RankScan(model, options, &ranked, &evaluations);
+    if (ranked.empty()) throw std::runtime_error("the metric is not finite at any scan point");
+
+    const FitSolve solve = SolveFromScan(problem, fit_problem, options, ranked, evaluations,
+                                         options.max_time_s - elapsed_s(), &summary);
+    const std::vector<double>& x = solve.x;
 
     // The result: repair the ordering round-off, build the bat, classify.
-    std::vector<double> t = model.ToParameters(search.best.data());
-    const ThreeSegmentShape repaired = design_detail::ThreeSegmentShapeAt(t, problem.shape);
+    std::vector<double> t = ParametersAtX(problem, x);
     const DesignParameterLayout lay{4};
+    const ThreeSegmentShape repaired = design_detail::ThreeSegmentShapeAt(t, problem.shape);
     t[static_cast<std::size_t>(lay.KnotPosition(1))] = repaired.taper_start_m;
     t[static_cast<std::size_t>(lay.KnotPosition(2))] = repaired.taper_end_m;
-    BuildBat(problem, t, &result);
-    summary.iterations = search.local_runs + search.gauss_newton_steps;
-    summary.evaluations = model.evaluations();
-    summary.constraint_violation = std::max(0.0, model.MaxViolationM(search.best.data()));
+    BuildBat(problem, t, &result, solve.bat);
     if (Refusal bat_why; !result.bat.Validate(&bat_why)) {
       summary.termination = Termination::kFailure;
       summary.message = "the fitted bat is invalid: " + bat_why.Message();
-      summary.objective = search.best_phi;
+      summary.objective = kNaN;
       summary.solve_time_s = elapsed_s();
       return result;
     }
-    Classify(problem, options, model, search.best, &result);
+    Classify(problem, options, model, x, &result);
   } catch (const std::bad_alloc&) {
     summary.termination = Termination::kFailure;
     summary.message = "out of memory";

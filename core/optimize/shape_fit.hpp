@@ -15,12 +15,15 @@
 // x2) is such a case: the closest bat is x1 = 0.17964 m, x2 = L = 0.855 m
 // (no barrel cylinder), M = 0.8920 kg, C = 0.5827 m.
 //
-// Method: a deterministic low-discrepancy scan of the bounds, NLopt SLSQP
-// (exact gradients) from the best feasible scan points, then Gauss-Newton on
-// the residuals to reach machine precision when the targets are attainable.
-// The problem is a least-squares design problem over the design code's
-// variables of the same fields (three_segment.*, material.density_kg_m3, ...):
-// core/optimize/shape_fit_model.hpp.
+// Method: the fit is a DesignProblem solved by the one solver layer (issue 33
+// item 3): the unknowns are the design variables of the same fields
+// (three_segment.*, material.density_kg_m3, ...), the objective the design
+// model's least-squares objective (DesignObjective::kLeastSquares), the
+// constraints its validity rules (with the exact bore rule). A deterministic
+// low-discrepancy scan of the bounds gives the starts; OptimizeDesign runs NLopt
+// SLSQP (exact gradients) from the best feasible scan points, then its
+// Gauss-Newton polish on the residuals reaches machine precision when the
+// targets are attainable (core/optimize/shape_fit_checks.hpp builds the problem).
 #pragma once
 
 #include <optional>
@@ -93,6 +96,10 @@ struct ShapeFitProblem {
   std::optional<Fill> fill;          ///< Optional fill.
   std::vector<FitUnknown> unknowns;  ///< 1 to 10 distinct unknowns.
   FitTargets targets;                ///< What to meet.
+  /// The rigid-body mass properties of the bat as given (shape, material, wall, fill) when the
+  /// caller has computed them (the api's ParseBat): used for the fit's design problem when its
+  /// start is that bat (no unknown clamped), instead of computing them again. Unset = computed.
+  std::optional<MassProperties> bat_mass_properties;
 
   /// True when the problem can be solved; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "field = value: rule".
@@ -128,9 +135,9 @@ struct ShapeFitOptions {
 /// them; the result is the certified closest bat), kNoConvergence (best bat
 /// found, not certified), kFailure or kInvalidInput (message names the field);
 /// backend "nlopt:slsqp+gauss_newton"; raw_status = the NLopt result of the
-/// SLSQP run that produced the result (of the last run if none improved on the
-/// scan; 0 if none ran); iterations = SLSQP runs
-/// + accepted Gauss-Newton steps; evaluations = objective evaluations;
+/// SLSQP run that produced the result (OptimizeDesign's chosen start; 0 if none
+/// ran); iterations = SLSQP runs + accepted Gauss-Newton steps; evaluations =
+/// the scan's and the design layer's model evaluations;
 /// objective = phi; constraint_violation in m; error_estimate = the largest
 /// scaled residual when converged, else kkt_error; models_used =
 /// {"mass_properties"}.
