@@ -80,6 +80,43 @@ std::vector<BatPreset> BuildPresets() {
       "white ash from the Wood Handbook FPL-GTR-190 (material 'ash').";
   out.push_back(ash);
 
+  // A turned pro maple bat (issue 35, "wood bats that ring like wood bats"): the knots below,
+  // in inches, are this service's reading of the published descriptions of a medium-handle
+  // pro turning model (C271 class), not a manufacturer's drawing; see `source`.
+  BatPreset maple;
+  maple.name = "wood-34-maple-turned";
+  maple.bat.knots = FromInches({{0.0, 1.70},
+                                {0.25, 1.85},
+                                {0.55, 1.85},
+                                {1.0, 1.20},
+                                {2.5, 0.96},
+                                {3.5, 0.95},
+                                {11.0, 0.95},
+                                {14.0, 1.10},
+                                {17.5, 1.50},
+                                {21.0, 2.08},
+                                {23.0, 2.38},
+                                {24.5, 2.50},
+                                {33.6, 2.50},
+                                {34.0, 2.30}});
+  maple.bat.material = *FindMaterial("maple-bat-billet");
+  maple.description =
+      "A 34-in solid maple bat turned to a medium-handle pro model: flared 1.85-in knob, "
+      "0.95-in handle to 11 in, S-shaped taper to a 2.50-in barrel at 24.5 in, rounded end; "
+      "bat-grade maple billet (637 kg/m3, E = 15.16 GPa); 32.0 oz (drop 2), balance point "
+      "23.2 in; first free-free bending mode 143 Hz.";
+  maple.source =
+      "Profile: MLB Official Baseball Rules 3.02 (solid wood, at most 2.61 in); handle 0.95 in, "
+      "'medium handles are the most common and are typically around .95\"', flared knob, "
+      "models 271 and others (Outlaw Bats, 'Anatomy of a wood bat'); handle length 10.5-11.5 in "
+      "for a 34-in professional bat (dimensions.com, 'Baseball bat - professional'), so the taper "
+      "starts at 11 in; a 2.5-in barrel (below the 2.61-in maximum, as most turning models); "
+      "volume 87.0 in3, within the 79.7-90.4 in3 of the four popular pro profiles of Appl. Sci. "
+      "12(7), 3494 (2022). No published table of a turning model's diameters was found, so the "
+      "knots between those anchors are this service's. Material 'maple-bat-billet' (that "
+      "study's bat-grade billet values).";
+  out.push_back(maple);
+
   BatPreset bbcor;
   bbcor.name = "bbcor-33-aluminium";
   bbcor.bat.knots = FromInches({{0.0, 1.50},

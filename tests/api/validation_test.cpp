@@ -57,6 +57,35 @@ TEST(ValidationTest, FirstBendingModeAndItsNodesOfWoodBats) {
   EXPECT_NEAR(frequency_of("paper-wood", "ash"), 140.9, 0.01 * 140.9);
 }
 
+// Issue 35, "wood bats that ring like wood bats": a turned pro maple bat in the bat-grade
+// billet values of Appl. Sci. 12(7), 3494 (2022) (material "maple-bat-billet", E = 15.16 GPa at
+// 637 kg/m3) rings at 143.1 Hz, 16 % below Russell's "around 170 Hz": outside +-10 %, for the
+// reason validation.md gives (with these moduli a medium handle tapering from 11 in rings
+// near 143 Hz; 170 Hz needs E = 21.4 GPa on this profile, or a thick handle and a taper from
+// 9 in). Pinned at
+// +-1 % (the model's own number; a change of the preset, the material or the beam moves it by
+// more), with the material's share the row quotes (the Wood Handbook's hard maple on this
+// profile: 124.0 Hz).
+TEST(ValidationTest, TurnedMapleBatRingsWithBatGradeBillets) {
+  const auto mode_of = [](const Json& bat) {
+    return Post("/v1/sweet-spot", Json{{"bat", bat}, {"outputs", {"vibration_node"}}});
+  };
+  const Json maple = mode_of(Json{{"preset", "wood-34-maple-turned"}});
+  const double f1 = maple["vibration_node"]["frequency_hz"].get<double>();
+  EXPECT_NEAR(f1, 143.1, 0.01 * 143.1);
+  EXPECT_NEAR(f1, 170.0, 0.20 * 170.0);  // within 20 % of the measurement: the row's verdict
+  EXPECT_GT(f1, 116.1 * 1.2);            // and 23 % above wood-34-ash
+  const double length = maple["properties"]["length_m"].get<double>();
+  const double node_from_tip =
+      (length - maple["vibration_node"]["position_from_knob_m"].get<double>()) / kInch;
+  EXPECT_GE(node_from_tip, 5.0);  // Russell's barrel node, 5-7 in from the end
+  EXPECT_LE(node_from_tip, 7.5);  // 7.1 in: 0.1 in past "usually 5-7 inches"
+  EXPECT_NEAR(maple["properties"]["imperial"]["weight_oz"].get<double>(), 32.05, 0.01);
+  // The material alone: the handbook's small clear hard maple (12.6 GPa, 706 kg/m3).
+  const Json handbook = mode_of(Json{{"preset", "wood-34-maple-turned"}, {"material", "maple"}});
+  EXPECT_NEAR(handbook["vibration_node"]["frequency_hz"].get<double>(), 124.0, 0.01 * 124.0);
+}
+
 // The max-exit-speed point of a swung bat: 5-7 in from the barrel end (Russell, "What is the
 // sweet spot of a baseball bat?"). The default model (free_bat) is there; the paper's pinned bat
 // puts it at the tip (docs/models.md, "Which model").

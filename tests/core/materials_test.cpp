@@ -17,8 +17,8 @@ namespace {
 
 TEST(MaterialsCatalogue, HasEveryEntryValidWithASource) {
   const std::set<std::string> expected = {"ash",        "hard-maple",     "yellow-birch",
-                                          "paper-wood", "aluminium-7046", "aluminium-7050",
-                                          "cork",       "rubber"};
+                                          "maple-bat-billet", "paper-wood", "aluminium-7046",
+                                          "aluminium-7050", "cork", "rubber"};
   std::set<std::string> names;
   for (const Material& m : MaterialCatalogue()) {
     std::string why;
@@ -50,6 +50,13 @@ TEST(MaterialsCatalogue, Values) {
   EXPECT_EQ(cork.density_max_kg_m3, 320.0);
   EXPECT_FALSE(cork.cor.has_value());
   EXPECT_FALSE(FindMaterial("rubber")->cor.has_value());
+  // Bat-grade maple (Appl. Sci. 12(7), 3494, Appendix A, Profile B): psi x 6894.757293168.
+  const Material billet = *FindMaterial("maple-bat-billet");
+  EXPECT_EQ(billet.density_kg_m3, 637.0);
+  EXPECT_NEAR(billet.youngs_modulus_pa, 2198507.0 * 6894.757293168, 1e-3);
+  EXPECT_NEAR(billet.shear_modulus_pa, 244034.0 * 6894.757293168, 1e-3);
+  EXPECT_EQ(billet.base, "hard-maple");  // its species, for league rules
+  EXPECT_EQ(billet.kind, MaterialKind::kWood);
   EXPECT_FALSE(FindMaterial("balsa").has_value());
   EXPECT_FALSE(FindMaterial("").has_value());
 }

@@ -80,6 +80,21 @@ TEST(Presets, Wood34Ash) {
   EXPECT_EQ(bat.material.name, "ash");
 }
 
+TEST(Presets, Wood34MapleTurned) {
+  const Bat bat = FindPreset("wood-34-maple-turned")->bat;
+  const ImperialProperties imp = ToImperial(ComputeMassProperties(bat), bat.LengthM());
+  EXPECT_NEAR(imp.length_in, 34.0, 1e-12);
+  EXPECT_NEAR(MaxDiameterIn(bat), 2.50, 1e-12);
+  // Frusta summed by an independent script (plain Python, pi h (a^2 + ab + b^2) / 3 per
+  // segment): 32.0481 oz, balance point 23.2142 in; 1e-3 covers the script's printout.
+  EXPECT_NEAR(imp.weight_oz, 32.0481, 1e-3);
+  EXPECT_NEAR(imp.balance_point_in, 23.2142, 1e-3);
+  EXPECT_FALSE(bat.IsHollow());
+  EXPECT_EQ(bat.material.name, "maple-bat-billet");
+  EXPECT_EQ(bat.material.density_kg_m3, 637.0);
+  EXPECT_NEAR(bat.material.youngs_modulus_pa, 15.158e9, 0.001e9);  // 2,198,507 psi
+}
+
 TEST(Presets, Bbcor33Aluminium) {
   const Bat bat = FindPreset("bbcor-33-aluminium")->bat;
   const MassProperties p = ComputeMassProperties(bat);
