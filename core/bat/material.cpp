@@ -128,6 +128,29 @@ std::vector<Material> BuildCatalogue() {
   al7050.base = al7050.name;
   out.push_back(al7050);
 
+  // Issue 35: the catalogue's composite. A bat's lay-up varies along it and between models; this
+  // is one laminate, isotropic here with the fabric's in-plane values (the axial modulus the
+  // beam bends with and the hoop modulus the barrel rings with are both E1 = E2).
+  Material carbon;
+  carbon.name = "carbon-epoxy-fabric";
+  carbon.density_kg_m3 = 1600.0;
+  carbon.youngs_modulus_pa = 70.0e9;
+  carbon.shear_modulus_pa = 5.0e9;
+  carbon.poissons_ratio = 0.10;
+  carbon.cor = 0.5;
+  carbon.kind = MaterialKind::kComposite;
+  carbon.base = carbon.name;
+  carbon.source =
+      "Standard carbon fibre 0/90 fabric in epoxy (120 C cure, fibre volume fraction 50 %): "
+      "E1 = E2 = 70 GPa, in-plane shear modulus G12 = 5 GPa, major Poisson's ratio 0.10 "
+      "(Performance Composites Ltd, 'Mechanical properties of carbon fibre composite "
+      "materials', performance-composites.com/carbonfibre/mechanicalproperties_2.asp, column "
+      "'Std CF Fabric'); density 1600 kg/m3 (SubsTech, 'Epoxy matrix composite reinforced by 70% "
+      "carbon fibers': 1.6e3 kg/m3; a 50 % fabric laminate is a few per cent lighter). One "
+      "laminate standing for a composite bat's shell; its lay-up is not modelled." +
+      bbcor;
+  out.push_back(carbon);
+
   Material cork;
   cork.name = "cork";
   cork.density_kg_m3 = 290.0;

@@ -16,9 +16,10 @@ namespace materials_test {
 namespace {
 
 TEST(MaterialsCatalogue, HasEveryEntryValidWithASource) {
-  const std::set<std::string> expected = {"ash",        "hard-maple",     "yellow-birch",
-                                          "maple-bat-billet", "paper-wood", "aluminium-7046",
-                                          "aluminium-7050", "cork", "rubber"};
+  const std::set<std::string> expected = {
+      "ash",        "hard-maple",     "yellow-birch",   "maple-bat-billet",
+      "paper-wood", "aluminium-7046", "aluminium-7050", "carbon-epoxy-fabric",
+      "cork",       "rubber"};
   std::set<std::string> names;
   for (const Material& m : MaterialCatalogue()) {
     std::string why;
@@ -57,6 +58,12 @@ TEST(MaterialsCatalogue, Values) {
   EXPECT_NEAR(billet.shear_modulus_pa, 244034.0 * 6894.757293168, 1e-3);
   EXPECT_EQ(billet.base, "hard-maple");  // its species, for league rules
   EXPECT_EQ(billet.kind, MaterialKind::kWood);
+  // The composite (Performance Composites' "Std CF Fabric" column; SubsTech's density).
+  const Material carbon = *FindMaterial("carbon-epoxy-fabric");
+  EXPECT_EQ(carbon.kind, MaterialKind::kComposite);
+  EXPECT_EQ(carbon.youngs_modulus_pa, 70.0e9);
+  EXPECT_EQ(carbon.shear_modulus_pa, 5.0e9);
+  EXPECT_EQ(carbon.density_kg_m3, 1600.0);
   EXPECT_FALSE(FindMaterial("balsa").has_value());
   EXPECT_FALSE(FindMaterial("").has_value());
 }
