@@ -92,7 +92,7 @@ TEST(ValidationTest, TurnedMapleBatRingsWithBatGradeBillets) {
 // 1-oz knob with its handle wall solved for the same 30 oz (bbcor-33-alloy-capped) it is at
 // 6.8 in, inside; the end cap is the lever (validation.md). The model's own numbers are pinned
 // at +-0.05 in (a change of the presets, the barrel or the exit model moves them by more);
-// the BBCOR scan's maximum location and the hoop frequency at +-0.05 in and +-1 %.
+// the BBCOR scan's maximum location and the hoop frequency at +-0.1 in and +-1 %.
 TEST(ValidationTest, BuiltHollowBatsMaxExitPointAndHoopFrequency) {
   struct Row {
     Json bat;
@@ -116,8 +116,10 @@ TEST(ValidationTest, BuiltHollowBatsMaxExitPointAndHoopFrequency) {
     const double length = r["properties"]["length_m"].get<double>();
     from_tip[i] = (length - r["max_exit_speed"]["position_from_knob_m"].get<double>()) / kInch;
     EXPECT_NEAR(from_tip[i], row.max_exit_from_tip_in, 0.05) << row.bat.dump();
+    // The scan's maximum is flat, its location the least certain of the three: +-0.1 in (the
+    // scan's polished search moves the open tube's by 0.009 in against this single parabola).
     EXPECT_NEAR(r["bbcor_scan"]["max_from_tip_m"].get<double>() / kInch, row.scan_max_from_tip_in,
-                0.05)
+                0.1)
         << row.bat.dump();
     EXPECT_NEAR(r["barrel"]["hoop_frequency_hz"].get<double>(), row.hoop_hz, 0.01 * row.hoop_hz)
         << row.bat.dump();
