@@ -90,6 +90,27 @@ std::optional<core::Fill> ParseFill(const Json& value, const std::string& path, 
   return fill;
 }
 
+// An end cap or knob object at `path` into *part: mass_kg and length_m (the table of fields;
+// their ranges: Bat::ValidateSize) and an optional catalogue "material" name.
+bool ParsePart(const Json& value, const std::string& path, FieldGroup group, core::Bat* bat,
+               ApiError* error) {
+  ObjectReader reader(value, path, error);
+  std::optional<core::BatPart>& part = group == FieldGroup::kEndCap ? bat->end_cap : bat->knob;
+  part = core::BatPart{};
+  FieldHost host;
+  host.bat = bat;
+  ReadFieldGroup(reader, group, host);
+  reader.OptionalString("material", &part->material);
+  if (!reader.ok()) return false;
+  if (reader.Has("material") && !core::FindMaterial(part->material)) {
+    reader.Fail("material", "is not a catalogue material (GET /v1/materials lists: " +
+                                core::MaterialNamesList() + ")");
+    return false;
+  }
+  if (const auto found = core::FindMaterial(part->material)) part->material = found->name;
+  return reader.Finish();
+}
+
 }  // namespace
 
 std::optional<core::Material> ParseMaterial(const Json& value, const std::string& path,
@@ -213,6 +234,17 @@ std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& pa
       spec.bat.fill = *parsed;
     }
   }
+  // The end cap and the knob (a preset's own are replaced; null removes one).
+  for (const auto& [key, group] :
+       {std::pair{"end_cap", FieldGroup::kEndCap}, std::pair{"knob", FieldGroup::kKnob}}) {
+    if (const Json* part = reader.Get(key)) {
+      if (part->is_null()) {
+        (group == FieldGroup::kEndCap ? spec.bat.end_cap : spec.bat.knob).reset();
+      } else if (!ParsePart(*part, JoinPath(path, key), group, &spec.bat, error)) {
+        return std::nullopt;
+      }
+    }
+  }
   if (!reader.Finish()) return std::nullopt;
   if (core::Refusal refusal; !spec.bat.ValidateSize(&refusal)) {
     // Knot refusals belong under the profile (or the preset's/three-segment's knots).
@@ -272,7 +304,11 @@ Json MaterialToJson(const core::Material& material) {
 
 Json BatToJson(const core::Bat& bat) {
   Json knots = Json::array();
-  for (const auto& k : bat.knots) knots.push_back({{"x_m", k.x_m}, {"radius_m", k.radius_m}});
+  for (const auto& k : bat.knots) {
+    Json knot{{"x_m", k.x_m}, {"radius_m", k.radius_m}};
+    if (k.wall_thickness_m > 0.0) knot["wall_thickness_m"] = k.wall_thickness_m;
+    knots.push_back(std::move(knot));
+  }
   Json out{{"profile", {{"knots", std::move(knots)}}}, {"material", bat.material.name}};
   if (bat.material.name == "custom" || !core::FindMaterial(bat.material.name)) {
     out["material"] = MaterialToJson(bat.material);
@@ -286,6 +322,13 @@ Json BatToJson(const core::Bat& bat) {
         {"material", bat.fill->IsEmpty() ? Json("empty") : Json(bat.fill->material.name)},
         {"diameter_m", bat.fill->diameter_m},
         {"depth_m", bat.fill->depth_m}};
+  }
+  for (const auto& [key, part] :
+       {std::pair{"end_cap", &bat.end_cap}, std::pair{"knob", &bat.knob}}) {
+    if (!part->has_value()) continue;
+    Json p{{"mass_kg", (*part)->mass_kg}, {"length_m", (*part)->length_m}};
+    if (!(*part)->material.empty()) p["material"] = (*part)->material;
+    out[key] = std::move(p);
   }
   return out;
 }

@@ -113,6 +113,10 @@ std::vector<Field> MakeFields() {
   f.push_back({"bat.profile.knots[].radius_m", "m", G::kKnot, 0.0, core::kMaxBatRadiusM, true,
                true, "", [](const H& h) { return BatOf(h).knots[h.knot].radius_m; },
                [](const H& h, double v) { BatOf(h).knots[h.knot].radius_m = v; }, true});
+  f.push_back({"bat.profile.knots[].wall_thickness_m", "m", G::kKnot, 0.0, core::kMaxBatRadiusM,
+               false, false, "",
+               [](const H& h) { return BatOf(h).knots[h.knot].wall_thickness_m; },
+               [](const H& h, double v) { BatOf(h).knots[h.knot].wall_thickness_m = v; }});
   // The material, given as an object.
   f.push_back({"bat.material.density_kg_m3", "kg/m³", G::kMaterial, 0.0, core::kMaxDensityKgM3,
                true, true, "density_kg_m3",
@@ -146,6 +150,19 @@ std::vector<Field> MakeFields() {
   f.push_back({"bat.fill.depth_m", "m", G::kFill, 0.0, core::kMaxBatLengthM, true, true,
                "fill.depth_m", [](const H& h) { return FillOf(h).depth_m; },
                [](const H& h, double v) { FillOf(h).depth_m = v; }, true});
+  // The end cap and the knob (issue 35): each its mass and length, required in its object.
+  f.push_back({"bat.end_cap.mass_kg", "kg", G::kEndCap, 0.0, core::kMaxBatPartMassKg, false,
+               false, "", [](const H& h) { return BatOf(h).end_cap->mass_kg; },
+               [](const H& h, double v) { BatOf(h).end_cap->mass_kg = v; }, true});
+  f.push_back({"bat.end_cap.length_m", "m", G::kEndCap, 0.0, core::kMaxBatLengthM, false, false,
+               "", [](const H& h) { return BatOf(h).end_cap->length_m; },
+               [](const H& h, double v) { BatOf(h).end_cap->length_m = v; }, true});
+  f.push_back({"bat.knob.mass_kg", "kg", G::kKnob, 0.0, core::kMaxBatPartMassKg, false, false,
+               "", [](const H& h) { return BatOf(h).knob->mass_kg; },
+               [](const H& h, double v) { BatOf(h).knob->mass_kg = v; }, true});
+  f.push_back({"bat.knob.length_m", "m", G::kKnob, 0.0, core::kMaxBatLengthM, false, false, "",
+               [](const H& h) { return BatOf(h).knob->length_m; },
+               [](const H& h, double v) { BatOf(h).knob->length_m = v; }, true});
   f.push_back({"bat.fill.material.density_kg_m3", "kg/m³", G::kFillMaterial, 0.0,
                core::kMaxDensityKgM3, false, true, "fill.density_kg_m3",
                [](const H& h) { return FillOf(h).material.density_kg_m3; },

@@ -37,6 +37,8 @@ enum class FieldGroup {
   kWall,          ///< "bat.wall_thickness_m".
   kFill,          ///< "bat.fill.*" (its size).
   kFillMaterial,  ///< "bat.fill.material.*".
+  kEndCap,        ///< "bat.end_cap.*": its mass and length.
+  kKnob,          ///< "bat.knob.*": its mass and length.
 };
 
 /// Where a field's accessor reads and writes: the parts of a request a field sits in, each null
@@ -47,7 +49,7 @@ struct FieldHost {
   core::Swing* swing = nullptr;
   std::optional<double>* cor = nullptr;
   core::Contact* contact = nullptr;
-  core::Bat* bat = nullptr;                  ///< Knots, wall.
+  core::Bat* bat = nullptr;                  ///< Knots, wall, end cap, knob.
   core::Material* material = nullptr;        ///< The bat's material (a material object's rows).
   core::ThreeSegmentShape* shape = nullptr;  ///< A three-segment bat's shape.
   core::Fill* fill = nullptr;                ///< The bat's fill.

@@ -132,6 +132,8 @@ std::optional<DesignBinder> DesignBinder::Compile(
           break;
         case FieldGroup::kWall:
         case FieldGroup::kFill:
+        case FieldGroup::kEndCap:  // not swept (fields.cpp): never reached
+        case FieldGroup::kKnob:
           binder.changes_.bat_geometry = true;
           break;
       }

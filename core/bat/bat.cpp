@@ -177,8 +177,12 @@ bool Bat::ValidateGeometryOfShapeKnots(Refusal* why) const {
     if (!(knots[i].x_m > knots[i - 1].x_m)) return ValidateGeometry(why);  // refused there
     min_radius = std::min(min_radius, knots[i].radius_m);
   }
-  // No fill and a wall in [0, min_radius) (so finite): ValidateBody's checks all pass.
-  if (!fill.has_value() && wall_thickness_m >= 0.0 && wall_thickness_m < min_radius) return true;
+  // No fill, no parts, no knot walls and a wall in [0, min_radius) (so finite): ValidateBody's
+  // checks all pass.
+  if (!fill.has_value() && !end_cap.has_value() && !knob.has_value() && !HasKnotWalls() &&
+      wall_thickness_m >= 0.0 && wall_thickness_m < min_radius) {
+    return true;
+  }
   return ValidateBody(why, /*materials=*/false, min_radius);
 }
 
@@ -234,6 +238,24 @@ bool Bat::ValidateBody(Refusal* why, bool materials, double min_radius) const {
     return Refuse(why, "wall_thickness_m", wall_thickness_m,
                   "must be less than the smallest outer radius " + FormatNumber(min_radius));
   }
+  for (std::size_t i = 0; i < knots.size(); ++i) {
+    const double t = knots[i].wall_thickness_m;
+    if (t == 0.0) continue;
+    if (why == nullptr) {
+      if (!(std::isfinite(t) && t > 0.0 && IsHollow() && t < knots[i].radius_m)) return false;
+      continue;
+    }
+    const std::string field = IndexedField("knots", i, "wall_thickness_m");
+    if (!std::isfinite(t)) return Refuse(why, field, t, "must be finite");
+    if (t < 0.0) return Refuse(why, field, t, "must be non-negative (0 = the bat's wall)");
+    if (!IsHollow()) {
+      return Refuse(why, field, t, "needs a hollow bat (wall_thickness_m > 0, the default wall)");
+    }
+    if (t >= knots[i].radius_m) {
+      return Refuse(why, field, t,
+                    "must be less than the knot's radius " + FormatNumber(knots[i].radius_m));
+    }
+  }
 
   if (fill.has_value()) {
     const Fill& f = *fill;
@@ -270,7 +292,19 @@ bool Bat::ValidateBody(Refusal* why, bool materials, double min_radius) const {
         worst_x = k.x_m;
       }
     }
-    const double around = worst_r - wall_thickness_m;  // wall is 0 for a solid bat
+    // The wall at that point (0 for a solid bat; linear between knots' own walls, so the
+    // inner radius is linear too and thinnest at the same places).
+    double around = worst_r - (IsHollow() ? WallAtM(worst_x) : 0.0);
+    if (HasKnotWalls() && IsHollow()) {  // the inner radius's own minimum over the range
+      around = InnerRadiusAtM(start);
+      worst_x = start;
+      for (std::size_t i = 0; i < knots.size(); ++i) {
+        if (knots[i].x_m > start && knots[i].radius_m - KnotWallM(i) < around) {
+          around = knots[i].radius_m - KnotWallM(i);
+          worst_x = knots[i].x_m;
+        }
+      }
+    }
     if (!(f.RadiusM() < around)) {
       return why == nullptr
                  ? false
@@ -281,7 +315,17 @@ bool Bat::ValidateBody(Refusal* why, bool materials, double min_radius) const {
                               " at x_m = " + FormatNumber(worst_x) + " (over the fill's depth)");
     }
   }
-  return true;
+  return ValidatePart(end_cap, "end_cap.", why) && ValidatePart(knob, "knob.", why);
+}
+
+bool Bat::ValidatePart(const std::optional<BatPart>& part, std::string_view prefix,
+                       Refusal* why) const {
+  if (!part.has_value()) return true;
+  const std::string p(prefix);
+  if (!std::isfinite(part->mass_kg))
+    return Refuse(why, p + "mass_kg", part->mass_kg, "must be finite");
+  if (!(part->mass_kg > 0.0)) return Refuse(why, p + "mass_kg", part->mass_kg, "must be positive");
+  return CheckInRange(why, p + "length_m", part->length_m, 0.0, LengthM(), /*lo_open=*/true);
 }
 
 bool Bat::ValidateSize(Refusal* why) const { return Validate(why) && ValidateCaps(why); }
@@ -314,6 +358,14 @@ bool Bat::ValidateCaps(Refusal* why) const {
       return false;
     }
   }
+  if (end_cap.has_value() &&
+      !CheckInRange(why, "end_cap.mass_kg", end_cap->mass_kg, 0.0, kMaxBatPartMassKg, true)) {
+    return false;
+  }
+  if (knob.has_value() &&
+      !CheckInRange(why, "knob.mass_kg", knob->mass_kg, 0.0, kMaxBatPartMassKg, true)) {
+    return false;
+  }
   return true;
 }
 
@@ -324,9 +376,30 @@ double Bat::RadiusAtM(double x_m) const {
   return Interpolate(knots, x_m);
 }
 
+bool Bat::HasKnotWalls() const {
+  for (const ProfileKnot& k : knots) {
+    if (k.wall_thickness_m != 0.0) return true;
+  }
+  return false;
+}
+
+double Bat::WallAtM(double x_m) const {
+  if (!IsHollow() || knots.empty() || !(x_m >= knots.front().x_m && x_m <= knots.back().x_m)) {
+    return 0.0;
+  }
+  if (!HasKnotWalls()) return wall_thickness_m;
+  const auto it = std::upper_bound(knots.begin(), knots.end(), x_m,
+                                   [](double v, const ProfileKnot& k) { return v < k.x_m; });
+  if (it == knots.begin()) return KnotWallM(0);
+  if (it == knots.end()) return KnotWallM(knots.size() - 1);
+  const std::size_t b = static_cast<std::size_t>(it - knots.begin());
+  const double t = (x_m - knots[b - 1].x_m) / (knots[b].x_m - knots[b - 1].x_m);
+  return KnotWallM(b - 1) + (KnotWallM(b) - KnotWallM(b - 1)) * t;
+}
+
 double Bat::InnerRadiusAtM(double x_m) const {
   if (!IsHollow()) return 0.0;
-  return std::max(RadiusAtM(x_m) - wall_thickness_m, 0.0);
+  return std::max(RadiusAtM(x_m) - WallAtM(x_m), 0.0);
 }
 
 double Bat::MinRadiusM() const {
@@ -334,6 +407,13 @@ double Bat::MinRadiusM() const {
   double r = std::numeric_limits<double>::infinity();
   for (const ProfileKnot& k : knots) r = std::min(r, k.radius_m);
   return r;
+}
+
+double Bat::PartRadiusM(bool at_tip) const {
+  if (knots.empty()) return 0.0;
+  const std::size_t i = at_tip ? knots.size() - 1 : 0;
+  const double r = knots[i].radius_m;
+  return IsHollow() ? std::max(r - KnotWallM(i), 0.0) : r;
 }
 
 Bat MakeThreeSegmentBat(const ThreeSegmentShape& shape, const Material& material) {

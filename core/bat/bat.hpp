@@ -7,23 +7,33 @@
 //   to L. A step in the radius is two knots a tiny distance apart (1e-12 m
 //   works: the mass properties integrate each segment without dividing by its
 //   length, so a short segment costs no accuracy).
-// - Hollow shell (wall_thickness_m = t > 0): the inner radius is r(x) - t at
-//   every x (the wall is measured radially, not normal to the surface), and
-//   the shell is an OPEN tube: both ends are open, no end cap and no solid
-//   knob plug are modelled (a real metal bat's end cap and knob add a few tens
-//   of grams; put them into the profile or the wall if they matter). The
-//   cavity holds nothing unless a fill is given. t = 0 is a solid bat; t must
-//   be less than the smallest outer radius.
+// - Hollow shell (wall_thickness_m = t > 0): the inner radius is r(x) - t(x)
+//   at every x (the wall is measured radially, not normal to the surface).
+//   t(x) is the bat's wall_thickness_m, or, where knots give their own
+//   wall_thickness_m (issue 35), linear between the knots' walls (a knot
+//   without one takes the bat's): r - t stays linear per segment, so the mass
+//   properties stay exact. The shell is an open tube unless an end cap and a
+//   knob (BatPart, below) close it. The cavity holds nothing unless a fill is
+//   given. t = 0 is a solid bat; t must be less than the smallest outer
+//   radius, and a knot's own wall less than its radius.
 // - Fill: a coaxial cylinder of radius diameter_m / 2 occupying
 //   [L - depth_m, L]. In a solid bat it is bored out of the bat's material and
 //   holds the fill material (density 0 = left empty, e.g. a cupped end); in a
 //   hollow bat it sits inside the cavity, so it must fit inside the inner
 //   radius. Either way it must lie strictly inside the material around it
 //   over its whole depth, and depth_m <= L.
+// - End cap and knob (BatPart, issue 35): parts the profile's material does not give, each a
+//   uniform solid cylinder on the axis from its end of the bat inwards over its length_m, of
+//   the bat's inner radius at that end (a solid bat's outer radius). Its mass adds to the
+//   profile's there (the shell, or a solid bat's wood, is kept), exactly in the mass
+//   properties (mass, balance point, moments with the part's own m (l^2/12 + r^2/4)) and in the
+//   beam (its mass and rotary inertia per length over its range, no stiffness). It adds no
+//   volume to MassProperties::volume_m3.
 #pragma once
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/bat/material.hpp"
@@ -39,11 +49,16 @@ inline constexpr double kMaxBatLengthM = 100.0;
 inline constexpr double kMaxBatRadiusM = 10.0;
 /// Largest diameter of a fill's bore, m.
 inline constexpr double kMaxFillDiameterM = 10.0;
+/// Largest mass of an end cap or a knob, kg (a 100 kg end cap is already absurd).
+inline constexpr double kMaxBatPartMassKg = 100.0;
 
 /// One knot of the outer radius profile.
 struct ProfileKnot {
   double x_m = 0.0;       ///< Position from the knob, m.
   double radius_m = 0.0;  ///< Outer radius at x_m, m (> 0).
+  /// The shell's wall at x_m, m: 0 = the bat's wall_thickness_m; > 0 (a hollow bat only, below
+  /// radius_m) this knot's own. Linear between knots.
+  double wall_thickness_m = 0.0;
 };
 
 /// The paper's three-segment shape: handle cylinder r1 on [0, x1], linear
@@ -93,14 +108,25 @@ struct Fill {
   bool IsEmpty() const { return material.density_kg_m3 == 0.0; }
 };
 
+/// An end cap or a knob: a part the profile's material does not give (see the file comment).
+struct BatPart {
+  double mass_kg = 0.0;   ///< The mass it adds, kg (> 0).
+  double length_m = 0.0;  ///< Its length along the axis from its end of the bat, m (0 < l <= L).
+  /// What it is made of: a catalogue material's name ("rubber", "aluminium-7050") or "" when
+  /// not given. Informational (reported back); its mass is mass_kg.
+  std::string material;
+};
+
 /// A complete bat.
 struct Bat {
   /// Outer radius; x strictly increasing from 0 to L (a step is two knots at
   /// nearly the same x).
   std::vector<ProfileKnot> knots;
-  Material material;              ///< The bat's material.
-  double wall_thickness_m = 0.0;  ///< Hollow shell wall, m; 0 = solid (see the file comment).
-  std::optional<Fill> fill;       ///< Optional fill.
+  Material material;               ///< The bat's material.
+  double wall_thickness_m = 0.0;   ///< Hollow shell wall, m; 0 = solid (see the file comment).
+  std::optional<Fill> fill;        ///< Optional fill.
+  std::optional<BatPart> end_cap;  ///< Optional end cap at the barrel tip (x in [L - l, L]).
+  std::optional<BatPart> knob;     ///< Optional knob at the handle end (x in [0, l]).
 
   /// True when the bat is physically valid; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "field = value: rule", e.g.
@@ -110,13 +136,15 @@ struct Bat {
   /// material, wall < 0 or >= the smallest outer radius, a fill deeper than
   /// the bat, negative fill dimensions, a bore not strictly inside the
   /// material around it (outer radius, or inner radius of a hollow bat) over
-  /// the fill's depth, an invalid non-empty fill material.
+  /// the fill's depth, an invalid non-empty fill material, an end cap or knob whose mass is not
+  /// positive or whose length is not in (0, L] ("end_cap.length_m = 0.9: must be in (0, 0.84]").
   /// Does not allocate when refusal is null and the bat is valid.
   /// Core's field names: "wall_thickness_m", "knots[2].x_m", "fill.material.density_kg_m3".
   bool Validate(Refusal* refusal) const;
   /// Validate, then the plausible sizes: knots' x in [0, kMaxBatLengthM], radii in
   /// (0, kMaxBatRadiusM] (so the wall, below the smallest radius, and the fill's depth, within
-  /// the length, are capped too), fill diameter in [0, kMaxFillDiameterM], the materials'
+  /// the length, are capped too), fill diameter in [0, kMaxFillDiameterM], an end cap's and a
+  /// knob's mass in (0, kMaxBatPartMassKg], the materials'
   /// Material::ValidateSize ("knots[1].x_m = 150: must be in [0, 100]"); for a bat given from
   /// outside.
   bool ValidateSize(Refusal* refusal) const;
@@ -143,11 +171,23 @@ struct Bat {
   double RadiusAtM(double x_m) const;
   /// True for a hollow shell (wall_thickness_m > 0).
   bool IsHollow() const { return wall_thickness_m > 0.0; }
-  /// Inner radius of the shell at x, m: RadiusAtM(x) - wall for a hollow bat,
+  /// True when a knot gives its own wall (the wall varies along the bat).
+  bool HasKnotWalls() const;
+  /// The wall at knot i, m: its own wall_thickness_m when > 0, else the bat's.
+  double KnotWallM(std::size_t i) const {
+    return knots[i].wall_thickness_m > 0.0 ? knots[i].wall_thickness_m : wall_thickness_m;
+  }
+  /// The wall at x (from the knob), m: linear between the knots' walls (KnotWallM); 0 for a
+  /// solid bat or outside [0, L].
+  double WallAtM(double x_m) const;
+  /// Inner radius of the shell at x, m: RadiusAtM(x) - WallAtM(x) for a hollow bat,
   /// 0 for a solid bat or outside [0, L].
   double InnerRadiusAtM(double x_m) const;
   /// Smallest outer radius over the bat, m (0 without knots).
   double MinRadiusM() const;
+  /// The radius of a part's cylinder, m: the inner radius at the bat's tip (end_cap = true) or
+  /// knob end (false), the outer radius there for a solid bat; 0 without knots.
+  double PartRadiusM(bool end_cap) const;
 
  private:
   // Validate's checks in its order; the materials' own only when `materials`.
@@ -155,6 +195,9 @@ struct Bat {
   // The knots' checks of ValidateChecks, in order: their count, finite numbers, the first at 0,
   // x strictly increasing, radii positive.
   bool ValidateKnotOrder(Refusal* refusal) const;
+  // An end cap's or knob's checks (its fields prefixed by `prefix`, "end_cap."); true without one.
+  bool ValidatePart(const std::optional<BatPart>& part, std::string_view prefix,
+                    Refusal* refusal) const;
   // The rest of ValidateChecks, for valid knots whose smallest radius is `min_radius`: the
   // materials (when `materials`), the wall and the fill.
   bool ValidateBody(Refusal* refusal, bool materials, double min_radius) const;

@@ -68,16 +68,65 @@ SegmentIntegrals<T> IntegrateSegment(const T& h, const T& r_a, const T& r_b, con
   return out;
 }
 
-/// Read-only view of a knot list as a profile of doubles.
+/// Exact integrals of a hollow segment whose wall is linear from wall_a to wall_b (issue 35:
+/// walls per knot). With the inner radius s = r - t, linear too (s_m = r_m - t_m,
+/// ds = dr - dt): A / pi = r^2 - s^2 = t (r + s), a quadratic in tau written as a product (no
+/// difference of nearly equal squares), and r^4 - s^4 = (r^2 - s^2)(r^2 + s^2), a quartic.
+/// For wall_a = wall_b it equals IntegrateSegment's hollow case up to rounding (that one is
+/// used then, so a uniform wall's numbers do not move).
+template <typename T>
+SegmentIntegrals<T> IntegrateTaperedWallSegment(const T& h, const T& r_a, const T& r_b,
+                                                const T& wall_a, const T& wall_b) {
+  const T half = 0.5 * h;
+  const T r_m = 0.5 * (r_a + r_b);
+  const T dr = 0.5 * (r_b - r_a);
+  const T t_m = 0.5 * (wall_a + wall_b);
+  const T dt = 0.5 * (wall_b - wall_a);
+  const T s_m = r_m - t_m;
+  const T ds = dr - dt;
+  const T sum_m = r_m + s_m;
+  const T sum_d = dr + ds;
+  const T a0 = t_m * sum_m;
+  const T a1 = t_m * sum_d + dt * sum_m;
+  const T a2 = dt * sum_d;
+  const T g0 = r_m * r_m + s_m * s_m;
+  const T g1 = 2.0 * (r_m * dr + s_m * ds);
+  const T g2 = dr * dr + ds * ds;
+  const T disk_tau =
+      2.0 * (a0 * g0) + (2.0 / 3.0) * (a0 * g2 + a1 * g1 + a2 * g0) + 0.4 * (a2 * g2);
+  SegmentIntegrals<T> out;
+  out.volume = (kPi * half) * (2.0 * a0 + (2.0 / 3.0) * a2);
+  out.first = (kPi * half * half) * ((2.0 / 3.0) * a1);
+  out.second = (kPi * half * half * half) * ((2.0 / 3.0) * a0 + 0.4 * a2);
+  out.disk = (0.25 * kPi * half) * disk_tau;
+  return out;
+}
+
+/// The integrals of a segment with walls wall_a, wall_b at its ends: IntegrateSegment when
+/// they are equal (or the segment is solid), IntegrateTaperedWallSegment otherwise.
+template <typename T>
+SegmentIntegrals<T> IntegrateSegmentWalls(const T& h, const T& r_a, const T& r_b, const T& wall_a,
+                                          const T& wall_b, bool hollow, bool walls_equal) {
+  if (!hollow || walls_equal) return IntegrateSegment<T>(h, r_a, r_b, wall_a, hollow);
+  return IntegrateTaperedWallSegment<T>(h, r_a, r_b, wall_a, wall_b);
+}
+
+/// Read-only view of a knot list as a profile of doubles, with each knot's wall (its own, or
+/// the bat's `wall`).
 class KnotListProfile {
  public:
-  explicit KnotListProfile(const std::vector<ProfileKnot>& knots) : knots_(knots) {}
+  KnotListProfile(const std::vector<ProfileKnot>& knots, double wall)
+      : knots_(knots), wall_(wall) {}
   std::size_t size() const { return knots_.size(); }
   double x(std::size_t i) const { return knots_[i].x_m; }
   double r(std::size_t i) const { return knots_[i].radius_m; }
+  double wall(std::size_t i) const {
+    return knots_[i].wall_thickness_m > 0.0 ? knots_[i].wall_thickness_m : wall_;
+  }
 
  private:
   const std::vector<ProfileKnot>& knots_;
+  double wall_;
 };
 
 /// Everything but the profile, in the scalar type T.
@@ -129,7 +178,9 @@ MassMoment<T> ComputeMassMoment(const Profile& p, const BodyScalars<T>& b) {
     const T xb = p.x(i + 1);
     const T h = xb - xa;
     const T mid = 0.5 * (xa + xb);
-    const SegmentIntegrals<T> s = IntegrateSegment<T>(h, p.r(i), p.r(i + 1), b.wall, b.hollow);
+    const double wa = p.wall(i), wb = p.wall(i + 1);
+    const SegmentIntegrals<T> s =
+        IntegrateSegmentWalls<T>(h, p.r(i), p.r(i + 1), T(wa), T(wb), b.hollow, wa == wb);
     volume += s.volume;
     first += mid * s.volume + s.first;
   }
@@ -161,8 +212,9 @@ double ComputeCentroidalMoment(const Profile& p, const BodyScalars<double>& b, d
     const double xa = p.x(i);
     const double xb = p.x(i + 1);
     const double d = 0.5 * (xa + xb) - c;
+    const double wa = p.wall(i), wb = p.wall(i + 1);
     const SegmentIntegrals<double> s =
-        IntegrateSegment<double>(xb - xa, p.r(i), p.r(i + 1), b.wall, b.hollow);
+        IntegrateSegmentWalls<double>(xb - xa, p.r(i), p.r(i + 1), wa, wb, b.hollow, wa == wb);
     second += (d * d) * s.volume + 2.0 * d * s.first + s.second;
     disk += s.disk;
   }

@@ -25,6 +25,37 @@ double FillVolumeSign(const Bat& bat) {
   return (bat.fill->IsEmpty() ? 0.0 : 1.0) - (bat.IsHollow() ? 0.0 : 1.0);
 }
 
+// An end cap or knob as mass-property terms (bat.hpp): a uniform solid cylinder of mass m,
+// length l and radius r whose centre is `centroid` from the knob.
+struct PartTerm {
+  double mass = 0.0;      // kg
+  double centroid = 0.0;  // m from the knob
+  double length = 0.0;    // m
+  double radius = 0.0;    // m
+  bool at_tip = false;    // the end cap (its centre moves with L)
+};
+
+// The bat's parts as terms into out[0..2); returns how many.
+int PartTerms(const Bat& bat, PartTerm out[2]) {
+  int n = 0;
+  const double length = bat.LengthM();
+  if (bat.end_cap.has_value()) {
+    out[n++] = {bat.end_cap->mass_kg, length - 0.5 * bat.end_cap->length_m, bat.end_cap->length_m,
+                bat.PartRadiusM(true), true};
+  }
+  if (bat.knob.has_value()) {
+    out[n++] = {bat.knob->mass_kg, 0.5 * bat.knob->length_m, bat.knob->length_m,
+                bat.PartRadiusM(false), false};
+  }
+  return n;
+}
+
+// A part's own moment about a diameter through its centre, kg m^2: m l^2 / 12, plus m r^2 / 4
+// for the rigid body (the slender rod omits the cross-section's own moment, as for the profile).
+double PartOwnMoment(const PartTerm& p, bool rigid) {
+  return p.mass * (p.length * p.length / 12.0 + (rigid ? 0.25 * p.radius * p.radius : 0.0));
+}
+
 // Derivatives of one segment's integrals w.r.t. (x_a, x_b, r_a, r_b, wall).
 using SegmentAd = jet::Jet<5, false>;
 // Derivatives of the fill's terms w.r.t. (bore radius, depth, L, excess density).
@@ -60,8 +91,16 @@ struct ProfileSums {
                     rb = SegmentAd::Variable(b.radius_m, 3);
     const SegmentAd h = xb - xa;
     const SegmentAd d = 0.5 * (xa + xb) - c;
+    // A knot's own wall is not a design parameter (a constant); a knot without one has the
+    // bat's wall, the layout's wall_thickness_m.
+    const bool own_a = a.wall_thickness_m > 0.0, own_b = b.wall_thickness_m > 0.0;
+    const SegmentAd wall_a = own_a ? SegmentAd(a.wall_thickness_m) : wall;
+    const SegmentAd wall_b = own_b ? SegmentAd(b.wall_thickness_m) : wall;
+    const bool same = !own_a && !own_b;  // both the bat's wall: the uniform formula
     const geometry::SegmentIntegrals<SegmentAd> s =
-        geometry::IntegrateSegment<SegmentAd>(h, ra, rb, wall, body.hollow);
+        same ? geometry::IntegrateSegment<SegmentAd>(h, ra, rb, wall, body.hollow)
+             : geometry::IntegrateSegmentWalls<SegmentAd>(h, ra, rb, wall_a, wall_b, body.hollow,
+                                                          false);
     const SegmentAd q1 = d * s.volume + s.first;
     // d^2 V + 2 d F + S with two products: d (q1 + F) + S.
     SegmentAd q2 = d * (q1 + s.first) + s.second;
@@ -105,19 +144,34 @@ MassProperties MassWithoutMoments(const Bat& bat, const geometry::KnotListProfil
                                   const geometry::BodyScalars<double>& body) {
   const geometry::MassMoment<double> mm = geometry::ComputeMassMoment<double>(profile, body);
   MassProperties out;
-  out.mass_kg = mm.mass;
-  out.balance_point_m = mm.moment / mm.mass;
+  double mass = mm.mass;
+  double moment = mm.moment;
+  PartTerm parts[2];
+  const int num_parts = PartTerms(bat, parts);
+  for (int i = 0; i < num_parts; ++i) {
+    mass += parts[i].mass;
+    moment += parts[i].mass * parts[i].centroid;
+  }
+  out.mass_kg = mass;
+  out.balance_point_m = moment / mass;
   out.volume_m3 = mm.bat_volume + FillVolumeSign(bat) * mm.fill_volume;
   return out;
 }
 
 // `base` with its moments under `model`.
-MassProperties WithMoments(MassProperties out, InertiaModel model,
+MassProperties WithMoments(const Bat& bat, MassProperties out, InertiaModel model,
                            const geometry::KnotListProfile& profile,
                            const geometry::BodyScalars<double>& body) {
   out.inertia_model = model;
-  out.moi_centroid_kg_m2 = geometry::ComputeCentroidalMoment(profile, body, out.balance_point_m,
-                                                             model == InertiaModel::kRigidBody);
+  const bool rigid = model == InertiaModel::kRigidBody;
+  out.moi_centroid_kg_m2 =
+      geometry::ComputeCentroidalMoment(profile, body, out.balance_point_m, rigid);
+  PartTerm parts[2];
+  const int num_parts = PartTerms(bat, parts);
+  for (int i = 0; i < num_parts; ++i) {
+    const double d = parts[i].centroid - out.balance_point_m;
+    out.moi_centroid_kg_m2 += parts[i].mass * (d * d) + PartOwnMoment(parts[i], rigid);
+  }
   out.moi_knob_kg_m2 = out.MoiAboutKgM2(0.0);
   return out;
 }
@@ -133,9 +187,9 @@ MassProperties ComputeMassProperties(const Bat& bat, InertiaModel model) {
 
 MassProperties ComputeMassPropertiesOfValidBat(const Bat& bat, InertiaModel model) {
   ++computations_on_this_thread;
-  const geometry::KnotListProfile profile(bat.knots);
+  const geometry::KnotListProfile profile(bat.knots, bat.wall_thickness_m);
   const geometry::BodyScalars<double> body = geometry::BodyOf(bat);
-  return WithMoments(MassWithoutMoments(bat, profile, body), model, profile, body);
+  return WithMoments(bat, MassWithoutMoments(bat, profile, body), model, profile, body);
 }
 
 MassPropertiesOfBothModels ComputeMassPropertiesOfBothModels(const Bat& bat) {
@@ -143,11 +197,11 @@ MassPropertiesOfBothModels ComputeMassPropertiesOfBothModels(const Bat& bat) {
     return {NanProperties(InertiaModel::kRigidBody), NanProperties(InertiaModel::kSlenderRod)};
   }
   ++computations_on_this_thread;
-  const geometry::KnotListProfile profile(bat.knots);
+  const geometry::KnotListProfile profile(bat.knots, bat.wall_thickness_m);
   const geometry::BodyScalars<double> body = geometry::BodyOf(bat);
   const MassProperties mass = MassWithoutMoments(bat, profile, body);
-  return {WithMoments(mass, InertiaModel::kRigidBody, profile, body),
-          WithMoments(mass, InertiaModel::kSlenderRod, profile, body)};
+  return {WithMoments(bat, mass, InertiaModel::kRigidBody, profile, body),
+          WithMoments(bat, mass, InertiaModel::kSlenderRod, profile, body)};
 }
 
 std::string DesignParameterLayout::Name(int index) const {
@@ -274,6 +328,25 @@ MassPropertiesWithGradient ComputeMassPropertiesWithGradient(const Bat& bat, Ine
     g_mass[lay.Density()] += d_excess_d_density * f_mass.g[3];
     g_q1[lay.Density()] += d_excess_d_density * f_q1.g[3];
     g_q2[lay.Density()] += d_excess_d_density * f_q2.g[3];
+  }
+
+  // The end cap and knob: their masses are not design parameters; the end cap's centre,
+  // L - l / 2, moves with L (the last knot's x), and a rigid body's m r^2 / 4 with the radius
+  // at the part's end (r = r_end - wall for a hollow bat).
+  PartTerm parts[2];
+  const int num_parts = PartTerms(bat, parts);
+  for (int i = 0; i < num_parts; ++i) {
+    const PartTerm& p = parts[i];
+    if (p.at_tip) {
+      g_q1[lay.KnotPosition(k - 1)] += p.mass;
+      g_q2[lay.KnotPosition(k - 1)] += 2.0 * p.mass * (p.centroid - c);
+    }
+    if (rigid) {
+      const double d_own_d_r = 0.5 * p.mass * p.radius;
+      g_q2[p.at_tip ? lay.KnotRadius(k - 1) : lay.KnotRadius(0)] += d_own_d_r;
+      const ProfileKnot& end = p.at_tip ? bat.knots.back() : bat.knots.front();
+      if (body.hollow && end.wall_thickness_m <= 0.0) g_q2[lay.WallThickness()] -= d_own_d_r;
+    }
   }
 
   out.volume_gradient = std::move(g_volume);

@@ -27,7 +27,8 @@ enum class InertiaModel {
 /// Mass properties of a bat. Moments are about axes perpendicular to the bat.
 struct MassProperties {
   InertiaModel inertia_model = InertiaModel::kRigidBody;  ///< How the moments were computed.
-  double volume_m3 = 0.0;           ///< Volume of material (bat material + non-empty fill), m³.
+  /// Volume of material (bat material + non-empty fill; an end cap or knob adds none), m³.
+  double volume_m3 = 0.0;
   double mass_kg = 0.0;             ///< Total mass, kg.
   double balance_point_m = 0.0;     ///< Centroid from the knob, m.
   double moi_knob_kg_m2 = 0.0;      ///< About the knob (x = 0), kg·m² (= MoiAboutKgM2(0)).

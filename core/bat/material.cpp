@@ -44,6 +44,39 @@ std::vector<Material> BuildCatalogue() {
   out.push_back(
       Wood("yellow-birch", 0.62, 13.9e9, 0.074, 0.426, "yellow birch (Betula alleghaniensis)"));
 
+  // Bat-grade maple: the properties a finite-element study of MLB bats gives billets of the
+  // density MLB approves, from tests (four-point bending, Charpy) of billets by UMass Lowell's
+  // Baseball Research Center with the US Forest Products Laboratory. Unlike the Wood
+  // Handbook's small clear specimens (hard-maple: 12.6 GPa, 706 kg/m3), these are the wood
+  // bats are turned from. The study's pairs (density, E_L) in psi and lb/in3 per profile:
+  // (0.0243, 2,250,424), (0.0230, 2,198,507), (0.0236, 2,220,880), (0.0214, 2,135,444);
+  // this entry is its "Profile B" pair, the middle of the four.
+  constexpr double kPsi = 6894.757293168;  // Pa per psi
+  Material billet;
+  billet.name = "maple-bat-billet";
+  billet.density_kg_m3 = 637.0;  // 0.637 g/cm3 (0.0230 lb/in3)
+  billet.density_min_kg_m3 = 592.0;
+  billet.density_max_kg_m3 = 673.0;
+  billet.youngs_modulus_pa = 2198507.0 * kPsi;  // E_L, 15.16 GPa
+  billet.shear_modulus_pa = 244034.0 * kPsi;    // G_LT, 1.683 GPa
+  billet.poissons_ratio = 0.476;
+  billet.cor = 0.5;
+  billet.kind = MaterialKind::kWood;
+  // Its species' entry, so league rules (core/optimize/rules.cpp's allowed woods, which read
+  // the base) see sugar maple.
+  billet.base = "hard-maple";
+  billet.source =
+      "Bat-grade sugar maple (Acer saccharum): UMass Lowell Baseball Research Center, "
+      "'An Investigation of Wood Baseball Bat Durability as a Function of Bat Profile and Slope "
+      "of Grain Using Finite Element Modeling and Statistical Analysis', Appl. Sci. 12(7), 3494 "
+      "(2022), doi:10.3390/app12073494, Appendix A (its LS-DYNA *MAT_WOOD inputs, from the "
+      "group's bend and Charpy tests of MLB-grade billets with the US Forest Products "
+      "Laboratory, Appl. Sci. 8(11), 2256 (2018)): its "
+      "Profile B column, density 0.637 g/cm3, E_L = 2,198,507 psi (15.16 GPa), "
+      "G_LT = 244,034 psi (1.683 GPa), nu = 0.476; density range 0.592-0.673 g/cm3 across the "
+      "study's four profiles. COR 0.5 as for the other woods.";
+  out.push_back(billet);
+
   Material paper;
   paper.name = "paper-wood";
   paper.density_kg_m3 = 649.0;
@@ -94,6 +127,29 @@ std::vector<Material> BuildCatalogue() {
   al7050.kind = MaterialKind::kMetal;
   al7050.base = al7050.name;
   out.push_back(al7050);
+
+  // Issue 35: the catalogue's composite. A bat's lay-up varies along it and between models; this
+  // is one laminate, isotropic here with the fabric's in-plane values (the axial modulus the
+  // beam bends with and the hoop modulus the barrel rings with are both E1 = E2).
+  Material carbon;
+  carbon.name = "carbon-epoxy-fabric";
+  carbon.density_kg_m3 = 1600.0;
+  carbon.youngs_modulus_pa = 70.0e9;
+  carbon.shear_modulus_pa = 5.0e9;
+  carbon.poissons_ratio = 0.10;
+  carbon.cor = 0.5;
+  carbon.kind = MaterialKind::kComposite;
+  carbon.base = carbon.name;
+  carbon.source =
+      "Standard carbon fibre 0/90 fabric in epoxy (120 C cure, fibre volume fraction 50 %): "
+      "E1 = E2 = 70 GPa, in-plane shear modulus G12 = 5 GPa, major Poisson's ratio 0.10 "
+      "(Performance Composites Ltd, 'Mechanical properties of carbon fibre composite "
+      "materials', performance-composites.com/carbonfibre/mechanicalproperties_2.asp, column "
+      "'Std CF Fabric'); density 1600 kg/m3 (SubsTech, 'Epoxy matrix composite reinforced by 70% "
+      "carbon fibers': 1.6e3 kg/m3; a 50 % fabric laminate is a few per cent lighter). One "
+      "laminate standing for a composite bat's shell; its lay-up is not modelled." +
+      bbcor;
+  out.push_back(carbon);
 
   Material cork;
   cork.name = "cork";

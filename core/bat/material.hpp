@@ -69,8 +69,8 @@ struct Material {
 };
 
 /// The built-in catalogue (immutable, thread-safe to read). Entries: "ash",
-/// "hard-maple", "yellow-birch", "paper-wood", "aluminium-7046",
-/// "aluminium-7050", "cork", "rubber"; each with its source.
+/// "hard-maple", "yellow-birch", "maple-bat-billet", "paper-wood", "aluminium-7046",
+/// "aluminium-7050", "carbon-epoxy-fabric", "cork", "rubber"; each with its source.
 const std::vector<Material>& MaterialCatalogue();
 /// The catalogue entry called `name` or one of its aliases (MaterialAliases), or nullopt.
 std::optional<Material> FindMaterial(std::string_view name);

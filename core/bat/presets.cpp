@@ -23,6 +23,13 @@ std::vector<ProfileKnot> FromInches(std::initializer_list<std::pair<double, doub
 // to 1e-12 m (presets_test re-solves it and checks the weight).
 constexpr double kBbcorWallM = 0.0027614431802374;
 
+// The handle-and-taper wall of "bbcor-33-alloy-capped", m: the root of mass(wall) = 30 oz with
+// its barrel wall kBbcorWallM, end cap and knob (presets_test re-solves it).
+constexpr double kCappedHandleWallM = 0.0022337768345169033;
+// The wall of "composite-33-bbcor", m: the root of mass(wall) = 30 oz with its end cap and
+// knob (presets_test re-solves it).
+constexpr double kCompositeWallM = 0.00479454539185681;
+
 std::vector<BatPreset> BuildPresets() {
   std::vector<BatPreset> out;
   const Material paper_wood = *FindMaterial("paper-wood");
@@ -80,6 +87,43 @@ std::vector<BatPreset> BuildPresets() {
       "white ash from the Wood Handbook FPL-GTR-190 (material 'ash').";
   out.push_back(ash);
 
+  // A turned pro maple bat (issue 35, "wood bats that ring like wood bats"): the knots below,
+  // in inches, are this service's reading of the published descriptions of a medium-handle
+  // pro turning model (C271 class), not a manufacturer's drawing; see `source`.
+  BatPreset maple;
+  maple.name = "wood-34-maple-turned";
+  maple.bat.knots = FromInches({{0.0, 1.70},
+                                {0.25, 1.85},
+                                {0.55, 1.85},
+                                {1.0, 1.20},
+                                {2.5, 0.96},
+                                {3.5, 0.95},
+                                {11.0, 0.95},
+                                {14.0, 1.10},
+                                {17.5, 1.50},
+                                {21.0, 2.08},
+                                {23.0, 2.38},
+                                {24.5, 2.50},
+                                {33.6, 2.50},
+                                {34.0, 2.30}});
+  maple.bat.material = *FindMaterial("maple-bat-billet");
+  maple.description =
+      "A 34-in solid maple bat turned to a medium-handle pro model: flared 1.85-in knob, "
+      "0.95-in handle to 11 in, S-shaped taper to a 2.50-in barrel at 24.5 in, rounded end; "
+      "bat-grade maple billet (637 kg/m3, E = 15.16 GPa); 32.0 oz (drop 2), balance point "
+      "23.2 in; first free-free bending mode 143 Hz.";
+  maple.source =
+      "Profile: MLB Official Baseball Rules 3.02 (solid wood, at most 2.61 in); handle 0.95 in, "
+      "'medium handles are the most common and are typically around .95\"', flared knob, "
+      "models 271 and others (Outlaw Bats, 'Anatomy of a wood bat'); handle length 10.5-11.5 in "
+      "for a 34-in professional bat (dimensions.com, 'Baseball bat - professional'), so the taper "
+      "starts at 11 in; a 2.5-in barrel (below the 2.61-in maximum, as most turning models); "
+      "volume 87.0 in3, within the 79.7-90.4 in3 of the four popular pro profiles of Appl. Sci. "
+      "12(7), 3494 (2022). No published table of a turning model's diameters was found, so the "
+      "knots between those anchors are this service's. Material 'maple-bat-billet' (that "
+      "study's bat-grade billet values).";
+  out.push_back(maple);
+
   BatPreset bbcor;
   bbcor.name = "bbcor-33-aluminium";
   bbcor.bat.knots = FromInches({{0.0, 1.50},
@@ -107,6 +151,44 @@ std::vector<BatPreset> BuildPresets() {
       "is solved so that the open-tube shell (no end cap, no knob plug; see bat.hpp) weighs "
       "exactly 30 oz; real bats vary the wall along the barrel.";
   out.push_back(bbcor);
+
+  // Issue 35, "bats as they are built": the same alloy bat closed by an end cap and a knob,
+  // its barrel wall kept (the barrel model's calibration, validation.md) and its handle and
+  // taper wall solved for the weight.
+  BatPreset capped = bbcor;
+  capped.name = "bbcor-33-alloy-capped";
+  for (ProfileKnot& k : capped.bat.knots) {
+    if (k.x_m < InchesToMetres(20.5)) k.wall_thickness_m = kCappedHandleWallM;
+  }
+  capped.bat.end_cap = BatPart{OuncesToKilograms(1.0), InchesToMetres(0.5), "rubber"};
+  capped.bat.knob = BatPart{OuncesToKilograms(1.0), InchesToMetres(0.75), "aluminium-7050"};
+  capped.description =
+      "bbcor-33-aluminium closed as built: a 1-oz end cap over the last 0.5 in and a 1-oz knob "
+      "over the first 0.75 in; barrel wall 2.761 mm (from 20.5 in), handle and taper wall "
+      "solved for 30.0 oz (drop 3).";
+  capped.source =
+      "bbcor-33-aluminium's profile and alloy (its source). The end cap and knob masses (1 oz "
+      "each) and lengths are this service's round figures for a polymer end cap and an alloy "
+      "knob, not a manufacturer's: no published part masses were found. The barrel keeps the "
+      "BBCOR-calibrated 2.761 mm wall; the wall from the knob to the taper's end (20.5 in) is "
+      "solved so that the bat weighs 30 oz (kCappedHandleWallM, presets_test re-solves it).";
+  out.push_back(capped);
+
+  BatPreset composite = bbcor;
+  composite.name = "composite-33-bbcor";
+  composite.bat.material = *FindMaterial("carbon-epoxy-fabric");
+  composite.bat.wall_thickness_m = kCompositeWallM;
+  composite.bat.end_cap = capped.bat.end_cap;
+  composite.bat.knob = BatPart{OuncesToKilograms(1.0), InchesToMetres(0.75), ""};
+  composite.description =
+      "A 33-in one-piece composite BBCOR bat: bbcor-33-aluminium's profile in carbon/epoxy "
+      "fabric, a 1-oz end cap and a 1-oz knob, uniform wall solved for 30.0 oz (drop 3).";
+  composite.source =
+      "The BBCOR limits and bbcor-33-aluminium's profile (its source); material "
+      "'carbon-epoxy-fabric' (its source); end cap and knob as bbcor-33-alloy-capped's (this "
+      "service's figures); the uniform wall solved for 30 oz (kCompositeWallM, presets_test "
+      "re-solves it). A real composite bat's lay-up and wall vary; not a specific model.";
+  out.push_back(composite);
   return out;
 }
 

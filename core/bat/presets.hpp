@@ -26,6 +26,8 @@ struct BatPreset {
 /// - "paper-wood-m885": the same shape at 569.9 kg/m³, which weighs the
 ///   paper's 0.885 kg.
 /// - "wood-34-ash": a 34-in solid white-ash bat, 2.61-in barrel, 31.5 oz.
+/// - "wood-34-maple-turned": a 34-in solid maple bat turned to a medium-handle pro model,
+///   bat-grade maple billet ("maple-bat-billet"), 2.50-in barrel, 32.0 oz.
 /// - "bbcor-33-aluminium": a 33-in hollow 7050-aluminium BBCOR bat, 2 5/8-in
 ///   barrel, 30 oz (drop 3), wall thickness solved for the weight.
 const std::vector<BatPreset>& BatPresets();

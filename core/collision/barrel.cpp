@@ -196,11 +196,12 @@ bool BarrelOptions::Validate(Refusal* why) const {
 BarrelWall BarrelWallAt(const Bat& bat, double x_m, const BarrelOptions& options) {
   BarrelWall w;
   const double r_out = bat.RadiusAtM(x_m);
-  if (!bat.IsHollow() || !(r_out > bat.wall_thickness_m)) return w;
+  const double wall = bat.WallAtM(x_m);  // the wall there (issue 35: walls per knot)
+  if (!bat.IsHollow() || !(r_out > wall)) return w;
   const Material& mat = bat.material;
   w.hollow = true;
   w.outer_radius_m = r_out;
-  w.thickness_m = bat.wall_thickness_m;
+  w.thickness_m = wall;
   const double h = w.thickness_m;
   const double r = r_out - 0.5 * h;
   w.mid_radius_m = r;

@@ -69,7 +69,7 @@ BeamSection SectionAt(const Bat& bat, double x_m) {
   const double length = bat.LengthM();
   const bool in_fill = bat.fill.has_value() && bat.fill->depth_m > 0.0 &&
                        bat.fill->RadiusM() > 0.0 && x_m >= length - bat.fill->depth_m;
-  double r_in = bat.IsHollow() ? std::max(r - bat.wall_thickness_m, 0.0) : 0.0;
+  double r_in = bat.IsHollow() ? std::max(r - bat.WallAtM(x_m), 0.0) : 0.0;
   const double r_fill = in_fill ? bat.fill->RadiusM() : 0.0;
   if (in_fill && !bat.IsHollow()) r_in = r_fill;  // the bore replaces the solid's core
   // r^2 - ri^2 and r^4 - ri^4 as products: no cancellation for a thin wall.
@@ -92,6 +92,19 @@ BeamSection SectionAt(const Bat& bat, double x_m) {
     s.shear_stiffness_n +=
         CowperShearCoefficient(mf.poissons_ratio, 0.0) * mf.EffectiveShearModulusPa() * a_f;
   }
+  // An end cap or knob (bat.hpp): its mass and rotary inertia per length over its range, no
+  // stiffness (a cap or knob plug is a lumped part, not a bonded section).
+  const auto add_part = [&](const std::optional<BatPart>& part, bool at_tip) {
+    if (!part.has_value() || !(part->length_m > 0.0)) return;
+    const bool inside = at_tip ? x_m >= length - part->length_m : x_m <= part->length_m;
+    if (!inside) return;
+    const double per_length = part->mass_kg / part->length_m;
+    const double rp = bat.PartRadiusM(at_tip);
+    s.mass_per_length_kg_m += per_length;
+    s.rotary_inertia_kg_m += per_length * 0.25 * rp * rp;
+  };
+  add_part(bat.end_cap, true);
+  add_part(bat.knob, false);
   return s;
 }
 
@@ -99,12 +112,17 @@ namespace {
 
 std::vector<double> Breakpoints(const Bat& bat) {
   std::vector<double> out;
-  out.reserve(bat.knots.size() + 1);
+  out.reserve(bat.knots.size() + 3);
   for (const ProfileKnot& k : bat.knots) out.push_back(k.x_m);
   const double length = bat.LengthM();
   if (bat.fill.has_value() && bat.fill->depth_m > 0.0 && bat.fill->depth_m < length) {
     out.push_back(length - bat.fill->depth_m);
   }
+  // Where an end cap or knob ends inside the bat: the sections jump there.
+  if (bat.end_cap.has_value() && bat.end_cap->length_m < length) {
+    out.push_back(length - bat.end_cap->length_m);
+  }
+  if (bat.knob.has_value() && bat.knob->length_m < length) out.push_back(bat.knob->length_m);
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;

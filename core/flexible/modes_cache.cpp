@@ -38,6 +38,7 @@ std::string ModesCache::Key(const Bat& bat, const BeamModesOptions& options) {
   for (const ProfileKnot& k : bat.knots) {
     PutDouble(&key, k.x_m);
     PutDouble(&key, k.radius_m);
+    PutDouble(&key, k.wall_thickness_m);
   }
   PutMaterial(&key, bat.material);
   PutDouble(&key, bat.wall_thickness_m);
@@ -46,6 +47,13 @@ std::string ModesCache::Key(const Bat& bat, const BeamModesOptions& options) {
     PutMaterial(&key, bat.fill->material);
     PutDouble(&key, bat.fill->diameter_m);
     PutDouble(&key, bat.fill->depth_m);
+  }
+  for (const std::optional<BatPart>* part : {&bat.end_cap, &bat.knob}) {
+    PutInt(&key, part->has_value() ? 1 : 0);
+    if (part->has_value()) {
+      PutDouble(&key, (*part)->mass_kg);
+      PutDouble(&key, (*part)->length_m);
+    }
   }
   PutInt(&key, static_cast<long long>(options.theory));
   PutInt(&key, options.num_modes);

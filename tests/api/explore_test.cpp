@@ -291,7 +291,7 @@ TEST(ExploreTest, AnUnknownLastKeyIsRefusedBeforeTheFirstDesign) {
   const Case cases[] = {
       {profile, "profile.knots[3].radius",
        "parameters[0].path = \"profile.knots[3].radius\": bat.profile.knots[3].radius is not a "
-       "known field; did you mean radius_m? (known: radius_m, x_m)"},
+       "known field; did you mean radius_m? (known: radius_m, wall_thickness_m, x_m)"},
       {CorkSweep()["bat"], "fill.depht_m",
        "parameters[0].path = \"fill.depht_m\": bat.fill.depht_m is not a known field; did you "
        "mean depth_m? (known: depth_m, diameter_m, material)"},

@@ -37,7 +37,8 @@ Response Post(const std::string& path, const Json& body) {
 // angular speed).
 Json Template(bool profile, bool bat_speed = false) {
   Json bat = profile ? Json::parse(R"({"profile": {"knots": [{"x_m": 0, "radius_m": 0.012},
-                         {"x_m": 0.3, "radius_m": 0.013}, {"x_m": 0.6, "radius_m": 0.033},
+                         {"x_m": 0.3, "radius_m": 0.013, "wall_thickness_m": 0.0028},
+                         {"x_m": 0.6, "radius_m": 0.033},
                          {"x_m": 0.84, "radius_m": 0.033}]}})")
                      : Json::parse(R"({"three_segment": {"length_m": 0.8636,
                          "handle_radius_m": 0.0125, "barrel_radius_m": 0.033,
@@ -47,6 +48,8 @@ Json Template(bool profile, bool bat_speed = false) {
   bat["wall_thickness_m"] = 0.003;
   bat["fill"] = Json::parse(R"({"material": {"density_kg_m3": 200, "youngs_modulus_pa": 2e7},
       "diameter_m": 0.02, "depth_m": 0.1})");
+  bat["end_cap"] = Json::parse(R"({"mass_kg": 0.03, "length_m": 0.01, "material": "rubber"})");
+  bat["knob"] = Json::parse(R"({"mass_kg": 0.02, "length_m": 0.015})");
   Json swing = {{"angular_speed_rad_s", 40.0}, {"pivot_from_knob_m", 0.01},
                 {"hands_from_knob_m", 0.15}, {"attack_angle_deg", 8.0}};
   if (bat_speed) {
@@ -108,7 +111,7 @@ bool IsBatSpeedField(const Field& field) {
 // accessor; bound by the sweep's binder to the same scene the parser gives; and, when a
 // variable, named by core's variable path in every form.
 TEST(FieldsTest, EveryFieldRoundTripsThroughParserBinderAndOptimizeVariable) {
-  ASSERT_EQ(Fields().size(), 33u);
+  ASSERT_EQ(Fields().size(), 38u);
   for (const Field& field : Fields()) {
     SCOPED_TRACE(std::string(field.path));
     const Json base = Template(IsProfileField(field), IsBatSpeedField(field));

@@ -57,6 +57,78 @@ TEST(ValidationTest, FirstBendingModeAndItsNodesOfWoodBats) {
   EXPECT_NEAR(frequency_of("paper-wood", "ash"), 140.9, 0.01 * 140.9);
 }
 
+// Issue 35, "wood bats that ring like wood bats": a turned pro maple bat in the bat-grade
+// billet values of Appl. Sci. 12(7), 3494 (2022) (material "maple-bat-billet", E = 15.16 GPa at
+// 637 kg/m3) rings at 143.1 Hz, 16 % below Russell's "around 170 Hz": outside +-10 %, for the
+// reason validation.md gives (with these moduli a medium handle tapering from 11 in rings
+// near 143 Hz; 170 Hz needs E = 21.4 GPa on this profile, or a thick handle and a taper from
+// 9 in). Pinned at
+// +-1 % (the model's own number; a change of the preset, the material or the beam moves it by
+// more), with the material's share the row quotes (the Wood Handbook's hard maple on this
+// profile: 124.0 Hz).
+TEST(ValidationTest, TurnedMapleBatRingsWithBatGradeBillets) {
+  const auto mode_of = [](const Json& bat) {
+    return Post("/v1/sweet-spot", Json{{"bat", bat}, {"outputs", {"vibration_node"}}});
+  };
+  const Json maple = mode_of(Json{{"preset", "wood-34-maple-turned"}});
+  const double f1 = maple["vibration_node"]["frequency_hz"].get<double>();
+  EXPECT_NEAR(f1, 143.1, 0.01 * 143.1);
+  EXPECT_NEAR(f1, 170.0, 0.20 * 170.0);  // within 20 % of the measurement: the row's verdict
+  EXPECT_GT(f1, 116.1 * 1.2);            // and 23 % above wood-34-ash
+  const double length = maple["properties"]["length_m"].get<double>();
+  const double node_from_tip =
+      (length - maple["vibration_node"]["position_from_knob_m"].get<double>()) / kInch;
+  EXPECT_GE(node_from_tip, 5.0);  // Russell's barrel node, 5-7 in from the end
+  EXPECT_LE(node_from_tip, 7.5);  // 7.1 in: 0.1 in past "usually 5-7 inches"
+  EXPECT_NEAR(maple["properties"]["imperial"]["weight_oz"].get<double>(), 32.05, 0.01);
+  // The material alone: the handbook's small clear hard maple (12.6 GPa, 706 kg/m3).
+  const Json handbook = mode_of(Json{{"preset", "wood-34-maple-turned"}, {"material", "maple"}});
+  EXPECT_NEAR(handbook["vibration_node"]["frequency_hz"].get<double>(), 124.0, 0.01 * 124.0);
+}
+
+// Issue 35, "bats as they are built": the hollow presets' max-exit point against Russell's
+// 5-7 in from the barrel end (the row above), in the issue's scene (90 mph pitch, 70 mph bat
+// speed). The open tube (bbcor-33-aluminium) sits at 7.7 in; closed by a 1-oz end cap and a
+// 1-oz knob with its handle wall solved for the same 30 oz (bbcor-33-alloy-capped) it is at
+// 6.8 in, inside; the end cap is the lever (validation.md). The model's own numbers are pinned
+// at +-0.05 in (a change of the presets, the barrel or the exit model moves them by more);
+// the BBCOR scan's maximum location and the hoop frequency at +-0.1 in and +-1 %.
+TEST(ValidationTest, BuiltHollowBatsMaxExitPointAndHoopFrequency) {
+  struct Row {
+    Json bat;
+    double max_exit_from_tip_in, scan_max_from_tip_in, hoop_hz;
+  };
+  const Json cap = {{"mass_oz", 1.0}, {"length_in", 0.5}};
+  const Row rows[] = {
+      {Json{{"preset", "bbcor-33-aluminium"}}, 7.73, 6.01, 1777.5},
+      {Json{{"preset", "bbcor-33-alloy-capped"}}, 6.83, 5.43, 1777.5},
+      {Json{{"preset", "composite-33-bbcor"}}, 7.12, 5.56, 4105.0},
+      {Json{{"preset", "bbcor-33-aluminium"}, {"end_cap", cap}}, 7.12, 5.44, 1777.5},
+  };
+  double from_tip[4];
+  for (int i = 0; i < 4; ++i) {
+    const Row& row = rows[i];
+    const Json r =
+        Post("/v1/sweet-spot", Json{{"bat", row.bat},
+                                    {"ball", {{"speed_mph", 90}}},
+                                    {"swing", {{"bat_speed_mph", 70}}},
+                                    {"outputs", {"max_exit_speed", "bbcor_scan", "barrel"}}});
+    const double length = r["properties"]["length_m"].get<double>();
+    from_tip[i] = (length - r["max_exit_speed"]["position_from_knob_m"].get<double>()) / kInch;
+    EXPECT_NEAR(from_tip[i], row.max_exit_from_tip_in, 0.05) << row.bat.dump();
+    // The scan's maximum is flat, its location the least certain of the three: +-0.1 in (the
+    // scan's polished search moves the open tube's by 0.009 in against this single parabola).
+    EXPECT_NEAR(r["bbcor_scan"]["max_from_tip_m"].get<double>() / kInch, row.scan_max_from_tip_in,
+                0.1)
+        << row.bat.dump();
+    EXPECT_NEAR(r["barrel"]["hoop_frequency_hz"].get<double>(), row.hoop_hz, 0.01 * row.hoop_hz)
+        << row.bat.dump();
+  }
+  EXPECT_GT(from_tip[0], 7.0);  // the open tube: outside Russell's 5-7 in
+  EXPECT_GE(from_tip[1], 5.0);  // as built: inside
+  EXPECT_LE(from_tip[1], 7.0);
+}
+
 // The max-exit-speed point of a swung bat: 5-7 in from the barrel end (Russell, "What is the
 // sweet spot of a baseball bat?"). The default model (free_bat) is there; the paper's pinned bat
 // puts it at the tip (docs/models.md, "Which model").

@@ -273,6 +273,16 @@ TEST(FlexibleModes, RigidBodyPropertiesOfTheMassMatrixAreTheExactMassProperties)
   Bat cupped = FindPreset("paper-wood")->bat;
   cupped.fill = Fill{EmptyFillMaterial(), 0.02, 0.03};
   bats.push_back(cupped);
+  // Issue 35: an end cap and a knob are in the beam exactly (mass and rotary inertia per length
+  // over their ranges, which are breakpoints).
+  Bat capped = FindPreset("bbcor-33-aluminium")->bat;
+  capped.end_cap = BatPart{0.030, 0.012, "rubber"};
+  capped.knob = BatPart{0.025, 0.02, ""};
+  bats.push_back(capped);
+  Bat walled = capped;  // and walls per knot (the inner radius linear between them)
+  walled.knots[5].wall_thickness_m = 0.0035;
+  walled.knots[11].wall_thickness_m = 0.0022;
+  bats.push_back(walled);
   for (const Bat& bat : bats) {
     for (BeamTheory theory : {BeamTheory::kEulerBernoulli, BeamTheory::kTimoshenko}) {
       BeamModesOptions o;

@@ -33,6 +33,22 @@ std::vector<NamedBat> GradientBats() {
   Bat hollow_fill = FindPreset("bbcor-33-aluminium")->bat;
   hollow_fill.fill = Fill{*FindMaterial("rubber"), 0.04, 0.2};
   out.push_back({"bbcor+rubber", hollow_fill});
+  // Issue 35: an end cap and a knob (their centres and radii move with the tip's and knob's
+  // knots and the wall).
+  Bat capped = FindPreset("bbcor-33-aluminium")->bat;
+  capped.end_cap = BatPart{0.030, 0.012, "rubber"};
+  capped.knob = BatPart{0.025, 0.02, "aluminium-7050"};
+  out.push_back({"bbcor+cap+knob", capped});
+  Bat weighted = FindPreset("wood-34-ash")->bat;
+  weighted.knob = BatPart{0.05, 0.03, ""};
+  out.push_back({"wood-34-ash+knob", weighted});
+  // Walls per knot (the bat's wall entry moves the knots without their own).
+  Bat walled = FindPreset("bbcor-33-aluminium")->bat;
+  walled.knots[0].wall_thickness_m = 0.004;
+  walled.knots[5].wall_thickness_m = 0.0035;
+  walled.knots[11].wall_thickness_m = 0.0022;
+  walled.end_cap = BatPart{0.02, 0.01, ""};
+  out.push_back({"bbcor+knot-walls", walled});
   // A short (1e-6 m) segment: the finite-difference step on its positions
   // must stay below its length, so it is not 1e-12 here.
   Bat short_step;

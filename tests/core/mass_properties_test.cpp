@@ -101,7 +101,11 @@ Reference Quadrature(const Bat& bat) {
     const auto& ka = bat.knots[s];
     const auto& kb = bat.knots[s + 1];
     const double r = ka.radius_m + (kb.radius_m - ka.radius_m) * (x - ka.x_m) / (kb.x_m - ka.x_m);
-    const double ri = t > 0.0 ? r - t : 0.0;
+    // The wall: linear between the knots' walls (a knot's own, else the bat's).
+    const double wa = ka.wall_thickness_m > 0.0 ? ka.wall_thickness_m : t;
+    const double wb = kb.wall_thickness_m > 0.0 ? kb.wall_thickness_m : t;
+    const double w = wa + (wb - wa) * (x - ka.x_m) / (kb.x_m - ka.x_m);
+    const double ri = t > 0.0 ? r - w : 0.0;
     const bool in_bore = has_fill && 0.5 * (a + b) > bottom;
     // Material annuli: [ri, r] of the bat, except where the bore is.
     double l = 0.0, m = 0.0;
@@ -253,6 +257,13 @@ TEST(MassPropertiesQuadrature, RandomProfilesAgreeTo1e12) {
   for (int trial = 0; trial < 60; ++trial) {
     Bat bat = RandomBat(rng, 2 + trial % 15, 0.5 + u(rng));
     if (trial % 3 == 1) bat.wall_thickness_m = 0.9 * bat.MinRadiusM() * u(rng);
+    // Issue 35: every other hollow bat with its own wall at some knots (linear between them).
+    if (trial % 6 == 4 || trial % 6 == 1) {
+      if (bat.wall_thickness_m == 0.0) bat.wall_thickness_m = 0.5 * bat.MinRadiusM() * u(rng);
+      for (std::size_t k = 0; k < bat.knots.size(); k += 2) {
+        bat.knots[k].wall_thickness_m = (0.05 + 0.9 * u(rng)) * bat.knots[k].radius_m;
+      }
+    }
     if (trial % 4 == 2) {
       Fill fill;
       fill.material = trial % 8 == 2 ? EmptyFillMaterial() : *FindMaterial("cork");
@@ -261,7 +272,18 @@ TEST(MassPropertiesQuadrature, RandomProfilesAgreeTo1e12) {
       for (const auto& k : bat.knots) {
         if (k.x_m > bat.LengthM() - fill.depth_m) around = std::min(around, k.radius_m);
       }
-      fill.diameter_m = 1.8 * (around - bat.wall_thickness_m) * u(rng);
+      if (bat.IsHollow()) {  // the inner radius's minimum over the bore (walls per knot)
+        const double start = bat.LengthM() - fill.depth_m;
+        around = bat.InnerRadiusAtM(start);
+        for (std::size_t k = 0; k < bat.knots.size(); ++k) {
+          if (bat.knots[k].x_m > start) {
+            around = std::min(around, bat.knots[k].radius_m - bat.KnotWallM(k));
+          }
+        }
+      } else {
+        around -= bat.wall_thickness_m;
+      }
+      fill.diameter_m = 1.8 * around * u(rng);
       bat.fill = fill;
     }
     ASSERT_TRUE(bat.Validate(nullptr)) << trial;
@@ -576,6 +598,115 @@ TEST(MassPropertiesPivot, APivotWithinAHundredMetresOfTheKnobIsValid) {
   EXPECT_FALSE(ValidatePivotFromKnob(-150.0, &r));
   EXPECT_EQ(r.Message(), "pivot_from_knob_m = -150: must be in [-100, 100]");
   EXPECT_FALSE(ValidatePivotFromKnob(std::nan(""), nullptr));
+}
+
+// Issue 35: an end cap and a knob on an open tube, against the closed forms of three uniform
+// cylinders: the tube (mass rho pi (R^2 - r^2) L, its own moment m (L^2 / 12 + (R^2 + r^2) / 4)),
+// the cap (m_c at L - l_c / 2, own m_c (l_c^2 / 12 + r^2 / 4)) and the knob (m_k at l_k / 2, own
+// m_k (l_k^2 / 12 + r^2 / 4)), r = R - t the inner radius. Sums of a few exact terms: 1e-14.
+TEST(MassProperties, EndCapAndKnobAreCylindersAtTheirEnds) {
+  const double length = 0.8382, outer = 0.0333375, wall = 0.0025, density = 2830.0;
+  const double mc = 0.030, lc = 0.012, mk = 0.025, lk = 0.02;
+  Bat bat = Cylinder(length, outer, density);
+  bat.wall_thickness_m = wall;
+  bat.end_cap = BatPart{mc, lc, "rubber"};
+  bat.knob = BatPart{mk, lk, ""};
+  ASSERT_TRUE(bat.Validate(nullptr));
+  const double inner = outer - wall;
+  EXPECT_DOUBLE_EQ(bat.PartRadiusM(true), inner);
+  EXPECT_DOUBLE_EQ(bat.PartRadiusM(false), inner);
+  const double mt = density * kPi * (outer * outer - inner * inner) * length;
+  const double mass = mt + mc + mk;
+  const double ct = 0.5 * length, cc = length - 0.5 * lc, ck = 0.5 * lk;
+  const double balance = (mt * ct + mc * cc + mk * ck) / mass;
+  for (const InertiaModel model : {InertiaModel::kRigidBody, InertiaModel::kSlenderRod}) {
+    const bool rigid = model == InertiaModel::kRigidBody;
+    const double disk_t = rigid ? 0.25 * (outer * outer + inner * inner) : 0.0;
+    const double disk_p = rigid ? 0.25 * inner * inner : 0.0;
+    const double own = mt * (length * length / 12.0 + disk_t) + mc * (lc * lc / 12.0 + disk_p) +
+                       mk * (lk * lk / 12.0 + disk_p);
+    const double moi_cm = own + mt * (ct - balance) * (ct - balance) +
+                          mc * (cc - balance) * (cc - balance) +
+                          mk * (ck - balance) * (ck - balance);
+    const double moi_knob = own + mt * ct * ct + mc * cc * cc + mk * ck * ck;
+    const MassProperties p = ComputeMassProperties(bat, model);
+    EXPECT_NEAR(Rel(p.mass_kg, mass), 0.0, 1e-14);
+    EXPECT_NEAR(Rel(p.balance_point_m, balance), 0.0, 1e-14);
+    EXPECT_NEAR(Rel(p.moi_centroid_kg_m2, moi_cm), 0.0, 1e-13);
+    EXPECT_NEAR(Rel(p.moi_knob_kg_m2, moi_knob), 0.0, 1e-13);
+    // The parts add no volume: the tube's alone.
+    EXPECT_NEAR(Rel(p.volume_m3, mt / density), 0.0, 1e-14);
+    // Both inertia models from one computation agree.
+    EXPECT_EQ(ComputeMassPropertiesOfBothModels(bat).Of(model).moi_centroid_kg_m2,
+              p.moi_centroid_kg_m2);
+  }
+  // A solid bat's parts take its outer radius.
+  Bat solid = Cylinder(length, outer, 650.0);
+  solid.knob = BatPart{mk, lk, ""};
+  EXPECT_DOUBLE_EQ(solid.PartRadiusM(false), outer);
+}
+
+// Issue 35: a tube of outer radius R whose wall goes linearly from t_a at the knob to t_b at
+// the tip (knots' own walls) against the closed forms: the inner radius s(x) = s_a + (s_b -
+// s_a) x / L, so mass = rho pi L (R^2 - (s_a^2 + s_a s_b + s_b^2) / 3) and the first moment
+// rho pi L^2 (R^2 / 2 - (s_a^2 + 2 s_a s_b + 3 s_b^2) / 12) (integrals of a quadratic).
+TEST(MassProperties, WallPerKnotIsExact) {
+  const double length = 0.84, outer = 0.033, density = 2830.0, ta = 0.004, tb = 0.002;
+  Bat bat = Cylinder(length, outer, density);
+  bat.wall_thickness_m = 0.003;  // the default wall: both knots override it
+  bat.knots[0].wall_thickness_m = ta;
+  bat.knots[1].wall_thickness_m = tb;
+  ASSERT_TRUE(bat.Validate(nullptr));
+  EXPECT_TRUE(bat.HasKnotWalls());
+  EXPECT_DOUBLE_EQ(bat.WallAtM(0.5 * length), 0.5 * (ta + tb));
+  const double sa = outer - ta, sb = outer - tb;
+  const double mass =
+      density * kPi * length * (outer * outer - (sa * sa + sa * sb + sb * sb) / 3.0);
+  const double first = density * kPi * length * length *
+                       (0.5 * outer * outer - (sa * sa + 2.0 * sa * sb + 3.0 * sb * sb) / 12.0);
+  const MassProperties p = ComputeMassProperties(bat);
+  // A few exact terms each side: 1e-13.
+  EXPECT_NEAR(Rel(p.mass_kg, mass), 0.0, 1e-13);
+  EXPECT_NEAR(Rel(p.balance_point_m, first / mass), 0.0, 1e-13);
+  // Equal knot walls give the uniform wall's numbers exactly (the same formula).
+  Bat uniform = Cylinder(length, outer, density);
+  uniform.wall_thickness_m = 0.003;
+  Bat same = uniform;
+  same.knots[0].wall_thickness_m = same.knots[1].wall_thickness_m = 0.003;
+  EXPECT_EQ(ComputeMassProperties(same).mass_kg, ComputeMassProperties(uniform).mass_kg);
+  EXPECT_EQ(ComputeMassProperties(same).moi_centroid_kg_m2,
+            ComputeMassProperties(uniform).moi_centroid_kg_m2);
+  // Refusals: a knot's wall on a solid bat, and one not below its radius.
+  Refusal r;
+  Bat solid = Cylinder(length, outer, 650.0);
+  solid.knots[1].wall_thickness_m = 0.002;
+  EXPECT_FALSE(solid.Validate(&r));
+  EXPECT_EQ(r.field, "knots[1].wall_thickness_m");
+  bat.knots[1].wall_thickness_m = outer;
+  EXPECT_FALSE(bat.Validate(&r));
+  EXPECT_EQ(r.field, "knots[1].wall_thickness_m");
+}
+
+// The parts' refusals name the field, the value and the rule.
+TEST(MassProperties, EndCapAndKnobRefusals) {
+  Bat bat = Cylinder(0.8, 0.03, 650.0);
+  Refusal r;
+  bat.end_cap = BatPart{0.0, 0.01, ""};
+  EXPECT_FALSE(bat.Validate(&r));
+  EXPECT_EQ(r.field, "end_cap.mass_kg");
+  bat.end_cap = BatPart{0.03, 0.9, ""};
+  EXPECT_FALSE(bat.Validate(&r));
+  EXPECT_EQ(r.field, "end_cap.length_m");
+  EXPECT_EQ(r.Message(), "end_cap.length_m = 0.9: must be in (0, 0.8]");
+  bat.end_cap.reset();
+  bat.knob = BatPart{std::nan(""), 0.01, ""};
+  EXPECT_FALSE(bat.Validate(&r));
+  EXPECT_EQ(r.field, "knob.mass_kg");
+  bat.knob = BatPart{200.0, 0.01, ""};
+  EXPECT_TRUE(bat.Validate(nullptr));
+  EXPECT_FALSE(bat.ValidateSize(&r));
+  EXPECT_EQ(r.field, "knob.mass_kg");
+  EXPECT_TRUE(std::isnan(ComputeMassProperties(Bat{}).mass_kg));
 }
 
 }  // namespace

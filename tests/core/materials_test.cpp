@@ -16,9 +16,10 @@ namespace materials_test {
 namespace {
 
 TEST(MaterialsCatalogue, HasEveryEntryValidWithASource) {
-  const std::set<std::string> expected = {"ash",        "hard-maple",     "yellow-birch",
-                                          "paper-wood", "aluminium-7046", "aluminium-7050",
-                                          "cork",       "rubber"};
+  const std::set<std::string> expected = {
+      "ash",        "hard-maple",     "yellow-birch",   "maple-bat-billet",
+      "paper-wood", "aluminium-7046", "aluminium-7050", "carbon-epoxy-fabric",
+      "cork",       "rubber"};
   std::set<std::string> names;
   for (const Material& m : MaterialCatalogue()) {
     std::string why;
@@ -50,6 +51,19 @@ TEST(MaterialsCatalogue, Values) {
   EXPECT_EQ(cork.density_max_kg_m3, 320.0);
   EXPECT_FALSE(cork.cor.has_value());
   EXPECT_FALSE(FindMaterial("rubber")->cor.has_value());
+  // Bat-grade maple (Appl. Sci. 12(7), 3494, Appendix A, Profile B): psi x 6894.757293168.
+  const Material billet = *FindMaterial("maple-bat-billet");
+  EXPECT_EQ(billet.density_kg_m3, 637.0);
+  EXPECT_NEAR(billet.youngs_modulus_pa, 2198507.0 * 6894.757293168, 1e-3);
+  EXPECT_NEAR(billet.shear_modulus_pa, 244034.0 * 6894.757293168, 1e-3);
+  EXPECT_EQ(billet.base, "hard-maple");  // its species, for league rules
+  EXPECT_EQ(billet.kind, MaterialKind::kWood);
+  // The composite (Performance Composites' "Std CF Fabric" column; SubsTech's density).
+  const Material carbon = *FindMaterial("carbon-epoxy-fabric");
+  EXPECT_EQ(carbon.kind, MaterialKind::kComposite);
+  EXPECT_EQ(carbon.youngs_modulus_pa, 70.0e9);
+  EXPECT_EQ(carbon.shear_modulus_pa, 5.0e9);
+  EXPECT_EQ(carbon.density_kg_m3, 1600.0);
   EXPECT_FALSE(FindMaterial("balsa").has_value());
   EXPECT_FALSE(FindMaterial("").has_value());
 }

@@ -32,7 +32,8 @@ TEST(Presets, AllValidWithSourcesAndUniqueNames) {
     EXPECT_FALSE(p.bat.material.source.empty()) << p.name;
     EXPECT_TRUE(names.insert(p.name).second) << p.name;
   }
-  for (const char* name : {"paper-wood", "paper-wood-m885", "wood-34-ash", "bbcor-33-aluminium"}) {
+  for (const char* name : {"paper-wood", "paper-wood-m885", "wood-34-ash", "wood-34-maple-turned",
+                           "bbcor-33-aluminium", "bbcor-33-alloy-capped", "composite-33-bbcor"}) {
     EXPECT_EQ(names.count(name), 1u) << name;
     ASSERT_TRUE(FindPreset(name).has_value()) << name;
     EXPECT_EQ(FindPreset(name)->name, name);
@@ -78,6 +79,56 @@ TEST(Presets, Wood34Ash) {
     }
   }
   EXPECT_EQ(bat.material.name, "ash");
+}
+
+TEST(Presets, Wood34MapleTurned) {
+  const Bat bat = FindPreset("wood-34-maple-turned")->bat;
+  const ImperialProperties imp = ToImperial(ComputeMassProperties(bat), bat.LengthM());
+  EXPECT_NEAR(imp.length_in, 34.0, 1e-12);
+  EXPECT_NEAR(MaxDiameterIn(bat), 2.50, 1e-12);
+  // Frusta summed by an independent script (plain Python, pi h (a^2 + ab + b^2) / 3 per
+  // segment): 32.0481 oz, balance point 23.2142 in; 1e-3 covers the script's printout.
+  EXPECT_NEAR(imp.weight_oz, 32.0481, 1e-3);
+  EXPECT_NEAR(imp.balance_point_in, 23.2142, 1e-3);
+  EXPECT_FALSE(bat.IsHollow());
+  EXPECT_EQ(bat.material.name, "maple-bat-billet");
+  EXPECT_EQ(bat.material.density_kg_m3, 637.0);
+  EXPECT_NEAR(bat.material.youngs_modulus_pa, 15.158e9, 0.001e9);  // 2,198,507 psi
+}
+
+// Issue 35: the alloy bat closed by an end cap and a knob, its handle-and-taper wall solved
+// for 30 oz, and the composite bat; each stored wall re-solved here by bisection on core's own
+// mass (independent of the stored number): dM/dt ~ 0.1-0.3 kg/mm, so 1e-6 oz.
+double ResolveWall(Bat bat, bool handle_only) {
+  double lo = 1e-4, hi = 0.9 * bat.MinRadiusM();
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    for (ProfileKnot& k : bat.knots) {
+      if (handle_only && k.wall_thickness_m > 0.0) k.wall_thickness_m = mid;
+    }
+    if (!handle_only) bat.wall_thickness_m = mid;
+    const double oz = KilogramsToOunces(ComputeMassProperties(bat).mass_kg);
+    (oz > 30.0 ? hi : lo) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+TEST(Presets, BuiltAlloyAndCompositeBats) {
+  const Bat capped = FindPreset("bbcor-33-alloy-capped")->bat;
+  const Bat bare = FindPreset("bbcor-33-aluminium")->bat;
+  ASSERT_TRUE(capped.end_cap.has_value());
+  ASSERT_TRUE(capped.knob.has_value());
+  EXPECT_NEAR(KilogramsToOunces(capped.end_cap->mass_kg), 1.0, 1e-12);
+  EXPECT_NEAR(KilogramsToOunces(ComputeMassProperties(capped).mass_kg), 30.0, 1e-6);
+  EXPECT_TRUE(capped.HasKnotWalls());
+  EXPECT_EQ(capped.WallAtM(InchesToMetres(25.0)), bare.wall_thickness_m);  // the barrel's kept
+  EXPECT_NEAR(capped.WallAtM(InchesToMetres(5.0)), ResolveWall(capped, true), 1e-12);
+  EXPECT_NEAR(capped.WallAtM(InchesToMetres(5.0)), 0.0022338, 1e-7);
+  const Bat composite = FindPreset("composite-33-bbcor")->bat;
+  EXPECT_EQ(composite.material.name, "carbon-epoxy-fabric");
+  EXPECT_NEAR(KilogramsToOunces(ComputeMassProperties(composite).mass_kg), 30.0, 1e-6);
+  EXPECT_NEAR(composite.wall_thickness_m, ResolveWall(composite, false), 1e-12);
+  EXPECT_NEAR(composite.wall_thickness_m, 0.0047945, 1e-7);
 }
 
 TEST(Presets, Bbcor33Aluminium) {

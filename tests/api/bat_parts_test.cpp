@@ -1,0 +1,119 @@
+// Issue 35, "bats as they are built": an end cap and a knob in a request (bat.end_cap,
+// bat.knob: mass, length, material), in SI and trade units, their refusals and their answer.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "api/router.hpp"
+#include "core/units.hpp"
+
+namespace sweetspot::api {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace bat_parts_test {
+namespace {
+
+using Json = nlohmann::json;
+
+Response Post(const std::string& path, const Json& body) {
+  return Dispatch({"POST", path, body.dump()}, Context{});
+}
+
+Json Properties(const Json& bat) {
+  const Response r = Post("/v1/bat/properties", Json{{"bat", bat}});
+  EXPECT_EQ(r.status, 200) << r.body.dump();
+  return r.body;
+}
+
+// The parts add their masses exactly and move the balance point by the closed form: a part
+// of mass m centred at c moves the centroid from C0 (mass M0) to (M0 C0 + m c) / (M0 + m).
+TEST(BatPartsTest, EndCapAndKnobAddTheirMassesInSiAndTradeUnits) {
+  const Json bare = Properties(Json{{"preset", "bbcor-33-aluminium"}});
+  const double m0 = bare["mass_kg"].get<double>();
+  const double c0 = bare["balance_point_m"].get<double>();
+  const double length = bare["length_m"].get<double>();
+  // 1 oz over 0.5 in at the tip; 0.8 oz over 1 in at the knob.
+  const double kOz = 0.028349523125, kIn = 0.0254;
+  const Json capped =
+      Properties(Json{{"preset", "bbcor-33-aluminium"},
+                      {"end_cap", {{"mass_oz", 1.0}, {"length_in", 0.5}, {"material", "rubber"}}},
+                      {"knob", {{"mass_kg", 0.8 * kOz}, {"length_m", kIn}}}});
+  const double m = m0 + 1.0 * kOz + 0.8 * kOz;
+  // Sums of three exact terms: 1e-14 relative.
+  EXPECT_NEAR(capped["mass_kg"].get<double>(), m, 1e-14 * m);
+  const double c = (m0 * c0 + kOz * (length - 0.25 * kIn) + 0.8 * kOz * 0.5 * kIn) / m;
+  EXPECT_NEAR(capped["balance_point_m"].get<double>(), c, 1e-14 * c);
+  EXPECT_GT(capped["moi_knob_kg_m2"].get<double>(), bare["moi_knob_kg_m2"].get<double>());
+}
+
+TEST(BatPartsTest, RefusalsNameTheFieldAsWritten) {
+  const auto refused = [](const Json& bat) {
+    const Response r = Post("/v1/bat/properties", Json{{"bat", bat}});
+    EXPECT_EQ(r.status, 400) << r.body.dump();
+    return r.body;
+  };
+  Json e = refused(Json{{"preset", "wood-34-ash"}, {"end_cap", {{"length_m", 0.01}}}});
+  EXPECT_EQ(e["field"], "bat.end_cap.mass_kg") << e.dump();
+  e = refused(Json{{"preset", "wood-34-ash"}, {"knob", {{"mass_oz", 1}, {"length_in", 40}}}});
+  EXPECT_EQ(e["field"], "bat.knob.length_in") << e.dump();
+  e = refused(Json{{"preset", "wood-34-ash"},
+                   {"end_cap", {{"mass_kg", 0.02}, {"length_m", 0.01}, {"material", "lead"}}}});
+  EXPECT_EQ(e["field"], "bat.end_cap.material") << e.dump();
+  e = refused(Json{{"preset", "wood-34-ash"},
+                   {"end_cap", {{"mass_kg", 0.02}, {"length_m", 0.01}, {"colour", "red"}}}});
+  EXPECT_NE(e.dump().find("colour"), std::string::npos) << e.dump();
+  // /v1/optimize's design model has no parts yet: refused, not optimised without them.
+  const Response o = Post(
+      "/v1/optimize",
+      Json{{"bat", {{"preset", "wood-34-ash"}, {"knob", {{"mass_kg", 0.02}, {"length_m", 0.02}}}}},
+           {"variables", {{{"path", "wall_thickness_m"}}}}});
+  EXPECT_EQ(o.status, 400) << o.body.dump();
+  EXPECT_EQ(o.body["field"], "bat.knob") << o.body.dump();
+}
+
+// The answer's bat carries its parts (BatToJson), and the flexible model sees them: the
+// first bending mode drops with a heavy end cap (mass at the antinode, no stiffness).
+TEST(BatPartsTest, PartsAreRenderedAndLowerTheFirstMode) {
+  const Json cap = {{"mass_kg", 0.05}, {"length_m", 0.02}, {"material", "rubber"}};
+  const Response r =
+      Post("/v1/sweet-spot", Json{{"bat", {{"preset", "bbcor-33-aluminium"}, {"end_cap", cap}}},
+                                  {"outputs", {"vibration_node"}}});
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const Response bare = Post("/v1/sweet-spot", Json{{"bat", {{"preset", "bbcor-33-aluminium"}}},
+                                                    {"outputs", {"vibration_node"}}});
+  ASSERT_EQ(bare.status, 200);
+  EXPECT_LT(r.body["vibration_node"]["frequency_hz"].get<double>(),
+            bare.body["vibration_node"]["frequency_hz"].get<double>());
+}
+
+// Walls per knot in a request (profile.knots[i].wall_thickness_m or _in), against the closed
+// form of a tube whose wall tapers linearly (WallPerKnotIsExact in core's tests), and refused
+// on a solid bat with the field as written.
+TEST(BatPartsTest, WallPerKnotInTradeUnits) {
+  const double kIn = 0.0254, length = 33 * kIn, outer = 1.3125 * kIn, density = 2830.0;
+  const double ta = 0.16 * kIn, tb = 0.09 * kIn;
+  const Json material = {{"base", "aluminium-7050"}};
+  const Json props =
+      Properties(Json{{"profile",
+                       {{"knots",
+                         {{{"x_in", 0}, {"diameter_in", 2.625}, {"wall_thickness_in", 0.16}},
+                          {{"x_in", 33}, {"diameter_in", 2.625}, {"wall_thickness_in", 0.09}}}}}},
+                      {"material", material},
+                      {"wall_thickness_in", 0.1}});
+  const double sa = outer - ta, sb = outer - tb;
+  const double mass =
+      density * core::kPi * length * (outer * outer - (sa * sa + sa * sb + sb * sb) / 3.0);
+  EXPECT_NEAR(props["mass_kg"].get<double>(), mass, 1e-12 * mass);  // inch conversions: 1e-12
+  const Response r =
+      Post("/v1/bat/properties",
+           Json{{"bat",
+                 {{"profile",
+                   {{"knots",
+                     {{{"x_m", 0}, {"radius_m", 0.03}},
+                      {{"x_m", 0.8}, {"radius_m", 0.03}, {"wall_thickness_in", 0.1}}}}}}}}});
+  EXPECT_EQ(r.status, 400) << r.body.dump();
+  EXPECT_EQ(r.body["field"], "bat.profile.knots[1].wall_thickness_in") << r.body.dump();
+}
+
+}  // namespace
+}  // namespace bat_parts_test
+}  // namespace sweetspot::api
