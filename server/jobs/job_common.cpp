@@ -147,6 +147,18 @@ api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const
                                        ""});
 }
 
+api::Response IncompleteStreamAnswer(bool cancelled) {
+  if (cancelled) {
+    return api::ToResponse(api::ApiError{409, api::ErrorCode::kCancelled,
+                                         "the job was stopped before its answer was complete", ""});
+  }
+  return api::ToResponse(api::ApiError{
+      503, api::ErrorCode::kUnavailable,
+      "the job's answer stopped before it was complete (its sweep failed, e.g. out of memory): "
+      "no partial answer is kept; submit the job again later",
+      ""});
+}
+
 CollectedStream CollectJobStream(api::Response* response, std::size_t max_bytes,
                                  const ResultChunkWriter& write) {
   CollectedStream out;

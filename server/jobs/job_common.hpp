@@ -108,6 +108,12 @@ api::Response JobTimedOut(double max_time_s);
 api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const std::string& limit,
                               std::size_t value, const std::string& flag, bool stopped = false);
 
+/// The answer of a job whose streamed answer stopped before its end (StreamOutcome::kStopped):
+/// never the rows made so far (docs/api.md, "A sweep that does not finish"). `cancelled` (its
+/// cancel flag: DELETE, the time limit, a shutdown): 409 Cancelled; otherwise the sweep itself
+/// failed (out of memory): 503 Unavailable.
+api::Response IncompleteStreamAnswer(bool cancelled);
+
 /// What CollectJobStream did.
 enum class StreamOutcome {
   kComplete,     ///< The producer ran to its end: the whole body is in text or written.
