@@ -162,6 +162,7 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
   reader.OptionalNumber("max_cpu_time_s", NonNegative(limits.max_time_s), &o->max_cpu_time_s);
   reader.OptionalNumber("tolerance", AnyNumber(), &o->tolerance);
   reader.OptionalNumber("constraint_tolerance", AnyNumber(), &o->constraint_tolerance);
+  reader.OptionalNumber("feasibility_tolerance", AnyNumber(), &o->feasibility_tolerance);
   reader.OptionalBool("explain_infeasibility", &o->explain_infeasibility);
   if (const Json* f = reader.Get("flexible")) {
     if (!ReadFlexibleOptions(*f, reader.PathOf("flexible"), limits, flexible, top.error())) {
@@ -259,7 +260,9 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
                       : a.unit},
          {"value", a.value / f},
          {"bound", a.bound / f},
-         {"multiplier", Finite(a.multiplier * f)}});  // null for min_sting
+         {"multiplier", Finite(a.multiplier * f)},  // null for min_sting
+         {"satisfied", a.satisfied},
+         {"tolerance", a.tolerance / f}});
   }
   Json runs = Json::array();
   for (const auto& s : r.spread.runs) {
@@ -461,6 +464,9 @@ std::optional<Response> OptimizeFailure(const OptimizeRequest& request,
 
 Json RenderOptimize(const OptimizeRequest& request, const OptimizeResult& result) {
   Json out = ResultToJson(*result.Chosen(), request.request_bat, request.variable_names);
+  // The verdicts' tolerance (each active constraint's "satisfied"), relative to a constraint's
+  // scale.
+  out["summary"]["feasibility_tolerance"] = request.options.feasibility_tolerance;
   if (result.by_material) {
     Json per_material = Json::array();
     for (const auto& m : result.choice.per_material) {

@@ -116,6 +116,10 @@ bool DesignOptions::Validate(Refusal* why) const {
       !(constraint_tolerance < 1.0)) {
     return Refuse(why, "constraint_tolerance", constraint_tolerance, "must be in (0, 1)");
   }
+  if (!std::isfinite(feasibility_tolerance) || !(feasibility_tolerance > 0.0) ||
+      !(feasibility_tolerance <= 0.01)) {
+    return Refuse(why, "feasibility_tolerance", feasibility_tolerance, "must be in (0, 0.01]");
+  }
   if (starts < 1 || starts > 64) return Refuse(why, "starts", starts, "must be between 1 and 64");
   if (!std::isfinite(min_knot_gap_m) || !(min_knot_gap_m > 0.0) || min_knot_gap_m > 0.1) {
     return Refuse(why, "min_knot_gap_m", min_knot_gap_m, "must be in (0, 0.1]");

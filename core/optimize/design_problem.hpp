@@ -280,6 +280,11 @@ struct DesignOptions {
   /// Largest violation accepted for a converged point, relative to each constraint's scale
   /// (Ipopt constr_viol_tol; > 0, < 1).
   double constraint_tolerance = 1e-10;
+  /// The verdicts' tolerance: a constraint holds (DesignActiveConstraint::satisfied, a feasible
+  /// design, the bbcor rule's re-check) when it is met to this, relative to its scale (a
+  /// solver lands on an active bound from either side: a drop of 3.0000000002 holds "drop <=
+  /// 3"); in (0, 0.01].
+  double feasibility_tolerance = 1e-6;
   int starts = 1;          ///< Local solves (1..64): the base design, then seeded random designs.
   std::uint64_t seed = 1;  ///< Seed of the random starts (std::mt19937_64).
   /// Smallest gap between neighbouring knots when knot positions are variables, m (> 0).
@@ -325,6 +330,11 @@ struct DesignActiveConstraint {
   /// objective value (better when maximising, worse when minimising). NaN for min_sting (the
   /// sting has no derivative, so no multiplier can be estimated).
   double multiplier = 0.0;
+  /// The verdict: the value is within the bound to `tolerance` (DesignOptions::
+  /// feasibility_tolerance of the constraint's scale).
+  bool satisfied = true;
+  /// The largest overshoot of the bound that still holds, in the constraint's unit (>= 0).
+  double tolerance = 0.0;
 };
 
 /// Which finding a DesignConflict states; code tells conflicts apart by this, never by reading
