@@ -19,7 +19,10 @@
 // - The range (default 4.0 to 8.0 in from the tip every 0.5 in) is this service's choice; no
 //   source gives it. The maximum is the largest sampled point, refined by the parabola through
 //   it and its two neighbours when it is interior (never outside them).
-// The bat's modes are computed once by the caller and reused for every point.
+// The bat's modes are computed once by the caller and reused for every point; when a
+// point uses all of them and its mode cutoff lies above twice the highest (the protocol's
+// 136 mph impact on a solid wood bat), the scan computes twice as many (at most 50) once and
+// scans again with them.
 #pragma once
 
 #include <string>
