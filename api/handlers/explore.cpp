@@ -224,6 +224,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   const std::size_t limit =
       context.batch ? context.limits.max_batch_samples : context.limits.max_samples;
   const char* limit_name = context.batch ? "max_batch_samples" : "max_samples";
+  const char* limit_flag = context.batch ? "max-batch-samples" : "max-samples";
   core::SweepPlan plan;
   std::string sampling = "grid";
   reader.OptionalString("sampling", &sampling, {"grid", "lhs", "sobol"});
@@ -492,7 +493,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   if (total > limit) {
     SetError(error, ErrorCode::kTooBig, "parameters", nullptr,
              "describe " + std::to_string(total) + " designs, over the limit " + limit_name +
-                 " = " + std::to_string(limit));
+                 " = " + std::to_string(limit) + " (--" + limit_flag + ")");
     return std::nullopt;
   }
 
