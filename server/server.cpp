@@ -276,7 +276,9 @@ httplib::Server::HandlerResponse Server::Impl::PreRoute(const httplib::Request& 
   if (path == LeanPath::kWithBody) {
     // httplib's payload limit, from the head alone (the loop did not read such a body).
     if (stream->content_length() > config.max_body_bytes) {
-      WriteApiResponse(api::ErrorResponse(413, CodeForStatus(413), BodyTooLargeMessage(config.max_body_bytes)), res);
+      WriteApiResponse(
+          api::ErrorResponse(413, CodeForStatus(413), BodyTooLargeMessage(config.max_body_bytes)),
+          res);
       return httplib::Server::HandlerResponse::Handled;  // logged "unrouted", as before
     }
     body = stream->body();

@@ -74,8 +74,8 @@ struct JobView {
   std::string state;                     ///< "queued", "running", "done", "failed", "cancelled".
   double progress = 0.0;                 ///< 0..1.
   std::string path;                      ///< The inner request's path.
-  double created_unix_s = 0.0;            ///< Submit time, s since the Unix epoch.
-  std::optional<double> started_unix_s;   ///< Start (of the last run), s since the epoch.
+  double created_unix_s = 0.0;           ///< Submit time, s since the Unix epoch.
+  std::optional<double> started_unix_s;  ///< Start (of the last run), s since the epoch.
   std::optional<double> finished_unix_s;  ///< Finish, s since the epoch.
   std::string created_at;                 ///< Submit time, ISO-8601 UTC.
   std::optional<int> status;             ///< Inner status once done or failed.

@@ -6,9 +6,9 @@
 
 #include "api/explore/design.hpp"
 #include "api/fields.hpp"
-#include "core/bat/presets.hpp"
 #include "api/json_path.hpp"
 #include "api/router.hpp"
+#include "core/bat/presets.hpp"
 
 namespace sweetspot::api {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).

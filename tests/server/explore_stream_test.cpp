@@ -143,8 +143,9 @@ TEST(ExploreStreamTest, AStreamStoppedByTheDeadlineEndsIncomplete) {
   Json sweep = Json::parse(R"({"bat": {"preset": "paper-wood",
       "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
     "outputs": ["max_exit_speed"], "options": {"model": "hertz"}})");
-  sweep["parameters"] = {{{"path", "fill.depth_m"}, {"min", 0.0}, {"max", 0.3}, {"count", 100}},
-                         {{"path", "fill.diameter_m"}, {"min", 0.01}, {"max", 0.03}, {"count", 100}}};
+  sweep["parameters"] = {
+      {{"path", "fill.depth_m"}, {"min", 0.0}, {"max", 0.3}, {"count", 100}},
+      {{"path", "fill.diameter_m"}, {"min", 0.01}, {"max", 0.03}, {"count", 100}}};
   for (const char* format : {"csv", "ndjson"}) {
     SCOPED_TRACE(format);
     sweep["format"] = format;
@@ -167,7 +168,7 @@ TEST(ExploreStreamTest, AStreamStoppedByTheDeadlineEndsIncomplete) {
       return true;
     };
     const auto result = client.send(request);
-    EXPECT_EQ(status, 200);      // sent with the first rows
+    EXPECT_EQ(status, 200);  // sent with the first rows
     EXPECT_FALSE(streamed.empty());
     EXPECT_FALSE(result) << "a body cut short must not end as a complete chunked body";
     if (std::string(format) == "ndjson") {

@@ -558,7 +558,7 @@ TEST(JobStoreTest, JobRunningWhenTheProcessDiedTooOftenIsFailedWithItsReason) {
     EXPECT_EQ(status.body["status"], 503);
     EXPECT_EQ(status.body["resumes"], max_resumes);
     EXPECT_NEAR(status.body["started_s"].get<double>(), 1.0, 1e-3);  // The start that was cut.
-    EXPECT_GE(status.body["finished_s"].get<double>(), 9.5);  // Failed by this manager.
+    EXPECT_GE(status.body["finished_s"].get<double>(), 9.5);         // Failed by this manager.
     const Response result = jobs.Result(Hex('d'));
     EXPECT_EQ(result.status, 503);
     EXPECT_EQ(result.body,
