@@ -51,8 +51,8 @@ std::optional<std::vector<core::ProfileKnot>> ParseProfile(const Json& value,
   }
   if (knots->size() > limits.max_knots) {
     SetError(error, ErrorCode::kTooBig, knots_path, nullptr,
-             "has " + std::to_string(knots->size()) +
-                 " knots, over the limit max_knots = " + std::to_string(limits.max_knots));
+             "has " + std::to_string(knots->size()) + " knots, over the limit max_knots = " +
+                 std::to_string(limits.max_knots) + " (--max-knots)");
     return std::nullopt;
   }
   // Each knot's x_m and radius_m, from the table of fields (api/fields.hpp); the ranges: core's

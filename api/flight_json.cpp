@@ -231,11 +231,11 @@ std::optional<FlightRequest> ParseFlight(const nlohmann::json& body, const ApiLi
       return std::nullopt;
     }
     if (many->size() > limits.max_launches) {
-      reader.Fail(
-          "launches",
-          "has " + std::to_string(many->size()) +
-              " launches, over the limit max_launches = " + std::to_string(limits.max_launches),
-          ErrorCode::kTooBig);
+      reader.Fail("launches",
+                  "has " + std::to_string(many->size()) +
+                      " launches, over the limit max_launches = " +
+                      std::to_string(limits.max_launches) + " (--max-launches)",
+                  ErrorCode::kTooBig);
       return std::nullopt;
     }
     request.launches.resize(many->size());

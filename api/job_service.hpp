@@ -11,11 +11,13 @@
 //    "progress":    0..1 (0 while queued, the runner's reports while running,
 //                   1 when done, frozen at the last report when failed/cancelled),
 //    "path":        the inner request's path,
+//    "created_at", "started_at", "finished_at":
+//                   wall-clock times, ISO-8601 UTC ("2024-05-01T12:00:00.123Z"): the submit,
+//                   the start of the last run, the finish; null until the event happened,
 //    "created_s", "started_s", "finished_s":
-//                   seconds since this server process started (so differences
-//                   are durations; negative for events before it started,
-//                   converted through the wall clock); null until the event happened,
-//    "created_at":  wall-clock submit time, ISO-8601 UTC ("2024-05-01T12:00:00.123Z"),
+//                   the same times in seconds after the submit (created_s is 0; started_s
+//                   the wait in the queue), never relative to a process's start, so they
+//                   read the same after a restart and from every replica; null until then,
 //    "status":      the inner HTTP status once done or failed (or cancelled
 //                   with a kept result), else null,
 //    "error":       once failed, the error object the inner request answered

@@ -120,7 +120,7 @@ class LimitedSax : public nlohmann::detail::json_sax_dom_parser<Json> {
     return Refuse(413, ErrorCode::kTooBig,
                   std::string("a ") + what + " of " + std::to_string(size) +
                       " bytes exceeds the limit max_string_length = " +
-                      std::to_string(limits_.max_string_length));
+                      std::to_string(limits_.max_string_length) + " (--max-string-length)");
   }
   // Counts one value in the enclosing array.
   bool Value() {
@@ -128,16 +128,16 @@ class LimitedSax : public nlohmann::detail::json_sax_dom_parser<Json> {
         ++containers_.back().count > limits_.max_array_length) {
       return Refuse(413, ErrorCode::kTooBig,
                     "an array exceeds the limit max_array_length = " +
-                        std::to_string(limits_.max_array_length));
+                        std::to_string(limits_.max_array_length) + " (--max-array-length)");
     }
     return true;
   }
   bool Open(bool is_array) {
     if (!Value()) return false;
     if (static_cast<int>(containers_.size()) >= limits_.max_json_depth) {
-      return Refuse(
-          413, ErrorCode::kTooBig,
-          "nesting exceeds the limit max_json_depth = " + std::to_string(limits_.max_json_depth));
+      return Refuse(413, ErrorCode::kTooBig,
+                    "nesting exceeds the limit max_json_depth = " +
+                        std::to_string(limits_.max_json_depth) + " (--max-json-depth)");
     }
     containers_.push_back({is_array, 0});
     return true;

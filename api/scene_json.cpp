@@ -334,7 +334,8 @@ bool ReadSceneOptions(ObjectReader& top, const ApiLimits& limits, core::SceneOpt
       return reader.Fail("curve_positions_from_knob_m",
                          "has " + std::to_string(positions->size()) +
                              " positions, over the limit max_curve_samples = " +
-                             std::to_string(static_cast<long long>(max_samples)),
+                             std::to_string(static_cast<long long>(max_samples)) +
+                             " (--max-curve-samples)",
                          ErrorCode::kTooBig);
     }
     for (std::size_t i = 0; i < positions->size(); ++i) {

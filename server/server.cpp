@@ -276,7 +276,9 @@ httplib::Server::HandlerResponse Server::Impl::PreRoute(const httplib::Request& 
   if (path == LeanPath::kWithBody) {
     // httplib's payload limit, from the head alone (the loop did not read such a body).
     if (stream->content_length() > config.max_body_bytes) {
-      WriteApiResponse(api::ErrorResponse(413, CodeForStatus(413), kBodyTooLargeMessage), res);
+      WriteApiResponse(
+          api::ErrorResponse(413, CodeForStatus(413), BodyTooLargeMessage(config.max_body_bytes)),
+          res);
       return httplib::Server::HandlerResponse::Handled;  // logged "unrouted", as before
     }
     body = stream->body();
@@ -326,7 +328,7 @@ void Server::Impl::InstallHandlers() {
 httplib::Server::HandlerResponse Server::Impl::ErrorEnvelope(httplib::Response& res) {
   if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
   std::string message = "HTTP status " + std::to_string(res.status);
-  if (res.status == 413) message = kBodyTooLargeMessage;
+  if (res.status == 413) message = BodyTooLargeMessage(config.max_body_bytes);
   if (res.status == 400) {
     message =
         "the request could not be read: malformed, or its body did not arrive within "

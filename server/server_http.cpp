@@ -162,8 +162,9 @@ void WriteStreamedResponse(const api::Response& response, httplib::Response& res
           last_flush = std::chrono::steady_clock::now();
           return writable;
         };
+        bool finished = false;
         try {
-          producer([&](std::string_view chunk) {
+          finished = producer([&](std::string_view chunk) {
             buffer.append(chunk);
             if (buffer.size() >= kChunkBytes ||
                 std::chrono::steady_clock::now() - last_flush >= kChunkTime) {
@@ -175,6 +176,10 @@ void WriteStreamedResponse(const api::Response& response, httplib::Response& res
           return false;  // closes the connection: the client sees a truncated stream
         }
         if (!flush()) return false;
+        // A stream that did not finish (a sweep stopped by the deadline or a shutdown; its
+        // NDJSON already ends with an {"error"} line) ends without the chunked body's last
+        // chunk: the client sees an incomplete body, never a complete-looking one.
+        if (!finished) return false;
         sink.done();
         return true;
       });

@@ -73,9 +73,14 @@ bool IsStaticRequest(const httplib::Request& req, const StaticFiles& files);
 void WriteStaticResponse(const httplib::Request& req, const StaticFiles& files,
                          httplib::Response& res);
 
-/// The message of the 413 for a body over max_body_bytes (httplib's and the lean path's).
-inline constexpr const char* kBodyTooLargeMessage =
-    "request body exceeds the configured max_body_bytes";
+/// The message of the 413 for a body over max_body_bytes (httplib's and the lean path's): the
+/// limit's value, bytes, and the flag and variable that set it.
+inline std::string BodyTooLargeMessage(std::size_t max_body_bytes) {
+  return "the request body is larger than the limit max_body_bytes = " +
+         std::to_string(max_body_bytes) +
+         " bytes: send a smaller body, or raise the limit with --max-body-bytes "
+         "(SWEETSPOT_MAX_BODY_BYTES)";
+}
 
 /// How the pre-routing hook answers a request: on httplib's own path (kHttplib), or itself,
 /// with the body the loop received (kWithBody: the methods whose body httplib reads) or

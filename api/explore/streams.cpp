@@ -39,17 +39,14 @@ Response StreamedNdjsonAnswer(std::shared_ptr<Sweep> sweep, std::vector<ExploreC
     const SweepOutcome outcome = RunSweep(*sweep, RowFormat::kNdjson, columns, progress,
                                           [&](BlockRows& rows) { return sink(rows.text); });
     if (outcome.stopped) return false;
-    if (outcome.failed) {
-      return line({{"error",
-                    {{"code", ErrorCodeName(ErrorCode::kUnavailable)},
-                     {"message", outcome.message},
-                     {"field", nullptr}}}});
-    }
-    if (outcome.cancelled) {
-      return line({{"error",
-                    {{"code", ErrorCodeName(ErrorCode::kCancelled)},
-                     {"message", outcome.message},
-                     {"field", nullptr}}}});
+    // A sweep that does not finish ends with an error line in place of the summary, and is
+    // still incomplete (false): the server then ends the HTTP body without its last chunk and a
+    // job keeps no result (docs/api.md, "A sweep that does not finish").
+    if (outcome.failed || outcome.cancelled) {
+      const ErrorCode code = outcome.failed ? ErrorCode::kUnavailable : ErrorCode::kCancelled;
+      line({{"error",
+             {{"code", ErrorCodeName(code)}, {"message", outcome.message}, {"field", nullptr}}}});
+      return false;
     }
     return line({{"summary", outcome.summary}});
   };

@@ -14,12 +14,14 @@
 namespace sweetspot::api {
 
 /// text/csv: the header row, then the rows block by block as they are evaluated. Only rows: the
-/// summary is in the json and ndjson answers (docs/api.md). A stopped sweep is cut short.
+/// summary is in the json and ndjson answers (docs/api.md). A stopped sweep is cut short and
+/// reports itself unfinished (false).
 Response StreamedCsvAnswer(std::shared_ptr<Sweep> sweep, std::vector<ExploreColumn> columns,
                            core::Progress* progress);
 
 /// application/x-ndjson: the rows block by block, then the summary line, or an {"error"} line
-/// when the sweep was cancelled or ran out of memory.
+/// when the sweep was cancelled or ran out of memory (then the stream still reports itself
+/// unfinished: false).
 Response StreamedNdjsonAnswer(std::shared_ptr<Sweep> sweep, std::vector<ExploreColumn> columns,
                               core::Progress* progress);
 

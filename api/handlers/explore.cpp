@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 
+#include "api/bat_json.hpp"
 #include "api/explore/columns.hpp"
 #include "api/explore/design.hpp"
 #include "api/explore/engine.hpp"
@@ -23,6 +24,7 @@
 #include "api/memory_reserve.hpp"
 #include "api/scene_json.hpp"
 #include "api/trade_units.hpp"
+#include "core/bat/presets.hpp"
 #include "core/explore/sampling.hpp"
 #include "core/scene/output_registry.hpp"
 
@@ -46,6 +48,18 @@ bool IsKnownField(const Json& probe, const ApiLimits& limits, ApiError* unknown)
   if (error.code != ErrorCode::kUnknownField) return true;
   *unknown = std::move(error);
   return false;
+}
+
+// A template bat given as a preset and no shape of its own gets the preset's knots as its
+// "profile" (ParseBatGeometry: the preset's material, wall and fill, these knots): the same bat,
+// whose knots a sweep can now name. Anything else is left as it is.
+void WritePresetProfile(Json* bat) {
+  if (!bat->is_object() || bat->contains("profile") || bat->contains("three_segment")) return;
+  const auto name = bat->find("preset");
+  if (name == bat->end() || !name->is_string()) return;
+  const std::optional<core::BatPreset> preset = core::FindPreset(name->get<std::string>());
+  if (!preset) return;
+  (*bat)["profile"] = BatToJson(preset->bat)["profile"];
 }
 
 // A swept path written in a trade unit ("ball.speed_mph", "three_segment.barrel_diameter_in")
@@ -211,6 +225,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   const std::size_t limit =
       context.batch ? context.limits.max_batch_samples : context.limits.max_samples;
   const char* limit_name = context.batch ? "max_batch_samples" : "max_samples";
+  const char* limit_flag = context.batch ? "max-batch-samples" : "max-samples";
   core::SweepPlan plan;
   std::string sampling = "grid";
   reader.OptionalString("sampling", &sampling, {"grid", "lhs", "sobol"});
@@ -304,6 +319,10 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
       if ((head == "ball" || head == "swing" || head == "contact") && !base.contains(head)) {
         base[head] = Json::object();
       }
+      // A preset's profile points, as /v1/optimize's variables take them: the template's bat
+      // gets the preset's knots written out (the preset with a "profile" is the same bat), so
+      // a knot path, in SI or a trade form, names a number of the template.
+      if (path.rfind("bat.profile.", 0) == 0) WritePresetProfile(&base["bat"]);
       std::string why;
       // A preset (bat.preset, ball.preset) is a catalogue name: every design would fail alike.
       if (path.size() >= 7 && path.compare(path.size() - 7, 7, ".preset") == 0) {
@@ -475,7 +494,7 @@ std::optional<ExploreRequest> ParseExploreRequest(const Json& body, const Contex
   if (total > limit) {
     SetError(error, ErrorCode::kTooBig, "parameters", nullptr,
              "describe " + std::to_string(total) + " designs, over the limit " + limit_name +
-                 " = " + std::to_string(limit));
+                 " = " + std::to_string(limit) + " (--" + limit_flag + ")");
     return std::nullopt;
   }
 

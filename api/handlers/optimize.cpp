@@ -165,9 +165,9 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
   reader.OptionalNumber("max_cpu_time_s", NonNegative(limits.max_time_s), &o->max_cpu_time_s);
   reader.OptionalNumber("tolerance", AnyNumber(), &o->tolerance);
   reader.OptionalNumber("constraint_tolerance", AnyNumber(), &o->constraint_tolerance);
+  reader.OptionalNumber("feasibility_tolerance", AnyNumber(), &o->feasibility_tolerance);
   reader.OptionalBool("explain_infeasibility", &o->explain_infeasibility);
   reader.OptionalNumber("stationarity_tolerance", AnyNumber(), &o->stationarity_tolerance);
-  reader.OptionalNumber("feasibility_tolerance", AnyNumber(), &o->feasibility_tolerance);
   reader.OptionalNumber("complementarity_tolerance", AnyNumber(), &o->complementarity_tolerance);
   if (const Json* f = reader.Get("flexible")) {
     if (!ReadFlexibleOptions(*f, reader.PathOf("flexible"), limits, flexible, top.error())) {
@@ -269,7 +269,9 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
                       : a.unit},
          {"value", a.value / f},
          {"bound", a.bound / f},
-         {"multiplier", Finite(a.multiplier * f)}});  // null for min_sting
+         {"multiplier", Finite(a.multiplier * f)},  // null for min_sting
+         {"satisfied", a.satisfied},
+         {"tolerance", a.tolerance / f}});
   }
   Json runs = Json::array();
   for (const auto& s : r.spread.runs) {
@@ -499,6 +501,9 @@ std::optional<Response> OptimizeFailure(const OptimizeRequest& request,
 
 Json RenderOptimize(const OptimizeRequest& request, const OptimizeResult& result) {
   Json out = ResultToJson(*result.Chosen(), request.request_bat, request.variable_names);
+  // The verdicts' tolerance (each active constraint's "satisfied"), relative to a constraint's
+  // scale.
+  out["summary"]["feasibility_tolerance"] = request.options.feasibility_tolerance;
   if (result.by_material) {
     Json per_material = Json::array();
     for (const auto& m : result.choice.per_material) {

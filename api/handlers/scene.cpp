@@ -233,7 +233,7 @@ std::optional<CompareRequest> ParseCompare(const Json& body, const Context& cont
     reader.Fail("variants",
                 "has " + std::to_string(variants->size()) +
                     " variants, over the limit max_variants = " +
-                    std::to_string(context.limits.max_variants),
+                    std::to_string(context.limits.max_variants) + " (--max-variants)",
                 ErrorCode::kTooBig);
     return std::nullopt;
   }

@@ -116,7 +116,8 @@ def direct(server, method, path, body=None, token=TOKEN):
 
 
 VOLATILE = {"timing_s", "solve_time_s", "time_s", "timings", "cache_hit", "created_s",
-            "started_s", "finished_s", "expires_in_s", "created_at"}
+            "started_s", "finished_s", "expires_in_s", "created_at", "started_at",
+            "finished_at"}
 
 
 def steady(value):

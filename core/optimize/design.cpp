@@ -37,7 +37,6 @@ using design_detail::ChooseRun;
 using design_detail::Clock;
 using design_detail::Explain;
 using design_detail::Finish;
-using design_detail::kFeasibleRelative;
 using design_detail::MainBackend;
 using design_detail::ReportActiveConstraints;
 using design_detail::Run;
@@ -172,7 +171,7 @@ std::vector<Run> RunStarts(const DesignModel& model, const DesignOptions& option
       result->derivative_check_errors = o.derivative_check_errors;
       result->derivative_check_report = o.derivative_check_report;
     }
-    runs.push_back(Finish(model, std::move(o)));
+    runs.push_back(Finish(model, std::move(o), options.feasibility_tolerance));
     if (progress != nullptr) {
       progress->Report(progress_from + (progress_to - progress_from) * (i + 1.0) / options.starts);
     }
@@ -303,7 +302,7 @@ void ClassifyFeasibility(const DesignModel& model, const DesignOptions& options,
                          Clock::time_point deadline, Progress* progress, const Run& chosen,
                          double worst, double worst_relative, DesignResult* result) {
   const LocalSolveOutcome& o = chosen.outcome;
-  const bool feasible = worst_relative <= kFeasibleRelative;
+  const bool feasible = worst_relative <= options.feasibility_tolerance;
   if (result->summary.termination == Termination::kConverged && !feasible) {
     result->summary.termination = Termination::kNoConvergence;
     result->summary.warnings.push_back(
@@ -378,14 +377,16 @@ void MarkCancelledMultiStart(const DesignOptions& options, const std::vector<Run
 // The bbcor rule set on a hollow answer, by the public model: a design over its limit is
 // infeasible.
 void CheckBbcorRule(const DesignProblem& problem, const PublicEvaluation& pub,
-                    DesignResult* result) {
+                    double feasibility_tolerance, DesignResult* result) {
   const std::optional<double> bound = BbcorBoundOf(problem);  // bbcor_constraint.hpp
   if (!result->bat.IsHollow() || !bound.has_value()) return;
   std::string bbcor_why;
-  // The constraint's own acceptance: kFeasibleRelative of the limit (the re-check above).
+  // The constraint's own acceptance: the feasibility tolerance of the limit (the re-check
+  // above).
   const double limit = *LimitsOf(RuleSet::kBbcor).max_bbcor;
-  if (!BbcorRuleHolds(result->bat, &result->bbcor.emplace(), &bbcor_why, kFeasibleRelative * limit,
-                      RigidBodyPropertiesOrNull(pub.properties), *bound)) {
+  if (!BbcorRuleHolds(result->bat, &result->bbcor.emplace(), &bbcor_why,
+                      feasibility_tolerance * limit, RigidBodyPropertiesOrNull(pub.properties),
+                      *bound)) {
     result->summary.termination = Termination::kInfeasible;
     result->summary.message = bbcor_why;
     result->message_kind = DesignMessageKind::kInfeasible;
@@ -490,10 +491,10 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
     ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, &result);
     ReportActiveConstraints(
         model, x, design_detail::WithCertifiedMultipliers(model, options, x, chosen.outcome, &result),
-        &result);
+        &result, options.feasibility_tolerance);
     design_detail::FinishCertificate(chosen, &result);
     MarkCancelledMultiStart(options, runs, progress, &result);
-    CheckBbcorRule(problem, pub, &result);
+    CheckBbcorRule(problem, pub, options.feasibility_tolerance, &result);
   } catch (const std::bad_alloc&) {
     summary.termination = Termination::kFailure;
     summary.message = "out of memory";

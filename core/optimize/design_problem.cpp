@@ -120,9 +120,12 @@ bool DesignOptions::Validate(Refusal* why) const {
       !(constraint_tolerance < 1.0)) {
     return Refuse(why, "constraint_tolerance", constraint_tolerance, "must be in (0, 1)");
   }
+  if (!std::isfinite(feasibility_tolerance) || !(feasibility_tolerance > 0.0) ||
+      !(feasibility_tolerance <= 0.01)) {
+    return Refuse(why, "feasibility_tolerance", feasibility_tolerance, "must be in (0, 0.01]");
+  }
   const std::pair<const char*, double> certificate[] = {
       {"stationarity_tolerance", stationarity_tolerance},
-      {"feasibility_tolerance", feasibility_tolerance},
       {"complementarity_tolerance", complementarity_tolerance}};
   for (const auto& [name, value] : certificate) {
     if (!std::isfinite(value) || !(value > 0.0) || !(value < 1.0)) {

@@ -297,6 +297,11 @@ struct DesignOptions {
   /// Largest violation accepted for a converged point, relative to each constraint's scale
   /// (Ipopt constr_viol_tol; > 0, < 1).
   double constraint_tolerance = 1e-10;
+  /// The verdicts' tolerance: a constraint holds (DesignActiveConstraint::satisfied, a feasible
+  /// design, the bbcor rule's re-check) when it is met to this, relative to its scale (a
+  /// solver lands on an active bound from either side: a drop of 3.0000000002 holds "drop <=
+  /// 3"); in (0, 0.01]. Also the certificate's largest violation (DesignCertificate).
+  double feasibility_tolerance = kDefaultFeasibilityTolerance;
   int starts = 1;          ///< Local solves (1..64): the base design, then seeded random designs.
   std::uint64_t seed = 1;  ///< Seed of the random starts (std::mt19937_64).
   /// Given starts: start i is start_points[i] (the variables' values, field units, clamped into
@@ -317,8 +322,6 @@ struct DesignOptions {
   /// certified answer, in (0, 1). A solve whose backend reports convergence is converged only
   /// when its certificate holds.
   double stationarity_tolerance = kDefaultStationarityTolerance;
-  /// The certificate's largest violation, relative to each constraint's scale, in (0, 1).
-  double feasibility_tolerance = kDefaultFeasibilityTolerance;
   /// The certificate's largest complementarity product (relative), in (0, 1).
   double complementarity_tolerance = kDefaultComplementarityTolerance;
 
@@ -356,6 +359,11 @@ struct DesignActiveConstraint {
   /// minimising). NaN for min_sting (the sting has no derivative, so no multiplier can be
   /// estimated) and when the active gradients are dependent (no unique multiplier).
   double multiplier = 0.0;
+  /// The verdict: the value is within the bound to `tolerance` (DesignOptions::
+  /// feasibility_tolerance of the constraint's scale).
+  bool satisfied = true;
+  /// The largest overshoot of the bound that still holds, in the constraint's unit (>= 0).
+  double tolerance = 0.0;
 };
 
 /// Which finding a DesignConflict states; code tells conflicts apart by this, never by reading

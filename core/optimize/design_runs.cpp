@@ -90,7 +90,7 @@ double KktResidual(ScaledDesignNlp& nlp, const LocalSolveOutcome& o) {
 }  // namespace
 
 // Evaluates the end of a local solve.
-Run Finish(const DesignModel& model, LocalSolveOutcome outcome) {
+Run Finish(const DesignModel& model, LocalSolveOutcome outcome, double feasibility_tolerance) {
   Run run;
   ScaledDesignNlp nlp(model);
   std::vector<double> s = outcome.s;
@@ -105,7 +105,7 @@ Run Finish(const DesignModel& model, LocalSolveOutcome outcome) {
     run.objective =
         model.derivative_free() ? nlp.objective() : model.Value(model.objective(), run.x.data());
     run.violation = nlp.Violation();
-    run.feasible = run.violation <= kFeasibleRelative;
+    run.feasible = run.violation <= feasibility_tolerance;
   }
   run.outcome = std::move(outcome);
   return run;
@@ -188,7 +188,7 @@ LocalSolveSettings SettingsFrom(const DesignOptions& options, Clock::time_point 
   s.max_cpu_time_s = options.max_cpu_time_s;
   s.deadline = deadline;
   s.progress = progress;
-  s.feasibility_tolerance = kFeasibleRelative;
+  s.feasibility_tolerance = options.feasibility_tolerance;
   return s;
 }
 
@@ -198,7 +198,8 @@ double Violation(const DesignConstraintSpec& c, double v) {
 }
 
 void ReportActiveConstraints(const DesignModel& model, const std::vector<double>& x,
-                             const LocalSolveOutcome& o, DesignResult* result) {
+                             const LocalSolveOutcome& o, DesignResult* result,
+                             double feasibility_tolerance) {
   ScaledDesignNlp nlp(model);
   std::vector<double> s = nlp.ToScaled(x);
   LocalSolveOutcome mult = o;
@@ -236,6 +237,9 @@ void ReportActiveConstraints(const DesignModel& model, const std::vector<double>
       a.value = g * c.scale;
       a.bound = at_upper ? c.upper : c.lower;
       a.multiplier = -sense * fs * mult.lambda[kk] / c.scale;
+      // The verdict: met to the stated tolerance of the constraint's scale.
+      a.tolerance = feasibility_tolerance * std::abs(c.scale);
+      a.satisfied = Violation(c, a.value) <= a.tolerance;
       result->active_constraints.push_back(a);
     }
     for (int j = 0; j < model.n(); ++j) {
@@ -256,6 +260,10 @@ void ReportActiveConstraints(const DesignModel& model, const std::vector<double>
       } else {
         continue;
       }
+      // A bound holds to the stated tolerance of the variable's range (the solution is clamped
+      // into it: always satisfied).
+      a.tolerance = feasibility_tolerance * width;
+      a.satisfied = a.value >= v.lower - a.tolerance && a.value <= v.upper + a.tolerance;
       result->active_constraints.push_back(a);
     }
   }

@@ -24,14 +24,16 @@ struct Run {
   std::vector<double> x;      ///< The point, user units, clamped into the bounds.
   double objective = std::numeric_limits<double>::quiet_NaN();  ///< Model objective at x.
   double violation = std::numeric_limits<double>::infinity();   ///< Largest scaled violation.
-  bool feasible = false;  ///< violation <= kFeasibleRelative.
+  bool feasible = false;  ///< violation <= the feasibility tolerance (Finish's).
   /// The solver reported convergence but the certificate failed (its termination is then
   /// no_convergence, its message what failed).
   bool uncertified = false;
 };
 
 /// Evaluates the end of a local solve (clamped into the bounds, objective, violation).
-Run Finish(const DesignModel& model, LocalSolveOutcome outcome);
+/// `feasibility_tolerance`: DesignOptions::feasibility_tolerance (Run::feasible).
+Run Finish(const DesignModel& model, LocalSolveOutcome outcome,
+           double feasibility_tolerance = kFeasibleRelative);
 /// Index of the run to answer with: feasible and converged by objective, then feasible by
 /// objective, then the least violation (-1 when no run has a finite violation).
 int ChooseRun(const DesignModel& model, const std::vector<Run>& runs);
@@ -53,9 +55,11 @@ LocalSolveSettings SettingsFrom(const DesignOptions& options, Clock::time_point 
 double Violation(const DesignConstraintSpec& c, double v);
 /// Fills result->active_constraints (with the multipliers, sensitivities of the objective) at
 /// x, the answer of solve `o`, and result->summary.error_estimate with the KKT residual (NaN
-/// for min_sting, which has no derivative: a warning says so).
+/// for min_sting, which has no derivative: a warning says so). Each verdict (satisfied) with
+/// `feasibility_tolerance` (DesignOptions') of the constraint's scale.
 void ReportActiveConstraints(const DesignModel& model, const std::vector<double>& x,
-                             const LocalSolveOutcome& o, DesignResult* result);
+                             const LocalSolveOutcome& o, DesignResult* result,
+                             double feasibility_tolerance = kFeasibleRelative);
 /// Why no design meets the constraints: single constraints that cannot be met within the
 /// variable bounds and the geometric constraints, then pairs of property constraints.
 std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOptions& options,

@@ -1,5 +1,6 @@
 #include "server/jobs/job_common.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -83,15 +84,26 @@ bool JobConfig::Validate(core::Refusal* refusal) const {
 }
 
 nlohmann::json JobJson(const JobView& job) {
+  // After the submit, s: never negative (PostgreSQL's clock stamps the start and the finish,
+  // the replica's the submit: a skew of a few ms between the two is not a time before it).
+  auto after_submit = [&job](const std::optional<double>& unix_s) {
+    return unix_s ? std::optional<double>(std::max(0.0, *unix_s - job.created_unix_s))
+                  : std::nullopt;
+  };
+  auto iso = [](const std::optional<double>& unix_s) {
+    return unix_s ? nlohmann::json(IsoUtcOfUnixSeconds(*unix_s)) : nlohmann::json();
+  };
   return nlohmann::json{
       {"id", job.id},
       {"state", job.state},
       {"progress", job.progress},
       {"path", job.path},
-      {"created_s", RoundedSeconds(job.created_s)},
-      {"started_s", OptionalSeconds(job.started_s)},
-      {"finished_s", OptionalSeconds(job.finished_s)},
+      {"created_s", 0.0},
+      {"started_s", OptionalSeconds(after_submit(job.started_unix_s))},
+      {"finished_s", OptionalSeconds(after_submit(job.finished_unix_s))},
       {"created_at", job.created_at},
+      {"started_at", iso(job.started_unix_s)},
+      {"finished_at", iso(job.finished_unix_s)},
       {"status", job.status ? nlohmann::json(*job.status) : nlohmann::json()},
       {"error", job.error ? *job.error : nlohmann::json()},
       {"cancel_requested", job.cancel_requested},
@@ -145,6 +157,18 @@ api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const
                                            " = " + std::to_string(value) +
                                            "): ask for fewer rows or outputs, or raise " + flag,
                                        ""});
+}
+
+api::Response IncompleteStreamAnswer(bool cancelled) {
+  if (cancelled) {
+    return api::ToResponse(api::ApiError{409, api::ErrorCode::kCancelled,
+                                         "the job was stopped before its answer was complete", ""});
+  }
+  return api::ToResponse(api::ApiError{
+      503, api::ErrorCode::kUnavailable,
+      "the job's answer stopped before it was complete (its sweep failed, e.g. out of memory): "
+      "no partial answer is kept; submit the job again later",
+      ""});
 }
 
 CollectedStream CollectJobStream(api::Response* response, std::size_t max_bytes,
@@ -242,6 +266,12 @@ std::string IsoUtc(std::chrono::system_clock::time_point time) {
   char text[48];
   std::snprintf(text, sizeof(text), "%s.%03dZ", date, static_cast<int>(ms.count() % 1000));
   return text;
+}
+
+std::string IsoUtcOfUnixSeconds(double unix_s) {
+  return IsoUtc(std::chrono::system_clock::time_point(
+      std::chrono::duration_cast<std::chrono::system_clock::duration>(
+          std::chrono::duration<double>(unix_s))));
 }
 
 std::string SerializeJobBody(const nlohmann::json& body) {

@@ -74,10 +74,10 @@ struct JobView {
   std::string state;                     ///< "queued", "running", "done", "failed", "cancelled".
   double progress = 0.0;                 ///< 0..1.
   std::string path;                      ///< The inner request's path.
-  double created_s = 0.0;                ///< Submit time, s since this process started.
-  std::optional<double> started_s;       ///< Start, s since this process started.
-  std::optional<double> finished_s;      ///< Finish, s since this process started.
-  std::string created_at;                ///< Submit time, ISO-8601 UTC.
+  double created_unix_s = 0.0;           ///< Submit time, s since the Unix epoch.
+  std::optional<double> started_unix_s;  ///< Start (of the last run), s since the epoch.
+  std::optional<double> finished_unix_s;  ///< Finish, s since the epoch.
+  std::string created_at;                 ///< Submit time, ISO-8601 UTC.
   std::optional<int> status;             ///< Inner status once done or failed.
   std::optional<nlohmann::json> error;   ///< The error object once failed.
   bool cancel_requested = false;         ///< DELETE asked it to stop.
@@ -85,7 +85,10 @@ struct JobView {
   std::optional<double> expires_in_s;    ///< Until a finished job is dropped, s.
 };
 
-/// The job's JSON (api/job_service.hpp); times rounded to microseconds.
+/// The job's JSON (api/job_service.hpp): its times absolute (created_at, started_at,
+/// finished_at: ISO-8601 UTC) and relative to its submit (created_s = 0, started_s,
+/// finished_s: s after created_at, never negative, rounded to microseconds), never relative to
+/// a process's start, so they read the same after a restart and from every replica.
 nlohmann::json JobJson(const JobView& job);
 
 /// 404 NotFound "no job with id ...".
@@ -107,6 +110,12 @@ api::Response JobTimedOut(double max_time_s);
 /// "--job-max-result-bytes"); "at least" when `stopped`: its producer was stopped there.
 api::Response JobResultTooBig(std::size_t size, const std::string& keeper, const std::string& limit,
                               std::size_t value, const std::string& flag, bool stopped = false);
+
+/// The answer of a job whose streamed answer stopped before its end (StreamOutcome::kStopped):
+/// never the rows made so far (docs/api.md, "A sweep that does not finish"). `cancelled` (its
+/// cancel flag: DELETE, the time limit, a shutdown): 409 Cancelled; otherwise the sweep itself
+/// failed (out of memory): 503 Unavailable.
+api::Response IncompleteStreamAnswer(bool cancelled);
 
 /// What CollectJobStream did.
 enum class StreamOutcome {
@@ -151,6 +160,8 @@ bool NormalizeJsonResult(api::Response* response, bool chunked);
 std::string QuoteJobId(const std::string& id);
 /// "2024-05-01T12:00:00.123Z".
 std::string IsoUtc(std::chrono::system_clock::time_point time);
+/// IsoUtc of `unix_s` seconds since the Unix epoch.
+std::string IsoUtcOfUnixSeconds(double unix_s);
 /// A JSON body serialised for a store; never throws (invalid UTF-8 is replaced).
 std::string SerializeJobBody(const nlohmann::json& body);
 /// The failure's message of an inner response: its "message", else its status.

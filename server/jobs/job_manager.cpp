@@ -340,18 +340,16 @@ double JobManager::ProgressOf(const Job& job) {
 }
 
 nlohmann::json JobManager::ToJsonLocked(const Job& job, Clock::time_point now) const {
-  auto since_start = [this](Clock::time_point time) {
-    return std::chrono::duration<double>(time - start_).count();
-  };
   JobView view;
   view.id = job.id;
   view.state = StateName(job.state);
   view.progress = ProgressOf(job);
   view.path = job.path;
-  view.created_s = since_start(job.created);
-  if (job.started) view.started_s = since_start(*job.started);
+  // Absolute (a stored job's times are its stored ones, whatever this process's start).
+  view.created_unix_s = ToUnixSeconds(job.created);
+  if (job.started) view.started_unix_s = ToUnixSeconds(*job.started);
   if (job.finished) {
-    view.finished_s = since_start(*job.finished);
+    view.finished_unix_s = ToUnixSeconds(*job.finished);
     view.expires_in_s =
         config_.keep_results_s - std::chrono::duration<double>(now - *job.finished).count();
   }

@@ -74,10 +74,9 @@ JobManager::RunOutcome JobManager::RunJob(Job& job, Request inner) {
   if (!run.threw) streamed = CollectJobStream(&run.response, largest, write);
   run.chunks = streamed.pieces;
   if (streamed.outcome == StreamOutcome::kStopped) {
-    // Cancelled (DELETE, the time limit, a shutdown): an incomplete body is no answer.
+    // Cancelled (DELETE, the time limit, a shutdown) or failed: an incomplete body is no answer.
     KeepOnlyJobStatus(&run.response);
-    run.response = ToResponse(ApiError{409, api::ErrorCode::kCancelled,
-                                       "the job was stopped before its answer was complete", ""});
+    run.response = IncompleteStreamAnswer(job.progress.Cancelled());
   } else if (streamed.outcome == StreamOutcome::kWriteFailed) {
     KeepOnlyJobStatus(&run.response);
     run.response = ToResponse(

@@ -68,9 +68,6 @@ struct PostgresJobService::Impl {
         log(std::move(log_in)),
         db(std::move(uri_in)),
         owner(pg::LeaseOwner()),
-        wall_start_unix_s(
-            std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
-                .count()),
         random(SeededEngine()) {}
 
   bool Migrate(std::string* error);
@@ -102,7 +99,6 @@ struct PostgresJobService::Impl {
   const std::function<void(const std::string&)> log;
   mutable pg::Connections db;
   const std::string owner;
-  const double wall_start_unix_s;  // The wall clock when this replica started, s.
 
   mutable std::mutex mutex;
   std::condition_variable work_cv;       // `wakeups` moved, or stopping.

@@ -141,10 +141,10 @@ JobView PostgresJobService::Impl::ViewOf(const PGresult* result, int row) const 
   view.progress = Number(result, row, 2);
   view.path = Text(result, row, 3);
   view.created_at = Text(result, row, 4);
-  view.created_s = Number(result, row, 5) - wall_start_unix_s;
-  if (auto started = OptionalNumber(result, row, 6)) view.started_s = *started - wall_start_unix_s;
+  view.created_unix_s = Number(result, row, 5);
+  view.started_unix_s = OptionalNumber(result, row, 6);
   if (auto finished = OptionalNumber(result, row, 7)) {
-    view.finished_s = *finished - wall_start_unix_s;
+    view.finished_unix_s = *finished;
     view.expires_in_s = config.keep_results_s - (db_now - *finished);
   }
   const int status = std::atoi(PQgetvalue(result, row, 8));

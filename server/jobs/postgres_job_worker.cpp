@@ -96,9 +96,8 @@ PostgresJobService::Impl::RunOutcome PostgresJobService::Impl::RunClaimed(Runnin
         });
   }
   job.chunks = streamed.pieces;
-  if (streamed.outcome == StreamOutcome::kStopped) {  // Cancelled: an incomplete body is no answer.
-    run.response = api::ToResponse(api::ApiError{
-        409, api::ErrorCode::kCancelled, "the job was stopped before its answer was complete", ""});
+  if (streamed.outcome == StreamOutcome::kStopped) {  // An incomplete body is no answer.
+    run.response = IncompleteStreamAnswer(job.progress.Cancelled());
   } else if (streamed.outcome == StreamOutcome::kOverLimit) {
     run.response = JobResultTooBig(streamed.bytes, "the jobs database", "max_result_bytes",
                                    config.max_result_bytes, "--job-max-result-bytes", true);

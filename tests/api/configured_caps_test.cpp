@@ -64,7 +64,8 @@ TEST(ConfiguredCapsTest, CurveLimitBelowTheDefaultIsEnforced) {
   EXPECT_EQ(listed.body.at("field"), "options.curve_positions_from_knob_m");
   const std::string message = listed.body.at("message");
   EXPECT_EQ(message.rfind("options.curve_positions_from_knob_m = [0.5,", 0), 0u) << message;
-  const std::string rule = ": has 101 positions, over the limit max_curve_samples = 100";
+  const std::string rule =
+      ": has 101 positions, over the limit max_curve_samples = 100 (--max-curve-samples)";
   ASSERT_GE(message.size(), rule.size());
   EXPECT_EQ(message.substr(message.size() - rule.size()), rule) << message;
 }

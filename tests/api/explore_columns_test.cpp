@@ -305,7 +305,8 @@ TEST(ExploreCsvTest, BatchesHaveTheirOwnLimit) {
   body["columns"] = {"index"};
   Response r = Explore(body, context);
   EXPECT_EQ(r.status, 413);
-  EXPECT_EQ(r.body["message"], "parameters describe 150 designs, over the limit max_samples = 100");
+  EXPECT_EQ(r.body["message"],
+            "parameters describe 150 designs, over the limit max_samples = 100 (--max-samples)");
   context.batch = true;
   r = Explore(body, context);
   ASSERT_EQ(r.status, 200) << r.body.dump();
@@ -314,7 +315,8 @@ TEST(ExploreCsvTest, BatchesHaveTheirOwnLimit) {
   r = Explore(body, context);
   EXPECT_EQ(r.status, 413);
   EXPECT_EQ(r.body["message"],
-            "parameters describe 201 designs, over the limit max_batch_samples = 200");
+            "parameters describe 201 designs, over the limit max_batch_samples = 200 "
+            "(--max-batch-samples)");
 }
 
 }  // namespace

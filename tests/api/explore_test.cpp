@@ -5,8 +5,10 @@
 #include <set>
 
 #include "api/explore/design.hpp"
+#include "api/fields.hpp"
 #include "api/json_path.hpp"
 #include "api/router.hpp"
+#include "core/bat/presets.hpp"
 
 namespace sweetspot::api {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -354,6 +356,57 @@ TEST(ExploreTest, ARowComputesTheMassPropertiesOnce) {
   EXPECT_EQ(p.timings[0].model, "mass_properties");
   EXPECT_EQ(p.timings[0].calls, 1);
   EXPECT_NEAR(p.row["properties"]["mass_kg"].get<double>(), 1.0078, 1e-4);  // paper-wood
+}
+
+// A preset's profile points can be swept, as /v1/optimize's variables take them (issue 35: "no
+// field bat.profile" before): every knot path the optimiser accepts, SI and trade forms, on
+// "wood-34-ash"; each row's bat is the preset with that knot moved (the same mass as the
+// explicit profile through /v1/sweet-spot, bit for bit: the same parser and code).
+TEST(ExploreTest, APresetsProfileKnotsAreSweptAsTheOptimiserTakesThem) {
+  const std::vector<core::ProfileKnot> knots = core::FindPreset("wood-34-ash")->bat.knots;
+  ASSERT_GT(knots.size(), 3u);
+  std::size_t checked = 0;
+  for (const std::string& name : FieldNames(FieldScope::kVariable)) {
+    if (name.rfind("profile.knots[i]", 0) != 0) continue;
+    SCOPED_TRACE(name);
+    const std::string path = "profile.knots[2]" + name.substr(16);
+    const auto use = ResolveField(path, FieldScope::kVariable);
+    ASSERT_TRUE(use.has_value());
+    // The knot's own value and 1 % more, in the written unit (x between its neighbours).
+    const bool is_x = use->si.find(".x_m") != std::string::npos;
+    // The knot's SI field in the written unit (a diameter in inches: the radius / 0.0127 m).
+    const double lo = (is_x ? knots[2].x_m : knots[2].radius_m) / use->to_si;
+    Json body = Json::parse(R"({"bat": {"preset": "wood-34-ash"}, "outputs": ["properties"]})");
+    body["parameters"] = {{{"path", path}, {"min", lo}, {"max", lo * 1.01}, {"count", 2}}};
+    const Response r = Explore(body);
+    ASSERT_EQ(r.status, 200) << r.body.dump();
+    for (const Json& row : r.body["rows"]) {
+      ASSERT_TRUE(row["feasible"].get<bool>()) << row.dump();
+      const double written = row["parameters"][path].get<double>();
+      Json profile = Json::array();
+      for (std::size_t k = 0; k < knots.size(); ++k) {
+        Json knot{{"x_m", knots[k].x_m}, {"radius_m", knots[k].radius_m}};
+        if (k == 2) knot[is_x ? "x_m" : "radius_m"] = use->to_si * written;
+        profile.push_back(knot);
+      }
+      Json single{{"bat", {{"preset", "wood-34-ash"}, {"profile", {{"knots", profile}}}}}};
+      const Response s = Dispatch({"POST", "/v1/bat/properties", single.dump()}, Context{});
+      ASSERT_EQ(s.status, 200) << s.body.dump();
+      EXPECT_EQ(row["properties"]["mass_kg"], s.body["mass_kg"]) << single.dump();
+    }
+    // The sweep moved the bat: its two designs differ.
+    EXPECT_NE(r.body["rows"][0]["properties"]["moi_knob_kg_m2"],
+              r.body["rows"][1]["properties"]["moi_knob_kg_m2"]);
+    ++checked;
+  }
+  EXPECT_GE(checked, 3u);  // x_m, radius_m and at least one trade form (diameter_in)
+  // Linked knots (one barrel diameter) too, and the template's preset is untouched elsewhere.
+  Json linked = Json::parse(R"({"bat": {"preset": "wood-34-ash"}, "outputs": ["properties"],
+      "parameters": [{"paths": ["profile.knots[2].radius_m", "profile.knots[3].radius_m"],
+                      "min": 0.03, "max": 0.032, "count": 2}]})");
+  const Response l = Explore(linked);
+  ASSERT_EQ(l.status, 200) << l.body.dump();
+  EXPECT_EQ(l.body["summary"]["failed"], 0);
 }
 
 TEST(ExploreTest, CancelledSweepStops) {

@@ -146,7 +146,8 @@ TEST(JobSubmitTest, AnExploreJobHasTheBatchLimitAtSubmitToo) {
   const Response over = SubmitJob(&jobs, "/v1/explore", sweep(21), limits);
   EXPECT_EQ(over.status, 413);
   EXPECT_EQ(over.body["message"],
-            "parameters describe 21 designs, over the limit max_batch_samples = 20");
+            "parameters describe 21 designs, over the limit max_batch_samples = 20 "
+            "(--max-batch-samples)");
   EXPECT_EQ(jobs.submitted.size(), 1u);
 }
 

@@ -54,7 +54,7 @@ TEST(ParseBodyTest, DeepNestingIsRefusedWithoutBuildingIt) {
   const ApiError error = ParseError(bomb);
   EXPECT_EQ(error.status, 413);
   EXPECT_EQ(error.code, ErrorCode::kTooBig);
-  EXPECT_EQ(error.message, "nesting exceeds the limit max_json_depth = 32");
+  EXPECT_EQ(error.message, "nesting exceeds the limit max_json_depth = 32 (--max-json-depth)");
 }
 
 TEST(ParseBodyTest, DepthAtTheLimitIsAccepted) {
@@ -72,11 +72,11 @@ TEST(ParseBodyTest, LongArraysAndStringsAreRefused) {
   ApiError error;
   EXPECT_TRUE(ParseBody("[1,2,3]", limits, &error).has_value());
   EXPECT_EQ(ParseError("[1,2,3,4]", limits).message,
-            "an array exceeds the limit max_array_length = 3");
+            "an array exceeds the limit max_array_length = 3 (--max-array-length)");
   EXPECT_EQ(ParseError("\"abcdef\"", limits).message,
-            "a string of 6 bytes exceeds the limit max_string_length = 5");
+            "a string of 6 bytes exceeds the limit max_string_length = 5 (--max-string-length)");
   EXPECT_EQ(ParseError("{\"abcdef\": 1}", limits).message,
-            "a key of 6 bytes exceeds the limit max_string_length = 5");
+            "a key of 6 bytes exceeds the limit max_string_length = 5 (--max-string-length)");
 }
 
 TEST(ObjectReaderTest, ReadsNumbersAndRefusesUnknownFields) {

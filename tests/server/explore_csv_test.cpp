@@ -186,8 +186,9 @@ TEST(ExploreCsvEndToEndTest, TheCliRunsASweepLargerThanARequestMayBe) {
     EXPECT_EQ(refused->status, 413);
     const Json body = Json::parse(refused->body);
     EXPECT_EQ(body["code"], "TooBig");
-    EXPECT_EQ(body["message"],
-              "parameters describe 150000 designs, over the limit max_samples = 100000");
+    EXPECT_EQ(
+        body["message"],
+        "parameters describe 150000 designs, over the limit max_samples = 100000 (--max-samples)");
   }
   const TemporaryFile request_file("sweep.json", sweep.dump());
   const std::string& file = request_file.path();
@@ -222,7 +223,8 @@ TEST(ExploreCsvEndToEndTest, TheCliRunsASweepLargerThanARequestMayBe) {
   const CliOutput limited = RunSweetspot("explore --max-batch-samples 149999 " + file);
   EXPECT_EQ(limited.exit_code, 2);
   EXPECT_EQ(Json::parse(limited.out)["message"],
-            "parameters describe 150000 designs, over the limit max_batch_samples = 149999");
+            "parameters describe 150000 designs, over the limit max_batch_samples = 149999 "
+            "(--max-batch-samples)");
 }
 
 // --explore-threads (flag or environment, CLI and server) changes the threads, never the
@@ -317,7 +319,8 @@ TEST(ExploreCsvEndToEndTest, AJobHasTheBatchLimit) {
   const Json refusal = Json::parse(refused_job->body);
   EXPECT_EQ(refusal["code"], "TooBig");
   EXPECT_EQ(refusal["message"],
-            "parameters describe 25 designs, over the limit max_batch_samples = 20");
+            "parameters describe 25 designs, over the limit max_batch_samples = 20 "
+            "(--max-batch-samples)");
   EXPECT_EQ(Json::parse(client.Get("/v1/jobs")->body)["total"], 1);  // Only the first job.
 }
 

@@ -128,6 +128,65 @@ TEST(ExploreStreamTest, ClientGoingAwayMidStreamStopsTheSweepAndTheServerKeepsSe
   }
 }
 
+// A streamed sweep the server stops (here --max-request-time-s; a shutdown alike) never looks
+// complete: the 200 and some rows are already sent, so the NDJSON ends with an {"error"} line in
+// place of its summary and, in every format, the chunked body gets no last chunk: the client
+// reports the body incomplete. Before, a CSV cut short ended as a complete chunked body (curl
+// exited 0 on a truncated CSV) and an NDJSON one too, after its error line. A JSON answer is
+// not streamed: it is the 503 Timeout.
+TEST(ExploreStreamTest, AStreamStoppedByTheDeadlineEndsIncomplete) {
+  ServerConfig config = StreamConfig();
+  config.max_request_time_s = 0.5;
+  RunningServer server(config);
+  ASSERT_TRUE(server.bound());
+  // 10,000 Hertz designs (~1.5 ms each in Release: ~15 s, far past the 0.5 s budget).
+  Json sweep = Json::parse(R"({"bat": {"preset": "paper-wood",
+      "fill": {"material": "cork", "diameter_m": 0.0254, "depth_m": 0.254}},
+    "outputs": ["max_exit_speed"], "options": {"model": "hertz"}})");
+  sweep["parameters"] = {
+      {{"path", "fill.depth_m"}, {"min", 0.0}, {"max", 0.3}, {"count", 100}},
+      {{"path", "fill.diameter_m"}, {"min", 0.01}, {"max", 0.03}, {"count", 100}}};
+  for (const char* format : {"csv", "ndjson"}) {
+    SCOPED_TRACE(format);
+    sweep["format"] = format;
+    httplib::Client client("127.0.0.1", server.port());
+    client.set_read_timeout(std::chrono::seconds(60));
+    std::string streamed;
+    int status = 0;
+    httplib::Request request;
+    request.method = "POST";
+    request.path = "/v1/explore";
+    request.body = sweep.dump();
+    request.set_header("Content-Type", "application/json");
+    request.response_handler = [&](const httplib::Response& response) {
+      status = response.status;
+      return true;
+    };
+    request.content_receiver = [&](const char* data, std::size_t length, std::uint64_t,
+                                   std::uint64_t) {
+      streamed.append(data, length);
+      return true;
+    };
+    const auto result = client.send(request);
+    EXPECT_EQ(status, 200);  // sent with the first rows
+    EXPECT_FALSE(streamed.empty());
+    EXPECT_FALSE(result) << "a body cut short must not end as a complete chunked body";
+    if (std::string(format) == "ndjson") {
+      const std::size_t last = streamed.rfind('\n', streamed.size() - 2);
+      const Json tail = Json::parse(streamed.substr(last + 1), nullptr, false);
+      EXPECT_TRUE(tail.contains("error")) << streamed.substr(last + 1);
+      EXPECT_FALSE(tail.contains("summary"));
+    }
+  }
+  sweep["format"] = "json";
+  httplib::Client client("127.0.0.1", server.port());
+  client.set_read_timeout(std::chrono::seconds(60));
+  const auto json = client.Post("/v1/explore", sweep.dump(), "application/json");
+  ASSERT_TRUE(json);
+  EXPECT_EQ(json->status, 503);
+  EXPECT_EQ(Json::parse(json->body)["code"], "Timeout");
+}
+
 }  // namespace
 }  // namespace explore_stream_test
 }  // namespace sweetspot::server

@@ -443,11 +443,12 @@ TEST(JobStoreTest, FinishedJobsAndResultsSurviveARestart) {
   for (const auto& [id, before] : {std::pair{done, done_json}, std::pair{failed, failed_json}}) {
     const Response status = restarted.Status(id);
     ASSERT_EQ(status.status, 200);
-    // Times are re-based on the new manager's start (so they are now negative),
-    // within a millisecond of the wall-clock difference; everything else is equal.
+    // Times are the job's, not the manager's: after its submit (*_s, equal within the
+    // microsecond they are rounded to) and absolute (*_at, equal); everything else is equal.
     Json after = status.body;
     for (const char* key : {"created_s", "started_s", "finished_s"}) {
-      EXPECT_LE(after[key].get<double>(), 0.0) << key;
+      EXPECT_GE(after[key].get<double>(), 0.0) << key;
+      EXPECT_NEAR(after[key].get<double>(), before[key].get<double>(), 2e-6) << key;
       after.erase(key);
     }
     Json expected = before;
@@ -493,7 +494,9 @@ TEST(JobStoreTest, QueuedJobsRunAfterARestartInTheirOrder) {
   const Json status = jobs.Status(Hex('a')).body;
   EXPECT_EQ(status["resumes"], 0);  // Never started before: not a resume.
   EXPECT_EQ(status["created_at"], "2024-05-01T12:00:00.123Z");
-  EXPECT_NEAR(status["created_s"].get<double>(), -1.0, 0.5);
+  EXPECT_EQ(status["created_s"], 0.0);  // After its submit, s: not before this manager's start.
+  // Submitted 1 s before this manager started, run at once: started about 1 s after it.
+  EXPECT_NEAR(status["started_s"].get<double>(), 1.0, 0.5);
 }
 
 TEST(JobStoreTest, JobRunningWhenTheProcessDiedIsResumedFromTheStart) {
@@ -523,7 +526,8 @@ TEST(JobStoreTest, JobRunningWhenTheProcessDiedIsResumedFromTheStart) {
   release.Open();
   const Json done = WaitForState(jobs, Hex('c'), "done");
   EXPECT_EQ(done["resumes"], 1);
-  EXPECT_GE(done["started_s"].get<double>(), 0.0);  // Started again by this manager.
+  // Started again by this manager, 10 s after its submit (the first start was 1 s after it).
+  EXPECT_GE(done["started_s"].get<double>(), 9.5);
   EXPECT_EQ(jobs.Result(Hex('c')).body,
             (Json{{"method", "POST"}, {"path", "/v1/explore"}, {"body", running.body}}));
   EXPECT_EQ(calls.load(), 1);
@@ -553,8 +557,8 @@ TEST(JobStoreTest, JobRunningWhenTheProcessDiedTooOftenIsFailedWithItsReason) {
               (Json{{"code", "Interrupted"}, {"message", reason}, {"field", nullptr}}));
     EXPECT_EQ(status.body["status"], 503);
     EXPECT_EQ(status.body["resumes"], max_resumes);
-    EXPECT_LE(status.body["started_s"].get<double>(), -8.0);  // The start that was cut.
-    EXPECT_GE(status.body["finished_s"].get<double>(), 0.0);  // Failed by this manager.
+    EXPECT_NEAR(status.body["started_s"].get<double>(), 1.0, 1e-3);  // The start that was cut.
+    EXPECT_GE(status.body["finished_s"].get<double>(), 9.5);         // Failed by this manager.
     const Response result = jobs.Result(Hex('d'));
     EXPECT_EQ(result.status, 503);
     EXPECT_EQ(result.body,

@@ -68,12 +68,15 @@ TEST(JobsRestartTest, SigkillMidJobThenRestartResumesItWithTheSameResult) {
       << resumed.body.dump();
   EXPECT_EQ(resumed.body["resumes"], 1);
   EXPECT_EQ(resumed.body["created_at"], created_at);
-  EXPECT_LT(resumed.body["created_s"].get<double>(), 0.0);  // Before this process started.
+  // The job's own times, not this process's (they were negative here: before its start).
+  EXPECT_EQ(resumed.body["created_s"], 0.0);
 
   const Json done = WaitForState(second, id, "done");
   EXPECT_EQ(done["status"], 200);
   EXPECT_EQ(done["resumes"], 1);
-  EXPECT_GE(done["started_s"].get<double>(), 0.0);  // Run again, from the start, by this process.
+  // Run again, from the start, by this process: started after the first process was killed,
+  // so after the job's submit.
+  EXPECT_GT(done["started_s"].get<double>(), 0.0);
   const Answer result = Get(second, "/v1/jobs/" + id + "/result");
   ASSERT_EQ(result.status, 200);
   ASSERT_EQ(result.body["rows"].size(), kSlowSweepRows);
@@ -151,6 +154,56 @@ TEST(JobsRestartTest, FinishedJobAndItsResultSurviveACleanRestartAndSoDoesADelet
   ASSERT_TRUE(third.Start(ServerArgs(db))) << third.log();
   EXPECT_EQ(Get(third, "/v1/jobs/" + id).status, 404);
   EXPECT_EQ(third.Stop(SIGTERM), 0);
+}
+
+// Job times are absolute (created_at, started_at, finished_at: ISO-8601 UTC) or relative to the
+// job (created_s = 0, started_s and finished_s after its submit), never to a process's start:
+// a restarted server shows a finished job's times as the first did. Before, *_s counted from
+// the process's start, so after a restart they were negative, and started_at/finished_at did
+// not exist.
+TEST(JobsRestartTest, JobTimesReadTheSameAfterARestart) {
+  TempDir dir;
+  const std::string db = dir.File("jobs.db");
+  std::string id;
+  Json before;
+  {
+    testing::ServerProcess first;
+    ASSERT_TRUE(first.Start(ServerArgs(db))) << first.log();
+    id = SubmitJob(first, "/v1/sweet-spot", kQuick);
+    ASSERT_FALSE(id.empty());
+    before = WaitForState(first, id, "done");
+    EXPECT_EQ(first.Stop(SIGTERM), 0);
+  }
+  // The second process starts later than the job ran: a time relative to a process's start
+  // would differ (by at least this long).
+  std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+  testing::ServerProcess second;
+  ASSERT_TRUE(second.Start(ServerArgs(db))) << second.log();
+  const Answer after = Get(second, "/v1/jobs/" + id);
+  ASSERT_EQ(after.status, 200);
+  for (const Json* job : {static_cast<const Json*>(&before), &after.body}) {
+    EXPECT_EQ((*job)["created_s"], 0.0) << job->dump();
+    // ISO-8601 UTC to the millisecond, "2026-11-28T05:17:05.317Z": 24 characters.
+    for (const char* key : {"created_at", "started_at", "finished_at"}) {
+      ASSERT_TRUE((*job)[key].is_string()) << key << " " << job->dump();
+      const std::string text = (*job)[key];
+      EXPECT_EQ(text.size(), 24u) << text;
+      EXPECT_EQ(text.back(), 'Z') << text;
+    }
+    EXPECT_GE((*job)["started_s"].get<double>(), 0.0) << job->dump();
+    EXPECT_GE((*job)["finished_s"].get<double>(), (*job)["started_s"].get<double>());
+    // A quick job waits and runs well under a minute.
+    EXPECT_LT((*job)["finished_s"].get<double>(), 60.0) << job->dump();
+  }
+  for (const char* key : {"created_at", "started_at", "finished_at"}) {
+    EXPECT_EQ(after.body[key], before[key]) << key;
+  }
+  // Stored as seconds since the epoch (a double) and rounded to microseconds on each side:
+  // equal within 2 us.
+  for (const char* key : {"started_s", "finished_s"}) {
+    EXPECT_NEAR(after.body[key].get<double>(), before[key].get<double>(), 2e-6) << key;
+  }
+  EXPECT_EQ(second.Stop(SIGTERM), 0);
 }
 
 TEST(JobsRestartTest, SigtermLetsARunningJobFinishWithinTheGrace) {

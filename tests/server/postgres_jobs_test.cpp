@@ -92,6 +92,19 @@ TEST_F(PostgresJobsTest, EveryJobIsVisibleFromEveryReplicaAndTheQueueIsShared) {
     const Answer answer = Get(*replicas[i % 3], "/v1/jobs/" + quick);
     EXPECT_EQ(answer.status, 200) << "read " << i << ": " << answer.body.dump();
   }
+  // The job's times are its own, the same through every replica (issue 35: they counted from
+  // each replica's start, so they differed from replica to replica and went negative on one
+  // started after the job): absolute (*_at) or after its submit (*_s).
+  const Answer first_view = Get(*replicas[0], "/v1/jobs/" + quick);
+  for (auto& replica : replicas) {
+    const Answer view = Get(*replica, "/v1/jobs/" + quick);
+    ASSERT_EQ(view.status, 200);
+    EXPECT_EQ(view.body["created_s"], 0.0) << view.body.dump();
+    EXPECT_GE(view.body["started_s"].get<double>(), 0.0) << view.body.dump();
+    for (const char* key : {"created_at", "started_at", "finished_at", "started_s", "finished_s"}) {
+      EXPECT_EQ(view.body[key], first_view.body[key]) << key;
+    }
+  }
   const Answer direct = PostJson(*replicas[0], "/v1/bat/properties", kQuick);
   for (auto& replica : replicas) {
     const Answer result = Get(*replica, "/v1/jobs/" + quick + "/result");
