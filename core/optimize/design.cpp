@@ -457,6 +457,10 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
                                                   progress_from, progress_to, &result)
                                       : std::vector<Run>{};
     FillSpread(runs, &result.spread);
+    // Which formulation Ipopt solved: "lifted_integrals" when the lifted one (lifted_nlp.hpp).
+    if (std::any_of(runs.begin(), runs.end(), [](const Run& r) { return r.outcome.lifted; })) {
+      summary.models_used.push_back("lifted_integrals");
+    }
 
     // The answer.
     const int best = ChooseRun(model, runs);

@@ -211,6 +211,12 @@ void ComputeIntegrals(const IntegralContext& c, int n, bool gradients, Integrals
 // Adds sum_c w_c d2P_c/dx2 into *h (n x n).
 void AddIntegralHessian(const IntegralContext& c, const std::array<double, 3>& w,
                         Eigen::MatrixXd* h) {
+  VisitIntegralHessian(c, w, [h](int ja, int jb, double v) { (*h)(ja, jb) += v; });
+}
+
+// Visits sum_c w_c d2P_c/dx2 term by term.
+void VisitIntegralHessian(const IntegralContext& c, const std::array<double, 3>& w,
+                          const std::function<void(int, int, double)>& add) {
   const DesignParameterLayout lay{c.num_knots};
   auto at = [&](int idx) { return c.t[static_cast<std::size_t>(idx)]; };
   auto scatter = [&](const LocalMap& map, const auto& combined, int size) {
@@ -226,7 +232,7 @@ void AddIntegralHessian(const IntegralContext& c, const std::array<double, 3>& w
         const int jb = c.parameter_variable[ib];
         if (jb < 0) continue;
         const double kb = map.coefficient[static_cast<std::size_t>(b)] * c.parameter_scale[ib];
-        (*h)(ja, jb) += ka * kb * combined.h[static_cast<std::size_t>(a * size + b)];
+        add(ja, jb, ka * kb * combined.h[static_cast<std::size_t>(a * size + b)]);
       }
     }
   };

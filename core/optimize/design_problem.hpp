@@ -290,7 +290,13 @@ struct DesignOptions {
   DerivativeCheck derivative_check = DerivativeCheck::kNone;  ///< Ipopt's checker (first start).
   /// Most continuous variables a problem may have (>= 1). The api sets it from its configured
   /// limit (ApiLimits::max_design_variables, server flag --max-design-variables).
-  int max_variables = 200;
+  int max_variables = 1000;
+  /// Ipopt: when every variable is a knot radius and the objective and constraints are linear
+  /// or functions of the mass integrals P = (M, S1, S2, L), solve the lifted formulation (P as
+  /// variables, its definition as sparse equality constraints: a sparse exact Hessian, whatever
+  /// `hessian` says; core/optimize/lifted_nlp.hpp). false: always the dense formulation over
+  /// the variables alone.
+  bool lift = true;
 
   /// True when every field is in range; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "field = value: rule".

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <sstream>
 #include <string>
@@ -20,6 +21,7 @@
 
 #include "core/numerics/termination.hpp"
 #include "core/optimize/design_backends.hpp"
+#include "core/optimize/lifted_nlp.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -225,12 +227,21 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
                                  const LocalSolveSettings& settings) {
   LocalSolveOutcome out;
   const int evaluations_before = nlp.evaluations();
+  // The lifted formulation when the problem qualifies (lifted_nlp.hpp): the sparse exact
+  // Hessian of the problem with the mass integrals as variables.
+  std::unique_ptr<LiftedDesignNlp> lifted;
   try {
+    if (settings.lift && LiftedDesignNlp::Qualifies(nlp.model(), nullptr)) {
+      lifted = std::make_unique<LiftedDesignNlp>(nlp);
+    }
     std::ostringstream journal_text;
     // Held until the application and the TNLP are gone (declared first, destroyed last).
     std::lock_guard<std::mutex> lock(IpoptMutex());
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-    Ipopt::SmartPtr<Ipopt::TNLP> tnlp = new DesignTnlp(nlp, s0, settings, &out);
+    Ipopt::SmartPtr<Ipopt::TNLP> tnlp =
+        lifted ? NewLiftedTnlp(*lifted, s0, settings, &out)
+               : static_cast<Ipopt::TNLP*>(new DesignTnlp(nlp, s0, settings, &out));
+    out.lifted = lifted != nullptr;
     Ipopt::SmartPtr<Ipopt::OptionsList> options = app->Options();
     bool ok = true;
     ok = ok && options->SetStringValue("sb", "yes");
@@ -240,7 +251,7 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
     ok = ok && options->SetNumericValue("constr_viol_tol", settings.constraint_tolerance);
     ok = ok && options->SetStringValue(
                    "hessian_approximation",
-                   settings.hessian == HessianMode::kExact ? "exact" : "limited-memory");
+                   settings.hessian == HessianMode::kExact || lifted ? "exact" : "limited-memory");
     ok = ok && options->SetStringValue("mu_strategy", "adaptive");
     // Less work that is not the solve (bench/ipopt_phases.sh; docs/benchmarks.md, "Ipopt's
     // overhead"). The probing oracle picks the adaptive barrier parameter from one affine
@@ -299,7 +310,7 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
   }
   out.termination = TerminationFromIpoptStatus(out.raw_status);
   out.status_name = IpoptStatusName(out.raw_status);
-  out.evaluations = nlp.evaluations() - evaluations_before;
+  out.evaluations = nlp.evaluations() - evaluations_before + (lifted ? lifted->evaluations() : 0);
   if (!out.has_point) out.s = s0;
   return out;
 }
