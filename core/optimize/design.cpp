@@ -18,6 +18,7 @@
 #include "core/flexible/modes.hpp"
 #include "core/geometry_format.hpp"
 #include "core/numerics/limits.hpp"
+#include "core/optimize/backend_choice.hpp"
 #include "core/optimize/design_backends.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
@@ -425,6 +426,8 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
     why = TextRefusal("options.derivative_check",
                       "objective = min_sting has no derivatives to check (it is solved "
                       "derivative-free by COBYLA)");
+  } else if (!design_detail::SlsqpSizeAllowed(problem, options, &why)) {
+    invalid = true;
   } else if (!DesignModel::Build(problem, options, &model, &why)) {
     invalid = true;
   }
@@ -503,7 +506,26 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
 
 DesignResult OptimizeDesign(const DesignProblem& problem, const DesignOptions& options,
                             Progress* progress) {
-  return Optimize(problem, options, progress, 0.0, 1.0, std::nullopt);
+  if (!options.choose_backend) return Optimize(problem, options, progress, 0.0, 1.0, std::nullopt);
+  // The optimiser chooses (backend_choice.hpp): SLSQP's answer only when certified, otherwise
+  // Ipopt's from the start again.
+  DesignOptions chosen = options;
+  chosen.choose_backend = false;
+  chosen.backend = design_detail::ChooseBackend(problem, options);
+  DesignResult first = Optimize(problem, chosen, progress, 0.0, 1.0, std::nullopt);
+  if (chosen.backend != DesignBackend::kNloptSlsqp || design_detail::ChosenAnswerCertified(first)) {
+    return first;
+  }
+  chosen.backend = DesignBackend::kIpopt;
+  DesignResult again = Optimize(problem, chosen, progress, 0.0, 1.0, std::nullopt);
+  again.summary.warnings.push_back(
+      "the chosen backend NLopt SLSQP's answer was not certified (" + first.summary.message +
+      ", KKT residual " + FormatNumber(first.summary.error_estimate) +
+      "): solved again by Ipopt");
+  again.summary.iterations += std::max(first.summary.iterations, 0);
+  again.summary.evaluations += std::max(first.summary.evaluations, 0);
+  again.summary.solve_time_s += std::max(first.summary.solve_time_s, 0.0);
+  return again;
 }
 
 MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,

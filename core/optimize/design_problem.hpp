@@ -297,6 +297,12 @@ struct DesignOptions {
   /// `hessian` says; core/optimize/lifted_nlp.hpp). false: always the dense formulation over
   /// the variables alone.
   bool lift = true;
+  /// Let the optimiser choose the backend (the api's default when a request names none):
+  /// NLopt SLSQP for a problem that qualifies for the lifted formulation with at most
+  /// kChosenSlsqpMaxVariables variables, its answer kept only when certified (converged,
+  /// feasible, KKT residual at most kChosenSlsqpMaxKkt), otherwise Ipopt from the start again;
+  /// Ipopt for every other problem. `backend` is then ignored (core/optimize/backend_choice.hpp).
+  bool choose_backend = false;
 
   /// True when every field is in range; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "field = value: rule".

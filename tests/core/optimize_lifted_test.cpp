@@ -179,6 +179,39 @@ void ExpectSameOptimum(int knots) {
 TEST(OptimizeLifted, SameOptimumAsDenseAtSixteenKnots) { ExpectSameOptimum(16); }
 TEST(OptimizeLifted, SameOptimumAsDenseAtSixtyFourKnots) { ExpectSameOptimum(64); }
 
+// The default request (the optimiser chooses): SLSQP at 14 variables, its certified answer the
+// lifted Ipopt's optimum; Ipopt lifted at 62. SLSQP asked for by name above 32 variables is
+// refused with the reason.
+TEST(OptimizeLifted, TheChosenBackendIsCertifiedAndSlsqpIsRefusedAboveItsSize) {
+  DesignOptions chosen;
+  chosen.choose_backend = true;
+  DesignOptions ipopt;
+  const DesignResult small = OptimizeDesign(KnotProblem(16), chosen);
+  const DesignResult small_ipopt = OptimizeDesign(KnotProblem(16), ipopt);
+  ASSERT_EQ(small.summary.termination, Termination::kConverged) << small.summary.message;
+  EXPECT_EQ(small.summary.backend, "nlopt:LD_SLSQP");
+  EXPECT_LE(small.summary.error_estimate, 1e-6);
+  // Both to their tolerance 1e-9 (scaled objective ~1): 1e-8 relative covers both.
+  EXPECT_NEAR(small.objective_value, small_ipopt.objective_value,
+              1e-8 * std::abs(small_ipopt.objective_value));
+  const DesignResult large = OptimizeDesign(KnotProblem(64), chosen);
+  ASSERT_EQ(large.summary.termination, Termination::kConverged) << large.summary.message;
+  EXPECT_EQ(large.summary.backend, "ipopt");
+  const auto& used = large.summary.models_used;
+  EXPECT_NE(std::find(used.begin(), used.end(), "lifted_integrals"), used.end());
+
+  DesignOptions slsqp;
+  slsqp.backend = DesignBackend::kNloptSlsqp;
+  const DesignResult refused = OptimizeDesign(KnotProblem(64), slsqp);
+  EXPECT_EQ(refused.summary.termination, Termination::kInvalidInput);
+  ASSERT_TRUE(refused.summary.refusal.has_value());
+  EXPECT_EQ(refused.summary.refusal->field, "options.backend");
+  EXPECT_NE(refused.summary.message.find("at most 32 variables (this problem has 62)"),
+            std::string::npos)
+      << refused.summary.message;
+  EXPECT_EQ(OptimizeDesign(KnotProblem(32), slsqp).summary.termination, Termination::kConverged);
+}
+
 }  // namespace
 }  // namespace optimize_lifted_test
 }  // namespace sweetspot::core
