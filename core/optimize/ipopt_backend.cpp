@@ -269,13 +269,15 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
       // The lifted problem's iterations cost mostly MUMPS's per-call work (its KKT matrix is
       // banded, ~3n rows; bench/ipopt_phases.sh): no iterative-refinement step unless the
       // residual asks for one, no MC64/row scaling analysis of a matrix that needs none, and
-      // the start pushed 1e-5 (not 1e-2) into the bounds, which saves an iteration or two.
-      // Together -25 % CPU at 16 to 256 knots (docs/benchmarks.md, issue 36).
+      // the start pushed 1e-5 (not 1e-2) into the bounds, which saves an iteration or two, and
+      // no least-squares estimate of the first multipliers (a factorisation of its own; they
+      // start at 0). Together -30 % CPU at 16 to 256 knots (docs/benchmarks.md, issue 36).
       ok = ok && options->SetIntegerValue("min_refinement_steps", 0);
       ok = ok && options->SetIntegerValue("mumps_permuting_scaling", 0);
       ok = ok && options->SetIntegerValue("mumps_scaling", 0);
       ok = ok && options->SetNumericValue("bound_push", 1e-5);
       ok = ok && options->SetNumericValue("bound_frac", 1e-5);
+      ok = ok && options->SetNumericValue("constr_mult_init_max", 0.0);
     }
     if (settings.max_cpu_time_s > 0.0) {
       ok = ok && options->SetNumericValue("max_cpu_time", settings.max_cpu_time_s);
