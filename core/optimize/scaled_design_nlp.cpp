@@ -97,15 +97,16 @@ bool ScaledDesignNlp::Evaluate(const double* s, bool with_gradients) {
                                       model_.constraints()[static_cast<std::size_t>(k)].scale;
   }
   if (with_gradients) {
-    // d/ds = d/dx times the widths; each constraint row over its scale (one pass over the
-    // m x n matrix: it is the answer's largest object at hundreds of knots).
-    const Eigen::Map<const Eigen::VectorXd> w(width_.data(), static_cast<Eigen::Index>(n));
-    Eigen::VectorXd inverse_scale(m());
-    for (int k = 0; k < m(); ++k) {
-      inverse_scale(k) = 1.0 / model_.constraints()[static_cast<std::size_t>(k)].scale;
+    grad_f_.resize(static_cast<Eigen::Index>(n));
+    jacobian_.resize(m(), static_cast<Eigen::Index>(n));
+    for (std::size_t j = 0; j < n; ++j) {
+      const auto jj = static_cast<Eigen::Index>(j);
+      grad_f_(jj) = fs * point_.objective_gradient(jj) * width_[j];
+      for (int k = 0; k < m(); ++k) {
+        jacobian_(k, jj) = point_.jacobian(k, jj) * width_[j] /
+                           model_.constraints()[static_cast<std::size_t>(k)].scale;
+      }
     }
-    grad_f_ = fs * point_.objective_gradient.cwiseProduct(w);
-    jacobian_.noalias() = inverse_scale.asDiagonal() * point_.jacobian * w.asDiagonal();
     have_gradients_ = true;
   }
   have_values_ = true;
