@@ -25,8 +25,9 @@ struct ApiLimits {
   /// go to a job's result or a file. The CLI lifts it (no limit) unless told otherwise.
   std::size_t max_batch_samples = 1000000;
   /// Variables of one /v1/optimize design. The optimiser has its own ceiling
-  /// of 200 (core/optimize): a larger limit lets such requests reach it.
-  std::size_t max_design_variables = 200;
+  /// of 1000 (core/optimize, DesignOptions::max_variables): a larger limit lets such requests
+  /// reach it.
+  std::size_t max_design_variables = 1000;
   int max_iterations = 10000;                  ///< Solver iterations a request may ask for.
   double max_time_s = 60.0;                    ///< Solver wall time a request may ask for, s.
   long long max_integration_steps = 10000000;  ///< ODE steps of one impact (hertz, flexible).

@@ -3,8 +3,10 @@
 # --knots n`: maximise the rigid-pivot exit speed over the radii of knots 1..n-2 of a solid ash
 # bat, equal mass, balance point <= 0.60 m, diameter bounds, non-decreasing taper) at 16, 32, 64,
 # 128 and 256 knots: the SciPy SLSQP peer (finite-difference gradients, best CPU time of R
-# solves) against sweetspot's backends in the same run (BM_OptimizeKnots: Ipopt exact Hessian,
-# Ipopt limited memory, NLopt SLSQP; CPU time per solve), the ratios and the optima's relative
+# solves) against sweetspot in the same run (BM_OptimizeKnots: the default request, whose
+# backend the optimiser chooses (DesignOptions::choose_backend; the cell names the one that ran),
+# Ipopt exact Hessian, Ipopt limited memory (both the lifted formulation here), NLopt SLSQP
+# (refused above 32 variables); CPU time per solve), the ratios and the optima's relative
 # differences from the best objective found at that size.
 #   bench/optimize_scaling.sh [BUILD_DIR] [KNOTS...]   (default: build; 16 32 64 128 256)
 # Needs Debian's python3-scipy for /usr/bin/python3. Never run by the service, ctest or CI.
@@ -37,7 +39,7 @@ echo "machine: load average $(cut -d' ' -f1-3 /proc/loadavg) at the end"
 import json, sys
 work, knots = sys.argv[1], [int(k) for k in sys.argv[2:]]
 bench = {b["name"]: b for b in json.load(open(f"{work}/bench.json"))["benchmarks"]}
-names = {0: "Ipopt exact", 1: "Ipopt limited memory", 2: "NLopt SLSQP"}
+names = {3: "default request", 0: "Ipopt exact", 1: "Ipopt limited memory", 2: "NLopt SLSQP"}
 print("| knots | SciPy SLSQP (CPU) | " + " | ".join(f"{names[b]} (CPU, ratio)" for b in names) + " |")
 print("|---|---|" + "---|" * len(names))
 for n in knots:
@@ -55,7 +57,8 @@ for n in knots:
         else:
             ms = r["cpu_time"] if r["time_unit"] == "ms" else r["cpu_time"] / 1e6
             ok = "converged" if r["converged"] else "not converged"
-            cells.append(f"{ms:.2f} ms, {peer['cpu_s'] * 1e3 / ms:.1f}x, {r['objective_mps']:.6f} m/s"
+            ran = f" ({r.get('label', '')})" if b == 3 else ""
+            cells.append(f"{ms:.2f} ms{ran}, {peer['cpu_s'] * 1e3 / ms:.1f}x, {r['objective_mps']:.6f} m/s"
                          f" (rel. {rel(r['objective_mps']):.1e}), {ok}")
     print(f"| {n} | {peer['cpu_s'] * 1e3:.1f} ms, {peer['objective_mps']:.6f} m/s "
           f"(rel. {rel(peer['objective_mps']):.1e}), success {peer['success']} | " + " | ".join(cells) + " |")

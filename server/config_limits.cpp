@@ -86,7 +86,7 @@ const std::vector<Option>& LimitOptions() {
          return ParseSecondsUpTo(v, 1e7, &c->limits.max_job_cpu_s, rule);
        }},
       {"--max-design-variables", "SWEETSPOT_MAX_DESIGN_VARIABLES",
-       "variables of one /v1/optimize design (default 200, the optimiser's ceiling)", true,
+       "variables of one /v1/optimize design (default 1000, the optimiser's ceiling)", true,
        [](ServerConfig* c, const std::string& v, std::string* rule) {
          return SetSize(&c->limits.max_design_variables, v, rule);
        }},

@@ -133,11 +133,15 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
   ClampToLimits(limits, flexible);
   const bool sting = objective == core::DesignObjective::kMinSting;
   if (sting) o->backend = core::DesignBackend::kNloptCobyla;
+  // Without "backend" the optimiser chooses (DesignOptions::choose_backend): NLopt SLSQP for a
+  // small lifted problem when its answer is certified, Ipopt otherwise.
+  o->choose_backend = !sting;
   const Json* value = top.Get("options");
   if (value == nullptr || !top.ok()) return top.ok();
   ObjectReader reader(*value, "options", top.error());
   std::string backend = sting ? "nlopt_cobyla" : "ipopt", hessian = "limited_memory",
               check = "none";
+  if (reader.Has("backend")) o->choose_backend = false;
   reader.OptionalString("backend", &backend, {"ipopt", "nlopt_slsqp", "nlopt_cobyla"});
   reader.OptionalString("hessian", &hessian, {"limited_memory", "exact"});
   reader.OptionalString("derivative_check", &check, {"none", "first_order", "second_order"});

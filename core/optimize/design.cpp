@@ -20,6 +20,7 @@
 #include "core/numerics/limits.hpp"
 #include "core/optimize/bbcor_constraint.hpp"
 #include "core/optimize/certificate_runs.hpp"
+#include "core/optimize/backend_choice.hpp"
 #include "core/optimize/design_backends.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
@@ -431,6 +432,8 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
     why = TextRefusal("options.derivative_check",
                       "objective = min_sting has no derivatives to check (it is solved "
                       "derivative-free by COBYLA)");
+  } else if (!design_detail::SlsqpSizeAllowed(problem, options, &why)) {
+    invalid = true;
   } else if (!DesignModel::Build(problem, options, &model, &why)) {
     invalid = true;
   }
@@ -466,6 +469,10 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
                                 : std::vector<Run>{};
     design_detail::CertifyRuns(model, options, &runs);
     FillSpread(runs, &result.spread);
+    // Which formulation Ipopt solved: "lifted_integrals" when the lifted one (lifted_nlp.hpp).
+    if (std::any_of(runs.begin(), runs.end(), [](const Run& r) { return r.outcome.lifted; })) {
+      summary.models_used.push_back("lifted_integrals");
+    }
 
     // The answer.
     const int best = ChooseRun(model, runs);
@@ -532,7 +539,26 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
 
 DesignResult OptimizeDesign(const DesignProblem& problem, const DesignOptions& options,
                             Progress* progress) {
-  return Optimize(problem, options, progress, 0.0, 1.0, std::nullopt);
+  if (!options.choose_backend) return Optimize(problem, options, progress, 0.0, 1.0, std::nullopt);
+  // The optimiser chooses (backend_choice.hpp): SLSQP's answer only when certified, otherwise
+  // Ipopt's from the start again.
+  DesignOptions chosen = options;
+  chosen.choose_backend = false;
+  chosen.backend = design_detail::ChooseBackend(problem, options);
+  DesignResult first = Optimize(problem, chosen, progress, 0.0, 1.0, std::nullopt);
+  if (chosen.backend != DesignBackend::kNloptSlsqp || design_detail::ChosenAnswerCertified(first)) {
+    return first;
+  }
+  chosen.backend = DesignBackend::kIpopt;
+  DesignResult again = Optimize(problem, chosen, progress, 0.0, 1.0, std::nullopt);
+  again.summary.warnings.push_back(
+      "the chosen backend NLopt SLSQP's answer was not certified (" + first.summary.message +
+      ", KKT residual " + FormatNumber(first.summary.error_estimate) +
+      "): solved again by Ipopt");
+  again.summary.iterations += std::max(first.summary.iterations, 0);
+  again.summary.evaluations += std::max(first.summary.evaluations, 0);
+  again.summary.solve_time_s += std::max(first.summary.solve_time_s, 0.0);
+  return again;
 }
 
 MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,

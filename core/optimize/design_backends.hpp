@@ -31,6 +31,9 @@ struct LocalSolveSettings {
   /// ~1e-11 relative round-off (an eigenvalue): at 1e-8 the difference quotient is off by
   /// ~1e-3, above the checker's tolerance 1e-4, though the gradient is exact.
   double derivative_test_perturbation = 0.0;
+  /// Ipopt: solve the lifted formulation (lifted_nlp.hpp, exact sparse Hessian whatever
+  /// `hessian` says) when the problem qualifies.
+  bool lift = true;
 };
 
 /// The outcome of one local solve (scaled variables and multipliers).
@@ -51,6 +54,7 @@ struct LocalSolveOutcome {
   std::string message;                              ///< Extra detail (exceptions, ...).
   int derivative_check_errors = -1;     ///< Ipopt's checker: errors found (-1 = not run).
   std::string derivative_check_report;  ///< Ipopt's checker: its output.
+  bool lifted = false;  ///< Ipopt solved the lifted formulation (lifted_nlp.hpp).
 };
 
 /// Solves from s0 with Ipopt (holds the process-wide Ipopt lock for the whole lifecycle of

@@ -211,6 +211,12 @@ void ComputeIntegrals(const IntegralContext& c, int n, bool gradients, Integrals
 // Adds sum_c w_c d2P_c/dx2 into *h (n x n).
 void AddIntegralHessian(const IntegralContext& c, const std::array<double, 3>& w,
                         Eigen::MatrixXd* h) {
+  VisitIntegralHessian(c, w, [h](int ja, int jb, double v) { (*h)(ja, jb) += v; });
+}
+
+// Visits sum_c w_c d2P_c/dx2 term by term.
+void VisitIntegralHessian(const IntegralContext& c, const std::array<double, 3>& w,
+                          const std::function<void(int, int, double)>& add) {
   const DesignParameterLayout lay{c.num_knots};
   auto at = [&](int idx) { return c.t[static_cast<std::size_t>(idx)]; };
   auto scatter = [&](const LocalMap& map, const auto& combined, int size) {
@@ -226,12 +232,47 @@ void AddIntegralHessian(const IntegralContext& c, const std::array<double, 3>& w
         const int jb = c.parameter_variable[ib];
         if (jb < 0) continue;
         const double kb = map.coefficient[static_cast<std::size_t>(b)] * c.parameter_scale[ib];
-        (*h)(ja, jb) += ka * kb * combined.h[static_cast<std::size_t>(a * size + b)];
+        add(ja, jb, ka * kb * combined.h[static_cast<std::size_t>(a * size + b)]);
       }
     }
   };
   for (int i = 0; i + 1 < c.num_knots; ++i) {
     const LocalMap map = SegmentMap(lay, i);
+    // The local parameters that are variables: none, no term; at most two (the knot radii of a
+    // profile design), a jet over those alone (the others constants: the same second
+    // derivatives, 4 entries instead of 36); otherwise all six.
+    std::array<int, 6> active{};
+    int count = 0;
+    for (int a = 0; a < 6; ++a) {
+      if (c.parameter_variable[static_cast<std::size_t>(map.index[static_cast<std::size_t>(a)])] >=
+          0) {
+        active[static_cast<std::size_t>(count++)] = a;
+      }
+    }
+    if (count == 0) continue;
+    if (count <= 2) {
+      using J2 = jet::Jet<2, true>;
+      std::array<J2, 6> v;
+      for (int a = 0; a < 6; ++a) v[static_cast<std::size_t>(a)] = J2(at(map.index[static_cast<std::size_t>(a)]));
+      LocalMap reduced;
+      for (int q = 0; q < count; ++q) {
+        const auto a = static_cast<std::size_t>(active[static_cast<std::size_t>(q)]);
+        v[a] = J2::Variable(at(map.index[a]), q);
+        reduced.index[static_cast<std::size_t>(q)] = map.index[a];
+        reduced.coefficient[static_cast<std::size_t>(q)] = map.coefficient[a];
+      }
+      // A single variable: the second slot is a constant, its entries 0 (scatter skips none,
+      // so point it at the same parameter with a zero coefficient).
+      if (count == 1) {
+        reduced.index[1] = reduced.index[0];
+        reduced.coefficient[1] = 0.0;
+      }
+      const Sums<J2> s =
+          SegmentSums<J2>(v[0], v[1], v[2], v[3], v[4], v[5], c.hollow, c.rigid, c.c0);
+      const J2 combined = w[0] * s.mass + w[1] * s.s1 + w[2] * s.s2;
+      scatter(reduced, combined, 2);
+      continue;
+    }
     using J = jet::Jet<6, true>;
     std::array<J, 6> v;
     for (int a = 0; a < 6; ++a)

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -59,5 +60,12 @@ void ComputeIntegrals(const IntegralContext& c, int n, bool gradients, Integrals
 /// Adds sum_c w_c d2P_c/dx2 (c = M, S1, S2) into *h (n x n).
 void AddIntegralHessian(const IntegralContext& c, const std::array<double, 3>& w,
                         Eigen::MatrixXd* h);
+
+/// The same sum term by term, for a sparse Hessian (the lifted formulation, lifted_nlp.hpp):
+/// add(j_a, j_b, v) for every pair of variables that share a segment or the fill (both orders,
+/// the same pair several times; the caller sums), v possibly 0. Its calls at any point list
+/// the Hessian's structure.
+void VisitIntegralHessian(const IntegralContext& c, const std::array<double, 3>& w,
+                          const std::function<void(int, int, double)>& add);
 
 }  // namespace sweetspot::core::design_detail

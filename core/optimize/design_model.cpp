@@ -539,6 +539,35 @@ bool DesignModel::Hessian(const double* x, double objective_weight,
   return out->allFinite();
 }
 
+bool DesignModel::IsFunctionOfP(DesignFunction f) const {
+  switch (f) {
+    case DesignFunction::kMass:
+    case DesignFunction::kBalancePoint:
+    case DesignFunction::kMoiSixInch:
+    case DesignFunction::kDrop:
+      return true;
+    case DesignFunction::kObjective:
+      return objective_kind_ != DesignObjective::kMinSting && barrel_cor_ == nullptr;
+    default:
+      return false;
+  }
+}
+
+double DesignModel::FunctionOfP(DesignFunction f, const double* p, double* gradient,
+                                double* hessian) const {
+  if (!IsFunctionOfP(f)) return kNaN;
+  if (gradient == nullptr && hessian == nullptr) return FunctionOf<double>(f, p);
+  using J = jet::Jet<4, true>;
+  std::array<J, 4> pj;
+  for (int c = 0; c < 4; ++c) pj[static_cast<std::size_t>(c)] = J::Variable(p[c], c);
+  const J phi = FunctionOf<J>(f, pj.data());
+  for (std::size_t a = 0; a < 4; ++a) {
+    if (gradient != nullptr) gradient[a] = phi.g[a];
+    for (std::size_t b = 0; hessian != nullptr && b < 4; ++b) hessian[a * 4 + b] = phi.h[a * 4 + b];
+  }
+  return phi.v;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Designs.
 

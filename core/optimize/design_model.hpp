@@ -35,6 +35,7 @@
 namespace sweetspot::core {
 
 struct FixedMeshBeam;  // core/flexible/beam_frequency.hpp
+class LiftedDesignNlp;  // core/optimize/lifted_nlp.hpp
 
 namespace design_detail {
 struct ModelBuilder;        // DesignModel::Build's steps (design_model_build.cpp)
@@ -193,6 +194,13 @@ class DesignModel {
   /// units); false when not finite (and for the sting objective with a nonzero weight).
   bool Hessian(const double* x, double objective_weight, const double* constraint_weights,
                Eigen::MatrixXd* out) const;
+  /// True when `f` is a function of P = (M, S1, S2, L) alone (kMass, kBalancePoint,
+  /// kMoiSixInch, kDrop, and kObjective unless it is the sting or uses the barrel's COR).
+  bool IsFunctionOfP(DesignFunction f) const;
+  /// Such a function at P = (M kg, S1 kg·m, S2 kg·m², L m), in its unit, with (when non-null)
+  /// its gradient over P (4) and its Hessian (4 x 4, row-major); NaN otherwise. The lifted
+  /// formulation's (lifted_nlp.hpp) objective and property constraints.
+  double FunctionOfP(DesignFunction f, const double* p, double* gradient, double* hessian) const;
 
   /// kLeastSquares: the scaled residuals r = ((M - M*) / s_M, (C - C*) / s_C) of the targets
   /// given (phi = |r|^2) and, if `jacobian`, dr/dx (one row per residual, n columns); false
@@ -234,6 +242,7 @@ class DesignModel {
 
  private:
   friend struct design_detail::ModelBuilder;
+  friend class LiftedDesignNlp;  // lifted_nlp.hpp: the integrals' context and parameters
 
   // The objective of P = (M, S1, S2, L) with the COR `e` (a double: fixed; a jet: the barrel's).
   template <typename Scalar, typename Cor>

@@ -317,7 +317,19 @@ struct DesignOptions {
   DerivativeCheck derivative_check = DerivativeCheck::kNone;  ///< Ipopt's checker (first start).
   /// Most continuous variables a problem may have (>= 1). The api sets it from its configured
   /// limit (ApiLimits::max_design_variables, server flag --max-design-variables).
-  int max_variables = 200;
+  int max_variables = 1000;
+  /// Ipopt: when every variable is a knot radius and the objective and constraints are linear
+  /// or functions of the mass integrals P = (M, S1, S2, L), solve the lifted formulation (P as
+  /// variables, its definition as sparse equality constraints: a sparse exact Hessian, whatever
+  /// `hessian` says; core/optimize/lifted_nlp.hpp). false: always the dense formulation over
+  /// the variables alone.
+  bool lift = true;
+  /// Let the optimiser choose the backend (the api's default when a request names none):
+  /// NLopt SLSQP for a problem that qualifies for the lifted formulation with at most
+  /// kChosenSlsqpMaxVariables variables, its answer kept only when certified (converged,
+  /// feasible, KKT residual at most kChosenSlsqpMaxKkt), otherwise Ipopt from the start again;
+  /// Ipopt for every other problem. `backend` is then ignored (core/optimize/backend_choice.hpp).
+  bool choose_backend = false;
   /// The answer's certificate (DesignCertificate): largest relative stationarity residual of a
   /// certified answer, in (0, 1). A solve whose backend reports convergence is converged only
   /// when its certificate holds.

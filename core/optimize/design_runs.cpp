@@ -189,6 +189,7 @@ LocalSolveSettings SettingsFrom(const DesignOptions& options, Clock::time_point 
   s.deadline = deadline;
   s.progress = progress;
   s.feasibility_tolerance = options.feasibility_tolerance;
+  s.lift = options.lift;
   return s;
 }
 

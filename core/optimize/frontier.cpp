@@ -257,6 +257,7 @@ FrontierSummary OptimizeFrontier(const DesignProblem& problem, const FrontierSpe
         // The continuation step: a local solve from the predicted start, kept when converged.
         DesignOptions step = options;
         step.backend = spec.continuation_backend;
+        step.choose_backend = false;  // the continuation's own backend, not the chosen one
         step.starts = 1;
         point.result = OptimizeDesign(p, step, nullptr);
         point.continued = point.result.summary.termination == Termination::kConverged;

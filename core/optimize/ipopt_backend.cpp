@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <sstream>
 #include <string>
@@ -20,6 +21,7 @@
 
 #include "core/numerics/termination.hpp"
 #include "core/optimize/design_backends.hpp"
+#include "core/optimize/lifted_nlp.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -225,12 +227,21 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
                                  const LocalSolveSettings& settings) {
   LocalSolveOutcome out;
   const int evaluations_before = nlp.evaluations();
+  // The lifted formulation when the problem qualifies (lifted_nlp.hpp): the sparse exact
+  // Hessian of the problem with the mass integrals as variables.
+  std::unique_ptr<LiftedDesignNlp> lifted;
   try {
+    if (settings.lift && LiftedDesignNlp::Qualifies(nlp.model(), nullptr)) {
+      lifted = std::make_unique<LiftedDesignNlp>(nlp);
+    }
     std::ostringstream journal_text;
     // Held until the application and the TNLP are gone (declared first, destroyed last).
     std::lock_guard<std::mutex> lock(IpoptMutex());
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-    Ipopt::SmartPtr<Ipopt::TNLP> tnlp = new DesignTnlp(nlp, s0, settings, &out);
+    Ipopt::SmartPtr<Ipopt::TNLP> tnlp =
+        lifted ? NewLiftedTnlp(*lifted, s0, settings, &out)
+               : static_cast<Ipopt::TNLP*>(new DesignTnlp(nlp, s0, settings, &out));
+    out.lifted = lifted != nullptr;
     Ipopt::SmartPtr<Ipopt::OptionsList> options = app->Options();
     bool ok = true;
     ok = ok && options->SetStringValue("sb", "yes");
@@ -240,7 +251,7 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
     ok = ok && options->SetNumericValue("constr_viol_tol", settings.constraint_tolerance);
     ok = ok && options->SetStringValue(
                    "hessian_approximation",
-                   settings.hessian == HessianMode::kExact ? "exact" : "limited-memory");
+                   settings.hessian == HessianMode::kExact || lifted ? "exact" : "limited-memory");
     ok = ok && options->SetStringValue("mu_strategy", "adaptive");
     // Less work that is not the solve (bench/ipopt_phases.sh; docs/benchmarks.md, "Ipopt's
     // overhead"). The probing oracle picks the adaptive barrier parameter from one affine
@@ -254,6 +265,20 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
     // No relaxation of the bounds: a design at a bound (a variable or a constraint) then meets
     // it to round-off, not to 1e-8 of its scale (Ipopt's default relaxes both).
     ok = ok && options->SetNumericValue("bound_relax_factor", 0.0);
+    if (lifted) {
+      // The lifted problem's iterations cost mostly MUMPS's per-call work (its KKT matrix is
+      // banded, ~3n rows; bench/ipopt_phases.sh): no iterative-refinement step unless the
+      // residual asks for one, no MC64/row scaling analysis of a matrix that needs none, and
+      // the start pushed 1e-5 (not 1e-2) into the bounds, which saves an iteration or two, and
+      // no least-squares estimate of the first multipliers (a factorisation of its own; they
+      // start at 0). Together -30 % CPU at 16 to 256 knots (docs/benchmarks.md, issue 36).
+      ok = ok && options->SetIntegerValue("min_refinement_steps", 0);
+      ok = ok && options->SetIntegerValue("mumps_permuting_scaling", 0);
+      ok = ok && options->SetIntegerValue("mumps_scaling", 0);
+      ok = ok && options->SetNumericValue("bound_push", 1e-5);
+      ok = ok && options->SetNumericValue("bound_frac", 1e-5);
+      ok = ok && options->SetNumericValue("constr_mult_init_max", 0.0);
+    }
     if (settings.max_cpu_time_s > 0.0) {
       ok = ok && options->SetNumericValue("max_cpu_time", settings.max_cpu_time_s);
     }
@@ -299,7 +324,7 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
   }
   out.termination = TerminationFromIpoptStatus(out.raw_status);
   out.status_name = IpoptStatusName(out.raw_status);
-  out.evaluations = nlp.evaluations() - evaluations_before;
+  out.evaluations = nlp.evaluations() - evaluations_before + (lifted ? lifted->evaluations() : 0);
   if (!out.has_point) out.s = s0;
   return out;
 }

@@ -23,17 +23,22 @@ ScaledDesignNlp::ScaledDesignNlp(const DesignModel& model) : model_(model) {
   // Jacobian structure from a gradient at the start (linear rows: exact; nonlinear rows: all
   // variables, since every variable moves the mass integrals).
   structure_.resize(static_cast<std::size_t>(model.m()));
+  // Parameter -> the variables that set it (a linear row's variables in O(its terms)).
+  std::vector<std::vector<int>> setters;
+  for (int j = 0; j < n; ++j) {
+    for (int idx : model.variables()[static_cast<std::size_t>(j)].parameters) {
+      if (idx >= static_cast<int>(setters.size())) setters.resize(static_cast<std::size_t>(idx) + 1);
+      setters[static_cast<std::size_t>(idx)].push_back(j);
+    }
+  }
   for (int k = 0; k < model.m(); ++k) {
     const DesignConstraintSpec& c = model.constraints()[static_cast<std::size_t>(k)];
     std::vector<int>& row = structure_[static_cast<std::size_t>(k)];
     if (c.f.function == DesignFunction::kLinear) {
       std::set<int> vars;
-      for (int j = 0; j < n; ++j) {
-        for (int idx : model.variables()[static_cast<std::size_t>(j)].parameters) {
-          for (const auto& [pidx, coef] : c.f.terms) {
-            if (pidx == idx && coef != 0.0) vars.insert(j);
-          }
-        }
+      for (const auto& [pidx, coef] : c.f.terms) {
+        if (coef == 0.0 || pidx < 0 || pidx >= static_cast<int>(setters.size())) continue;
+        for (int j : setters[static_cast<std::size_t>(pidx)]) vars.insert(j);
       }
       row.assign(vars.begin(), vars.end());
     } else {

@@ -107,13 +107,13 @@ TEST(ConfiguredCapsTest, DesignVariablesFollowTheConfiguredLimit) {
             "variables = " + two.at("variables").dump().substr(0, 57) +
                 "...: must be an array of 1 to 1 {\"path\", \"min\", \"max\"}");
 
-  // The default keeps the optimiser's 200.
-  EXPECT_EQ(ApiLimits{}.max_design_variables, 200u);
-  const Response many = Post("/v1/optimize", OptimizeWith(201), Context{});
+  // The default keeps the optimiser's 1000.
+  EXPECT_EQ(ApiLimits{}.max_design_variables, 1000u);
+  const Response many = Post("/v1/optimize", OptimizeWith(1001), Context{});
   EXPECT_EQ(many.status, 400);
   EXPECT_EQ(many.body.at("field"), "variables");
   const std::string message = many.body.at("message");
-  const std::string rule = "must be an array of 1 to 200 {\"path\", \"min\", \"max\"}";
+  const std::string rule = "must be an array of 1 to 1000 {\"path\", \"min\", \"max\"}";
   ASSERT_GE(message.size(), rule.size());
   EXPECT_EQ(message.substr(message.size() - rule.size()), rule) << message;
 }

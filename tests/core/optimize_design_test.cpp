@@ -415,7 +415,7 @@ TEST(OptimizeInvalid, IllPosedRequestsAreRefusedByName) {
       "variables[0].max = 0.005: must be greater than variables[0].min = 0.01");
   with(
       "no variables", [](DesignProblem& p) { p.variables.clear(); },
-      "variables.size() = 0: must be between 1 and 200");
+      "variables.size() = 0: must be between 1 and 1000");
   with(
       "unknown path", [](DesignProblem& p) { p.variables[0].path = "three_segment.radius_m"; },
       "variables[0].path = three_segment.radius_m: not a design variable (known: ");

@@ -110,7 +110,7 @@ TEST(RefusalTest, SamplingAndDesignOptions) {
   EXPECT_EQ(r.field, "max_variables");
   EXPECT_EQ(r.Message(), "max_variables = 0: must be >= 1");
   options = DesignOptions{};
-  EXPECT_EQ(options.max_variables, 200);
+  EXPECT_EQ(options.max_variables, 1000);
   options.backend = DesignBackend::kNloptCobyla;
   options.derivative_check = DerivativeCheck::kFirstOrder;
   r = RefusalOf(options);

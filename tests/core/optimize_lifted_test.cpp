@@ -1,0 +1,228 @@
+// The lifted formulation (core/optimize/lifted_nlp.hpp): which problems qualify, its gradient,
+// Jacobian and Hessian against central differences, and the same optimum as the dense
+// formulation at 16 and 64 knots.
+#include "core/optimize/lifted_nlp.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/bat/mass_properties.hpp"
+#include "core/bat/material.hpp"
+#include "core/optimize/design_model.hpp"
+#include "core/optimize/design_problem.hpp"
+#include "core/units.hpp"
+
+namespace sweetspot::core {
+// In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
+namespace optimize_lifted_test {
+namespace {
+
+// bench/core_optimize.cpp's KnotProblem: max exit speed over the radii of knots 1..n-2 of a
+// solid ash bat, equal mass, balance point <= 0.60 m, diameter limits, non-decreasing taper.
+DesignProblem KnotProblem(int n) {
+  DesignProblem p;
+  const double length = 0.86;
+  for (int i = 0; i < n; ++i) {
+    const double x = length * i / (n - 1);
+    const double s = x / length;
+    p.bat.knots.push_back({x, 0.0125 + 0.020 / (1.0 + std::exp(-14.0 * (s - 0.55)))});
+  }
+  p.bat.material = *FindMaterial("ash");
+  for (int i = 1; i <= n - 2; ++i) {
+    p.variables.push_back({"profile.knots[" + std::to_string(i) + "].radius_m", 0.0110, 0.0332});
+  }
+  p.constraints.mass_kg = DesignRange::Equal(ComputeMassProperties(p.bat).mass_kg);
+  p.constraints.balance_point_m = DesignRange::AtMost(0.60);
+  p.constraints.max_barrel_diameter_m = InchesToMetres(2.61);
+  p.constraints.min_handle_diameter_m = InchesToMetres(0.9);
+  p.constraints.taper = TaperRule::kNonDecreasing;
+  return p;
+}
+
+DesignModel Build(const DesignProblem& p) {
+  DesignModel model;
+  Refusal why;
+  EXPECT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, &why)) << why.Message();
+  return model;
+}
+
+TEST(OptimizeLifted, QualifiesOnlyForKnotRadiiAndFunctionsOfP) {
+  std::string why;
+  EXPECT_TRUE(LiftedDesignNlp::Qualifies(Build(KnotProblem(16)), &why)) << why;
+  // A knot position moves the length's neighbours' integrals: not lifted (the dense path).
+  DesignProblem positions = KnotProblem(16);
+  positions.variables.push_back({"profile.knots[7].x_m", 0.39, 0.41});
+  EXPECT_FALSE(LiftedDesignNlp::Qualifies(Build(positions), &why));
+  EXPECT_NE(why.find("profile.knots[7].x_m"), std::string::npos) << why;
+  // min_moi is a function of P: lifted too.
+  DesignProblem moi = KnotProblem(16);
+  moi.objective = DesignObjective::kMinMoi;
+  EXPECT_TRUE(LiftedDesignNlp::Qualifies(Build(moi), &why)) << why;
+}
+
+// The gradient, the Jacobian and the Lagrangian's Hessian against central differences at a
+// random interior point with random multipliers.
+TEST(OptimizeLifted, DerivativesMatchCentralDifferences) {
+  const DesignModel model = Build(KnotProblem(16));
+  ScaledDesignNlp dense(model);
+  LiftedDesignNlp nlp(dense);
+  const int n = nlp.n(), m = nlp.m();
+  std::vector<double> z;
+  ASSERT_TRUE(nlp.Start(dense.ToScaled(model.BaseX()), &z));
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int j = 0; j < n; ++j) {
+    // The knot radii in the middle of their range; q moved off P(x) (a point of the lifted
+    // space, where the definitions are not met).
+    z[static_cast<std::size_t>(j)] =
+        j < nlp.design_variables() ? 0.5 + 0.3 * u(rng) : z[static_cast<std::size_t>(j)] + 0.01 * u(rng);
+  }
+  std::vector<double> lambda(static_cast<std::size_t>(m));
+  for (double& l : lambda) l = u(rng);
+  const double sigma_f = 0.7;
+  ASSERT_TRUE(nlp.Evaluate(z.data(), true));
+  const std::vector<double> grad = nlp.grad_f();
+  const std::vector<double> jac = nlp.jacobian_values();
+  std::vector<double> hess(nlp.hessian_structure().size());
+  ASSERT_TRUE(nlp.Hessian(z.data(), sigma_f, lambda.data(), hess.data()));
+  // Dense copies of the Jacobian and the Hessian (lower triangle mirrored).
+  std::vector<std::vector<double>> jd(static_cast<std::size_t>(m), std::vector<double>(n, 0.0));
+  for (std::size_t e = 0; e < jac.size(); ++e) {
+    const auto [r, c] = nlp.jacobian_structure()[e];
+    jd[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] += jac[e];
+  }
+  std::vector<std::vector<double>> hd(static_cast<std::size_t>(n), std::vector<double>(n, 0.0));
+  for (std::size_t e = 0; e < hess.size(); ++e) {
+    const auto [r, c] = nlp.hessian_structure()[e];
+    hd[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] += hess[e];
+    if (r != c) hd[static_cast<std::size_t>(c)][static_cast<std::size_t>(r)] += hess[e];
+  }
+  // The Lagrangian's gradient sigma_f grad f + J^T lambda at a point.
+  auto lagrangian_gradient = [&](const std::vector<double>& at) {
+    EXPECT_TRUE(nlp.Evaluate(at.data(), true));
+    std::vector<double> out(static_cast<std::size_t>(n));
+    for (int j = 0; j < n; ++j) out[static_cast<std::size_t>(j)] = sigma_f * nlp.grad_f()[static_cast<std::size_t>(j)];
+    for (std::size_t e = 0; e < nlp.jacobian_values().size(); ++e) {
+      const auto [r, c] = nlp.jacobian_structure()[e];
+      out[static_cast<std::size_t>(c)] += lambda[static_cast<std::size_t>(r)] * nlp.jacobian_values()[e];
+    }
+    return out;
+  };
+  // Step 1e-6 on variables of order 1 (s in [0, 1], q ~ 1): truncation ~h^2 |f'''| ~ 1e-12 and
+  // round-off ~1e-16 / 1e-6 = 1e-10 of the values (order 1): 1e-6 absolute is 1e4 times both,
+  // and far below a wrong derivative (an entry off by a factor or a sign: >= 1e-3 here).
+  const double h = 1e-6, tol = 1e-6;
+  for (int j = 0; j < n; ++j) {
+    std::vector<double> plus = z, minus = z;
+    plus[static_cast<std::size_t>(j)] += h;
+    minus[static_cast<std::size_t>(j)] -= h;
+    ASSERT_TRUE(nlp.Evaluate(plus.data(), false));
+    const double f_plus = nlp.f();
+    const std::vector<double> g_plus = nlp.g();
+    ASSERT_TRUE(nlp.Evaluate(minus.data(), false));
+    const double f_minus = nlp.f();
+    const std::vector<double> g_minus = nlp.g();
+    EXPECT_NEAR(grad[static_cast<std::size_t>(j)], (f_plus - f_minus) / (2 * h), tol) << "df/dz" << j;
+    for (int k = 0; k < m; ++k) {
+      EXPECT_NEAR(jd[static_cast<std::size_t>(k)][static_cast<std::size_t>(j)],
+                  (g_plus[static_cast<std::size_t>(k)] - g_minus[static_cast<std::size_t>(k)]) / (2 * h), tol)
+          << "dg" << k << "/dz" << j;
+    }
+    const std::vector<double> lp = lagrangian_gradient(plus), lm = lagrangian_gradient(minus);
+    for (int i = 0; i < n; ++i) {
+      EXPECT_NEAR(hd[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)],
+                  (lp[static_cast<std::size_t>(i)] - lm[static_cast<std::size_t>(i)]) / (2 * h), tol)
+          << "H(" << i << ", " << j << ")";
+    }
+  }
+}
+
+// The lifted and the dense formulation (exact Hessian) reach the same optimum.
+void ExpectSameOptimum(const DesignProblem& p) {
+  DesignOptions lifted;
+  lifted.hessian = HessianMode::kExact;
+  DesignOptions dense = lifted;
+  dense.lift = false;
+  const DesignResult a = OptimizeDesign(p, lifted);
+  const DesignResult b = OptimizeDesign(p, dense);
+  ASSERT_EQ(a.summary.termination, Termination::kConverged) << a.summary.message;
+  ASSERT_EQ(b.summary.termination, Termination::kConverged) << b.summary.message;
+  const auto& used_a = a.summary.models_used;
+  const auto& used_b = b.summary.models_used;
+  EXPECT_NE(std::find(used_a.begin(), used_a.end(), "lifted_integrals"), used_a.end());
+  EXPECT_EQ(std::find(used_b.begin(), used_b.end(), "lifted_integrals"), used_b.end());
+  // Both converge to Ipopt's tol 1e-9 on the scaled problem (objective ~1): the objectives
+  // agree to that, relative (22.8 m/s).
+  EXPECT_NEAR(a.objective_value, b.objective_value, 1e-9 * std::abs(b.objective_value));
+  // The KKT residual of each answer with its own multipliers (the lifted ones mapped back).
+  EXPECT_LT(a.summary.error_estimate, 1e-7);
+  EXPECT_LT(b.summary.error_estimate, 1e-7);
+  // The mass constraint's multiplier (a sensitivity, m/s per kg) is the same to 1e-4
+  // relative: a multiplier is one order less accurate than the objective at tol 1e-9 and the
+  // mapped bound multipliers enter it.
+  auto mass_multiplier = [](const DesignResult& r) {
+    for (const auto& c : r.active_constraints) {
+      if (c.name == "mass_kg") return c.multiplier;
+    }
+    return std::nan("");
+  };
+  EXPECT_NEAR(mass_multiplier(a), mass_multiplier(b), 1e-4 * std::abs(mass_multiplier(b)));
+  EXPECT_EQ(a.active_constraints.size(), b.active_constraints.size());
+}
+
+TEST(OptimizeLifted, SameOptimumAsDenseAtSixteenKnots) { ExpectSameOptimum(KnotProblem(16)); }
+TEST(OptimizeLifted, SameOptimumAsDenseAtSixtyFourKnots) { ExpectSameOptimum(KnotProblem(64)); }
+
+// A hollow aluminium profile of 69 stations (a knot every half inch of a 34-in bat) with a
+// 3 mm wall: lifted too (the wall is fixed), the same optimum as the dense formulation.
+TEST(OptimizeLifted, SameOptimumAsDenseForAHollowSixtyNineStationProfile) {
+  DesignProblem p = KnotProblem(69);
+  p.bat.material = *FindMaterial("aluminium-7050");
+  p.bat.wall_thickness_m = 0.003;
+  // The handle's smallest radius above the wall; the mass of the hollow base.
+  for (auto& v : p.variables) v.min = 0.0115;
+  p.constraints.mass_kg = DesignRange::Equal(ComputeMassProperties(p.bat).mass_kg);
+  ExpectSameOptimum(p);
+}
+
+// The default request (the optimiser chooses): SLSQP at 14 variables, its certified answer the
+// lifted Ipopt's optimum; Ipopt lifted at 62. SLSQP asked for by name above 32 variables is
+// refused with the reason.
+TEST(OptimizeLifted, TheChosenBackendIsCertifiedAndSlsqpIsRefusedAboveItsSize) {
+  DesignOptions chosen;
+  chosen.choose_backend = true;
+  DesignOptions ipopt;
+  const DesignResult small = OptimizeDesign(KnotProblem(16), chosen);
+  const DesignResult small_ipopt = OptimizeDesign(KnotProblem(16), ipopt);
+  ASSERT_EQ(small.summary.termination, Termination::kConverged) << small.summary.message;
+  EXPECT_EQ(small.summary.backend, "nlopt:LD_SLSQP");
+  EXPECT_LE(small.summary.error_estimate, 1e-6);
+  // Both to their tolerance 1e-9 (scaled objective ~1): 1e-8 relative covers both.
+  EXPECT_NEAR(small.objective_value, small_ipopt.objective_value,
+              1e-8 * std::abs(small_ipopt.objective_value));
+  const DesignResult large = OptimizeDesign(KnotProblem(64), chosen);
+  ASSERT_EQ(large.summary.termination, Termination::kConverged) << large.summary.message;
+  EXPECT_EQ(large.summary.backend, "ipopt");
+  const auto& used = large.summary.models_used;
+  EXPECT_NE(std::find(used.begin(), used.end(), "lifted_integrals"), used.end());
+
+  DesignOptions slsqp;
+  slsqp.backend = DesignBackend::kNloptSlsqp;
+  const DesignResult refused = OptimizeDesign(KnotProblem(64), slsqp);
+  EXPECT_EQ(refused.summary.termination, Termination::kInvalidInput);
+  ASSERT_TRUE(refused.summary.refusal.has_value());
+  EXPECT_EQ(refused.summary.refusal->field, "options.backend");
+  EXPECT_NE(refused.summary.message.find("at most 32 variables (this problem has 62)"),
+            std::string::npos)
+      << refused.summary.message;
+  EXPECT_EQ(OptimizeDesign(KnotProblem(32), slsqp).summary.termination, Termination::kConverged);
+}
+
+}  // namespace
+}  // namespace optimize_lifted_test
+}  // namespace sweetspot::core
