@@ -218,6 +218,34 @@ scenario('opens at game conditions: a real bat, mlb at 90 mph, 70 mph bat speed,
     Number(await page.locator('#properties tr[data-key="mass_kg"] td[data-imperial]').getAttribute('data-imperial')),
     properties.body.imperial.weight_oz,
   );
+  // The flight from the side: /v1/flight at the batted ball's launch, as the test asks it.
+  const bb = sweet.body.batted_ball;
+  const flight = await apiPost(url, '/v1/flight', {
+    launch: {
+      exit_speed_mps: bb.exit_speed_mps,
+      launch_angle_deg: bb.launch_angle_deg,
+      backspin_rpm: bb.backspin_rpm,
+      sidespin_rpm: bb.sidespin_rpm,
+    },
+    outputs: ['trajectory'],
+    report_units: 'imperial',
+  });
+  assert.equal(flight.status, 200, JSON.stringify(flight.body));
+  await page.waitForSelector('#flight-chart[data-points]');
+  assert.equal(Number(await page.locator('#flight-chart').getAttribute('data-distance')), flight.body.distance_ft);
+  assert.equal(Number(await page.locator('#flight-chart').getAttribute('data-points')), flight.body.trajectory.length);
+  // The same flight as the batted_ball block's: both integrate to the flight's default
+  // tolerance (the landing within 0.1 ft, docs/api.md), so the carries agree within 0.2 ft.
+  assert.ok(Math.abs(flight.body.distance_ft - bb.distance_ft) < 0.2, `${flight.body.distance_ft} vs ${bb.distance_ft}`);
+  assert.match(await page.locator('#flight-chart').textContent(), /height \(ft\)/);
+
+  // Keyboard: the unit switch is a labelled radio group reached with Tab and changed with arrows.
+  await page.locator('input[name="units"][value="imperial"]').focus();
+  assert.equal(await page.evaluate(() => document.activeElement.closest('fieldset')?.querySelector('legend')?.textContent), 'Units');
+  for (const control of await page.locator('#bat-form input, #bat-form select').all()) {
+    const id = await control.evaluate((e) => e.name);
+    assert.ok(await control.evaluate((e) => Boolean(e.labels?.length || e.getAttribute('aria-label'))), `${id} has no label`);
+  }
   await assertNoOverflow(page, 1280);
   await shot(page, '00-game-conditions');
 
@@ -238,8 +266,10 @@ scenario('opens at game conditions: a real bat, mlb at 90 mph, 70 mph bat speed,
 
 scenario('the unit switch: SI inputs and answers, a link that restores them, CSV, a phone width', async ({ page, url, browser }) => {
   const rev = await revision(page);
-  await page.locator('input[name="units"][value="si"]').check();
+  await page.locator('input[name="units"][value="imperial"]').focus();
+  await page.keyboard.press('ArrowRight'); // the keyboard's way to the next radio of the group
   await waitForRefresh(page, rev);
+  assert.equal(await page.locator('input[name="units"][value="si"]').isChecked(), true);
   assert.equal(await page.locator('input[name="ball_speed_mps"]').inputValue(), '40.2336');
   assert.equal(await page.locator('input[name="ball_speed_mps"]').getAttribute('data-field'), 'ball.speed_mps');
   assert.equal(await page.locator('input[name="bat_speed_mps"]').inputValue(), '31.2928');
