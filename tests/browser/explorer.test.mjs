@@ -246,6 +246,15 @@ scenario('opens at game conditions: a real bat, mlb at 90 mph, 70 mph bat speed,
     const id = await control.evaluate((e) => e.name);
     assert.ok(await control.evaluate((e) => Boolean(e.labels?.length || e.getAttribute('aria-label'))), `${id} has no label`);
   }
+  // The variants' table and the drawing's axis in the trade's units too: the baseline's mass is
+  // the properties' own mass_oz (one bat, one answer), the axis in inches.
+  await page.waitForSelector('#compare-table[data-variants]');
+  assert.equal(
+    Number(await page.locator('#compare-table tbody tr:first-child td').first().getAttribute('data-value')),
+    properties.body.mass_oz,
+  );
+  assert.match(await page.locator('#compare-table tbody tr:first-child th').textContent(), /Mass oz/);
+  assert.match(await page.locator('#bat-drawing .axis').textContent(), /in from the knob/);
   await assertNoOverflow(page, 1280);
   await shot(page, '00-game-conditions');
 

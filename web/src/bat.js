@@ -193,7 +193,7 @@ function outlinePath(knots, inset = 0) {
  * "original" drawn as a dashed outline only, or "optimised"). `marks` are
  * {key, label, position_m} vertical lines; `zone` a {from_m, to_m} band.
  */
-export function drawBat(svg, bats, { marks = [], zone = null, axis = true } = {}) {
+export function drawBat(svg, bats, { marks = [], zone = null, axis = true, axisUnit = 'm' } = {}) {
   svg.replaceChildren();
   const shown = bats.filter(Boolean);
   if (!shown.length) return;
@@ -249,14 +249,18 @@ export function drawBat(svg, bats, { marks = [], zone = null, axis = true } = {}
     const y = radius + 8;
     const g = svgEl('g', { class: 'axis' });
     g.append(svgEl('line', { x1: 0, x2: length, y1: y, y2: y }));
-    for (let mm = 0; mm <= length + 1e-6; mm += 100) {
+    // Ticks every 0.1 m, or every 4 in (101.6 drawing units: the scale of the drawing only).
+    const inches = axisUnit === 'in';
+    const step = inches ? 4 * 25.4 : 100;
+    for (let i = 0; i * step <= length + 1e-6; ++i) {
+      const mm = i * step;
       g.append(svgEl('line', { x1: mm, x2: mm, y1: y, y2: y + 5 }));
       const label = svgEl('text', { x: mm, y: y + 19, 'text-anchor': 'middle' });
-      label.textContent = (mm / 1000).toFixed(1);
+      label.textContent = inches ? String(4 * i) : (i / 10).toFixed(1);
       g.append(label);
     }
     const unit = svgEl('text', { x: length, y: y + 32, 'text-anchor': 'end' });
-    unit.textContent = 'm from the knob';
+    unit.textContent = `${inches ? 'in' : 'm'} from the knob`;
     g.append(unit);
     svg.append(g);
   }
@@ -270,7 +274,8 @@ export function drawBat(svg, bats, { marks = [], zone = null, axis = true } = {}
     const label = svgEl('text', { x, y: -radius - 9 - (i % 3) * 9, 'text-anchor': 'middle' });
     label.textContent = mark.short || mark.label;
     const title = svgEl('title');
-    title.textContent = `${mark.label}: ${mark.position_m.toFixed(4)} m from the knob`;
+    const shown = mark.at ?? mark.position_m;
+    title.textContent = `${mark.label}: ${shown.toFixed(axisUnit === 'in' ? 2 : 4)} ${axisUnit} from the knob`;
     g.append(title);
     g.append(label);
     svg.append(g);

@@ -196,11 +196,11 @@ export class VariantsChart extends Chart {
   }
 
   /** `rows`: the API's compare rows, each with exit_speed_curve. */
-  update(rows) {
-    const tables = rows.map((r) => [
-      r.exit_speed_curve.map((p) => p.position_from_knob_m),
-      r.exit_speed_curve.map((p) => p.exit_speed_mps),
-    ]);
+  update(rows, axes = {}) {
+    const { x = 'position_from_knob_m', y = 'exit_speed_mps' } = axes;
+    this.xLabel = axes.xLabel || 'position from the knob (m)';
+    this.yLabel = axes.yLabel || 'exit speed (m/s)';
+    const tables = rows.map((r) => [r.exit_speed_curve.map((p) => p[x]), r.exit_speed_curve.map((p) => p[y])]);
     const xs = tables[0][0];
     const aligned = tables.every((t) => t[0].length === xs.length && t[0].every((x, i) => x === xs[i]));
     const data = aligned ? [xs, ...tables.map((t) => t[1])] : uPlot.join(tables);

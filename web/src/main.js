@@ -321,7 +321,11 @@ async function refreshBat() {
   page.good = { bat, scene, properties, sweet, modes, outline };
   const marks = marksOf(sweet);
   const zone = { from_m: sweet.sweet_zone.from_knob_m, to_m: sweet.sweet_zone.to_knob_m };
-  drawBat($('#bat-drawing'), [outline && { ...outline, role: 'main' }], { marks, zone });
+  drawBat($('#bat-drawing'), [outline && { ...outline, role: 'main' }], {
+    marks,
+    zone,
+    axisUnit: page.units === 'imperial' ? 'in' : 'm',
+  });
   renderProperties(properties);
   page.curve.update(
     sweet.exit_speed_curve,
@@ -534,6 +538,7 @@ async function refreshCompare() {
     ...page.good.scene,
     outputs: ['max_exit_speed', 'center_of_percussion', 'sweet_zone', 'exit_speed_curve'],
     options: { curve_samples: CURVE_SAMPLES },
+    report_units: page.units,
   };
   let answer;
   try {
@@ -582,56 +587,39 @@ async function refreshCompare() {
     el(
       'tbody',
       {},
-      line(
-        'Mass',
-        'kg',
-        (r) => r.properties.mass_kg,
-        4,
-        (r) => r.deltas?.mass_kg,
-      ),
+      line('Mass', u('mass_kg'), (r) => q(r.properties, 'mass_kg'), 4, (r) => q(r.deltas, 'mass_kg')),
       line('Weight', 'oz', (r) => r.properties.imperial?.weight_oz, 4),
-      line(
-        'Balance point',
-        'm',
-        (r) => r.properties.balance_point_m,
-        4,
-        (r) => r.deltas?.balance_point_m,
+      line('Balance point', u('balance_point_m'), (r) => q(r.properties, 'balance_point_m'), 4, (r) =>
+        q(r.deltas, 'balance_point_m'),
       ),
-      line(
-        'MOI about 6 in',
-        'kg·m²',
-        (r) => r.properties.moi_six_inch_kg_m2,
-        4,
-        (r) => r.deltas?.moi_six_inch_kg_m2,
+      line('MOI about 6 in', u('moi_six_inch_kg_m2'), (r) => q(r.properties, 'moi_six_inch_kg_m2'), 4, (r) =>
+        q(r.deltas, 'moi_six_inch_kg_m2'),
       ),
-      line(
-        'Max exit speed',
-        'm/s',
-        (r) => r.max_exit_speed.exit_speed_mps,
-        4,
-        (r) => r.deltas?.max_exit_speed_mps,
+      line('Max exit speed', u('exit_speed_mps'), (r) => q(r.max_exit_speed, 'exit_speed_mps'), 4, (r) =>
+        q(r.deltas, 'max_exit_speed_mps'),
       ),
-      line(
-        '… at',
-        'm',
-        (r) => r.max_exit_speed.position_from_knob_m,
-        4,
-        (r) => r.deltas?.max_exit_speed_position_m,
+      line('… at', u('position_from_knob_m'), (r) => q(r.max_exit_speed, 'position_from_knob_m'), 4, (r) =>
+        q(r.deltas, 'max_exit_speed_position_m'),
       ),
       line(
         'Centre of percussion',
-        'm',
-        (r) => r.center_of_percussion.position_from_knob_m,
+        u('position_from_knob_m'),
+        (r) => q(r.center_of_percussion, 'position_from_knob_m'),
         4,
-        (r) => r.deltas?.center_of_percussion_m,
+        (r) => q(r.deltas, 'center_of_percussion_m'),
       ),
-      line('Sweet zone from', 'm', (r) => r.sweet_zone.from_knob_m, 4),
-      line('Sweet zone to', 'm', (r) => r.sweet_zone.to_knob_m, 4),
+      line('Sweet zone from', u('from_knob_m'), (r) => q(r.sweet_zone, 'from_knob_m'), 4),
+      line('Sweet zone to', u('to_knob_m'), (r) => q(r.sweet_zone, 'to_knob_m'), 4),
       line('COR', '', (r) => r.cor, 3),
     ),
   );
   table.dataset.variants = rows.map((r) => r.name).join(',');
-  page.variantsChart.update(rows);
+  page.variantsChart.update(rows, {
+    x: page.units === 'imperial' ? 'position_from_knob_in' : 'position_from_knob_m',
+    y: page.units === 'imperial' ? 'exit_speed_mph' : 'exit_speed_mps',
+    xLabel: `position from the knob (${u('position_from_knob_m')})`,
+    yLabel: `exit speed (${u('exit_speed_mps')})`,
+  });
 }
 
 // ---- optimisation --------------------------------------------------------
