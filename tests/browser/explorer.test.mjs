@@ -258,6 +258,19 @@ scenario('opens at game conditions: a real bat, mlb at 90 mph, 70 mph bat speed,
   await assertNoOverflow(page, 1280);
   await shot(page, '00-game-conditions');
 
+  // The optimisation in the trade's units: diameters in inches, the mass at most 32 oz.
+  await page.click('#optimize-run');
+  await page.waitForSelector('#optimize-state[data-state="done"]', { timeout: 60000 });
+  const id = await page.locator('#optimize-state').getAttribute('data-job-id');
+  const result = await (await fetch(`${url}/v1/jobs/${id}/result`)).json();
+  assert.equal(result.summary.termination, 'converged', result.summary.message);
+  assert.equal(Object.keys(result.variables).length, 14); // one per knot of wood-34-ash
+  assert.ok(Object.keys(result.variables).every((k) => k.endsWith('.diameter_in')), Object.keys(result.variables).join());
+  assert.ok(result.properties.mass_oz <= 32 + 1e-6, `mass ${result.properties.mass_oz} oz over the 32 oz bound`);
+  const massRow = page.locator('#optimize-result tbody tr', { hasText: 'Mass' });
+  assert.equal(Number(await massRow.locator('td').first().getAttribute('data-value')), result.properties.mass_oz);
+  assert.match(await massRow.textContent(), / oz/);
+
   // A hollow bat: its barrel's hoop frequency and THE BBCOR, as the API gives them.
   const rev = await revision(page);
   await page.selectOption('select[name="preset"]', 'bbcor-33-aluminium');

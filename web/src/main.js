@@ -403,9 +403,12 @@ async function refreshFlight(battedBall) {
 
 // ---- units and the URL ----------------------------------------------------
 
+/** The forms whose inputs the URL keeps. */
+const stateForms = () => [$('#bat-form'), $('#optimize-form')];
+
 /** Writes the inputs that differ from the defaults into the URL's hash (a link restores them). */
 function saveState() {
-  const hash = `#${stateParams([$('#bat-form')], page.units).toString()}`;
+  const hash = `#${stateParams(stateForms(), page.units).toString()}`;
   if (hash !== window.location.hash) history.replaceState(null, '', hash);
   $('#share-link').href = window.location.href;
 }
@@ -415,7 +418,7 @@ function restoreState() {
   const params = new URLSearchParams(window.location.hash.slice(1));
   const units = params.get('units');
   if (units === 'si' || units === 'imperial') setUnits(units);
-  restoreParams([$('#bat-form')], params);
+  restoreParams(stateForms(), params);
   page.batForm.syncShape();
 }
 
@@ -424,11 +427,11 @@ function setUnits(system) {
   page.units = system;
   for (const radio of document.querySelectorAll('input[name="units"]')) radio.checked = radio.value === system;
   document.body.dataset.units = system;
-  switchInputs($('#bat-form'), system);
+  for (const form of stateForms()) switchInputs(form, system);
 }
 
 function setupUnits() {
-  for (const input of unitInputs($('#bat-form'))) {
+  for (const input of stateForms().flatMap(unitInputs)) {
     setInputSystem(input, 'si');
     input.value = formOf(input, 'si').value;
   }
@@ -625,26 +628,31 @@ async function refreshCompare() {
 // ---- optimisation --------------------------------------------------------
 
 /** The variables the optimisation may change, for the bat above. */
-function optimizeVariables(bat, radiusMin, radiusMax) {
+function optimizeVariables(bat, radiusMin, radiusMax, byDiameterIn) {
+  // The bounds' input says the variables' form: radii in m, or diameters in inches (the API
+  // takes either, docs/api.md "The trade's units"; the answer names them as written).
+  const radius = byDiameterIn ? 'diameter_in' : 'radius_m';
   if (bat.three_segment) {
-    const length = bat.three_segment.length_m;
+    // The taper's positions in the unit the shape's inputs give them, bounded by its length.
+    const unit = 'taper_start_in' in bat.three_segment ? 'in' : 'm';
+    const length = bat.three_segment[`length_${unit}`];
     return [
-      { path: 'three_segment.handle_radius_m', min: radiusMin, max: radiusMax },
-      { path: 'three_segment.barrel_radius_m', min: radiusMin, max: radiusMax },
-      { path: 'three_segment.taper_start_m', min: 0, max: length },
-      { path: 'three_segment.taper_end_m', min: 0, max: length },
+      { path: `three_segment.handle_${radius}`, min: radiusMin, max: radiusMax },
+      { path: `three_segment.barrel_${radius}`, min: radiusMin, max: radiusMax },
+      { path: `three_segment.taper_start_${unit}`, min: 0, max: length },
+      { path: `three_segment.taper_end_${unit}`, min: 0, max: length },
     ];
   }
   const knots = page.catalogue.presets.get(bat.preset)?.bat.profile.knots || [];
-  return knots.map((_, i) => ({ path: `profile.knots[${i}].radius_m`, min: radiusMin, max: radiusMax }));
+  return knots.map((_, i) => ({ path: `profile.knots[${i}].${radius}`, min: radiusMin, max: radiusMax }));
 }
 
 function updateVariablesAbout() {
   const bat = page.good?.bat;
   if (!bat) return;
   $('#variables-about').textContent = bat.three_segment
-    ? 'The handle and barrel radii (between the bounds below) and where the taper starts and ends.'
-    : `The radius of each of the preset's ${page.catalogue.presets.get(bat.preset)?.bat.profile.knots.length} knots (between the bounds below); their positions stay.`;
+    ? 'The handle and barrel radii or diameters (between the bounds below) and where the taper starts and ends.'
+    : `The radius (or diameter) of each of the preset's ${page.catalogue.presets.get(bat.preset)?.bat.profile.knots.length} knots (between the bounds below); their positions stay.`;
 }
 
 function optimizeBody() {
@@ -655,10 +663,16 @@ function optimizeBody() {
   return {
     bat,
     ...page.batForm.scene(),
-    variables: optimizeVariables(bat, readValue(form.elements.radius_min), readValue(form.elements.radius_max)),
+    variables: optimizeVariables(
+      bat,
+      readValue(form.elements.radius_min),
+      readValue(form.elements.radius_max),
+      form.elements.radius_min.dataset.system === 'imperial',
+    ),
     constraints,
     objective: form.elements.objective.value,
     options: readFields(form, 'options.'),
+    report_units: page.units,
   };
 }
 
@@ -718,15 +732,20 @@ function renderOptimum(result, original) {
       ),
       row(`Objective (${result.objective})`, result.objective_value, undefined, result.objective_unit),
       row(
-        'Sweet spot',
-        result.sweet_spot?.position_from_knob_m,
-        original?.sweet.max_exit_speed.position_from_knob_m,
-        'm',
+        'Sweet spot (from the knob)',
+        q(result.sweet_spot, 'position_from_knob_m'),
+        q(original?.sweet.max_exit_speed, 'position_from_knob_m'),
+        u('position_from_knob_m'),
       ),
-      row('Exit speed there', result.sweet_spot?.exit_speed_mps, original?.sweet.max_exit_speed.exit_speed_mps, 'm/s'),
-      row('Mass', p.mass_kg, o.mass_kg, 'kg'),
-      row('Balance point', p.balance_point_m, o.balance_point_m, 'm'),
-      row('MOI about 6 in', p.moi_six_inch_kg_m2, o.moi_six_inch_kg_m2, 'kg·m²'),
+      row(
+        'Exit speed there',
+        q(result.sweet_spot, 'exit_speed_mps'),
+        q(original?.sweet.max_exit_speed, 'exit_speed_mps'),
+        u('exit_speed_mps'),
+      ),
+      row('Mass', q(p, 'mass_kg'), q(o, 'mass_kg'), u('mass_kg')),
+      row('Balance point', q(p, 'balance_point_m'), q(o, 'balance_point_m'), u('balance_point_m')),
+      row('MOI about 6 in', q(p, 'moi_six_inch_kg_m2'), q(o, 'moi_six_inch_kg_m2'), u('moi_six_inch_kg_m2')),
       row('Constraint violation', s.constraint_violation, undefined, '', 3),
       row('Starts converged', s.spread?.converged, undefined, `of ${s.spread?.starts}`, 3),
     ),
@@ -793,6 +812,7 @@ async function runOptimisation() {
 }
 
 function setupOptimizeForm() {
+  $('#optimize-form').addEventListener('change', () => saveState());
   $('#optimize-form').addEventListener('submit', (event) => {
     event.preventDefault();
     runOptimisation();
@@ -868,7 +888,7 @@ async function start() {
   setupOptimizeForm();
   setupExports();
   window.addEventListener('hashchange', () => {
-    if (window.location.hash === `#${stateParams([$('#bat-form')], page.units).toString()}`) return;
+    if (window.location.hash === `#${stateParams(stateForms(), page.units).toString()}`) return;
     restoreState();
     refreshBat();
   });

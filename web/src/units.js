@@ -23,7 +23,7 @@ export function setInputSystem(input, system) {
   const previous = input.dataset.field;
   input.dataset.system = system;
   input.dataset.field = form.field;
-  const label = input.closest('label');
+  const label = input.closest('label, .field');
   const unit = label?.querySelector('small.unit');
   if (unit) unit.textContent = form.unit;
   const name = label?.querySelector('span.name');
@@ -40,6 +40,10 @@ export function setInputSystem(input, system) {
  * the user changed keeps its text and its unit (so nothing is converted).
  */
 export function switchInputs(scope, system) {
+  // A group's error slot (a pair's "constraints.mass_kg") follows the switch.
+  for (const slot of scope.querySelectorAll('output[data-si][data-imperial]')) {
+    slot.dataset.errorFor = slot.dataset[system];
+  }
   for (const input of unitInputs(scope)) {
     const own = input.dataset.system || 'si';
     if (own === system) continue;
@@ -48,6 +52,13 @@ export function switchInputs(scope, system) {
       input.value = formOf(input, system).value;
     }
   }
+}
+
+/** A control's value as the page's HTML sets it. */
+function defaultOf(control) {
+  if (control.tagName !== 'SELECT') return control.defaultValue;
+  const options = [...control.options];
+  return (options.find((o) => o.defaultSelected) || options[0])?.value ?? '';
 }
 
 /** The page's state that differs from its defaults in `system`, as URL parameters. */
@@ -61,7 +72,7 @@ export function stateParams(forms, system) {
         const own = control.dataset.system || 'si';
         if (own === system && control.value === formOf(control, system).value) continue;
         params.set(control.dataset.field, control.value);
-      } else if (control.value !== (control.dataset.default ?? control.defaultValue)) {
+      } else if (control.value !== (control.dataset.default ?? defaultOf(control))) {
         params.set(control.name, control.value);
       }
     }
