@@ -284,6 +284,26 @@ scenario('opens at game conditions: a real bat, mlb at 90 mph, 70 mph bat speed,
   assert.equal(ha.bbcor.value, alloy.body.bbcor.value);
   assert.equal(ha.carry.value, alloy.body.batted_ball.distance_ft);
   await shot(page, '00b-hollow-bat');
+
+  // A refused trade-unit input: the API names the field as written (ball.speed_mph), and its
+  // message is shown beside that input.
+  const good = await revision(page);
+  await page.fill('input[name="ball_speed_mps"]', '-10');
+  await page.press('input[name="ball_speed_mps"]', 'Tab');
+  const slot = page.locator('[data-error-for="ball.speed_mph"]');
+  await slot.waitFor({ state: 'visible', timeout: 20000 });
+  const refused = await apiPost(url, '/v1/sweet-spot', {
+    ...body,
+    bat: { preset: 'bbcor-33-aluminium' },
+    ball: { ...GAME.ball, speed_mph: -10 },
+  });
+  assert.equal(refused.status, 400);
+  assert.equal(refused.body.field, 'ball.speed_mph');
+  assert.equal(await slot.textContent(), `${refused.body.message} (${refused.body.code})`);
+  await page.fill('input[name="ball_speed_mps"]', '90');
+  await page.press('input[name="ball_speed_mps"]', 'Tab');
+  await waitForRefresh(page, good);
+  assert.equal(await slot.isVisible(), false);
 });
 
 scenario('the unit switch: SI inputs and answers, a link that restores them, CSV, a phone width', async ({ page, url, browser }) => {
