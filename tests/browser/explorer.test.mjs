@@ -363,6 +363,23 @@ scenario('the unit switch: SI inputs and answers, a link that restores them, CSV
   await assertNoOverflow(small, 390);
   await shot(small, '00c-phone-si');
   await phone.close();
+
+  // Another link in the same tab: everything it does not name goes back to the defaults.
+  const before = await revision(page);
+  await page.evaluate(() => {
+    window.location.hash = '#units=imperial&preset=paper-wood';
+  });
+  await waitForRefresh(page, before);
+  assert.equal(await page.locator('input[name="units"][value="imperial"]').isChecked(), true);
+  assert.equal(await page.locator('select[name="preset"]').inputValue(), 'paper-wood');
+  assert.equal(await page.locator('input[name="ball_speed_mps"]').inputValue(), '90');
+  const paper = await apiPost(url, '/v1/sweet-spot', {
+    bat: { preset: 'paper-wood' },
+    ...GAME,
+    outputs: ['max_exit_speed'],
+    report_units: 'imperial',
+  });
+  assert.equal((await headline(page)).exit_speed.value, paper.body.max_exit_speed.exit_speed_mph);
 });
 
 scenario('load the page: bat, properties, curve with markers, modes, variants', async ({ page, url }) => {

@@ -7,7 +7,7 @@ import { BatForm, drawBat, outlineOf } from './bat.js';
 import { CurveChart, FlightChart, ModesChart, PALETTE, VariantsChart } from './charts.js';
 import { downloadCsv, downloadSvg } from './export.js';
 import { clearErrors, el, fmt, fmtDelta, readFields, readValue, showError } from './form.js';
-import { formOf, restoreParams, setInputSystem, stateParams, switchInputs, unitInputs } from './units.js';
+import { resetControls, restoreParams, stateParams, switchInputs } from './units.js';
 
 const $ = (selector) => document.querySelector(selector);
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
@@ -413,11 +413,12 @@ function saveState() {
   $('#share-link').href = window.location.href;
 }
 
-/** The units and inputs of the URL's hash, if any (before the first refresh). */
+/** The page as the URL's hash says: the defaults, in its units, with its inputs over them. */
 function restoreState() {
   const params = new URLSearchParams(window.location.hash.slice(1));
   const units = params.get('units');
-  if (units === 'si' || units === 'imperial') setUnits(units);
+  resetControls(stateForms());
+  setUnits(units === 'si' ? 'si' : 'imperial');
   restoreParams(stateForms(), params);
   page.batForm.syncShape();
 }
@@ -431,11 +432,6 @@ function setUnits(system) {
 }
 
 function setupUnits() {
-  for (const input of stateForms().flatMap(unitInputs)) {
-    setInputSystem(input, 'si');
-    input.value = formOf(input, 'si').value;
-  }
-  setUnits('imperial');
   $('#units').addEventListener('change', (event) => {
     setUnits(event.target.value);
     refreshBat();

@@ -110,3 +110,18 @@ export function restoreParams(forms, params) {
   }
   return unknown;
 }
+
+/** Puts every control of `forms` back to the page's defaults, unit inputs in SI (then switch). */
+export function resetControls(forms) {
+  for (const form of forms) {
+    for (const control of form.querySelectorAll('input[name], select[name]')) {
+      if (control.type === 'radio' || control.type === 'checkbox') continue;
+      if (control.dataset.si !== undefined && control.dataset.imperial !== undefined) {
+        setInputSystem(control, 'si');
+        control.value = formOf(control, 'si').value;
+      } else {
+        control.value = control.dataset.default ?? defaultOf(control);
+      }
+    }
+  }
+}
