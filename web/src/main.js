@@ -530,7 +530,13 @@ async function refreshCompare() {
   const form = $('#compare-form');
   const chosen = VARIANTS.filter((v) => form.elements[v.id]?.checked);
   const base = page.good.bat;
-  const variants = chosen.map((v) => ({ name: v.id, bat: { ...base, ...v.make() } }));
+  const variants = chosen.map((v) => {
+    const change = v.make();
+    const bat = { ...base, ...change };
+    // A change in metres replaces the base's own form of that field (a wall typed in inches).
+    for (const key of Object.keys(change)) if (key.endsWith('_m')) delete bat[`${key.slice(0, -2)}_in`];
+    return { name: v.id, bat };
+  });
   const body = {
     baseline: base,
     variants,
