@@ -106,6 +106,23 @@ async function apiPost(url, route, body, headers = {}) {
 // ---- the scenarios ---------------------------------------------------------
 
 const SWEET = ['max_exit_speed', 'center_of_percussion', 'vibration_node', 'sweet_zone', 'exit_speed_curve'];
+/** What the page asks /v1/sweet-spot for (the markers' outputs and the headline's). */
+const PAGE_OUTPUTS = [...SWEET, 'bbcor', 'barrel', 'batted_ball'];
+/** The page's opening scene: the mlb ball at 90 mph, a 70 mph bat speed (issue 37). */
+const GAME = {
+  ball: { preset: 'mlb', speed_mph: 90, descent_angle_deg: 7 },
+  swing: { bat_speed_mph: 70, attack_angle_deg: 10 },
+  contact: { undercut_in: 0.5 },
+};
+/** The same scene in SI, as the unit switch's defaults write it (90 mph and 70 mph exactly). */
+const GAME_SI = {
+  ball: { preset: 'mlb', speed_mps: 40.2336, descent_angle_deg: 7 },
+  swing: { bat_speed_mps: 31.2928, attack_angle_deg: 10 },
+  contact: { undercut_m: 0.0127 },
+};
+/** The state the scenarios after the game-condition ones start from: the paper's bat, SI, the API's scene. */
+const PAPER_HASH =
+  '#units=si&preset=paper-wood&ball_preset=&ball.speed_mps=&swing.bat_speed_mps=&descent_angle_deg=&attack_angle_deg=&contact.undercut_m=';
 
 async function revision(page) {
   return Number(await page.evaluate(() => document.body.dataset.revision || 0));
@@ -130,14 +147,244 @@ async function markerOf(page, key) {
 }
 
 async function shot(page, name) {
-  await page.screenshot({ path: path.join(artifacts, `${name}.png`), fullPage: true });
+  const file = path.join(artifacts, `${name}.png`);
+  await page.screenshot({ path: file, fullPage: true });
+  // The screenshot is part of the test's evidence: it must exist and hold an image.
+  assert.ok(fs.statSync(file).size > 1000, `${file} is empty`);
+}
+
+/** The page is no wider than its viewport (nothing cut off or scrolled sideways). */
+async function assertNoOverflow(page, width) {
+  const sizes = await page.evaluate(() => ({
+    scroll: document.documentElement.scrollWidth,
+    client: document.documentElement.clientWidth,
+    wide: [...document.querySelectorAll('main *')]
+      .filter((e) => e.getBoundingClientRect().right > document.documentElement.clientWidth + 0.5)
+      .filter((e) => !e.closest('.scroll'))
+      .slice(0, 5)
+      .map((e) => `${e.tagName.toLowerCase()}#${e.id}.${e.className}`),
+  }));
+  assert.equal(sizes.client, width);
+  assert.ok(sizes.scroll <= sizes.client, `page ${sizes.scroll} px wide in ${sizes.client} px: ${sizes.wide.join(', ')}`);
+  assert.deepEqual(sizes.wide, [], 'elements past the right edge');
+}
+
+/** The headline's items: key -> {value (the API number it shows), path, text}. */
+async function headline(page) {
+  return page.evaluate(() =>
+    Object.fromEntries(
+      [...document.querySelectorAll('#headline-values .item')].map((item) => [
+        item.dataset.key,
+        { value: item.dataset.value === '' ? null : Number(item.dataset.value), path: item.dataset.path, text: item.textContent },
+      ]),
+    ),
+  );
 }
 
 const scenarios = [];
 const scenario = (name, fn) => scenarios.push({ name, fn });
 
-scenario('load the page: bat, properties, curve with markers, modes, variants', async ({ page, url }) => {
+scenario('opens at game conditions: a real bat, mlb at 90 mph, 70 mph bat speed, in inches and mph', async ({ page, url }) => {
   const response = await page.goto(url);
+  assert.equal(response.status(), 200);
+  await page.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+  assert.equal(await page.locator('select[name="preset"]').inputValue(), 'wood-34-ash');
+  assert.equal(await page.locator('select[name="ball_preset"]').inputValue(), 'mlb');
+  assert.equal(await page.locator('input[name="ball_speed_mps"]').inputValue(), '90');
+  assert.equal(await page.locator('input[name="ball_speed_mps"]').getAttribute('data-field'), 'ball.speed_mph');
+  assert.equal(await page.locator('input[name="bat_speed_mps"]').inputValue(), '70');
+  assert.equal(await page.locator('input[name="bat_speed_mps"]').getAttribute('data-field'), 'swing.bat_speed_mph');
+  assert.equal(await page.locator('input[name="units"][value="imperial"]').isChecked(), true);
+
+  const bat = { preset: 'wood-34-ash' };
+  const body = { bat, ...GAME, outputs: PAGE_OUTPUTS, options: { curve_samples: 121 }, report_units: 'imperial' };
+  const sweet = await apiPost(url, '/v1/sweet-spot', body);
+  assert.equal(sweet.status, 200, JSON.stringify(sweet.body));
+  const h = await headline(page);
+  assert.equal(h.sweet_spot.value, sweet.body.max_exit_speed.position_from_tip_in);
+  assert.match(h.sweet_spot.text, / in from the tip/);
+  assert.equal(h.exit_speed.value, sweet.body.max_exit_speed.exit_speed_mph);
+  assert.match(h.exit_speed.text, / mph/);
+  assert.equal(h.bbcor.value, sweet.body.bbcor.value);
+  assert.equal(h.carry.value, sweet.body.batted_ball.distance_ft);
+  assert.match(h.carry.text, / ft/);
+  assert.equal(h.hoop_frequency, undefined, 'a solid wood bat has no hoop mode');
+  assert.equal(sweet.body.barrel.hollow, false);
+  // The curve in inches and mph, its markers at the API's positions.
+  assert.equal((await markerOf(page, 'max_exit_speed')).positionM, sweet.body.max_exit_speed.position_from_knob_m);
+  assert.match(await page.locator('#curve-chart').textContent(), /exit speed \(mph\)/);
+  const properties = await apiPost(url, '/v1/bat/properties', { bat, report_units: 'imperial' });
+  assert.equal(
+    Number(await page.locator('#properties tr[data-key="mass_kg"] td[data-imperial]').getAttribute('data-imperial')),
+    properties.body.imperial.weight_oz,
+  );
+  // The flight from the side: /v1/flight at the batted ball's launch, as the test asks it.
+  const bb = sweet.body.batted_ball;
+  const flight = await apiPost(url, '/v1/flight', {
+    launch: {
+      exit_speed_mps: bb.exit_speed_mps,
+      launch_angle_deg: bb.launch_angle_deg,
+      backspin_rpm: bb.backspin_rpm,
+      sidespin_rpm: bb.sidespin_rpm,
+    },
+    outputs: ['trajectory'],
+    report_units: 'imperial',
+  });
+  assert.equal(flight.status, 200, JSON.stringify(flight.body));
+  await page.waitForSelector('#flight-chart[data-points]');
+  assert.equal(Number(await page.locator('#flight-chart').getAttribute('data-distance')), flight.body.distance_ft);
+  assert.equal(Number(await page.locator('#flight-chart').getAttribute('data-points')), flight.body.trajectory.length);
+  // The same flight as the batted_ball block's: both integrate to the flight's default
+  // tolerance (the landing within 0.1 ft, docs/api.md), so the carries agree within 0.2 ft.
+  assert.ok(Math.abs(flight.body.distance_ft - bb.distance_ft) < 0.2, `${flight.body.distance_ft} vs ${bb.distance_ft}`);
+  assert.match(await page.locator('#flight-chart').textContent(), /height \(ft\)/);
+
+  // Keyboard: the unit switch is a labelled radio group reached with Tab and changed with arrows.
+  await page.locator('input[name="units"][value="imperial"]').focus();
+  assert.equal(await page.evaluate(() => document.activeElement.closest('fieldset')?.querySelector('legend')?.textContent), 'Units');
+  for (const control of await page.locator('#bat-form input, #bat-form select').all()) {
+    const id = await control.evaluate((e) => e.name);
+    assert.ok(await control.evaluate((e) => Boolean(e.labels?.length || e.getAttribute('aria-label'))), `${id} has no label`);
+  }
+  // The variants' table and the drawing's axis in the trade's units too: the baseline's mass is
+  // the properties' own mass_oz (one bat, one answer), the axis in inches.
+  await page.waitForSelector('#compare-table[data-variants]');
+  assert.equal(
+    Number(await page.locator('#compare-table tbody tr:first-child td').first().getAttribute('data-value')),
+    properties.body.mass_oz,
+  );
+  assert.match(await page.locator('#compare-table tbody tr:first-child th').textContent(), /Mass oz/);
+  assert.match(await page.locator('#bat-drawing .axis').textContent(), /in from the knob/);
+  await assertNoOverflow(page, 1280);
+  await shot(page, '00-game-conditions');
+
+  // The optimisation in the trade's units: diameters in inches, the mass at most 32 oz.
+  await page.click('#optimize-run');
+  await page.waitForSelector('#optimize-state[data-state="done"]', { timeout: 60000 });
+  const id = await page.locator('#optimize-state').getAttribute('data-job-id');
+  const result = await (await fetch(`${url}/v1/jobs/${id}/result`)).json();
+  assert.equal(result.summary.termination, 'converged', result.summary.message);
+  assert.equal(Object.keys(result.variables).length, 14); // one per knot of wood-34-ash
+  assert.ok(Object.keys(result.variables).every((k) => k.endsWith('.diameter_in')), Object.keys(result.variables).join());
+  assert.ok(result.properties.mass_oz <= 32 + 1e-6, `mass ${result.properties.mass_oz} oz over the 32 oz bound`);
+  const massRow = page.locator('#optimize-result tbody tr', { hasText: 'Mass' });
+  assert.equal(Number(await massRow.locator('td').first().getAttribute('data-value')), result.properties.mass_oz);
+  assert.match(await massRow.textContent(), / oz/);
+
+  // A hollow bat: its barrel's hoop frequency and THE BBCOR, as the API gives them.
+  const rev = await revision(page);
+  await page.selectOption('select[name="preset"]', 'bbcor-33-aluminium');
+  await waitForRefresh(page, rev);
+  const alloy = await apiPost(url, '/v1/sweet-spot', { ...body, bat: { preset: 'bbcor-33-aluminium' } });
+  assert.equal(alloy.status, 200, JSON.stringify(alloy.body));
+  assert.equal(alloy.body.barrel.hollow, true);
+  const ha = await headline(page);
+  assert.equal(ha.hoop_frequency.value, alloy.body.barrel.hoop_frequency_hz);
+  assert.match(ha.hoop_frequency.text, / Hz/);
+  assert.equal(ha.bbcor.value, alloy.body.bbcor.value);
+  assert.equal(ha.carry.value, alloy.body.batted_ball.distance_ft);
+  await shot(page, '00b-hollow-bat');
+
+  // A refused trade-unit input: the API names the field as written (ball.speed_mph), and its
+  // message is shown beside that input.
+  const good = await revision(page);
+  await page.fill('input[name="ball_speed_mps"]', '-10');
+  await page.press('input[name="ball_speed_mps"]', 'Tab');
+  const slot = page.locator('[data-error-for="ball.speed_mph"]');
+  await slot.waitFor({ state: 'visible', timeout: 20000 });
+  const refused = await apiPost(url, '/v1/sweet-spot', {
+    ...body,
+    bat: { preset: 'bbcor-33-aluminium' },
+    ball: { ...GAME.ball, speed_mph: -10 },
+  });
+  assert.equal(refused.status, 400);
+  assert.equal(refused.body.field, 'ball.speed_mph');
+  assert.equal(await slot.textContent(), `${refused.body.message} (${refused.body.code})`);
+  await page.fill('input[name="ball_speed_mps"]', '90');
+  await page.press('input[name="ball_speed_mps"]', 'Tab');
+  await waitForRefresh(page, good);
+  assert.equal(await slot.isVisible(), false);
+});
+
+scenario('the unit switch: SI inputs and answers, a link that restores them, CSV, a phone width', async ({ page, url, browser }) => {
+  const rev = await revision(page);
+  await page.locator('input[name="units"][value="imperial"]').focus();
+  await page.keyboard.press('ArrowRight'); // the keyboard's way to the next radio of the group
+  await waitForRefresh(page, rev);
+  assert.equal(await page.locator('input[name="units"][value="si"]').isChecked(), true);
+  assert.equal(await page.locator('input[name="ball_speed_mps"]').inputValue(), '40.2336');
+  assert.equal(await page.locator('input[name="ball_speed_mps"]').getAttribute('data-field'), 'ball.speed_mps');
+  assert.equal(await page.locator('input[name="bat_speed_mps"]').inputValue(), '31.2928');
+  const bat = { preset: 'bbcor-33-aluminium' };
+  const si = await apiPost(url, '/v1/sweet-spot', {
+    bat,
+    ...GAME_SI,
+    outputs: PAGE_OUTPUTS,
+    options: { curve_samples: 121 },
+    report_units: 'si',
+  });
+  assert.equal(si.status, 200, JSON.stringify(si.body));
+  const h = await headline(page);
+  assert.equal(h.sweet_spot.value, si.body.max_exit_speed.position_from_knob_m);
+  assert.match(h.sweet_spot.text, / m from the knob/);
+  assert.equal(h.exit_speed.value, si.body.max_exit_speed.exit_speed_mps);
+  assert.match(h.exit_speed.text, / m\/s/);
+  assert.equal(h.carry.value, si.body.batted_ball.distance_m);
+  assert.equal(h.hoop_frequency.value, si.body.barrel.hoop_frequency_hz);
+  // The same conditions in either unit: 90 mph is 40.2336 m/s exactly, so the two answers agree
+  // to the rounding of the factor's product (a few ulps; 1e-9 relative is ample).
+  const imperial = await apiPost(url, '/v1/sweet-spot', { bat, ...GAME, outputs: ['max_exit_speed'] });
+  const rel = Math.abs(imperial.body.max_exit_speed.exit_speed_mps / si.body.max_exit_speed.exit_speed_mps - 1);
+  assert.ok(rel < 1e-9, `exit speed differs by ${rel} between the units`);
+
+  // The curve's CSV is what the chart shows: the API's curve in SI.
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('[data-export="curve-csv"]')]);
+  const csv = fs.readFileSync(await download.path(), 'utf8').trim().split('\r\n');
+  assert.equal(csv[0], 'position from the knob (m),exit speed (m/s)');
+  assert.equal(csv.length, 122);
+  assert.deepEqual(csv[61].split(',').map(Number), [
+    si.body.exit_speed_curve[60].position_from_knob_m,
+    si.body.exit_speed_curve[60].exit_speed_mps,
+  ]);
+  const [svgDownload] = await Promise.all([page.waitForEvent('download'), page.click('[data-export="bat-drawing-svg"]')]);
+  assert.match(fs.readFileSync(await svgDownload.path(), 'utf8'), /<svg[^>]*xmlns="http:\/\/www.w3.org\/2000\/svg"/);
+
+  // The link restores the page: units and inputs, at a phone's width, nothing cut off.
+  const hash = new URL(page.url()).hash;
+  assert.match(hash, /units=si/);
+  assert.match(hash, /preset=bbcor-33-aluminium/);
+  const phone = await browser.newContext({ viewport: { width: 390, height: 844 }, isMobile: true });
+  const small = await phone.newPage();
+  await small.goto(`${url}/${hash}`);
+  await small.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+  assert.equal(await small.locator('input[name="units"][value="si"]').isChecked(), true);
+  assert.equal(await small.locator('select[name="preset"]').inputValue(), 'bbcor-33-aluminium');
+  assert.equal((await headline(small)).sweet_spot.value, si.body.max_exit_speed.position_from_knob_m);
+  await assertNoOverflow(small, 390);
+  await shot(small, '00c-phone-si');
+  await phone.close();
+
+  // Another link in the same tab: everything it does not name goes back to the defaults.
+  const before = await revision(page);
+  await page.evaluate(() => {
+    window.location.hash = '#units=imperial&preset=paper-wood';
+  });
+  await waitForRefresh(page, before);
+  assert.equal(await page.locator('input[name="units"][value="imperial"]').isChecked(), true);
+  assert.equal(await page.locator('select[name="preset"]').inputValue(), 'paper-wood');
+  assert.equal(await page.locator('input[name="ball_speed_mps"]').inputValue(), '90');
+  const paper = await apiPost(url, '/v1/sweet-spot', {
+    bat: { preset: 'paper-wood' },
+    ...GAME,
+    outputs: ['max_exit_speed'],
+    report_units: 'imperial',
+  });
+  assert.equal((await headline(page)).exit_speed.value, paper.body.max_exit_speed.exit_speed_mph);
+});
+
+scenario('load the page: bat, properties, curve with markers, modes, variants', async ({ page, url }) => {
+  await page.goto('about:blank');
+  const response = await page.goto(`${url}/${PAPER_HASH}`);
   assert.equal(response.status(), 200);
   assert.match(response.headers()['content-type'], /^text\/html/);
   await page.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
@@ -423,7 +670,7 @@ try {
   for (const { name, fn } of scenarios) {
     const t0 = Date.now();
     try {
-      await fn({ page, url: server.url });
+      await fn({ page, url: server.url, browser });
       assert.deepEqual(pageErrors, [], 'errors in the page');
       console.log(`ok    ${name} (${((Date.now() - t0) / 1000).toFixed(1)} s)`);
     } catch (error) {
@@ -454,7 +701,7 @@ if (!failures.length) {
     const sweet = await apiPost(
       guarded.url,
       '/v1/sweet-spot',
-      { bat: { preset: 'paper-wood' }, outputs: SWEET, options: { curve_samples: 121 } },
+      { bat: { preset: 'wood-34-ash' }, ...GAME, outputs: SWEET, options: { curve_samples: 121 } },
       { Authorization: `Bearer ${TOKEN}` },
     );
     assert.equal(

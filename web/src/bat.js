@@ -15,16 +15,22 @@ export class BatForm {
     this.form = form;
     this.catalogue = catalogue;
     this.populate();
+    for (const select of form.querySelectorAll('select')) select.dataset.default = select.value;
     this.syncShape();
   }
 
-  /** Fills the preset and material lists from the API's catalogues. */
+  /** Fills the preset, material and ball lists from the API's catalogues. */
   populate() {
     const preset = this.form.elements.preset;
     for (const p of this.catalogue.presets.values()) {
       preset.append(new Option(p.name, p.name));
     }
-    preset.value = this.catalogue.presets.has('paper-wood') ? 'paper-wood' : preset.options[1]?.value || '';
+    // A real bat at game conditions (issue 37); the paper's bat is one choice away.
+    preset.value = ['wood-34-ash', 'paper-wood'].find((name) => this.catalogue.presets.has(name)) ||
+      preset.options[1]?.value || '';
+    const ball = this.form.elements.ball_preset;
+    for (const b of this.catalogue.balls.values()) ball.append(new Option(b.name, b.name));
+    if (this.catalogue.balls.has('mlb')) ball.value = 'mlb';
     const material = this.form.elements.material;
     const fill = this.form.elements.fill_material;
     for (const m of this.catalogue.materials.values()) {
@@ -66,7 +72,7 @@ export class BatForm {
     }
     if (e.material.value) bat.material = e.material.value;
     const wall = readValue(e.wall_thickness_m);
-    if (wall !== undefined) bat.wall_thickness_m = wall;
+    if (wall !== undefined) bat[e.wall_thickness_m.dataset.field.slice('bat.'.length)] = wall;
     if (e.fill_material.value === 'none') {
       bat.fill = null;
     } else if (e.fill_material.value) {
@@ -78,7 +84,9 @@ export class BatForm {
   /** The scene fields of a request (ball, swing, cor): only those given. */
   scene() {
     const scene = {};
-    for (const prefix of ['ball.', 'swing.', 'cor']) readFields(this.form, prefix, true, scene);
+    const ball = this.form.elements.ball_preset.value;
+    if (ball) scene.ball = { preset: ball };
+    for (const prefix of ['ball.', 'swing.', 'contact.', 'cor']) readFields(this.form, prefix, true, scene);
     return scene;
   }
 
@@ -100,7 +108,13 @@ export function outlineOf(bat, catalogue) {
   if (bat.profile && Array.isArray(bat.profile.knots)) {
     knots = bat.profile.knots;
   } else if (bat.three_segment) {
-    const s = bat.three_segment;
+    const s = {
+      length_m: lengthM(bat.three_segment, 'length'),
+      handle_radius_m: radiusM(bat.three_segment, 'handle'),
+      barrel_radius_m: radiusM(bat.three_segment, 'barrel'),
+      taper_start_m: lengthM(bat.three_segment, 'taper_start'),
+      taper_end_m: lengthM(bat.three_segment, 'taper_end'),
+    };
     const values = [s.length_m, s.handle_radius_m, s.barrel_radius_m, s.taper_start_m, s.taper_end_m];
     if (!values.every((v) => typeof v === 'number' && Number.isFinite(v))) return null;
     knots = [
@@ -113,9 +127,13 @@ export function outlineOf(bat, catalogue) {
     knots = preset.bat.profile.knots;
   }
   if (!knots) return null;
-  const wall = 'wall_thickness_m' in bat ? bat.wall_thickness_m : preset?.bat.wall_thickness_m || 0;
+  const wall =
+    'wall_thickness_m' in bat || 'wall_thickness_in' in bat
+      ? lengthM(bat, 'wall_thickness')
+      : preset?.bat.wall_thickness_m || 0;
   let fill = 'fill' in bat ? bat.fill : preset?.bat.fill || null;
-  if (fill && !(typeof fill.diameter_m === 'number' && typeof fill.depth_m === 'number')) fill = null;
+  if (fill) fill = { ...fill, diameter_m: lengthM(fill, 'diameter'), depth_m: lengthM(fill, 'depth') };
+  if (fill && !(Number.isFinite(fill.diameter_m) && Number.isFinite(fill.depth_m))) fill = null;
   let material = bat.material ?? preset?.bat.material ?? 'paper-wood';
   if (typeof material === 'object') material = material.name || 'custom';
   let fillMaterial = fill?.material ?? null;
@@ -126,6 +144,24 @@ export function outlineOf(bat, catalogue) {
     fill: fill ? { diameter_m: fill.diameter_m, depth_m: fill.depth_m, material: fillMaterial } : null,
     material,
   };
+}
+
+/** Drawing units per inch: a length given in inches is drawn at its size (pixels only). */
+const DRAWN_M_PER_IN = 0.0254;
+
+/** `obj[stem_m]`, or `obj[stem_in]` at its drawn size; undefined when neither is a number. */
+function lengthM(obj, stem) {
+  if (typeof obj[`${stem}_m`] === 'number') return obj[`${stem}_m`];
+  if (typeof obj[`${stem}_in`] === 'number') return obj[`${stem}_in`] * DRAWN_M_PER_IN;
+  return undefined;
+}
+
+/** A radius given as `stem_radius_m`, or as a diameter `stem_diameter_{m,in}`, for the drawing. */
+function radiusM(obj, stem) {
+  const radius = lengthM(obj, `${stem}_radius`);
+  if (radius !== undefined) return radius;
+  const diameter = lengthM(obj, `${stem}_diameter`);
+  return diameter === undefined ? undefined : diameter / 2;
 }
 
 function svgEl(tag, attrs = {}) {
@@ -157,7 +193,7 @@ function outlinePath(knots, inset = 0) {
  * "original" drawn as a dashed outline only, or "optimised"). `marks` are
  * {key, label, position_m} vertical lines; `zone` a {from_m, to_m} band.
  */
-export function drawBat(svg, bats, { marks = [], zone = null, axis = true } = {}) {
+export function drawBat(svg, bats, { marks = [], zone = null, axis = true, axisUnit = 'm' } = {}) {
   svg.replaceChildren();
   const shown = bats.filter(Boolean);
   if (!shown.length) return;
@@ -213,14 +249,18 @@ export function drawBat(svg, bats, { marks = [], zone = null, axis = true } = {}
     const y = radius + 8;
     const g = svgEl('g', { class: 'axis' });
     g.append(svgEl('line', { x1: 0, x2: length, y1: y, y2: y }));
-    for (let mm = 0; mm <= length + 1e-6; mm += 100) {
+    // Ticks every 0.1 m, or every 4 in (101.6 drawing units: the scale of the drawing only).
+    const inches = axisUnit === 'in';
+    const step = inches ? 4 * 25.4 : 100;
+    for (let i = 0; i * step <= length + 1e-6; ++i) {
+      const mm = i * step;
       g.append(svgEl('line', { x1: mm, x2: mm, y1: y, y2: y + 5 }));
       const label = svgEl('text', { x: mm, y: y + 19, 'text-anchor': 'middle' });
-      label.textContent = (mm / 1000).toFixed(1);
+      label.textContent = inches ? String(4 * i) : (i / 10).toFixed(1);
       g.append(label);
     }
     const unit = svgEl('text', { x: length, y: y + 32, 'text-anchor': 'end' });
-    unit.textContent = 'm from the knob';
+    unit.textContent = `${inches ? 'in' : 'm'} from the knob`;
     g.append(unit);
     svg.append(g);
   }
@@ -234,7 +274,8 @@ export function drawBat(svg, bats, { marks = [], zone = null, axis = true } = {}
     const label = svgEl('text', { x, y: -radius - 9 - (i % 3) * 9, 'text-anchor': 'middle' });
     label.textContent = mark.short || mark.label;
     const title = svgEl('title');
-    title.textContent = `${mark.label}: ${mark.position_m.toFixed(4)} m from the knob`;
+    const shown = mark.at ?? mark.position_m;
+    title.textContent = `${mark.label}: ${shown.toFixed(axisUnit === 'in' ? 2 : 4)} ${axisUnit} from the knob`;
     g.append(title);
     g.append(label);
     svg.append(g);

@@ -15,8 +15,9 @@ function widthOf(container) {
 
 /** A uPlot chart that follows its container's width. */
 class Chart {
-  constructor(container, { yLabel, onDraw }) {
+  constructor(container, { xLabel = 'position from the knob (m)', yLabel, onDraw }) {
     this.container = container;
+    this.xLabel = xLabel;
     this.yLabel = yLabel;
     this.onDraw = onDraw;
     this.plot = null;
@@ -28,7 +29,9 @@ class Chart {
 
   /** Shows `data` ([xs, ys1, ys2, ...]) with `series` ([{label, stroke, dash}]). */
   show(data, series) {
-    const key = JSON.stringify(series);
+    this.data = data;
+    this.seriesLabels = series.map((s) => s.label);
+    const key = JSON.stringify([series, this.xLabel, this.yLabel]);
     if (this.plot && key === this.seriesKey) {
       this.plot.setData(data);
       return;
@@ -41,11 +44,11 @@ class Chart {
         height: HEIGHT,
         scales: { x: { time: false } },
         axes: [
-          { label: 'position from the knob (m)', size: 40 },
+          { label: this.xLabel, size: 40 },
           { label: this.yLabel, size: 60 },
         ],
         series: [
-          { label: 'x (m)', value: (u, v) => (v == null ? '—' : v.toFixed(3)) },
+          { label: 'at', value: (u, v) => (v == null ? '—' : v.toFixed(3)) },
           ...series.map((s) => ({
             label: s.label,
             stroke: s.stroke,
@@ -61,6 +64,14 @@ class Chart {
       data,
       this.container,
     );
+  }
+
+  /** What the chart shows, as a table: [header, ...rows] (the API's numbers, unrounded). */
+  table() {
+    if (!this.data) return [[]];
+    const header = [this.xLabel, ...this.seriesLabels];
+    const rows = this.data[0].map((x, i) => [x, ...this.data.slice(1).map((ys) => ys[i])]);
+    return [header, ...rows];
   }
 }
 
@@ -80,13 +91,16 @@ export class CurveChart extends Chart {
    * `curve`: the API's exit_speed_curve; `marks`: [{key, label, position_m}];
    * `zone`: {from_m, to_m} or null; `peak`: {position_m, speed_mps} or null.
    */
-  update(curve, marks, zone, peak) {
+  update(curve, marks, zone, peak, axes = {}) {
+    const { x = 'position_from_knob_m', y = 'exit_speed_mps' } = axes;
+    this.xLabel = axes.xLabel || 'position from the knob (m)';
+    this.yLabel = axes.yLabel || 'exit speed (m/s)';
     this.marks = marks;
     this.zone = zone;
     this.peak = peak;
-    const xs = curve.map((p) => p.position_from_knob_m);
-    const ys = curve.map((p) => p.exit_speed_mps);
-    this.show([xs, ys], [{ label: 'exit speed (m/s)', stroke: PALETTE[0] }]);
+    const xs = curve.map((p) => p[x]);
+    const ys = curve.map((p) => p[y]);
+    this.show([xs, ys], [{ label: this.yLabel, stroke: PALETTE[0] }]);
     this.placeMarks(this.plot);
   }
 
@@ -94,27 +108,27 @@ export class CurveChart extends Chart {
     if (!u) return;
     for (const old of u.over.querySelectorAll('.u-mark, .u-zone, .u-peak')) old.remove();
     if (this.zone) {
-      const left = u.valToPos(this.zone.from_m, 'x');
-      const right = u.valToPos(this.zone.to_m, 'x');
+      const left = u.valToPos(this.zone.from ?? this.zone.from_m, 'x');
+      const right = u.valToPos(this.zone.to ?? this.zone.to_m, 'x');
       const band = document.createElement('div');
       band.className = 'u-zone';
       band.style.left = `${left}px`;
       band.style.width = `${Math.max(0, right - left)}px`;
       band.dataset.fromM = String(this.zone.from_m);
       band.dataset.toM = String(this.zone.to_m);
-      band.title = `sweet zone ${this.zone.from_m.toFixed(3)}–${this.zone.to_m.toFixed(3)} m`;
+      band.title = `sweet zone ${(this.zone.from ?? this.zone.from_m).toFixed(3)}–${(this.zone.to ?? this.zone.to_m).toFixed(3)}`;
       u.over.append(band);
     }
     this.marks.forEach((mark, i) => {
       if (!Number.isFinite(mark.position_m)) return;
-      const x = u.valToPos(mark.position_m, 'x');
+      const x = u.valToPos(mark.at ?? mark.position_m, 'x');
       const line = document.createElement('div');
       line.className = `u-mark ${mark.key}`;
       line.style.left = `${x}px`;
       line.dataset.marker = mark.key;
       line.dataset.positionM = String(mark.position_m);
       line.dataset.xPx = x.toFixed(1);
-      line.title = `${mark.label}: ${mark.position_m.toFixed(4)} m`;
+      line.title = `${mark.label}: ${(mark.at ?? mark.position_m).toFixed(4)}`;
       const label = document.createElement('span');
       label.textContent = mark.short;
       label.style.top = `${2 + (i % 3) * 14}px`;
@@ -124,9 +138,9 @@ export class CurveChart extends Chart {
     if (this.peak) {
       const dot = document.createElement('div');
       dot.className = 'u-peak';
-      dot.style.left = `${u.valToPos(this.peak.position_m, 'x')}px`;
-      dot.style.top = `${u.valToPos(this.peak.speed_mps, 'y')}px`;
-      dot.title = `max exit speed ${this.peak.speed_mps.toFixed(3)} m/s`;
+      dot.style.left = `${u.valToPos(this.peak.position, 'x')}px`;
+      dot.style.top = `${u.valToPos(this.peak.speed, 'y')}px`;
+      dot.title = `max exit speed ${this.peak.speed.toFixed(3)}`;
       u.over.append(dot);
     }
   }
@@ -182,17 +196,37 @@ export class VariantsChart extends Chart {
   }
 
   /** `rows`: the API's compare rows, each with exit_speed_curve. */
-  update(rows) {
-    const tables = rows.map((r) => [
-      r.exit_speed_curve.map((p) => p.position_from_knob_m),
-      r.exit_speed_curve.map((p) => p.exit_speed_mps),
-    ]);
+  update(rows, axes = {}) {
+    const { x = 'position_from_knob_m', y = 'exit_speed_mps' } = axes;
+    this.xLabel = axes.xLabel || 'position from the knob (m)';
+    this.yLabel = axes.yLabel || 'exit speed (m/s)';
+    const tables = rows.map((r) => [r.exit_speed_curve.map((p) => p[x]), r.exit_speed_curve.map((p) => p[y])]);
     const xs = tables[0][0];
     const aligned = tables.every((t) => t[0].length === xs.length && t[0].every((x, i) => x === xs[i]));
     const data = aligned ? [xs, ...tables.map((t) => t[1])] : uPlot.join(tables);
     this.show(
       data,
       rows.map((r, i) => ({ label: r.name, stroke: PALETTE[i % PALETTE.length], dash: i === 0 ? undefined : [6, 3] })),
+    );
+  }
+}
+
+/** The batted ball's path from the side: height against the distance toward centre field. */
+export class FlightChart extends Chart {
+  constructor(container) {
+    super(container, { xLabel: 'toward centre field (m)', yLabel: 'height (m)' });
+  }
+
+  /**
+   * `trajectory`: the API's points; `x`, `y`: their keys to plot (`y_m`/`z_m`,
+   * or the `_ft` twins); `unit`: the label's unit.
+   */
+  update(trajectory, x, y, unit) {
+    this.xLabel = `toward centre field (${unit})`;
+    this.yLabel = `height (${unit})`;
+    this.show(
+      [trajectory.map((p) => p[x]), trajectory.map((p) => p[y])],
+      [{ label: this.yLabel, stroke: PALETTE[2] }],
     );
   }
 }

@@ -4,8 +4,10 @@
 import './style.css';
 import * as api from './api.js';
 import { BatForm, drawBat, outlineOf } from './bat.js';
-import { CurveChart, ModesChart, PALETTE, VariantsChart } from './charts.js';
+import { CurveChart, FlightChart, ModesChart, PALETTE, VariantsChart } from './charts.js';
+import { downloadCsv, downloadSvg } from './export.js';
 import { clearErrors, el, fmt, fmtDelta, readFields, readValue, showError } from './form.js';
+import { resetControls, restoreParams, stateParams, switchInputs } from './units.js';
 
 const $ = (selector) => document.querySelector(selector);
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
@@ -17,6 +19,9 @@ const SWEET_SPOT_OUTPUTS = [
   'vibration_node',
   'sweet_zone',
   'exit_speed_curve',
+  'bbcor',
+  'barrel',
+  'batted_ball',
 ];
 /** Points of the exit-speed curve, knob to tip. */
 const CURVE_SAMPLES = 121;
@@ -30,10 +35,41 @@ const page = {
   modes: null,
   variantsChart: null,
   refreshSeq: 0,
+  flightSeq: 0,
+  flight: null,
   compareSeq: 0,
   good: null, // the last bat the API accepted, with its answers
   job: null, // the optimisation job being watched
+  units: 'imperial', // the unit switch: 'imperial' (in, oz, mph) or 'si'
 };
+
+/** The trade unit's twin of an SI key, as the API names it with report_units "imperial". */
+const TWINS = [
+  ['_kg_m2', '_oz_in2', 'oz·in²', 'kg·m²'],
+  ['_mps', '_mph', 'mph', 'm/s'],
+  ['_kg', '_oz', 'oz', 'kg'],
+  ['_m', '_in', 'in', 'm'],
+];
+
+/** `obj`'s value of the SI key `key` in the page's units (the API's twin, never converted here). */
+function q(obj, key) {
+  if (!obj) return undefined;
+  if (page.units !== 'imperial') return obj[key];
+  const twin = TWINS.find(([si]) => key.endsWith(si));
+  return twin ? obj[key.slice(0, -twin[0].length) + twin[1]] : obj[key];
+}
+
+/** The unit shown for the SI key `key` in the page's units. */
+function u(key) {
+  const twin = TWINS.find(([si]) => key.endsWith(si));
+  if (!twin) return '';
+  return page.units === 'imperial' ? twin[2] : twin[3];
+}
+
+/** The number with its unit ("31.2 in"), `digits` significant digits. */
+function qu(obj, key, digits = 4) {
+  return `${fmt(q(obj, key), digits)} ${u(key)}`;
+}
 
 function setStatus(text, kind = '') {
   const status = $('#status');
@@ -102,7 +138,7 @@ function renderProperties(properties) {
 
 /** The markers of a /v1/sweet-spot answer, for the chart and the drawing. */
 function marksOf(sweet) {
-  return [
+  const marks = [
     {
       key: 'max_exit_speed',
       label: 'max exit speed',
@@ -122,6 +158,8 @@ function marksOf(sweet) {
       position_m: sweet.vibration_node?.position_from_knob_m,
     },
   ];
+  for (const mark of marks) mark.at = q(sweet[mark.key], 'position_from_knob_m');
+  return marks;
 }
 
 function renderMarkers(sweet) {
@@ -136,23 +174,25 @@ function renderMarkers(sweet) {
       el('b', { text: title }),
       ` ${text}`,
     );
+  const tip = (obj, key) =>
+    page.units === 'imperial' && typeof obj?.[key] === 'number' ? `, ${fmt(obj[key], 3)} in from the tip` : '';
   $('#markers').replaceChildren(
     item(
       'max_exit_speed',
       'Max exit speed',
-      `${fmt(m.exit_speed_mps, 4)} m/s at ${fmt(m.position_from_knob_m, 4)} m from the knob (${m.model}, ${m.placement.replaceAll('_', ' ')})`,
+      `${qu(m, 'exit_speed_mps')} at ${qu(m, 'position_from_knob_m')} from the knob${tip(m, 'position_from_tip_in')} (${m.model}, ${m.placement.replaceAll('_', ' ')})`,
       m.position_from_knob_m,
     ),
     item(
       'center_of_percussion',
       'Centre of percussion',
-      `${fmt(cop.position_from_knob_m, 4)} m (hands at ${fmt(cop.hands_from_knob_m, 4)} m; ${cop.placement.replaceAll('_', ' ')})`,
+      `${qu(cop, 'position_from_knob_m')} (hands at ${qu(cop, 'hands_from_knob_m')}; ${cop.placement.replaceAll('_', ' ')})`,
       cop.position_from_knob_m,
     ),
     item(
       'vibration_node',
       'Vibration node',
-      `${fmt(node.position_from_knob_m, 4)} m (fundamental bending mode, ${fmt(node.frequency_hz, 4)} Hz)`,
+      `${qu(node, 'position_from_knob_m')} (fundamental bending mode, ${fmt(node.frequency_hz, 4)} Hz)`,
       node.position_from_knob_m,
     ),
     el(
@@ -162,9 +202,63 @@ function renderMarkers(sweet) {
         dataset: { marker: 'sweet_zone', fromM: String(zone.from_knob_m), toM: String(zone.to_knob_m) },
       },
       el('b', { text: 'Sweet zone' }),
-      ` ${fmt(zone.from_knob_m, 4)}–${fmt(zone.to_knob_m, 4)} m (within ${fmt(zone.tolerance_mps, 3)} m/s of the maximum)`,
+      ` ${fmt(q(zone, 'from_knob_m'), 4)}–${qu(zone, 'to_knob_m')} from the knob (within ${qu(zone, 'tolerance_mps', 3)} of the maximum)`,
     ),
   );
+}
+
+/**
+ * The headline: the sweet spot, its exit speed, THE BBCOR, the barrel's hoop
+ * frequency (hollow bats) and the batted ball's carry, each the API's number
+ * in the page's units (`data-value` holds it, `data-path` says where it is).
+ */
+function renderHeadline(sweet, scene) {
+  const m = sweet.max_exit_speed;
+  const bb = sweet.batted_ball;
+  const barrel = sweet.barrel;
+  const imperial = page.units === 'imperial';
+  const item = (key, title, path, value, unit, digits, note = '') =>
+    el(
+      'div',
+      { class: 'item', dataset: { key, path, value: value === undefined || value === null ? '' : String(value) } },
+      el('dt', { text: title }),
+      el('dd', {}, el('b', { text: fmt(value, digits) }), unit ? ` ${unit}` : '', note ? el('small', { text: note }) : ''),
+    );
+  const spotKey = imperial ? 'position_from_tip_in' : 'position_from_knob_m';
+  const items = [
+    item(
+      'sweet_spot',
+      'Sweet spot',
+      `max_exit_speed.${spotKey}`,
+      m[spotKey],
+      imperial ? 'in from the tip' : 'm from the knob',
+      3,
+      imperial ? ` ${fmt(m.position_from_knob_in, 4)} in from the knob` : '',
+    ),
+    item('exit_speed', 'Exit speed there', `max_exit_speed.${imperial ? 'exit_speed_mph' : 'exit_speed_mps'}`,
+      q(m, 'exit_speed_mps'), u('exit_speed_mps'), 4, ` ${m.model} model, head-on`),
+    item('bbcor', 'BBCOR', 'bbcor.value', sweet.bbcor?.value, '', 3,
+      sweet.bbcor ? ` max of the scan, ${qu(sweet.bbcor, 'impact_from_tip_m', 3)} from the tip` : ''),
+  ];
+  if (barrel?.hollow) {
+    items.push(item('hoop_frequency', 'Barrel hoop frequency', 'barrel.hoop_frequency_hz', barrel.hoop_frequency_hz, 'Hz', 4,
+      ` effective COR ${fmt(barrel.effective_cor, 3)}`));
+  }
+  if (bb) {
+    const carryKey = imperial ? 'distance_ft' : 'distance_m';
+    items.push(
+      item('carry', 'Carry', `batted_ball.${carryKey}`, bb[carryKey], imperial ? 'ft' : 'm', 4,
+        ` at ${qu(bb, 'exit_speed_mps', 4)}, ${fmt(bb.launch_angle_deg, 3)}°, ${fmt(bb.backspin_rpm, 4)} rpm`),
+    );
+  }
+  $('#headline-values').replaceChildren(...items);
+  const ball = scene.ball?.preset ? `the ${scene.ball.preset} ball` : 'the default ball';
+  const pitch = scene.ball?.speed_mph ?? scene.ball?.speed_mps;
+  const pitchUnit = scene.ball?.speed_mph !== undefined ? 'mph' : 'm/s';
+  const swing = sweet.swing;
+  $('#headline-about').textContent =
+    `(${ball}${pitch === undefined ? '' : ` at ${pitch} ${pitchUnit}`}` +
+    `${swing?.bat_speed_mps !== undefined ? `, bat speed ${qu(swing, 'bat_speed_mps', 3)}` : ''}; POST /v1/sweet-spot)`;
 }
 
 function renderModes(modes) {
@@ -188,12 +282,13 @@ async function refreshBat() {
   setStatus('Computing…');
   const started = performance.now();
   const results = await Promise.allSettled([
-    api.post('/v1/bat/properties', { bat }),
+    api.post('/v1/bat/properties', { bat, report_units: page.units }),
     api.post('/v1/sweet-spot', {
       bat,
       ...scene,
       outputs: SWEET_SPOT_OUTPUTS,
       options: { curve_samples: CURVE_SAMPLES },
+      report_units: page.units,
     }),
     api.post('/v1/bat/modes', { bat, modes: 2, shape_samples: 81 }),
   ]);
@@ -208,7 +303,9 @@ async function refreshBat() {
       seen.add(key);
       showError(form, error);
     }
-    for (const section of ['#bat-section', '#curve-section', '#modes-section']) $(section).classList.add('stale');
+    for (const section of ['#headline', '#bat-section', '#curve-section', '#modes-section']) {
+      $(section).classList.add('stale');
+    }
     document.body.dataset.state = 'error';
     setStatus(
       'The API refused the inputs: see the message beside the field. The charts show the last valid bat.',
@@ -217,17 +314,35 @@ async function refreshBat() {
     return;
   }
   const [properties, sweet, modes] = results.map((r) => r.value);
-  for (const section of ['#bat-section', '#curve-section', '#modes-section']) $(section).classList.remove('stale');
+  for (const section of ['#headline', '#bat-section', '#curve-section', '#modes-section']) {
+    $(section).classList.remove('stale');
+  }
   const outline = page.batForm.outline(bat);
   page.good = { bat, scene, properties, sweet, modes, outline };
   const marks = marksOf(sweet);
   const zone = { from_m: sweet.sweet_zone.from_knob_m, to_m: sweet.sweet_zone.to_knob_m };
-  drawBat($('#bat-drawing'), [outline && { ...outline, role: 'main' }], { marks, zone });
-  renderProperties(properties);
-  page.curve.update(sweet.exit_speed_curve, marks, zone, {
-    position_m: sweet.max_exit_speed.position_from_knob_m,
-    speed_mps: sweet.max_exit_speed.exit_speed_mps,
+  drawBat($('#bat-drawing'), [outline && { ...outline, role: 'main' }], {
+    marks,
+    zone,
+    axisUnit: page.units === 'imperial' ? 'in' : 'm',
   });
+  renderProperties(properties);
+  page.curve.update(
+    sweet.exit_speed_curve,
+    marks,
+    { ...zone, from: q(sweet.sweet_zone, 'from_knob_m'), to: q(sweet.sweet_zone, 'to_knob_m') },
+    {
+      position: q(sweet.max_exit_speed, 'position_from_knob_m'),
+      speed: q(sweet.max_exit_speed, 'exit_speed_mps'),
+    },
+    {
+      x: page.units === 'imperial' ? 'position_from_knob_in' : 'position_from_knob_m',
+      y: page.units === 'imperial' ? 'exit_speed_mph' : 'exit_speed_mps',
+      xLabel: `position from the knob (${u('position_from_knob_m')})`,
+      yLabel: `exit speed (${u('exit_speed_mps')})`,
+    },
+  );
+  renderHeadline(sweet, scene);
   const chart = $('#curve-chart');
   chart.dataset.maxExitSpeedPositionM = String(sweet.max_exit_speed.position_from_knob_m);
   chart.dataset.maxExitSpeedMps = String(sweet.max_exit_speed.exit_speed_mps);
@@ -236,10 +351,91 @@ async function refreshBat() {
   renderMarkers(sweet);
   renderModes(modes);
   updateVariablesAbout();
+  saveState();
   document.body.dataset.revision = String(Number(document.body.dataset.revision || 0) + 1);
   document.body.dataset.state = 'ready';
   setStatus(`Up to date (3 requests, ${Math.round(performance.now() - started)} ms).`, 'ok');
   refreshCompare();
+  refreshFlight(sweet.batted_ball);
+}
+
+/**
+ * The batted ball's path from the side: /v1/flight with the launch the
+ * batted_ball block gives (its exit speed, angle and spins, from 3 ft as it
+ * flew), sampled every 0.05 s.
+ */
+async function refreshFlight(battedBall) {
+  const seq = ++page.flightSeq;
+  const section = $('#flight-section');
+  if (!battedBall) return;
+  const launch = {
+    exit_speed_mps: battedBall.exit_speed_mps,
+    launch_angle_deg: battedBall.launch_angle_deg,
+    backspin_rpm: battedBall.backspin_rpm,
+    sidespin_rpm: battedBall.sidespin_rpm,
+  };
+  const body = { launch, outputs: ['trajectory'], report_units: page.units };
+  let answer;
+  try {
+    answer = await api.post('/v1/flight', body);
+  } catch (error) {
+    if (seq !== page.flightSeq) return;
+    section.classList.add('stale');
+    $('#flight-about').textContent = `The flight was refused: ${error.message}`;
+    return;
+  }
+  if (seq !== page.flightSeq) return;
+  section.classList.remove('stale');
+  const imperial = page.units === 'imperial';
+  const unit = imperial ? 'ft' : 'm';
+  page.flight.update(answer.trajectory, imperial ? 'y_ft' : 'y_m', imperial ? 'z_ft' : 'z_m', unit);
+  const distance = imperial ? answer.distance_ft : answer.distance_m;
+  const apex = imperial ? answer.apex_ft : answer.apex_m;
+  const chart = $('#flight-chart');
+  chart.dataset.distance = String(distance);
+  chart.dataset.points = String(answer.trajectory.length);
+  $('#flight-about').textContent =
+    `Launched at ${qu(answer.trajectory[0], 'speed_mps', 4)}, ${fmt(battedBall.launch_angle_deg, 3)}°, ` +
+    `${fmt(answer.backspin_rpm, 4)} rpm backspin: ${fmt(distance, 4)} ${unit} from home plate, apex ` +
+    `${fmt(apex, 3)} ${unit}, ${fmt(answer.hang_time_s, 3)} s in the air (${answer.aero_model}, ` +
+    `${answer.classification?.barrel ? 'a barrel' : 'not a barrel'} by Statcast's definition).`;
+}
+
+// ---- units and the URL ----------------------------------------------------
+
+/** The forms whose inputs the URL keeps. */
+const stateForms = () => [$('#bat-form'), $('#optimize-form')];
+
+/** Writes the inputs that differ from the defaults into the URL's hash (a link restores them). */
+function saveState() {
+  const hash = `#${stateParams(stateForms(), page.units).toString()}`;
+  if (hash !== window.location.hash) history.replaceState(null, '', hash);
+  $('#share-link').href = window.location.href;
+}
+
+/** The page as the URL's hash says: the defaults, in its units, with its inputs over them. */
+function restoreState() {
+  const params = new URLSearchParams(window.location.hash.slice(1));
+  const units = params.get('units');
+  resetControls(stateForms());
+  setUnits(units === 'si' ? 'si' : 'imperial');
+  restoreParams(stateForms(), params);
+  page.batForm.syncShape();
+}
+
+/** Switches the page to `system`: the inputs at their defaults, the answers' units. */
+function setUnits(system) {
+  page.units = system;
+  for (const radio of document.querySelectorAll('input[name="units"]')) radio.checked = radio.value === system;
+  document.body.dataset.units = system;
+  for (const form of stateForms()) switchInputs(form, system);
+}
+
+function setupUnits() {
+  $('#units').addEventListener('change', (event) => {
+    setUnits(event.target.value);
+    refreshBat();
+  });
 }
 
 let editTimer = 0;
@@ -334,13 +530,20 @@ async function refreshCompare() {
   const form = $('#compare-form');
   const chosen = VARIANTS.filter((v) => form.elements[v.id]?.checked);
   const base = page.good.bat;
-  const variants = chosen.map((v) => ({ name: v.id, bat: { ...base, ...v.make() } }));
+  const variants = chosen.map((v) => {
+    const change = v.make();
+    const bat = { ...base, ...change };
+    // A change in metres replaces the base's own form of that field (a wall typed in inches).
+    for (const key of Object.keys(change)) if (key.endsWith('_m')) delete bat[`${key.slice(0, -2)}_in`];
+    return { name: v.id, bat };
+  });
   const body = {
     baseline: base,
     variants,
     ...page.good.scene,
     outputs: ['max_exit_speed', 'center_of_percussion', 'sweet_zone', 'exit_speed_curve'],
     options: { curve_samples: CURVE_SAMPLES },
+    report_units: page.units,
   };
   let answer;
   try {
@@ -389,81 +592,69 @@ async function refreshCompare() {
     el(
       'tbody',
       {},
-      line(
-        'Mass',
-        'kg',
-        (r) => r.properties.mass_kg,
-        4,
-        (r) => r.deltas?.mass_kg,
-      ),
+      line('Mass', u('mass_kg'), (r) => q(r.properties, 'mass_kg'), 4, (r) => q(r.deltas, 'mass_kg')),
       line('Weight', 'oz', (r) => r.properties.imperial?.weight_oz, 4),
-      line(
-        'Balance point',
-        'm',
-        (r) => r.properties.balance_point_m,
-        4,
-        (r) => r.deltas?.balance_point_m,
+      line('Balance point', u('balance_point_m'), (r) => q(r.properties, 'balance_point_m'), 4, (r) =>
+        q(r.deltas, 'balance_point_m'),
       ),
-      line(
-        'MOI about 6 in',
-        'kg·m²',
-        (r) => r.properties.moi_six_inch_kg_m2,
-        4,
-        (r) => r.deltas?.moi_six_inch_kg_m2,
+      line('MOI about 6 in', u('moi_six_inch_kg_m2'), (r) => q(r.properties, 'moi_six_inch_kg_m2'), 4, (r) =>
+        q(r.deltas, 'moi_six_inch_kg_m2'),
       ),
-      line(
-        'Max exit speed',
-        'm/s',
-        (r) => r.max_exit_speed.exit_speed_mps,
-        4,
-        (r) => r.deltas?.max_exit_speed_mps,
+      line('Max exit speed', u('exit_speed_mps'), (r) => q(r.max_exit_speed, 'exit_speed_mps'), 4, (r) =>
+        q(r.deltas, 'max_exit_speed_mps'),
       ),
-      line(
-        '… at',
-        'm',
-        (r) => r.max_exit_speed.position_from_knob_m,
-        4,
-        (r) => r.deltas?.max_exit_speed_position_m,
+      line('… at', u('position_from_knob_m'), (r) => q(r.max_exit_speed, 'position_from_knob_m'), 4, (r) =>
+        q(r.deltas, 'max_exit_speed_position_m'),
       ),
       line(
         'Centre of percussion',
-        'm',
-        (r) => r.center_of_percussion.position_from_knob_m,
+        u('position_from_knob_m'),
+        (r) => q(r.center_of_percussion, 'position_from_knob_m'),
         4,
-        (r) => r.deltas?.center_of_percussion_m,
+        (r) => q(r.deltas, 'center_of_percussion_m'),
       ),
-      line('Sweet zone from', 'm', (r) => r.sweet_zone.from_knob_m, 4),
-      line('Sweet zone to', 'm', (r) => r.sweet_zone.to_knob_m, 4),
+      line('Sweet zone from', u('from_knob_m'), (r) => q(r.sweet_zone, 'from_knob_m'), 4),
+      line('Sweet zone to', u('to_knob_m'), (r) => q(r.sweet_zone, 'to_knob_m'), 4),
       line('COR', '', (r) => r.cor, 3),
     ),
   );
   table.dataset.variants = rows.map((r) => r.name).join(',');
-  page.variantsChart.update(rows);
+  page.variantsChart.update(rows, {
+    x: page.units === 'imperial' ? 'position_from_knob_in' : 'position_from_knob_m',
+    y: page.units === 'imperial' ? 'exit_speed_mph' : 'exit_speed_mps',
+    xLabel: `position from the knob (${u('position_from_knob_m')})`,
+    yLabel: `exit speed (${u('exit_speed_mps')})`,
+  });
 }
 
 // ---- optimisation --------------------------------------------------------
 
 /** The variables the optimisation may change, for the bat above. */
-function optimizeVariables(bat, radiusMin, radiusMax) {
+function optimizeVariables(bat, radiusMin, radiusMax, byDiameterIn) {
+  // The bounds' input says the variables' form: radii in m, or diameters in inches (the API
+  // takes either, docs/api.md "The trade's units"; the answer names them as written).
+  const radius = byDiameterIn ? 'diameter_in' : 'radius_m';
   if (bat.three_segment) {
-    const length = bat.three_segment.length_m;
+    // The taper's positions in the unit the shape's inputs give them, bounded by its length.
+    const unit = 'taper_start_in' in bat.three_segment ? 'in' : 'm';
+    const length = bat.three_segment[`length_${unit}`];
     return [
-      { path: 'three_segment.handle_radius_m', min: radiusMin, max: radiusMax },
-      { path: 'three_segment.barrel_radius_m', min: radiusMin, max: radiusMax },
-      { path: 'three_segment.taper_start_m', min: 0, max: length },
-      { path: 'three_segment.taper_end_m', min: 0, max: length },
+      { path: `three_segment.handle_${radius}`, min: radiusMin, max: radiusMax },
+      { path: `three_segment.barrel_${radius}`, min: radiusMin, max: radiusMax },
+      { path: `three_segment.taper_start_${unit}`, min: 0, max: length },
+      { path: `three_segment.taper_end_${unit}`, min: 0, max: length },
     ];
   }
   const knots = page.catalogue.presets.get(bat.preset)?.bat.profile.knots || [];
-  return knots.map((_, i) => ({ path: `profile.knots[${i}].radius_m`, min: radiusMin, max: radiusMax }));
+  return knots.map((_, i) => ({ path: `profile.knots[${i}].${radius}`, min: radiusMin, max: radiusMax }));
 }
 
 function updateVariablesAbout() {
   const bat = page.good?.bat;
   if (!bat) return;
   $('#variables-about').textContent = bat.three_segment
-    ? 'The handle and barrel radii (between the bounds below) and where the taper starts and ends.'
-    : `The radius of each of the preset's ${page.catalogue.presets.get(bat.preset)?.bat.profile.knots.length} knots (between the bounds below); their positions stay.`;
+    ? 'The handle and barrel radii or diameters (between the bounds below) and where the taper starts and ends.'
+    : `The radius (or diameter) of each of the preset's ${page.catalogue.presets.get(bat.preset)?.bat.profile.knots.length} knots (between the bounds below); their positions stay.`;
 }
 
 function optimizeBody() {
@@ -474,10 +665,16 @@ function optimizeBody() {
   return {
     bat,
     ...page.batForm.scene(),
-    variables: optimizeVariables(bat, readValue(form.elements.radius_min), readValue(form.elements.radius_max)),
+    variables: optimizeVariables(
+      bat,
+      readValue(form.elements.radius_min),
+      readValue(form.elements.radius_max),
+      form.elements.radius_min.dataset.system === 'imperial',
+    ),
     constraints,
     objective: form.elements.objective.value,
     options: readFields(form, 'options.'),
+    report_units: page.units,
   };
 }
 
@@ -537,15 +734,20 @@ function renderOptimum(result, original) {
       ),
       row(`Objective (${result.objective})`, result.objective_value, undefined, result.objective_unit),
       row(
-        'Sweet spot',
-        result.sweet_spot?.position_from_knob_m,
-        original?.sweet.max_exit_speed.position_from_knob_m,
-        'm',
+        'Sweet spot (from the knob)',
+        q(result.sweet_spot, 'position_from_knob_m'),
+        q(original?.sweet.max_exit_speed, 'position_from_knob_m'),
+        u('position_from_knob_m'),
       ),
-      row('Exit speed there', result.sweet_spot?.exit_speed_mps, original?.sweet.max_exit_speed.exit_speed_mps, 'm/s'),
-      row('Mass', p.mass_kg, o.mass_kg, 'kg'),
-      row('Balance point', p.balance_point_m, o.balance_point_m, 'm'),
-      row('MOI about 6 in', p.moi_six_inch_kg_m2, o.moi_six_inch_kg_m2, 'kg·m²'),
+      row(
+        'Exit speed there',
+        q(result.sweet_spot, 'exit_speed_mps'),
+        q(original?.sweet.max_exit_speed, 'exit_speed_mps'),
+        u('exit_speed_mps'),
+      ),
+      row('Mass', q(p, 'mass_kg'), q(o, 'mass_kg'), u('mass_kg')),
+      row('Balance point', q(p, 'balance_point_m'), q(o, 'balance_point_m'), u('balance_point_m')),
+      row('MOI about 6 in', q(p, 'moi_six_inch_kg_m2'), q(o, 'moi_six_inch_kg_m2'), u('moi_six_inch_kg_m2')),
       row('Constraint violation', s.constraint_violation, undefined, '', 3),
       row('Starts converged', s.spread?.converged, undefined, `of ${s.spread?.starts}`, 3),
     ),
@@ -612,6 +814,7 @@ async function runOptimisation() {
 }
 
 function setupOptimizeForm() {
+  $('#optimize-form').addEventListener('change', () => saveState());
   $('#optimize-form').addEventListener('submit', (event) => {
     event.preventDefault();
     runOptimisation();
@@ -627,6 +830,23 @@ function setupOptimizeForm() {
   });
 }
 
+// ---- exports ---------------------------------------------------------------
+
+/** The CSV / SVG buttons under each chart: what the chart shows, as files. */
+function setupExports() {
+  const stem = () => (page.good?.bat.preset || 'bat').replace(/[^A-Za-z0-9_-]/g, '_');
+  const actions = {
+    'bat-drawing-svg': () => downloadSvg(`${stem()}-drawing.svg`, $('#bat-drawing')),
+    'curve-csv': () => downloadCsv(`${stem()}-exit-speed-${page.units}.csv`, page.curve.table()),
+    'flight-csv': () => downloadCsv(`${stem()}-flight-${page.units}.csv`, page.flight.table()),
+    'modes-csv': () => downloadCsv(`${stem()}-modes.csv`, page.modes.table()),
+    'compare-csv': () => downloadCsv(`${stem()}-variants.csv`, page.variantsChart.table()),
+  };
+  for (const button of document.querySelectorAll('[data-export]')) {
+    button.addEventListener('click', () => actions[button.dataset.export]?.());
+  }
+}
+
 // ---- start ---------------------------------------------------------------
 
 async function start() {
@@ -634,9 +854,14 @@ async function start() {
   setupTokenForm();
   let presets;
   let materials;
+  let balls;
   for (;;) {
     try {
-      [presets, materials] = await Promise.all([api.get('/v1/presets'), api.get('/v1/materials')]);
+      [presets, materials, balls] = await Promise.all([
+        api.get('/v1/presets'),
+        api.get('/v1/materials'),
+        api.get('/v1/balls'),
+      ]);
       break;
     } catch (error) {
       if (error.status !== 401) {
@@ -651,14 +876,24 @@ async function start() {
   page.catalogue = {
     presets: new Map(presets.presets.map((p) => [p.name, p])),
     materials: new Map(materials.materials.map((m) => [m.name, m])),
+    balls: new Map(balls.balls.map((b) => [b.name, b])),
   };
   page.batForm = new BatForm($('#bat-form'), page.catalogue);
   page.curve = new CurveChart($('#curve-chart'));
   page.modes = new ModesChart($('#modes-chart'));
   page.variantsChart = new VariantsChart($('#compare-chart'));
+  page.flight = new FlightChart($('#flight-chart'));
+  setupUnits();
+  restoreState();
   setupBatForm();
   setupVariants();
   setupOptimizeForm();
+  setupExports();
+  window.addEventListener('hashchange', () => {
+    if (window.location.hash === `#${stateParams(stateForms(), page.units).toString()}`) return;
+    restoreState();
+    refreshBat();
+  });
   await refreshBat();
 }
 
