@@ -306,10 +306,11 @@ bool RunWaves(const FlightSweep& sweep, Make make, Consume consume, int* lanes_u
   return true;
 }
 
-// Prefixes an error of the template's parser with "flight.".
+// Prefixes an error of the template's parser with "flight.": an error naming a field states it
+// first (SetError and CoreRefusal write "field = value: rule"), so both gain the prefix.
 void PrefixFlight(ApiError* error) {
   if (error->field.empty()) return;
-  if (error->message.rfind(error->field, 0) == 0) error->message = "flight." + error->message;
+  error->message = "flight." + error->message;
   error->field = "flight." + error->field;
 }
 
