@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "core/numerics/timing_book.hpp"
 #include "core/scene/resolved_scene.hpp"
 
 namespace sweetspot::core {
@@ -21,7 +22,8 @@ DistanceEvaluation EvaluateDistance(const Bat& bat, const DistanceScene& scene) 
     s.outputs = {SceneOutput::kDistanceSweetSpot};
     ResolvedScene resolved;
     Summary summary;
-    if (!ResolveScene(s, /*needs_cor=*/true, nullptr, &resolved, &summary, std::nullopt,
+    TimingBook book(/*timed=*/false);  // ResolveScene books the mass properties: not reported
+    if (!ResolveScene(s, /*needs_cor=*/true, &book, &resolved, &summary, std::nullopt,
                       scene.model)) {
       out.message = summary.refusal.has_value() ? summary.refusal->Message() : summary.message;
       return out;
