@@ -369,7 +369,8 @@ double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
   if (f.function == DesignFunction::kObjective && objective_kind_ == DesignObjective::kMinSting) {
     return StingOf(BatAt(x), false).sting_j;  // NaN when it cannot be computed
   }
-  if (f.function == DesignFunction::kObjective && objective_kind_ == DesignObjective::kMaxDistance) {
+  if (f.function == DesignFunction::kObjective &&
+      objective_kind_ == DesignObjective::kMaxDistance) {
     return DistanceOf(BatAt(x)).distance_m;  // NaN when it cannot be computed
   }
   if (f.function == DesignFunction::kFirstFrequency) return FirstFrequencyAt(x);

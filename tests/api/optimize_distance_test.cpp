@@ -78,8 +78,8 @@ TEST(OptimizeDistanceEndpointTest, EnvironmentReachesTheObjective) {
   // barrel (the heavier bat); the default scene's slow swing carries it 49.25 m calm, 50.89 m
   // with the wind (measured), so > 1 m farther.
   Json calm = DistanceRequest();
-  calm["variables"] = Json::parse(
-      R"([{"path": "three_segment.barrel_radius_m", "min": 0.031, "max": 0.034}])");
+  calm["variables"] =
+      Json::parse(R"([{"path": "three_segment.barrel_radius_m", "min": 0.031, "max": 0.034}])");
   calm.erase("constraints");
   Json wind = calm;
   wind["environment"] = {{"wind", {{"speed_mph", 10}, {"direction_deg", 0}}}};

@@ -167,8 +167,10 @@ TEST(OptimizeDistanceTest, CarryIsSmoothInTheDesignDownToTinySteps) {
   // 1.12 x the median); a jump of the size of the search's resolution (~1e-6 m) would not show,
   // one of the coarse cell's change (the optimum moving to another local maximum) would.
   EXPECT_LT(worst2, 3.0 * median2);
-  std::printf("sweep r in [0.030, 0.0345] m, step 2.5e-5 m: F %.6f..%.6f m, |2nd diff| median "
-              "%.3g m, max %.3g m\n", f.front(), f.back(), median2, worst2);
+  std::printf(
+      "sweep r in [0.030, 0.0345] m, step 2.5e-5 m: F %.6f..%.6f m, |2nd diff| median "
+      "%.3g m, max %.3g m\n",
+      f.front(), f.back(), median2, worst2);
 }
 
 TEST(OptimizeDistanceTest, Refusals) {
