@@ -123,7 +123,7 @@ bool ReadConstraints(ObjectReader& top, core::DesignConstraints* c) {
 // nlopt_cobyla (the only solver it can use) and the other objectives ipopt.
 bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjective objective,
                  core::DesignOptions* o, core::FlexibleOptions* flexible,
-                 core::CollisionModel* model) {
+                 core::DistanceOptions* distance, core::CollisionModel* model) {
   // Defaults never exceed the configured limits.
   o->max_iterations = std::min(o->max_iterations, limits.max_iterations);
   o->max_time_s = std::min(o->max_time_s, limits.max_time_s);
@@ -131,7 +131,10 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
   o->max_variables = static_cast<int>(std::min<std::size_t>(
       limits.max_design_variables, static_cast<std::size_t>(std::numeric_limits<int>::max())));
   ClampToLimits(limits, flexible);
-  const bool sting = objective == core::DesignObjective::kMinSting;
+  // The objectives without a derivative: COBYLA unless another backend is asked for (core
+  // then solves them by COBYLA anyway, with a warning).
+  const bool sting = objective == core::DesignObjective::kMinSting ||
+                     objective == core::DesignObjective::kMaxDistance;
   if (sting) o->backend = core::DesignBackend::kNloptCobyla;
   // Without "backend" the optimiser chooses (DesignOptions::choose_backend): NLopt SLSQP for a
   // small lifted problem when its answer is certified, Ipopt otherwise.
@@ -177,6 +180,13 @@ bool ReadOptions(ObjectReader& top, const ApiLimits& limits, core::DesignObjecti
     if (!ReadFlexibleOptions(*f, reader.PathOf("flexible"), limits, flexible, top.error())) {
       return false;
     }
+  }
+  // max_distance: the distance sweet spot's region and tolerances, as /v1/sweet-spot reads them.
+  if (const Json* d = reader.Get("distance")) {
+    if (objective != core::DesignObjective::kMaxDistance) {
+      return reader.Fail("distance", "applies to objective max_distance only");
+    }
+    if (!ReadDistanceOptions(*d, reader.PathOf("distance"), distance, top.error())) return false;
   }
   if (!reader.Finish()) return false;
   if (core::Refusal refusal; !o->Validate(&refusal)) {
@@ -372,6 +382,27 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
                     {"error_estimate_j", r.sting->error_estimate_j},
                     {"flexible", FlexibleImpactToJson(r.sting->impact)}};
   }
+  if (r.distance_sweet_spot) {
+    // max_distance: the answer's distance sweet spot, as /v1/sweet-spot's distance_sweet_spot
+    // gives it for the returned bat in the same scene.
+    const core::DistanceSweetSpotResult& d = *r.distance_sweet_spot;
+    out["distance_sweet_spot"] = {
+        {"position_from_knob_m", d.position_from_knob_m},
+        {"undercut_m", d.undercut_m},
+        {"distance_m", d.distance_m},
+        {"exit_speed_mps", d.exit_speed_mps},
+        {"launch_angle_deg", d.launch_angle_deg},
+        {"backspin_rpm", d.backspin_rpm + 0.0},
+        {"hang_time_s", d.ball.flight.hang_time_s},
+        {"apex_m", d.ball.flight.apex_m},
+        {"bat_speed_at_impact_mps", d.ball.bat_speed_at_impact_mps},
+        {"aero_model", core::flight::AeroModelName(d.ball.aero_model)},
+        {"air_density_kg_m3", d.ball.flight.air_density_kg_m3},
+        {"distance_error_estimate_m", Finite(d.ball.flight.error_estimate_m)},
+        {"at_position_bound", d.at_position_bound},
+        {"at_undercut_bound", d.at_undercut_bound},
+        {"evaluations", d.evaluations}};
+  }
   return out;
 }
 
@@ -411,6 +442,8 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
   problem.swing = scene.swing;
   problem.cor = scene.cor;
   problem.inertia_model = scene.inertia_model;
+  problem.environment = scene.environment;  // max_distance: the flight's air and aero
+  problem.aero = scene.aero;
   if (!ReadVariables(reader, context.limits, &problem, &request.material_choices,
                      &request.variable_names) ||
       !ReadConstraints(reader, &problem.constraints)) {
@@ -419,7 +452,7 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
   request.objective = "max_exit_speed";
   reader.OptionalString("objective", &request.objective,
                         {"max_exit_speed", "max_exit_speed_swing_weight", "widest_sweet_zone",
-                         "min_moi", "min_sting"});
+                         "min_moi", "min_sting", "max_distance"});
   problem.objective = *core::ParseDesignObjective(request.objective);
   request.base_properties = spec->properties->Of(scene.inertia_model);
   problem.base_mass_properties = request.base_properties;  // computed once, by ParseBat
@@ -430,7 +463,7 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
   reader.OptionalNumber("sweet_zone_tolerance_mps", AnyNumber(), &problem.sweet_zone_tolerance_mps);
   core::CollisionModel model = core::CollisionModel::kAuto;
   if (!ReadOptions(reader, context.limits, problem.objective, &request.options, &problem.flexible,
-                   &model) ||
+                   &problem.distance, &model) ||
       !reader.Finish()) {
     return std::nullopt;
   }

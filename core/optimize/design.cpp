@@ -128,6 +128,8 @@ const char* ObjectiveUnit(DesignObjective objective) {
       return "m";
     case DesignObjective::kMinSting:
       return "j";
+    case DesignObjective::kMaxDistance:
+      return "m";
     case DesignObjective::kLeastSquares:
       return "";
     default:
@@ -295,6 +297,24 @@ void ClassifyChosen(const DesignOptions& options, DesignBackend backend, const R
       result->message_kind = DesignMessageKind::kStingFailed;
     }
   }
+  if (pub.distance.has_value()) {  // max_distance
+    const DistanceEvaluation& d = *pub.distance;
+    if (d.ok) {
+      result->distance_sweet_spot = d.result;
+      if (d.result.at_position_bound || d.result.at_undercut_bound) {
+        result->summary.warnings.push_back(
+            std::string("distance_sweet_spot: the farthest carry of the answer is at the edge of "
+                        "the region searched (") +
+            (d.result.at_position_bound ? "position" : "undercut") +
+            "): widen options.distance's ranges to see whether it carries farther beyond");
+      }
+    } else if (result->summary.termination != Termination::kFailure) {
+      result->summary.termination = Termination::kFailure;
+      result->summary.message =
+          "the distance sweet spot of the optimised bat cannot be computed: " + d.message;
+      result->message_kind = DesignMessageKind::kDistanceFailed;
+    }
+  }
 }
 
 // A design that violates a constraint after the re-check: not converged, and infeasible when
@@ -417,6 +437,15 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
     summary.models_used.push_back(kFlexibleBeamModel);
   }
   if (sting) summary.models_used.push_back("flexible");
+  // max_distance: the oblique impact and the flight of every design's distance sweet spot.
+  const bool distance = problem.objective == DesignObjective::kMaxDistance;
+  if (distance) {
+    summary.models_used.push_back("oblique_impact");
+    summary.models_used.push_back("flight");
+  }
+  // The objectives without a derivative (COBYLA whatever was asked).
+  const bool values_only = sting || distance;
+  const char* objective_name = DesignObjectiveName(problem.objective);
   summary.iterations = 0;
   summary.evaluations = 0;
   result.objective_unit = ObjectiveUnit(problem.objective);
@@ -427,11 +456,11 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
   if (!options.Validate(&why)) {
     invalid = true;
     why = Prefixed("options.", std::move(why));
-  } else if (sting && options.derivative_check != DerivativeCheck::kNone) {
+  } else if (values_only && options.derivative_check != DerivativeCheck::kNone) {
     invalid = true;
     why = TextRefusal("options.derivative_check",
-                      "objective = min_sting has no derivatives to check (it is solved "
-                      "derivative-free by COBYLA)");
+                      std::string("objective = ") + objective_name +
+                          " has no derivatives to check (it is solved derivative-free by COBYLA)");
   } else if (!design_detail::SlsqpSizeAllowed(problem, options, &why)) {
     invalid = true;
   } else if (!DesignModel::Build(problem, options, &model, &why)) {
@@ -451,6 +480,14 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
   const bool cor_known =
       problem.cor.has_value() || problem.bat.material.cor.has_value() || model.cor_from_barrel();
   result.cor = cor_known ? model.cor() : kNaN;
+  if (distance && options.backend != DesignBackend::kNloptCobyla) {
+    summary.warnings.push_back(
+        std::string("objective = max_distance: solved by NLopt LN_COBYLA, not ") +
+        BackendName(options.backend) +
+        ": the carry comes from an adaptive flight integration inside an iterative search over "
+        "the impact point and undercut (piecewise smooth at the 1e-7 m level, no usable "
+        "derivative: docs/optimization.md), so a derivative-free solver is used");
+  }
   if (sting && options.backend != DesignBackend::kNloptCobyla) {
     summary.warnings.push_back(
         std::string("objective = min_sting: solved by NLopt LN_COBYLA, not ") +

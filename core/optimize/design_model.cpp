@@ -369,6 +369,10 @@ double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
   if (f.function == DesignFunction::kObjective && objective_kind_ == DesignObjective::kMinSting) {
     return StingOf(BatAt(x), false).sting_j;  // NaN when it cannot be computed
   }
+  if (f.function == DesignFunction::kObjective &&
+      objective_kind_ == DesignObjective::kMaxDistance) {
+    return DistanceOf(BatAt(x)).distance_m;  // NaN when it cannot be computed
+  }
   if (f.function == DesignFunction::kFirstFrequency) return FirstFrequencyAt(x);
   const std::vector<double> t = ParametersAt(x);
   if (f.function == DesignFunction::kBoreBottom) {
@@ -455,8 +459,10 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
     out->jacobian = Eigen::MatrixXd::Zero(mc, nv);
   }
   if (derivative_free()) {
-    if (with_gradients) return false;  // the sting has no derivative
-    out->objective = StingOf(BatAt(x), false).sting_j;
+    if (with_gradients) return false;  // the sting and the carry have no derivative
+    out->objective = objective_kind_ == DesignObjective::kMaxDistance
+                         ? DistanceOf(BatAt(x)).distance_m
+                         : StingOf(BatAt(x), false).sting_j;
     if (!std::isfinite(out->objective)) return false;
   } else if (!evaluate(objective_, &out->objective,
                        with_gradients ? out->objective_gradient.data() : nullptr, 1)) {

@@ -30,6 +30,7 @@
 
 #include "core/bat/bat.hpp"
 #include "core/flexible/modes_cache.hpp"
+#include "core/optimize/design_distance.hpp"
 #include "core/optimize/design_problem.hpp"
 
 namespace sweetspot::core {
@@ -218,11 +219,16 @@ class DesignModel {
   /// The three-segment shape at x (nullopt for a profile design).
   std::optional<ThreeSegmentShape> ShapeAt(const double* x) const;
 
-  /// True when the objective is the sting (min_sting: values only, no derivatives).
+  /// True when the objective has values only, no derivatives: the sting (min_sting) or the
+  /// distance sweet spot's carry (max_distance).
   bool derivative_free() const {
-    return objective_kind_ == DesignObjective::kMinSting &&
+    return (objective_kind_ == DesignObjective::kMinSting ||
+            objective_kind_ == DesignObjective::kMaxDistance) &&
            objective_.function == DesignFunction::kObjective;
   }
+  /// The objective's name for the messages of a derivative-free objective ("min_sting",
+  /// "max_distance").
+  const char* objective_name() const { return DesignObjectiveName(objective_kind_); }
   /// The first bending frequency at x on the model's fixed mesh, Hz (NaN without the
   /// min_frequency_hz constraint or when it cannot be computed).
   double FirstFrequencyAt(const double* x) const;
@@ -233,6 +239,8 @@ class DesignModel {
   double BbcorAt(const double* x) const;
   /// The sting of `bat` in this problem's scene (EvaluateSting with the model's modes cache).
   StingEvaluation StingOf(const Bat& bat, bool refine_check) const;
+  /// The distance sweet spot of `bat` in this problem's scene (max_distance; EvaluateDistance).
+  DistanceEvaluation DistanceOf(const Bat& bat) const;
 
   /// A copy that minimises or maximises `f` instead of the objective (same constraints).
   DesignModel WithObjective(const DesignFunctionSpec& f, bool maximize, double scale,
@@ -347,6 +355,8 @@ class DesignModel {
   // model's copies; thread-safe), so repeated points do not recompute them.
   StingScene sting_scene_;
   std::shared_ptr<ModesCache> sting_modes_;
+  // max_distance: the scene of the distance sweet spot (immutable, shared by the copies).
+  std::shared_ptr<const DistanceScene> distance_scene_;
   // min_frequency_hz: the beam on its fixed mesh (immutable, shared by the model's copies).
   std::shared_ptr<const FixedMeshBeam> frequency_beam_;
   // rules bbcor on a hollow design: the protocol's constants (immutable, shared by the copies).

@@ -110,6 +110,15 @@ StingEvaluation DesignModel::StingOf(const Bat& bat, bool refine_check) const {
   return EvaluateSting(bat, sting_scene_, refine_check, sting_modes_.get());
 }
 
+DistanceEvaluation DesignModel::DistanceOf(const Bat& bat) const {
+  if (distance_scene_ == nullptr) {
+    DistanceEvaluation none;
+    none.message = "the objective is not max_distance";
+    return none;
+  }
+  return EvaluateDistance(bat, *distance_scene_);
+}
+
 DesignModel DesignModel::WithObjective(const DesignFunctionSpec& f, bool maximize, double scale,
                                        const std::string& unit) const {
   DesignModel copy = *this;

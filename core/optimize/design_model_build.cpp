@@ -381,8 +381,13 @@ bool ModelBuilder::SceneNumbers() {
   if (problem.model != CollisionModel::kRigidPivot && problem.model != CollisionModel::kFreeBat) {
     return Refuse(why, Refusal{"model", std::numeric_limits<double>::quiet_NaN(),
                                CollisionModelName(problem.model),
-                               "must be rigid_pivot or free_bat (the design's derivatives need a "
-                               "closed form)"});
+                               problem.objective == DesignObjective::kMaxDistance
+                                   ? "must be rigid_pivot or free_bat (max_distance searches the "
+                                     "distance sweet spot of every design with the closed-form "
+                                     "normal law; hertz and flexible need a table of ODE impacts "
+                                     "per design)"
+                                   : "must be rigid_pivot or free_bat (the design's derivatives "
+                                     "need a closed form)"});
   }
   model.free_bat_ = problem.model == CollisionModel::kFreeBat;
   model.swing_weight_exponent_ = problem.swing_weight_exponent;
@@ -397,6 +402,19 @@ bool ModelBuilder::SceneNumbers() {
     model.sting_scene_.flexible = problem.flexible;
     model.sting_scene_.flexible.modes_cache = nullptr;  // the model's own cache instead
     model.sting_modes_ = std::make_shared<ModesCache>(kStingModesCacheEntries);
+  }
+  if (problem.objective == DesignObjective::kMaxDistance) {
+    if (!problem.distance.Validate(why)) return false;  // names "distance.<field>"
+    auto scene = std::make_shared<DistanceScene>();
+    scene->ball = problem.ball;
+    scene->swing = problem.swing;
+    scene->cor = model.cor_;
+    scene->inertia_model = problem.inertia_model;
+    scene->model = problem.model;
+    scene->environment = problem.environment;
+    scene->aero = problem.aero;
+    scene->distance = problem.distance;
+    model.distance_scene_ = std::move(scene);
   }
   const MassProperties base_properties = problem.base_mass_properties.has_value()
                                              ? *problem.base_mass_properties
@@ -447,6 +465,7 @@ bool ModelBuilder::Objective() {
                     problem.objective != DesignObjective::kLeastSquares;
   model.objective_unit_ = problem.objective == DesignObjective::kMinMoi            ? "kg_m2"
                           : problem.objective == DesignObjective::kWidestSweetZone ? "m"
+                          : problem.objective == DesignObjective::kMaxDistance     ? "m"
                           : problem.objective == DesignObjective::kMinSting        ? "j"
                           : problem.objective == DesignObjective::kLeastSquares    ? ""
                                                                                    : "mps";
@@ -462,6 +481,15 @@ bool ModelBuilder::Objective() {
                                            sting.message));
     }
     f0 = sting.sting_j;
+  } else if (problem.objective == DesignObjective::kMaxDistance) {
+    const DistanceEvaluation d = model.DistanceOf(model.BatAt(x0.data()));
+    if (!d.ok) {
+      return Refuse(why, QuotedRefusal("objective", "max_distance",
+                                       "the distance sweet spot of the start (the base design "
+                                       "clamped into the variables' bounds) cannot be computed: " +
+                                           d.message));
+    }
+    f0 = d.distance_m;
   } else {
     f0 = model.Value(model.objective_, x0.data());
   }

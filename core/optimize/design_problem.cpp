@@ -43,6 +43,7 @@ constexpr ObjectiveName kObjectiveNames[] = {
     {DesignObjective::kWidestSweetZone, "widest_sweet_zone"},
     {DesignObjective::kMinMoi, "min_moi"},
     {DesignObjective::kMinSting, "min_sting"},
+    {DesignObjective::kMaxDistance, "max_distance"},
 };
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "core/optimize/least_squares_objective.hpp"
 #include "core/optimize/rules.hpp"
 #include "core/progress.hpp"
+#include "core/scene/batted_ball.hpp"
 #include "core/scene/collide.hpp"
 #include "core/summary.hpp"
 
@@ -176,6 +177,12 @@ enum class DesignObjective {
   /// max-exit-speed point (the flexible beam, as least_sting_zone measures sting), J
   /// (minimise). No derivative exists (adaptive mesh and integration): solved by NLopt COBYLA.
   kMinSting,
+  /// "max_distance": the carry of the design's distance sweet spot (the impact position and
+  /// undercut that carry the ball farthest, DistanceSweetSpot) in the problem's scene (ball with
+  /// its descent angle and spin, swing with its attack angle, environment, aero), m (maximise).
+  /// An adaptive flight integration inside an iterative 2-D search: solved by NLopt COBYLA
+  /// (docs/optimization.md, "max_distance", says why no gradient is used).
+  kMaxDistance,
   /// "least_squares" (the shape fit's, FitShape; not a request objective): the metric
   /// ((M - M*)/s_M)^2 + ((C - C*)/s_C)^2 of DesignProblem::least_squares, dimensionless
   /// (minimise).
@@ -239,6 +246,14 @@ struct DesignProblem {
   /// for /v1/sweet-spot). flexible.modes_cache is not used: every design has new modes, so each
   /// solve keeps its own small cache (repeated points) instead of filling a shared one.
   FlexibleOptions flexible;
+  /// kMaxDistance: the air the batted ball flies through (the scene's `environment`; the
+  /// flight's defaults: 70 F, sea level, 50 %, 29.92 inHg, calm).
+  flight::Environment environment;
+  /// kMaxDistance: the flight's aero model (the scene's `aero`; default nathan-2016).
+  flight::AeroOptions aero;
+  /// kMaxDistance: the distance sweet spot's search region and tolerances (/v1/sweet-spot's
+  /// options.distance; its defaults).
+  DistanceOptions distance;
   /// The base design's mass properties under inertia_model when the caller has computed them
   /// already (the api's ParseBat): the design model uses them instead of computing them again
   /// (DesignProblem::Validate and OptimizeDesign each build one). Must be those of `bat` (with
@@ -406,6 +421,8 @@ enum class DesignMessageKind {
   kCancelledStarts,
   kInvalidBat,   ///< "the optimised bat is invalid: ...".
   kStingFailed,  ///< "the sting of the optimised bat cannot be computed: ...".
+  /// "the distance sweet spot of the optimised bat cannot be computed: ..." (max_distance).
+  kDistanceFailed,
   kInfeasible,   ///< "infeasible: ..." (the conflicts), or the BBCOR rule's refusal of the answer.
   kNoDesign,     ///< "no local solve returned a design (...)".
   /// The backend reported convergence but the certificate failed: "not certified: <status>
@@ -494,7 +511,7 @@ struct DesignResult {
   std::vector<DesignValue> variables;              ///< The variables' values (see DesignValue).
   MassProperties properties;                       ///< Its mass properties (problem.inertia_model).
   double objective_value = 0.0;                    ///< The objective, in objective_unit.
-  std::string objective_unit;                      ///< "mps", "m", "kg_m2" or "j" (joules).
+  std::string objective_unit;  ///< "mps", "m" (also max_distance), "kg_m2" or "j" (joules).
   double cor = 0.0;  ///< The COR used (NaN when none is known: min_moi without one).
   /// problem.cor_from_barrel: the answer's COR is its own barrel's, recomputed through the public
   /// path (EffectiveCorAt at cor_impact_from_knob_m and cor_impact_speed_mps); NaN otherwise.
@@ -517,6 +534,9 @@ struct DesignResult {
   std::vector<DesignConflict> conflicts;                   ///< For an infeasible request: why.
   DesignSpread spread;                                     ///< Over the starts.
   std::optional<DesignSting> sting;  ///< min_sting: the answer's impact (else empty).
+  /// max_distance: the answer's distance sweet spot, recomputed through the public path
+  /// (EvaluateDistance: ResolveScene of the answer's bat, then DistanceSweetSpot), else empty.
+  std::optional<DistanceSweetSpotResult> distance_sweet_spot;
   /// constraints.min_frequency_hz: the answer's first bending mode (else empty).
   std::optional<DesignFrequency> first_bending_mode;
   /// rules bbcor or constraints.bbcor_max on a hollow answer: THE BBCOR (the flexible scan's

@@ -83,6 +83,11 @@ PublicEvaluation EvaluatePublic(const DesignProblem& problem, const DesignModel&
       out.sting = model.StingOf(bat, true);
       out.objective = out.sting->sting_j;
       break;
+    case DesignObjective::kMaxDistance: {
+      out.distance = model.DistanceOf(bat);
+      out.objective = out.distance->distance_m;  // NaN when it cannot be computed
+      break;
+    }
   }
   return out;
 }

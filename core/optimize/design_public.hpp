@@ -27,8 +27,9 @@ struct PublicEvaluation {
   double sweet_spot_m = kNaN;
   double max_exit_speed_mps = kNaN;
   double omega_rad_s = kNaN;
-  Placement placement = Placement::kOnBat;  ///< Of the sweet spot.
-  std::optional<StingEvaluation> sting;     ///< min_sting.
+  Placement placement = Placement::kOnBat;     ///< Of the sweet spot.
+  std::optional<StingEvaluation> sting;        ///< min_sting.
+  std::optional<DistanceEvaluation> distance;  ///< max_distance: the distance sweet spot.
   /// The COR used: the model's fixed one, or (cor_from_barrel) the design's barrel's through
   /// EffectiveCorAt at the point and speed below.
   double cor = kNaN;

@@ -156,8 +156,10 @@ LocalSolveOutcome Solve(DesignBackend backend, ScaledDesignNlp& nlp, const std::
 // The backend of the design's local solves: min_sting has no derivative, so COBYLA whatever
 // was asked.
 DesignBackend MainBackend(const DesignProblem& problem, const DesignOptions& options) {
-  return problem.objective == DesignObjective::kMinSting ? DesignBackend::kNloptCobyla
-                                                         : options.backend;
+  return problem.objective == DesignObjective::kMinSting ||
+                 problem.objective == DesignObjective::kMaxDistance
+             ? DesignBackend::kNloptCobyla
+             : options.backend;
 }
 
 // The backend of the infeasibility analysis, whose sub-problems are smooth (the objective is
@@ -211,8 +213,9 @@ void ReportActiveConstraints(const DesignModel& model, const std::vector<double>
     mult.z_lower.assign(static_cast<std::size_t>(model.n()), kNaN);
     mult.z_upper.assign(static_cast<std::size_t>(model.n()), kNaN);
     result->summary.warnings.push_back(
-        "objective = min_sting: the sting has no derivative, so the active constraints have "
-        "no multipliers (NaN) and error_estimate (the KKT residual) is not computed");
+        std::string("objective = ") + model.objective_name() +
+        ": the objective has no derivative, so the active constraints have no multipliers "
+        "(NaN) and error_estimate (the KKT residual) is not computed");
   } else if (o.has_multipliers && o.lambda.size() == static_cast<std::size_t>(model.m())) {
     mult.s = s;
     kkt = KktResidual(nlp, mult);

@@ -179,6 +179,12 @@ bool FrontierSpec::Validate(const DesignProblem& problem, Refusal* refusal) cons
                               "min_sting has no frontier: each solve is a derivative-free search "
                               "over the flexible beam (seconds per value)"));
   }
+  if (problem.objective == DesignObjective::kMaxDistance) {
+    return refuse(TextRefusal("objective",
+                              "max_distance has no frontier: each solve is a derivative-free "
+                              "search, and the frontier's continuation needs the objective's "
+                              "multipliers"));
+  }
   return true;
 }
 
