@@ -89,12 +89,22 @@ double MultiplierOf(const core::DesignResult& r, const std::string& name) {
 std::vector<CoreCase> CertificateCases() {
   return {
       // 64 knots: SLSQP stopped by its ftol at 22.662 m/s, the optimum is 22.786 m/s (0.5 %
-      // below); it reported FTOL_REACHED as converged.
-      {"NloptSlsqpAtSixtyFourKnotsIsNotConvergedBelowTheOptimum",
+      // below); it reported FTOL_REACHED as converged. The certificate now fails such a
+      // stop (Certificate.*), and since issue 36's size limit SLSQP is refused at this
+      // size with the reason: never a converged answer short of the optimum.
+      {"NloptSlsqpAtSixtyFourKnotsIsRefusedWithTheReason",
        [] {
          core::DesignOptions o;
          o.backend = core::DesignBackend::kNloptSlsqp;
          return ShortfallIfConverged(KnotProblem(64, 0.86), o);
+       },
+       Refused("invalid_input", "at most 32 variables")},
+      // 30 knots (28 variables, within SLSQP's limit): converged only at the optimum.
+      {"NloptSlsqpAtThirtyKnotsConvergesAtTheOptimum",
+       [] {
+         core::DesignOptions o;
+         o.backend = core::DesignBackend::kNloptSlsqp;
+         return ShortfallIfConverged(KnotProblem(30, 0.86), o);
        },
        Within(-1e-7, 1e-7).With("usable")},
       // 33 in, 30 oz and bbcor (drop <= 3): SLSQP reported FTOL_REACHED 0.2 % below Ipopt's
