@@ -5,7 +5,9 @@
 #include <set>
 #include <string>
 #include <utility>
+#include <vector>
 
+#include "api/openapi_document.hpp"
 #include "api/router.hpp"
 #include "core/scene/output_registry.hpp"
 
@@ -17,6 +19,48 @@ namespace {
 std::string Lower(std::string text) {
   for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return text;
+}
+
+// Records every object's keys as the document is read, and the first key given twice in one
+// object (a JSON reader silently keeps one of the two: a merge once left two
+// "feasibility_tolerance" schemas with different ranges).
+class DuplicateKeyFinder : public nlohmann::json_sax<nlohmann::json> {
+ public:
+  std::string duplicate;  // "" = none
+
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t) override { return true; }
+  bool number_unsigned(number_unsigned_t) override { return true; }
+  bool number_float(number_float_t, const string_t&) override { return true; }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override {
+    keys_.emplace_back();
+    return true;
+  }
+  bool key(string_t& k) override {
+    if (!keys_.back().insert(k).second && duplicate.empty()) duplicate = k;
+    return true;
+  }
+  bool end_object() override {
+    keys_.pop_back();
+    return true;
+  }
+  bool start_array(std::size_t) override { return true; }
+  bool end_array() override { return true; }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;
+  }
+
+ private:
+  std::vector<std::set<std::string>> keys_;
+};
+
+TEST(OpenApiTest, NoObjectGivesAKeyTwice) {
+  DuplicateKeyFinder finder;
+  ASSERT_TRUE(nlohmann::json::sax_parse(std::string(OpenApiDocumentText()), &finder));
+  EXPECT_EQ(finder.duplicate, "");
 }
 
 TEST(OpenApiTest, DocumentIsOpenApi3) {
