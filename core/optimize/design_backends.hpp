@@ -57,6 +57,23 @@ struct LocalSolveOutcome {
   bool lifted = false;  ///< Ipopt solved the lifted formulation (lifted_nlp.hpp).
 };
 
+/// What Ipopt's intermediate callback does in every design solve (the dense and the lifted
+/// formulation): records `iteration` in out->iterations and answers whether to go on (false,
+/// with out->cancelled or out->deadline_reached set, on a cancel or past settings.deadline).
+inline bool ContinueLocalSolve(int iteration, const LocalSolveSettings& settings,
+                               LocalSolveOutcome* out) {
+  out->iterations = iteration;
+  if (IsCancelled(settings.progress)) {
+    out->cancelled = true;
+    return false;
+  }
+  if (std::chrono::steady_clock::now() >= settings.deadline) {
+    out->deadline_reached = true;
+    return false;
+  }
+  return true;
+}
+
 /// Solves from s0 with Ipopt (holds the process-wide Ipopt lock for the whole lifecycle of
 /// the application and the TNLP). Never throws.
 LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>& s0,

@@ -152,16 +152,7 @@ class LiftedTnlp : public Ipopt::TNLP {
                              Number /*alpha_pr*/, Index /*ls_trials*/,
                              const Ipopt::IpoptData* /*ip_data*/,
                              Ipopt::IpoptCalculatedQuantities* /*ip_cq*/) override {
-    out_->iterations = iter;
-    if (IsCancelled(settings_.progress)) {
-      out_->cancelled = true;
-      return false;
-    }
-    if (std::chrono::steady_clock::now() >= settings_.deadline) {
-      out_->deadline_reached = true;
-      return false;
-    }
-    return true;
+    return ContinueLocalSolve(iter, settings_, out_);
   }
 
  private:
