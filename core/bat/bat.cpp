@@ -336,7 +336,8 @@ bool Bat::ValidateHandle(Refusal* why, bool materials) const {
   if (h.wall_thickness_m.has_value()) {
     const double t = *h.wall_thickness_m;
     if (!std::isfinite(t)) return Refuse(why, "handle.wall_thickness_m", t, "must be finite");
-    if (t < 0.0) return Refuse(why, "handle.wall_thickness_m", t, "must be non-negative (0 = solid)");
+    if (t < 0.0)
+      return Refuse(why, "handle.wall_thickness_m", t, "must be non-negative (0 = solid)");
     double r_min = Interpolate(knots, h.joint_from_knob_m);
     for (const ProfileKnot& k : knots) {
       if (k.x_m < h.joint_from_knob_m) r_min = std::min(r_min, k.radius_m);

@@ -720,9 +720,9 @@ TEST(MassProperties, TwoPieceCylinderIsTwoCylinders) {
     double t_b, t_h;
     bool handle_wall_given;
   };
-  for (const Case& k : {Case{0.0, 0.0, false}, Case{0.0025, 0.0025, false},
-                        Case{0.0025, 0.0040, true}, Case{0.0025, 0.0, true},
-                        Case{0.0, 0.0030, true}}) {
+  for (const Case& k :
+       {Case{0.0, 0.0, false}, Case{0.0025, 0.0025, false}, Case{0.0025, 0.0040, true},
+        Case{0.0025, 0.0, true}, Case{0.0, 0.0030, true}}) {
     const double rho_b = 2830.0, rho_h = 1550.0;
     Bat bat = Cylinder(length, outer, rho_b);
     bat.wall_thickness_m = k.t_b;
@@ -741,8 +741,8 @@ TEST(MassProperties, TwoPieceCylinderIsTwoCylinders) {
     const double ch = 0.5 * joint, cb = joint + 0.5 * (length - joint);
     const double balance = (mh * ch + mb * cb) / mass;
     const double lh2 = joint * joint / 12.0, lb2 = (length - joint) * (length - joint) / 12.0;
-    const double rod = mh * (lh2 + (ch - balance) * (ch - balance)) +
-                       mb * (lb2 + (cb - balance) * (cb - balance));
+    const double rod =
+        mh * (lh2 + (ch - balance) * (ch - balance)) + mb * (lb2 + (cb - balance) * (cb - balance));
     const double rigid = rod + mh * ah + mb * ab;
     const double volume = mh / rho_h + mb / rho_b;
     for (InertiaModel model : {InertiaModel::kRigidBody, InertiaModel::kSlenderRod}) {
@@ -750,8 +750,7 @@ TEST(MassProperties, TwoPieceCylinderIsTwoCylinders) {
       EXPECT_LT(Rel(p.mass_kg, mass), 1e-12);
       EXPECT_LT(Rel(p.balance_point_m, balance), 1e-12);
       EXPECT_LT(Rel(p.volume_m3, volume), 1e-12);
-      EXPECT_LT(Rel(p.moi_centroid_kg_m2,
-                    model == InertiaModel::kRigidBody ? rigid : rod), 1e-12);
+      EXPECT_LT(Rel(p.moi_centroid_kg_m2, model == InertiaModel::kRigidBody ? rigid : rod), 1e-12);
     }
   }
 }
@@ -798,7 +797,7 @@ TEST(MassProperties, TwoPieceBatRefusesAJointOutsideTheBatAndAWallTooThick) {
   EXPECT_EQ(why.field, "handle.wall_thickness_m");
   bat.handle = Handle{bat.material, 0.0, 0.3};  // a solid handle on a hollow barrel
   EXPECT_TRUE(bat.Validate(&why)) << why.Message();
-  bat.handle->joint_from_knob_m = length - 0.1;  // in the barrel
+  bat.handle->joint_from_knob_m = length - 0.1;       // in the barrel
   bat.fill = Fill{*FindMaterial("cork"), 0.02, 0.2};  // reaches past the joint
   EXPECT_FALSE(bat.Validate(&why));
   EXPECT_EQ(why.field, "handle.joint_from_knob_m");
