@@ -423,6 +423,9 @@ bool Bat::ValidateCaps(Refusal* why) const {
       !CheckInRange(why, "knob.mass_kg", knob->mass_kg, 0.0, kMaxBatPartMassKg, true)) {
     return false;
   }
+  if (handle.has_value() && !CheckMaterialSize(handle->material, "handle.material.", why)) {
+    return false;
+  }
   return true;
 }
 

@@ -163,7 +163,7 @@ struct Bat {
   /// Validate, then the plausible sizes: knots' x in [0, kMaxBatLengthM], radii in
   /// (0, kMaxBatRadiusM] (so the wall, below the smallest radius, and the fill's depth, within
   /// the length, are capped too), fill diameter in [0, kMaxFillDiameterM], an end cap's and a
-  /// knob's mass in (0, kMaxBatPartMassKg], the materials'
+  /// knob's mass in (0, kMaxBatPartMassKg], the materials' (the bat's, a fill's, a handle's)
   /// Material::ValidateSize ("knots[1].x_m = 150: must be in [0, 100]"); for a bat given from
   /// outside.
   bool ValidateSize(Refusal* refusal) const;

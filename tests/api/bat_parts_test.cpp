@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "api/bat_json.hpp"
 #include "api/router.hpp"
 #include "core/bat/material.hpp"
 #include "core/units.hpp"
@@ -164,6 +165,10 @@ TEST(BatPartsTest, TwoPieceRefusalsNameTheFieldAsWritten) {
   EXPECT_EQ(e["field"], "bat.handle.material") << e.dump();
   e = refused(Json{{"material", "unobtainium"}, {"joint_from_knob_in", 12}});
   EXPECT_EQ(e["field"], "bat.handle.material") << e.dump();
+  // A material object past the caps (Bat::ValidateCaps: the handle's material too).
+  e = refused(Json{{"material", {{"base", "ash"}, {"density_kg_m3", 1e9}}},
+                   {"joint_from_knob_in", 12}});
+  EXPECT_EQ(e["field"], "bat.handle.material.density_kg_m3") << e.dump();
   e = refused(Json{{"material", "ash"}});
   EXPECT_EQ(e["field"], "bat.handle.joint_from_knob_m") << e.dump();
   // /v1/optimize's design model has no handle: refused, not optimised as a one-piece bat.
@@ -189,6 +194,26 @@ TEST(BatPartsTest, TwoPieceHandleMovesTheFirstMode) {
       {"preset", "bbcor-33-aluminium"},
       {"handle", {{"material", "ash"}, {"joint_from_knob_in", 14}, {"wall_thickness_in", 0}}}});
   EXPECT_GT(std::abs(two / one - 1.0), 0.01) << one << " Hz, two-piece " << two << " Hz";
+}
+
+// The answer's bat (BatToJson: presets, /v1/optimize's designs) carries the handle, and what it
+// renders parses back to the same bat: the same mass, bit for bit.
+TEST(BatPartsTest, TwoPieceBatRendersAndParsesBack) {
+  const Json request = {{"preset", "bbcor-33-aluminium"},
+                        {"handle",
+                         {{"material", "ash"}, {"joint_from_knob_in", 12}, {"wall_thickness_in", 0}}}};
+  ApiError error;
+  const auto spec = ParseBatGeometry(request, "bat", ApiLimits{}, &error);
+  ASSERT_TRUE(spec) << error.message;
+  const Json rendered = BatToJson(spec->bat);
+  ASSERT_TRUE(rendered.contains("handle")) << rendered.dump();
+  EXPECT_EQ(rendered["handle"]["material"], "ash");
+  EXPECT_EQ(rendered["handle"]["wall_thickness_m"].get<double>(), 0.0);
+  const auto back = ParseBatGeometry(rendered, "bat", ApiLimits{}, &error);
+  ASSERT_TRUE(back) << error.message << " " << rendered.dump();
+  ASSERT_TRUE(back->bat.handle.has_value());
+  EXPECT_EQ(back->bat.handle->joint_from_knob_m, 12 * 0.0254);
+  EXPECT_EQ(Properties(rendered)["mass_kg"].get<double>(), Properties(request)["mass_kg"].get<double>());
 }
 
 }  // namespace

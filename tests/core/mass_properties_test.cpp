@@ -801,6 +801,14 @@ TEST(MassProperties, TwoPieceBatRefusesAJointOutsideTheBatAndAWallTooThick) {
   bat.fill = Fill{*FindMaterial("cork"), 0.02, 0.2};  // reaches past the joint
   EXPECT_FALSE(bat.Validate(&why));
   EXPECT_EQ(why.field, "handle.joint_from_knob_m");
+  // ValidateSize holds the handle's material to the caps as the bat's (Material::ValidateSize).
+  bat.fill.reset();
+  bat.handle = Handle{bat.material, std::nullopt, 0.3};
+  bat.handle->material.density_kg_m3 = 1e9;
+  EXPECT_TRUE(bat.Validate(&why)) << why.Message();
+  EXPECT_FALSE(bat.ValidateSize(&why));
+  EXPECT_EQ(why.field, "handle.material.density_kg_m3");
+  bat.handle->material.density_kg_m3 = bat.material.density_kg_m3;
   // The design model has no handle: the values, NaN gradients.
   bat.fill.reset();
   const MassPropertiesWithGradient g = ComputeMassPropertiesWithGradient(bat);
