@@ -166,8 +166,8 @@ TEST(BatPartsTest, TwoPieceRefusalsNameTheFieldAsWritten) {
   e = refused(Json{{"material", "unobtainium"}, {"joint_from_knob_in", 12}});
   EXPECT_EQ(e["field"], "bat.handle.material") << e.dump();
   // A material object past the caps (Bat::ValidateCaps: the handle's material too).
-  e = refused(Json{{"material", {{"base", "ash"}, {"density_kg_m3", 1e9}}},
-                   {"joint_from_knob_in", 12}});
+  e = refused(
+      Json{{"material", {{"base", "ash"}, {"density_kg_m3", 1e9}}}, {"joint_from_knob_in", 12}});
   EXPECT_EQ(e["field"], "bat.handle.material.density_kg_m3") << e.dump();
   e = refused(Json{{"material", "ash"}});
   EXPECT_EQ(e["field"], "bat.handle.joint_from_knob_m") << e.dump();
@@ -199,9 +199,9 @@ TEST(BatPartsTest, TwoPieceHandleMovesTheFirstMode) {
 // The answer's bat (BatToJson: presets, /v1/optimize's designs) carries the handle, and what it
 // renders parses back to the same bat: the same mass, bit for bit.
 TEST(BatPartsTest, TwoPieceBatRendersAndParsesBack) {
-  const Json request = {{"preset", "bbcor-33-aluminium"},
-                        {"handle",
-                         {{"material", "ash"}, {"joint_from_knob_in", 12}, {"wall_thickness_in", 0}}}};
+  const Json request = {
+      {"preset", "bbcor-33-aluminium"},
+      {"handle", {{"material", "ash"}, {"joint_from_knob_in", 12}, {"wall_thickness_in", 0}}}};
   ApiError error;
   const auto spec = ParseBatGeometry(request, "bat", ApiLimits{}, &error);
   ASSERT_TRUE(spec) << error.message;
@@ -213,7 +213,8 @@ TEST(BatPartsTest, TwoPieceBatRendersAndParsesBack) {
   ASSERT_TRUE(back) << error.message << " " << rendered.dump();
   ASSERT_TRUE(back->bat.handle.has_value());
   EXPECT_EQ(back->bat.handle->joint_from_knob_m, 12 * 0.0254);
-  EXPECT_EQ(Properties(rendered)["mass_kg"].get<double>(), Properties(request)["mass_kg"].get<double>());
+  EXPECT_EQ(Properties(rendered)["mass_kg"].get<double>(),
+            Properties(request)["mass_kg"].get<double>());
 }
 
 }  // namespace
