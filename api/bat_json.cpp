@@ -111,6 +111,26 @@ bool ParsePart(const Json& value, const std::string& path, FieldGroup group, cor
   return reader.Finish();
 }
 
+// A two-piece bat's handle object at `path` into bat->handle: its "material" (a catalogue name
+// or a material object, as the bat's), joint_from_knob_m (required) and wall_thickness_m
+// (optional: absent = the bat's walls) through the table of fields; ranges: Bat::ValidateSize.
+bool ParseHandle(const Json& value, const std::string& path, core::Bat* bat, ApiError* error) {
+  ObjectReader reader(value, path, error);
+  bat->handle = core::Handle{};
+  const Json* material = reader.Get("material");
+  if (material == nullptr) {
+    reader.Fail("material", "is required (a catalogue name or a material object)");
+    return false;
+  }
+  auto parsed = ParseMaterial(*material, JoinPath(path, "material"), /*allow_empty=*/false, error);
+  if (!parsed) return false;
+  bat->handle->material = *parsed;
+  FieldHost host;
+  host.bat = bat;
+  ReadFieldGroup(reader, FieldGroup::kHandle, host);
+  return reader.Finish();
+}
+
 }  // namespace
 
 std::optional<core::Material> ParseMaterial(const Json& value, const std::string& path,
@@ -245,6 +265,14 @@ std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& pa
       }
     }
   }
+  // A two-piece bat's handle (a preset's own is replaced; null removes it).
+  if (const Json* handle = reader.Get("handle")) {
+    if (handle->is_null()) {
+      spec.bat.handle.reset();
+    } else if (!ParseHandle(*handle, JoinPath(path, "handle"), &spec.bat, error)) {
+      return std::nullopt;
+    }
+  }
   if (!reader.Finish()) return std::nullopt;
   if (core::Refusal refusal; !spec.bat.ValidateSize(&refusal)) {
     // Knot refusals belong under the profile (or the preset's/three-segment's knots).
@@ -329,6 +357,15 @@ Json BatToJson(const core::Bat& bat) {
     Json p{{"mass_kg", (*part)->mass_kg}, {"length_m", (*part)->length_m}};
     if (!(*part)->material.empty()) p["material"] = (*part)->material;
     out[key] = std::move(p);
+  }
+  if (bat.handle.has_value()) {
+    const core::Handle& h = *bat.handle;
+    Json j{{"material", h.material.name}, {"joint_from_knob_m", h.joint_from_knob_m}};
+    if (h.material.name == "custom" || !core::FindMaterial(h.material.name)) {
+      j["material"] = MaterialToJson(h.material);
+    }
+    if (h.wall_thickness_m.has_value()) j["wall_thickness_m"] = *h.wall_thickness_m;
+    out["handle"] = std::move(j);
   }
   return out;
 }

@@ -163,6 +163,15 @@ std::vector<Field> MakeFields() {
   f.push_back({"bat.knob.length_m", "m", G::kKnob, 0.0, core::kMaxBatLengthM, false, false, "",
                [](const H& h) { return BatOf(h).knob->length_m; },
                [](const H& h, double v) { BatOf(h).knob->length_m = v; }, true});
+  // A two-piece bat's handle (issue 35): where it joins the barrel (required in its object) and
+  // its own wall (optional: absent = the bat's walls, 0 = solid).
+  f.push_back({"bat.handle.joint_from_knob_m", "m", G::kHandle, 0.0, core::kMaxBatLengthM, false,
+               false, "", [](const H& h) { return BatOf(h).handle->joint_from_knob_m; },
+               [](const H& h, double v) { BatOf(h).handle->joint_from_knob_m = v; }, true});
+  f.push_back({"bat.handle.wall_thickness_m", "m", G::kHandle, 0.0, core::kMaxBatRadiusM, false,
+               false, "",
+               [](const H& h) { return BatOf(h).handle->wall_thickness_m.value_or(0.0); },
+               [](const H& h, double v) { BatOf(h).handle->wall_thickness_m = v; }});
   f.push_back({"bat.fill.material.density_kg_m3", "kg/m³", G::kFillMaterial, 0.0,
                core::kMaxDensityKgM3, false, true, "fill.density_kg_m3",
                [](const H& h) { return FillOf(h).material.density_kg_m3; },

@@ -39,6 +39,7 @@ enum class FieldGroup {
   kFillMaterial,  ///< "bat.fill.material.*".
   kEndCap,        ///< "bat.end_cap.*": its mass and length.
   kKnob,          ///< "bat.knob.*": its mass and length.
+  kHandle,        ///< "bat.handle.*": a two-piece bat's joint and handle wall.
 };
 
 /// Where a field's accessor reads and writes: the parts of a request a field sits in, each null
@@ -49,7 +50,7 @@ struct FieldHost {
   core::Swing* swing = nullptr;
   std::optional<double>* cor = nullptr;
   core::Contact* contact = nullptr;
-  core::Bat* bat = nullptr;                  ///< Knots, wall, end cap, knob.
+  core::Bat* bat = nullptr;                  ///< Knots, wall, end cap, knob, handle.
   core::Material* material = nullptr;        ///< The bat's material (a material object's rows).
   core::ThreeSegmentShape* shape = nullptr;  ///< A three-segment bat's shape.
   core::Fill* fill = nullptr;                ///< The bat's fill.

@@ -134,6 +134,7 @@ std::optional<DesignBinder> DesignBinder::Compile(
         case FieldGroup::kFill:
         case FieldGroup::kEndCap:  // not swept (fields.cpp): never reached
         case FieldGroup::kKnob:
+        case FieldGroup::kHandle:
           binder.changes_.bat_geometry = true;
           break;
       }

@@ -416,16 +416,17 @@ std::optional<OptimizeRequest> ParseOptimize(const Json& body, const Context& co
   }
   const auto spec = ParseBat(*bat_json, "bat", context.limits, error);
   if (!spec) return std::nullopt;
-  // The design model's integrals and fixed-mesh beam (core/optimize) have no end cap or knob
-  // yet: refused rather than optimised without them.
-  if (spec->bat.end_cap.has_value() || spec->bat.knob.has_value() ||
-      spec->bat.HasKnotWalls()) {
-    const char* part = spec->bat.end_cap.has_value() ? "bat.end_cap"
-                       : spec->bat.knob.has_value()  ? "bat.knob"
-                                                     : "bat.profile.knots";
+  // The design model's integrals and fixed-mesh beam (core/optimize) have no end cap, knob,
+  // wall per knot or two-piece handle yet: refused rather than optimised without them.
+  if (spec->bat.end_cap.has_value() || spec->bat.knob.has_value() || spec->bat.HasKnotWalls() ||
+      spec->bat.handle.has_value()) {
+    const char* part = spec->bat.end_cap.has_value()  ? "bat.end_cap"
+                       : spec->bat.knob.has_value()   ? "bat.knob"
+                       : spec->bat.handle.has_value() ? "bat.handle"
+                                                      : "bat.profile.knots";
     SetError(error, ErrorCode::kInvalidValue, part, nullptr,
-             "is not taken by /v1/optimize yet (its design model has no end cap, knob or wall "
-             "per knot); "
+             "is not taken by /v1/optimize yet (its design model has no end cap, knob, wall "
+             "per knot or two-piece handle); "
              "/v1/sweet-spot, /v1/compare and /v1/explore take it");
     return std::nullopt;
   }

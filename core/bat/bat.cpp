@@ -179,8 +179,8 @@ bool Bat::ValidateGeometryOfShapeKnots(Refusal* why) const {
   }
   // No fill, no parts, no knot walls and a wall in [0, min_radius) (so finite): ValidateBody's
   // checks all pass.
-  if (!fill.has_value() && !end_cap.has_value() && !knob.has_value() && !HasKnotWalls() &&
-      wall_thickness_m >= 0.0 && wall_thickness_m < min_radius) {
+  if (!fill.has_value() && !end_cap.has_value() && !knob.has_value() && !handle.has_value() &&
+      !HasKnotWalls() && wall_thickness_m >= 0.0 && wall_thickness_m < min_radius) {
     return true;
   }
   return ValidateBody(why, /*materials=*/false, min_radius);
@@ -315,7 +315,64 @@ bool Bat::ValidateBody(Refusal* why, bool materials, double min_radius) const {
                               " at x_m = " + FormatNumber(worst_x) + " (over the fill's depth)");
     }
   }
-  return ValidatePart(end_cap, "end_cap.", why) && ValidatePart(knob, "knob.", why);
+  return ValidatePart(end_cap, "end_cap.", why) && ValidatePart(knob, "knob.", why) &&
+         ValidateHandle(why, materials);
+}
+
+bool Bat::ValidateHandle(Refusal* why, bool materials) const {
+  if (!handle.has_value()) return true;
+  const Handle& h = *handle;
+  if (materials && !CheckMaterial(h.material, "handle.material.", why)) return false;
+  const double length = LengthM();
+  if (!(h.joint_from_knob_m > 0.0 && h.joint_from_knob_m < length)) {
+    return Refuse(why, "handle.joint_from_knob_m", h.joint_from_knob_m,
+                  "must be in (0, " + FormatNumber(length) + ") (inside the bat)");
+  }
+  if (fill.has_value() && fill->depth_m > length - h.joint_from_knob_m) {
+    return Refuse(why, "handle.joint_from_knob_m", h.joint_from_knob_m,
+                  "the fill (depth " + FormatNumber(fill->depth_m) +
+                      ") must not reach past the joint into the handle");
+  }
+  if (h.wall_thickness_m.has_value()) {
+    const double t = *h.wall_thickness_m;
+    if (!std::isfinite(t)) return Refuse(why, "handle.wall_thickness_m", t, "must be finite");
+    if (t < 0.0)
+      return Refuse(why, "handle.wall_thickness_m", t, "must be non-negative (0 = solid)");
+    double r_min = Interpolate(knots, h.joint_from_knob_m);
+    for (const ProfileKnot& k : knots) {
+      if (k.x_m < h.joint_from_knob_m) r_min = std::min(r_min, k.radius_m);
+    }
+    if (t >= r_min) {
+      return Refuse(why, "handle.wall_thickness_m", t,
+                    "must be less than the handle's smallest outer radius " + FormatNumber(r_min));
+    }
+  }
+  return true;
+}
+
+Bat Bat::HandleRegion(bool handle_side) const {
+  Bat out;
+  const double joint = handle->joint_from_knob_m;
+  const bool knot_walls = IsHollow() && HasKnotWalls();
+  for (const ProfileKnot& k : knots) {
+    if (!(k.x_m < joint)) break;
+    out.knots.push_back(k);
+  }
+  ProfileKnot end;
+  end.x_m = joint;
+  end.radius_m = Interpolate(knots, joint);
+  end.wall_thickness_m = knot_walls ? WallAtM(joint) : 0.0;
+  out.knots.push_back(end);
+  out.material = material;
+  out.wall_thickness_m = wall_thickness_m;
+  if (handle_side) {
+    out.material = handle->material;
+    if (handle->wall_thickness_m.has_value()) {
+      out.wall_thickness_m = *handle->wall_thickness_m;
+      for (ProfileKnot& k : out.knots) k.wall_thickness_m = 0.0;
+    }
+  }
+  return out;
 }
 
 bool Bat::ValidatePart(const std::optional<BatPart>& part, std::string_view prefix,
@@ -366,6 +423,9 @@ bool Bat::ValidateCaps(Refusal* why) const {
       !CheckInRange(why, "knob.mass_kg", knob->mass_kg, 0.0, kMaxBatPartMassKg, true)) {
     return false;
   }
+  if (handle.has_value() && !CheckMaterialSize(handle->material, "handle.material.", why)) {
+    return false;
+  }
   return true;
 }
 
@@ -413,7 +473,9 @@ double Bat::PartRadiusM(bool at_tip) const {
   if (knots.empty()) return 0.0;
   const std::size_t i = at_tip ? knots.size() - 1 : 0;
   const double r = knots[i].radius_m;
-  return IsHollow() ? std::max(r - KnotWallM(i), 0.0) : r;
+  double wall = IsHollow() ? KnotWallM(i) : 0.0;
+  if (!at_tip && handle.has_value()) wall = handle->WallM(wall);  // the handle's own wall
+  return wall > 0.0 ? std::max(r - wall, 0.0) : r;
 }
 
 Bat MakeThreeSegmentBat(const ThreeSegmentShape& shape, const Material& material) {

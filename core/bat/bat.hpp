@@ -117,6 +117,24 @@ struct BatPart {
   std::string material;
 };
 
+/// The handle of a two-piece bat (issue 35): its own material, and optionally its own wall,
+/// from the knob to the joint; the bat's profile is unchanged, the bat's own material and wall
+/// run from the joint to the tip. Exact in the mass properties (the integrals split at the
+/// joint) and in the beam (the sections' material and wall per side).
+struct Handle {
+  Material material;  ///< The handle's material.
+  /// The handle's wall, m: absent = the bat's walls (its wall_thickness_m and knots' walls);
+  /// 0 = a solid handle; > 0 a hollow handle of this uniform wall (below the handle's radii).
+  std::optional<double> wall_thickness_m;
+  /// Where the handle ends and the barrel begins, from the knob, m (0 < joint < L).
+  double joint_from_knob_m = 0.0;
+
+  /// The handle's wall at a point whose bat's wall is `bat_wall_m`, m.
+  double WallM(double bat_wall_m) const {
+    return wall_thickness_m.has_value() ? *wall_thickness_m : bat_wall_m;
+  }
+};
+
 /// A complete bat.
 struct Bat {
   /// Outer radius; x strictly increasing from 0 to L (a step is two knots at
@@ -127,6 +145,7 @@ struct Bat {
   std::optional<Fill> fill;        ///< Optional fill.
   std::optional<BatPart> end_cap;  ///< Optional end cap at the barrel tip (x in [L - l, L]).
   std::optional<BatPart> knob;     ///< Optional knob at the handle end (x in [0, l]).
+  std::optional<Handle> handle;    ///< A two-piece bat's handle (x in [0, joint]).
 
   /// True when the bat is physically valid; otherwise the refusal in *refusal (if
   /// non-null): field, value and rule, its Message() "field = value: rule", e.g.
@@ -144,7 +163,7 @@ struct Bat {
   /// Validate, then the plausible sizes: knots' x in [0, kMaxBatLengthM], radii in
   /// (0, kMaxBatRadiusM] (so the wall, below the smallest radius, and the fill's depth, within
   /// the length, are capped too), fill diameter in [0, kMaxFillDiameterM], an end cap's and a
-  /// knob's mass in (0, kMaxBatPartMassKg], the materials'
+  /// knob's mass in (0, kMaxBatPartMassKg], the materials' (the bat's, a fill's, a handle's)
   /// Material::ValidateSize ("knots[1].x_m = 150: must be in [0, 100]"); for a bat given from
   /// outside.
   bool ValidateSize(Refusal* refusal) const;
@@ -186,8 +205,13 @@ struct Bat {
   /// Smallest outer radius over the bat, m (0 without knots).
   double MinRadiusM() const;
   /// The radius of a part's cylinder, m: the inner radius at the bat's tip (end_cap = true) or
-  /// knob end (false), the outer radius there for a solid bat; 0 without knots.
+  /// knob end (false; a two-piece bat's handle wall there), the outer radius there for a solid
+  /// bat; 0 without knots.
   double PartRadiusM(bool end_cap) const;
+  /// One side of a two-piece bat as a bat of its own over [0, joint] (knots cut at the joint,
+  /// walls as there, no fill or parts): with the handle's material and wall (`handle_side`) or
+  /// with the bat's. Needs a valid bat with a handle.
+  Bat HandleRegion(bool handle_side) const;
 
  private:
   // Validate's checks in its order; the materials' own only when `materials`.
@@ -198,6 +222,8 @@ struct Bat {
   // An end cap's or knob's checks (its fields prefixed by `prefix`, "end_cap."); true without one.
   bool ValidatePart(const std::optional<BatPart>& part, std::string_view prefix,
                     Refusal* refusal) const;
+  // A handle's checks ("handle.joint_from_knob_m", ...); true without one.
+  bool ValidateHandle(Refusal* refusal, bool materials) const;
   // The rest of ValidateChecks, for valid knots whose smallest radius is `min_radius`: the
   // materials (when `materials`), the wall and the fill.
   bool ValidateBody(Refusal* refusal, bool materials, double min_radius) const;

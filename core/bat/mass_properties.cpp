@@ -152,9 +152,23 @@ MassProperties MassWithoutMoments(const Bat& bat, const geometry::KnotListProfil
     mass += parts[i].mass;
     moment += parts[i].mass * parts[i].centroid;
   }
+  double volume = mm.bat_volume + FillVolumeSign(bat) * mm.fill_volume;
+  // A two-piece bat (bat.hpp Handle): over [0, joint] the handle's side replaces the bat's
+  // (their difference first: 0 exactly for a handle of the bat's own material and wall).
+  if (bat.handle.has_value()) {
+    geometry::MassMoment<double> s[2];
+    for (int i = 0; i < 2; ++i) {
+      const Bat side = bat.HandleRegion(/*handle_side=*/i == 0);
+      s[i] = geometry::ComputeMassMoment<double>(
+          geometry::KnotListProfile(side.knots, side.wall_thickness_m), geometry::BodyOf(side));
+    }
+    mass += s[0].mass - s[1].mass;
+    moment += s[0].moment - s[1].moment;
+    volume += s[0].bat_volume - s[1].bat_volume;
+  }
   out.mass_kg = mass;
   out.balance_point_m = moment / mass;
-  out.volume_m3 = mm.bat_volume + FillVolumeSign(bat) * mm.fill_volume;
+  out.volume_m3 = volume;
   return out;
 }
 
@@ -171,6 +185,16 @@ MassProperties WithMoments(const Bat& bat, MassProperties out, InertiaModel mode
   for (int i = 0; i < num_parts; ++i) {
     const double d = parts[i].centroid - out.balance_point_m;
     out.moi_centroid_kg_m2 += parts[i].mass * (d * d) + PartOwnMoment(parts[i], rigid);
+  }
+  if (bat.handle.has_value()) {  // as in MassWithoutMoments
+    double side_moment[2];
+    for (int i = 0; i < 2; ++i) {
+      const Bat side = bat.HandleRegion(/*handle_side=*/i == 0);
+      side_moment[i] = geometry::ComputeCentroidalMoment(
+          geometry::KnotListProfile(side.knots, side.wall_thickness_m), geometry::BodyOf(side),
+          out.balance_point_m, rigid);
+    }
+    out.moi_centroid_kg_m2 += side_moment[0] - side_moment[1];
   }
   out.moi_knob_kg_m2 = out.MoiAboutKgM2(0.0);
   return out;
@@ -275,7 +299,7 @@ MassPropertiesWithGradient ComputeMassPropertiesWithGradient(const Bat& bat, Ine
   out.layout.num_knots = k;
   const int n = out.layout.Size();
   out.properties = ComputeMassProperties(bat, model);
-  if (!std::isfinite(out.properties.mass_kg)) {
+  if (!std::isfinite(out.properties.mass_kg) || bat.handle.has_value()) {
     out.volume_gradient = out.mass_gradient = out.balance_point_gradient = out.moi_knob_gradient =
         out.moi_centroid_gradient = Eigen::VectorXd::Constant(n, kNaN);
     return out;

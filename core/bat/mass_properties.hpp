@@ -144,7 +144,8 @@ struct MassPropertiesWithGradient {
 };
 
 /// Mass properties of `bat` with exact gradients. For an invalid bat every
-/// value and gradient entry is NaN (gradients sized for bat.knots.size()).
+/// value and gradient entry is NaN (gradients sized for bat.knots.size()); for a two-piece bat
+/// (bat.handle: the design model has no handle) the values and NaN gradients.
 /// Never throws; allocates only the gradient vectors.
 MassPropertiesWithGradient ComputeMassPropertiesWithGradient(
     const Bat& bat, InertiaModel model = InertiaModel::kRigidBody);

@@ -69,13 +69,16 @@ BeamSection SectionAt(const Bat& bat, double x_m) {
   const double length = bat.LengthM();
   const bool in_fill = bat.fill.has_value() && bat.fill->depth_m > 0.0 &&
                        bat.fill->RadiusM() > 0.0 && x_m >= length - bat.fill->depth_m;
-  double r_in = bat.IsHollow() ? std::max(r - bat.WallAtM(x_m), 0.0) : 0.0;
+  // A two-piece bat's handle side (x < joint): the handle's material and wall.
+  const bool in_handle = bat.handle.has_value() && x_m < bat.handle->joint_from_knob_m;
+  const double wall = in_handle ? bat.handle->WallM(bat.WallAtM(x_m)) : bat.WallAtM(x_m);
+  double r_in = wall > 0.0 ? std::max(r - wall, 0.0) : 0.0;
   const double r_fill = in_fill ? bat.fill->RadiusM() : 0.0;
   if (in_fill && !bat.IsHollow()) r_in = r_fill;  // the bore replaces the solid's core
   // r^2 - ri^2 and r^4 - ri^4 as products: no cancellation for a thin wall.
   const double a_b = kPi * (r - r_in) * (r + r_in);
   const double i_b = 0.25 * kPi * (r - r_in) * (r + r_in) * (r * r + r_in * r_in);
-  const Material& mb = bat.material;
+  const Material& mb = in_handle ? bat.handle->material : bat.material;
   s.mass_per_length_kg_m = mb.density_kg_m3 * a_b;
   s.rotary_inertia_kg_m = mb.density_kg_m3 * i_b;
   s.bending_stiffness_n_m2 = mb.youngs_modulus_pa * i_b;
@@ -123,6 +126,7 @@ std::vector<double> Breakpoints(const Bat& bat) {
     out.push_back(length - bat.end_cap->length_m);
   }
   if (bat.knob.has_value() && bat.knob->length_m < length) out.push_back(bat.knob->length_m);
+  if (bat.handle.has_value()) out.push_back(bat.handle->joint_from_knob_m);  // the joint
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;

@@ -55,6 +55,13 @@ std::string ModesCache::Key(const Bat& bat, const BeamModesOptions& options) {
       PutDouble(&key, (*part)->length_m);
     }
   }
+  PutInt(&key, bat.handle.has_value() ? 1 : 0);
+  if (bat.handle.has_value()) {
+    PutMaterial(&key, bat.handle->material);
+    PutInt(&key, bat.handle->wall_thickness_m.has_value() ? 1 : 0);
+    PutDouble(&key, bat.handle->WallM(0.0));
+    PutDouble(&key, bat.handle->joint_from_knob_m);
+  }
   PutInt(&key, static_cast<long long>(options.theory));
   PutInt(&key, options.num_modes);
   PutDouble(&key, options.relative_tolerance);

@@ -50,6 +50,8 @@ Json Template(bool profile, bool bat_speed = false) {
       "diameter_m": 0.02, "depth_m": 0.1})");
   bat["end_cap"] = Json::parse(R"({"mass_kg": 0.03, "length_m": 0.01, "material": "rubber"})");
   bat["knob"] = Json::parse(R"({"mass_kg": 0.02, "length_m": 0.015})");
+  bat["handle"] = Json::parse(R"({"material": "ash", "joint_from_knob_m": 0.25,
+      "wall_thickness_m": 0.002})");
   Json swing = {{"angular_speed_rad_s", 40.0}, {"pivot_from_knob_m", 0.01},
                 {"hands_from_knob_m", 0.15}, {"attack_angle_deg", 8.0}};
   if (bat_speed) {
@@ -111,7 +113,7 @@ bool IsBatSpeedField(const Field& field) {
 // accessor; bound by the sweep's binder to the same scene the parser gives; and, when a
 // variable, named by core's variable path in every form.
 TEST(FieldsTest, EveryFieldRoundTripsThroughParserBinderAndOptimizeVariable) {
-  ASSERT_EQ(Fields().size(), 38u);
+  ASSERT_EQ(Fields().size(), 40u);
   for (const Field& field : Fields()) {
     SCOPED_TRACE(std::string(field.path));
     const Json base = Template(IsProfileField(field), IsBatSpeedField(field));

@@ -283,6 +283,14 @@ TEST(FlexibleModes, RigidBodyPropertiesOfTheMassMatrixAreTheExactMassProperties)
   walled.knots[5].wall_thickness_m = 0.0035;
   walled.knots[11].wall_thickness_m = 0.0022;
   bats.push_back(walled);
+  // Issue 35: a two-piece bat (a composite handle, its own wall, joined inside a knot segment):
+  // the joint is a breakpoint and each side has its own density and wall.
+  Bat two_piece = walled;
+  two_piece.handle = Handle{*FindMaterial("carbon-epoxy-fabric"), 0.0031, 0.301};
+  bats.push_back(two_piece);
+  Bat solid_handle = FindPreset("paper-wood")->bat;  // a solid maple handle on an ash bat
+  solid_handle.handle = Handle{*FindMaterial("maple"), std::nullopt, 0.25};
+  bats.push_back(solid_handle);
   for (const Bat& bat : bats) {
     for (BeamTheory theory : {BeamTheory::kEulerBernoulli, BeamTheory::kTimoshenko}) {
       BeamModesOptions o;

@@ -188,6 +188,31 @@ TEST(FlexibleScene, TheCacheServesRepeatedRequestsWithIdenticalResults) {
   EXPECT_NE(ModesCache::Key(*s.bat, {}), ModesCache::Key(*s.bat, eb));
 }
 
+// Issue 35: a two-piece bat's handle (material, wall, joint) is in the key: each field changes it.
+TEST(FlexibleScene, TheCacheKeyHoldsTheHandle) {
+  const Bat one = FindPreset("bbcor-33-aluminium")->bat;
+  Bat two = one;
+  two.handle = Handle{one.material, std::nullopt, 0.3};
+  std::vector<std::string> keys{ModesCache::Key(one, {}), ModesCache::Key(two, {})};
+  Bat b = two;
+  b.handle->material.density_kg_m3 *= 1.01;
+  keys.push_back(ModesCache::Key(b, {}));
+  b = two;
+  b.handle->material.youngs_modulus_pa *= 1.01;
+  keys.push_back(ModesCache::Key(b, {}));
+  b = two;
+  b.handle->wall_thickness_m = one.wall_thickness_m;  // given (the same value): a new key
+  keys.push_back(ModesCache::Key(b, {}));
+  b.handle->wall_thickness_m = 0.0021;
+  keys.push_back(ModesCache::Key(b, {}));
+  b = two;
+  b.handle->joint_from_knob_m = 0.31;
+  keys.push_back(ModesCache::Key(b, {}));
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    for (std::size_t j = i + 1; j < keys.size(); ++j) EXPECT_NE(keys[i], keys[j]) << i << " " << j;
+  }
+}
+
 TEST(FlexibleScene, TheCacheIsBoundedLeastRecentlyUsedFirst) {
   ModesCache cache(2);
   const Bat bat = FindPreset("paper-wood")->bat;

@@ -709,6 +709,113 @@ TEST(MassProperties, EndCapAndKnobRefusals) {
   EXPECT_TRUE(std::isnan(ComputeMassProperties(Bat{}).mass_kg));
 }
 
+// Issue 35: a two-piece bat is two cylinders when its profile is one: a handle of density rho_h
+// (wall t_h) over [0, j] and the bat's rho_b (wall t_b) over [j, L], each of mass
+// m = rho pi (R^2 - r^2) l at its middle with its own moment m (l^2 / 12 + (R^2 + r^2) / 4)
+// (rigid) or m l^2 / 12 (slender rod). Sums of a few exact terms, each side's integral exact:
+// 1e-12 relative leaves room for the subtraction of the bat's side over [0, j].
+TEST(MassProperties, TwoPieceCylinderIsTwoCylinders) {
+  const double length = 0.8382, outer = 0.0333375, joint = 0.3;
+  struct Case {
+    double t_b, t_h;
+    bool handle_wall_given;
+  };
+  for (const Case& k :
+       {Case{0.0, 0.0, false}, Case{0.0025, 0.0025, false}, Case{0.0025, 0.0040, true},
+        Case{0.0025, 0.0, true}, Case{0.0, 0.0030, true}}) {
+    const double rho_b = 2830.0, rho_h = 1550.0;
+    Bat bat = Cylinder(length, outer, rho_b);
+    bat.wall_thickness_m = k.t_b;
+    Material handle_material = Wood(rho_h);
+    bat.handle = Handle{handle_material,
+                        k.handle_wall_given ? std::optional<double>(k.t_h) : std::nullopt, joint};
+    ASSERT_TRUE(bat.Validate(nullptr));
+    const auto side = [&](double rho, double t, double l) {
+      const double r = t > 0.0 ? outer - t : 0.0;
+      return std::pair<double, double>{rho * kPi * (outer * outer - r * r) * l,
+                                       (outer * outer + r * r) / 4.0};
+    };
+    const auto [mh, ah] = side(rho_h, k.t_h, joint);
+    const auto [mb, ab] = side(rho_b, k.t_b, length - joint);
+    const double mass = mh + mb;
+    const double ch = 0.5 * joint, cb = joint + 0.5 * (length - joint);
+    const double balance = (mh * ch + mb * cb) / mass;
+    const double lh2 = joint * joint / 12.0, lb2 = (length - joint) * (length - joint) / 12.0;
+    const double rod =
+        mh * (lh2 + (ch - balance) * (ch - balance)) + mb * (lb2 + (cb - balance) * (cb - balance));
+    const double rigid = rod + mh * ah + mb * ab;
+    const double volume = mh / rho_h + mb / rho_b;
+    for (InertiaModel model : {InertiaModel::kRigidBody, InertiaModel::kSlenderRod}) {
+      const MassProperties p = ComputeMassProperties(bat, model);
+      EXPECT_LT(Rel(p.mass_kg, mass), 1e-12);
+      EXPECT_LT(Rel(p.balance_point_m, balance), 1e-12);
+      EXPECT_LT(Rel(p.volume_m3, volume), 1e-12);
+      EXPECT_LT(Rel(p.moi_centroid_kg_m2, model == InertiaModel::kRigidBody ? rigid : rod), 1e-12);
+    }
+  }
+}
+
+// A two-piece bat whose handle is the bat's own material and wall is the one-piece bat: the
+// handle's side and the bat's side over [0, joint] are the same integrals, so their difference
+// is exactly 0 and the sums are bit for bit the one-piece bat's.
+TEST(MassProperties, TwoPieceOfOneMaterialIsTheOnePieceBatBitForBit) {
+  for (const char* name : {"bbcor-33-aluminium", "paper-wood", "bbcor-33-alloy-capped"}) {
+    const Bat one = FindPreset(name)->bat;
+    for (bool wall_given : {false, true}) {
+      if (wall_given && one.HasKnotWalls()) continue;  // one uniform wall stands for the bat's
+      Bat two = one;
+      two.handle = Handle{one.material,
+                          wall_given ? std::optional<double>(one.wall_thickness_m) : std::nullopt,
+                          0.37 * one.LengthM()};
+      ASSERT_TRUE(two.Validate(nullptr)) << name;
+      for (InertiaModel model : {InertiaModel::kRigidBody, InertiaModel::kSlenderRod}) {
+        const MassProperties a = ComputeMassProperties(one, model);
+        const MassProperties b = ComputeMassProperties(two, model);
+        EXPECT_EQ(a.mass_kg, b.mass_kg) << name;
+        EXPECT_EQ(a.balance_point_m, b.balance_point_m) << name;
+        EXPECT_EQ(a.moi_centroid_kg_m2, b.moi_centroid_kg_m2) << name;
+        EXPECT_EQ(a.volume_m3, b.volume_m3) << name;
+      }
+    }
+  }
+}
+
+TEST(MassProperties, TwoPieceBatRefusesAJointOutsideTheBatAndAWallTooThick) {
+  Bat bat = FindPreset("bbcor-33-aluminium")->bat;
+  const double length = bat.LengthM();
+  Refusal why;
+  for (double joint : {0.0, length, -0.1, length + 0.1, std::nan("")}) {
+    bat.handle = Handle{bat.material, std::nullopt, joint};
+    EXPECT_FALSE(bat.Validate(&why)) << joint;
+    EXPECT_EQ(why.field, "handle.joint_from_knob_m");
+  }
+  bat.handle = Handle{bat.material, 0.5, 0.3};  // 0.5 m: thicker than the handle's radius
+  EXPECT_FALSE(bat.Validate(&why));
+  EXPECT_EQ(why.field, "handle.wall_thickness_m");
+  bat.handle = Handle{bat.material, -0.001, 0.3};
+  EXPECT_FALSE(bat.Validate(&why));
+  EXPECT_EQ(why.field, "handle.wall_thickness_m");
+  bat.handle = Handle{bat.material, 0.0, 0.3};  // a solid handle on a hollow barrel
+  EXPECT_TRUE(bat.Validate(&why)) << why.Message();
+  bat.handle->joint_from_knob_m = length - 0.1;       // in the barrel
+  bat.fill = Fill{*FindMaterial("cork"), 0.02, 0.2};  // reaches past the joint
+  EXPECT_FALSE(bat.Validate(&why));
+  EXPECT_EQ(why.field, "handle.joint_from_knob_m");
+  // ValidateSize holds the handle's material to the caps as the bat's (Material::ValidateSize).
+  bat.fill.reset();
+  bat.handle = Handle{bat.material, std::nullopt, 0.3};
+  bat.handle->material.density_kg_m3 = 1e9;
+  EXPECT_TRUE(bat.Validate(&why)) << why.Message();
+  EXPECT_FALSE(bat.ValidateSize(&why));
+  EXPECT_EQ(why.field, "handle.material.density_kg_m3");
+  bat.handle->material.density_kg_m3 = bat.material.density_kg_m3;
+  // The design model has no handle: the values, NaN gradients.
+  bat.fill.reset();
+  const MassPropertiesWithGradient g = ComputeMassPropertiesWithGradient(bat);
+  EXPECT_EQ(g.properties.mass_kg, ComputeMassProperties(bat).mass_kg);
+  EXPECT_TRUE(std::isnan(g.mass_gradient[0]));
+}
+
 }  // namespace
 }  // namespace mass_properties_test
 }  // namespace sweetspot::core
