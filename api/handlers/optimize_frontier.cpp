@@ -216,8 +216,6 @@ std::optional<FrontierRequest> ParseFrontierRequest(Json body, const Context& co
   return r;
 }
 
-Json Finite(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
-
 // One value's row: its index among all values, the value as written, how it was started, and
 // the design's answer as /v1/optimize gives it.
 Json RowOf(const FrontierRequest& r, const core::FrontierPoint& point) {

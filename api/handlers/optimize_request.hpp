@@ -41,6 +41,13 @@ struct OptimizeRequest {
 std::optional<OptimizeRequest> ParseOptimize(const nlohmann::json& body, const Context& context,
                                              ApiError* error);
 
+/// `v`, or null when it is not finite (an answer never holds NaN or infinity).
+nlohmann::json Finite(double v);
+
+/// A material written out whole, as a request gives one (no source or density range; no null
+/// cor).
+nlohmann::json MaterialInRequestForm(const core::Material& m);
+
 /// One design's answer: bat in the request's form, variables as written, properties, objective,
 /// sweet spot, summary (with active constraints and the multi-start spread).
 nlohmann::json ResultToJson(const core::DesignResult& r, const nlohmann::json& request_bat,
