@@ -183,39 +183,6 @@ std::vector<Run> RunStarts(const DesignModel& model, const DesignOptions& option
   return runs;
 }
 
-// The spread of the starts' answers.
-void FillSpread(const std::vector<Run>& runs, DesignSpread* spread_out) {
-  DesignSpread& spread = *spread_out;
-  spread.starts = static_cast<int>(runs.size());
-  std::vector<double> feasible_objectives;
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    const Run& r = runs[i];
-    DesignStart d;
-    d.index = static_cast<int>(i);
-    d.termination = r.outcome.termination;
-    d.raw_status = r.outcome.raw_status;
-    d.iterations = r.outcome.iterations;
-    d.objective = r.objective;
-    d.constraint_violation = r.violation;
-    spread.runs.push_back(d);
-    if (r.outcome.termination == Termination::kConverged) ++spread.converged;
-    if (r.feasible) {
-      ++spread.feasible;
-      feasible_objectives.push_back(r.objective);
-    }
-  }
-  spread.objective_min = spread.objective_max = spread.objective_median = kNaN;
-  if (!feasible_objectives.empty()) {
-    std::sort(feasible_objectives.begin(), feasible_objectives.end());
-    const std::size_t q = feasible_objectives.size();
-    spread.objective_min = feasible_objectives.front();
-    spread.objective_max = feasible_objectives.back();
-    spread.objective_median =
-        q % 2 == 1 ? feasible_objectives[q / 2]
-                   : 0.5 * (feasible_objectives[q / 2 - 1] + feasible_objectives[q / 2]);
-  }
-}
-
 // The answer when a constraint no variable changes is violated: infeasible, with each one.
 void ReportFixedViolations(const DesignModel& model, DesignResult* result) {
   result->summary.termination = Termination::kInfeasible;
@@ -416,7 +383,7 @@ void CheckBbcorRule(const DesignProblem& problem, const PublicEvaluation& pub,
 
 // The optimisation, with the progress it reports mapped into [progress_from, progress_to]
 // and an overall deadline (OptimizeOverMaterials shares one budget between materials).
-DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& options,
+DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions& options,
                           Progress* progress, double progress_from, double progress_to,
                           std::optional<Clock::time_point> shared_deadline) {
   const Clock::time_point start = Clock::now();
@@ -552,13 +519,17 @@ DesignResult OptimizeOnce(const DesignProblem& problem, const DesignOptions& opt
   return result;
 }
 
+}  // namespace
+
+namespace design_detail {
+
 // The optimisation, in certification rounds when the problem bounds the BBCOR
 // (bbcor_constraint.hpp): the rounds share one deadline.
 DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options,
                       Progress* progress, double progress_from, double progress_to,
                       std::optional<Clock::time_point> shared_deadline) {
   if (!BbcorBoundOf(problem).has_value()) {
-    return OptimizeOnce(problem, options, progress, progress_from, progress_to, shared_deadline);
+    return OptimizeOneRound(problem, options, progress, progress_from, progress_to, shared_deadline);
   }
   const Clock::time_point start = Clock::now();
   const Clock::time_point deadline = shared_deadline.value_or(
@@ -566,13 +537,15 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
                   std::isfinite(options.max_time_s) && options.max_time_s > 0.0 ? options.max_time_s
                                                                                 : 0.0)));
   DesignResult r = OptimizeWithCertifiedBbcor(problem, [&](const DesignProblem& p) {
-    return OptimizeOnce(p, options, progress, progress_from, progress_to, deadline);
+    return OptimizeOneRound(p, options, progress, progress_from, progress_to, deadline);
   });
   r.summary.solve_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return r;
 }
 
-}  // namespace
+}  // namespace design_detail
+
+using design_detail::Optimize;
 
 DesignResult OptimizeDesign(const DesignProblem& problem, const DesignOptions& options,
                             Progress* progress) {
@@ -596,91 +569,6 @@ DesignResult OptimizeDesign(const DesignProblem& problem, const DesignOptions& o
   again.summary.evaluations += std::max(first.summary.evaluations, 0);
   again.summary.solve_time_s += std::max(first.summary.solve_time_s, 0.0);
   return again;
-}
-
-MaterialChoiceResult OptimizeOverMaterials(const DesignProblem& problem,
-                                           const std::vector<Material>& materials,
-                                           const DesignOptions& options, Progress* progress) {
-  const Clock::time_point start = Clock::now();
-  const Clock::time_point deadline =
-      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
-                  std::isfinite(options.max_time_s) && options.max_time_s > 0.0 ? options.max_time_s
-                                                                                : 0.0));
-  MaterialChoiceResult out;
-  out.summary.backend = BackendName(MainBackend(problem, options));
-  out.summary.iterations = 0;
-  out.summary.evaluations = 0;
-  out.summary.objective = kNaN;
-  if (materials.empty()) {
-    out.summary.SetRefusal(TextRefusal("materials", "give at least one material"));
-    out.summary.solve_time_s = 0.0;
-    return out;
-  }
-  const bool maximize = problem.objective != DesignObjective::kMinMoi &&
-                        problem.objective != DesignObjective::kMinSting &&
-                        problem.objective != DesignObjective::kLeastSquares;
-  for (std::size_t i = 0; i < materials.size(); ++i) {
-    if (IsCancelled(progress)) {
-      out.summary.warnings.push_back("cancelled after " + std::to_string(i) + " materials");
-      break;
-    }
-    DesignProblem p = problem;
-    p.bat.material = materials[i];
-    p.base_mass_properties.reset();  // another bat's
-    MaterialDesignResult r;
-    r.material = materials[i].name;
-    const double n = static_cast<double>(materials.size());
-    r.result = Optimize(p, options, progress, i / n, (i + 1.0) / n, deadline);
-    out.summary.iterations += std::max(r.result.summary.iterations, 0);
-    out.summary.evaluations += std::max(r.result.summary.evaluations, 0);
-    out.per_material.push_back(std::move(r));
-  }
-  auto rank = [](const DesignResult& r) {
-    if (r.summary.termination == Termination::kConverged) return 0;
-    if (r.summary.termination == Termination::kNoConvergence) return 1;
-    return 2;
-  };
-  for (std::size_t i = 0; i < out.per_material.size(); ++i) {
-    const DesignResult& r = out.per_material[i].result;
-    if (rank(r) == 2 || !std::isfinite(r.objective_value)) continue;
-    if (out.best < 0) {
-      out.best = static_cast<int>(i);
-      continue;
-    }
-    const DesignResult& b = out.per_material[static_cast<std::size_t>(out.best)].result;
-    if (rank(r) < rank(b) ||
-        (rank(r) == rank(b) && (maximize ? r.objective_value > b.objective_value
-                                         : r.objective_value < b.objective_value))) {
-      out.best = static_cast<int>(i);
-    }
-  }
-  if (out.best >= 0) {
-    const MaterialDesignResult& b = out.per_material[static_cast<std::size_t>(out.best)];
-    out.summary.termination = b.result.summary.termination;
-    out.summary.raw_status = b.result.summary.raw_status;
-    out.summary.objective = b.result.objective_value;
-    out.summary.constraint_violation = b.result.summary.constraint_violation;
-    out.summary.error_estimate = b.result.summary.error_estimate;
-    out.summary.models_used = b.result.summary.models_used;
-    out.summary.message = "best material: " + b.material + " (" + b.result.summary.message + ")";
-  } else {
-    bool all_infeasible = !out.per_material.empty();
-    bool all_invalid = !out.per_material.empty();
-    for (const auto& r : out.per_material) {
-      all_infeasible = all_infeasible && r.result.summary.termination == Termination::kInfeasible;
-      all_invalid = all_invalid && r.result.summary.termination == Termination::kInvalidInput;
-    }
-    out.summary.termination = all_infeasible ? Termination::kInfeasible
-                              : all_invalid  ? Termination::kInvalidInput
-                                             : Termination::kFailure;
-    std::string text;
-    for (const auto& r : out.per_material) {
-      text += (text.empty() ? "" : "; ") + r.material + ": " + r.result.summary.message;
-    }
-    out.summary.message = "no material gives a usable design: " + text;
-  }
-  out.summary.solve_time_s = std::chrono::duration<double>(Clock::now() - start).count();
-  return out;
 }
 
 }  // namespace sweetspot::core

@@ -272,4 +272,37 @@ void ReportActiveConstraints(const DesignModel& model, const std::vector<double>
     }
   }
 }
+// The spread of the starts' answers.
+void FillSpread(const std::vector<Run>& runs, DesignSpread* spread_out) {
+  DesignSpread& spread = *spread_out;
+  spread.starts = static_cast<int>(runs.size());
+  std::vector<double> feasible_objectives;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const Run& r = runs[i];
+    DesignStart d;
+    d.index = static_cast<int>(i);
+    d.termination = r.outcome.termination;
+    d.raw_status = r.outcome.raw_status;
+    d.iterations = r.outcome.iterations;
+    d.objective = r.objective;
+    d.constraint_violation = r.violation;
+    spread.runs.push_back(d);
+    if (r.outcome.termination == Termination::kConverged) ++spread.converged;
+    if (r.feasible) {
+      ++spread.feasible;
+      feasible_objectives.push_back(r.objective);
+    }
+  }
+  spread.objective_min = spread.objective_max = spread.objective_median = kNaN;
+  if (!feasible_objectives.empty()) {
+    std::sort(feasible_objectives.begin(), feasible_objectives.end());
+    const std::size_t q = feasible_objectives.size();
+    spread.objective_min = feasible_objectives.front();
+    spread.objective_max = feasible_objectives.back();
+    spread.objective_median =
+        q % 2 == 1 ? feasible_objectives[q / 2]
+                   : 0.5 * (feasible_objectives[q / 2 - 1] + feasible_objectives[q / 2]);
+  }
+}
+
 }  // namespace sweetspot::core::design_detail

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "core/optimize/design_backends.hpp"
@@ -66,5 +67,15 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
                                     Clock::time_point deadline, Progress* progress,
                                     const Run& least_violating, bool solver_says_infeasible,
                                     int* evaluations, int* iterations);
+
+/// The spread of the starts' answers (their objectives, terminations and violations).
+void FillSpread(const std::vector<Run>& runs, DesignSpread* spread_out);
+
+/// OptimizeDesign's solve of `problem` with `options` (its backend as given), in certification
+/// rounds when the problem bounds the BBCOR; progress reported over [progress_from,
+/// progress_to]; `shared_deadline` (when set) bounds it instead of options.max_time_s.
+DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options,
+                      Progress* progress, double progress_from, double progress_to,
+                      std::optional<Clock::time_point> shared_deadline);
 
 }  // namespace sweetspot::core::design_detail
