@@ -46,7 +46,7 @@ LocalSolveOutcome WithCertifiedMultipliers(const DesignModel& model, const Desig
   return out;
 }
 
-void FinishCertificate(const Run& chosen, DesignResult* result) {
+void FinishCertificate(const Run& chosen, bool reports_multipliers, DesignResult* result) {
   for (const MergedConstraint& m : result->merged_constraints) {
     result->summary.warnings.push_back(m.message);
   }
@@ -55,9 +55,11 @@ void FinishCertificate(const Run& chosen, DesignResult* result) {
   result->summary.error_estimate = c.stationarity;
   if (!c.multipliers_unique && !result->active_constraints.empty()) {
     for (DesignActiveConstraint& a : result->active_constraints) a.multiplier = kNaN;
-    result->summary.warnings.push_back(
-        "the active constraints' gradients are linearly dependent, so their multipliers are not "
-        "unique and are not reported (null)");
+    if (reports_multipliers) {
+      result->summary.warnings.push_back(
+          "the active constraints' gradients are linearly dependent, so their multipliers are "
+          "not unique and are not reported (null)");
+    }
   }
   if (chosen.uncertified && result->message_kind == DesignMessageKind::kSolver &&
       result->summary.termination == Termination::kNoConvergence) {

@@ -28,9 +28,10 @@ LocalSolveOutcome WithCertifiedMultipliers(const DesignModel& model, const Desig
                                            DesignResult* result);
 
 /// After ReportActiveConstraints: error_estimate is the certificate's stationarity; multipliers
-/// that are not unique become NaN (with a warning); the message of a chosen run that reported
+/// that are not unique become NaN (with a warning when `reports_multipliers`: the shape fit
+/// reports none, so it gets no warning about them); the message of a chosen run that reported
 /// convergence without a certificate says so (message_kind kNotCertified); merged constraints
 /// get a warning each.
-void FinishCertificate(const Run& chosen, DesignResult* result);
+void FinishCertificate(const Run& chosen, bool reports_multipliers, DesignResult* result);
 
 }  // namespace sweetspot::core::design_detail

@@ -503,7 +503,9 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
     ReportActiveConstraints(
         model, x, design_detail::WithCertifiedMultipliers(model, options, x, chosen.outcome, &result),
         &result, options.feasibility_tolerance);
-    design_detail::FinishCertificate(chosen, &result);
+    // The shape fit (a least-squares objective) reports no multipliers: no warning about them.
+    design_detail::FinishCertificate(
+        chosen, problem.objective != DesignObjective::kLeastSquares, &result);
     MarkCancelledMultiStart(options, runs, progress, &result);
     CheckBbcorRule(problem, pub, options.feasibility_tolerance, &result);
   } catch (const std::bad_alloc&) {
