@@ -26,6 +26,7 @@
 #include <ctime>
 #include <fstream>
 #include <functional>
+#include <iomanip>
 #include <iostream>
 #include <limits>
 #include <optional>
@@ -687,8 +688,8 @@ void FlightRows(const TimingOptions& timing, bool quick, Report* report) {
        "one core::flight::Fly: 100 mph at 28 degrees, the Statcast spin relation, 70 F, sea "
        "level, 50 %, 29.92 inHg, calm; Dormand-Prince 5(4), the landing as a dense-output event",
        "the same flight at relative and absolute tolerance 1e-12",
-       "relative_tolerance = " + Tol(defaults.relative_tolerance) + ", absolute_tolerance_m = " +
-           Tol(defaults.absolute_tolerance_m) +
+       "relative_tolerance = " + Tol(defaults.relative_tolerance) +
+           ", absolute_tolerance_m = " + Tol(defaults.absolute_tolerance_m) +
            ": core::flight::FlightOptions (core/flight/flight.hpp), chosen for 0.1 ft (3 cm) of "
            "distance"});
   flight::FlightOptions ref_o;
@@ -913,12 +914,11 @@ void FlexibleImpactRows(const TimingOptions& timing, bool quick, Report* report)
 
 // ---------------------------------------------------------------------------------- design
 
-/// The paper-wood bat resampled on 16 evenly spaced knots (same material).
-core::Bat SixteenKnotPaperWood() {
+/// The paper-wood bat resampled on `n` evenly spaced knots (same material).
+core::Bat KnotPaperWood(int n) {
   const core::Bat base = core::FindPreset(kPreset)->bat;
   core::Bat bat;
   bat.material = base.material;
-  const int n = 16;
   const double length = base.LengthM();
   for (int i = 0; i < n; ++i) {
     const double x = length * i / (n - 1);
@@ -927,12 +927,13 @@ core::Bat SixteenKnotPaperWood() {
   return bat;
 }
 
-/// Max exit speed over the radii of knots 1..14 at the base mass, balance point <= 0.60 m,
-/// diameters within the paper bat's (handle 0.025 m, barrel 0.07 m), non-decreasing taper.
-core::DesignProblem SixteenKnotProblem() {
+/// Max exit speed over the radii of the inner knots 1..n-2 at the base mass, balance point
+/// <= 0.60 m, diameters within the paper bat's (handle 0.025 m, barrel 0.07 m), non-decreasing
+/// taper.
+core::DesignProblem KnotProblem(int n) {
   core::DesignProblem p;
-  p.bat = SixteenKnotPaperWood();
-  for (int i = 1; i <= 14; ++i) {
+  p.bat = KnotPaperWood(n);
+  for (int i = 1; i <= n - 2; ++i) {
     p.variables.push_back({"profile.knots[" + std::to_string(i) + "].radius_m", 0.0110, 0.0350});
   }
   p.constraints.mass_kg = core::DesignRange::Equal(core::ComputeMassProperties(p.bat).mass_kg);
@@ -943,20 +944,47 @@ core::DesignProblem SixteenKnotProblem() {
   return p;
 }
 
-void DesignRows(const TimingOptions& timing, bool quick, Report* report) {
-  const std::string model = "ipopt_design_16_knots";
+/// The largest |x - x*| over the variables of two answers to the same problem, m.
+double DesignDistanceM(const core::DesignResult& a, const core::DesignResult& b) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.variables.size() && i < b.variables.size(); ++i) {
+    worst = std::max(worst, std::abs(a.variables[i].value - b.variables[i].value));
+  }
+  return worst;
+}
+
+/// The design model's name at `knots` knots.
+std::string DesignModelName(int knots) { return "design_" + std::to_string(knots) + "_knots"; }
+
+/// Rows of one design problem (KnotProblem(knots)): the request's default (the optimiser's
+/// chosen backend), Ipopt on the lifted formulation (exact sparse Hessian) at three tolerances,
+/// Ipopt on the dense formulation with its default limited-memory Hessian, and NLopt SLSQP
+/// where it is allowed (at most 32 variables). The reference is a certified Ipopt solve at
+/// tolerance 1e-12; error = the objective's difference, and each row states the design's
+/// distance to the reference's (the largest |x - x*|, m) and whether its certificate held.
+void DesignRowsAt(int knots, const TimingOptions& timing, bool quick, Report* report) {
+  const std::string model = DesignModelName(knots);
   const core::DesignOptions defaults;
+  core::DesignOptions request_default;  // What /v1/optimize sets without "backend"/"hessian".
+  request_default.choose_backend = true;
   report->models.push_back(
-      {model, "Design optimisation (Ipopt), 16 knots",
-       "one core::OptimizeDesign: max exit speed over the radii of 14 knots of the paper-wood "
-       "bat resampled on 16 knots, at its mass, balance point <= 0.60 m, diameters within "
-       "[0.025, 0.07] m, non-decreasing taper (one start)",
-       "the same with the exact Hessian at tolerance 1e-12 (the tighter solve); error = the "
-       "objective's (max exit speed's) difference",
-       "hessian = limited_memory, tolerance = " + Tol(defaults.tolerance) +
-           ", backend ipopt: core::DesignOptions (core/optimize/design_problem.hpp), request "
-           "default \"limited_memory\" (api/handlers/optimize.cpp)"});
-  const core::DesignProblem problem = SixteenKnotProblem();
+      {model, "Design optimisation, " + std::to_string(knots) + " knots",
+       "one core::OptimizeDesign: max exit speed over the radii of the " +
+           std::to_string(knots - 2) + " inner knots of the paper-wood bat resampled on " +
+           std::to_string(knots) +
+           " knots, at its mass, balance point <= 0.60 m, diameters within [0.025, 0.07] m, "
+           "non-decreasing taper (one start)",
+       "Ipopt with the exact Hessian at tolerance 1e-12, certified (its first-order conditions "
+       "checked by the service); error = the objective's (max exit speed's) difference, and "
+       "distance_to_optimum_m = the largest difference of a variable",
+       "the request's default: the optimiser chooses the backend (NLopt SLSQP up to " +
+           std::to_string(24) +
+           " variables when its answer is certified, else Ipopt on the lifted formulation), "
+           "tolerance " +
+           Tol(defaults.tolerance) +
+           ": core::DesignOptions::choose_backend (core/optimize/backend_choice.hpp), set by "
+           "api/handlers/optimize.cpp"});
+  const core::DesignProblem problem = KnotProblem(knots);
   core::DesignOptions ref_o;
   ref_o.hessian = core::HessianMode::kExact;
   ref_o.tolerance = 1e-12;
@@ -970,7 +998,8 @@ void DesignRows(const TimingOptions& timing, bool quick, Report* report) {
   report->models.back().reference +=
       " (" + std::string(core::TerminationName(ref.summary.termination)) + ", " +
       std::to_string(ref.summary.iterations) + " iterations, objective " +
-      Fixed(ref.objective_value, 9) + " m/s)";
+      Fixed(ref.objective_value, 9) + " m/s, certified " +
+      (ref.certificate.certified ? "yes" : "no") + ")";
   auto run = [&](const core::DesignOptions& o, const std::string& setting, bool is_auto) {
     core::DesignResult r = core::OptimizeDesign(problem, o);
     if (!r.summary.IsSolutionUsable()) {
@@ -985,36 +1014,41 @@ void DesignRows(const TimingOptions& timing, bool quick, Report* report) {
         {"objective_mps", "m/s", r.objective_value, ref.objective_value},
         {"sweet_spot_from_knob_m", "m", r.sweet_spot_from_knob_m, ref.sweet_spot_from_knob_m}};
     row.parameters = {
-        {"backend", o.backend == core::DesignBackend::kIpopt ? "ipopt" : "nlopt_slsqp"},
-        {"hessian", o.hessian == core::HessianMode::kExact ? "exact" : "limited_memory"},
+        {"backend", r.summary.backend},
+        {"hessian", o.hessian == core::HessianMode::kExact || o.lift ? "exact" : "limited_memory"},
+        {"lifted", o.lift},
         {"tolerance", o.tolerance},
         {"iterations", r.summary.iterations},
-        {"evaluations", r.summary.evaluations}};
+        {"evaluations", r.summary.evaluations},
+        {"distance_to_optimum_m", DesignDistanceM(r, ref)},
+        {"certified", r.certificate.certified}};
     row.is_auto = is_auto;
     row.termination = core::TerminationName(r.summary.termination);
     report->rows.push_back(row);
     Progress(*report);
   };
+  run(request_default, "default (chosen backend), tolerance " + Tol(defaults.tolerance), true);
   std::vector<double> tols = {1e-3, 1e-6, defaults.tolerance};
   if (quick) tols = {defaults.tolerance};
-  for (const core::HessianMode hessian :
-       {core::HessianMode::kLimitedMemory, core::HessianMode::kExact}) {
-    for (const double tol : tols) {
-      core::DesignOptions o;
-      o.hessian = hessian;
-      o.tolerance = tol;
-      const std::string name =
-          hessian == core::HessianMode::kExact ? "exact Hessian" : "limited-memory Hessian";
-      run(o, "ipopt, " + name + ", tolerance " + Tol(tol),
-          hessian == defaults.hessian && tol == defaults.tolerance &&
-              defaults.backend == core::DesignBackend::kIpopt);
-    }
+  for (const double tol : tols) {
+    core::DesignOptions o;
+    o.tolerance = tol;
+    run(o, "ipopt, lifted (exact sparse Hessian), tolerance " + Tol(tol), false);
   }
-  if (!quick) {
+  if (quick) return;
+  core::DesignOptions dense;
+  dense.lift = false;
+  run(dense, "ipopt, dense, limited-memory Hessian, tolerance " + Tol(dense.tolerance), false);
+  if (knots - 2 <= 32) {
     core::DesignOptions o;
     o.backend = core::DesignBackend::kNloptSlsqp;
     run(o, "nlopt LD_SLSQP backend, tolerance " + Tol(o.tolerance), false);
   }
+}
+
+void DesignRows(const TimingOptions& timing, bool quick, Report* report) {
+  DesignRowsAt(16, timing, quick, report);
+  if (!quick) DesignRowsAt(64, timing, quick, report);
 }
 
 // -------------------------------------------------------------------------------- machine
@@ -1288,17 +1322,33 @@ std::string HowToChoose(const Report& report) {
      << "). Computing the modes is most of a fresh call: the default costs " << TimeOf(f_auto)
      << " fresh and " << TimeOf(f_cached) << " with the modes cached, as the server does "
      << "for a repeated bat.\n";
-  const Row* d_lm =
-      FindRow(report, "ipopt_design_16_knots",
-              "ipopt, limited-memory Hessian, tolerance " + Tol(core::DesignOptions{}.tolerance));
-  const Row* d_ex =
-      FindRow(report, "ipopt_design_16_knots",
-              "ipopt, exact Hessian, tolerance " + Tol(core::DesignOptions{}.tolerance));
-  const Row* d_sl = FindRow(report, "ipopt_design_16_knots", "nlopt LD_SLSQP");
-  md << "* **Design** (16 knots): the default limited-memory Hessian took " << TimeOf(d_lm)
-     << " and the exact Hessian " << TimeOf(d_ex) << ", both within " << ErrorOf(d_lm) << " / "
-     << ErrorOf(d_ex) << " of the reference objective; the NLopt SLSQP backend " << TimeOf(d_sl)
-     << " (" << ErrorOf(d_sl) << "). One problem only: time your own design before switching.\n";
+  for (const int knots : {16, 64}) {
+    const std::string name = DesignModelName(knots);
+    const std::string tol = Tol(core::DesignOptions{}.tolerance);
+    const Row* d_auto = FindRow(report, name, "default (chosen backend)");
+    const Row* d_lifted =
+        FindRow(report, name, "ipopt, lifted (exact sparse Hessian), tolerance " + tol);
+    const Row* d_loose =
+        FindRow(report, name, "ipopt, lifted (exact sparse Hessian), tolerance 1e-03");
+    const Row* d_dense = FindRow(report, name, "ipopt, dense, limited-memory Hessian");
+    if (d_auto == nullptr) continue;  // Not run (--quick runs 16 knots only).
+    auto distance = [](const Row* r) -> std::string {
+      if (r == nullptr) return "n/a";
+      std::ostringstream o;
+      o << std::setprecision(2) << std::scientific
+        << r->parameters.value("distance_to_optimum_m", 0.0) << " m";
+      return o.str();
+    };
+    md << "* **Design** (" << knots << " knots): the request's default ("
+       << (d_auto ? d_auto->parameters.value("backend", std::string("?")) : std::string("?"))
+       << ") took " << TimeOf(d_auto) << ", " << ErrorOf(d_auto) << " from the certified "
+       << "optimum's objective, its design " << distance(d_auto) << " from it; Ipopt on the "
+       << "lifted formulation " << TimeOf(d_lifted) << " (" << ErrorOf(d_lifted) << ", "
+       << distance(d_lifted) << "), at tolerance 1e-3 " << TimeOf(d_loose) << " ("
+       << ErrorOf(d_loose) << ", " << distance(d_loose) << "); the dense formulation with its "
+       << "limited-memory Hessian " << TimeOf(d_dense) << " (" << ErrorOf(d_dense) << ", "
+       << distance(d_dense) << ").\n";
+  }
   const Row* hoop = FindRow(report, "barrel_hoop", "closed form");
   const Row* hoop_fe = FindRow(report, "barrel_hoop", "ring FE, 64 elements");
   const Row* tr_auto = FindRow(report, "barrel_trampoline", "defaults");
