@@ -204,7 +204,7 @@ scenario('a preset added by keyboard beside the bat above: same bat speed, in in
   assert.equal(table.find((r) => r.key === 'max_exit_speed').deltaPath, 'deltas.max_exit_speed_mph');
   const mode = await readMode(page);
   assert.equal(mode.mode, 'same_bat_speed');
-  assert.match(mode.text, /Mode: same bat speed/);
+  assert.match(mode.text, /^Mode: same bat speed\. swing\.speed_model "fixed"/);
   assert.deepEqual(
     mode.speeds.map((s) => s.value),
     answer.rows.map((r) => r.swing.bat_speed_mph),
@@ -227,7 +227,7 @@ scenario('"same batter" switched on by keyboard: the swing-weight model, each ba
   const answer = await compare(url, compareBody({ preset: 'wood-34-ash' }, [{ name: ALLOY, bat: { preset: ALLOY } }], { sameBatter: true }));
   const mode = await readMode(page);
   assert.equal(mode.mode, 'same_batter');
-  assert.match(mode.text, /Mode: same batter\. .*swing_weight.*Cross & Bower/);
+  assert.match(mode.text, /^Mode: same batter\. swing\.speed_model "swing_weight".*Cross & Bower/);
   assert.match(mode.text, /wood-34-ash/, 'the reference bat named');
   assert.deepEqual(
     mode.speeds.map((s) => s.value),
@@ -341,6 +341,7 @@ scenario('the link restores the bats and the switch on a 390-px phone, nothing c
   assert.ok(chart.textRight <= chart.right + 0.5 && chart.textLeft >= chart.left - 0.5, `a label past the chart's edge: ${JSON.stringify(chart)}`);
   await assertNoOverflow(small, 390);
   await shot(small, artifacts, 'compare-04-phone');
+  await small.locator('#bats-section').screenshot({ path: `${artifacts}/compare-04-phone-section.png` });
   assert.deepEqual(errors, []);
   await phone.close();
 });

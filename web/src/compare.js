@@ -304,17 +304,17 @@ export class ComparePanel {
     if (sameBatter && sw) {
       const ref = sw.reference_bat ? `${sw.reference_bat}, ` : '';
       text =
-        `Same batter (swing.speed_model "swing_weight", Cross & Bower 2006): the batter swings the reference bat ` +
+        `swing.speed_model "swing_weight" (Cross & Bower 2006): the batter swings the reference bat ` +
         `(${ref}${fmt(this.q(sw, 'reference_moi_kg_m2'), 5)} ${this.u('reference_moi_kg_m2')} about the hands) at ` +
         `${fmt(this.q(sw, 'given_bat_speed_mps'), 4)} ${this.u('given_bat_speed_mps')}, and each bat at that speed × ` +
         `(its MOI about the hands / the reference's)^−${fmt(sw.exponent, 3)}. Bat speeds: `;
     } else if (withSpeed) {
-      text = `Same bat speed (swing.speed_model "fixed"): every bat swung at the speed given, at ${fmt(
+      text = `swing.speed_model "fixed": every bat swung at the speed given, at ${fmt(
         this.q(rows[0].swing, 'bat_speed_from_tip_m'),
         3,
       )} ${this.u('bat_speed_from_tip_m')} from its tip. Bat speeds: `;
     } else {
-      text = 'Same swing (no bat speed given): every bat at the same angular speed. Angular speeds: ';
+      text = 'no bat speed given: every bat at the same angular speed. Angular speeds: ';
     }
     mode.replaceChildren(el('strong', { text: sameBatter ? 'Mode: same batter. ' : 'Mode: same bat speed. ' }), text, ...speeds, '.');
   }
@@ -431,7 +431,7 @@ export class ComparePanel {
       'aria-label': `Exit speed along each bat: ${names.join(', ')}`,
     });
     const grid = svgEl('g', { class: 'grid' });
-    for (const t of ticks(x0, x1, Math.max(3, Math.floor(width / 90)))) {
+    for (const t of ticks(x0, x1, Math.max(4, Math.floor(width / 80)))) {
       grid.append(svgEl('line', { x1: px(t), x2: px(t), y1: top, y2: top + plotH }));
       grid.append(svgEl('text', { x: px(t), y: top + plotH + 16, 'text-anchor': 'middle' }, fmt(t, 4)));
     }
