@@ -63,7 +63,11 @@ async function waitForBats(page, after) {
   await page.waitForFunction(
     (r) => {
       const state = document.querySelector('#bats-state');
-      return Number(state.dataset.revision || 0) > r && state.dataset.state === 'ready' && document.body.dataset.state === 'ready';
+      return (
+        Number(state.dataset.revision || 0) > r &&
+        state.dataset.state === 'ready' &&
+        document.body.dataset.state === 'ready'
+      );
     },
     after,
     { timeout: 30000 },
@@ -104,7 +108,11 @@ async function assertTableIsTheApis(page, answer, expect) {
       } else {
         // The API gives a bat speed's delta only with the swing-weight model: none shown then.
         const delta = at(answer.rows[i], row.deltaPath);
-        assert.equal(cell.delta, typeof delta === 'number' ? delta : null, `${row.key}: bat ${i}'s delta (${row.deltaPath})`);
+        assert.equal(
+          cell.delta,
+          typeof delta === 'number' ? delta : null,
+          `${row.key}: bat ${i}'s delta (${row.deltaPath})`,
+        );
       }
     });
   }
@@ -118,7 +126,10 @@ function readMode(page) {
     return {
       mode: mode.dataset.mode,
       text: mode.textContent,
-      speeds: [...mode.querySelectorAll('.speed')].map((s) => ({ name: s.dataset.name, value: Number(s.dataset.batSpeed) })),
+      speeds: [...mode.querySelectorAll('.speed')].map((s) => ({
+        name: s.dataset.name,
+        value: Number(s.dataset.batSpeed),
+      })),
     };
   });
 }
@@ -129,7 +140,10 @@ function readViews(page) {
     series: [...document.querySelectorAll('#bats-curves-svg .series')].map((g) => ({
       bat: g.dataset.bat,
       points: g.querySelector('polyline').getAttribute('points').trim().split(/\s+/).length,
-      peak: g.querySelector('.peak') && { x: Number(g.querySelector('.peak').dataset.x), y: Number(g.querySelector('.peak').dataset.y) },
+      peak: g.querySelector('.peak') && {
+        x: Number(g.querySelector('.peak').dataset.x),
+        y: Number(g.querySelector('.peak').dataset.y),
+      },
     })),
     legend: [...document.querySelectorAll('#bats-curves-svg .legend-item')].map((g) => g.textContent),
     lanes: [...document.querySelectorAll('#bats-profiles .lane')].map((g) => ({
@@ -177,174 +191,238 @@ async function download(page, selector) {
 const scenarios = [];
 const scenario = (name, fn) => scenarios.push({ name, fn });
 
-scenario('a preset added by keyboard beside the bat above: same bat speed, in inches and mph', async ({ page, url }) => {
-  await page.goto(url);
-  await page.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
-  await page.waitForFunction(() => document.querySelector('#bats-state').dataset.state === 'ready', null, { timeout: 20000 });
-  assert.equal(await page.locator('#bats-views').isHidden(), true, 'no views before a bat is added');
-  // Labelled controls: the list, the switch, every button says what it does.
-  assert.equal(await page.locator('#bats-add-choice').evaluate((s) => s.labels.length), 1);
-  assert.equal(await page.locator('#bats-same-batter').evaluate((s) => s.labels.length), 1);
-  // Keyboard only: the list offers the alloy bat first (alloy against wood), Tab to "Add", Enter.
-  assert.equal(await page.locator('#bats-add-choice').inputValue(), ALLOY);
-  await page.focus('#bats-add-choice');
-  const before = await batsRevision(page);
-  await page.keyboard.press('Tab');
-  assert.equal(await page.evaluate(() => document.activeElement.id), 'bats-add');
-  await page.keyboard.press('Enter');
-  await waitForBats(page, before);
+scenario(
+  'a preset added by keyboard beside the bat above: same bat speed, in inches and mph',
+  async ({ page, url }) => {
+    await page.goto(url);
+    await page.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+    await page.waitForFunction(() => document.querySelector('#bats-state').dataset.state === 'ready', null, {
+      timeout: 20000,
+    });
+    assert.equal(await page.locator('#bats-views').isHidden(), true, 'no views before a bat is added');
+    // Labelled controls: the list, the switch, every button says what it does.
+    assert.equal(await page.locator('#bats-add-choice').evaluate((s) => s.labels.length), 1);
+    assert.equal(await page.locator('#bats-same-batter').evaluate((s) => s.labels.length), 1);
+    // Keyboard only: the list offers the alloy bat first (alloy against wood), Tab to "Add", Enter.
+    assert.equal(await page.locator('#bats-add-choice').inputValue(), ALLOY);
+    await page.focus('#bats-add-choice');
+    const before = await batsRevision(page);
+    await page.keyboard.press('Tab');
+    assert.equal(await page.evaluate(() => document.activeElement.id), 'bats-add');
+    await page.keyboard.press('Enter');
+    await waitForBats(page, before);
 
-  const answer = await compare(url, compareBody({ preset: 'wood-34-ash' }, [{ name: ALLOY, bat: { preset: ALLOY } }]));
-  await assertTableIsTheApis(page, answer, ['bat_speed', 'max_exit_speed', 'max_exit_speed_position', 'mass', 'balance_point', 'moi_six_inch']);
-  const table = await readTable(page);
-  assert.equal(table.find((r) => r.key === 'mass').path, 'properties.mass_oz', 'the mass in ounces');
-  assert.equal(table.find((r) => r.key === 'mass').cells[1].delta, answer.rows[1].deltas.mass_oz);
-  assert.equal(table.find((r) => r.key === 'max_exit_speed').cells[1].delta, answer.rows[1].deltas.max_exit_speed_mph);
-  assert.equal(table.find((r) => r.key === 'bat_speed').cells[1].delta, null, 'no bat-speed delta at a fixed bat speed');
-  assert.equal(table.find((r) => r.key === 'max_exit_speed').deltaPath, 'deltas.max_exit_speed_mph');
-  const mode = await readMode(page);
-  assert.equal(mode.mode, 'same_bat_speed');
-  assert.match(mode.text, /^Mode: same bat speed\. swing\.speed_model "fixed"/);
-  assert.deepEqual(
-    mode.speeds.map((s) => s.value),
-    answer.rows.map((r) => r.swing.bat_speed_mph),
-  );
-  assert.deepEqual(mode.speeds.map((s) => s.value), [70, 70], 'both bats at the 70 mph given');
-  const views = await assertViewsAreTheApis(page, answer);
-  assert.match(views.legend[1], new RegExp(`^${ALLOY}: max `));
-  await assertNoOverflow(page, 1280);
-  await page.locator('#bats-section').screenshot({ path: `${artifacts}/compare-01-section.png` });
-  await shot(page, artifacts, 'compare-01-two-bats');
-});
+    const answer = await compare(
+      url,
+      compareBody({ preset: 'wood-34-ash' }, [{ name: ALLOY, bat: { preset: ALLOY } }]),
+    );
+    await assertTableIsTheApis(page, answer, [
+      'bat_speed',
+      'max_exit_speed',
+      'max_exit_speed_position',
+      'mass',
+      'balance_point',
+      'moi_six_inch',
+    ]);
+    const table = await readTable(page);
+    assert.equal(table.find((r) => r.key === 'mass').path, 'properties.mass_oz', 'the mass in ounces');
+    assert.equal(table.find((r) => r.key === 'mass').cells[1].delta, answer.rows[1].deltas.mass_oz);
+    assert.equal(
+      table.find((r) => r.key === 'max_exit_speed').cells[1].delta,
+      answer.rows[1].deltas.max_exit_speed_mph,
+    );
+    assert.equal(
+      table.find((r) => r.key === 'bat_speed').cells[1].delta,
+      null,
+      'no bat-speed delta at a fixed bat speed',
+    );
+    assert.equal(table.find((r) => r.key === 'max_exit_speed').deltaPath, 'deltas.max_exit_speed_mph');
+    const mode = await readMode(page);
+    assert.equal(mode.mode, 'same_bat_speed');
+    assert.match(mode.text, /^Mode: same bat speed\. swing\.speed_model "fixed"/);
+    assert.deepEqual(
+      mode.speeds.map((s) => s.value),
+      answer.rows.map((r) => r.swing.bat_speed_mph),
+    );
+    assert.deepEqual(
+      mode.speeds.map((s) => s.value),
+      [70, 70],
+      'both bats at the 70 mph given',
+    );
+    const views = await assertViewsAreTheApis(page, answer);
+    assert.match(views.legend[1], new RegExp(`^${ALLOY}: max `));
+    await assertNoOverflow(page, 1280);
+    await page.locator('#bats-section').screenshot({ path: `${artifacts}/compare-01-section.png` });
+    await shot(page, artifacts, 'compare-01-two-bats');
+  },
+);
 
-scenario('"same batter" switched on by keyboard: the swing-weight model, each bat speed the API\'s', async ({ page, url }) => {
-  const before = await batsRevision(page);
-  await page.focus('#bats-same-batter');
-  await page.keyboard.press('Space');
-  await waitForBats(page, before);
-  assert.equal(await page.locator('#bats-same-batter').isChecked(), true);
+scenario(
+  '"same batter" switched on by keyboard: the swing-weight model, each bat speed the API\'s',
+  async ({ page, url }) => {
+    const before = await batsRevision(page);
+    await page.focus('#bats-same-batter');
+    await page.keyboard.press('Space');
+    await waitForBats(page, before);
+    assert.equal(await page.locator('#bats-same-batter').isChecked(), true);
 
-  const answer = await compare(url, compareBody({ preset: 'wood-34-ash' }, [{ name: ALLOY, bat: { preset: ALLOY } }], { sameBatter: true }));
-  const mode = await readMode(page);
-  assert.equal(mode.mode, 'same_batter');
-  assert.match(mode.text, /^Mode: same batter\. swing\.speed_model "swing_weight".*Cross & Bower/);
-  assert.match(mode.text, /wood-34-ash/, 'the reference bat named');
-  assert.deepEqual(
-    mode.speeds.map((s) => s.value),
-    answer.rows.map((r) => r.swing.bat_speed_mph),
-  );
-  // The alloy bat is lighter to swing: the batter swings it faster than the 70 mph given.
-  assert.equal(mode.speeds[0].value, 70);
-  assert.ok(mode.speeds[1].value > 70, `${mode.speeds[1].value}`);
-  const table = await assertTableIsTheApis(page, answer, ['bat_speed', 'max_exit_speed']);
-  assert.equal(table.find((r) => r.key === 'bat_speed').cells[1].delta, answer.rows[1].deltas.bat_speed_mph);
-  await assertViewsAreTheApis(page, answer);
-  assert.match(page.url(), /cmp\.same_batter=on/);
-  await assertNoOverflow(page, 1280);
-  await shot(page, artifacts, 'compare-02-same-batter');
-});
+    const answer = await compare(
+      url,
+      compareBody({ preset: 'wood-34-ash' }, [{ name: ALLOY, bat: { preset: ALLOY } }], { sameBatter: true }),
+    );
+    const mode = await readMode(page);
+    assert.equal(mode.mode, 'same_batter');
+    assert.match(mode.text, /^Mode: same batter\. swing\.speed_model "swing_weight".*Cross & Bower/);
+    assert.match(mode.text, /wood-34-ash/, 'the reference bat named');
+    assert.deepEqual(
+      mode.speeds.map((s) => s.value),
+      answer.rows.map((r) => r.swing.bat_speed_mph),
+    );
+    // The alloy bat is lighter to swing: the batter swings it faster than the 70 mph given.
+    assert.equal(mode.speeds[0].value, 70);
+    assert.ok(mode.speeds[1].value > 70, `${mode.speeds[1].value}`);
+    const table = await assertTableIsTheApis(page, answer, ['bat_speed', 'max_exit_speed']);
+    assert.equal(table.find((r) => r.key === 'bat_speed').cells[1].delta, answer.rows[1].deltas.bat_speed_mph);
+    await assertViewsAreTheApis(page, answer);
+    assert.match(page.url(), /cmp\.same_batter=on/);
+    await assertNoOverflow(page, 1280);
+    await shot(page, artifacts, 'compare-02-same-batter');
+  },
+);
 
-scenario('a copy of the bat above, then the bat above changed: three bats, and every view exported', async ({ page, url }) => {
-  let before = await batsRevision(page);
-  await page.selectOption('#bats-add-choice', '@current');
-  await page.click('#bats-add');
-  await waitForBats(page, before);
-  before = await batsRevision(page);
-  await page.selectOption('select[name="material"]', 'hard-maple');
-  await waitForBats(page, before);
+scenario(
+  'a copy of the bat above, then the bat above changed: three bats, and every view exported',
+  async ({ page, url }) => {
+    let before = await batsRevision(page);
+    await page.selectOption('#bats-add-choice', '@current');
+    await page.click('#bats-add');
+    await waitForBats(page, before);
+    before = await batsRevision(page);
+    await page.selectOption('select[name="material"]', 'hard-maple');
+    await waitForBats(page, before);
 
-  const variants = [
-    { name: ALLOY, bat: { preset: ALLOY } },
-    { name: 'copy: wood-34-ash', bat: { preset: 'wood-34-ash' } },
-  ];
-  const answer = await compare(url, compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, variants, { sameBatter: true }));
-  await assertTableIsTheApis(page, answer, ['bat_speed', 'max_exit_speed', 'mass']);
-  const views = await assertViewsAreTheApis(page, answer);
-  assert.deepEqual(views.listed.slice(1), [ALLOY, 'copy: wood-34-ash']);
-  const mode = await readMode(page);
-  assert.deepEqual(mode.speeds.map((s) => s.value), answer.rows.map((r) => r.swing.bat_speed_mph));
+    const variants = [
+      { name: ALLOY, bat: { preset: ALLOY } },
+      { name: 'copy: wood-34-ash', bat: { preset: 'wood-34-ash' } },
+    ];
+    const answer = await compare(
+      url,
+      compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, variants, { sameBatter: true }),
+    );
+    await assertTableIsTheApis(page, answer, ['bat_speed', 'max_exit_speed', 'mass']);
+    const views = await assertViewsAreTheApis(page, answer);
+    assert.deepEqual(views.listed.slice(1), [ALLOY, 'copy: wood-34-ash']);
+    const mode = await readMode(page);
+    assert.deepEqual(
+      mode.speeds.map((s) => s.value),
+      answer.rows.map((r) => r.swing.bat_speed_mph),
+    );
 
-  // The curves' CSV: the header names each bat, and every row is the API's curve point.
-  const csv = await download(page, '[data-bats-export="curves-csv"]');
-  assert.match(csv.name, /^bats-same-batter-exit-speed-imperial\.csv$/);
-  const lines = csv.text.trim().split('\r\n');
-  assert.equal(
-    lines[0],
-    'position from the knob (in),the bat above (wood-34-ash): exit speed (mph),bbcor-33-aluminium: exit speed (mph),copy: wood-34-ash: exit speed (mph)',
-  );
-  const byX = new Map(lines.slice(1).map((line) => [Number(line.split(',')[0]), line.split(',').slice(1)]));
-  answer.rows.forEach((row, i) => {
-    for (const p of row.exit_speed_curve) {
-      assert.equal(Number(byX.get(p.position_from_knob_in)[i]), p.exit_speed_mph, `bat ${i} at ${p.position_from_knob_in} in`);
-    }
-  });
-  // The chart as SVG: a standalone file with the three curves and the legend.
-  const curves = await download(page, '[data-bats-export="curves-svg"]');
-  assert.match(curves.text, /^<\?xml/);
-  assert.match(curves.text, /xmlns="http:\/\/www\.w3\.org\/2000\/svg"/);
-  assert.equal((curves.text.match(/<polyline/g) || []).length, 3);
-  for (const name of ['the bat above (wood-34-ash)', ALLOY, 'copy: wood-34-ash']) assert.ok(curves.text.includes(name), name);
-  // The profiles as SVG (three lanes) and as CSV (each bat's knots, a preset's as GET /v1/presets gives them).
-  const profiles = await download(page, '[data-bats-export="profiles-svg"]');
-  assert.equal((profiles.text.match(/class="lane"/g) || []).length, 3);
-  const presets = (await (await fetch(`${url}/v1/presets`)).json()).presets;
-  const alloyKnots = presets.find((p) => p.name === ALLOY).bat.profile.knots;
-  const knots = (await download(page, '[data-bats-export="profiles-csv"]')).text.trim().split('\r\n');
-  assert.equal(knots[0], 'bat,knot,x from the knob (m),radius (m),wall (m; 0: solid)');
-  const alloyRows = knots.filter((line) => line.startsWith(`${ALLOY},`));
-  assert.equal(alloyRows.length, alloyKnots.length);
-  alloyRows.forEach((line, j) => {
-    const [, knot, x, r] = line.split(',');
-    assert.equal(Number(knot), j);
-    assert.equal(Number(x), alloyKnots[j].x_m);
-    assert.equal(Number(r), alloyKnots[j].radius_m);
-  });
-  // The numbers' CSV: one row per bat, each value and delta the API's.
-  const numbers = (await download(page, '[data-bats-export="table-csv"]')).text.trim().split('\r\n');
-  assert.equal(numbers.length, 4);
-  const header = numbers[0].split(',');
-  const alloy = numbers[2].split(',');
-  assert.equal(alloy[0], ALLOY);
-  assert.equal(Number(alloy[header.indexOf('Mass: delta from the bat above (oz)')]), answer.rows[1].deltas.mass_oz);
-  assert.equal(Number(alloy[header.indexOf('Bat speed (mph)')]), answer.rows[1].swing.bat_speed_mph);
-  assert.equal(Number(alloy[header.indexOf('Max exit speed: delta from the bat above (mph)')]), answer.rows[1].deltas.max_exit_speed_mph);
-  await assertNoOverflow(page, 1280);
-  await shot(page, artifacts, 'compare-03-three-bats');
-});
+    // The curves' CSV: the header names each bat, and every row is the API's curve point.
+    const csv = await download(page, '[data-bats-export="curves-csv"]');
+    assert.match(csv.name, /^bats-same-batter-exit-speed-imperial\.csv$/);
+    const lines = csv.text.trim().split('\r\n');
+    assert.equal(
+      lines[0],
+      'position from the knob (in),the bat above (wood-34-ash): exit speed (mph),bbcor-33-aluminium: exit speed (mph),copy: wood-34-ash: exit speed (mph)',
+    );
+    const byX = new Map(lines.slice(1).map((line) => [Number(line.split(',')[0]), line.split(',').slice(1)]));
+    answer.rows.forEach((row, i) => {
+      for (const p of row.exit_speed_curve) {
+        assert.equal(
+          Number(byX.get(p.position_from_knob_in)[i]),
+          p.exit_speed_mph,
+          `bat ${i} at ${p.position_from_knob_in} in`,
+        );
+      }
+    });
+    // The chart as SVG: a standalone file with the three curves and the legend.
+    const curves = await download(page, '[data-bats-export="curves-svg"]');
+    assert.match(curves.text, /^<\?xml/);
+    assert.match(curves.text, /xmlns="http:\/\/www\.w3\.org\/2000\/svg"/);
+    assert.equal((curves.text.match(/<polyline/g) || []).length, 3);
+    for (const name of ['the bat above (wood-34-ash)', ALLOY, 'copy: wood-34-ash'])
+      assert.ok(curves.text.includes(name), name);
+    // The profiles as SVG (three lanes) and as CSV (each bat's knots, a preset's as GET /v1/presets gives them).
+    const profiles = await download(page, '[data-bats-export="profiles-svg"]');
+    assert.equal((profiles.text.match(/class="lane"/g) || []).length, 3);
+    const presets = (await (await fetch(`${url}/v1/presets`)).json()).presets;
+    const alloyKnots = presets.find((p) => p.name === ALLOY).bat.profile.knots;
+    const knots = (await download(page, '[data-bats-export="profiles-csv"]')).text.trim().split('\r\n');
+    assert.equal(knots[0], 'bat,knot,x from the knob (m),radius (m),wall (m; 0: solid)');
+    const alloyRows = knots.filter((line) => line.startsWith(`${ALLOY},`));
+    assert.equal(alloyRows.length, alloyKnots.length);
+    alloyRows.forEach((line, j) => {
+      const [, knot, x, r] = line.split(',');
+      assert.equal(Number(knot), j);
+      assert.equal(Number(x), alloyKnots[j].x_m);
+      assert.equal(Number(r), alloyKnots[j].radius_m);
+    });
+    // The numbers' CSV: one row per bat, each value and delta the API's.
+    const numbers = (await download(page, '[data-bats-export="table-csv"]')).text.trim().split('\r\n');
+    assert.equal(numbers.length, 4);
+    const header = numbers[0].split(',');
+    const alloy = numbers[2].split(',');
+    assert.equal(alloy[0], ALLOY);
+    assert.equal(Number(alloy[header.indexOf('Mass: delta from the bat above (oz)')]), answer.rows[1].deltas.mass_oz);
+    assert.equal(Number(alloy[header.indexOf('Bat speed (mph)')]), answer.rows[1].swing.bat_speed_mph);
+    assert.equal(
+      Number(alloy[header.indexOf('Max exit speed: delta from the bat above (mph)')]),
+      answer.rows[1].deltas.max_exit_speed_mph,
+    );
+    await assertNoOverflow(page, 1280);
+    await shot(page, artifacts, 'compare-03-three-bats');
+  await page.locator('#bats-section').screenshot({ path: `${artifacts}/compare-03-section.png` });
+  },
+);
 
-scenario('the link restores the bats and the switch on a 390-px phone, nothing cut off', async ({ page, url, browser }) => {
-  const hash = new URL(page.url()).hash;
-  assert.match(hash, /cmp\.bat=/);
-  const phone = await browser.newContext({ viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true });
-  const small = await phone.newPage();
-  const errors = [];
-  small.on('pageerror', (error) => errors.push(error.message));
-  await small.goto(`${url}/${hash}`);
-  await small.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
-  await waitForBats(small, 0);
-  assert.equal(await small.locator('#bats-same-batter').isChecked(), true);
-  const variants = [
-    { name: ALLOY, bat: { preset: ALLOY } },
-    { name: 'copy: wood-34-ash', bat: { preset: 'wood-34-ash' } },
-  ];
-  const answer = await compare(url, compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, variants, { sameBatter: true }));
-  await assertTableIsTheApis(small, answer, ['bat_speed', 'max_exit_speed']);
-  await assertViewsAreTheApis(small, answer);
-  // The chart is drawn at the phone's width, its legend inside it.
-  const chart = await small.evaluate(() => {
-    const svg = document.querySelector('#bats-curves-svg');
-    const box = svg.getBoundingClientRect();
-    const texts = [...svg.querySelectorAll('text')].map((t) => t.getBoundingClientRect());
-    return { right: box.right, left: box.left, textRight: Math.max(...texts.map((r) => r.right)), textLeft: Math.min(...texts.map((r) => r.left)) };
-  });
-  assert.ok(chart.right <= 390, `chart ends at ${chart.right}`);
-  assert.ok(chart.textRight <= chart.right + 0.5 && chart.textLeft >= chart.left - 0.5, `a label past the chart's edge: ${JSON.stringify(chart)}`);
-  await assertNoOverflow(small, 390);
-  await shot(small, artifacts, 'compare-04-phone');
-  await small.locator('#bats-section').screenshot({ path: `${artifacts}/compare-04-phone-section.png` });
-  assert.deepEqual(errors, []);
-  await phone.close();
-});
+scenario(
+  'the link restores the bats and the switch on a 390-px phone, nothing cut off',
+  async ({ page, url, browser }) => {
+    const hash = new URL(page.url()).hash;
+    assert.match(hash, /cmp\.bat=/);
+    const phone = await browser.newContext({ viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true });
+    const small = await phone.newPage();
+    const errors = [];
+    small.on('pageerror', (error) => errors.push(error.message));
+    await small.goto(`${url}/${hash}`);
+    await small.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+    await waitForBats(small, 0);
+    assert.equal(await small.locator('#bats-same-batter').isChecked(), true);
+    const variants = [
+      { name: ALLOY, bat: { preset: ALLOY } },
+      { name: 'copy: wood-34-ash', bat: { preset: 'wood-34-ash' } },
+    ];
+    const answer = await compare(
+      url,
+      compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, variants, { sameBatter: true }),
+    );
+    await assertTableIsTheApis(small, answer, ['bat_speed', 'max_exit_speed']);
+    await assertViewsAreTheApis(small, answer);
+    // The chart is drawn at the phone's width, its legend inside it.
+    const chart = await small.evaluate(() => {
+      const svg = document.querySelector('#bats-curves-svg');
+      const box = svg.getBoundingClientRect();
+      const texts = [...svg.querySelectorAll('text')].map((t) => t.getBoundingClientRect());
+      return {
+        right: box.right,
+        left: box.left,
+        textRight: Math.max(...texts.map((r) => r.right)),
+        textLeft: Math.min(...texts.map((r) => r.left)),
+      };
+    });
+    assert.ok(chart.right <= 390, `chart ends at ${chart.right}`);
+    assert.ok(
+      chart.textRight <= chart.right + 0.5 && chart.textLeft >= chart.left - 0.5,
+      `a label past the chart's edge: ${JSON.stringify(chart)}`,
+    );
+    await assertNoOverflow(small, 390);
+    await shot(small, artifacts, 'compare-04-phone');
+    await small.locator('#bats-section').screenshot({ path: `${artifacts}/compare-04-phone-section.png` });
+    assert.deepEqual(errors, []);
+    await phone.close();
+  },
+);
 
 scenario('the unit switch: the same bats in SI, then a bat removed by keyboard', async ({ page, url }) => {
   let before = await batsRevision(page);
@@ -356,14 +434,21 @@ scenario('the unit switch: the same bats in SI, then a bat removed by keyboard',
   ];
   const answer = await compare(
     url,
-    compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, variants, { sameBatter: true, units: 'si', scene: GAME_SI }),
+    compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, variants, {
+      sameBatter: true,
+      units: 'si',
+      scene: GAME_SI,
+    }),
   );
   const table = await assertTableIsTheApis(page, answer, ['bat_speed', 'max_exit_speed', 'mass']);
   assert.equal(table.find((r) => r.key === 'mass').path, 'properties.mass_kg');
   assert.equal(table.find((r) => r.key === 'mass').deltaPath, 'deltas.mass_kg');
   await assertViewsAreTheApis(page, answer, 'si');
   const mode = await readMode(page);
-  assert.deepEqual(mode.speeds.map((s) => s.value), answer.rows.map((r) => r.swing.bat_speed_mps));
+  assert.deepEqual(
+    mode.speeds.map((s) => s.value),
+    answer.rows.map((r) => r.swing.bat_speed_mps),
+  );
   assert.match(mode.text, /m\/s/);
   await shot(page, artifacts, 'compare-05-si');
 
@@ -373,7 +458,11 @@ scenario('the unit switch: the same bats in SI, then a bat removed by keyboard',
   await waitForBats(page, before);
   const two = await compare(
     url,
-    compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, [variants[1]], { sameBatter: true, units: 'si', scene: GAME_SI }),
+    compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, [variants[1]], {
+      sameBatter: true,
+      units: 'si',
+      scene: GAME_SI,
+    }),
   );
   await assertTableIsTheApis(page, two, ['bat_speed', 'mass']);
   await assertViewsAreTheApis(page, two, 'si');

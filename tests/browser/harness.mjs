@@ -124,7 +124,10 @@ export async function assertNoOverflow(page, width) {
       .map((e) => `${e.tagName.toLowerCase()}#${e.id}.${e.className?.baseVal ?? e.className}`),
   }));
   assert.equal(sizes.client, width);
-  assert.ok(sizes.scroll <= sizes.client, `page ${sizes.scroll} px wide in ${sizes.client} px: ${sizes.wide.join(', ')}`);
+  assert.ok(
+    sizes.scroll <= sizes.client,
+    `page ${sizes.scroll} px wide in ${sizes.client} px: ${sizes.wide.join(', ')}`,
+  );
   assert.deepEqual(sizes.wide, [], 'elements past the right edge');
 }
 
@@ -151,7 +154,8 @@ export async function run({ args, chromium, artifacts, scenarios }) {
     page.on('pageerror', (error) => pageErrors.push(error.message));
     page.on('console', (message) => {
       // The browser logs every 4xx answer ("Failed to load resource"): those are the test's.
-      if (message.type() === 'error' && !/Failed to load resource/.test(message.text())) pageErrors.push(message.text());
+      if (message.type() === 'error' && !/Failed to load resource/.test(message.text()))
+        pageErrors.push(message.text());
     });
     for (const { name, fn } of scenarios) {
       const t0 = Date.now();

@@ -88,6 +88,11 @@ export class ComparePanel {
       button.addEventListener('click', () => this.export(button.dataset.batsExport));
     }
     new ResizeObserver(() => this.drawCurves()).observe(section.querySelector('#bats-curves'));
+    // The profiles' text sizes follow the drawing's width: drawn again when the width changes.
+    new ResizeObserver(() => {
+      const width = section.querySelector('#bats-profiles').getBoundingClientRect().width;
+      if (this.shown && width && Math.abs(width - (this.profilesWidthPx || 0)) > 1) this.drawProfiles();
+    }).observe(section.querySelector('#bats-profiles'));
     this.renderList();
   }
 
@@ -164,16 +169,28 @@ export class ComparePanel {
   /** The list of bats: the bat above first (not removable), then each added bat with its remove button. */
   renderList() {
     const list = this.section.querySelector('#bats-list');
-    const swatch = (i) => el('span', { class: 'swatch', style: `--series: ${PALETTE[i % PALETTE.length]}`, 'aria-hidden': 'true' });
+    const swatch = (i) =>
+      el('span', { class: 'swatch', style: `--series: ${PALETTE[i % PALETTE.length]}`, 'aria-hidden': 'true' });
     list.replaceChildren(
-      el('li', { dataset: { bat: 'baseline' } }, swatch(0), el('span', { class: 'name', text: 'the bat above' }), el('small', { text: ' (the baseline of the deltas)' })),
+      el(
+        'li',
+        { dataset: { bat: 'baseline' } },
+        swatch(0),
+        el('span', { class: 'name', text: 'the bat above' }),
+        el('small', { text: ' (the baseline of the deltas)' }),
+      ),
       ...this.bats.map((b, i) =>
         el(
           'li',
           { dataset: { bat: b.name } },
           swatch(i + 1),
           el('span', { class: 'name', text: b.name }),
-          el('button', { type: 'button', dataset: { remove: String(i) }, 'aria-label': `Remove ${b.name}`, text: 'Remove' }),
+          el('button', {
+            type: 'button',
+            dataset: { remove: String(i) },
+            'aria-label': `Remove ${b.name}`,
+            text: 'Remove',
+          }),
           el('output', { class: 'error', hidden: true, dataset: { errorFor: `bats:${i}` } }),
         ),
       ),
@@ -271,7 +288,12 @@ export class ComparePanel {
     this.section.classList.remove('stale');
     this.section.querySelector('#bats-views').hidden = false;
     const names = [`the bat above (${body.baseline.preset || 'three-segment'})`, ...this.bats.map((b) => b.name)];
-    this.shown = { rows: answer.rows, names, bats: [body.baseline, ...body.variants.map((v) => v.bat)], units: this.units() };
+    this.shown = {
+      rows: answer.rows,
+      names,
+      bats: [body.baseline, ...body.variants.map((v) => v.bat)],
+      units: this.units(),
+    };
     this.section.dataset.bats = String(answer.rows.length);
     this.renderMode(answer.rows, body.swing?.speed_model === 'swing_weight');
     this.drawProfiles();
@@ -316,7 +338,12 @@ export class ComparePanel {
     } else {
       text = 'no bat speed given: every bat at the same angular speed. Angular speeds: ';
     }
-    mode.replaceChildren(el('strong', { text: sameBatter ? 'Mode: same batter. ' : 'Mode: same bat speed. ' }), text, ...speeds, '.');
+    mode.replaceChildren(
+      el('strong', { text: sameBatter ? 'Mode: same batter. ' : 'Mode: same bat speed. ' }),
+      text,
+      ...speeds,
+      '.',
+    );
   }
 
   /** The bats' profiles, one lane each, to one scale (1 unit = 1 mm along and across), knobs aligned. */
@@ -328,13 +355,20 @@ export class ComparePanel {
     const drawn = outlines.filter(Boolean);
     if (!drawn.length) return;
     const pad = 10;
-    const label = 22; // room above each lane for its name
     const length = Math.max(...drawn.map((o) => o.knots[o.knots.length - 1].x_m)) * 1000;
+    // The names and the axis's numbers at about 13 and 11 screen pixels whatever the width (a
+    // phone draws the bats at under half a pixel per mm): text sizes in drawing units.
+    const widthPx = svg.getBoundingClientRect().width || length + 2 * pad;
+    const perPx = Math.max(1, (length + 2 * pad) / widthPx);
+    const nameSize = 13 * perPx;
+    const tickSize = 11 * perPx;
+    const label = nameSize + 8; // room above each lane for its name
     let y = 0;
     outlines.forEach((outline, i) => {
       const lane = svgEl('g', { class: 'lane', 'data-bat': names[i] });
-      const title = svgEl('text', { class: 'lane-name', x: 0, y: y + 16 }, names[i]);
+      const title = svgEl('text', { class: 'lane-name', x: 0, y: y + nameSize + 2 }, names[i]);
       title.style.setProperty('--series', PALETTE[i % PALETTE.length]);
+      title.style.fontSize = `${nameSize}px`;
       lane.append(title);
       y += label;
       if (outline) {
@@ -342,7 +376,15 @@ export class ComparePanel {
         const position = rows[i]?.max_exit_speed?.position_from_knob_m;
         drawBat(inner, [{ ...outline, role: 'main' }], {
           axis: false,
-          marks: [{ key: 'max_exit_speed', label: 'max exit speed', short: 'max', position_m: position, at: this.q(rows[i]?.max_exit_speed, 'position_from_knob_m') }],
+          marks: [
+            {
+              key: 'max_exit_speed',
+              label: 'max exit speed',
+              short: 'max',
+              position_m: position,
+              at: this.q(rows[i]?.max_exit_speed, 'position_from_knob_m'),
+            },
+          ],
           axisUnit: this.units() === 'imperial' ? 'in' : 'm',
         });
         const box = inner.viewBox.baseVal;
@@ -369,11 +411,25 @@ export class ComparePanel {
     const step = inches ? 4 * 25.4 : 100;
     for (let i = 0; i * step <= length + 1e-6; ++i) {
       axis.append(svgEl('line', { x1: i * step, x2: i * step, y1: top, y2: top + 5 }));
-      axis.append(svgEl('text', { x: i * step, y: top + 19, 'text-anchor': 'middle' }, inches ? String(4 * i) : (i / 10).toFixed(1)));
+      axis.append(
+        svgEl(
+          'text',
+          { x: i * step, y: top + 8 + tickSize, 'text-anchor': 'middle' },
+          inches ? String(4 * i) : (i / 10).toFixed(1),
+        ),
+      );
     }
-    axis.append(svgEl('text', { x: length, y: top + 33, 'text-anchor': 'end' }, `${inches ? 'in' : 'm'} from the knob`));
+    axis.append(
+      svgEl(
+        'text',
+        { x: length, y: top + 12 + 2 * tickSize, 'text-anchor': 'end' },
+        `${inches ? 'in' : 'm'} from the knob`,
+      ),
+    );
+    for (const text of axis.querySelectorAll('text')) text.style.fontSize = `${tickSize}px`;
     svg.append(axis);
-    svg.setAttribute('viewBox', `${-pad} 0 ${length + 2 * pad} ${top + 40}`);
+    svg.setAttribute('viewBox', `${-pad} 0 ${length + 2 * pad} ${top + 18 + 2 * tickSize}`);
+    this.profilesWidthPx = widthPx;
     svg.dataset.lanes = String(outlines.length);
   }
 
@@ -439,8 +495,24 @@ export class ComparePanel {
       grid.append(svgEl('line', { x1: left, x2: width - right, y1: py(t), y2: py(t) }));
       grid.append(svgEl('text', { x: left - 6, y: py(t) + 4, 'text-anchor': 'end' }, fmt(t, 4)));
     }
-    grid.append(svgEl('text', { class: 'label', x: (left + width - right) / 2, y: top + plotH + 34, 'text-anchor': 'middle' }, table.xLabel));
-    const yLabel = svgEl('text', { class: 'label', x: 0, y: 0, 'text-anchor': 'middle', transform: `translate(14 ${top + plotH / 2}) rotate(-90)` }, table.yLabel);
+    grid.append(
+      svgEl(
+        'text',
+        { class: 'label', x: (left + width - right) / 2, y: top + plotH + 34, 'text-anchor': 'middle' },
+        table.xLabel,
+      ),
+    );
+    const yLabel = svgEl(
+      'text',
+      {
+        class: 'label',
+        x: 0,
+        y: 0,
+        'text-anchor': 'middle',
+        transform: `translate(14 ${top + plotH / 2}) rotate(-90)`,
+      },
+      table.yLabel,
+    );
     grid.append(yLabel);
     grid.append(svgEl('rect', { class: 'frame', x: left, y: top, width: width - left - right, height: plotH }));
     svg.append(grid);
@@ -448,20 +520,52 @@ export class ComparePanel {
       const color = PALETTE[i % PALETTE.length];
       const points = row.exit_speed_curve.map((p) => `${px(p[table.xKey]).toFixed(2)},${py(p[table.yKey]).toFixed(2)}`);
       const series = svgEl('g', { class: 'series', 'data-bat': names[i] });
-      series.append(svgEl('polyline', { points: points.join(' '), fill: 'none', stroke: color, 'stroke-width': 2, 'stroke-dasharray': i ? '6 3' : 'none' }));
+      series.append(
+        svgEl('polyline', {
+          points: points.join(' '),
+          fill: 'none',
+          stroke: color,
+          'stroke-width': 2,
+          'stroke-dasharray': i ? '6 3' : 'none',
+        }),
+      );
       const m = row.max_exit_speed;
       const mx = this.q(m, 'position_from_knob_m');
       const my = this.q(m, 'exit_speed_mps');
       if (Number.isFinite(mx) && Number.isFinite(my)) {
-        const dot = svgEl('circle', { class: 'peak', cx: px(mx), cy: py(my), r: 4, fill: color, 'data-x': mx, 'data-y': my });
-        dot.append(svgEl('title', {}, `${names[i]}: max ${fmt(my, 4)} ${this.u('exit_speed_mps')} at ${fmt(mx, 4)} ${this.u('position_from_knob_m')} from the knob`));
+        const dot = svgEl('circle', {
+          class: 'peak',
+          cx: px(mx),
+          cy: py(my),
+          r: 4,
+          fill: color,
+          'data-x': mx,
+          'data-y': my,
+        });
+        dot.append(
+          svgEl(
+            'title',
+            {},
+            `${names[i]}: max ${fmt(my, 4)} ${this.u('exit_speed_mps')} at ${fmt(mx, 4)} ${this.u('position_from_knob_m')} from the knob`,
+          ),
+        );
         series.append(dot);
       }
       svg.append(series);
       const legend = svgEl('g', { class: 'legend-item', 'data-bat': names[i] });
       const ly = legendTop + i * itemH;
       const lx = narrow ? 4 : left;
-      legend.append(svgEl('line', { x1: lx, x2: lx + 28, y1: ly - 4, y2: ly - 4, stroke: color, 'stroke-width': 3, 'stroke-dasharray': i ? '6 3' : 'none' }));
+      legend.append(
+        svgEl('line', {
+          x1: lx,
+          x2: lx + 28,
+          y1: ly - 4,
+          y2: ly - 4,
+          stroke: color,
+          'stroke-width': 3,
+          'stroke-dasharray': i ? '6 3' : 'none',
+        }),
+      );
       const peak = `max ${fmt(my, 4)} ${this.u('exit_speed_mps')} at ${fmt(mx, 4)} ${this.u('position_from_knob_m')} from the knob`;
       if (narrow) {
         legend.append(svgEl('text', { x: lx + 36, y: ly }, names[i]));
@@ -479,16 +583,86 @@ export class ComparePanel {
     const { rows } = this.shown;
     const k = (key) => this.key(key);
     const lines = [
-      ['bat_speed', 'Bat speed', this.u('bat_speed_mps'), (r) => this.q(r.swing, 'bat_speed_mps'), `swing.${k('bat_speed_mps')}`, 'bat_speed_mps'],
-      ['angular_speed', 'Angular speed', 'rad/s', (r) => r.swing?.angular_speed_rad_s, 'swing.angular_speed_rad_s', 'angular_speed_rad_s'],
-      ['max_exit_speed', 'Max exit speed', this.u('exit_speed_mps'), (r) => this.q(r.max_exit_speed, 'exit_speed_mps'), `max_exit_speed.${k('exit_speed_mps')}`, 'max_exit_speed_mps'],
-      ['max_exit_speed_position', '… at (from the knob)', this.u('position_from_knob_m'), (r) => this.q(r.max_exit_speed, 'position_from_knob_m'), `max_exit_speed.${k('position_from_knob_m')}`, 'max_exit_speed_position_m'],
-      ['center_of_percussion', 'Centre of percussion', this.u('position_from_knob_m'), (r) => this.q(r.center_of_percussion, 'position_from_knob_m'), `center_of_percussion.${k('position_from_knob_m')}`, 'center_of_percussion_m'],
-      ['length', 'Length', this.u('length_m'), (r) => this.q(r.properties, 'length_m'), `properties.${k('length_m')}`, null],
-      ['mass', 'Mass', this.u('mass_kg'), (r) => this.q(r.properties, 'mass_kg'), `properties.${k('mass_kg')}`, 'mass_kg'],
-      ['balance_point', 'Balance point', this.u('balance_point_m'), (r) => this.q(r.properties, 'balance_point_m'), `properties.${k('balance_point_m')}`, 'balance_point_m'],
-      ['moi_six_inch', 'MOI about 6 in (swing weight)', this.u('moi_six_inch_kg_m2'), (r) => this.q(r.properties, 'moi_six_inch_kg_m2'), `properties.${k('moi_six_inch_kg_m2')}`, 'moi_six_inch_kg_m2'],
-      ['moi_knob', 'MOI about the knob', this.u('moi_knob_kg_m2'), (r) => this.q(r.properties, 'moi_knob_kg_m2'), `properties.${k('moi_knob_kg_m2')}`, 'moi_knob_kg_m2'],
+      [
+        'bat_speed',
+        'Bat speed',
+        this.u('bat_speed_mps'),
+        (r) => this.q(r.swing, 'bat_speed_mps'),
+        `swing.${k('bat_speed_mps')}`,
+        'bat_speed_mps',
+      ],
+      [
+        'angular_speed',
+        'Angular speed',
+        'rad/s',
+        (r) => r.swing?.angular_speed_rad_s,
+        'swing.angular_speed_rad_s',
+        'angular_speed_rad_s',
+      ],
+      [
+        'max_exit_speed',
+        'Max exit speed',
+        this.u('exit_speed_mps'),
+        (r) => this.q(r.max_exit_speed, 'exit_speed_mps'),
+        `max_exit_speed.${k('exit_speed_mps')}`,
+        'max_exit_speed_mps',
+      ],
+      [
+        'max_exit_speed_position',
+        '… at (from the knob)',
+        this.u('position_from_knob_m'),
+        (r) => this.q(r.max_exit_speed, 'position_from_knob_m'),
+        `max_exit_speed.${k('position_from_knob_m')}`,
+        'max_exit_speed_position_m',
+      ],
+      [
+        'center_of_percussion',
+        'Centre of percussion',
+        this.u('position_from_knob_m'),
+        (r) => this.q(r.center_of_percussion, 'position_from_knob_m'),
+        `center_of_percussion.${k('position_from_knob_m')}`,
+        'center_of_percussion_m',
+      ],
+      [
+        'length',
+        'Length',
+        this.u('length_m'),
+        (r) => this.q(r.properties, 'length_m'),
+        `properties.${k('length_m')}`,
+        null,
+      ],
+      [
+        'mass',
+        'Mass',
+        this.u('mass_kg'),
+        (r) => this.q(r.properties, 'mass_kg'),
+        `properties.${k('mass_kg')}`,
+        'mass_kg',
+      ],
+      [
+        'balance_point',
+        'Balance point',
+        this.u('balance_point_m'),
+        (r) => this.q(r.properties, 'balance_point_m'),
+        `properties.${k('balance_point_m')}`,
+        'balance_point_m',
+      ],
+      [
+        'moi_six_inch',
+        'MOI about 6 in (swing weight)',
+        this.u('moi_six_inch_kg_m2'),
+        (r) => this.q(r.properties, 'moi_six_inch_kg_m2'),
+        `properties.${k('moi_six_inch_kg_m2')}`,
+        'moi_six_inch_kg_m2',
+      ],
+      [
+        'moi_knob',
+        'MOI about the knob',
+        this.u('moi_knob_kg_m2'),
+        (r) => this.q(r.properties, 'moi_knob_kg_m2'),
+        `properties.${k('moi_knob_kg_m2')}`,
+        'moi_knob_kg_m2',
+      ],
       ['cor', 'COR', '', (r) => r.cor, 'cor', null],
     ];
     return lines
@@ -512,8 +686,14 @@ export class ComparePanel {
       el(
         'thead',
         {},
-        el('tr', {}, el('th', { scope: 'col', text: '' }), ...names.map((n, i) =>
-          el('th', { scope: 'col', dataset: { bat: n }, style: `--series: ${PALETTE[i % PALETTE.length]}`, text: n }))),
+        el(
+          'tr',
+          {},
+          el('th', { scope: 'col', text: '' }),
+          ...names.map((n, i) =>
+            el('th', { scope: 'col', dataset: { bat: n }, style: `--series: ${PALETTE[i % PALETTE.length]}`, text: n }),
+          ),
+        ),
       ),
       el(
         'tbody',
@@ -534,7 +714,9 @@ export class ComparePanel {
                   },
                 },
                 fmt(value, 4),
-                line.deltas[i] === undefined ? '' : el('small', { class: 'delta', text: ` ${fmtDelta(line.deltas[i], 3)}` }),
+                line.deltas[i] === undefined
+                  ? ''
+                  : el('small', { class: 'delta', text: ` ${fmtDelta(line.deltas[i], 3)}` }),
               ),
             ),
           ),
@@ -583,7 +765,8 @@ export class ComparePanel {
     const actions = {
       'profiles-svg': () => downloadSvg(`${stem}-profiles.svg`, this.section.querySelector('#bats-profiles')),
       'profiles-csv': () => downloadCsv(`${stem}-profiles.csv`, this.profilesTable()),
-      'curves-svg': () => downloadSvg(`${stem}-exit-speed-${units}.svg`, this.section.querySelector('#bats-curves-svg')),
+      'curves-svg': () =>
+        downloadSvg(`${stem}-exit-speed-${units}.svg`, this.section.querySelector('#bats-curves-svg')),
       'curves-csv': () => {
         const t = this.curveTable();
         downloadCsv(`${stem}-exit-speed-${units}.csv`, [t.header, ...t.rows]);
