@@ -488,4 +488,25 @@ scenario('"same batter" without a bat speed: the API\'s message beside the switc
   assert.equal((await readMode(page)).mode, 'same_bat_speed');
 });
 
+scenario('a link naming a bat the API does not know: its message beside that bat', async ({ page, url }) => {
+  await page.goto(`${url}/#cmp.bat=no-such-bat`);
+  await page.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+  const slot = page.locator('#bats-list [data-error-for="bats:0"]');
+  await slot.waitFor({ state: 'visible', timeout: 20000 });
+  const answer = await apiPost(
+    url,
+    '/v1/compare',
+    compareBody({ preset: 'wood-34-ash' }, [{ name: 'no-such-bat', bat: { preset: 'no-such-bat' } }]),
+  );
+  assert.equal(answer.status, 400);
+  assert.equal(await slot.textContent(), `${answer.body.message} (${answer.body.code})`);
+  await shot(page, artifacts, 'compare-07-unknown-bat');
+  // Removed, the section is back to the bat above alone.
+  const before = await batsRevision(page);
+  await page.click('#bats-list button[aria-label="Remove no-such-bat"]');
+  await waitForBats(page, before);
+  assert.equal(await page.locator('#bats-views').isHidden(), true);
+  assert.equal(await slot.count(), 0);
+});
+
 await run({ args, chromium, artifacts, scenarios });
