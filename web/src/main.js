@@ -5,6 +5,7 @@ import './style.css';
 import * as api from './api.js';
 import { BatForm, drawBat, outlineOf } from './bat.js';
 import { CurveChart, FlightChart, ModesChart, PALETTE, VariantsChart } from './charts.js';
+import { ComparePanel } from './compare.js';
 import { downloadCsv, downloadSvg } from './export.js';
 import { clearErrors, el, fmt, fmtDelta, readFields, readValue, showError } from './form.js';
 import { resetControls, restoreParams, stateParams, switchInputs } from './units.js';
@@ -356,6 +357,7 @@ async function refreshBat() {
   document.body.dataset.state = 'ready';
   setStatus(`Up to date (3 requests, ${Math.round(performance.now() - started)} ms).`, 'ok');
   refreshCompare();
+  page.bats.refresh();
   refreshFlight(sweet.batted_ball);
 }
 
@@ -406,9 +408,16 @@ async function refreshFlight(battedBall) {
 /** The forms whose inputs the URL keeps. */
 const stateForms = () => [$('#bat-form'), $('#optimize-form')];
 
+/** The URL's hash of the page's state: the forms' inputs, then the bats side by side. */
+function stateHash() {
+  const params = stateParams(stateForms(), page.units);
+  page.bats.writeParams(params);
+  return `#${params.toString()}`;
+}
+
 /** Writes the inputs that differ from the defaults into the URL's hash (a link restores them). */
 function saveState() {
-  const hash = `#${stateParams(stateForms(), page.units).toString()}`;
+  const hash = stateHash();
   if (hash !== window.location.hash) history.replaceState(null, '', hash);
   $('#share-link').href = window.location.href;
 }
@@ -420,6 +429,7 @@ function restoreState() {
   resetControls(stateForms());
   setUnits(units === 'si' ? 'si' : 'imperial');
   restoreParams(stateForms(), params);
+  page.bats.readParams(params);
   page.batForm.syncShape();
 }
 
@@ -883,6 +893,12 @@ async function start() {
   page.modes = new ModesChart($('#modes-chart'));
   page.variantsChart = new VariantsChart($('#compare-chart'));
   page.flight = new FlightChart($('#flight-chart'));
+  page.bats = new ComparePanel($('#bats-section'), {
+    catalogue: page.catalogue,
+    units: () => page.units,
+    current: () => page.good,
+    onChange: saveState,
+  });
   setupUnits();
   restoreState();
   setupBatForm();
@@ -890,7 +906,7 @@ async function start() {
   setupOptimizeForm();
   setupExports();
   window.addEventListener('hashchange', () => {
-    if (window.location.hash === `#${stateParams(stateForms(), page.units).toString()}`) return;
+    if (window.location.hash === stateHash()) return;
     restoreState();
     refreshBat();
   });
