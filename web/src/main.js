@@ -6,6 +6,8 @@ import * as api from './api.js';
 import { BatForm, drawBat, outlineOf } from './bat.js';
 import { CurveChart, FlightChart, ModesChart, PALETTE, VariantsChart } from './charts.js';
 import { downloadCsv, downloadSvg } from './export.js';
+import { FlightViews } from './flight_views.js';
+import { Frontier } from './frontier.js';
 import { clearErrors, el, fmt, fmtDelta, readFields, readValue, showError } from './form.js';
 import { resetControls, restoreParams, stateParams, switchInputs } from './units.js';
 
@@ -357,6 +359,7 @@ async function refreshBat() {
   setStatus(`Up to date (3 requests, ${Math.round(performance.now() - started)} ms).`, 'ok');
   refreshCompare();
   refreshFlight(sweet.batted_ball);
+  page.flightViews.update(page.good);
 }
 
 /**
@@ -404,7 +407,9 @@ async function refreshFlight(battedBall) {
 // ---- units and the URL ----------------------------------------------------
 
 /** The forms whose inputs the URL keeps. */
-const stateForms = () => [$('#bat-form'), $('#optimize-form')];
+const stateForms = () => [$('#bat-form'), $('#optimize-form'), ...FLIGHT_FORMS.map((id) => $(id))];
+/** The flight views' and the frontier's forms (flight_views.js, frontier.js). */
+const FLIGHT_FORMS = ['#flight-top-form', '#carry-form', '#frontier-form'];
 
 /** Writes the inputs that differ from the defaults into the URL's hash (a link restores them). */
 function saveState() {
@@ -883,6 +888,9 @@ async function start() {
   page.modes = new ModesChart($('#modes-chart'));
   page.variantsChart = new VariantsChart($('#compare-chart'));
   page.flight = new FlightChart($('#flight-chart'));
+  const stem = () => (page.good?.bat.preset || 'bat').replace(/[^A-Za-z0-9_-]/g, '_');
+  page.flightViews = new FlightViews({ units: () => page.units, saveState, stem });
+  page.frontier = new Frontier({ optimizeBody, saveState, stem });
   setupUnits();
   restoreState();
   setupBatForm();

@@ -1,0 +1,201 @@
+// The optimisation frontier: the best bat at every weight (issue 37, item 3). One
+// /v1/optimize request with "frontier" (docs/optimization.md, "The frontier"), run as a
+// job on a button press (its progress is the fraction of weights solved), drawn as the
+// best exit speed (or the objective) against the weight, the Pareto front joined.
+// The problem is the optimisation section's (its rule set, objective, other
+// constraints, variables and options); the frontier's weights replace its mass bounds.
+import * as api from './api.js';
+import { downloadCsv, downloadSvg } from './export.js';
+import { clearErrors, el, fmt, readValue, showError } from './form.js';
+import { axes, scale, svgEl } from './svg.js';
+
+const $ = (selector) => document.querySelector(selector);
+const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+const FINAL_STATES = new Set(['done', 'failed', 'cancelled']);
+
+/** The frontier of the page. */
+export class Frontier {
+  /** `ctx`: {optimizeBody() the optimisation section's request, saveState(), stem()}. */
+  constructor(ctx) {
+    this.ctx = ctx;
+    this.job = null;
+    this.shown = null; // {rows, summary, constraint, xLabel, yLabel, ys}
+    const form = $('#frontier-form');
+    form.addEventListener('change', () => this.ctx.saveState());
+    form.addEventListener('submit', (event) => {
+      event.preventDefault();
+      this.run();
+    });
+    $('#frontier-cancel').addEventListener('click', () => this.cancel());
+    $('[data-export="frontier-svg"]').addEventListener('click', () =>
+      downloadSvg(`${this.ctx.stem()}-frontier.svg`, $('#frontier-chart')),
+    );
+    $('[data-export="frontier-csv"]').addEventListener('click', () =>
+      downloadCsv(`${this.ctx.stem()}-frontier.csv`, this.table()),
+    );
+  }
+
+  /** The request: the optimisation's, its mass bounds replaced by the frontier's weights. */
+  body() {
+    const form = $('#frontier-form');
+    const from = form.elements.frontier_from;
+    const to = form.elements.frontier_to;
+    const body = this.ctx.optimizeBody();
+    const constraints = { ...body.constraints };
+    delete constraints.mass_kg;
+    delete constraints.mass_oz;
+    const constraint = (from.dataset.system || 'si') === 'imperial' ? 'mass_oz' : 'mass_kg';
+    const frontier = { constraint };
+    for (const [key, input] of [
+      ['from', from],
+      ['to', to],
+      ['count', form.elements.frontier_count],
+    ]) {
+      const value = readValue(input);
+      if (value !== undefined) frontier[key] = value;
+    }
+    return { ...body, constraints, frontier };
+  }
+
+  showJob(job) {
+    const progress = $('#frontier-progress');
+    progress.hidden = false;
+    progress.value = job.progress || 0;
+    const state = $('#frontier-state');
+    state.dataset.state = job.state;
+    state.dataset.jobId = job.id;
+    const percent = Math.round((job.progress || 0) * 100);
+    state.textContent =
+      job.state === 'running' || job.state === 'queued'
+        ? `${job.state}${job.cancel_requested ? ', cancelling' : ''}: ${percent} % of the weights`
+        : job.state;
+  }
+
+  async run() {
+    const form = $('#frontier-form');
+    const section = $('#frontier-section');
+    clearErrors(form);
+    let job;
+    const body = this.body();
+    try {
+      job = await api.post('/v1/jobs', { path: '/v1/optimize', body });
+    } catch (error) {
+      // The job's body is the optimize request: its fields are named under "body.".
+      showError(form, error, (field) => field.replace(/^body\./, ''));
+      section.dataset.state = 'error';
+      return;
+    }
+    this.job = job;
+    section.dataset.state = 'busy';
+    section.setAttribute('aria-busy', 'true');
+    $('#frontier-run').disabled = true;
+    $('#frontier-cancel').disabled = false;
+    this.showJob(job);
+    try {
+      while (!FINAL_STATES.has(job.state)) {
+        await sleep(150);
+        job = await api.get(`/v1/jobs/${job.id}`);
+        this.showJob(job);
+      }
+      if (job.state === 'cancelled') {
+        section.dataset.state = 'cancelled';
+        return;
+      }
+      const result = await api.get(`/v1/jobs/${job.id}/result`);
+      this.draw(result, body);
+      section.dataset.state = 'ready';
+    } catch (error) {
+      showError(form, error, (field) => field.replace(/^body\./, ''));
+      section.dataset.state = 'error';
+    } finally {
+      section.removeAttribute('aria-busy');
+      $('#frontier-run').disabled = false;
+      $('#frontier-cancel').disabled = true;
+      this.job = null;
+    }
+  }
+
+  async cancel() {
+    if (!this.job) return;
+    $('#frontier-cancel').disabled = true;
+    try {
+      this.showJob(await api.del(`/v1/jobs/${this.job.id}`));
+    } catch (error) {
+      showError($('#frontier-form'), error);
+    }
+  }
+
+  /** Draws the answer {rows, summary} of `body`'s request. */
+  draw(result, body) {
+    const { rows, summary } = result;
+    const constraint = summary.constraint;
+    const imperial = body.report_units === 'imperial';
+    const weightUnit = constraint.endsWith('_oz') ? 'oz' : 'kg';
+    const speed = body.objective === 'max_exit_speed' || body.objective === 'max_exit_speed_swing_weight';
+    // The best exit speed in the answer's units, or the objective in its own unit.
+    const yOf = (row) =>
+      speed ? row.sweet_spot?.[imperial ? 'exit_speed_mph' : 'exit_speed_mps'] : row.objective_value;
+    const yUnit = speed ? (imperial ? 'mph' : 'm/s') : rows[0]?.objective_unit || '';
+    const yLabel = speed ? `best exit speed (${yUnit})` : `${summary.objective} (${yUnit})`;
+    const xLabel = `weight (${weightUnit})`;
+    const pareto = new Set(summary.pareto || []);
+    const points = rows.map((row) => ({
+      index: row.index,
+      x: row[constraint],
+      y: yOf(row),
+      converged: row.summary?.termination === 'converged',
+      pareto: pareto.has(row.index),
+      termination: row.summary?.termination || row.code || 'failed',
+    }));
+    this.shown = { points, xLabel, yLabel };
+    const good = points.filter((p) => typeof p.x === 'number' && typeof p.y === 'number');
+    const svg = $('#frontier-chart');
+    const W = 640;
+    const H = 300;
+    const box = { left: 64, top: 12, width: W - 64 - 16, height: H - 12 - 46 };
+    const xs = good.map((p) => p.x);
+    const ys = good.map((p) => p.y);
+    const pad = (lo, hi) => (hi > lo ? (hi - lo) * 0.06 : Math.abs(lo) * 0.01 || 1);
+    const xr = [Math.min(...xs) - pad(Math.min(...xs), Math.max(...xs)), Math.max(...xs) + pad(Math.min(...xs), Math.max(...xs))];
+    const yr = [Math.min(...ys) - pad(Math.min(...ys), Math.max(...ys)), Math.max(...ys) + pad(Math.min(...ys), Math.max(...ys))];
+    const x = scale(xr[0], xr[1], box.left, box.left + box.width);
+    const y = scale(yr[0], yr[1], box.top + box.height, box.top);
+    svg.setAttribute('viewBox', `0 0 ${W} ${H}`);
+    const front = good.filter((p) => p.pareto).sort((a, b) => a.x - b.x);
+    svg.replaceChildren(
+      good.length ? axes(box, x, y, xr, yr, xLabel, yLabel) : svgEl('g'),
+      svgEl('polyline', { class: 'all', points: good.map((p) => `${x(p.x).toFixed(2)},${y(p.y).toFixed(2)}`).join(' ') }),
+      svgEl('polyline', { class: 'pareto', points: front.map((p) => `${x(p.x).toFixed(2)},${y(p.y).toFixed(2)}`).join(' ') }),
+      ...good.map((p) =>
+        svgEl('circle', {
+          class: `point${p.pareto ? ' on-front' : ''}${p.converged ? '' : ' unconverged'}`,
+          cx: x(p.x).toFixed(2),
+          cy: y(p.y).toFixed(2),
+          r: p.pareto ? 5 : 4,
+          dataset: { index: String(p.index), x: String(p.x), y: String(p.y), pareto: String(p.pareto) },
+          title: `${fmt(p.x, 4)} ${weightUnit}: ${fmt(p.y, 5)} ${yUnit} (${p.termination}${p.pareto ? ', on the Pareto front' : ''})`,
+        }),
+      ),
+    );
+    svg.dataset.points = String(good.length);
+    svg.dataset.pareto = (summary.pareto || []).join(',');
+    svg.dataset.constraint = constraint;
+    $('#frontier-figure').hidden = false;
+    $('#frontier-about').replaceChildren(
+      el('b', { text: `${summary.termination}: ` }),
+      `${summary.message}. ${summary.points} weights, ${summary.continued} answered by the continuation step, ` +
+        `${summary.iterations} iterations in ${fmt(summary.solve_time_s * 1000, 3)} ms of solving. ` +
+        `Filled and joined: the Pareto front (no other weight is both lighter and better).`,
+    );
+  }
+
+  /** What the chart shows, a row per weight. */
+  table() {
+    if (!this.shown) return [[]];
+    const { points, xLabel, yLabel } = this.shown;
+    return [
+      ['index', xLabel, yLabel, 'termination', 'pareto'],
+      ...points.map((p) => [p.index, p.x, p.y, p.termination, p.pareto]),
+    ];
+  }
+}
