@@ -358,6 +358,42 @@ scenario('the frontier: the best bat from 28 to 32 oz, run by keyboard, equal to
   await slot.waitFor({ state: 'visible' });
   assert.match(await slot.textContent(), /frontier\.count/);
   await typeInto(page, 'frontier_count', '9');
+
+  // The unit switch (keyboard) asks the frontier again in SI: its weights in kg (28 and 32 oz
+  // written in kg, exactly), its speeds in m/s. (Not the same optima as in ounces: the
+  // optimisation section's radius bounds differ between the systems, 0.008-0.034 m against
+  // diameters of 0.6-2.61 in.)
+  const switchUnits = async (from, key) => {
+    await page.evaluate(() => {
+      window.frontierStates = [];
+    });
+    const before = await revision(page);
+    await page.locator(`input[name="units"][value="${from}"]`).focus();
+    await page.keyboard.press(key);
+    await waitForRefresh(page, before);
+    await page.waitForFunction(() => window.frontierStates.includes('ready') || window.frontierStates.includes('error'), null, {
+      timeout: 60000,
+    });
+    assert.equal((await page.evaluate(() => window.frontierStates)).at(-1), 'ready');
+    return jobsSeen[0][jobsSeen[0].length - 1].body;
+  };
+  const siBody = await switchUnits('imperial', 'ArrowRight');
+  assert.deepEqual(siBody.frontier, { constraint: 'mass_kg', from: 0.7937866475, to: 0.90718474, count: 9 });
+  assert.equal(siBody.report_units, 'si');
+  const si = await apiPost(url, '/v1/optimize', siBody);
+  assert.equal(si.status, 200, JSON.stringify(si.body));
+  const shownSi = await shownFrontier(page);
+  for (const [i, point] of shownSi.points.entries()) {
+    const row = si.body.rows[i];
+    assert.equal(point.x, row.mass_kg);
+    assert.ok(Math.abs(point.y - row.sweet_spot.exit_speed_mps) <= 1e-9 * point.y, `${point.y} vs ${row.sweet_spot.exit_speed_mps}`);
+  }
+  assert.match(shownSi.text, /weight \(kg\)/);
+  assert.match(shownSi.text, /best exit speed \(m\/s\)/);
+  await page.locator('#frontier-section').scrollIntoViewIfNeeded();
+  await shot(artifacts, page, 'flight-04b-frontier-si');
+  const back = await switchUnits('si', 'ArrowLeft');
+  assert.equal(back.frontier.constraint, 'mass_oz');
 });
 
 scenario('the link restores the flight views and the frontier at a phone width, nothing cut off', async ({ page, url, browser }) => {

@@ -6,7 +6,7 @@
 import * as api from './api.js';
 import { downloadCsv, downloadSvg } from './export.js';
 import { clearErrors, el, fmt, readValue, showError } from './form.js';
-import { axes, scale, svgEl, tickLabel, ticks } from './svg.js';
+import { axes, redrawOnResize, scale, svgEl, tickLabel, ticks, widthFor } from './svg.js';
 
 const $ = (selector) => document.querySelector(selector);
 
@@ -133,6 +133,8 @@ export class FlightViews {
     for (const [key, action] of Object.entries(actions)) {
       $(`[data-export="${key}"]`).addEventListener('click', action);
     }
+    redrawOnResize($('#flight-top'), () => this.top && this.drawTop());
+    redrawOnResize($('#carry-map'), () => this.carryAnswer && this.drawCarry(...this.carryAnswer));
   }
 
   /** The bat the API last accepted ({bat, scene, sweet}): both views follow it. */
@@ -191,12 +193,12 @@ export class FlightViews {
     const path = answer.trajectory.map((p) => [p[xKey], p[yKey]]);
     const landing = [answer.landing[xKey], answer.landing[yKey]];
     const all = [...field.fence, ...field.lines, [0, 0], ...path, landing, ...field.labels.map((l) => l.at)];
-    const pad = (unit === 'ft' ? 25 : 25 * M_PER_FT);
+    const pad = unit === 'ft' ? 40 : 40 * M_PER_FT; // room for the fence's labels
     const xmin = Math.min(...all.map((p) => p[0])) - pad;
     const xmax = Math.max(...all.map((p) => p[0])) + pad;
     const ymin = Math.min(...all.map((p) => p[1])) - pad;
     const ymax = Math.max(...all.map((p) => p[1])) + pad;
-    const W = 640;
+    const W = widthFor(svg);
     const k = W / (xmax - xmin); // one scale both ways: to scale
     const H = Math.round((ymax - ymin) * k);
     const px = (p) => [((p[0] - xmin) * k).toFixed(2), ((ymax - p[1]) * k).toFixed(2)];
@@ -297,10 +299,11 @@ export class FlightViews {
     const lo = Math.min(...values);
     const hi = Math.max(...values);
     this.carry = { xs, us, cells, len, far };
+    this.carryAnswer = [answer, imperial];
 
     const svg = $('#carry-map');
-    const W = 640;
-    const H = 340;
+    const W = widthFor(svg);
+    const H = Math.round(Math.min(340, W * 0.62));
     const box = { left: 58, top: 10, width: W - 58 - 86, height: H - 10 - 46 };
     const edges = (list) => {
       const mids = list.slice(1).map((v, i) => (v + list[i]) / 2);

@@ -7,7 +7,7 @@
 import * as api from './api.js';
 import { downloadCsv, downloadSvg } from './export.js';
 import { clearErrors, el, fmt, readValue, showError } from './form.js';
-import { axes, scale, svgEl } from './svg.js';
+import { axes, redrawOnResize, scale, svgEl, widthFor } from './svg.js';
 
 const $ = (selector) => document.querySelector(selector);
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
@@ -32,6 +32,14 @@ export class Frontier {
     );
     $('[data-export="frontier-csv"]').addEventListener('click', () =>
       downloadCsv(`${this.ctx.stem()}-frontier.csv`, this.table()),
+    );
+    redrawOnResize($('#frontier-chart'), () => this.drawn && this.draw(...this.drawn));
+    // The unit switch: a frontier on show is asked again in the new units (after the page's own
+    // handler has switched the inputs, hence the timeout).
+    $('#units').addEventListener('change', () =>
+      setTimeout(() => {
+        if (this.drawn) this.run();
+      }, 0),
     );
   }
 
@@ -72,46 +80,52 @@ export class Frontier {
   }
 
   async run() {
+    if (this.running) return;
+    this.running = true;
     const form = $('#frontier-form');
     const section = $('#frontier-section');
     clearErrors(form);
-    let job;
-    const body = this.body();
-    try {
-      job = await api.post('/v1/jobs', { path: '/v1/optimize', body });
-    } catch (error) {
-      // The job's body is the optimize request: its fields are named under "body.".
-      showError(form, error, (field) => field.replace(/^body\./, ''));
-      section.dataset.state = 'error';
-      return;
-    }
-    this.job = job;
     section.dataset.state = 'busy';
     section.setAttribute('aria-busy', 'true');
     $('#frontier-run').disabled = true;
-    $('#frontier-cancel').disabled = false;
-    this.showJob(job);
+    const body = this.body();
     try {
-      while (!FINAL_STATES.has(job.state)) {
-        await sleep(150);
-        job = await api.get(`/v1/jobs/${job.id}`);
-        this.showJob(job);
-      }
-      if (job.state === 'cancelled') {
-        section.dataset.state = 'cancelled';
+      // The job's body is the optimize request: a refusal may name its fields under "body.".
+      const rename = (field) => field.replace(/^body\./, '');
+      let job;
+      try {
+        job = await api.post('/v1/jobs', { path: '/v1/optimize', body });
+      } catch (error) {
+        showError(form, error, rename);
+        section.dataset.state = 'error';
         return;
       }
-      const result = await api.get(`/v1/jobs/${job.id}/result`);
-      this.draw(result, body);
-      section.dataset.state = 'ready';
-    } catch (error) {
-      showError(form, error, (field) => field.replace(/^body\./, ''));
-      section.dataset.state = 'error';
+      this.job = job;
+      $('#frontier-cancel').disabled = false;
+      this.showJob(job);
+      try {
+        while (!FINAL_STATES.has(job.state)) {
+          await sleep(150);
+          job = await api.get(`/v1/jobs/${job.id}`);
+          this.showJob(job);
+        }
+        if (job.state === 'cancelled') {
+          section.dataset.state = 'cancelled';
+          return;
+        }
+        const result = await api.get(`/v1/jobs/${job.id}/result`);
+        this.draw(result, body);
+        section.dataset.state = 'ready';
+      } catch (error) {
+        showError(form, error, rename);
+        section.dataset.state = 'error';
+      }
     } finally {
       section.removeAttribute('aria-busy');
       $('#frontier-run').disabled = false;
       $('#frontier-cancel').disabled = true;
       this.job = null;
+      this.running = false;
     }
   }
 
@@ -127,6 +141,8 @@ export class Frontier {
 
   /** Draws the answer {rows, summary} of `body`'s request. */
   draw(result, body) {
+    this.drawn = [result, body];
+    $('#frontier-figure').hidden = false; // first: the drawing takes its box's width
     const { rows, summary } = result;
     const constraint = summary.constraint;
     const imperial = body.report_units === 'imperial';
@@ -150,8 +166,8 @@ export class Frontier {
     this.shown = { points, xLabel, yLabel };
     const good = points.filter((p) => typeof p.x === 'number' && typeof p.y === 'number');
     const svg = $('#frontier-chart');
-    const W = 640;
-    const H = 300;
+    const W = widthFor(svg);
+    const H = Math.round(Math.min(300, W * 0.6));
     const box = { left: 64, top: 12, width: W - 64 - 16, height: H - 12 - 46 };
     const xs = good.map((p) => p.x);
     const ys = good.map((p) => p.y);
@@ -180,7 +196,6 @@ export class Frontier {
     svg.dataset.points = String(good.length);
     svg.dataset.pareto = (summary.pareto || []).join(',');
     svg.dataset.constraint = constraint;
-    $('#frontier-figure').hidden = false;
     $('#frontier-about').replaceChildren(
       el('b', { text: `${summary.termination}: ` }),
       `${summary.message}. ${summary.points} weights, ${summary.continued} answered by the continuation step, ` +

@@ -73,3 +73,19 @@ export function axes(box, x, y, xr, yr, xLabel, yLabel) {
   );
   return g;
 }
+
+/** The drawing width for `svg`: its box's width in CSS pixels (so text keeps its size), 320 to 640. */
+export function widthFor(svg) {
+  const box = svg.parentElement?.getBoundingClientRect().width || 640;
+  return Math.round(Math.max(320, Math.min(640, box)));
+}
+
+/** Calls `redraw` when `svg`'s drawing width changes (a phone turned, a window resized). */
+export function redrawOnResize(svg, redraw) {
+  let last = 0;
+  new ResizeObserver(() => {
+    const width = widthFor(svg);
+    if (last && width !== last) redraw();
+    last = width;
+  }).observe(svg.parentElement);
+}
