@@ -107,6 +107,14 @@ scenario('the flight from above: a generic field, the API landing point, the spr
   assert.match(await page.locator('#flight-top').textContent(), /400 ft/);
   assert.match(await page.locator('#flight-top-section figcaption').textContent(), /generic outline/);
 
+  // A spray angle the API refuses: its message beside the field, the view dimmed.
+  await typeInto(page, 'spray_angle_deg', '200');
+  const slot = page.locator('#flight-top-form [data-error-for="launch.spray_angle_deg"]');
+  await slot.waitFor({ state: 'visible' });
+  assert.match(await slot.textContent(), /^launch\.spray_angle_deg = 200: /);
+  assert.equal(await page.locator('input[name="spray_angle_deg"]').getAttribute('aria-invalid'), 'true');
+  assert.ok(await page.locator('#flight-top-section.stale').count());
+
   // 25° toward right field, typed from the keyboard: the landing moves right, to the API's.
   await typeInto(page, 'spray_angle_deg', '25');
   const sprayed = await apiPost(url, '/v1/flight', {
@@ -120,6 +128,8 @@ scenario('the flight from above: a generic field, the API landing point, the spr
   assert.ok(shown.x > 100, `a 25° spray lands toward right field (x = ${shown.x} ft)`);
   assert.match(await page.locator('#flight-top-about').textContent(), /spray angle 25°/);
   assert.match(page.url(), /spray_angle_deg=25/);
+  assert.equal(await slot.isVisible(), false);
+  assert.equal(await page.locator('#flight-top-section.stale').count(), 0);
 
   // The exports: the path as CSV (the API's numbers), the view as a standalone SVG.
   const csv = await download(page, 'flight-top-csv');
@@ -186,6 +196,23 @@ scenario('the carry map: a heat map equal to carry_map, the distance sweet spot,
   // (it is the search's optimum; 0.1 ft: the flights' default tolerance, docs/api.md).
   assert.ok(spot.distance_ft >= map.best.distance_ft - 0.1);
   assert.match(await page.locator('#carry-about').textContent(), new RegExp(`${spot.distance_ft.toPrecision(4)} ft`));
+
+  // A bat the API refuses (a negative barrel): the views keep the last valid bat's, dimmed.
+  await page.selectOption('select[name="shape"]', 'three_segment');
+  await page.waitForSelector('body[data-state="ready"]');
+  await typeInto(page, 'barrel_radius_m', '-1');
+  await page.waitForSelector('body[data-state="error"]');
+  assert.equal(await page.locator('#flight-top-section.stale, #carry-section.stale').count(), 2);
+  let fixed = await revision(page);
+  await typeInto(page, 'barrel_radius_m', '2.6');
+  await waitForRefresh(page, fixed);
+  fixed = await revision(page);
+  await page.selectOption('select[name="shape"]', 'preset');
+  await waitForRefresh(page, fixed);
+  assert.doesNotMatch(page.url(), /barrel|shape/);
+  await page.waitForSelector('#carry-section[data-state="ready"]');
+  assert.equal(await page.locator('#flight-top-section.stale, #carry-section.stale').count(), 0);
+  assert.deepEqual((await shownMap()).cells, map.positions.flatMap((row) => row.distance_ft));
 
   // A coarser grid typed from the keyboard: 21 positions.
   await typeInto(page, 'map_positions', '21');

@@ -133,6 +133,11 @@ export class FlightViews {
     for (const [key, action] of Object.entries(actions)) {
       $(`[data-export="${key}"]`).addEventListener('click', action);
     }
+    // A bat the API refused: the views keep the last valid bat's answers, dimmed (as the page's).
+    new MutationObserver(() => {
+      const refused = document.body.dataset.state === 'error';
+      for (const id of ['#flight-top-section', '#carry-section']) $(id).classList.toggle('stale', refused);
+    }).observe(document.body, { attributes: true, attributeFilter: ['data-state'] });
     redrawOnResize($('#flight-top'), () => this.top && this.drawTop());
     redrawOnResize($('#carry-map'), () => this.carryAnswer && this.drawCarry(...this.carryAnswer));
   }
@@ -182,7 +187,8 @@ export class FlightViews {
     $('#flight-top-about').textContent =
       `Lands ${fmt(answer[key('distance')], 4)} ${unit} from home plate at ` +
       `${fmt(landing[key('x')], 4)} ${unit} toward right field, ${fmt(landing[key('y')], 4)} ${unit} toward centre ` +
-      `(bearing ${fmt(answer.bearing_deg, 3)}°, + toward right field; spray angle ${fmt(launch.spray_angle_deg ?? 0, 3)}°, ` +
+      `(bearing ${fmt(answer.bearing_deg, 3)}°, + toward right field; ` +
+      `spray angle ${fmt(launch.spray_angle_deg ?? 0, 3)}°, ` +
       `sidespin ${fmt(answer.sidespin_rpm, 4)} rpm).`;
   }
 
@@ -226,7 +232,9 @@ export class FlightViews {
         {
           class: 'landing',
           dataset: { x: String(landing[0]), y: String(landing[1]), distance: String(answer[`distance_${unit}`]) },
-          title: `landing: ${fmt(landing[0], 4)} ${unit} toward right field, ${fmt(landing[1], 4)} ${unit} toward centre field`,
+          title:
+            `landing: ${fmt(landing[0], 4)} ${unit} toward right field, ` +
+            `${fmt(landing[1], 4)} ${unit} toward centre field`,
         },
         svgEl('circle', { cx: lx, cy: ly, r: 6 }),
         svgEl('line', { x1: Number(lx) - 9, x2: Number(lx) + 9, y1: ly, y2: ly }),
@@ -308,7 +316,8 @@ export class FlightViews {
     const edges = (list) => {
       const mids = list.slice(1).map((v, i) => (v + list[i]) / 2);
       const first = list.length > 1 ? list[0] - (list[1] - list[0]) / 2 : list[0] - 0.5;
-      const last = list.length > 1 ? list[list.length - 1] + (list[list.length - 1] - list[list.length - 2]) / 2 : list[0] + 0.5;
+      const n = list.length;
+      const last = n > 1 ? list[n - 1] + (list[n - 1] - list[n - 2]) / 2 : list[0] + 0.5;
       return [first, ...mids, last];
     };
     const xe = edges(xs);
@@ -334,7 +343,9 @@ export class FlightViews {
             height: (y1 - y0 + 0.4).toFixed(2),
             fill: typeof v === 'number' ? colour(t(v)) : undefined,
             dataset: { i: String(i), j: String(j), value: v === null ? '' : String(v) },
-            title: `${fmt(xs[i], 4)} ${len} from the knob, undercut ${fmt(us[j], 3)} ${len}: ${typeof v === 'number' ? `${fmt(v, 4)} ${far}` : 'no carry'}`,
+            title:
+              `${fmt(xs[i], 4)} ${len} from the knob, undercut ${fmt(us[j], 3)} ${len}: ` +
+              (typeof v === 'number' ? `${fmt(v, 4)} ${far}` : 'no carry'),
           }),
         );
       }),
@@ -368,7 +379,13 @@ export class FlightViews {
     legend.append(
       svgEl('defs', {}, gradient),
       svgEl('rect', { x: lx, y: box.top, width: 14, height: box.height, fill: 'url(#carry-scale)', class: 'bar' }),
-      svgEl('text', { x: lx + 7, y: box.top + box.height + 30, 'text-anchor': 'middle', class: 'label', text: `carry (${far})` }),
+      svgEl('text', {
+        x: lx + 7,
+        y: box.top + box.height + 30,
+        'text-anchor': 'middle',
+        class: 'label',
+        text: `carry (${far})`,
+      }),
     );
     for (const v of hi > lo ? ticks(lo, hi, 5) : [lo]) {
       legend.append(
@@ -389,7 +406,8 @@ export class FlightViews {
     const best = map.best;
     $('#carry-about').replaceChildren(
       el('b', { text: 'Distance sweet spot ' }),
-      `(the ring): ${fmt(spot[`distance_${far}`], 4)} ${far} at ${fmt(spot[`position_from_knob_${len}`], 4)} ${len} from the knob`,
+      `(the ring): ${fmt(spot[`distance_${far}`], 4)} ${far} at ` +
+        `${fmt(spot[`position_from_knob_${len}`], 4)} ${len} from the knob`,
       imperial ? ` (${fmt(spot.position_from_tip_in, 3)} in from the tip)` : '',
       `, ${fmt(spot[`undercut_${len}`], 3)} ${len} undercut, launched at ${fmt(spot.launch_angle_deg, 3)}° with ` +
         `${fmt(spot.backspin_rpm, 4)} rpm. The grid's largest: ${fmt(best[`distance_${far}`], 4)} ${far}. ` +

@@ -172,16 +172,21 @@ export class Frontier {
     const xs = good.map((p) => p.x);
     const ys = good.map((p) => p.y);
     const pad = (lo, hi) => (hi > lo ? (hi - lo) * 0.06 : Math.abs(lo) * 0.01 || 1);
-    const xr = [Math.min(...xs) - pad(Math.min(...xs), Math.max(...xs)), Math.max(...xs) + pad(Math.min(...xs), Math.max(...xs))];
-    const yr = [Math.min(...ys) - pad(Math.min(...ys), Math.max(...ys)), Math.max(...ys) + pad(Math.min(...ys), Math.max(...ys))];
+    const range = (list) => {
+      const [lo, hi] = [Math.min(...list), Math.max(...list)];
+      return [lo - pad(lo, hi), hi + pad(lo, hi)];
+    };
+    const xr = range(xs);
+    const yr = range(ys);
     const x = scale(xr[0], xr[1], box.left, box.left + box.width);
     const y = scale(yr[0], yr[1], box.top + box.height, box.top);
     svg.setAttribute('viewBox', `0 0 ${W} ${H}`);
     const front = good.filter((p) => p.pareto).sort((a, b) => a.x - b.x);
+    const line = (list) => list.map((p) => `${x(p.x).toFixed(2)},${y(p.y).toFixed(2)}`).join(' ');
     svg.replaceChildren(
       good.length ? axes(box, x, y, xr, yr, xLabel, yLabel) : svgEl('g'),
-      svgEl('polyline', { class: 'all', points: good.map((p) => `${x(p.x).toFixed(2)},${y(p.y).toFixed(2)}`).join(' ') }),
-      svgEl('polyline', { class: 'pareto', points: front.map((p) => `${x(p.x).toFixed(2)},${y(p.y).toFixed(2)}`).join(' ') }),
+      svgEl('polyline', { class: 'all', points: line(good) }),
+      svgEl('polyline', { class: 'pareto', points: line(front) }),
       ...good.map((p) =>
         svgEl('circle', {
           class: `point${p.pareto ? ' on-front' : ''}${p.converged ? '' : ' unconverged'}`,
@@ -189,7 +194,9 @@ export class Frontier {
           cy: y(p.y).toFixed(2),
           r: p.pareto ? 5 : 4,
           dataset: { index: String(p.index), x: String(p.x), y: String(p.y), pareto: String(p.pareto) },
-          title: `${fmt(p.x, 4)} ${weightUnit}: ${fmt(p.y, 5)} ${yUnit} (${p.termination}${p.pareto ? ', on the Pareto front' : ''})`,
+          title:
+            `${fmt(p.x, 4)} ${weightUnit}: ${fmt(p.y, 5)} ${yUnit} ` +
+            `(${p.termination}${p.pareto ? ', on the Pareto front' : ''})`,
         }),
       ),
     );

@@ -60,7 +60,8 @@ export function axes(box, x, y, xr, yr, xLabel, yLabel) {
     g.append(svgEl('line', { x1: box.left - 4, x2: box.left, y1: py, y2: py }));
     g.append(svgEl('text', { x: box.left - 7, y: py + 4, 'text-anchor': 'end', text: tickLabel(v) }));
   }
-  g.append(svgEl('text', { x: box.left + box.width / 2, y: bottom + 34, 'text-anchor': 'middle', class: 'label', text: xLabel }));
+  const middle = box.left + box.width / 2;
+  g.append(svgEl('text', { x: middle, y: bottom + 34, 'text-anchor': 'middle', class: 'label', text: xLabel }));
   g.append(
     svgEl('text', {
       x: 14,
