@@ -77,6 +77,9 @@ function fieldShape(unit) {
   };
 }
 
+/** True while the page's bat is refused: the views then show the last valid bat's answers, dimmed. */
+const refusedBat = () => document.body.dataset.state === 'error';
+
 /** Viridis, five stops: the heat map's colour of t in [0, 1]. */
 const VIRIDIS = ['#440154', '#3b528b', '#21918c', '#5ec962', '#fde725'];
 function colour(t) {
@@ -135,8 +138,7 @@ export class FlightViews {
     }
     // A bat the API refused: the views keep the last valid bat's answers, dimmed (as the page's).
     new MutationObserver(() => {
-      const refused = document.body.dataset.state === 'error';
-      for (const id of ['#flight-top-section', '#carry-section']) $(id).classList.toggle('stale', refused);
+      for (const id of ['#flight-top-section', '#carry-section']) $(id).classList.toggle('stale', refusedBat());
     }).observe(document.body, { attributes: true, attributeFilter: ['data-state'] });
     redrawOnResize($('#flight-top'), () => this.top && this.drawTop());
     redrawOnResize($('#carry-map'), () => this.carryAnswer && this.drawCarry(...this.carryAnswer));
@@ -177,7 +179,7 @@ export class FlightViews {
     }
     if (seq !== this.topSeq) return;
     clearErrors(form);
-    $('#flight-top-section').classList.remove('stale');
+    $('#flight-top-section').classList.toggle('stale', refusedBat());
     const imperial = units === 'imperial';
     const unit = imperial ? 'ft' : 'm';
     const key = (name) => `${name}_${unit}`;
@@ -290,7 +292,7 @@ export class FlightViews {
     }
     if (seq !== this.carrySeq) return;
     clearErrors(form);
-    section.classList.remove('stale');
+    section.classList.toggle('stale', refusedBat());
     this.drawCarry(answer, units === 'imperial');
     section.dataset.state = 'ready';
   }
