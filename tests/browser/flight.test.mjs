@@ -463,6 +463,47 @@ scenario('the link restores the flight views and the frontier at a phone width, 
   await shot(artifacts, small, 'flight-05-phone');
   assert.deepEqual(errors, []);
   await phone.close();
+
+  // The first page (imperial, the last weight typed as 31 oz): a switch to SI keeps the typed
+  // weight's unit, and the other weight (at its default) stays in ounces with it; the frontier
+  // asked again in ounces answers in m/s.
+  await page.locator('input[name="units"][value="imperial"]').focus();
+  await page.evaluate(() => {
+    window.frontierStates = [];
+  });
+  await page.keyboard.press('ArrowRight');
+  await page.waitForFunction(() => window.frontierStates.includes('ready') || window.frontierStates.includes('error'), null, {
+    timeout: 30000,
+  });
+  assert.equal((await page.evaluate(() => window.frontierStates)).at(-1), 'ready');
+  assert.equal(await page.locator('input[name="frontier_from"]').inputValue(), '28');
+  assert.equal(await page.locator('input[name="frontier_from"]').getAttribute('data-field'), 'frontier.mass_oz.from');
+  const sent = jobsSeen[0][jobsSeen[0].length - 1].body;
+  assert.deepEqual(sent.frontier, { constraint: 'mass_oz', from: 28, to: 31, count: 9 });
+  assert.equal(sent.report_units, 'si');
+  const again = await apiPost(url, '/v1/optimize', sent);
+  const shownMixed = await shownFrontier(page);
+  assert.deepEqual(
+    shownMixed.points.map((p) => p.x),
+    again.body.rows.map((r) => r.mass_oz),
+  );
+  for (const [i, point] of shownMixed.points.entries()) {
+    const y = again.body.rows[i].sweet_spot.exit_speed_mps;
+    assert.ok(Math.abs(point.y - y) <= 1e-9 * y, `${point.y} vs ${y}`); // 1e-9: as above
+  }
+  assert.match(shownMixed.text, /weight \(oz\)/);
+  assert.match(shownMixed.text, /\(m\/s\)/);
+  // A link with the two weights in two units (both typed): the page says so, sends nothing.
+  const before = jobsSeen[0].length;
+  await page.evaluate(() => {
+    window.location.hash = 'units=si&frontier.mass_oz.from=27&frontier.mass_kg.to=0.9';
+  });
+  await page.waitForFunction(() => document.querySelector('input[name="frontier_to"]').value === '0.9');
+  await page.locator('#frontier-run').click();
+  const slot = page.locator('#frontier-form [data-error-for="frontier"]');
+  await slot.waitFor({ state: 'visible' });
+  assert.match(await slot.textContent(), /two units \(from in oz, to in kg\)/);
+  assert.equal(jobsSeen[0].length, before);
 });
 
 await run(harness, scenarios);

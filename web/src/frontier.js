@@ -8,6 +8,7 @@ import * as api from './api.js';
 import { downloadCsv, downloadSvg } from './export.js';
 import { clearErrors, el, fmt, readValue, showError } from './form.js';
 import { axes, redrawOnResize, scale, svgEl, widthFor } from './svg.js';
+import { formOf, setInputSystem } from './units.js';
 
 const $ = (selector) => document.querySelector(selector);
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
@@ -38,9 +39,32 @@ export class Frontier {
     // handler has switched the inputs, hence the timeout).
     $('#units').addEventListener('change', () =>
       setTimeout(() => {
+        this.syncPair();
         if (this.drawn) this.run();
       }, 0),
     );
+    // A link restored (now, and on every hash change) may leave the pair in two units.
+    window.addEventListener('hashchange', () => setTimeout(() => this.syncPair(), 0));
+    setTimeout(() => this.syncPair(), 0);
+  }
+
+  /**
+   * Keeps the two weights in one unit: the request has one constraint name. A weight you
+   * typed keeps its text and unit over a switch (docs/explorer.md); the other, still at its
+   * default, then takes that unit's default, so nothing is reinterpreted.
+   */
+  syncPair() {
+    const form = $('#frontier-form');
+    const pair = [form.elements.frontier_from, form.elements.frontier_to];
+    const [a, b] = pair.map((input) => input.dataset.system || 'si');
+    if (a === b) return;
+    const atDefault = pair.filter((input) => input.value.trim() === formOf(input, input.dataset.system || 'si').value);
+    if (atDefault.length !== 1) return; // both typed in two units (a crafted link): run() says so
+    const other = pair.find((input) => input !== atDefault[0]);
+    const system = other.dataset.system || 'si';
+    setInputSystem(atDefault[0], system);
+    atDefault[0].value = formOf(atDefault[0], system).value;
+    this.ctx.saveState();
   }
 
   /** The request: the optimisation's, its mass bounds replaced by the frontier's weights. */
@@ -90,6 +114,18 @@ export class Frontier {
     $('#frontier-run').disabled = true;
     const body = this.body();
     try {
+      // Weights typed in two units (a link can say so): the request has one constraint name,
+      // so the page says so instead of sending either number as the other.
+      const systems = ['frontier_from', 'frontier_to'].map((name) => form.elements[name].dataset.system || 'si');
+      if (systems[0] !== systems[1]) {
+        const unit = (system) => (system === 'imperial' ? 'oz' : 'kg');
+        showError(form, {
+          field: 'frontier',
+          message: `the weights are in two units (from in ${unit(systems[0])}, to in ${unit(systems[1])}): type both in one`,
+        });
+        section.dataset.state = 'error';
+        return;
+      }
       // The job's body is the optimize request: a refusal may name its fields under "body.".
       const rename = (field) => field.replace(/^body\./, '');
       let job;
