@@ -183,12 +183,32 @@ export class Frontier {
     const constraint = summary.constraint;
     const imperial = body.report_units === 'imperial';
     const weightUnit = constraint.endsWith('_oz') ? 'oz' : 'kg';
-    const speed = body.objective === 'max_exit_speed' || body.objective === 'max_exit_speed_swing_weight';
-    // The best exit speed in the answer's units, or the objective in its own unit.
-    const yOf = (row) =>
-      speed ? row.sweet_spot?.[imperial ? 'exit_speed_mph' : 'exit_speed_mps'] : row.objective_value;
-    const yUnit = speed ? (imperial ? 'mph' : 'm/s') : rows[0]?.objective_unit || '';
-    const yLabel = speed ? `best exit speed (${yUnit})` : `${summary.objective} (${yUnit})`;
+    // What the chart plots against the weight: the API's number in the answer's units where the
+    // answer has one (the sweet spot's exit speed, the MOI about 6 in), else the objective's value
+    // in its own unit (the widest sweet zone's width: m, which has no inch twin in the answer).
+    const plotted = {
+      max_exit_speed: [
+        'best exit speed',
+        'sweet_spot',
+        imperial ? 'exit_speed_mph' : 'exit_speed_mps',
+        imperial ? 'mph' : 'm/s',
+      ],
+      max_exit_speed_swing_weight: [
+        'best exit speed, swing-weight adjusted',
+        'sweet_spot',
+        imperial ? 'exit_speed_mph' : 'exit_speed_mps',
+        imperial ? 'mph' : 'm/s',
+      ],
+      min_moi: [
+        'least MOI about 6 in',
+        'properties',
+        imperial ? 'moi_six_inch_oz_in2' : 'moi_six_inch_kg_m2',
+        imperial ? 'oz·in²' : 'kg·m²',
+      ],
+    }[body.objective];
+    const yOf = (row) => (plotted ? row[plotted[1]]?.[plotted[2]] : row.objective_value);
+    const yUnit = plotted ? plotted[3] : rows.find((r) => r.objective_unit)?.objective_unit || '';
+    const yLabel = `${plotted ? plotted[0] : summary.objective.replaceAll('_', ' ')} (${yUnit})`;
     const xLabel = `weight (${weightUnit})`;
     const pareto = new Set(summary.pareto || []);
     const points = rows.map((row) => ({
