@@ -64,6 +64,29 @@ std::optional<double> LengthOf(const Json& object) {
 // length of its "landing" and "trajectory"); nothing else in an answer has these keys.
 bool IsFlightLength(std::string_view base) { return base == "distance" || base == "apex"; }
 
+// A non-empty array of numbers, some of them possibly null (a carry_map row's misses).
+bool IsNumberList(const Json& value) {
+  if (!value.is_array() || value.empty()) return false;
+  bool any_number = false;
+  for (const Json& item : value) {
+    if (item.is_number()) {
+      any_number = true;
+    } else if (!item.is_null()) {
+      return false;
+    }
+  }
+  return any_number;
+}
+
+// `list` with every number divided by `to_si` (SI -> the trade unit), nulls kept.
+Json ScaledList(const Json& list, double to_si) {
+  Json out = Json::array();
+  for (const Json& item : list) {
+    out.push_back(item.is_number() ? Json(item.get<double>() / to_si) : Json(nullptr));
+  }
+  return out;
+}
+
 void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false) {
   if (node->is_array()) {
     for (Json& item : *node) AddImperialTo(&item, length_m, feet);
@@ -71,8 +94,18 @@ void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false
   }
   if (!node->is_object()) return;
   if (const auto own = LengthOf(*node)) length_m = own;
-  std::vector<std::pair<std::string, double>> added;
+  std::vector<std::pair<std::string, Json>> added;
   for (auto& [key, value] : node->items()) {
+    if (const UnitRule* rule = RuleOf(key); rule != nullptr && IsNumberList(value)) {
+      // A list of one quantity (carry_map's "undercuts_m" and each row's "distance_m", a
+      // mode's "nodes_from_knob_m"): its twin list, element by element, null kept.
+      const std::string base = key.substr(0, key.size() - rule->si.size());
+      added.emplace_back(base + std::string(rule->trade), ScaledList(value, rule->to_si));
+      if (rule->trade == "_in" && (feet || IsFlightLength(base))) {
+        added.emplace_back(base + "_ft", ScaledList(value, 12.0 * core::kMetresPerInch));
+      }
+      continue;
+    }
     if (value.is_structured()) {
       // A "bat" is the request's own form (optimize, fit): a request again as it stands, so
       // one form per quantity, as the request gave it.

@@ -61,7 +61,9 @@ std::uint64_t ArrayCount(const std::string& key, const Json& array, const Sweep&
   if (key == "points") return 9;                // every 0.5 in from 4 to 8 in from the tip
   // carry_map: a row per position, each with a carry per undercut.
   if (key == "positions") return static_cast<std::uint64_t>(sweep.options.distance.map_positions);
-  if (key == "undercuts_m" || key == "distance_m") {
+  // With report_units "imperial" each list has its twins (api/trade_units.cpp): as long.
+  if (key == "undercuts_m" || key == "distance_m" || key == "undercuts_in" ||
+      key == "distance_in" || key == "distance_ft") {
     return static_cast<std::uint64_t>(sweep.options.distance.map_undercuts);
   }
   return array.size();

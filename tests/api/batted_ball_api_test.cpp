@@ -188,6 +188,28 @@ TEST(BattedBallApiTest, DistanceSweetSpotAndCarryMap) {
   ASSERT_EQ(m["positions"].size(), 5u) << m.dump();
   ASSERT_EQ(m["positions"][0]["distance_m"].size(), 4u);
   EXPECT_TRUE(m["positions"][0].contains("position_from_tip_in"));
+  // The lists get their trade twins element by element (the explorer's heat map in feet),
+  // nulls kept: 1 in = 0.0254 m and 1 ft = 0.3048 m exactly, so each twin is the SI number
+  // divided once (1e-12 relative: one division's rounding, and the test's own).
+  ASSERT_EQ(m["undercuts_in"].size(), 4u);
+  for (std::size_t j = 0; j < 4; ++j) {
+    EXPECT_NEAR(m["undercuts_in"][j].get<double>(), m["undercuts_m"][j].get<double>() / 0.0254,
+                1e-12);
+  }
+  int nulls = 0;
+  for (const auto& row : m["positions"]) {
+    ASSERT_EQ(row["distance_ft"].size(), 4u) << row.dump();
+    for (std::size_t j = 0; j < 4; ++j) {
+      if (row["distance_m"][j].is_null()) {
+        EXPECT_TRUE(row["distance_ft"][j].is_null()) << row.dump();
+        ++nulls;
+        continue;
+      }
+      const double m_value = row["distance_m"][j].get<double>();
+      EXPECT_NEAR(row["distance_ft"][j].get<double>(), m_value / 0.3048, 1e-12 * m_value / 0.3048);
+    }
+  }
+  EXPECT_GT(nulls, 0) << "the 2-in undercut column should hold misses (the null branch)";
   EXPECT_LE(m["best"]["distance_m"].get<double>(), d["distance_m"].get<double>() + 0.03);
   // options.distance's fields are refused by name.
   const struct {

@@ -84,9 +84,15 @@ TEST(ExploreEstimateTest, EstimateIsWithinAQuarterOfTheAnswer) {
   Json bat_speed_swept = defaults;
   bat_speed_swept["parameters"].push_back(
       {{"path", "swing.bat_speed_mph"}, {"min", 60}, {"max", 80}, {"count", 3}});
+  // A carry map in feet: its lists' twins (undercuts_in, each row's distance_in and _ft) are
+  // as long as the lists.
+  Json carry_map = imperial;
+  carry_map["outputs"] = {"carry_map"};
+  carry_map["options"] = {{"distance", {{"map_positions", 11}, {"map_undercuts", 21}}}};
   for (const Case& c : {Case{CurveSweep(40, 300), "curve of 300"}, Case{defaults, "defaults"},
                         Case{imperial, "imperial"}, Case{bat_speed, "bat speed"},
-                        Case{bat_speed_swept, "bat speed swept"}}) {
+                        Case{bat_speed_swept, "bat speed swept"},
+                        Case{carry_map, "imperial carry map"}}) {
     ApiError error;
     const auto parsed = ParseExploreRequest(c.body, Context{}, &error);
     ASSERT_TRUE(parsed) << c.what << ": " << error.message;

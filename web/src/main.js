@@ -7,6 +7,8 @@ import { BatForm, drawBat, outlineOf } from './bat.js';
 import { CurveChart, FlightChart, ModesChart, PALETTE, VariantsChart } from './charts.js';
 import { ComparePanel } from './compare.js';
 import { downloadCsv, downloadSvg } from './export.js';
+import { FlightViews } from './flight_views.js';
+import { Frontier } from './frontier.js';
 import { clearErrors, el, fmt, fmtDelta, readFields, readValue, showError } from './form.js';
 import { resetControls, restoreParams, stateParams, switchInputs } from './units.js';
 
@@ -359,6 +361,7 @@ async function refreshBat() {
   refreshCompare();
   page.bats.refresh();
   refreshFlight(sweet.batted_ball);
+  page.flightViews.update(page.good);
 }
 
 /**
@@ -406,7 +409,9 @@ async function refreshFlight(battedBall) {
 // ---- units and the URL ----------------------------------------------------
 
 /** The forms whose inputs the URL keeps. */
-const stateForms = () => [$('#bat-form'), $('#optimize-form')];
+const stateForms = () => [$('#bat-form'), $('#optimize-form'), ...FLIGHT_FORMS.map((id) => $(id))];
+/** The flight views' and the frontier's forms (flight_views.js, frontier.js). */
+const FLIGHT_FORMS = ['#flight-top-form', '#carry-form', '#frontier-form'];
 
 /** The URL's hash of the page's state: the forms' inputs, then the bats side by side. */
 function stateHash() {
@@ -899,6 +904,9 @@ async function start() {
     current: () => page.good,
     onChange: saveState,
   });
+  const stem = () => (page.good?.bat.preset || 'bat').replace(/[^A-Za-z0-9_-]/g, '_');
+  page.flightViews = new FlightViews({ units: () => page.units, saveState, stem });
+  page.frontier = new Frontier({ optimizeBody, saveState, stem });
   setupUnits();
   restoreState();
   setupBatForm();
