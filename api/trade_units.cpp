@@ -41,6 +41,8 @@ constexpr UnitRule kRules[] = {
 const UnitRule* RuleOf(std::string_view key) {
   // Stiffness (N/m) and damping (N·s/m) end in "_m" but are not lengths.
   if (EndsWith(key, "_n_m") || EndsWith(key, "_s_m")) return nullptr;
+  // A mode shape's scale per square root of a mass (1/sqrt(kg)) is no mass.
+  if (EndsWith(key, "_sqrt_kg")) return nullptr;
   for (const UnitRule& rule : kRules) {
     if (EndsWith(key, rule.si) && key.size() > rule.si.size()) return &rule;
   }
@@ -64,6 +66,37 @@ std::optional<double> LengthOf(const Json& object) {
 // length of its "landing" and "trajectory"); nothing else in an answer has these keys.
 bool IsFlightLength(std::string_view base) { return base == "distance" || base == "apex"; }
 
+// A number, or an array of numbers (and nulls, and such arrays: a mode's nodes, a carry map's
+// rows), each element passed through `f`; null stays null. Nullopt for anything else.
+template <class F>
+std::optional<Json> MapNumbers(const Json& value, const F& f) {
+  if (value.is_number()) return Json(f(value.get<double>()));
+  if (!value.is_array()) return std::nullopt;
+  Json out = Json::array();
+  for (const Json& item : value) {
+    if (item.is_null()) {
+      out.push_back(nullptr);
+    } else if (auto mapped = MapNumbers(item, f)) {
+      out.push_back(std::move(*mapped));
+    } else {
+      return std::nullopt;  // an array of objects: walked as a structure instead
+    }
+  }
+  return out;
+}
+
+// The rule of a number whose unit is its sibling's string rather than its name's suffix
+// ("objective_value" beside "objective_unit": "mps"), or nullptr.
+const UnitRule* SiblingUnitRule(const Json& node, std::string_view key) {
+  constexpr std::string_view kValue = "_value";
+  if (!EndsWith(key, kValue) || key.size() <= kValue.size()) return nullptr;
+  const std::string unit_key = std::string(key.substr(0, key.size() - kValue.size())) + "_unit";
+  const auto it = node.find(unit_key);
+  if (it == node.end() || !it->is_string()) return nullptr;
+  // The unit as a name's suffix: "mps" -> "x_mps", whose rule is "_mps" -> "_mph".
+  return RuleOf("x_" + it->get<std::string>());
+}
+
 void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false) {
   if (node->is_array()) {
     for (Json& item : *node) AddImperialTo(&item, length_m, feet);
@@ -71,9 +104,9 @@ void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false
   }
   if (!node->is_object()) return;
   if (const auto own = LengthOf(*node)) length_m = own;
-  std::vector<std::pair<std::string, double>> added;
+  std::vector<std::pair<std::string, Json>> added;
   for (auto& [key, value] : node->items()) {
-    if (value.is_structured()) {
+    if (value.is_structured() && !MapNumbers(value, [](double x) { return x; })) {
       // A "bat" is the request's own form (optimize, fit): a request again as it stands, so
       // one form per quantity, as the request gave it.
       if (key != "bat") {
@@ -81,21 +114,38 @@ void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false
       }
       continue;
     }
-    if (!value.is_number()) continue;
     const UnitRule* rule = RuleOf(key);
-    if (rule == nullptr) continue;
-    const std::string base = key.substr(0, key.size() - rule->si.size());
-    const double si = value.get<double>();
-    added.emplace_back(base + std::string(rule->trade), si / rule->to_si);
-    if (rule->trade == "_in" && (feet || IsFlightLength(base))) {
-      added.emplace_back(base + "_ft", si / (12.0 * core::kMetresPerInch));
+    std::string base;
+    bool carry = IsFlightLength(key.substr(0, key.size() - (rule ? rule->si.size() : 0)));
+    if (rule != nullptr) {
+      base = key.substr(0, key.size() - rule->si.size());
+    } else if ((rule = SiblingUnitRule(*node, key)) != nullptr) {
+      // "objective_value" in "objective_unit" -> "objective_value_mph"; max_distance's
+      // objective (the answer carries its distance_sweet_spot) is a carry: in feet too.
+      base = key;
+      carry = node->contains("distance_sweet_spot");
+    } else {
+      continue;
     }
-    if (rule->trade == "_in" && EndsWith(base, "_from_knob") && length_m) {
+    const double to_si = rule->to_si;
+    const auto twin = MapNumbers(value, [to_si](double si) { return si / to_si; });
+    if (!twin) continue;
+    added.emplace_back(base + std::string(rule->trade), *twin);
+    if (rule->trade == "_in" && (feet || carry)) {
+      added.emplace_back(base + "_ft", *MapNumbers(value, [](double si) {
+        return si / (12.0 * core::kMetresPerInch);
+      }));
+    }
+    if (rule->trade != "_in" || !length_m) continue;
+    const auto from_tip = [length = *length_m](double si) {
+      return (length - si) / core::kMetresPerInch;
+    };
+    if (EndsWith(base, "_from_knob")) {
       const std::string stem = base.substr(0, base.size() - std::string_view("_from_knob").size());
-      added.emplace_back(stem + "_from_tip_in", (*length_m - si) / core::kMetresPerInch);
-    } else if (rule->trade == "_in" && EndsWith(base, "_knob") && length_m) {
+      added.emplace_back(stem + "_from_tip_in", *MapNumbers(value, from_tip));
+    } else if (EndsWith(base, "_knob")) {
       // A zone's ends ("from_knob_m", "to_knob_m" of sweet_zone): each end from the tip too.
-      added.emplace_back(base + "_from_tip_in", (*length_m - si) / core::kMetresPerInch);
+      added.emplace_back(base + "_from_tip_in", *MapNumbers(value, from_tip));
     }
   }
   for (auto& [key, value] : added) {
