@@ -132,9 +132,8 @@ void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false
     if (!twin) continue;
     added.emplace_back(base + std::string(rule->trade), *twin);
     if (rule->trade == "_in" && (feet || carry)) {
-      added.emplace_back(base + "_ft", *MapNumbers(value, [](double si) {
-        return si / (12.0 * core::kMetresPerInch);
-      }));
+      const auto in_feet = [](double si) { return si / (12.0 * core::kMetresPerInch); };
+      added.emplace_back(base + "_ft", *MapNumbers(value, in_feet));
     }
     if (rule->trade != "_in" || !length_m) continue;
     const auto from_tip = [length = *length_m](double si) {

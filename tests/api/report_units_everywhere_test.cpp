@@ -17,8 +17,8 @@ namespace {
 
 using Json = nlohmann::json;
 
-constexpr double kInch = 0.0254;    // m, exact
-constexpr double kMph = 0.44704;    // m/s, exact
+constexpr double kInch = 0.0254;      // m, exact
+constexpr double kMph = 0.44704;      // m/s, exact
 constexpr double kFoot = 12 * kInch;  // m, exact
 
 Response Post(const std::string& path, const Json& body) {
@@ -75,9 +75,9 @@ TEST(ReportUnitsEverywhereTest, ModesNodesHaveInchTwinsFromKnobAndTip) {
 // /v1/sweet-spot's vibration node: its second mode's nodes are an array too.
 TEST(ReportUnitsEverywhereTest, SweetSpotSecondModeNodesHaveTwins) {
   const Json bat{{"preset", "paper-wood"}};
-  const Response r = Post("/v1/sweet-spot", Json{{"bat", bat},
-                                                 {"outputs", {"vibration_node"}},
-                                                 {"report_units", "imperial"}});
+  const Response r =
+      Post("/v1/sweet-spot",
+           Json{{"bat", bat}, {"outputs", {"vibration_node"}}, {"report_units", "imperial"}});
   ASSERT_EQ(r.status, 200) << r.body.dump();
   const double length = r.body["properties"]["length_m"].get<double>();
   const Json& second = r.body["vibration_node"]["second_mode"];
@@ -133,11 +133,38 @@ TEST(ReportUnitsEverywhereTest, CarryMapArraysHaveTwinsAndKeepTheirNulls) {
       if (row["distance_m"][j].is_null()) {
         EXPECT_TRUE(row["distance_ft"][j].is_null());
       } else {
-        EXPECT_EQ(row["distance_ft"][j].get<double>(),
-                  row["distance_m"][j].get<double>() / kFoot);
+        EXPECT_EQ(row["distance_ft"][j].get<double>(), row["distance_m"][j].get<double>() / kFoot);
       }
     }
   }
+}
+
+// /v1/explore's rows: the array twins as a single /v1/sweet-spot answer has them, in full rows
+// with report_units and in a column that names one element (read from the row's twins).
+TEST(ReportUnitsEverywhereTest, ExploreRowsAndColumnsHaveTheArrayTwins) {
+  Json body{{"bat", {{"preset", "paper-wood"}}},
+            {"outputs", {"vibration_node"}},
+            {"parameters", {{{"path", "cor"}, {"min", 0.45}, {"max", 0.5}, {"count", 2}}}},
+            {"report_units", "imperial"}};
+  const Response full = Post("/v1/explore", body);
+  ASSERT_EQ(full.status, 200) << full.body.dump();
+  const Json single = Post("/v1/sweet-spot", Json{{"bat", {{"preset", "paper-wood"}}},
+                                                  {"outputs", {"vibration_node"}},
+                                                  {"cor", 0.45},
+                                                  {"report_units", "imperial"}})
+                          .body;
+  const Json& second = full.body["rows"][0]["vibration_node"]["second_mode"];
+  ASSERT_TRUE(second.contains("nodes_from_tip_in")) << second.dump();
+  EXPECT_EQ(second["nodes_from_tip_in"],
+            single["vibration_node"]["second_mode"]["nodes_from_tip_in"]);
+  body.erase("report_units");
+  body["columns"] = {"vibration_node.second_mode.nodes_from_knob_m.0",
+                     "vibration_node.second_mode.nodes_from_tip_in.0"};
+  const Response columns = Post("/v1/explore", body);
+  ASSERT_EQ(columns.status, 200) << columns.body.dump();
+  const Json& row = columns.body["rows"][0];
+  EXPECT_EQ(row["vibration_node.second_mode.nodes_from_tip_in.0"], second["nodes_from_tip_in"][0])
+      << row.dump();
 }
 
 // The contract's three-segment ash bat, the taper's start free, at most 0.95 kg.
