@@ -41,6 +41,8 @@ constexpr UnitRule kRules[] = {
 const UnitRule* RuleOf(std::string_view key) {
   // Stiffness (N/m) and damping (N·s/m) end in "_m" but are not lengths.
   if (EndsWith(key, "_n_m") || EndsWith(key, "_s_m")) return nullptr;
+  // A mode shape's scale per square root of a mass (1/sqrt(kg)) is no mass.
+  if (EndsWith(key, "_sqrt_kg")) return nullptr;
   for (const UnitRule& rule : kRules) {
     if (EndsWith(key, rule.si) && key.size() > rule.si.size()) return &rule;
   }
@@ -64,27 +66,35 @@ std::optional<double> LengthOf(const Json& object) {
 // length of its "landing" and "trajectory"); nothing else in an answer has these keys.
 bool IsFlightLength(std::string_view base) { return base == "distance" || base == "apex"; }
 
-// A non-empty array of numbers, some of them possibly null (a carry_map row's misses).
-bool IsNumberList(const Json& value) {
-  if (!value.is_array() || value.empty()) return false;
-  bool any_number = false;
+// A number, or an array of numbers (and nulls, and such arrays: a mode's nodes, a carry map's
+// rows), each element passed through `f`; null stays null. Nullopt for anything else.
+template <class F>
+std::optional<Json> MapNumbers(const Json& value, const F& f) {
+  if (value.is_number()) return Json(f(value.get<double>()));
+  if (!value.is_array()) return std::nullopt;
+  Json out = Json::array();
   for (const Json& item : value) {
-    if (item.is_number()) {
-      any_number = true;
-    } else if (!item.is_null()) {
-      return false;
+    if (item.is_null()) {
+      out.push_back(nullptr);
+    } else if (auto mapped = MapNumbers(item, f)) {
+      out.push_back(std::move(*mapped));
+    } else {
+      return std::nullopt;  // an array of objects: walked as a structure instead
     }
   }
-  return any_number;
+  return out;
 }
 
-// `list` with every number divided by `to_si` (SI -> the trade unit), nulls kept.
-Json ScaledList(const Json& list, double to_si) {
-  Json out = Json::array();
-  for (const Json& item : list) {
-    out.push_back(item.is_number() ? Json(item.get<double>() / to_si) : Json(nullptr));
-  }
-  return out;
+// The rule of a number whose unit is its sibling's string rather than its name's suffix
+// ("objective_value" beside "objective_unit": "mps"), or nullptr.
+const UnitRule* SiblingUnitRule(const Json& node, std::string_view key) {
+  constexpr std::string_view kValue = "_value";
+  if (!EndsWith(key, kValue) || key.size() <= kValue.size()) return nullptr;
+  const std::string unit_key = std::string(key.substr(0, key.size() - kValue.size())) + "_unit";
+  const auto it = node.find(unit_key);
+  if (it == node.end() || !it->is_string()) return nullptr;
+  // The unit as a name's suffix: "mps" -> "x_mps", whose rule is "_mps" -> "_mph".
+  return RuleOf("x_" + it->get<std::string>());
 }
 
 void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false) {
@@ -96,17 +106,7 @@ void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false
   if (const auto own = LengthOf(*node)) length_m = own;
   std::vector<std::pair<std::string, Json>> added;
   for (auto& [key, value] : node->items()) {
-    if (const UnitRule* rule = RuleOf(key); rule != nullptr && IsNumberList(value)) {
-      // A list of one quantity (carry_map's "undercuts_m" and each row's "distance_m", a
-      // mode's "nodes_from_knob_m"): its twin list, element by element, null kept.
-      const std::string base = key.substr(0, key.size() - rule->si.size());
-      added.emplace_back(base + std::string(rule->trade), ScaledList(value, rule->to_si));
-      if (rule->trade == "_in" && (feet || IsFlightLength(base))) {
-        added.emplace_back(base + "_ft", ScaledList(value, 12.0 * core::kMetresPerInch));
-      }
-      continue;
-    }
-    if (value.is_structured()) {
+    if (value.is_structured() && !MapNumbers(value, [](double x) { return x; })) {
       // A "bat" is the request's own form (optimize, fit): a request again as it stands, so
       // one form per quantity, as the request gave it.
       if (key != "bat") {
@@ -114,21 +114,37 @@ void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false
       }
       continue;
     }
-    if (!value.is_number()) continue;
     const UnitRule* rule = RuleOf(key);
-    if (rule == nullptr) continue;
-    const std::string base = key.substr(0, key.size() - rule->si.size());
-    const double si = value.get<double>();
-    added.emplace_back(base + std::string(rule->trade), si / rule->to_si);
-    if (rule->trade == "_in" && (feet || IsFlightLength(base))) {
-      added.emplace_back(base + "_ft", si / (12.0 * core::kMetresPerInch));
+    std::string base;
+    bool carry = IsFlightLength(key.substr(0, key.size() - (rule ? rule->si.size() : 0)));
+    if (rule != nullptr) {
+      base = key.substr(0, key.size() - rule->si.size());
+    } else if ((rule = SiblingUnitRule(*node, key)) != nullptr) {
+      // "objective_value" in "objective_unit" -> "objective_value_mph"; max_distance's
+      // objective (the answer carries its distance_sweet_spot) is a carry: in feet too.
+      base = key;
+      carry = node->contains("distance_sweet_spot");
+    } else {
+      continue;
     }
-    if (rule->trade == "_in" && EndsWith(base, "_from_knob") && length_m) {
+    const double to_si = rule->to_si;
+    const auto twin = MapNumbers(value, [to_si](double si) { return si / to_si; });
+    if (!twin) continue;
+    added.emplace_back(base + std::string(rule->trade), *twin);
+    if (rule->trade == "_in" && (feet || carry)) {
+      const auto in_feet = [](double si) { return si / (12.0 * core::kMetresPerInch); };
+      added.emplace_back(base + "_ft", *MapNumbers(value, in_feet));
+    }
+    if (rule->trade != "_in" || !length_m) continue;
+    const auto from_tip = [length = *length_m](double si) {
+      return (length - si) / core::kMetresPerInch;
+    };
+    if (EndsWith(base, "_from_knob")) {
       const std::string stem = base.substr(0, base.size() - std::string_view("_from_knob").size());
-      added.emplace_back(stem + "_from_tip_in", (*length_m - si) / core::kMetresPerInch);
-    } else if (rule->trade == "_in" && EndsWith(base, "_knob") && length_m) {
+      added.emplace_back(stem + "_from_tip_in", *MapNumbers(value, from_tip));
+    } else if (EndsWith(base, "_knob")) {
       // A zone's ends ("from_knob_m", "to_knob_m" of sweet_zone): each end from the tip too.
-      added.emplace_back(base + "_from_tip_in", (*length_m - si) / core::kMetresPerInch);
+      added.emplace_back(base + "_from_tip_in", *MapNumbers(value, from_tip));
     }
   }
   for (auto& [key, value] : added) {

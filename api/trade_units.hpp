@@ -64,7 +64,13 @@ enum class ReportUnits {
 /// beside every position "*_from_knob_m" its distance from the barrel end in inches
 /// ("*_from_tip_in"; a zone's ends "from_knob_m", "to_knob_m": "*_knob_from_tip_in") where the
 /// bat's length is known (the object's own "length_m", its
-/// "properties.length_m", or the nearest enclosing one's). Keys already present are kept. An
+/// "properties.length_m", or the nearest enclosing one's). An array of numbers (and nulls, and
+/// of such arrays) gets its twin element by element, null staying null ("nodes_from_knob_m"
+/// -> "nodes_from_knob_in", "nodes_from_tip_in"); a number whose unit a sibling string names
+/// ("objective_value" beside "objective_unit": "mps") gets it named after itself
+/// ("objective_value_mph"; a length in inches, and in feet too where the object carries a
+/// "distance_sweet_spot": max_distance's carry). Lengths "distance_m", "apex_m" and those under
+/// "landing" and "trajectory" (a flight's) get "_ft" twins too. Keys already present are kept. An
 /// object under the key "bat" is left as it is: it is a request's form (optimize's, fit's
 /// answer), in the units the request gave, and can be sent again as it stands.
 void AddImperial(nlohmann::json* answer);

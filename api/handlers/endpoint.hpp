@@ -71,6 +71,9 @@ struct Endpoint {
   /// properties the result carries: computed once), appended to the answer's "warnings";
   /// empty = none.
   std::function<std::vector<std::string>(const Req& request, const Result& result)> warnings;
+  /// The bat's length, m, for "report_units": "imperial" where the answer states none
+  /// (AddImperial's distances from the tip, "*_from_tip_in"); empty = the answer's own.
+  std::function<std::optional<double>(const Req& request, const Result& result)> length_m;
 };
 
 namespace endpoint_detail {
@@ -150,7 +153,9 @@ Response ServeEndpoint(const Endpoint<Req, Result>& endpoint, const Request& req
   }
   nlohmann::json out = endpoint.render(*parsed, result);
   if (endpoint.warnings) AppendWarnings(endpoint.warnings(*parsed, result), &out);
-  if (units == ReportUnits::kImperial) AddImperial(&out);
+  if (units == ReportUnits::kImperial) {
+    AddImperial(&out, endpoint.length_m ? endpoint.length_m(*parsed, result) : std::nullopt);
+  }
   const core::Summary* summary = endpoint.summary ? &endpoint.summary(result) : nullptr;
   std::optional<ProvenanceInputs> provenance;
   if (endpoint.provenance) provenance = endpoint.provenance(*parsed, *body);

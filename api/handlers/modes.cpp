@@ -157,6 +157,10 @@ const Endpoint<ModesRequest, ModesResult>& ModesEndpoint() {
       return result.modes->summary;
     };
     e.provenance = [](const ModesRequest&, const Json&) { return ProvenanceInputs{}; };
+    // The answer states no length: the nodes' and the shape's distances from the tip need it.
+    e.length_m = [](const ModesRequest&, const ModesResult& result) -> std::optional<double> {
+      return result.modes->length_m;
+    };
     return e;
   }();
   return endpoint;

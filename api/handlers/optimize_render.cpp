@@ -32,6 +32,29 @@ bool GivesField(const Json& bat, const std::vector<PathStep>& steps) {
   return false;
 }
 
+// `block` (a shape, the fill) in the trade's form, as a request in inches writes a bat: each
+// length in inches, a radius as a diameter in inches, a mass in ounces (TradeForms' factors);
+// numbers with no trade form (a density, a modulus) stay as they are.
+void InTradeForm(Json* block) {
+  if (block->is_array()) {
+    for (Json& item : *block) InTradeForm(&item);
+    return;
+  }
+  if (!block->is_object()) return;
+  Json out = Json::object();
+  for (auto& [key, value] : block->items()) {
+    const std::vector<TradeForm> forms = TradeForms(key);
+    if (!value.is_number() || forms.empty()) {
+      InTradeForm(&value);
+      out[key] = std::move(value);
+      continue;
+    }
+    const TradeForm& form = forms.back();  // a radius: "diameter_in"; else the one form
+    out[form.key] = value.get<double>() / form.to_si;
+  }
+  *block = std::move(out);
+}
+
 Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r,
                       const VariableNames& names) {
   Json bat = request_bat;
@@ -51,6 +74,10 @@ Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r,
     }
     // In the request's own units: "taper_start_in" stays inches.
     if (steps && SetNumberInRequestForm(&bat, *steps, v.value, &why)) continue;
+    // The request's form lacks the block (a preset): written out whole, in the trade's form
+    // when the variable was written in it ("profile.knots[3].diameter_in": every knot in
+    // inches, each radius as a diameter), so the bat is in the units the request used.
+    const char* block = nullptr;
     if (v.path.rfind("three_segment.", 0) == 0 && r.three_segment) {
       const auto& s = *r.three_segment;
       bat["three_segment"] = {{"length_m", s.length_m},
@@ -58,14 +85,24 @@ Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r,
                               {"barrel_radius_m", s.barrel_radius_m},
                               {"taper_start_m", s.taper_start_m},
                               {"taper_end_m", s.taper_end_m}};
+      block = "three_segment";
     } else if (v.path.rfind("profile.", 0) == 0) {
       bat["profile"] = BatToJson(r.bat)["profile"];
+      block = "profile";
     } else if (v.path.rfind("material.", 0) == 0) {
       bat["material"] = MaterialInRequestForm(r.bat.material);
     } else if (v.path.rfind("fill.", 0) == 0 || v.path == "wall_thickness_m") {
       const Json built = BatToJson(r.bat);
       if (built.contains("fill")) bat["fill"] = built["fill"];
-      if (built.contains("wall_thickness_m")) bat["wall_thickness_m"] = built["wall_thickness_m"];
+      // The wall in the form the request gave it, if it gave one ("wall_thickness_in").
+      if (built.contains("wall_thickness_m")) {
+        const std::vector<PathStep> wall{std::string("wall_thickness_m")};
+        SetNumberInRequestForm(&bat, wall, built["wall_thickness_m"].get<double>(), &why);
+      }
+      block = "fill";
+    }
+    if (block != nullptr && written != nullptr && bat.contains(block)) {
+      InTradeForm(&bat[block]);
     }
   }
   return bat;

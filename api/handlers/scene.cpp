@@ -185,6 +185,12 @@ const Endpoint<CollisionRequest, core::CollisionResult>& CollisionEndpoint() {
       return core::SceneSanityWarnings(request.scene, result.mass_properties);
     };
     e.provenance = [](const CollisionRequest&, const Json&) { return ProvenanceInputs{}; };
+    // The answer states no length: the impact's and the swing's distances from the tip need it.
+    e.length_m = [](const CollisionRequest& request,
+                    const core::CollisionResult&) -> std::optional<double> {
+      const core::Scene& scene = request.scene;
+      return scene.bat ? scene.bat->LengthM() : scene.length_m;
+    };
     return e;
   }();
   return endpoint;

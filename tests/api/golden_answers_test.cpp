@@ -266,6 +266,16 @@ const std::vector<GoldenRequest>& Requests() {
                        "max_exit_speed.exit_speed_mph"],
            "parameters": [{"path": "swing.hands_from_knob_in", "min": 4, "max": 8, "count": 2},
                           {"path": "ball.speed_mph", "min": 80, "max": 90, "count": 2}]})"},
+      // Issue 33, item 2: report_units imperial everywhere: a mode's nodes (arrays) from the
+      // knob and the tip, optimize's objective_value_mph, a preset's design in diameters.
+      {"modes_imperial", "POST", "/v1/bat/modes",
+       R"({"bat": {"preset": "wood-34-ash"}, "modes": 2, "shape_samples": 3,
+           "report_units": "imperial"})"},
+      {"optimize_preset_diameters_imperial", "POST", "/v1/optimize",
+       R"({"bat": {"preset": "wood-34-ash"},
+           "variables": [{"path": "profile.knots[9].diameter_in", "min": 1.0, "max": 2.65}],
+           "constraints": {"mass_oz": {"max": 32}}, "objective": "max_exit_speed", "cor": 0.5,
+           "options": {"backend": "nlopt_slsqp"}, "report_units": "imperial"})"},
   };
   return requests;
 }
