@@ -153,7 +153,8 @@ struct AeroOptions {
   bool Validate(Refusal* why) const;
 };
 
-/// The integrator's settings (an adaptive Dormand–Prince 5(4) with dense output).
+/// The integrator's settings (an adaptive Dormand–Prince 5(4) with dense output; the first step
+/// min(0.5 s, 5·relative_tolerance^0.2 s), then PI step control).
 struct FlightOptions {
   /// Relative tolerance of a step's local error. The default keeps the distance within
   /// 0.1 ft (3 cm) of a converged answer (docs/speed-vs-error.md). In [1e-13, 1e-2].
@@ -252,7 +253,7 @@ struct FlightResult {
   /// summed over the accepted steps, plus each step's local velocity error carried to the
   /// landing, plus the landing interpolant's error (a cubic Hermite against the 4th-order dense
   /// output). An estimate, not a bound: measured over a grid of launches the error was at most
-  /// 3.6 times it (nathan-2016, custom; tests/core/flight_test.cpp); sawicki-2003's lift law
+  /// 1.6 times it (nathan-2016, custom; tests/core/flight_test.cpp); sawicki-2003's lift law
   /// has a kink it cannot see.
   double error_estimate_m = 0.0;
   int steps = 0;           ///< Accepted steps.
