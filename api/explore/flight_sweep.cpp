@@ -122,30 +122,66 @@ constexpr std::uint64_t kBlock = 1024;  // launches a block (one thread's turn)
 constexpr long long kBlockStepBudget = static_cast<long long>(kBlock) * 1000;
 constexpr int kMinSteps = 10;  // FlightOptions::max_steps's lower bound
 
-// The swept values of a list's launch: none.
-const std::vector<double> kNoPoint;
-
 // One launch's flight and the step limit it flew with.
 struct Flown {
   flight::FlightResult result;
   int max_steps = 0;
 };
 
-// Flies design `index` (its swept values in `point`; a list's launch `index`) within what is
-// left of its block's budget.
-Flown FlyDesign(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
-                long long* block_budget) {
-  flight::Launch launch = sweep.base.launches[sweep.list ? index : 0];
-  flight::Environment environment = sweep.base.environment;
+// Design `index`'s launch and environment (its swept values in `point`; a list's launch
+// `index`).
+void DesignOf(const FlightSweep& sweep, std::uint64_t index, const std::vector<double>& point,
+              flight::Launch* launch, flight::Environment* environment) {
+  *launch = sweep.base.launches[sweep.list ? index : 0];
+  *environment = sweep.base.environment;
   for (std::size_t d = 0; d < sweep.specs.size(); ++d) {
-    Apply(*sweep.specs[d], point[d], &launch, &environment);
+    Apply(*sweep.specs[d], point[d], launch, environment);
   }
-  flight::FlightOptions options = sweep.base.options;
-  options.max_steps = static_cast<int>(std::max<long long>(
-      kMinSteps, std::min<long long>(options.max_steps, *block_budget)));
-  Flown flown{flight::Fly(launch, environment, sweep.base.aero, options), options.max_steps};
-  *block_budget -= flown.result.steps + flown.result.rejected_steps;
-  return flown;
+}
+
+// Flies designs [first, last) of a block in order within the block's budget, their swept
+// values to points[i − first] and their flights to flown[i − first]. The same flights and step
+// limits as one at a time (each launch's limit the least of options.max_steps and what is left
+// of the budget, at least kMinSteps), flown side by side by flight::FlyMany while what is left
+// is at least the batch's launches times options.max_steps (then no launch of the batch can
+// find the budget short: each flies with options.max_steps, as it would alone).
+void FlyBlock(const FlightSweep& sweep, std::uint64_t first, std::uint64_t last,
+              core::DesignSequence* sequence, std::vector<std::vector<double>>* points,
+              std::vector<Flown>* flown) {
+  const std::size_t n = static_cast<std::size_t>(last - first);
+  points->assign(n, std::vector<double>());
+  std::vector<flight::Launch> launches(n);
+  std::vector<flight::Environment> environments(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (sequence != nullptr) (*points)[i] = sequence->Design(first + i);
+    DesignOf(sweep, first + i, (*points)[i], &launches[i], &environments[i]);
+  }
+  flown->assign(n, Flown());
+  std::vector<flight::FlightResult> results(n);
+  const int limit = sweep.base.options.max_steps;
+  long long budget = kBlockStepBudget;
+  std::size_t i = 0;
+  while (i < n) {
+    const std::size_t batch =
+        budget > 0 && limit > 0 ? std::min<std::size_t>(n - i, static_cast<std::size_t>(budget / limit)) : 0;
+    if (batch >= 2) {
+      flight::FlyMany(batch, &launches[i], &environments[i], false, sweep.base.aero,
+                      sweep.base.options, &results[i]);
+      for (std::size_t j = i; j < i + batch; ++j) {
+        (*flown)[j] = Flown{std::move(results[j]), limit};
+        budget -= (*flown)[j].result.steps + (*flown)[j].result.rejected_steps;
+      }
+      i += batch;
+      continue;
+    }
+    flight::FlightOptions options = sweep.base.options;
+    options.max_steps =
+        static_cast<int>(std::max<long long>(kMinSteps, std::min<long long>(limit, budget)));
+    (*flown)[i] = Flown{flight::Fly(launches[i], environments[i], sweep.base.aero, options),
+                        options.max_steps};
+    budget -= (*flown)[i].result.steps + (*flown)[i].result.rejected_steps;
+    ++i;
+  }
 }
 
 // Why a launch did not land (NotLandedMessage, and the block's budget when it cut the limit).
@@ -526,13 +562,11 @@ Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
           [&](std::uint64_t first, std::uint64_t last, core::DesignSequence* sequence) {
             std::string text;
             text.reserve(static_cast<std::size_t>(last - first) * 256);
-            long long budget = flight_sweep::kBlockStepBudget;
+            std::vector<std::vector<double>> points;
+            std::vector<flight_sweep::Flown> flown;
+            flight_sweep::FlyBlock(*sweep, first, last, sequence, &points, &flown);
             for (std::uint64_t i = first; i < last; ++i) {
-              const std::vector<double>& point =
-                  sequence != nullptr ? sequence->Design(i) : flight_sweep::kNoPoint;
-              flight_sweep::AppendCsvRow(*sweep, i, point,
-                                         flight_sweep::FlyDesign(*sweep, i, point, &budget),
-                                         &text);
+              flight_sweep::AppendCsvRow(*sweep, i, points[i - first], flown[i - first], &text);
             }
             return text;
           },
@@ -549,12 +583,11 @@ Response HandleFlightSweep(const nlohmann::json& body, const Context& context) {
       [&](std::uint64_t first, std::uint64_t last, core::DesignSequence* sequence) {
         std::vector<nlohmann::json> block;
         block.reserve(static_cast<std::size_t>(last - first));
-        long long budget = flight_sweep::kBlockStepBudget;
+        std::vector<std::vector<double>> points;
+        std::vector<flight_sweep::Flown> flown;
+        flight_sweep::FlyBlock(*sweep, first, last, sequence, &points, &flown);
         for (std::uint64_t i = first; i < last; ++i) {
-          const std::vector<double>& point =
-              sequence != nullptr ? sequence->Design(i) : flight_sweep::kNoPoint;
-          block.push_back(flight_sweep::JsonRow(
-              *sweep, i, point, flight_sweep::FlyDesign(*sweep, i, point, &budget)));
+          block.push_back(flight_sweep::JsonRow(*sweep, i, points[i - first], flown[i - first]));
         }
         return block;
       },

@@ -1,10 +1,14 @@
 // Batted-ball flight (core/flight/flight.hpp): the equations of Nathan's calculator in SI,
 // integrated by a hand-written Dormand–Prince 5(4) with its 4th-order dense output, the landing
 // and the apex found as events on that output. No allocation unless a trajectory is asked for.
+// One stepper flies one flight (Fly) or several side by side (FlyMany): docs/flight.md, "Where a
+// flight's time goes".
 #include "core/flight/flight.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <type_traits>
 
 #include "core/numerics/limits.hpp"
 #include "core/units.hpp"
@@ -32,24 +36,16 @@ struct State {
   double x, y, z, vx, vy, vz;
 };
 
-State Axpy(const State& a, double h, const State& k) {
-  return {a.x + h * k.x,   a.y + h * k.y,   a.z + h * k.z,
-          a.vx + h * k.vx, a.vy + h * k.vy, a.vz + h * k.vz};
-}
 
 // Everything a right-hand side needs, computed once per flight.
 struct Model {
-  bool air = true;           // false: vacuum.
   double k_per_m = 0.0;      // ½ρA/m, 1/m.
   double radius_m = 0.0;     // ball radius, m.
   double omega_rad_s = 0.0;  // initial spin, rad/s.
   double ux = 0, uy = 0, uz = 0;  // spin axis (unit; ω/|ω|), fixed (the calculator's).
   double spin_krpm = 0.0;    // total spin / 1000 rpm (the spin drag term).
   double cd0 = 0.0, cd_spin = 0.0;
-  bool decay = true;
   double decay_rate_per_m = 0.0;  // 1/(τ·44.704): exponent = −t·v_rel·rate.
-  AeroModel model = AeroModel::kNathan2016;
-  LiftLaw lift = LiftLaw::kSaturating;
   double cl0 = 0, cl1 = 0, cl2 = 0, cl_slope = 0;
   double wind_x = 0, wind_y = 0;  // wind velocity, m/s.
   // Products of the above, computed once per flight (Prepare) so that a right-hand side needs
@@ -81,34 +77,66 @@ double SawickiDrag(double v) {
 
 double SawickiLift(double s) { return s < 0.1 ? 1.5 * s : 0.09 + 0.6 * s; }
 
-// Inlined into the stepper: called 6 times a step, it is most of a flight's time. Its cost is
-// the latency of one chain (sqrt, exp, one division), so the constants are folded (Model::
-// Prepare) and Nathan's lift k·CL·v with CL = cl2·S/(cl0 + cl1·S), S = Rω·decay/v, is written
-// with one division: k·cl2·Rω·decay·v / (cl0·v + cl1·Rω·decay) (the same number to rounding).
-[[gnu::always_inline]] inline State Derivative(const Model& m, double t, const State& s) {
-  State d{s.vx, s.vy, s.vz, 0.0, 0.0, -kGravityMps2};
-  if (!m.air) return d;
-  const double rx = s.vx - m.wind_x, ry = s.vy - m.wind_y, rz = s.vz;
+// Which right-hand side a flight uses: fixed by the aero model, so uniform over a batch
+// (FlyMany shares one AeroOptions), and a template parameter so that the stages carry no
+// branch on it.
+enum class Kind {
+  kVacuum,      // gravity only
+  kSawicki,     // Sawicki's drag and lift, no spin decay
+  kSaturating,  // nathan-2016, or custom with the saturating lift law: spin decay
+  kLinear,      // custom with the linear lift law: spin decay
+};
+
+// The state's components: position (m) 0-2, velocity (m/s) 3-5, and with spin decay the decay
+// factor D = exp(−t·|v_rel|/(τ·44.704 m/s)) as component 6 (see Derivative).
+template <Kind K>
+constexpr int kComponents = (K == Kind::kSaturating || K == Kind::kLinear) ? 7 : 6;
+constexpr int kDecayComponent = 6;
+
+// The right-hand side at time t of state s (its velocity and decay part: the positions'
+// derivatives are the velocities, which the stepper copies). Inlined into the stepper: called
+// 6 times a step, it is most of a flight's time, and its cost is the latency of one chain.
+//
+// The spin decay D = exp(−t·v·rate) (the calculator's form: v the speed relative to the air,
+// rate = 1/(τ·44.704 m/s)) is carried as a state instead of evaluated: an `exp` per evaluation
+// was a quarter of a flight. It follows dD/dt = −rate·D·(v + t·dv/dt), and dv/dt needs no new
+// quantity: the Magnus force is normal to v_rel and does no work, so
+// dv/dt = (v_rel·a)/v = −k·CD·v² − g·v_rel,z/v. The state then integrates the same function
+// (D(0) = 1), with its local error controlled as the other components' (FlyLanes).
+//
+// Nathan's lift k·CL·v with CL = cl2·S/(cl0 + cl1·S), S = Rω·D/v, is written with one
+// division: k·cl2·Rω·D·v / (cl0·v + cl1·Rω·D) (the same number to rounding); the constants
+// are folded once per flight (Model::Prepare).
+template <Kind K>
+[[gnu::always_inline]] inline void Derivative(const Model& m, double t, const double* s,
+                                              double* d) {
+  d[3] = 0.0;
+  d[4] = 0.0;
+  d[5] = -kGravityMps2;
+  if constexpr (K == Kind::kVacuum) return;
+  const double rx = s[3] - m.wind_x, ry = s[4] - m.wind_y, rz = s[5];
   const double v = std::sqrt(rx * rx + ry * ry + rz * rz);
   double drag = 0.0, lift = 0.0;  // drag: −k·CD·v; lift: k·CL·v (1/s)
-  if (m.model == AeroModel::kSawicki2003) {
+  if constexpr (K == Kind::kSawicki) {
     const double spin_factor = v > 0.0 ? m.spin_speed_mps / v : 0.0;
     drag = -m.k_per_m * SawickiDrag(v) * v;
     lift = m.k_per_m * SawickiLift(spin_factor) * v;
   } else {
-    const double decay = m.decay ? std::exp(-t * v * m.decay_rate_per_m) : 1.0;
+    const double decay = s[kDecayComponent];
     drag = -(m.k_cd0 + m.k_cd_spin * decay) * v;
-    if (m.lift == LiftLaw::kLinear) {
+    if constexpr (K == Kind::kLinear) {
       lift = m.k_slope_spin * decay;  // k·slope·S·v: v cancels
-    } else if (v > 0.0) {
-      lift = m.k_cl2_spin * decay * v / (m.cl0 * v + m.cl1_spin * decay);
+    } else {
+      lift = v > 0.0 ? m.k_cl2_spin * decay * v / (m.cl0 * v + m.cl1_spin * decay) : 0.0;
     }
+    // dv/dt (at v = 0, where the speed has a kink, taken as drag only).
+    const double dv_dt = drag * v - (v > 0.0 ? kGravityMps2 * rz / v : 0.0);
+    d[kDecayComponent] = -m.decay_rate_per_m * decay * (v + t * dv_dt);
   }
   // Magnus: k·CL·v·(û × v_rel), û the (fixed) spin axis, as the calculator writes it.
-  d.vx += drag * rx + lift * (m.uy * rz - m.uz * ry);
-  d.vy += drag * ry + lift * (m.uz * rx - m.ux * rz);
-  d.vz += drag * rz + lift * (m.ux * ry - m.uy * rx);
-  return d;
+  d[3] += drag * rx + lift * (m.uy * rz - m.uz * ry);
+  d[4] += drag * ry + lift * (m.uz * rx - m.ux * rz);
+  d[5] += drag * rz + lift * (m.ux * ry - m.uy * rx);
 }
 
 // Dormand–Prince 5(4) tableau (Dormand & Prince 1980; Hairer, Nørsett & Wanner, Solving ODEs I,
@@ -142,7 +170,6 @@ struct Dense {
   }
 };
 
-const double* Array(const State& s) { return &s.x; }
 
 // The step controller's floors, as logarithms: err is taken as at least 1e-10, and the memory
 // of the last step's err as at least 1e-4 (Hairer's DOPRI5).
@@ -202,6 +229,407 @@ TrajectoryPoint Sample(double t, const State& s) {
 bool PrefixOnFailure(Refusal* why, const char* prefix, bool ok) {
   if (!ok && why != nullptr) *why = core::Prefixed(prefix, std::move(*why));
   return ok;
+}
+
+
+// One flight in progress on the stepper: its model and the integrator's state between steps.
+// Default-initialised to zeros, so that an idle lane computes on finite numbers.
+template <Kind K>
+struct Lane {
+  static constexpr int N = kComponents<K>;
+  Model m;
+  FlightResult* r = nullptr;  // the flight's answer; null: the lane is idle
+  std::vector<TrajectoryPoint>* trajectory = nullptr;
+  double t = 0.0, h = 0.0;
+  double y[N] = {}, y_new[N] = {}, s[N] = {};
+  double k[7][N] = {};  // the stages' derivatives; k[0] = f(t, y) (first same as last)
+  // The error estimate: the local position errors, plus each step's local velocity error
+  // carried to the landing (δv · (T − t_i), T the hang time): Σ|δx_i| + T·Σ|δv_i| − Σ|δv_i|·t_i.
+  double error_sum = 0.0, velocity_error_sum = 0.0, velocity_error_time_sum = 0.0;
+  // PI controller memory (Hairer's DOPRI5 "facold", 1e-4 at first), kept as its logarithm: the
+  // controller's err^0.17 · facold^−0.04 is one exp of logarithms (two pow calls cost more).
+  double log_previous_error_ratio = kLogMinErrorMemory;
+  long long next_sample = 1;  // the next sample is at next_sample · trajectory_interval_s
+};
+
+// The stage derivative k[j] at (t, s): the positions' derivatives are the velocities.
+template <Kind K>
+[[gnu::always_inline]] inline void Evaluate(Lane<K>& a, int j, double t, const double* s) {
+  a.k[j][0] = s[3];
+  a.k[j][1] = s[4];
+  a.k[j][2] = s[5];
+  Derivative<K>(a.m, t, s, a.k[j]);
+}
+
+// The model and the initial state of a flight (Fly's documented inputs), its spin, labels and
+// air density written to `r`; false (with `r` final) when an input is refused.
+// `checked`: the environment, aero and options are known valid (FlyMany checks shared ones
+// once), and `density` (when not null) is the environment's air density.
+bool Prepare(const Launch& launch, const Environment& environment, const AeroOptions& aero,
+             const FlightOptions& options, FlightResult* r, Model* model, double y0[6],
+             bool checked = false, const double* density = nullptr) {
+  {
+    Refusal why;
+    Refusal* out = &why;
+    if (!PrefixOnFailure(out, "launch.", launch.Validate(out)) ||
+        (!checked && (!PrefixOnFailure(out, "environment.", environment.Validate(out)) ||
+                      !PrefixOnFailure(out, "aero.", aero.Validate(out)) ||
+                      !PrefixOnFailure(out, "options.", options.Validate(out))))) {
+      r->termination = FlightTermination::kInvalidInput;
+      r->refusal = std::move(why);
+      return false;
+    }
+  }
+
+  // The spin and its axis (the calculator's cells D10-D12, gyrospin 0).
+  if (launch.backspin_rpm) {
+    r->spin = {*launch.backspin_rpm, *launch.sidespin_rpm};
+    r->spin_source = SpinSource::kGiven;
+  } else {
+    r->spin = EstimateSpin(launch.launch_angle_deg, launch.spray_angle_deg, launch.batter_hand);
+    r->spin_source = SpinSource::kStatcastRelation;
+  }
+  r->classification = Classify(launch.exit_speed_mps, launch.launch_angle_deg);
+  r->air_density_kg_m3 = aero.model == AeroModel::kVacuum ? 0.0
+                         : density != nullptr             ? *density
+                                                          : AirDensityKgM3(environment);
+
+  const double th = launch.launch_angle_deg * kDegToRad, ph = launch.spray_angle_deg * kDegToRad;
+  const double sth = std::sin(th), cth = std::cos(th), sph = std::sin(ph), cph = std::cos(ph);
+  Model& m = *model;
+  m = Model();
+  const double wb = r->spin.backspin_rpm, ws = r->spin.sidespin_rpm;
+  const double wx = (wb * cph - ws * sth * sph) * kRpmToRadS;
+  const double wy = (-wb * sph - ws * sth * cph) * kRpmToRadS;
+  const double wz = ws * cth * kRpmToRadS;
+  m.omega_rad_s = std::sqrt(wx * wx + wy * wy + wz * wz);
+  if (m.omega_rad_s > 0.0) {
+    m.ux = wx / m.omega_rad_s;
+    m.uy = wy / m.omega_rad_s;
+    m.uz = wz / m.omega_rad_s;
+  }
+  m.spin_krpm = std::hypot(wb, ws) / 1000.0;
+  m.radius_m = aero.ball_circumference_m / (2.0 * kPi);
+  const double area_m2 = kPi * m.radius_m * m.radius_m;
+  const double rho = r->air_density_kg_m3;
+  switch (aero.model) {
+    case AeroModel::kNathan2016:
+      m.k_per_m = kNathanC0PerDensity * rho * (kNathanMassKg / aero.ball_mass_kg) *
+                  std::pow(aero.ball_circumference_m / kNathanCircumferenceM, 2);
+      m.cd0 = 0.3008;
+      m.cd_spin = 0.0292;
+      m.cl0 = 0.583;
+      m.cl1 = 2.333;
+      m.cl2 = 1.120;
+      break;
+    case AeroModel::kCustom:
+      m.k_per_m = 0.5 * rho * area_m2 / aero.ball_mass_kg;
+      m.cd0 = aero.cd0;
+      m.cd_spin = aero.cd_spin_per_krpm;
+      m.cl0 = aero.cl0;
+      m.cl1 = aero.cl1;
+      m.cl2 = aero.cl2;
+      m.cl_slope = aero.cl_per_spin_factor;
+      break;
+    case AeroModel::kSawicki2003:
+      m.k_per_m = 0.5 * rho * area_m2 / aero.ball_mass_kg;
+      break;
+    case AeroModel::kVacuum:
+      break;
+  }
+  m.decay_rate_per_m = 1.0 / (aero.spin_decay_s * kDecayReferenceSpeedMps);
+  m.Prepare();
+  const double wind_dir = environment.wind.direction_deg * kDegToRad;
+  m.wind_x = environment.wind.speed_mps * std::sin(wind_dir);
+  m.wind_y = environment.wind.speed_mps * std::cos(wind_dir);
+
+  const double v0 = launch.exit_speed_mps;
+  const double start[6] = {launch.start_x_m, launch.start_y_m, launch.height_m,
+                           v0 * cth * sph,   v0 * cth * cph,   v0 * sth};
+  std::copy(start, start + 6, y0);
+  return true;
+}
+
+// Puts a flight on `lane` (false, with `r` final, when an input is refused).
+template <Kind K>
+bool Start(const Launch& launch, const Environment& environment, const AeroOptions& aero,
+           const FlightOptions& options, FlightResult* r,
+           std::vector<TrajectoryPoint>* trajectory, Lane<K>* lane, bool checked = false,
+           const double* density = nullptr) {
+  Lane<K>& a = *lane;
+  double y0[6];
+  if (!Prepare(launch, environment, aero, options, r, &a.m, y0, checked, density)) return false;
+  a.r = r;
+  a.trajectory = trajectory;
+  std::copy(y0, y0 + 6, a.y);
+  if constexpr (Lane<K>::N > 6) a.y[kDecayComponent] = 1.0;  // D(0) = exp(0)
+  a.t = 0.0;
+  r->apex_m = a.y[2];
+  r->apex_time_s = 0.0;
+  // The first step: about a tenth of a flight's time scale (0.5 s at the default tolerance),
+  // refined by the controller. 0.05 s (the earlier choice) let the controller spend two or
+  // three steps growing it (errors of 5e-7 and 8e-3 of the tolerance in the first two steps
+  // of a 400 ft fly ball): 0.5 s takes 6 steps (37 evaluations) instead of 8 (49), and the
+  // grid's worst errors are lower (docs/flight.md, "Where a flight's time goes").
+  a.h = std::min(0.5, std::pow(options.relative_tolerance, 0.2) * 5.0);
+  Evaluate<K>(a, 0, 0.0, a.y);
+  r->evaluations = 1;
+  a.error_sum = a.velocity_error_sum = a.velocity_error_time_sum = 0.0;
+  a.log_previous_error_ratio = kLogMinErrorMemory;
+  a.next_sample = 1;
+  if (trajectory != nullptr) {
+    trajectory->push_back(Sample(0.0, {a.y[0], a.y[1], a.y[2], a.y[3], a.y[4], a.y[5]}));
+  }
+  return true;
+}
+
+// Before a step: ends the flight (true) at its step or time limit, else bounds the step by
+// the time limit.
+template <Kind K>
+bool AtLimit(Lane<K>& a, const FlightOptions& options) {
+  FlightResult& r = *a.r;
+  // Rejected steps count too: a step size shrinking forever must end as well.
+  const bool step_limit = r.steps + r.rejected_steps >= options.max_steps;
+  if (step_limit || a.t >= options.max_flight_time_s) {
+    r.termination = step_limit ? FlightTermination::kStepLimit : FlightTermination::kTimeLimit;
+    r.error_estimate_m =  // of the flight so far
+        a.error_sum + a.t * a.velocity_error_sum - a.velocity_error_time_sum;
+    return true;
+  }
+  a.h = std::min(a.h, options.max_flight_time_s - a.t);
+  return false;
+}
+
+// One Dormand–Prince step attempt on each of the L lanes, stage by stage across the lanes: the
+// lanes' chains are independent, so the processor overlaps them (one flight's stages wait on
+// each other's square root and division). The positions are not formed at the inner stages:
+// the right-hand side does not read them.
+template <Kind K, int L>
+void Attempt(Lane<K>* lanes) {
+  constexpr int N = Lane<K>::N;
+  for (int l = 0; l < L; ++l) {
+    Lane<K>& a = lanes[l];
+    for (int i = 3; i < N; ++i) a.s[i] = a.y[i] + a.h * a21 * a.k[0][i];
+  }
+  for (int l = 0; l < L; ++l) Evaluate<K>(lanes[l], 1, lanes[l].t + c2 * lanes[l].h, lanes[l].s);
+  for (int l = 0; l < L; ++l) {
+    Lane<K>& a = lanes[l];
+    for (int i = 3; i < N; ++i) a.s[i] = a.y[i] + a.h * (a31 * a.k[0][i] + a32 * a.k[1][i]);
+  }
+  for (int l = 0; l < L; ++l) Evaluate<K>(lanes[l], 2, lanes[l].t + c3 * lanes[l].h, lanes[l].s);
+  for (int l = 0; l < L; ++l) {
+    Lane<K>& a = lanes[l];
+    for (int i = 3; i < N; ++i) {
+      a.s[i] = a.y[i] + a.h * (a41 * a.k[0][i] + a42 * a.k[1][i] + a43 * a.k[2][i]);
+    }
+  }
+  for (int l = 0; l < L; ++l) Evaluate<K>(lanes[l], 3, lanes[l].t + c4 * lanes[l].h, lanes[l].s);
+  for (int l = 0; l < L; ++l) {
+    Lane<K>& a = lanes[l];
+    for (int i = 3; i < N; ++i) {
+      a.s[i] = a.y[i] + a.h * (a51 * a.k[0][i] + a52 * a.k[1][i] + a53 * a.k[2][i] +
+                               a54 * a.k[3][i]);
+    }
+  }
+  for (int l = 0; l < L; ++l) Evaluate<K>(lanes[l], 4, lanes[l].t + c5 * lanes[l].h, lanes[l].s);
+  for (int l = 0; l < L; ++l) {
+    Lane<K>& a = lanes[l];
+    for (int i = 3; i < N; ++i) {
+      a.s[i] = a.y[i] + a.h * (a61 * a.k[0][i] + a62 * a.k[1][i] + a63 * a.k[2][i] +
+                               a64 * a.k[3][i] + a65 * a.k[4][i]);
+    }
+  }
+  for (int l = 0; l < L; ++l) Evaluate<K>(lanes[l], 5, lanes[l].t + lanes[l].h, lanes[l].s);
+  for (int l = 0; l < L; ++l) {
+    Lane<K>& a = lanes[l];
+    for (int i = 0; i < N; ++i) {
+      a.y_new[i] = a.y[i] + a.h * (a71 * a.k[0][i] + a73 * a.k[2][i] + a74 * a.k[3][i] +
+                                   a75 * a.k[4][i] + a76 * a.k[5][i]);
+    }
+  }
+  for (int l = 0; l < L; ++l) Evaluate<K>(lanes[l], 6, lanes[l].t + lanes[l].h, lanes[l].y_new);
+}
+
+// After an attempt: rejects it (a shorter h) or accepts it (the events on its dense output and
+// the next h). True when the flight ended (landed, or not finite).
+template <Kind K>
+bool Finish(Lane<K>& a, const FlightOptions& options) {
+  constexpr int N = Lane<K>::N;
+  FlightResult& r = *a.r;
+  const double h = a.h, t = a.t;
+  const double* y = a.y;
+  const double* y_new = a.y_new;
+  const auto& k = a.k;
+  r.evaluations += 6;
+  const double rtol = options.relative_tolerance, atol = options.absolute_tolerance_m;
+
+  // The local error (5th − 4th order), scaled per component, its RMS over the components;
+  // position's error kept in m. The decay factor D (of order 1) is scaled by rtol alone.
+  double err2 = 0.0, position_err2 = 0.0, velocity_err2 = 0.0;
+  bool finite = true;
+  for (int i = 0; i < N; ++i) {
+    const double e = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] + e5 * k[4][i] +
+                          e6 * k[5][i] + e7 * k[6][i]);
+    const double yn = y_new[i];
+    finite = finite && Finite(yn) && Finite(e);
+    const double scale =
+        i < 6 ? atol + rtol * std::max(std::abs(y[i]), std::abs(yn)) : rtol;
+    err2 += (e / scale) * (e / scale);
+    if (i < 3) {
+      position_err2 += e * e;
+    } else if (i < 6) {
+      velocity_err2 += e * e;
+    }
+  }
+  if (!finite) {
+    if (h > 1e-9) {  // a too-long step can overflow: retry shorter before giving up
+      a.h *= 0.1;
+      ++r.rejected_steps;
+      return false;
+    }
+    r.termination = FlightTermination::kNonFinite;
+    return true;
+  }
+  const double err = std::sqrt(err2 / 6.0);
+  const double log_err = std::log(err);  // −inf for a zero error: the clamps below hold
+  if (err > 1.0) {
+    a.h *= std::max(0.2, 0.9 * std::exp(-0.2 * log_err));
+    ++r.rejected_steps;
+    return false;
+  }
+
+  // Accepted.
+  ++r.steps;
+  a.error_sum += std::sqrt(position_err2);
+  const double velocity_error = std::sqrt(velocity_err2);
+  a.velocity_error_sum += velocity_error;
+  a.velocity_error_time_sum += velocity_error * (t + h);
+  const bool apex = y[5] > 0.0 && y_new[5] <= 0.0;  // vz crosses zero going down
+  const bool lands = y_new[2] <= 0.0 && y_new[5] < 0.0;
+  if (apex || lands || a.trajectory != nullptr) {
+    // The dense output of [t, t + h] (Hairer's contd5), formed only when it is read.
+    Dense dense;
+    for (int i = 0; i < 6; ++i) {
+      const double diff = y_new[i] - y[i];
+      const double bspl = h * k[0][i] - diff;
+      dense.r1[i] = y[i];
+      dense.r2[i] = diff;
+      dense.r3[i] = bspl;
+      dense.r4[i] = diff - h * k[6][i] - bspl;
+      dense.r5[i] = h * (d1 * k[0][i] + d3 * k[2][i] + d4 * k[3][i] + d5 * k[4][i] +
+                         d6 * k[5][i] + d7 * k[6][i]);
+    }
+    if (apex) {
+      const double theta = RootOf(dense, 5, y[5], y_new[5]);
+      const double z = dense.Component(2, theta);
+      if (z > r.apex_m) {
+        r.apex_m = z;
+        r.apex_time_s = t + theta * h;
+      }
+    }
+    const double theta_land = lands ? RootOf(dense, 2, y[2], y_new[2]) : 1.0;
+    const double t_end = t + theta_land * h;
+    if (a.trajectory != nullptr) {
+      for (double ts = a.next_sample * options.trajectory_interval_s; ts < t_end;
+           ts = ++a.next_sample * options.trajectory_interval_s) {
+        a.trajectory->push_back(Sample(ts, dense.At((ts - t) / h)));
+      }
+    }
+    if (lands) {
+      State landed = dense.At(theta_land);
+      landed.z = 0.0;
+      if (a.trajectory != nullptr) a.trajectory->push_back(Sample(t_end, landed));
+      r.termination = FlightTermination::kLanded;
+      r.hang_time_s = t_end;
+      r.landing_x_m = landed.x;
+      r.landing_y_m = landed.y;
+      r.distance_m = std::hypot(landed.x, landed.y);
+      r.bearing_deg = std::atan2(landed.x, landed.y) / kDegToRad;
+      r.landing_speed_mps = GroundSpeed(landed);
+      r.landing_angle_deg =
+          std::atan2(-landed.vz, std::hypot(landed.vx, landed.vy)) / kDegToRad;
+      // The landing is read from the step's 4th-order interpolant: its error is estimated by
+      // the cubic Hermite interpolant's difference from it at the landing, moved onto the
+      // ground along the path (a height error dz shifts the landing by v_h·dz/v_z).
+      const double u = theta_land, u2 = u * u, u3 = u2 * u;
+      const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u;
+      const double h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
+      double d[3];
+      for (int i = 0; i < 3; ++i) {
+        const double cubic = h00 * y[i] + h10 * h * k[0][i] + h01 * y_new[i] + h11 * h * k[6][i];
+        d[i] = cubic - dense.Component(i, u);
+      }
+      const double shift = landed.vz < 0.0 ? d[2] / landed.vz : 0.0;
+      const double interpolation_error =
+          std::hypot(d[0] - landed.vx * shift, d[1] - landed.vy * shift);
+      r.error_estimate_m = a.error_sum + t_end * a.velocity_error_sum -
+                           a.velocity_error_time_sum + interpolation_error;
+      return true;
+    }
+  }
+  for (int i = 0; i < N; ++i) {
+    a.y[i] = y_new[i];
+    a.k[0][i] = k[6][i];  // first same as last
+  }
+  a.t = t + h;
+  // Step-size control (Hairer's DOPRI5: PI control with β = 0.04).
+  // fac = max(err, 1e-10)^0.17 · facold^−0.04, facold = max(err, 1e-4) of the last step.
+  const double fac = std::exp((0.2 - 0.04 * 0.75) * std::max(log_err, kLogMinError) -
+                              0.04 * a.log_previous_error_ratio);
+  a.log_previous_error_ratio = std::max(log_err, kLogMinErrorMemory);
+  a.h = h * std::clamp(0.9 / fac, 0.2, 10.0);
+  return false;
+}
+
+// Flies flights 0 … count − 1 on L lanes: `start(i, lane)` puts flight i on a lane (false when
+// its input was refused: its answer is then final). A lane whose flight ends takes the next
+// flight, so the lanes stay busy until the last flights; each flight's arithmetic is the same
+// on any number of lanes (the same answers to the bit as Fly).
+template <Kind K, int L, class StartFlight>
+void FlyLanes(std::size_t count, const FlightOptions& options, const StartFlight& start) {
+  Lane<K> lanes[L];
+  std::size_t next = 0;
+  auto refill = [&](Lane<K>& lane) {
+    lane.r = nullptr;
+    while (next < count) {
+      if (start(next++, &lane)) return;
+    }
+  };
+  for (Lane<K>& lane : lanes) refill(lane);
+  while (true) {
+    int active = 0;
+    for (Lane<K>& lane : lanes) {
+      while (lane.r != nullptr && AtLimit(lane, options)) refill(lane);
+      active += lane.r != nullptr ? 1 : 0;
+    }
+    if (active == 0) return;
+    Attempt<K, L>(lanes);
+    for (Lane<K>& lane : lanes) {
+      if (lane.r != nullptr && Finish(lane, options)) refill(lane);
+    }
+  }
+}
+
+Kind KindOf(const AeroOptions& aero) {
+  switch (aero.model) {
+    case AeroModel::kVacuum: return Kind::kVacuum;
+    case AeroModel::kSawicki2003: return Kind::kSawicki;
+    case AeroModel::kCustom:
+      return aero.lift_law == LiftLaw::kLinear ? Kind::kLinear : Kind::kSaturating;
+    case AeroModel::kNathan2016: break;
+  }
+  return Kind::kSaturating;
+}
+
+// Calls f(std::integral_constant<Kind, kind>()): the stepper compiled for each kind.
+template <class F>
+void WithKind(Kind kind, const F& f) {
+  switch (kind) {
+    case Kind::kVacuum: f(std::integral_constant<Kind, Kind::kVacuum>()); return;
+    case Kind::kSawicki: f(std::integral_constant<Kind, Kind::kSawicki>()); return;
+    case Kind::kSaturating: f(std::integral_constant<Kind, Kind::kSaturating>()); return;
+    case Kind::kLinear: f(std::integral_constant<Kind, Kind::kLinear>()); return;
+  }
 }
 
 }  // namespace
@@ -315,259 +743,36 @@ FlightResult Fly(const Launch& launch, const Environment& environment, const Aer
                  const FlightOptions& options, std::vector<TrajectoryPoint>* trajectory) {
   FlightResult r;
   if (trajectory != nullptr) trajectory->clear();
-  {
-    Refusal why;
-    Refusal* out = &why;
-    if (!PrefixOnFailure(out, "launch.", launch.Validate(out)) ||
-        !PrefixOnFailure(out, "environment.", environment.Validate(out)) ||
-        !PrefixOnFailure(out, "aero.", aero.Validate(out)) ||
-        !PrefixOnFailure(out, "options.", options.Validate(out))) {
-      r.termination = FlightTermination::kInvalidInput;
-      r.refusal = std::move(why);
-      return r;
-    }
-  }
+  WithKind(KindOf(aero), [&](auto kind) {
+    constexpr Kind K = decltype(kind)::value;
+    FlyLanes<K, 1>(1, options, [&](std::size_t, Lane<K>* lane) {
+      return Start<K>(launch, environment, aero, options, &r, trajectory, lane);
+    });
+  });
+  return r;
+}
 
-  // The spin and its axis (the calculator's cells D10-D12, gyrospin 0).
-  if (launch.backspin_rpm) {
-    r.spin = {*launch.backspin_rpm, *launch.sidespin_rpm};
-    r.spin_source = SpinSource::kGiven;
-  } else {
-    r.spin = EstimateSpin(launch.launch_angle_deg, launch.spray_angle_deg, launch.batter_hand);
-    r.spin_source = SpinSource::kStatcastRelation;
-  }
-  r.classification = Classify(launch.exit_speed_mps, launch.launch_angle_deg);
-  r.air_density_kg_m3 = aero.model == AeroModel::kVacuum ? 0.0 : AirDensityKgM3(environment);
-
-  const double th = launch.launch_angle_deg * kDegToRad, ph = launch.spray_angle_deg * kDegToRad;
-  const double sth = std::sin(th), cth = std::cos(th), sph = std::sin(ph), cph = std::cos(ph);
-  Model m;
-  m.air = aero.model != AeroModel::kVacuum;
-  m.model = aero.model;
-  const double wb = r.spin.backspin_rpm, ws = r.spin.sidespin_rpm;
-  const double wx = (wb * cph - ws * sth * sph) * kRpmToRadS;
-  const double wy = (-wb * sph - ws * sth * cph) * kRpmToRadS;
-  const double wz = ws * cth * kRpmToRadS;
-  m.omega_rad_s = std::sqrt(wx * wx + wy * wy + wz * wz);
-  if (m.omega_rad_s > 0.0) {
-    m.ux = wx / m.omega_rad_s;
-    m.uy = wy / m.omega_rad_s;
-    m.uz = wz / m.omega_rad_s;
-  }
-  m.spin_krpm = std::hypot(wb, ws) / 1000.0;
-  m.radius_m = aero.ball_circumference_m / (2.0 * kPi);
-  const double area_m2 = kPi * m.radius_m * m.radius_m;
-  const double rho = r.air_density_kg_m3;
-  switch (aero.model) {
-    case AeroModel::kNathan2016:
-      m.k_per_m = kNathanC0PerDensity * rho * (kNathanMassKg / aero.ball_mass_kg) *
-                  std::pow(aero.ball_circumference_m / kNathanCircumferenceM, 2);
-      m.cd0 = 0.3008;
-      m.cd_spin = 0.0292;
-      m.lift = LiftLaw::kSaturating;
-      m.cl0 = 0.583;
-      m.cl1 = 2.333;
-      m.cl2 = 1.120;
-      m.decay = true;
-      break;
-    case AeroModel::kCustom:
-      m.k_per_m = 0.5 * rho * area_m2 / aero.ball_mass_kg;
-      m.cd0 = aero.cd0;
-      m.cd_spin = aero.cd_spin_per_krpm;
-      m.lift = aero.lift_law;
-      m.cl0 = aero.cl0;
-      m.cl1 = aero.cl1;
-      m.cl2 = aero.cl2;
-      m.cl_slope = aero.cl_per_spin_factor;
-      m.decay = true;
-      break;
-    case AeroModel::kSawicki2003:
-      m.k_per_m = 0.5 * rho * area_m2 / aero.ball_mass_kg;
-      m.decay = false;
-      break;
-    case AeroModel::kVacuum:
-      m.decay = false;
-      break;
-  }
-  m.decay_rate_per_m = 1.0 / (aero.spin_decay_s * kDecayReferenceSpeedMps);
-  m.Prepare();
-  const double wind_dir = environment.wind.direction_deg * kDegToRad;
-  m.wind_x = environment.wind.speed_mps * std::sin(wind_dir);
-  m.wind_y = environment.wind.speed_mps * std::cos(wind_dir);
-
-  const double v0 = launch.exit_speed_mps;
-  State y{launch.start_x_m, launch.start_y_m, launch.height_m,
-          v0 * cth * sph,   v0 * cth * cph,   v0 * sth};
-  double t = 0.0;
-  r.apex_m = y.z;
-  r.apex_time_s = 0.0;
-
-  const double rtol = options.relative_tolerance, atol = options.absolute_tolerance_m;
-  // The first step: about 1/100 of a flight's scale, refined by the controller.
-  double h = std::min(0.05, std::pow(rtol, 0.2) * 0.5);
-  State k1 = Derivative(m, t, y);
-  r.evaluations = 1;
-  long long next_sample = 1;  // the next sample is at next_sample · trajectory_interval_s
-  if (trajectory != nullptr) trajectory->push_back(Sample(0.0, y));
-  // The error estimate: the local position errors, plus each step's local velocity error
-  // carried to the landing (δv · (T − t_i), T the hang time): Σ|δx_i| + T·Σ|δv_i| − Σ|δv_i|·t_i.
-  double error_sum = 0.0, velocity_error_sum = 0.0, velocity_error_time_sum = 0.0;
-  // PI controller memory (Hairer's DOPRI5 "facold", 1e-4 at first), kept as its logarithm: the
-  // controller's err^0.17 · facold^−0.04 is one exp of logarithms (two pow calls cost more).
-  double log_previous_error_ratio = std::log(1e-4);
-
-  while (true) {
-    // Rejected steps count too: a step size shrinking forever must end as well.
-    const bool step_limit = r.steps + r.rejected_steps >= options.max_steps;
-    if (step_limit || t >= options.max_flight_time_s) {
-      r.termination = step_limit ? FlightTermination::kStepLimit : FlightTermination::kTimeLimit;
-      r.error_estimate_m =  // of the flight so far
-          error_sum + t * velocity_error_sum - velocity_error_time_sum;
-      return r;
-    }
-    h = std::min(h, options.max_flight_time_s - t);
-    const State k2 = Derivative(m, t + c2 * h, Axpy(y, h * a21, k1));
-    State s3 = y;
-    {
-      const double* a = Array(y);
-      const double* p1 = Array(k1);
-      const double* p2 = Array(k2);
-      double* o = &s3.x;
-      for (int i = 0; i < 6; ++i) o[i] = a[i] + h * (a31 * p1[i] + a32 * p2[i]);
-    }
-    const State k3 = Derivative(m, t + c3 * h, s3);
-    State s4 = y, s5 = y, s6 = y, y_new = y;
-    const double* a = Array(y);
-    const double* p1 = Array(k1);
-    const double* p2 = Array(k2);
-    const double* p3 = Array(k3);
-    for (int i = 0; i < 6; ++i) (&s4.x)[i] = a[i] + h * (a41 * p1[i] + a42 * p2[i] + a43 * p3[i]);
-    const State k4 = Derivative(m, t + c4 * h, s4);
-    const double* p4 = Array(k4);
-    for (int i = 0; i < 6; ++i) {
-      (&s5.x)[i] = a[i] + h * (a51 * p1[i] + a52 * p2[i] + a53 * p3[i] + a54 * p4[i]);
-    }
-    const State k5 = Derivative(m, t + c5 * h, s5);
-    const double* p5 = Array(k5);
-    for (int i = 0; i < 6; ++i) {
-      (&s6.x)[i] =
-          a[i] + h * (a61 * p1[i] + a62 * p2[i] + a63 * p3[i] + a64 * p4[i] + a65 * p5[i]);
-    }
-    const State k6 = Derivative(m, t + h, s6);
-    const double* p6 = Array(k6);
-    for (int i = 0; i < 6; ++i) {
-      (&y_new.x)[i] =
-          a[i] + h * (a71 * p1[i] + a73 * p3[i] + a74 * p4[i] + a75 * p5[i] + a76 * p6[i]);
-    }
-    const State k7 = Derivative(m, t + h, y_new);
-    const double* p7 = Array(k7);
-    r.evaluations += 6;
-
-    // The local error (5th − 4th order), scaled per component; position's error kept in m.
-    double err2 = 0.0, position_err2 = 0.0, velocity_err2 = 0.0;
-    bool finite = true;
-    for (int i = 0; i < 6; ++i) {
-      const double e = h * (e1 * p1[i] + e3 * p3[i] + e4 * p4[i] + e5 * p5[i] + e6 * p6[i] +
-                            e7 * p7[i]);
-      const double yn = (&y_new.x)[i];
-      finite = finite && Finite(yn) && Finite(e);
-      const double scale = atol + rtol * std::max(std::abs(a[i]), std::abs(yn));
-      err2 += (e / scale) * (e / scale);
-      (i < 3 ? position_err2 : velocity_err2) += e * e;
-    }
-    if (!finite) {
-      if (h > 1e-9) {  // a too-long step can overflow: retry shorter before giving up
-        h *= 0.1;
-        ++r.rejected_steps;
-        continue;
-      }
-      r.termination = FlightTermination::kNonFinite;
-      return r;
-    }
-    const double err = std::sqrt(err2 / 6.0);
-    const double log_err = std::log(err);  // −inf for a zero error: the clamps below hold
-    if (err > 1.0) {
-      h *= std::max(0.2, 0.9 * std::exp(-0.2 * log_err));
-      ++r.rejected_steps;
-      continue;
-    }
-
-    // Accepted: the dense output of [t, t + h].
-    ++r.steps;
-    error_sum += std::sqrt(position_err2);
-    const double velocity_error = std::sqrt(velocity_err2);
-    velocity_error_sum += velocity_error;
-    velocity_error_time_sum += velocity_error * (t + h);
-    Dense dense;
-    for (int i = 0; i < 6; ++i) {
-      const double diff = (&y_new.x)[i] - a[i];
-      const double bspl = h * p1[i] - diff;
-      dense.r1[i] = a[i];
-      dense.r2[i] = diff;
-      dense.r3[i] = bspl;
-      dense.r4[i] = diff - h * p7[i] - bspl;
-      dense.r5[i] = h * (d1 * p1[i] + d3 * p3[i] + d4 * p4[i] + d5 * p5[i] + d6 * p6[i] +
-                         d7 * p7[i]);
-    }
-    // The apex: vz crosses zero going down.
-    if (y.vz > 0.0 && y_new.vz <= 0.0) {
-      const double theta = RootOf(dense, 5, y.vz, y_new.vz);
-      const double z = dense.Component(2, theta);
-      if (z > r.apex_m) {
-        r.apex_m = z;
-        r.apex_time_s = t + theta * h;
-      }
-    }
-    const bool lands = y_new.z <= 0.0 && y_new.vz < 0.0;
-    const double theta_land = lands ? RootOf(dense, 2, y.z, y_new.z) : 1.0;
-    const double t_end = t + theta_land * h;
-    if (trajectory != nullptr) {
-      for (double ts = next_sample * options.trajectory_interval_s; ts < t_end;
-           ts = ++next_sample * options.trajectory_interval_s) {
-        trajectory->push_back(Sample(ts, dense.At((ts - t) / h)));
-      }
-    }
-    if (lands) {
-      State landed = dense.At(theta_land);
-      landed.z = 0.0;
-      if (trajectory != nullptr) trajectory->push_back(Sample(t_end, landed));
-      r.termination = FlightTermination::kLanded;
-      r.hang_time_s = t_end;
-      r.landing_x_m = landed.x;
-      r.landing_y_m = landed.y;
-      r.distance_m = std::hypot(landed.x, landed.y);
-      r.bearing_deg = std::atan2(landed.x, landed.y) / kDegToRad;
-      r.landing_speed_mps = GroundSpeed(landed);
-      r.landing_angle_deg =
-          std::atan2(-landed.vz, std::hypot(landed.vx, landed.vy)) / kDegToRad;
-      // The landing is read from the step's 4th-order interpolant: its error is estimated by
-      // the cubic Hermite interpolant's difference from it at the landing, moved onto the
-      // ground along the path (a height error dz shifts the landing by v_h·dz/v_z).
-      const double u = theta_land, u2 = u * u, u3 = u2 * u;
-      const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u;
-      const double h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
-      double d[3];
-      for (int i = 0; i < 3; ++i) {
-        const double cubic = h00 * a[i] + h10 * h * p1[i] + h01 * (&y_new.x)[i] + h11 * h * p7[i];
-        d[i] = cubic - dense.Component(i, u);
-      }
-      const double shift = landed.vz < 0.0 ? d[2] / landed.vz : 0.0;
-      const double interpolation_error =
-          std::hypot(d[0] - landed.vx * shift, d[1] - landed.vy * shift);
-      r.error_estimate_m = error_sum + t_end * velocity_error_sum - velocity_error_time_sum +
-                           interpolation_error;
-      return r;
-    }
-    y = y_new;
-    k1 = k7;  // first same as last
-    t += h;
-    // Step-size control (Hairer's DOPRI5: PI control with β = 0.04).
-    // fac = max(err, 1e-10)^0.17 · facold^−0.04, facold = max(err, 1e-4) of the last step.
-    const double fac = std::exp((0.2 - 0.04 * 0.75) * std::max(log_err, kLogMinError) -
-                                0.04 * log_previous_error_ratio);
-    log_previous_error_ratio = std::max(log_err, kLogMinErrorMemory);
-    h = h * std::clamp(0.9 / fac, 0.2, 10.0);
-  }
+void FlyMany(std::size_t count, const Launch* launches, const Environment* environments,
+             bool shared_environment, const AeroOptions& aero, const FlightOptions& options,
+             FlightResult* results) {
+  // What all the flights share is checked once (and the shared air's density computed once);
+  // when it is refused, each flight is checked in full, as Fly would (a launch's own refusal
+  // comes first).
+  const bool shared_valid = count > 0 && aero.Validate(nullptr) && options.Validate(nullptr) &&
+                            (!shared_environment || environments[0].Validate(nullptr));
+  double density = 0.0;
+  if (shared_valid && shared_environment) density = AirDensityKgM3(environments[0]);
+  WithKind(KindOf(aero), [&](auto kind) {
+    constexpr Kind K = decltype(kind)::value;
+    FlyLanes<K, kFlyManyLanes>(count, options, [&](std::size_t i, Lane<K>* lane) {
+      results[i] = FlightResult();
+      const Environment& environment = environments[shared_environment ? 0 : i];
+      bool checked = shared_valid;
+      if (checked && !shared_environment) checked = environment.Validate(nullptr);
+      return Start<K>(launches[i], environment, aero, options, &results[i], nullptr, lane,
+                      checked, shared_valid && shared_environment ? &density : nullptr);
+    });
+  });
 }
 
 }  // namespace sweetspot::core::flight

@@ -9,6 +9,7 @@
 // The equations, the aero models and their sources: docs/flight.md.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <vector>
 
@@ -152,7 +153,8 @@ struct AeroOptions {
   bool Validate(Refusal* why) const;
 };
 
-/// The integrator's settings (an adaptive Dormand–Prince 5(4) with dense output).
+/// The integrator's settings (an adaptive Dormand–Prince 5(4) with dense output; the first step
+/// min(0.5 s, 5·relative_tolerance^0.2 s), then PI step control).
 struct FlightOptions {
   /// Relative tolerance of a step's local error. The default keeps the distance within
   /// 0.1 ft (3 cm) of a converged answer (docs/speed-vs-error.md). In [1e-13, 1e-2].
@@ -251,7 +253,7 @@ struct FlightResult {
   /// summed over the accepted steps, plus each step's local velocity error carried to the
   /// landing, plus the landing interpolant's error (a cubic Hermite against the 4th-order dense
   /// output). An estimate, not a bound: measured over a grid of launches the error was at most
-  /// 3.6 times it (nathan-2016, custom; tests/core/flight_test.cpp); sawicki-2003's lift law
+  /// 1.6 times it (nathan-2016, custom; tests/core/flight_test.cpp); sawicki-2003's lift law
   /// has a kink it cannot see.
   double error_estimate_m = 0.0;
   int steps = 0;           ///< Accepted steps.
@@ -282,5 +284,17 @@ inline constexpr double kMetresPerFoot = 0.3048;
 FlightResult Fly(const Launch& launch, const Environment& environment = {},
                  const AeroOptions& aero = {}, const FlightOptions& options = {},
                  std::vector<TrajectoryPoint>* trajectory = nullptr);
+
+/// How many flights FlyMany flies side by side (the stepper's lanes).
+inline constexpr int kFlyManyLanes = 4;
+
+/// Flies `count` launches, results[i] = Fly(launches[i], environments[shared_environment ? 0 :
+/// i], aero, options) to the bit (no trajectories), several side by side: one flight's stages
+/// wait on each other's square root and division, the lanes' do not, so a batch costs less
+/// per flight than single flights (docs/flight.md, "Where a flight's time goes"). `results`
+/// holds `count` elements; no allocation beyond a refusal's message; re-entrant.
+void FlyMany(std::size_t count, const Launch* launches, const Environment* environments,
+             bool shared_environment, const AeroOptions& aero, const FlightOptions& options,
+             FlightResult* results);
 
 }  // namespace sweetspot::core::flight
