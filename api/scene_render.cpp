@@ -53,16 +53,19 @@ Json SwingToJson(const core::Swing& swing) {
 }
 
 Json SummaryToJson(const core::Summary& s) {
-  return {{"termination", core::TerminationName(s.termination)},
-          {"message", s.message},
-          {"backend", s.backend},
-          {"raw_status", s.raw_status},
-          {"iterations", s.iterations},
-          {"evaluations", s.evaluations},
-          {"error_estimate", s.error_estimate},
-          {"solve_time_s", s.solve_time_s},
-          {"models_used", s.models_used},
-          {"warnings", s.warnings}};
+  // Member by member: an initializer list would wrap each pair in an array first.
+  Json out = Json::object();
+  out.emplace("termination", core::TerminationName(s.termination));
+  out.emplace("message", s.message);
+  out.emplace("backend", s.backend);
+  out.emplace("raw_status", s.raw_status);
+  out.emplace("iterations", s.iterations);
+  out.emplace("evaluations", s.evaluations);
+  out.emplace("error_estimate", s.error_estimate);
+  out.emplace("solve_time_s", s.solve_time_s);
+  out.emplace("models_used", s.models_used);
+  out.emplace("warnings", s.warnings);
+  return out;
 }
 
 Json BarrelOutputToJson(const core::BarrelOutput& b) {

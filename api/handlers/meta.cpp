@@ -1,7 +1,7 @@
 // Handlers that describe the service: health, version, OpenAPI, metrics,
 // and the shared request plumbing (body parsing, provenance).
+#include <cstddef>
 #include <cstdint>
-#include <cstdio>
 
 #include "api/handlers/handlers.hpp"
 #include "api/openapi_document.hpp"
@@ -56,21 +56,30 @@ std::string InputHash(const nlohmann::json& canonical_input) {
     hash ^= c;
     hash *= 1099511628211ULL;
   }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-  return std::string("fnv1a64:") + hex;
+  std::string out = "fnv1a64:0000000000000000";  // 16 hex digits, most significant first
+  static constexpr char kHex[] = "0123456789abcdef";
+  for (std::size_t i = out.size(); hash != 0; hash >>= 4) out[--i] = kHex[hash & 0xf];
+  return out;
 }
 
 nlohmann::json Provenance(const nlohmann::json& input, const nlohmann::json& options,
                           std::optional<unsigned long long> seed) {
-  nlohmann::json out{{"sweetspot_version", core::SweetspotVersion()},
-                     {"libraries",
-                      {{"eigen", core::EigenVersion()},
-                       {"nlopt", core::NloptVersion()},
-                       {"ipopt", core::IpoptVersion()}}},
-                     {"input_hash", InputHash(input)},
-                     {"options", options}};
-  out["seed"] = seed ? nlohmann::json(*seed) : nlohmann::json(nullptr);
+  // Built member by member (an initializer list wraps each pair in an array first); the
+  // versions are the process's, read once.
+  static const std::string sweetspot = core::SweetspotVersion();
+  static const std::string eigen = core::EigenVersion();
+  static const std::string nlopt = core::NloptVersion();
+  static const std::string ipopt = core::IpoptVersion();
+  nlohmann::json libraries = nlohmann::json::object();
+  libraries.emplace("eigen", eigen);
+  libraries.emplace("nlopt", nlopt);
+  libraries.emplace("ipopt", ipopt);
+  nlohmann::json out = nlohmann::json::object();
+  out.emplace("sweetspot_version", sweetspot);
+  out.emplace("libraries", std::move(libraries));
+  out.emplace("input_hash", InputHash(input));
+  out.emplace("options", options);
+  out.emplace("seed", seed ? nlohmann::json(*seed) : nlohmann::json(nullptr));
   return out;
 }
 
