@@ -14,9 +14,10 @@ using Json = nlohmann::json;
 }  // namespace
 
 Json SwingToJson(const core::Swing& swing) {
-  Json out{{"angular_speed_rad_s", swing.angular_speed_rad_s},
-           {"pivot_from_knob_m", swing.pivot_from_knob_m},
-           {"hands_from_knob_m", swing.hands_from_knob_m}};
+  Json out = Json::object();  // member by member: no initializer list's arrays
+  out.emplace("angular_speed_rad_s", swing.angular_speed_rad_s);
+  out.emplace("pivot_from_knob_m", swing.pivot_from_knob_m);
+  out.emplace("hands_from_knob_m", swing.hands_from_knob_m);
   if (swing.bat_speed_mps.has_value()) {
     out["bat_speed_mps"] = *swing.bat_speed_mps;
     out["bat_speed_from_tip_m"] = swing.bat_speed_from_tip_m;
