@@ -377,22 +377,25 @@ const char* InertiaModelName(core::InertiaModel model) {
 Json PropertiesToJson(const core::MassProperties& p, double length_m,
                       std::optional<double> pivot_from_knob_m) {
   const core::ImperialProperties imperial = core::ToImperial(p, length_m);
-  Json out{{"mass_kg", p.mass_kg},
-           {"balance_point_m", p.balance_point_m},
-           {"moi_knob_kg_m2", p.moi_knob_kg_m2},
-           {"moi_six_inch_kg_m2", p.MoiSixInchKgM2()},
-           {"moi_centroid_kg_m2", p.moi_centroid_kg_m2},
-           {"volume_m3", p.volume_m3},
-           {"length_m", length_m},
-           {"inertia_model", InertiaModelName(p.inertia_model)},
-           {"imperial",
-            {{"length_in", imperial.length_in},
-             {"weight_oz", imperial.weight_oz},
-             {"drop", imperial.drop},
-             {"balance_point_in", imperial.balance_point_in},
-             {"moi_knob_oz_in2", imperial.moi_knob_oz_in2},
-             {"moi_six_inch_oz_in2", imperial.moi_six_inch_oz_in2},
-             {"moi_centroid_oz_in2", imperial.moi_centroid_oz_in2}}}};
+  // Member by member: an initializer list would wrap each pair in an array first.
+  Json in_imperial = Json::object();
+  in_imperial.emplace("length_in", imperial.length_in);
+  in_imperial.emplace("weight_oz", imperial.weight_oz);
+  in_imperial.emplace("drop", imperial.drop);
+  in_imperial.emplace("balance_point_in", imperial.balance_point_in);
+  in_imperial.emplace("moi_knob_oz_in2", imperial.moi_knob_oz_in2);
+  in_imperial.emplace("moi_six_inch_oz_in2", imperial.moi_six_inch_oz_in2);
+  in_imperial.emplace("moi_centroid_oz_in2", imperial.moi_centroid_oz_in2);
+  Json out = Json::object();
+  out.emplace("mass_kg", p.mass_kg);
+  out.emplace("balance_point_m", p.balance_point_m);
+  out.emplace("moi_knob_kg_m2", p.moi_knob_kg_m2);
+  out.emplace("moi_six_inch_kg_m2", p.MoiSixInchKgM2());
+  out.emplace("moi_centroid_kg_m2", p.moi_centroid_kg_m2);
+  out.emplace("volume_m3", p.volume_m3);
+  out.emplace("length_m", length_m);
+  out.emplace("inertia_model", InertiaModelName(p.inertia_model));
+  out.emplace("imperial", std::move(in_imperial));
   if (pivot_from_knob_m) {
     out["pivot_from_knob_m"] = *pivot_from_knob_m;
     out["moi_pivot_kg_m2"] = p.MoiAboutKgM2(*pivot_from_knob_m);

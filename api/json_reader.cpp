@@ -331,15 +331,30 @@ ObjectReader::ObjectReader(const nlohmann::json& value, std::string path, ApiErr
   }
 }
 
+bool ObjectReader::HasTradeSpelling() const {
+  // Once per object (SiFormsOf allocates nothing for a key that is no trade spelling): a plain
+  // request's every absent field would otherwise build its TradeForms and look them up.
+  if (has_trade_spelling_ < 0) {
+    has_trade_spelling_ = 0;
+    for (const auto& item : value_->items()) {
+      if (!SiFormsOf(item.key()).empty()) {
+        has_trade_spelling_ = 1;
+        break;
+      }
+    }
+  }
+  return has_trade_spelling_ == 1;
+}
+
 bool ObjectReader::Has(std::string_view key) {
   if (!value_->is_object()) return false;
-  known_.insert(std::string(key));
+  if (known_.find(key) == known_.end()) known_.emplace(key);
   return value_->contains(key);
 }
 
 const nlohmann::json* ObjectReader::Get(std::string_view key) {
   if (!Has(key)) return nullptr;
-  return &(*value_)[std::string(key)];
+  return &*value_->find(key);
 }
 
 bool ObjectReader::Fail(std::string_view key, const std::string& rule, ErrorCode code) {
@@ -372,7 +387,7 @@ const nlohmann::json* ObjectReader::GetInUnits(std::string_view key, std::string
   *given_as = std::string(key);
   *to_si = 1.0;
   const nlohmann::json* found = Get(key);
-  if (!value_->is_object()) return found;
+  if (!value_->is_object() || !HasTradeSpelling()) return found;
   for (const TradeForm& form : TradeForms(key)) {
     if (!value_->contains(form.key)) continue;
     known_.insert(form.key);
@@ -392,6 +407,7 @@ const nlohmann::json* ObjectReader::GetInUnits(std::string_view key, std::string
 bool ObjectReader::HasInUnits(std::string_view key) const {
   if (!value_->is_object()) return false;
   if (value_->contains(key)) return true;
+  if (!HasTradeSpelling()) return false;
   for (const TradeForm& form : TradeForms(key)) {
     if (value_->contains(form.key)) return true;
   }

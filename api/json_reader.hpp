@@ -121,7 +121,9 @@ class ObjectReader {
   /// An optional boolean; `*out` untouched when absent.
   bool OptionalBool(std::string_view key, bool* out);
   /// Marks `key` as read without reading it (the caller reads it itself).
-  void Skip(std::string_view key) { known_.insert(std::string(key)); }
+  void Skip(std::string_view key) {
+    if (known_.find(key) == known_.end()) known_.emplace(key);
+  }
   /// Records an error about `key` with `rule`, quoting its value.
   bool Fail(std::string_view key, const std::string& rule,
             ErrorCode code = ErrorCode::kInvalidValue);
@@ -135,6 +137,10 @@ class ObjectReader {
   std::string path_;
   ApiError* error_;
   std::set<std::string, std::less<>> known_;
+  // Whether some key of the object is a trade spelling (SiFormsOf): -1 until first needed.
+  // Without one, no field's TradeForms need be built and looked up.
+  mutable int has_trade_spelling_ = -1;
+  bool HasTradeSpelling() const;
 };
 
 /// The request's name of a core field: core's name except where the request names it

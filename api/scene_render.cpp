@@ -14,9 +14,10 @@ using Json = nlohmann::json;
 }  // namespace
 
 Json SwingToJson(const core::Swing& swing) {
-  Json out{{"angular_speed_rad_s", swing.angular_speed_rad_s},
-           {"pivot_from_knob_m", swing.pivot_from_knob_m},
-           {"hands_from_knob_m", swing.hands_from_knob_m}};
+  Json out = Json::object();  // member by member: no initializer list's arrays
+  out.emplace("angular_speed_rad_s", swing.angular_speed_rad_s);
+  out.emplace("pivot_from_knob_m", swing.pivot_from_knob_m);
+  out.emplace("hands_from_knob_m", swing.hands_from_knob_m);
   if (swing.bat_speed_mps.has_value()) {
     out["bat_speed_mps"] = *swing.bat_speed_mps;
     out["bat_speed_from_tip_m"] = swing.bat_speed_from_tip_m;
@@ -53,16 +54,19 @@ Json SwingToJson(const core::Swing& swing) {
 }
 
 Json SummaryToJson(const core::Summary& s) {
-  return {{"termination", core::TerminationName(s.termination)},
-          {"message", s.message},
-          {"backend", s.backend},
-          {"raw_status", s.raw_status},
-          {"iterations", s.iterations},
-          {"evaluations", s.evaluations},
-          {"error_estimate", s.error_estimate},
-          {"solve_time_s", s.solve_time_s},
-          {"models_used", s.models_used},
-          {"warnings", s.warnings}};
+  // Member by member: an initializer list would wrap each pair in an array first.
+  Json out = Json::object();
+  out.emplace("termination", core::TerminationName(s.termination));
+  out.emplace("message", s.message);
+  out.emplace("backend", s.backend);
+  out.emplace("raw_status", s.raw_status);
+  out.emplace("iterations", s.iterations);
+  out.emplace("evaluations", s.evaluations);
+  out.emplace("error_estimate", s.error_estimate);
+  out.emplace("solve_time_s", s.solve_time_s);
+  out.emplace("models_used", s.models_used);
+  out.emplace("warnings", s.warnings);
+  return out;
 }
 
 Json BarrelOutputToJson(const core::BarrelOutput& b) {

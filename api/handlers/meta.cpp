@@ -1,7 +1,8 @@
 // Handlers that describe the service: health, version, OpenAPI, metrics,
 // and the shared request plumbing (body parsing, provenance).
+#include <cstddef>
 #include <cstdint>
-#include <cstdio>
+#include <memory>
 
 #include "api/handlers/handlers.hpp"
 #include "api/openapi_document.hpp"
@@ -46,31 +47,62 @@ Response HandleVersion(const Request&, const Context&) {
   };
 }
 
+namespace {
+
+// FNV-1a 64 of the bytes nlohmann's serializer writes, taken as they are written (the dump
+// is never held as a string).
+class Fnv1a64Output : public nlohmann::detail::output_adapter_protocol<char> {
+ public:
+  void write_character(char c) override { Add(c); }
+  void write_characters(const char* s, std::size_t length) override {
+    for (std::size_t i = 0; i < length; ++i) Add(s[i]);
+  }
+  std::uint64_t hash() const { return hash_; }
+
+ private:
+  void Add(char c) {
+    hash_ ^= static_cast<unsigned char>(c);
+    hash_ *= 1099511628211ULL;
+  }
+  std::uint64_t hash_ = 1469598103934665603ULL;
+};
+
+}  // namespace
+
 std::string InputHash(const nlohmann::json& canonical_input) {
   // FNV-1a 64 over the compact dump (nlohmann objects keep keys sorted, so the
-  // dump is canonical). An identity key for reproduction, not a security hash.
-  const std::string text =
-      canonical_input.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  std::uint64_t hash = 1469598103934665603ULL;
-  for (const unsigned char c : text) {
-    hash ^= c;
-    hash *= 1099511628211ULL;
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-  return std::string("fnv1a64:") + hex;
+  // dump is canonical): dump(-1, ' ', false, replace)'s bytes, hashed as the serializer
+  // writes them. An identity key for reproduction, not a security hash.
+  const auto output = std::make_shared<Fnv1a64Output>();
+  nlohmann::detail::serializer<nlohmann::json> serializer(
+      output, ' ', nlohmann::json::error_handler_t::replace);
+  serializer.dump(canonical_input, /*pretty_print=*/false, /*ensure_ascii=*/false,
+                  /*indent_step=*/0);
+  std::uint64_t hash = output->hash();
+  std::string out = "fnv1a64:0000000000000000";  // 16 hex digits, most significant first
+  static constexpr char kHex[] = "0123456789abcdef";
+  for (std::size_t i = out.size(); hash != 0; hash >>= 4) out[--i] = kHex[hash & 0xf];
+  return out;
 }
 
 nlohmann::json Provenance(const nlohmann::json& input, const nlohmann::json& options,
                           std::optional<unsigned long long> seed) {
-  nlohmann::json out{{"sweetspot_version", core::SweetspotVersion()},
-                     {"libraries",
-                      {{"eigen", core::EigenVersion()},
-                       {"nlopt", core::NloptVersion()},
-                       {"ipopt", core::IpoptVersion()}}},
-                     {"input_hash", InputHash(input)},
-                     {"options", options}};
-  out["seed"] = seed ? nlohmann::json(*seed) : nlohmann::json(nullptr);
+  // Built member by member (an initializer list wraps each pair in an array first); the
+  // versions are the process's, read once.
+  static const std::string sweetspot = core::SweetspotVersion();
+  static const std::string eigen = core::EigenVersion();
+  static const std::string nlopt = core::NloptVersion();
+  static const std::string ipopt = core::IpoptVersion();
+  nlohmann::json libraries = nlohmann::json::object();
+  libraries.emplace("eigen", eigen);
+  libraries.emplace("nlopt", nlopt);
+  libraries.emplace("ipopt", ipopt);
+  nlohmann::json out = nlohmann::json::object();
+  out.emplace("sweetspot_version", sweetspot);
+  out.emplace("libraries", std::move(libraries));
+  out.emplace("input_hash", InputHash(input));
+  out.emplace("options", options);
+  out.emplace("seed", seed ? nlohmann::json(*seed) : nlohmann::json(nullptr));
   return out;
 }
 

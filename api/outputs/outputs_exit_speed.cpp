@@ -11,16 +11,20 @@ using Json = nlohmann::json;
 
 void RenderMaxExitSpeed(const core::SceneResult& r, Json* out, Json* errors) {
   const auto& m = *r.max_exit_speed;
-  Json block = {{"position_from_knob_m", m.position_from_knob_m},
-                {"exit_speed_mps", m.exit_speed_mps},
-                {"placement", core::PlacementName(m.placement)},
-                {"unconstrained_position_from_knob_m", m.unconstrained_position_from_knob_m},
-                {"model", m.model},
-                {"method", m.method}};
-  if (m.method != "closed_form") block["summary"] = SummaryToJson(m.summary);
+  // Member by member: an initializer list would wrap each pair in an array first.
+  Json block = Json::object();
+  block.emplace("position_from_knob_m", m.position_from_knob_m);
+  block.emplace("exit_speed_mps", m.exit_speed_mps);
+  block.emplace("placement", core::PlacementName(m.placement));
+  block.emplace("unconstrained_position_from_knob_m", m.unconstrained_position_from_knob_m);
+  block.emplace("model", m.model);
+  block.emplace("method", m.method);
+  if (m.method != "closed_form") block.emplace("summary", SummaryToJson(m.summary));
   (*out)["max_exit_speed"] = std::move(block);
-  (*errors)["max_exit_speed"] = {{"position_m", m.error_estimate_m},
-                                 {"exit_speed_mps", m.error_estimate_mps}};
+  Json error = Json::object();
+  error.emplace("position_m", m.error_estimate_m);
+  error.emplace("exit_speed_mps", m.error_estimate_mps);
+  (*errors)["max_exit_speed"] = std::move(error);
 }
 
 void ProbeMaxExitSpeed(core::SceneResult* r) {

@@ -88,7 +88,11 @@ Json SceneResultToJson(const core::SceneResult& r) {
   }
   Json timings = Json::array();
   for (const auto& t : r.timings) {
-    timings.push_back({{"model", t.model}, {"time_s", t.time_s}, {"calls", t.calls}});
+    Json timing = Json::object();  // member by member: no initializer list's arrays
+    timing.emplace("model", t.model);
+    timing.emplace("time_s", t.time_s);
+    timing.emplace("calls", t.calls);
+    timings.push_back(std::move(timing));
   }
   out["timings"] = std::move(timings);
   if (!r.summary.warnings.empty()) out["warnings"] = r.summary.warnings;

@@ -1,0 +1,106 @@
+#!/usr/bin/env bash
+# CPU time per request of the server and of the load generator, for sweetspot-server's
+# example POST /v1/sweet-spot and for Debian's nginx serving the same answer as a static file
+# (as bench/http_bench.sh), each under `wrk -t2 -c8` for SECONDS after a 1 s warm-up: the
+# server's user + system time from /proc/PID/stat (nginx's workers summed), wrk's from
+# /usr/bin/time. With both on the same saturated cores the ratio of the rates tends to the
+# inverse ratio of the sums (server + wrk), which moves far less with the machine's load
+# than the rates do.
+#
+#   bench/cpu_vs_nginx.sh [SERVER_BINARY] [SECONDS]
+#
+# Prints one line per server: requests/s, server and wrk microseconds per request, their sum;
+# then the ratio of the rates and of the sums, and the load average.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+server="${1:-build/server/sweetspot-server}"
+seconds="${2:-5}"
+[ -x /usr/sbin/nginx ] || { echo "cpu_vs_nginx.sh: needs nginx (scripts/install-deps.sh)" >&2; exit 1; }
+work="$(mktemp -d)"
+chmod 755 "$work"  # nginx's workers run as an unprivileged user
+pid=""
+nginx_pid=""
+cleanup() {
+  if [ -n "$pid" ]; then kill "$pid" 2>/dev/null || true; wait "$pid" 2>/dev/null || true; fi
+  if [ -n "$nginx_pid" ]; then kill -QUIT "$nginx_pid" 2>/dev/null || true; wait "$nginx_pid" 2>/dev/null || true; fi
+  rm -rf "$work"
+}
+trap cleanup EXIT
+body='{"bat": {"preset": "paper-wood"}, "ball": {"mass_kg": 0.145, "radius_m": 0.0366, "speed_mps": 27.7}, "swing": {"angular_speed_rad_s": 17.288, "pivot_from_knob_m": 0.0, "hands_from_knob_m": 0.1524}, "cor": 0.5, "outputs": ["max_exit_speed"]}'
+cat >"$work/post.lua" <<LUA
+wrk.method = "POST"
+wrk.headers["Content-Type"] = "application/json"
+wrk.body = '$body'
+LUA
+: >"$work/get.lua"
+"$server" --port 0 --access-log 0 --max-connections-per-client 256 --jobs-db none \
+  2>"$work/server.log" &
+pid=$!
+port=""
+for _ in $(seq 100); do
+  port="$(sed -n 's/.* listening on [^:]*:\([0-9]*\) .*/\1/p' "$work/server.log" | head -n1)"
+  [ -n "$port" ] && break
+  sleep 0.1
+done
+[ -n "$port" ] || { echo "cpu_vs_nginx.sh: no port in the server's log" >&2; cat "$work/server.log" >&2; exit 1; }
+url="http://127.0.0.1:$port/v1/sweet-spot"
+mkdir -p "$work/html"
+curl -sS -X POST -H 'Content-Type: application/json' -d "$body" "$url" >"$work/html/sweet-spot.json"
+nginx_port=""
+while [ -z "$nginx_port" ]; do  # a loopback port nobody listens on
+  candidate=$(( 20000 + RANDOM % 20000 ))
+  (echo >"/dev/tcp/127.0.0.1/$candidate") 2>/dev/null || nginx_port="$candidate"
+done
+cat >"$work/nginx.conf" <<CONF
+worker_processes auto;
+events { worker_connections 4096; }
+http {
+  access_log off;
+  keepalive_requests 100000;
+  client_body_temp_path $work/body;
+  proxy_temp_path $work/proxy;
+  fastcgi_temp_path $work/fastcgi;
+  uwsgi_temp_path $work/uwsgi;
+  scgi_temp_path $work/scgi;
+  server {
+    listen 127.0.0.1:$nginx_port;
+    root $work/html;
+    location / { default_type application/json; }
+  }
+}
+CONF
+/usr/sbin/nginx -p "$work" -c "$work/nginx.conf" \
+  -g "daemon off; pid $work/nginx.pid; error_log $work/nginx-error.log;" &
+nginx_pid=$!
+static_url="http://127.0.0.1:$nginx_port/sweet-spot.json"
+for _ in $(seq 100); do
+  curl -fsS "$static_url" >/dev/null 2>&1 && break
+  sleep 0.1
+done
+ticks() {
+  local total=0 p
+  for p in "$@"; do total=$((total + $(awk '{print $14 + $15}' "/proc/$p/stat"))); done
+  echo "$total"
+}
+# One measured run: prints "requests/s server_us wrk_us".
+measure() {
+  local target="$1" script="$2" before after out requests wrk_s
+  shift 2
+  wrk -t2 -c8 -d1s -s "$script" "$target" >/dev/null  # warm-up
+  before="$(ticks "$@")"
+  out="$({ /usr/bin/time -f "WRK_CPU %U %S" wrk -t2 -c8 -d"${seconds}s" -s "$script" "$target"; } 2>&1)"
+  after="$(ticks "$@")"
+  requests="$(echo "$out" | awk '/requests in/ {print $1}')"
+  wrk_s="$(echo "$out" | awk '/WRK_CPU/ {print $2 + $3}')"
+  awk -v r="$requests" -v t="$((after - before))" -v hz="$(getconf CLK_TCK)" -v w="$wrk_s" \
+      -v s="$seconds" 'BEGIN { printf "%.0f %.2f %.2f\n", r / s, 1e6 * t / hz / r, 1e6 * w / r }'
+}
+read -r s_rps s_us s_wrk <<<"$(measure "$url" "$work/post.lua" "$pid")"
+# shellcheck disable=SC2046
+read -r n_rps n_us n_wrk <<<"$(measure "$static_url" "$work/get.lua" $(pgrep -P "$nginx_pid"))"
+awk -v a="$s_rps" -v b="$s_us" -v c="$s_wrk" -v d="$n_rps" -v e="$n_us" -v f="$n_wrk" \
+    -v load="$(cut -d' ' -f1 /proc/loadavg)" 'BEGIN {
+  printf "sweetspot  requests/s %6d  server_us %6.2f  wrk_us %5.2f  sum %6.2f\n", a, b, c, b + c
+  printf "nginx      requests/s %6d  server_us %6.2f  wrk_us %5.2f  sum %6.2f\n", d, e, f, e + f
+  printf "rate ratio %.2f  inverse ratio of the sums %.2f  load %s\n", a / d, (e + f) / (b + c), load
+}'
