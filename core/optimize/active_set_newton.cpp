@@ -157,8 +157,9 @@ LocalSolveOutcome SolveWithActiveSetNewton(ScaledDesignNlp& nlp, const std::vect
         Eigen::VectorXd step;
         if (nw == nf) {
           // A vertex: the active constraints alone fix the point.
-          Eigen::FullPivLU<Eigen::MatrixXd> lu(j);
-          if (!lu.isInvertible()) return fail(Termination::kNoConvergence, "singular active set");
+          const Eigen::PartialPivLU<Eigen::MatrixXd> lu(j);
+          // rcond: LAPACK's estimate of 1 / cond_1; below 1e-12 the step carries nothing.
+          if (!(lu.rcond() > 1e-12)) return fail(Termination::kNoConvergence, "singular active set");
           step = -lu.solve(r);
           // The point is fixed; a vertex whose stationarity cannot vanish is the set's fault,
           // found by the multipliers below.

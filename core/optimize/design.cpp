@@ -10,6 +10,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -389,7 +390,7 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
                           Progress* progress, double progress_from, double progress_to,
                           std::optional<Clock::time_point> shared_deadline,
                           const design_detail::LocalSolver* solver, const char* solver_name,
-                          const design_detail::PreparedModel* prepared) {
+                          design_detail::PreparedModel* prepared) {
   const Clock::time_point start = Clock::now();
   const auto elapsed_s = [&start] {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -435,7 +436,7 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
   } else if (!design_detail::SlsqpSizeAllowed(problem, options, &why)) {
     invalid = true;
   } else if (prepared != nullptr) {
-    model = prepared->model;  // built and merged once by the caller
+    model = std::move(prepared->model);  // built and merged by the caller (moved from)
   } else if (!DesignModel::Build(problem, options, &model, &why)) {
     invalid = true;
   }
@@ -450,7 +451,7 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
   }
   // Constraints that repeat another are merged before the solve (certificate.hpp).
   result.merged_constraints = prepared != nullptr
-                                   ? prepared->merged
+                                   ? std::move(prepared->merged)
                                    : design_detail::MergeDuplicateConstraints(&model);
   const bool cor_known =
       problem.cor.has_value() || problem.bat.material.cor.has_value() || model.cor_from_barrel();
@@ -537,7 +538,7 @@ namespace design_detail {
 DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options,
                       Progress* progress, double progress_from, double progress_to,
                       std::optional<Clock::time_point> shared_deadline, const LocalSolver* solver,
-                      const char* solver_name, const PreparedModel* prepared) {
+                      const char* solver_name, PreparedModel* prepared) {
   if (!BbcorBoundOf(problem).has_value()) {
     return OptimizeOneRound(problem, options, progress, progress_from, progress_to, shared_deadline,
                             solver, solver_name, prepared);

@@ -96,11 +96,11 @@ struct PreparedModel {
 /// `solver` (non-null), every start's local solve is solver's, the summary's backend
 /// `solver_name`; the rest (model, certificate, re-check, answer) is unchanged. With
 /// `prepared` (non-null; not with a BBCOR bound, whose rounds change the problem), its model
-/// is the one of `problem` (the caller's promise) and is not built again.
+/// is the one of `problem` (the caller's promise), moved from instead of built again.
 DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options,
                       Progress* progress, double progress_from, double progress_to,
                       std::optional<Clock::time_point> shared_deadline,
                       const LocalSolver* solver = nullptr, const char* solver_name = nullptr,
-                      const PreparedModel* prepared = nullptr);
+                      PreparedModel* prepared = nullptr);
 
 }  // namespace sweetspot::core::design_detail
