@@ -118,6 +118,36 @@ TEST(ActiveSetNewtonTest, ChangesTheActiveSetWhereTheOptimumChangesIt) {
   EXPECT_NEAR(step.objective, independent.objective_value, 1e-9 * independent.objective_value);
 }
 
+TEST(ActiveSetNewtonTest, AWrongGuessIsDeclinedNotAnsweredWrongly) {
+  // The neighbour's set without its last inequality (a taper constraint): 13 held for 14
+  // variables, so the step takes the Lagrangian's Hessian; on this problem its curvature in the
+  // freed direction sends Newton out of the box, and the step declines (the frontier then runs
+  // SLSQP). It must never report convergence at another point.
+  const DesignResult from = OptimizeDesign(SixteenKnotProblem(0.0), Slsqp());
+  ASSERT_TRUE(from.certificate.certified);
+  ActiveSetGuess guess = GuessFromMultipliers(from.certificate.lambda, from.certificate.z_lower,
+                                              from.certificate.z_upper);
+  DesignModel model;
+  ASSERT_TRUE(DesignModel::Build(SixteenKnotProblem(0.2), Slsqp(), &model, nullptr));
+  int dropped = -1;
+  for (int k = model.m() - 1; k >= 0 && dropped < 0; --k) {
+    const DesignConstraintSpec& c = model.constraints()[static_cast<std::size_t>(k)];
+    if (guess.constraint_side[static_cast<std::size_t>(k)] != 0.0 && c.lower != c.upper) {
+      guess.constraint_side[static_cast<std::size_t>(k)] = 0.0;
+      dropped = k;
+    }
+  }
+  ASSERT_GE(dropped, 0);
+  const Step step = StepFrom(0.0, 0.2, &guess);
+  if (step.outcome.termination == Termination::kConverged) {
+    const DesignResult independent = OptimizeDesign(SixteenKnotProblem(0.2), Slsqp());
+    EXPECT_NEAR(step.objective, independent.objective_value, 1e-9 * independent.objective_value);
+  } else {
+    EXPECT_EQ(step.outcome.termination, Termination::kNoConvergence) << step.outcome.message;
+    EXPECT_FALSE(step.outcome.has_multipliers);
+  }
+}
+
 TEST(ActiveSetNewtonTest, RefusesAGuessThatDoesNotFit) {
   ActiveSetGuess wrong;
   wrong.constraint_side = {1.0};
