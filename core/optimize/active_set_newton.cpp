@@ -130,7 +130,8 @@ LocalSolveOutcome SolveWithActiveSetNewton(ScaledDesignNlp& nlp, const std::vect
         const Working w = WorkingOf(side, fixed);
         const auto nw = static_cast<Eigen::Index>(w.rows.size());
         const auto nf = static_cast<Eigen::Index>(w.cols.size());
-        if (nw > nf) return fail(Termination::kNoConvergence, "more active constraints than free variables");
+        if (nw > nf)
+          return fail(Termination::kNoConvergence, "more active constraints than free variables");
         const Eigen::MatrixXd j = JacobianOf(nlp, w);
         Eigen::VectorXd r(nw), grad_f(nf);
         for (Eigen::Index a = 0; a < nw; ++a)
@@ -159,7 +160,8 @@ LocalSolveOutcome SolveWithActiveSetNewton(ScaledDesignNlp& nlp, const std::vect
           // A vertex: the active constraints alone fix the point.
           const Eigen::PartialPivLU<Eigen::MatrixXd> lu(j);
           // rcond: LAPACK's estimate of 1 / cond_1; below 1e-12 the step carries nothing.
-          if (!(lu.rcond() > 1e-12)) return fail(Termination::kNoConvergence, "singular active set");
+          if (!(lu.rcond() > 1e-12))
+            return fail(Termination::kNoConvergence, "singular active set");
           step = -lu.solve(r);
           // The point is fixed; a vertex whose stationarity cannot vanish is the set's fault,
           // found by the multipliers below.
@@ -177,7 +179,8 @@ LocalSolveOutcome SolveWithActiveSetNewton(ScaledDesignNlp& nlp, const std::vect
           Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(nf + nw, nf + nw);
           for (Eigen::Index a = 0; a < nf; ++a)
             for (Eigen::Index b = 0; b < nf; ++b)
-              kkt(a, b) = h(w.cols[static_cast<std::size_t>(a)], w.cols[static_cast<std::size_t>(b)]);
+              kkt(a, b) =
+                  h(w.cols[static_cast<std::size_t>(a)], w.cols[static_cast<std::size_t>(b)]);
           kkt.block(0, nf, nf, nw) = j.transpose();
           kkt.block(nf, 0, nw, nf) = j;
           Eigen::VectorXd rhs(nf + nw);
@@ -188,13 +191,16 @@ LocalSolveOutcome SolveWithActiveSetNewton(ScaledDesignNlp& nlp, const std::vect
           step = lu.solve(rhs).head(nf);
         }
         if (!step.allFinite()) return fail(Termination::kNoConvergence, "no finite Newton step");
-        for (Eigen::Index b = 0; b < nf; ++b) s[static_cast<std::size_t>(w.cols[static_cast<std::size_t>(b)])] += step(b);
+        for (Eigen::Index b = 0; b < nf; ++b)
+          s[static_cast<std::size_t>(w.cols[static_cast<std::size_t>(b)])] += step(b);
         ++out.iterations;
         // Far outside the box: the guess was wrong, not a step to correct.
         for (std::size_t jj = 0; jj < nn; ++jj)
-          if (s[jj] < -0.5 || s[jj] > 1.5) return fail(Termination::kNoConvergence, "the Newton step left the box");
+          if (s[jj] < -0.5 || s[jj] > 1.5)
+            return fail(Termination::kNoConvergence, "the Newton step left the box");
       }
-      if (!settled) return fail(Termination::kNoConvergence, "Newton did not settle on the active set");
+      if (!settled)
+        return fail(Termination::kNoConvergence, "Newton did not settle on the active set");
 
       // Is the working set the active set? Primal: a bound or constraint left out is violated;
       // dual: a multiplier has the wrong sign.
@@ -330,8 +336,8 @@ LocalSolveOutcome SolveWithActiveSetNewton(ScaledDesignNlp& nlp, const std::vect
           a.col(c++) = column(added);
           const Eigen::MatrixXd sq = a.leftCols(c);
           const Eigen::VectorXd mu_new = sq.colPivHouseholderQr().solve(-nlp.grad_f());
-          if (!mu_new.allFinite() || (sq * mu_new + nlp.grad_f()).lpNorm<Eigen::Infinity>() >
-                                         1e-6 * g_norm) {
+          if (!mu_new.allFinite() ||
+              (sq * mu_new + nlp.grad_f()).lpNorm<Eigen::Infinity>() > 1e-6 * g_norm) {
             continue;  // the set without it cannot be stationary here
           }
           double least = std::numeric_limits<double>::infinity();

@@ -39,7 +39,8 @@ LocalSolveOutcome WithCertifiedMultipliers(const DesignModel& model, const Desig
                                            const std::vector<double>& x, const LocalSolveOutcome& o,
                                            DesignResult* result, const Run* chosen) {
   const bool cached = chosen != nullptr && chosen->certificate.has_value() && chosen->x == x;
-  result->certificate = cached ? *chosen->certificate : Certify(model, x, TolerancesFrom(options), true);
+  result->certificate =
+      cached ? *chosen->certificate : Certify(model, x, TolerancesFrom(options), true);
   LocalSolveOutcome out = o;
   const DesignCertificate& c = result->certificate;
   if (!c.checked) return out;

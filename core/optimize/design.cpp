@@ -398,7 +398,8 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
   DesignResult result;
   Summary& summary = result.summary;
   const DesignBackend backend = MainBackend(problem, options);
-  summary.backend = solver != nullptr && solver_name != nullptr ? solver_name : BackendName(backend);
+  summary.backend =
+      solver != nullptr && solver_name != nullptr ? solver_name : BackendName(backend);
   summary.models_used = {"mass_properties"};
   if (problem.objective != DesignObjective::kMinMoi &&
       problem.objective != DesignObjective::kLeastSquares) {
@@ -509,10 +510,10 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
     const Run& chosen = runs[static_cast<std::size_t>(best)];
     ClassifyChosen(options, backend, chosen, pub, result.bat, &result);
     ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, &result);
-    ReportActiveConstraints(
-        model, x, design_detail::WithCertifiedMultipliers(model, options, x, chosen.outcome, &result,
-                                                   &chosen),
-        &result, options.feasibility_tolerance);
+    ReportActiveConstraints(model, x,
+                            design_detail::WithCertifiedMultipliers(
+                                model, options, x, chosen.outcome, &result, &chosen),
+                            &result, options.feasibility_tolerance);
     design_detail::FinishCertificate(chosen, &result);
     MarkCancelledMultiStart(options, runs, progress, &result);
     CheckBbcorRule(problem, pub, options.feasibility_tolerance, &result);

@@ -78,9 +78,8 @@ void FillSpread(const std::vector<Run>& runs, DesignSpread* spread_out);
 
 /// A local solve in place of the backend's (the frontier's continuation step, frontier.cpp):
 /// from s0 with the settings of the start.
-using LocalSolver = std::function<LocalSolveOutcome(ScaledDesignNlp& nlp,
-                                                    const std::vector<double>& s0,
-                                                    const LocalSolveSettings& settings)>;
+using LocalSolver = std::function<LocalSolveOutcome(
+    ScaledDesignNlp& nlp, const std::vector<double>& s0, const LocalSolveSettings& settings)>;
 
 /// A model built (DesignModel::Build) and merged (MergeDuplicateConstraints) once for several
 /// solves: the frontier's values (frontier.cpp), whose models differ only in the swept

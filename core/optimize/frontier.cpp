@@ -185,7 +185,7 @@ std::optional<FrontierModel> PrepareFrontierModel(const DesignProblem& problem,
 // Build would refuse the value (a limit outside (0, cap]): that value builds its own model.
 std::optional<design_detail::PreparedModel> PreparedAt(const FrontierModel& f,
                                                        const FrontierSpec& spec, double value) {
-  const double cap = spec.quantity == FrontierQuantity::kMassKg       ? kMaxDesignMassKg
+  const double cap = spec.quantity == FrontierQuantity::kMassKg          ? kMaxDesignMassKg
                      : spec.quantity == FrontierQuantity::kBalancePointM ? kMaxBatLengthM
                                                                          : kMaxDesignMoiKgM2;
   if (!(value > 0.0 && value <= cap)) return std::nullopt;
@@ -396,8 +396,7 @@ FrontierSummary OptimizeFrontier(const DesignProblem& problem, const FrontierSpe
                                                       const std::vector<double>& s0,
                                                       const LocalSolveSettings& settings) {
           const bool given = x_start.size() == static_cast<std::size_t>(nlp.n());
-          return SolveWithActiveSetNewton(nlp, given ? nlp.ToScaled(x_start) : s0, guess,
-                                          settings);
+          return SolveWithActiveSetNewton(nlp, given ? nlp.ToScaled(x_start) : s0, guess, settings);
         };
         DesignOptions step = options;
         step.choose_backend = false;
@@ -406,8 +405,8 @@ FrontierSummary OptimizeFrontier(const DesignProblem& problem, const FrontierSpe
         step.explain_infeasibility = false;  // a failed step is solved again below
         point.result = prepared.has_value()
                            ? design_detail::Optimize(FrontierProblemAt(problem, spec, point.value),
-                                                     step, nullptr, 0.0, 1.0, std::nullopt,
-                                                     &newton, kActiveSetNewtonName, &*prepared)
+                                                     step, nullptr, 0.0, 1.0, std::nullopt, &newton,
+                                                     kActiveSetNewtonName, &*prepared)
                            : design_detail::Optimize(p, step, nullptr, 0.0, 1.0, std::nullopt,
                                                      &newton, kActiveSetNewtonName);
         point.continued = point.result.summary.termination == Termination::kConverged &&
