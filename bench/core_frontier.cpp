@@ -1,6 +1,7 @@
 // The frontier (issue 36, item 3): the best 16-knot bat at each of 20 masses (the base mass
 // -2 oz to +2 oz), solved as one frontier (each value from its neighbour's answer, a secant
-// predictor) against 20 independent solves of the same problems (each from the base design).
+// predictor, the Newton step on the neighbour's active set) against 20 independent solves of
+// the same problems (each from the base design).
 // Run: build/bench/sweetspot_bench_core --benchmark_filter=Frontier
 #include <benchmark/benchmark.h>
 
@@ -61,12 +62,15 @@ void BM_FrontierTwentyMasses(benchmark::State& state) {
   FrontierSummary s;
   double objective_sum = 0.0;
   std::vector<double> objectives;
+  int newton = 0;  // values answered by the Newton step (summary.backend active_set_newton)
   for (auto _ : state) {
     objective_sum = 0.0;
     objectives.clear();
+    newton = 0;
     s = OptimizeFrontier(p, spec, o, true, [&](const FrontierPoint& point) {
       objective_sum += point.result.objective_value;
       objectives.push_back(point.result.objective_value);
+      newton += point.result.summary.backend == "active_set_newton" ? 1 : 0;
       return true;
     });
     benchmark::DoNotOptimize(s);
@@ -90,6 +94,7 @@ void BM_FrontierTwentyMasses(benchmark::State& state) {
   state.counters["converged"] = s.converged;
   state.counters["restarts"] = s.restarts;
   state.counters["continued"] = s.continued;
+  state.counters["newton"] = newton;
   state.counters["objective_sum"] = objective_sum;
   state.SetLabel(state.range(0) != 0 ? "frontier" : "independent");
 }

@@ -20,9 +20,12 @@ CertificateTolerances TolerancesFrom(const DesignOptions& options) {
 void CertifyRuns(const DesignModel& model, const DesignOptions& options, std::vector<Run>* runs) {
   if (model.derivative_free()) return;  // no gradient: nothing to certify
   const CertificateTolerances tolerances = TolerancesFrom(options);
+  // One run: it is the answer's, whose certificate checks uniqueness too (kept in the run).
+  const bool only = runs->size() == 1;
   for (Run& run : *runs) {
     if (run.outcome.termination != Termination::kConverged || run.x.empty()) continue;
-    const DesignCertificate cert = Certify(model, run.x, tolerances, false);
+    const DesignCertificate cert = Certify(model, run.x, tolerances, only);
+    if (only) run.certificate = cert;
     if (!cert.checked || cert.certified) continue;
     run.uncertified = true;
     run.outcome.termination = Termination::kNoConvergence;
@@ -34,8 +37,10 @@ void CertifyRuns(const DesignModel& model, const DesignOptions& options, std::ve
 
 LocalSolveOutcome WithCertifiedMultipliers(const DesignModel& model, const DesignOptions& options,
                                            const std::vector<double>& x, const LocalSolveOutcome& o,
-                                           DesignResult* result) {
-  result->certificate = Certify(model, x, TolerancesFrom(options), true);
+                                           DesignResult* result, const Run* chosen) {
+  const bool cached = chosen != nullptr && chosen->certificate.has_value() && chosen->x == x;
+  result->certificate =
+      cached ? *chosen->certificate : Certify(model, x, TolerancesFrom(options), true);
   LocalSolveOutcome out = o;
   const DesignCertificate& c = result->certificate;
   if (!c.checked) return out;

@@ -23,9 +23,10 @@ void CertifyRuns(const DesignModel& model, const DesignOptions& options, std::ve
 /// The answer's certificate at x (with the uniqueness check) into result->certificate, and the
 /// solve `o` with the certificate's multipliers in place of the backend's (for
 /// ReportActiveConstraints); `o` unchanged when no certificate could be made (min_sting).
+/// `chosen` (may be null): the run whose certificate (CertifyRuns') is reused when x is its point.
 LocalSolveOutcome WithCertifiedMultipliers(const DesignModel& model, const DesignOptions& options,
                                            const std::vector<double>& x, const LocalSolveOutcome& o,
-                                           DesignResult* result);
+                                           DesignResult* result, const Run* chosen = nullptr);
 
 /// After ReportActiveConstraints: error_estimate is the certificate's stationarity; multipliers
 /// that are not unique become NaN (with a warning when `reports_multipliers`: the shape fit

@@ -10,6 +10,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -142,7 +143,8 @@ const char* ObjectiveUnit(DesignObjective objective) {
 // warnings go to result->summary.
 std::vector<Run> RunStarts(const DesignModel& model, const DesignOptions& options,
                            DesignBackend backend, Clock::time_point deadline, Progress* progress,
-                           double progress_from, double progress_to, DesignResult* result) {
+                           double progress_from, double progress_to, DesignResult* result,
+                           const design_detail::LocalSolver* solver) {
   std::vector<Run> runs;
   std::mt19937_64 rng(options.seed);
   const std::vector<double> x0 = model.BaseX();
@@ -167,7 +169,8 @@ std::vector<Run> RunStarts(const DesignModel& model, const DesignOptions& option
       // checker's tolerance 1e-4 (design_backends.hpp).
       if (model.frequency_elements() > 0) settings.derivative_test_perturbation = 1e-6;
     }
-    LocalSolveOutcome o = Solve(backend, nlp, nlp.ToScaled(x), settings);
+    LocalSolveOutcome o = solver != nullptr ? (*solver)(nlp, nlp.ToScaled(x), settings)
+                                            : Solve(backend, nlp, nlp.ToScaled(x), settings);
     result->summary.iterations += o.iterations;
     result->summary.evaluations += o.evaluations;
     if (i == 0) {
@@ -385,7 +388,9 @@ void CheckBbcorRule(const DesignProblem& problem, const PublicEvaluation& pub,
 // and an overall deadline (OptimizeOverMaterials shares one budget between materials).
 DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions& options,
                           Progress* progress, double progress_from, double progress_to,
-                          std::optional<Clock::time_point> shared_deadline) {
+                          std::optional<Clock::time_point> shared_deadline,
+                          const design_detail::LocalSolver* solver, const char* solver_name,
+                          design_detail::PreparedModel* prepared) {
   const Clock::time_point start = Clock::now();
   const auto elapsed_s = [&start] {
     return std::chrono::duration<double>(Clock::now() - start).count();
@@ -393,7 +398,8 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
   DesignResult result;
   Summary& summary = result.summary;
   const DesignBackend backend = MainBackend(problem, options);
-  summary.backend = BackendName(backend);
+  summary.backend =
+      solver != nullptr && solver_name != nullptr ? solver_name : BackendName(backend);
   summary.models_used = {"mass_properties"};
   if (problem.objective != DesignObjective::kMinMoi &&
       problem.objective != DesignObjective::kLeastSquares) {
@@ -430,6 +436,8 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
                           " has no derivatives to check (it is solved derivative-free by COBYLA)");
   } else if (!design_detail::SlsqpSizeAllowed(problem, options, &why)) {
     invalid = true;
+  } else if (prepared != nullptr) {
+    model = std::move(prepared->model);  // built and merged by the caller (moved from)
   } else if (!DesignModel::Build(problem, options, &model, &why)) {
     invalid = true;
   }
@@ -443,7 +451,9 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
     return result;
   }
   // Constraints that repeat another are merged before the solve (certificate.hpp).
-  result.merged_constraints = design_detail::MergeDuplicateConstraints(&model);
+  result.merged_constraints = prepared != nullptr
+                                   ? std::move(prepared->merged)
+                                   : design_detail::MergeDuplicateConstraints(&model);
   const bool cor_known =
       problem.cor.has_value() || problem.bat.material.cor.has_value() || model.cor_from_barrel();
   result.cor = cor_known ? model.cor() : kNaN;
@@ -469,7 +479,7 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
                                              std::chrono::duration<double>(options.max_time_s)));
     std::vector<Run> runs = model.fixed_violations().empty()
                                 ? RunStarts(model, options, backend, deadline, progress,
-                                            progress_from, progress_to, &result)
+                                            progress_from, progress_to, &result, solver)
                                 : std::vector<Run>{};
     design_detail::CertifyRuns(model, options, &runs);
     FillSpread(runs, &result.spread);
@@ -500,9 +510,10 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
     const Run& chosen = runs[static_cast<std::size_t>(best)];
     ClassifyChosen(options, backend, chosen, pub, result.bat, &result);
     ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, &result);
-    ReportActiveConstraints(
-        model, x, design_detail::WithCertifiedMultipliers(model, options, x, chosen.outcome, &result),
-        &result, options.feasibility_tolerance);
+    ReportActiveConstraints(model, x,
+                            design_detail::WithCertifiedMultipliers(
+                                model, options, x, chosen.outcome, &result, &chosen),
+                            &result, options.feasibility_tolerance);
     // The shape fit (a least-squares objective) reports no multipliers: no warning about them.
     design_detail::FinishCertificate(
         chosen, problem.objective != DesignObjective::kLeastSquares, &result);
@@ -529,9 +540,11 @@ namespace design_detail {
 // (bbcor_constraint.hpp): the rounds share one deadline.
 DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options,
                       Progress* progress, double progress_from, double progress_to,
-                      std::optional<Clock::time_point> shared_deadline) {
+                      std::optional<Clock::time_point> shared_deadline, const LocalSolver* solver,
+                      const char* solver_name, PreparedModel* prepared) {
   if (!BbcorBoundOf(problem).has_value()) {
-    return OptimizeOneRound(problem, options, progress, progress_from, progress_to, shared_deadline);
+    return OptimizeOneRound(problem, options, progress, progress_from, progress_to, shared_deadline,
+                            solver, solver_name, prepared);
   }
   const Clock::time_point start = Clock::now();
   const Clock::time_point deadline = shared_deadline.value_or(
@@ -539,7 +552,8 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
                   std::isfinite(options.max_time_s) && options.max_time_s > 0.0 ? options.max_time_s
                                                                                 : 0.0)));
   DesignResult r = OptimizeWithCertifiedBbcor(problem, [&](const DesignProblem& p) {
-    return OptimizeOneRound(p, options, progress, progress_from, progress_to, deadline);
+    return OptimizeOneRound(p, options, progress, progress_from, progress_to, deadline, solver,
+                            solver_name, nullptr);
   });
   r.summary.solve_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return r;

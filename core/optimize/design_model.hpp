@@ -247,6 +247,11 @@ class DesignModel {
                             const std::string& unit) const;
   /// A copy with only the constraints whose indices are in `keep` (in that order).
   DesignModel WithConstraints(const std::vector<int>& keep) const;
+  /// A copy with constraint `index`'s limits (its unit) set to [lower, upper] and its scale
+  /// recomputed as Build computes it: the model Build makes for the problem with that
+  /// property constraint's range changed (the frontier's swept constraint, frontier.cpp).
+  /// `index` must be a constraint's index.
+  DesignModel WithConstraintLimits(int index, double lower, double upper) const;
 
  private:
   friend struct design_detail::ModelBuilder;

@@ -527,6 +527,22 @@ bool ModelBuilder::Run() {
 
 }  // namespace design_detail
 
+DesignModel DesignModel::WithConstraintLimits(int index, double lower, double upper) const {
+  DesignModel copy = *this;
+  DesignConstraintSpec& c = copy.constraints_[static_cast<std::size_t>(index)];
+  c.lower = lower;
+  c.upper = upper;
+  // The scale as Objective() sets it (design_detail::ModelBuilder::Objective): the value at
+  // the start and the limits.
+  const std::vector<double> x0 = BaseX();
+  double s = std::abs(Value(c.f, x0.data()));
+  if (!std::isfinite(s)) s = 0.0;
+  if (std::isfinite(c.lower)) s = std::max(s, std::abs(c.lower));
+  if (std::isfinite(c.upper)) s = std::max(s, std::abs(c.upper));
+  c.scale = std::max(s, design_detail::ScaleFloor(c.unit));
+  return copy;
+}
+
 bool DesignModel::Build(const DesignProblem& problem, const DesignOptions& options,
                         DesignModel* out, Refusal* why) {
   design_detail::ModelBuilder builder(problem, options, why);

@@ -4,10 +4,12 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <vector>
 
+#include "core/optimize/certificate.hpp"
 #include "core/optimize/design_backends.hpp"
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
@@ -29,6 +31,9 @@ struct Run {
   /// The solver reported convergence but the certificate failed (its termination is then
   /// no_convergence, its message what failed).
   bool uncertified = false;
+  /// The certificate at x (CertifyRuns; with the uniqueness check when it is the only run),
+  /// reused by the answer when x is its point.
+  std::optional<DesignCertificate> certificate;
 };
 
 /// Evaluates the end of a local solve (clamped into the bounds, objective, violation).
@@ -71,11 +76,30 @@ std::vector<DesignConflict> Explain(const DesignModel& model, const DesignOption
 /// The spread of the starts' answers (their objectives, terminations and violations).
 void FillSpread(const std::vector<Run>& runs, DesignSpread* spread_out);
 
+/// A local solve in place of the backend's (the frontier's continuation step, frontier.cpp):
+/// from s0 with the settings of the start.
+using LocalSolver = std::function<LocalSolveOutcome(
+    ScaledDesignNlp& nlp, const std::vector<double>& s0, const LocalSolveSettings& settings)>;
+
+/// A model built (DesignModel::Build) and merged (MergeDuplicateConstraints) once for several
+/// solves: the frontier's values (frontier.cpp), whose models differ only in the swept
+/// constraint's limits (DesignModel::WithConstraintLimits).
+struct PreparedModel {
+  DesignModel model;                     ///< The model of the problem, merged.
+  std::vector<MergedConstraint> merged;  ///< What the merge removed.
+};
+
 /// OptimizeDesign's solve of `problem` with `options` (its backend as given), in certification
 /// rounds when the problem bounds the BBCOR; progress reported over [progress_from,
-/// progress_to]; `shared_deadline` (when set) bounds it instead of options.max_time_s.
+/// progress_to]; `shared_deadline` (when set) bounds it instead of options.max_time_s. With
+/// `solver` (non-null), every start's local solve is solver's, the summary's backend
+/// `solver_name`; the rest (model, certificate, re-check, answer) is unchanged. With
+/// `prepared` (non-null; not with a BBCOR bound, whose rounds change the problem), its model
+/// is the one of `problem` (the caller's promise), moved from instead of built again.
 DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options,
                       Progress* progress, double progress_from, double progress_to,
-                      std::optional<Clock::time_point> shared_deadline);
+                      std::optional<Clock::time_point> shared_deadline,
+                      const LocalSolver* solver = nullptr, const char* solver_name = nullptr,
+                      PreparedModel* prepared = nullptr);
 
 }  // namespace sweetspot::core::design_detail

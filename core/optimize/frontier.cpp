@@ -3,11 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 #include <utility>
 
 #include "core/geometry_format.hpp"
+#include "core/optimize/active_set_newton.hpp"
+#include "core/optimize/bbcor_constraint.hpp"
+#include "core/optimize/design_runs.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -107,6 +111,104 @@ Start PredictStart(const FrontierPoint* before, const FrontierPoint& last, doubl
   start.bat = std::move(moved);
   start.predicted = true;
   return start;
+}
+
+// The model of every value built once (issue 36: the fixed work of a continuation step): the
+// model of the first value, merged, and the swept constraint's index in it. Only for a
+// property constraint (mass, balance point, swing weight), whose limits and scale are all that
+// Build makes differently from one value to the next (DesignModel::WithConstraintLimits), and
+// which no other constraint repeats, so that the merge (MergeDuplicateConstraints) does not
+// depend on the value: no other constraint on the same property (the rules' drop repeats the
+// mass when the length is fixed), not a function of one variable (merged into its bounds), and
+// not linear in the variables (a linear constraint could repeat it). Otherwise nullopt: each
+// value builds its own.
+struct FrontierModel {
+  design_detail::PreparedModel prepared;  // the first value's model, merged
+  int index = -1;                         // the swept constraint in it
+};
+
+std::optional<FrontierModel> PrepareFrontierModel(const DesignProblem& problem,
+                                                  const FrontierSpec& spec,
+                                                  const DesignOptions& options) {
+  DesignFunction function = DesignFunction::kMass;
+  switch (spec.quantity) {
+    case FrontierQuantity::kMassKg:
+      break;
+    case FrontierQuantity::kBalancePointM:
+      function = DesignFunction::kBalancePoint;
+      break;
+    case FrontierQuantity::kMoiSixInchKgM2:
+      function = DesignFunction::kMoiSixInch;
+      break;
+    default:
+      return std::nullopt;
+  }
+  if (BbcorBoundOf(problem).has_value() || spec.values.empty()) return std::nullopt;
+  FrontierModel out;
+  DesignModel& model = out.prepared.model;
+  if (!DesignModel::Build(FrontierProblemAt(problem, spec, spec.values.front()), options, &model,
+                          nullptr) ||
+      !model.fixed_violations().empty() || model.derivative_free()) {
+    return std::nullopt;
+  }
+  int index = -1;
+  for (int k = 0; k < model.m(); ++k) {
+    const DesignConstraintSpec& c = model.constraints()[static_cast<std::size_t>(k)];
+    if (c.f.function == DesignFunction::kDrop) return std::nullopt;
+    if (c.f.function != function) continue;
+    if (index >= 0) return std::nullopt;  // two on the same property
+    index = k;
+  }
+  if (index < 0) return std::nullopt;
+  const std::vector<double> x0 = model.BaseX();
+  DesignPoint at;
+  if (!model.Evaluate(x0.data(), true, &at)) return std::nullopt;
+  int depends = 0;
+  for (int j = 0; j < model.n(); ++j) depends += at.jacobian(index, j) != 0.0 ? 1 : 0;
+  std::vector<double> weights(static_cast<std::size_t>(model.m()), 0.0);
+  weights[static_cast<std::size_t>(index)] = 1.0;
+  Eigen::MatrixXd h;
+  if (depends < 2 || !model.Hessian(x0.data(), 0.0, weights.data(), &h) ||
+      !(h.cwiseAbs().maxCoeff() > 0.0)) {
+    return std::nullopt;
+  }
+  const std::string name = model.constraints()[static_cast<std::size_t>(index)].name;
+  out.prepared.merged = design_detail::MergeDuplicateConstraints(&model);
+  for (int k = 0; k < model.m(); ++k) {
+    if (model.constraints()[static_cast<std::size_t>(k)].name == name) out.index = k;
+  }
+  if (out.index < 0) return std::nullopt;
+  return out;
+}
+
+// The prepared model of `value` (its limits as FrontierProblemAt sets them), or nullopt when
+// Build would refuse the value (a limit outside (0, cap]): that value builds its own model.
+std::optional<design_detail::PreparedModel> PreparedAt(const FrontierModel& f,
+                                                       const FrontierSpec& spec, double value) {
+  const double cap = spec.quantity == FrontierQuantity::kMassKg          ? kMaxDesignMassKg
+                     : spec.quantity == FrontierQuantity::kBalancePointM ? kMaxBatLengthM
+                                                                         : kMaxDesignMoiKgM2;
+  if (!(value > 0.0 && value <= cap)) return std::nullopt;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double lower = spec.bound == FrontierBound::kAtMost ? -inf : value;
+  const double upper = spec.bound == FrontierBound::kAtLeast ? inf : value;
+  design_detail::PreparedModel p;
+  p.model = f.prepared.model.WithConstraintLimits(f.index, lower, upper);
+  p.merged = f.prepared.merged;
+  return p;
+}
+
+// The variables' values of an answer (the problem's variables, in order), from its variables
+// (which list linked and scaled fields too); empty when one is missing.
+std::vector<double> VariablesOf(const DesignProblem& problem, const DesignResult& r) {
+  std::vector<double> x;
+  for (const DesignVariable& v : problem.variables) {
+    const auto it = std::find_if(r.variables.begin(), r.variables.end(),
+                                 [&v](const DesignValue& e) { return e.path == v.path; });
+    if (it == r.variables.end() || !std::isfinite(it->value)) return {};
+    x.push_back(it->value);
+  }
+  return x;
 }
 
 double Seconds(std::chrono::steady_clock::time_point since) {
@@ -233,6 +335,10 @@ FrontierSummary OptimizeFrontier(const DesignProblem& problem, const FrontierSpe
     // The continuation backend differs from the requested one (else the requested solve is
     // the step); min_frequency_hz needs limited-memory Ipopt or SLSQP either way.
     const bool continuation = spec.warm_start && spec.continuation_backend != options.backend;
+    // The continuation steps' model, built once when the swept quantity allows it.
+    const std::optional<FrontierModel> frontier_model =
+        spec.warm_start && spec.values.size() > 1 ? PrepareFrontierModel(problem, spec, options)
+                                                  : std::nullopt;
     std::vector<FrontierPoint> solved;  // the converged answers, for the predictor
     solved.reserve(2);
     int iterations = 0, evaluations = 0;
@@ -259,7 +365,55 @@ FrontierSummary OptimizeFrontier(const DesignProblem& problem, const FrontierSpe
         iterations += std::max(0, r.summary.iterations);
         evaluations += std::max(0, r.summary.evaluations);
       };
-      if (point.warm_started && continuation) {
+      const DesignCertificate* neighbour =
+          point.warm_started ? &solved.back().result.certificate : nullptr;
+      if (neighbour != nullptr && neighbour->checked && neighbour->certified) {
+        // The Newton step: the neighbour's active set, Newton's method on its KKT conditions
+        // from the predicted start (active_set_newton.hpp), kept when certified.
+        const ActiveSetGuess guess =
+            GuessFromMultipliers(neighbour->lambda, neighbour->z_lower, neighbour->z_upper);
+        // With the model built once, the problem keeps its base design (the model's) and the
+        // predicted start is given as the variables' values (the secant through the two
+        // previous answers' variables, as PredictStart moves the bat).
+        std::optional<design_detail::PreparedModel> prepared;
+        std::vector<double> x_start;
+        if (frontier_model.has_value()) {
+          prepared = PreparedAt(*frontier_model, spec, point.value);
+          x_start = VariablesOf(problem, solved.back().result);
+          if (solved.size() >= 2 && !x_start.empty()) {
+            const FrontierPoint& a = solved[solved.size() - 2];
+            const FrontierPoint& b = solved.back();
+            const std::vector<double> x_before = VariablesOf(problem, a.result);
+            if (x_before.size() == x_start.size() && b.value != a.value) {
+              const double t = (point.value - b.value) / (b.value - a.value);
+              for (std::size_t j = 0; j < x_start.size(); ++j)
+                x_start[j] += t * (x_start[j] - x_before[j]);
+            }
+          }
+        }
+        const design_detail::LocalSolver newton = [&guess, &x_start](
+                                                      ScaledDesignNlp& nlp,
+                                                      const std::vector<double>& s0,
+                                                      const LocalSolveSettings& settings) {
+          const bool given = x_start.size() == static_cast<std::size_t>(nlp.n());
+          return SolveWithActiveSetNewton(nlp, given ? nlp.ToScaled(x_start) : s0, guess, settings);
+        };
+        DesignOptions step = options;
+        step.choose_backend = false;
+        step.starts = 1;
+        step.derivative_check = DerivativeCheck::kNone;
+        step.explain_infeasibility = false;  // a failed step is solved again below
+        point.result = prepared.has_value()
+                           ? design_detail::Optimize(FrontierProblemAt(problem, spec, point.value),
+                                                     step, nullptr, 0.0, 1.0, std::nullopt, &newton,
+                                                     kActiveSetNewtonName, &*prepared)
+                           : design_detail::Optimize(p, step, nullptr, 0.0, 1.0, std::nullopt,
+                                                     &newton, kActiveSetNewtonName);
+        point.continued = point.result.summary.termination == Termination::kConverged &&
+                          point.result.certificate.certified;
+        if (!point.continued) count(point.result);
+      }
+      if (point.warm_started && continuation && !point.continued) {
         // The continuation step: a local solve from the predicted start, kept when converged.
         DesignOptions step = options;
         step.backend = spec.continuation_backend;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <set>
 #include <vector>
 
 #include "core/optimize/design_model.hpp"
@@ -35,14 +34,15 @@ ScaledDesignNlp::ScaledDesignNlp(const DesignModel& model) : model_(model) {
     const DesignConstraintSpec& c = model.constraints()[static_cast<std::size_t>(k)];
     std::vector<int>& row = structure_[static_cast<std::size_t>(k)];
     if (c.f.function == DesignFunction::kLinear) {
-      std::set<int> vars;
       for (const auto& [pidx, coef] : c.f.terms) {
         if (coef == 0.0 || pidx < 0 || pidx >= static_cast<int>(setters.size())) continue;
-        for (int j : setters[static_cast<std::size_t>(pidx)]) vars.insert(j);
+        for (int j : setters[static_cast<std::size_t>(pidx)]) row.push_back(j);
       }
-      row.assign(vars.begin(), vars.end());
+      std::sort(row.begin(), row.end());  // sorted, distinct (a std::set allocated per entry)
+      row.erase(std::unique(row.begin(), row.end()), row.end());
     } else {
-      for (int j = 0; j < n; ++j) row.push_back(j);
+      row.resize(static_cast<std::size_t>(n));
+      for (int j = 0; j < n; ++j) row[static_cast<std::size_t>(j)] = j;
     }
   }
 }

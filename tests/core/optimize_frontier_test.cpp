@@ -70,8 +70,13 @@ TEST(FrontierTest, WarmStartedValuesReachTheOptimaOfIndependentSolves) {
   ASSERT_EQ(cold.size(), 6u);
   EXPECT_EQ(warm_summary.summary.termination, Termination::kConverged) << warm_summary.summary.message;
   EXPECT_EQ(warm_summary.converged, 6);
-  // Every value after the first is a continuation step (SLSQP from the predicted start).
+  // Every value after the first is a continuation step (the active-set Newton step from the
+  // predicted start with the neighbour's active set), certified like any answer.
   EXPECT_EQ(warm_summary.continued, 5);
+  for (std::size_t i = 1; i < warm.size(); ++i) {
+    EXPECT_EQ(warm[i].result.summary.backend, "active_set_newton") << "value " << i;
+    EXPECT_TRUE(warm[i].result.certificate.certified) << "value " << i;
+  }
   EXPECT_EQ(cold_summary.continued, 0);
   for (std::size_t i = 0; i < warm.size(); ++i) {
     EXPECT_EQ(warm[i].index, static_cast<int>(i));
