@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -172,7 +173,34 @@ void ExpectSameOptimum(const DesignProblem& p) {
     return std::nan("");
   };
   EXPECT_NEAR(mass_multiplier(a), mass_multiplier(b), 1e-4 * std::abs(mass_multiplier(b)));
-  EXPECT_EQ(a.active_constraints.size(), b.active_constraints.size());
+  // The same active constraints, except a taper constraint (r[k+1] >= r[k], named
+  // "taper.knots[k]") that one answer reports active and the other leaves within 1e-8 m of its
+  // limit: at 64 knots the lifted answer (monotone barrier) has taper.knots[35] and [38] at
+  // 5e-10 and 5e-11 m with multipliers -0.07 and -0.16 m/s per unit, the dense one leaves
+  // them 3.1e-9 and 1.4e-9 m open (objective 5.5e-10 relative lower). Ipopt's tol 1e-9 on the
+  // scaled problem does not resolve the optimum that finely; 1e-8 m is 4e-7 of the radius.
+  auto names = [](const DesignResult& r) {
+    std::set<std::string> out;
+    for (const auto& c : r.active_constraints) out.insert(c.name);
+    return out;
+  };
+  const std::set<std::string> in_a = names(a), in_b = names(b);
+  auto gap_elsewhere = [](const std::string& name, const DesignResult& other) {
+    const std::string prefix = "taper.knots[";
+    if (name.rfind(prefix, 0) != 0) return std::nan("");
+    const auto k = static_cast<std::size_t>(std::stoi(name.substr(prefix.size())));
+    return other.bat.knots[k + 1].radius_m - other.bat.knots[k].radius_m;
+  };
+  for (const std::string& name : in_a) {
+    if (in_b.count(name) == 0) {
+      EXPECT_LE(std::abs(gap_elsewhere(name, b)), 1e-8) << name << " active in the lifted answer only";
+    }
+  }
+  for (const std::string& name : in_b) {
+    if (in_a.count(name) == 0) {
+      EXPECT_LE(std::abs(gap_elsewhere(name, a)), 1e-8) << name << " active in the dense answer only";
+    }
+  }
 }
 
 TEST(OptimizeLifted, SameOptimumAsDenseAtSixteenKnots) { ExpectSameOptimum(KnotProblem(16)); }
