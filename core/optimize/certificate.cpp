@@ -162,7 +162,8 @@ Eigen::VectorXd NonNegativeLeastSquares(const Eigen::MatrixXd& a, const Eigen::V
 }
 
 DesignCertificate Certify(const DesignModel& model, const std::vector<double>& x,
-                          const CertificateTolerances& tolerances, bool check_uniqueness) {
+                          const CertificateTolerances& tolerances, bool check_uniqueness,
+                          const DesignCertificate* known) {
   DesignCertificate cert;
   cert.stationarity_tolerance = tolerances.stationarity;
   cert.feasibility_tolerance = tolerances.feasibility;
@@ -213,7 +214,25 @@ DesignCertificate Certify(const DesignModel& model, const std::vector<double>& x
       }
       free[c] = col.free;
     }
-    const Eigen::VectorXd mu = NonNegativeLeastSquares(a, -grad, free);
+    // The multipliers: fitted, or the known certificate's at the same point (each column's
+    // from its constraint's or bound's entry: the same bits, the signs being +-1).
+    Eigen::VectorXd mu;
+    if (known != nullptr && known->checked && known->active == static_cast<int>(a_count) &&
+        known->lambda.size() == static_cast<std::size_t>(m) &&
+        known->z_lower.size() == static_cast<std::size_t>(n) &&
+        known->z_upper.size() == static_cast<std::size_t>(n)) {
+      mu.resize(a_count);
+      for (std::size_t c = 0; c < columns.size(); ++c) {
+        const Column& col = columns[c];
+        const auto idx = static_cast<std::size_t>(col.index);
+        mu(static_cast<Eigen::Index>(c)) = col.kind == Column::kConstraint
+                                               ? col.sign * known->lambda[idx]
+                                           : col.kind == Column::kLower ? known->z_lower[idx]
+                                                                        : known->z_upper[idx];
+      }
+    } else {
+      mu = NonNegativeLeastSquares(a, -grad, free);
+    }
     const Eigen::VectorXd r = grad + a * mu;
 
     cert.checked = true;
@@ -356,8 +375,6 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
         if (a < 0) std::swap(lo, hi);
         const double slop = 1e-12 * std::max({1.0, std::abs(cl.lower) * std::isfinite(cl.lower),
                                               std::abs(cl.upper) * std::isfinite(cl.upper)});
-        const std::string relation = ck.name + " = " + Short(a) + " " + cl.name +
-                                     (b < 0 ? " - " : " + ") + Short(std::abs(b));
         // Only a pair that can be active together (a shared limit) is merged: a redundant
         // limit strictly inside the other's range never binds and changes nothing.
         const bool shares = (std::isfinite(lo) && (std::abs(lo - cl.lower) <= slop ||
@@ -365,6 +382,8 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
                             (std::isfinite(hi) &&
                              (std::abs(hi - cl.lower) <= slop || std::abs(hi - cl.upper) <= slop));
         if (!shares) continue;
+        const std::string relation = ck.name + " = " + Short(a) + " " + cl.name +
+                                     (b < 0 ? " - " : " + ") + Short(std::abs(b));
         int drop = -1, keep = -1;
         if (Contains(lo, hi, cl.lower, cl.upper, slop)) {
           drop = k;
@@ -399,6 +418,7 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
       int var = -1;
       bool single = true;
       for (const DesignPoint& pt : points) {
+        if (!single) break;
         for (int j = 0; j < n && single; ++j) {
           if (pt.jacobian(k, j) == 0.0) continue;
           if (var >= 0 && var != j) single = false;

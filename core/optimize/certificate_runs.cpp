@@ -23,6 +23,8 @@ void CertifyRuns(const DesignModel& model, const DesignOptions& options, std::ve
   for (Run& run : *runs) {
     if (run.outcome.termination != Termination::kConverged || run.x.empty()) continue;
     const DesignCertificate cert = Certify(model, run.x, tolerances, false);
+    run.outcome.certificate = cert;  // the answer's certificate reuses its fit at this point
+    run.outcome.certificate_x = run.x;
     if (!cert.checked || cert.certified) continue;
     run.uncertified = true;
     run.outcome.termination = Termination::kNoConvergence;
@@ -35,7 +37,10 @@ void CertifyRuns(const DesignModel& model, const DesignOptions& options, std::ve
 LocalSolveOutcome WithCertifiedMultipliers(const DesignModel& model, const DesignOptions& options,
                                            const std::vector<double>& x, const LocalSolveOutcome& o,
                                            DesignResult* result) {
-  result->certificate = Certify(model, x, TolerancesFrom(options), true);
+  // The run's own certificate when the answer is its point (not moved by a polish).
+  const bool same = o.certificate.checked && o.certificate_x == x;
+  result->certificate =
+      Certify(model, x, TolerancesFrom(options), true, same ? &o.certificate : nullptr);
   LocalSolveOutcome out = o;
   const DesignCertificate& c = result->certificate;
   if (!c.checked) return out;
