@@ -83,6 +83,9 @@ struct CertificateTolerances {
   double stationarity = kDefaultStationarityTolerance;        ///< See DesignCertificate.
   double feasibility = kDefaultFeasibilityTolerance;          ///< See DesignCertificate.
   double complementarity = kDefaultComplementarityTolerance;  ///< See DesignCertificate.
+  /// Up to this many variables the active gradients are factorised densely (column-pivoted
+  /// QR), above it by a sparse QR (certificate.cpp); the tests compare the two.
+  int dense_max_variables = 32;
 };
 
 /// The certificate of `model` at x (user units, inside the bounds). `check_uniqueness`: also
