@@ -83,14 +83,22 @@ struct CertificateTolerances {
   double stationarity = kDefaultStationarityTolerance;        ///< See DesignCertificate.
   double feasibility = kDefaultFeasibilityTolerance;          ///< See DesignCertificate.
   double complementarity = kDefaultComplementarityTolerance;  ///< See DesignCertificate.
+  /// Up to this many variables the active gradients are factorised densely (column-pivoted
+  /// QR), above it by a sparse QR (certificate.cpp); the tests compare the two.
+  int dense_max_variables = 32;
 };
 
 /// The certificate of `model` at x (user units, inside the bounds). `check_uniqueness`: also
 /// decide whether the multipliers are unique (an SVD of the active gradients; only the answer's
-/// point needs it). Not checked (checked false) for a derivative-free model or when the model
-/// cannot be evaluated at x. Never throws.
+/// point needs it). `known`: a certificate this function already returned for the same model,
+/// x and tolerances: its multipliers are taken (the same bits) instead of fitted again (the fit
+/// is a dense least-squares solve over the active gradients, O(n^3): a tenth of a 256-knot
+/// solve).
+/// Not checked (checked false) for a derivative-free model or when the model cannot be
+/// evaluated at x. Never throws.
 DesignCertificate Certify(const DesignModel& model, const std::vector<double>& x,
-                          const CertificateTolerances& tolerances, bool check_uniqueness);
+                          const CertificateTolerances& tolerances, bool check_uniqueness,
+                          const DesignCertificate* known = nullptr);
 
 /// Finds the constraints of `model` that repeat another one (the same function up to an affine
 /// map, checked on the exact gradients and values at three points of the box: the base design,

@@ -26,6 +26,8 @@ void CertifyRuns(const DesignModel& model, const DesignOptions& options, std::ve
     if (run.outcome.termination != Termination::kConverged || run.x.empty()) continue;
     const DesignCertificate cert = Certify(model, run.x, tolerances, only);
     if (only) run.certificate = cert;
+    run.outcome.certificate = cert;  // the answer's certificate reuses its fit at this point
+    run.outcome.certificate_x = run.x;
     if (!cert.checked || cert.certified) continue;
     run.uncertified = true;
     run.outcome.termination = Termination::kNoConvergence;
@@ -38,9 +40,14 @@ void CertifyRuns(const DesignModel& model, const DesignOptions& options, std::ve
 LocalSolveOutcome WithCertifiedMultipliers(const DesignModel& model, const DesignOptions& options,
                                            const std::vector<double>& x, const LocalSolveOutcome& o,
                                            DesignResult* result, const Run* chosen) {
+  // The chosen run's whole certificate when it was the only run (uniqueness checked) and the
+  // answer is its point; otherwise the run's fit at this point, when it is the answer's (not
+  // moved by a polish), with the uniqueness check made here.
   const bool cached = chosen != nullptr && chosen->certificate.has_value() && chosen->x == x;
+  const bool same = o.certificate.checked && o.certificate_x == x;
   result->certificate =
-      cached ? *chosen->certificate : Certify(model, x, TolerancesFrom(options), true);
+      cached ? *chosen->certificate
+             : Certify(model, x, TolerancesFrom(options), true, same ? &o.certificate : nullptr);
   LocalSolveOutcome out = o;
   const DesignCertificate& c = result->certificate;
   if (!c.checked) return out;

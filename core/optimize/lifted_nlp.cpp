@@ -171,6 +171,16 @@ LiftedDesignNlp::LiftedDesignNlp(const ScaledDesignNlp& nlp)
   for (int a = 0; a < 3; ++a) {
     for (int b = 0; b <= a; ++b) pairs.insert({nx_ + a, nx_ + b});
   }
+  // Explicit zeros within kHessianBand of the diagonal among the design variables (the
+  // integrals couple adjacent knots only): the KKT matrix has the same values, but MUMPS's
+  // elimination tree then has fewer, wider fronts, and its fixed cost per front, not the
+  // arithmetic, is what a factorisation and a solve of this ~3n-row matrix cost (callgrind,
+  // the n-knot design: -9 / -10 / -8 % instructions per solve at 64 / 128 / 256 knots with a
+  // band of 4; 2 gives -7 %, 6 is worse at 128; docs/benchmarks.md, "Issue 36").
+  constexpr int kHessianBand = 4;
+  for (int a = 0; a < nx_; ++a) {
+    for (int b = std::max(0, a - kHessianBand); b <= a; ++b) pairs.insert({a, b});
+  }
   hess_.assign(pairs.begin(), pairs.end());
   hess_rows_.resize(static_cast<std::size_t>(n()));
   for (std::size_t e = 0; e < hess_.size(); ++e) {

@@ -67,7 +67,9 @@ class LiftedDesignNlp {
 
   /// The Jacobian's structure (row, column), one entry per value of jacobian_values().
   const std::vector<std::pair<int, int>>& jacobian_structure() const { return jac_; }
-  /// The Lagrangian Hessian's lower triangle (row >= column), one entry per value of Hessian().
+  /// The Lagrangian Hessian's lower triangle (row >= column), one entry per value of Hessian():
+  /// the pairs the integrals couple, q's block, and explicit zeros in a band of 4 around the
+  /// diagonal of the design variables (fewer, wider fronts for MUMPS; lifted_nlp.cpp).
   const std::vector<std::pair<int, int>>& hessian_structure() const { return hess_; }
 
   /// Evaluates at z (cached); false when not finite (or M(x) <= 0).

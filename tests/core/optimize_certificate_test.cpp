@@ -145,6 +145,37 @@ TEST(Certificate, HoldsAtTheOptimumAndNotAtTheStart) {
   }
 }
 
+// The answer's certificate reuses the run's multipliers (Certify's `known`, certificate_runs.cpp):
+// the same certificate, bit for bit, as fitting them again, at the optimum and at the start
+// (not certified there); the uniqueness is still decided.
+TEST(Certificate, KnownMultipliersGiveTheSameCertificateBitForBit) {
+  const DesignProblem p = Family();
+  const DesignResult r = OptimizeDesign(p);
+  ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.message;
+  DesignModel model;
+  ASSERT_TRUE(DesignModel::Build(p, DesignOptions{}, &model, nullptr));
+  std::vector<double> answer;
+  for (const DesignValue& v : r.variables) answer.push_back(v.value);
+  for (const std::vector<double>& x : {answer, model.BaseX()}) {
+    const DesignCertificate fitted = Certify(model, x, CertificateTolerances{}, true);
+    const DesignCertificate run = Certify(model, x, CertificateTolerances{}, false);
+    const DesignCertificate reused = Certify(model, x, CertificateTolerances{}, true, &run);
+    ASSERT_TRUE(fitted.checked);
+    EXPECT_EQ(reused.checked, fitted.checked);
+    EXPECT_EQ(reused.certified, fitted.certified);
+    EXPECT_EQ(reused.multipliers_unique, fitted.multipliers_unique);
+    EXPECT_EQ(reused.active, fitted.active);
+    EXPECT_EQ(reused.failed, fitted.failed);
+    // Exact equality: the same operations on the same numbers.
+    EXPECT_EQ(reused.stationarity, fitted.stationarity);
+    EXPECT_EQ(reused.feasibility, fitted.feasibility);
+    EXPECT_EQ(reused.complementarity, fitted.complementarity);
+    EXPECT_EQ(reused.lambda, fitted.lambda);
+    EXPECT_EQ(reused.z_lower, fitted.z_lower);
+    EXPECT_EQ(reused.z_upper, fitted.z_upper);
+  }
+}
+
 // The multi-start's choice: a start that reported convergence where the certificate fails is
 // no_convergence after CertifyRuns, so a certified start is chosen over it even with a worse
 // objective (here the uncertified start's objective is set above every design's).
