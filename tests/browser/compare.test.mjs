@@ -10,25 +10,29 @@
 //
 // ctest runs it as Browser.Compare (tests/CMakeLists.txt).
 import assert from 'node:assert/strict';
-import fs from 'node:fs';
-import { apiPost, assertNoOverflow, run, setup, shot } from './harness.mjs';
+import {
+  GAME,
+  GAME_SI,
+  apiPost,
+  assertNoOverflow,
+  download,
+  openPhone,
+  run,
+  setup,
+  shot,
+  waitForPage,
+} from './harness.mjs';
 
-const { args, chromium, artifacts } = setup('compare.test.mjs');
+const harness = setup('compare.test.mjs');
+const { artifacts } = harness;
 
-/** The page's opening scene (docs/explorer.md): the mlb ball at 90 mph, a 70 mph bat speed, a fly ball. */
-const GAME = {
-  ball: { preset: 'mlb', speed_mph: 90, descent_angle_deg: 7 },
-  swing: { bat_speed_mph: 70, attack_angle_deg: 10 },
-  contact: { undercut_in: 0.5 },
-};
-/** The same scene as the unit switch's SI defaults write it (exactly 90 mph and 70 mph). */
-const GAME_SI = {
-  ball: { preset: 'mlb', speed_mps: 40.2336, descent_angle_deg: 7 },
-  swing: { bat_speed_mps: 31.2928, attack_angle_deg: 10 },
-  contact: { undercut_m: 0.0127 },
-};
 const OUTPUTS = ['max_exit_speed', 'center_of_percussion', 'exit_speed_curve'];
 const ALLOY = 'bbcor-33-aluminium';
+/** The bats added once the scenarios have added the alloy bat and a copy of the bat above. */
+const TWO_ADDED = [
+  { name: ALLOY, bat: { preset: ALLOY } },
+  { name: 'copy: wood-34-ash', bat: { preset: 'wood-34-ash' } },
+];
 
 /** The request the section sends for these bats (the test's own copy of it). */
 function compareBody(baseline, variants, { sameBatter = false, units = 'imperial', scene = GAME } = {}) {
@@ -60,7 +64,7 @@ const batsRevision = (page) => page.evaluate(() => Number(document.querySelector
 
 /** Waits until the section has finished a refresh newer than `after`, and the page is ready. */
 async function waitForBats(page, after) {
-  await page.waitForFunction(
+  await waitForPage(page, 
     (r) => {
       const state = document.querySelector('#bats-state');
       return (
@@ -182,12 +186,6 @@ async function assertViewsAreTheApis(page, answer, units = 'imperial') {
   return views;
 }
 
-/** Downloads what clicking `selector` offers; resolves to its text and file name. */
-async function download(page, selector) {
-  const [file] = await Promise.all([page.waitForEvent('download'), page.click(selector)]);
-  return { name: file.suggestedFilename(), text: fs.readFileSync(await file.path(), 'utf8') };
-}
-
 const scenarios = [];
 const scenario = (name, fn) => scenarios.push({ name, fn });
 
@@ -196,7 +194,7 @@ scenario(
   async ({ page, url }) => {
     await page.goto(url);
     await page.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
-    await page.waitForFunction(() => document.querySelector('#bats-state').dataset.state === 'ready', null, {
+    await waitForPage(page, () => document.querySelector('#bats-state').dataset.state === 'ready', null, {
       timeout: 20000,
     });
     assert.equal(await page.locator('#bats-views').isHidden(), true, 'no views before a bat is added');
@@ -301,10 +299,7 @@ scenario(
     await page.selectOption('select[name="material"]', 'hard-maple');
     await waitForBats(page, before);
 
-    const variants = [
-      { name: ALLOY, bat: { preset: ALLOY } },
-      { name: 'copy: wood-34-ash', bat: { preset: 'wood-34-ash' } },
-    ];
+    const variants = TWO_ADDED;
     const answer = await compare(
       url,
       compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, variants, { sameBatter: true }),
@@ -381,18 +376,10 @@ scenario(
   async ({ page, url, browser }) => {
     const hash = new URL(page.url()).hash;
     assert.match(hash, /cmp\.bat=/);
-    const phone = await browser.newContext({ viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true });
-    const small = await phone.newPage();
-    const errors = [];
-    small.on('pageerror', (error) => errors.push(error.message));
-    await small.goto(`${url}/${hash}`);
-    await small.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+    const { context: phone, page: small, errors } = await openPhone(browser, `${url}/${hash}`, { hasTouch: true });
     await waitForBats(small, 0);
     assert.equal(await small.locator('#bats-same-batter').isChecked(), true);
-    const variants = [
-      { name: ALLOY, bat: { preset: ALLOY } },
-      { name: 'copy: wood-34-ash', bat: { preset: 'wood-34-ash' } },
-    ];
+    const variants = TWO_ADDED;
     const answer = await compare(
       url,
       compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, variants, { sameBatter: true }),
@@ -428,10 +415,7 @@ scenario('the unit switch: the same bats in SI, then a bat removed by keyboard',
   let before = await batsRevision(page);
   await page.check('input[name="units"][value="si"]');
   await waitForBats(page, before);
-  const variants = [
-    { name: ALLOY, bat: { preset: ALLOY } },
-    { name: 'copy: wood-34-ash', bat: { preset: 'wood-34-ash' } },
-  ];
+  const variants = TWO_ADDED;
   const answer = await compare(
     url,
     compareBody({ preset: 'wood-34-ash', material: 'hard-maple' }, variants, {
@@ -473,7 +457,7 @@ scenario('"same batter" without a bat speed: the API\'s message beside the switc
   let before = await batsRevision(page);
   const revision = await page.evaluate(() => Number(document.body.dataset.revision || 0));
   await page.fill('input[name="bat_speed_mps"]', '');
-  await page.waitForFunction((r) => Number(document.body.dataset.revision || 0) > r, revision, { timeout: 20000 });
+  await waitForPage(page, (r) => Number(document.body.dataset.revision || 0) > r, revision, { timeout: 20000 });
   const slot = page.locator('#bats-form [data-error-for="swing"]');
   await slot.waitFor({ state: 'visible', timeout: 20000 });
   assert.match(await slot.textContent(), /^swing\.speed_model = swing_weight: needs swing\.bat_speed_mps/);
@@ -509,4 +493,4 @@ scenario('a link naming a bat the API does not know: its message beside that bat
   assert.equal(await slot.count(), 0);
 });
 
-await run({ args, chromium, artifacts, scenarios });
+await run(harness, scenarios);

@@ -10,132 +10,34 @@
 // ctest runs it as Browser.Explorer (tests/CMakeLists.txt). Exit status 0 when
 // every scenario passed.
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
-import fs from 'node:fs';
-import { createRequire } from 'node:module';
 import path from 'node:path';
-import { parseArgs } from 'node:util';
+import {
+  GAME,
+  GAME_SI,
+  apiPost,
+  assertNoOverflow,
+  download,
+  openPhone,
+  revision,
+  run,
+  setup,
+  shot,
+  waitForRefresh,
+} from './harness.mjs';
 
-const { values: args } = parseArgs({
-  options: {
-    server: { type: 'string' },
-    'web-root': { type: 'string' },
-    'node-modules': { type: 'string' },
-    artifacts: { type: 'string' },
-    chromium: { type: 'string', default: '/usr/bin/chromium' },
-  },
-});
-for (const name of ['server', 'web-root', 'node-modules', 'artifacts']) {
-  if (!args[name]) {
-    console.error(`explorer.test.mjs: --${name} is required (see the comment at the top)`);
-    process.exit(2);
-  }
-}
-if (!fs.existsSync(args.chromium)) {
-  console.error(`explorer.test.mjs: no browser at ${args.chromium}: run scripts/install-deps.sh (Debian's chromium)`);
-  process.exit(1);
-}
-if (!fs.existsSync(path.join(args['web-root'], 'index.html'))) {
-  console.error(`explorer.test.mjs: no index.html in ${args['web-root']}: build the sweetspot_web target`);
-  process.exit(1);
-}
-const { chromium } = createRequire(path.join(path.resolve(args['node-modules']), 'x.cjs'))('playwright-core');
-const artifacts = path.resolve(args.artifacts);
-fs.rmSync(artifacts, { recursive: true, force: true });
-fs.mkdirSync(artifacts, { recursive: true });
+const harness = setup('explorer.test.mjs');
+const { artifacts } = harness;
 
 const TOKEN = 'browser-test-token-0123456789';
-
-// ---- the server ------------------------------------------------------------
-
-/** Starts sweetspot-server on 127.0.0.1:0; resolves to {url, stop()} once /health answers. */
-async function startServer(name, env = {}) {
-  const log = fs.createWriteStream(path.join(artifacts, `${name}.log`));
-  const child = spawn(
-    args.server,
-    ['--host', '127.0.0.1', '--port', '0', '--jobs-db', 'none', '--web-root', args['web-root'], '--job-workers', '2'],
-    { env: { ...process.env, ...env }, stdio: ['ignore', 'ignore', 'pipe'] },
-  );
-  let stderr = '';
-  const port = await new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error(`${name}: no "listening on" within 20 s:\n${stderr}`)), 20000);
-    child.stderr.on('data', (chunk) => {
-      log.write(chunk);
-      stderr += chunk;
-      const match = /listening on 127\.0\.0\.1:(\d+)/.exec(stderr);
-      if (match) {
-        clearTimeout(timer);
-        resolve(Number(match[1]));
-      }
-    });
-    child.on('exit', (code) => reject(new Error(`${name} exited with ${code}:\n${stderr}`)));
-  });
-  const url = `http://127.0.0.1:${port}`;
-  for (let i = 0; ; ++i) {
-    try {
-      if ((await fetch(`${url}/health`)).ok) break;
-    } catch (error) {
-      if (i > 100) throw error;
-    }
-    await new Promise((r) => setTimeout(r, 100));
-  }
-  return {
-    url,
-    stop: () =>
-      new Promise((resolve) => {
-        child.removeAllListeners('exit');
-        child.on('exit', () => {
-          log.end();
-          resolve();
-        });
-        child.kill('SIGTERM');
-      }),
-  };
-}
-
-/** The API's answer to a POST, as the test's own client (never through the page). */
-async function apiPost(url, route, body, headers = {}) {
-  const res = await fetch(`${url}${route}`, {
-    method: 'POST',
-    headers: { 'Content-Type': 'application/json', ...headers },
-    body: JSON.stringify(body),
-  });
-  return { status: res.status, body: await res.json() };
-}
 
 // ---- the scenarios ---------------------------------------------------------
 
 const SWEET = ['max_exit_speed', 'center_of_percussion', 'vibration_node', 'sweet_zone', 'exit_speed_curve'];
 /** What the page asks /v1/sweet-spot for (the markers' outputs and the headline's). */
 const PAGE_OUTPUTS = [...SWEET, 'bbcor', 'barrel', 'batted_ball'];
-/** The page's opening scene: the mlb ball at 90 mph, a 70 mph bat speed (issue 37). */
-const GAME = {
-  ball: { preset: 'mlb', speed_mph: 90, descent_angle_deg: 7 },
-  swing: { bat_speed_mph: 70, attack_angle_deg: 10 },
-  contact: { undercut_in: 0.5 },
-};
-/** The same scene in SI, as the unit switch's defaults write it (90 mph and 70 mph exactly). */
-const GAME_SI = {
-  ball: { preset: 'mlb', speed_mps: 40.2336, descent_angle_deg: 7 },
-  swing: { bat_speed_mps: 31.2928, attack_angle_deg: 10 },
-  contact: { undercut_m: 0.0127 },
-};
 /** The state the scenarios after the game-condition ones start from: the paper's bat, SI, the API's scene. */
 const PAPER_HASH =
   '#units=si&preset=paper-wood&ball_preset=&ball.speed_mps=&swing.bat_speed_mps=&descent_angle_deg=&attack_angle_deg=&contact.undercut_m=';
-
-async function revision(page) {
-  return Number(await page.evaluate(() => document.body.dataset.revision || 0));
-}
-
-/** Waits until the page has finished a refresh newer than `after`. */
-async function waitForRefresh(page, after) {
-  await page.waitForFunction(
-    (r) => Number(document.body.dataset.revision || 0) > r && document.body.dataset.state === 'ready',
-    after,
-    { timeout: 20000 },
-  );
-}
 
 async function markerOf(page, key) {
   const mark = page.locator(`#curve-chart .u-mark[data-marker="${key}"]`);
@@ -144,29 +46,6 @@ async function markerOf(page, key) {
     positionM: Number(await mark.getAttribute('data-position-m')),
     xPx: Number(await mark.getAttribute('data-x-px')),
   };
-}
-
-async function shot(page, name) {
-  const file = path.join(artifacts, `${name}.png`);
-  await page.screenshot({ path: file, fullPage: true });
-  // The screenshot is part of the test's evidence: it must exist and hold an image.
-  assert.ok(fs.statSync(file).size > 1000, `${file} is empty`);
-}
-
-/** The page is no wider than its viewport (nothing cut off or scrolled sideways). */
-async function assertNoOverflow(page, width) {
-  const sizes = await page.evaluate(() => ({
-    scroll: document.documentElement.scrollWidth,
-    client: document.documentElement.clientWidth,
-    wide: [...document.querySelectorAll('main *')]
-      .filter((e) => e.getBoundingClientRect().right > document.documentElement.clientWidth + 0.5)
-      .filter((e) => !e.closest('.scroll'))
-      .slice(0, 5)
-      .map((e) => `${e.tagName.toLowerCase()}#${e.id}.${e.className}`),
-  }));
-  assert.equal(sizes.client, width);
-  assert.ok(sizes.scroll <= sizes.client, `page ${sizes.scroll} px wide in ${sizes.client} px: ${sizes.wide.join(', ')}`);
-  assert.deepEqual(sizes.wide, [], 'elements past the right edge');
 }
 
 /** The headline's items: key -> {value (the API number it shows), path, text}. */
@@ -256,7 +135,7 @@ scenario('opens at game conditions: a real bat, mlb at 90 mph, 70 mph bat speed,
   assert.match(await page.locator('#compare-table tbody tr:first-child th').textContent(), /Mass oz/);
   assert.match(await page.locator('#bat-drawing .axis').textContent(), /in from the knob/);
   await assertNoOverflow(page, 1280);
-  await shot(page, '00-game-conditions');
+  await shot(page, artifacts, '00-game-conditions');
 
   // The optimisation in the trade's units: diameters in inches, the mass at most 32 oz.
   await page.click('#optimize-run');
@@ -283,7 +162,7 @@ scenario('opens at game conditions: a real bat, mlb at 90 mph, 70 mph bat speed,
   assert.match(ha.hoop_frequency.text, / Hz/);
   assert.equal(ha.bbcor.value, alloy.body.bbcor.value);
   assert.equal(ha.carry.value, alloy.body.batted_ball.distance_ft);
-  await shot(page, '00b-hollow-bat');
+  await shot(page, artifacts, '00b-hollow-bat');
 
   // A refused trade-unit input: the API names the field as written (ball.speed_mph), and its
   // message is shown beside that input.
@@ -338,30 +217,25 @@ scenario('the unit switch: SI inputs and answers, a link that restores them, CSV
   assert.ok(rel < 1e-9, `exit speed differs by ${rel} between the units`);
 
   // The curve's CSV is what the chart shows: the API's curve in SI.
-  const [download] = await Promise.all([page.waitForEvent('download'), page.click('[data-export="curve-csv"]')]);
-  const csv = fs.readFileSync(await download.path(), 'utf8').trim().split('\r\n');
+  const csv = (await download(page, '[data-export="curve-csv"]')).text.trim().split('\r\n');
   assert.equal(csv[0], 'position from the knob (m),exit speed (m/s)');
   assert.equal(csv.length, 122);
   assert.deepEqual(csv[61].split(',').map(Number), [
     si.body.exit_speed_curve[60].position_from_knob_m,
     si.body.exit_speed_curve[60].exit_speed_mps,
   ]);
-  const [svgDownload] = await Promise.all([page.waitForEvent('download'), page.click('[data-export="bat-drawing-svg"]')]);
-  assert.match(fs.readFileSync(await svgDownload.path(), 'utf8'), /<svg[^>]*xmlns="http:\/\/www.w3.org\/2000\/svg"/);
+  assert.match((await download(page, '[data-export="bat-drawing-svg"]')).text, /<svg[^>]*xmlns="http:\/\/www.w3.org\/2000\/svg"/);
 
   // The link restores the page: units and inputs, at a phone's width, nothing cut off.
   const hash = new URL(page.url()).hash;
   assert.match(hash, /units=si/);
   assert.match(hash, /preset=bbcor-33-aluminium/);
-  const phone = await browser.newContext({ viewport: { width: 390, height: 844 }, isMobile: true });
-  const small = await phone.newPage();
-  await small.goto(`${url}/${hash}`);
-  await small.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+  const { context: phone, page: small } = await openPhone(browser, `${url}/${hash}`);
   assert.equal(await small.locator('input[name="units"][value="si"]').isChecked(), true);
   assert.equal(await small.locator('select[name="preset"]').inputValue(), 'bbcor-33-aluminium');
   assert.equal((await headline(small)).sweet_spot.value, si.body.max_exit_speed.position_from_knob_m);
   await assertNoOverflow(small, 390);
-  await shot(small, '00c-phone-si');
+  await shot(small, artifacts, '00c-phone-si');
   await phone.close();
 
   // Another link in the same tab: everything it does not name goes back to the defaults.
@@ -453,7 +327,7 @@ scenario('load the page: bat, properties, curve with markers, modes, variants', 
   });
   const corkMass = await page.locator('#compare-table tbody tr:first-child td').nth(2).getAttribute('data-value');
   assert.equal(Number(corkMass), cork.body.rows[1].properties.mass_kg);
-  await shot(page, '01-loaded');
+  await shot(page, artifacts, '01-loaded');
 });
 
 scenario('change the bat: the curve and its markers move, to the API values', async ({ page, url }) => {
@@ -474,7 +348,7 @@ scenario('change the bat: the curve and its markers move, to the API values', as
     Number(await page.locator('#curve-chart').getAttribute('data-max-exit-speed-mps')),
     ash.body.max_exit_speed.exit_speed_mps,
   );
-  await shot(page, '02-wood-34-ash');
+  await shot(page, artifacts, '02-wood-34-ash');
 
   // A hollow bat: the shell is drawn.
   rev = await revision(page);
@@ -517,7 +391,7 @@ scenario('change the bat: the curve and its markers move, to the API values', as
   await page.selectOption('select[name="fill_material"]', 'cork');
   await waitForRefresh(page, rev);
   assert.equal(await page.locator('#bat-drawing g.bat.main rect.fill').count(), 1);
-  await shot(page, '03-three-segment-cork');
+  await shot(page, artifacts, '03-three-segment-cork');
 });
 
 scenario('a bad input shows the API message beside the field', async ({ page, url }) => {
@@ -550,7 +424,7 @@ scenario('a bad input shows the API message beside the field', async ({ page, ur
     Math.abs(box.y - (input.y + input.height)) < 30,
     `message at y=${box.y}, input ends at ${input.y + input.height}`,
   );
-  await shot(page, '04-bad-input');
+  await shot(page, artifacts, '04-bad-input');
 
   // A fixed input clears the message.
   await page.fill('input[name="barrel_radius_m"]', '0.035');
@@ -647,83 +521,32 @@ scenario('an optimisation the API refuses shows the message beside the field', a
   await page.fill('input[name="starts"]', '4');
 });
 
-// ---- run -------------------------------------------------------------------
-
-const started = Date.now();
-const failures = [];
-const browser = await chromium.launch({
-  executablePath: args.chromium,
-  headless: true,
-  args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
-});
-const server = await startServer('server');
-let page;
-try {
-  const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
-  page = await context.newPage();
-  const pageErrors = [];
-  page.on('pageerror', (error) => pageErrors.push(error.message));
-  page.on('console', (message) => {
-    // The browser logs every 4xx answer ("Failed to load resource"): those are the test's.
-    if (message.type() === 'error' && !/Failed to load resource/.test(message.text())) pageErrors.push(message.text());
-  });
-  for (const { name, fn } of scenarios) {
-    const t0 = Date.now();
-    try {
-      await fn({ page, url: server.url, browser });
-      assert.deepEqual(pageErrors, [], 'errors in the page');
-      console.log(`ok    ${name} (${((Date.now() - t0) / 1000).toFixed(1)} s)`);
-    } catch (error) {
-      failures.push(name);
-      console.log(`FAIL  ${name} (${((Date.now() - t0) / 1000).toFixed(1)} s)\n${error.stack}`);
-      await shot(page, `FAIL-${failures.length}`).catch(() => {});
-      break; // Later scenarios start from this one's page.
-    }
-  }
-} finally {
-  await server.stop();
-}
-
 // The page with a token configured: static files load without it, the page asks for it.
-if (!failures.length) {
-  const guarded = await startServer('server-with-token', { SWEETSPOT_AUTH_TOKEN: TOKEN });
-  const t0 = Date.now();
-  const name = 'a server with a token: the page asks for it and then works';
-  try {
-    const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
-    const tokenPage = await context.newPage();
-    const response = await tokenPage.goto(guarded.url);
-    assert.equal(response.status(), 200);
-    await tokenPage.waitForSelector('#token-form:not([hidden])', { timeout: 20000 });
-    await tokenPage.fill('#token', TOKEN);
-    await tokenPage.click('#token-form button[type="submit"]');
-    await tokenPage.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
-    const sweet = await apiPost(
-      guarded.url,
-      '/v1/sweet-spot',
-      { bat: { preset: 'wood-34-ash' }, ...GAME, outputs: SWEET, options: { curve_samples: 121 } },
-      { Authorization: `Bearer ${TOKEN}` },
-    );
-    assert.equal(
-      (await markerOf(tokenPage, 'max_exit_speed')).positionM,
-      sweet.body.max_exit_speed.position_from_knob_m,
-    );
-    assert.equal(await tokenPage.evaluate(() => sessionStorage.getItem('sweetspot-token')), TOKEN);
-    await tokenPage.screenshot({ path: path.join(artifacts, '08-token.png') });
-    console.log(`ok    ${name} (${((Date.now() - t0) / 1000).toFixed(1)} s)`);
-  } catch (error) {
-    failures.push(name);
-    console.log(`FAIL  ${name}\n${error.stack}`);
-  } finally {
-    await guarded.stop();
-  }
-}
-await browser.close();
+// Its own server (started with the test's, once) and its own context: the test's page
+// stays as the scenarios above left it.
+scenario('a server with a token: the page asks for it and then works', async ({ browser, servers }) => {
+  const guarded = servers['server-with-token'];
+  const context = await browser.newContext({ viewport: { width: 1280, height: 900 } });
+  const tokenPage = await context.newPage();
+  const response = await tokenPage.goto(guarded.url);
+  assert.equal(response.status(), 200);
+  await tokenPage.waitForSelector('#token-form:not([hidden])', { timeout: 20000 });
+  await tokenPage.fill('#token', TOKEN);
+  await tokenPage.click('#token-form button[type="submit"]');
+  await tokenPage.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+  const sweet = await apiPost(
+    guarded.url,
+    '/v1/sweet-spot',
+    { bat: { preset: 'wood-34-ash' }, ...GAME, outputs: SWEET, options: { curve_samples: 121 } },
+    { Authorization: `Bearer ${TOKEN}` },
+  );
+  assert.equal(
+    (await markerOf(tokenPage, 'max_exit_speed')).positionM,
+    sweet.body.max_exit_speed.position_from_knob_m,
+  );
+  assert.equal(await tokenPage.evaluate(() => sessionStorage.getItem('sweetspot-token')), TOKEN);
+  await tokenPage.screenshot({ path: path.join(artifacts, '08-token.png') });
+  await context.close();
+});
 
-const total = scenarios.length + 1;
-console.log(
-  `${failures.length ? `FAILED (${failures.join('; ')}; later scenarios not run)` : 'passed'}: ` +
-    `${total} scenarios, ${failures.length} failed, in ${((Date.now() - started) / 1000).toFixed(1)} s; ` +
-    `screenshots and server logs in ${artifacts}`,
-);
-process.exit(failures.length ? 1 : 0);
+await run(harness, scenarios, { servers: { 'server-with-token': { SWEETSPOT_AUTH_TOKEN: TOKEN } } });

@@ -10,24 +10,26 @@
 //
 // ctest runs it as Browser.Flight (tests/CMakeLists.txt).
 import assert from 'node:assert/strict';
-import fs from 'node:fs';
-import { apiPost, assertNoOverflow, readArgs, revision, run, shot, waitForRefresh } from './flight_harness.mjs';
+import {
+  GAME,
+  GAME_SI,
+  apiPost,
+  assertNoOverflow,
+  download as downloadFrom,
+  openPhone,
+  revision,
+  run,
+  setup,
+  shot,
+  waitForPage,
+  waitForRefresh,
+} from './harness.mjs';
 
-const harness = readArgs('flight.test.mjs');
+const harness = setup('flight.test.mjs');
 const { artifacts } = harness;
 
 /** The page's opening bat and scene (docs/explorer.md, "What it opens on"). */
 const BAT = { preset: 'wood-34-ash' };
-const GAME = {
-  ball: { preset: 'mlb', speed_mph: 90, descent_angle_deg: 7 },
-  swing: { bat_speed_mph: 70, attack_angle_deg: 10 },
-  contact: { undercut_in: 0.5 },
-};
-const GAME_SI = {
-  ball: { preset: 'mlb', speed_mps: 40.2336, descent_angle_deg: 7 },
-  swing: { bat_speed_mps: 31.2928, attack_angle_deg: 10 },
-  contact: { undercut_m: 0.0127 },
-};
 
 /** The batted ball's launch as the page flies it: the batted_ball block of /v1/sweet-spot. */
 async function launchOf(url, scene, units) {
@@ -64,11 +66,8 @@ async function typeInto(page, name, text) {
   await page.keyboard.press('Tab');
 }
 
-/** Downloads what the button `key` exports; returns its text. */
-async function download(page, key) {
-  const [file] = await Promise.all([page.waitForEvent('download'), page.click(`[data-export="${key}"]`)]);
-  return { name: file.suggestedFilename(), text: fs.readFileSync(await file.path(), 'utf8') };
-}
+/** Downloads what the button `key` exports; resolves to its file name and text. */
+const download = (page, key) => downloadFrom(page, `[data-export="${key}"]`);
 
 /** Every input of the new forms has a label (its own <label> or aria-label). */
 async function assertLabelled(page) {
@@ -122,7 +121,7 @@ scenario('the flight from above: a generic field, the API landing point, the spr
     outputs: ['trajectory'],
     report_units: 'imperial',
   });
-  await page.waitForFunction((x) => Number(document.querySelector('#flight-top .landing')?.dataset.x) === x, sprayed.body.landing.x_ft);
+  await waitForPage(page, (x) => Number(document.querySelector('#flight-top .landing')?.dataset.x) === x, sprayed.body.landing.x_ft);
   shown = await shownLanding(page);
   assert.equal(shown.y, sprayed.body.landing.y_ft);
   assert.ok(shown.x > 100, `a 25° spray lands toward right field (x = ${shown.x} ft)`);
@@ -145,7 +144,7 @@ scenario('the flight from above: a generic field, the API landing point, the spr
   assert.match(svg.text, /class="landing"/);
 
   await page.locator('#flight-top-section').scrollIntoViewIfNeeded();
-  await shot(artifacts, page, 'flight-01-above');
+  await shot(page, artifacts, 'flight-01-above');
   await assertNoOverflow(page, 1280);
 });
 
@@ -216,7 +215,7 @@ scenario('the carry map: a heat map equal to carry_map, the distance sweet spot,
 
   // A coarser grid typed from the keyboard: 21 positions.
   await typeInto(page, 'map_positions', '21');
-  await page.waitForFunction(() => document.querySelector('#carry-map')?.dataset.positions === '21');
+  await waitForPage(page, () => document.querySelector('#carry-map')?.dataset.positions === '21');
   const coarse = await apiPost(url, '/v1/sweet-spot', {
     ...body,
     options: { distance: { map_positions: 21, map_undercuts: 21 } },
@@ -234,14 +233,14 @@ scenario('the carry map: a heat map equal to carry_map, the distance sweet spot,
   assert.match(svg.text, /<svg[^>]*xmlns/);
   assert.match(svg.text, /linearGradient/);
   await page.locator('#carry-section').scrollIntoViewIfNeeded();
-  await shot(artifacts, page, 'flight-02-carry-map-ft');
+  await shot(page, artifacts, 'flight-02-carry-map-ft');
 
   // The unit switch, by keyboard: the map and the view from above in metres, the API's SI answers.
   const before = await revision(page);
   await page.locator('input[name="units"][value="imperial"]').focus();
   await page.keyboard.press('ArrowRight');
   await waitForRefresh(page, before);
-  await page.waitForFunction(() => document.querySelector('#carry-map .legend')?.dataset.unit === 'm');
+  await waitForPage(page, () => document.querySelector('#carry-map .legend')?.dataset.unit === 'm');
   await page.waitForSelector('#carry-section[data-state="ready"]');
   const si = await apiPost(url, '/v1/sweet-spot', {
     bat: BAT,
@@ -264,18 +263,18 @@ scenario('the carry map: a heat map equal to carry_map, the distance sweet spot,
     outputs: ['trajectory'],
     report_units: 'si',
   });
-  await page.waitForFunction(() => document.querySelector('#flight-top')?.dataset.unit === 'm');
-  await page.waitForFunction((x) => Number(document.querySelector('#flight-top .landing')?.dataset.x) === x, flight.body.landing.x_m);
+  await waitForPage(page, () => document.querySelector('#flight-top')?.dataset.unit === 'm');
+  await waitForPage(page, (x) => Number(document.querySelector('#flight-top .landing')?.dataset.x) === x, flight.body.landing.x_m);
   assert.equal((await shownLanding(page)).y, flight.body.landing.y_m);
   assert.match(await page.locator('#flight-top').textContent(), /121\.9 m/);
   await page.locator('#carry-section').scrollIntoViewIfNeeded();
-  await shot(artifacts, page, 'flight-03-carry-map-si');
+  await shot(page, artifacts, 'flight-03-carry-map-si');
 
   const back = await revision(page);
   await page.locator('input[name="units"][value="si"]').focus();
   await page.keyboard.press('ArrowLeft');
   await waitForRefresh(page, back);
-  await page.waitForFunction(() => document.querySelector('#carry-map .legend')?.dataset.unit === 'ft');
+  await waitForPage(page, () => document.querySelector('#carry-map .legend')?.dataset.unit === 'ft');
 });
 
 /** The /v1/jobs requests the page sends (their bodies), recorded from now on. */
@@ -299,7 +298,7 @@ async function runFrontier(page, jobs) {
   });
   await page.locator('#frontier-run').focus();
   await page.keyboard.press('Enter');
-  await page.waitForFunction(() => window.frontierStates.includes('ready') || window.frontierStates.includes('error'), null, {
+  await waitForPage(page, () => window.frontierStates.includes('ready') || window.frontierStates.includes('error'), null, {
     timeout: 60000,
   });
   const states = await page.evaluate(() => window.frontierStates);
@@ -375,7 +374,7 @@ scenario('the frontier: the best bat from 28 to 32 oz, run by keyboard, equal to
   const svg = await download(page, 'frontier-svg');
   assert.match(svg.text, /class="pareto"/);
   await page.locator('#frontier-section').scrollIntoViewIfNeeded();
-  await shot(artifacts, page, 'flight-04-frontier');
+  await shot(page, artifacts, 'flight-04-frontier');
   await assertNoOverflow(page, 1280);
 
   // A refusal beside its field: fewer than 2 weights.
@@ -416,7 +415,7 @@ scenario('the frontier: the best bat from 28 to 32 oz, run by keyboard, equal to
     await page.locator(`input[name="units"][value="${from}"]`).focus();
     await page.keyboard.press(key);
     await waitForRefresh(page, before);
-    await page.waitForFunction(() => window.frontierStates.includes('ready') || window.frontierStates.includes('error'), null, {
+    await waitForPage(page, () => window.frontierStates.includes('ready') || window.frontierStates.includes('error'), null, {
       timeout: 60000,
     });
     assert.equal((await page.evaluate(() => window.frontierStates)).at(-1), 'ready');
@@ -436,36 +435,31 @@ scenario('the frontier: the best bat from 28 to 32 oz, run by keyboard, equal to
   assert.match(shownSi.text, /weight \(kg\)/);
   assert.match(shownSi.text, /best exit speed \(m\/s\)/);
   await page.locator('#frontier-section').scrollIntoViewIfNeeded();
-  await shot(artifacts, page, 'flight-04b-frontier-si');
+  await shot(page, artifacts, 'flight-04b-frontier-si');
   const back = await switchUnits('si', 'ArrowLeft');
   assert.equal(back.frontier.constraint, 'mass_oz');
 });
 
 scenario('the link restores the flight views and the frontier at a phone width, nothing cut off', async ({ page, url, browser }) => {
   await typeInto(page, 'frontier_to', '31');
-  await page.waitForFunction(() => window.location.hash.includes('frontier.mass_oz.to=31'));
+  await waitForPage(page, () => window.location.hash.includes('frontier.mass_oz.to=31'));
   const hash = new URL(page.url()).hash;
   assert.match(hash, /spray_angle_deg=25/);
   assert.match(hash, /map_positions=21/);
 
-  const phone = await browser.newContext({ viewport: { width: 390, height: 844 }, isMobile: true, acceptDownloads: true });
-  const small = await phone.newPage();
-  const errors = [];
-  small.on('pageerror', (error) => errors.push(error.message));
-  await small.goto(`${url}/${hash}`);
-  await small.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+  const { context: phone, page: small, errors } = await openPhone(browser, `${url}/${hash}`, { acceptDownloads: true });
   assert.equal(await small.locator('input[name="spray_angle_deg"]').inputValue(), '25');
   assert.equal(await small.locator('input[name="map_positions"]').inputValue(), '21');
   assert.equal(await small.locator('input[name="frontier_to"]').inputValue(), '31');
   await small.waitForSelector('#carry-section[data-state="ready"]');
-  await small.waitForFunction(() => document.querySelector('#carry-map')?.dataset.positions === '21');
+  await waitForPage(small, () => document.querySelector('#carry-map')?.dataset.positions === '21');
   const launch = await launchOf(url, GAME, 'imperial');
   const flight = await apiPost(url, '/v1/flight', {
     launch: { ...launch, spray_angle_deg: 25 },
     outputs: ['trajectory'],
     report_units: 'imperial',
   });
-  await small.waitForFunction((x) => Number(document.querySelector('#flight-top .landing')?.dataset.x) === x, flight.body.landing.x_ft);
+  await waitForPage(small, (x) => Number(document.querySelector('#flight-top .landing')?.dataset.x) === x, flight.body.landing.x_ft);
 
   const jobs = recordJobs(small);
   const { request, states } = await runFrontier(small, jobs);
@@ -478,7 +472,7 @@ scenario('the link restores the flight views and the frontier at a phone width, 
     answer.body.rows.map((r) => r.mass_oz),
   );
   await assertNoOverflow(small, 390);
-  await shot(artifacts, small, 'flight-05-phone');
+  await shot(small, artifacts, 'flight-05-phone');
   assert.deepEqual(errors, []);
   await phone.close();
 
@@ -490,7 +484,7 @@ scenario('the link restores the flight views and the frontier at a phone width, 
     window.frontierStates = [];
   });
   await page.keyboard.press('ArrowRight');
-  await page.waitForFunction(() => window.frontierStates.includes('ready') || window.frontierStates.includes('error'), null, {
+  await waitForPage(page, () => window.frontierStates.includes('ready') || window.frontierStates.includes('error'), null, {
     timeout: 30000,
   });
   assert.equal((await page.evaluate(() => window.frontierStates)).at(-1), 'ready');
@@ -516,7 +510,7 @@ scenario('the link restores the flight views and the frontier at a phone width, 
   await page.evaluate(() => {
     window.location.hash = 'units=si&frontier.mass_oz.from=27&frontier.mass_kg.to=0.9';
   });
-  await page.waitForFunction(() => document.querySelector('input[name="frontier_to"]').value === '0.9');
+  await waitForPage(page, () => document.querySelector('input[name="frontier_to"]').value === '0.9');
   await page.locator('#frontier-run').click();
   const slot = page.locator('#frontier-form [data-error-for="frontier"]');
   await slot.waitFor({ state: 'visible' });

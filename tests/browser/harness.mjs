@@ -1,10 +1,14 @@
-// What a browser test of the explorer needs around its scenarios: the
-// arguments, the real sweetspot-server on 127.0.0.1 with an ephemeral port,
-// Debian's chromium driven by playwright-core, the API asked directly (never
-// through the page), screenshots that must hold an image, the no-overflow
-// check, and the run loop (a failing scenario stops the run: later ones start
-// from its page). compare.test.mjs uses it; explorer.test.mjs has its own copy
-// of the same pieces.
+// The one harness of the explorer's browser tests (explorer.test.mjs, compare.test.mjs,
+// flight.test.mjs): the arguments, the real sweetspot-server on 127.0.0.1 with an ephemeral
+// port, Debian's chromium driven by playwright-core, the API asked directly (never through
+// the page), the page's own ready/revision signals, screenshots that must hold a PNG image,
+// the no-overflow check, downloads, and the run loop (a failing scenario stops the run:
+// later ones start from its page).
+//
+// Cost: one chromium per test, launched while the test's servers start; every server a test
+// needs started once, before its first scenario; no fixed sleeps (each wait is for a signal
+// of the page, and a page-side wait is woken by the page's own changes rather than polled on
+// every animation frame).
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
 import fs from 'node:fs';
@@ -12,10 +16,27 @@ import { createRequire } from 'node:module';
 import path from 'node:path';
 import { parseArgs } from 'node:util';
 
+// ---- what the page opens on (docs/explorer.md, "What it opens on") -------------------------
+
+/** The page's opening scene: the mlb ball at 90 mph, a 70 mph bat speed, a fly ball (issue 37). */
+export const GAME = {
+  ball: { preset: 'mlb', speed_mph: 90, descent_angle_deg: 7 },
+  swing: { bat_speed_mph: 70, attack_angle_deg: 10 },
+  contact: { undercut_in: 0.5 },
+};
+/** The same scene in SI, as the unit switch's defaults write it (90 mph and 70 mph exactly). */
+export const GAME_SI = {
+  ball: { preset: 'mlb', speed_mps: 40.2336, descent_angle_deg: 7 },
+  swing: { bat_speed_mps: 31.2928, attack_angle_deg: 10 },
+  contact: { undercut_m: 0.0127 },
+};
+
+// ---- the test's arguments, the server ------------------------------------------------------
+
 /**
- * Reads --server, --web-root, --node-modules, --artifacts (required) and
- * --chromium; exits 2 (1) when one is missing (when a file is absent).
- * Returns {args, chromium (playwright-core's), artifacts (emptied)}.
+ * Reads --server, --web-root, --node-modules, --artifacts (required) and --chromium; exits 2
+ * (1) when one is missing (when a file is absent). Returns the harness: {args, chromium
+ * (playwright-core's), artifacts (the test's own folder, emptied)}.
  */
 export function setup(testName) {
   const { values: args } = parseArgs({
@@ -48,8 +69,11 @@ export function setup(testName) {
   return { args, chromium, artifacts };
 }
 
-/** Starts sweetspot-server on 127.0.0.1:0; resolves to {url, stop()} once /health answers. */
-export async function startServer(args, artifacts, name, env = {}) {
+/**
+ * Starts sweetspot-server on 127.0.0.1:0 with `env` added to the environment, its log in
+ * `name`.log of the artifacts; resolves to {url, stop()} once /health answers.
+ */
+export async function startServer({ args, artifacts }, name, env = {}) {
   const log = fs.createWriteStream(path.join(artifacts, `${name}.log`));
   const child = spawn(
     args.server,
@@ -71,6 +95,8 @@ export async function startServer(args, artifacts, name, env = {}) {
     child.on('exit', (code) => reject(new Error(`${name} exited with ${code}:\n${stderr}`)));
   });
   const url = `http://127.0.0.1:${port}`;
+  // Listening, so /health answers at once; the retry (every 0.1 s, 10 s at most) is for a
+  // machine too loaded to accept the first connection.
   for (let i = 0; ; ++i) {
     try {
       if ((await fetch(`${url}/health`)).ok) break;
@@ -103,12 +129,104 @@ export async function apiPost(url, route, body, headers = {}) {
   return { status: res.status, body: await res.json() };
 }
 
-/** A full-page screenshot `name`.png in `artifacts`, checked to exist and hold an image. */
+// ---- the page --------------------------------------------------------------------------------
+
+/**
+ * In the page: resolves once `test(arg)` is true, re-checking it on each change of the DOM,
+ * each hash change and, for state kept outside the DOM, every 0.1 s; rejects after `timeout`
+ * ms. Sent as source text (the page's Content-Security-Policy forbids building functions
+ * from strings inside the page).
+ */
+function pageWaiter(test, arg, timeout, source) {
+  return new Promise((resolve, reject) => {
+    let done = false;
+    let observer = null;
+    let interval = 0;
+    let timer = 0;
+    const finish = (error, value) => {
+      if (done) return;
+      done = true;
+      observer?.disconnect();
+      clearInterval(interval);
+      clearTimeout(timer);
+      window.removeEventListener('hashchange', check);
+      if (error) reject(error);
+      else resolve(value);
+    };
+    function check() {
+      try {
+        const value = test(arg);
+        if (value) finish(null, value);
+      } catch (error) {
+        finish(error);
+      }
+    }
+    observer = new MutationObserver(check);
+    observer.observe(document, { attributes: true, childList: true, subtree: true, characterData: true });
+    interval = setInterval(check, 100);
+    timer = setTimeout(() => finish(new Error(`not true within ${timeout} ms: ${source} (${JSON.stringify(arg)})`)), timeout);
+    window.addEventListener('hashchange', check);
+    check();
+  });
+}
+
+/**
+ * Waits until `predicate(arg)` is true in the page: page.waitForFunction's contract (the
+ * same predicate, `timeout` ms at most), but woken by the page's own changes instead of
+ * polled on every animation frame while the page works. Resolves to the predicate's value.
+ * Not across a navigation (wait for the new page with waitForSelector).
+ */
+export async function waitForPage(page, predicate, arg = null, { timeout = 30000 } = {}) {
+  const source = predicate.toString();
+  return page.evaluate(
+    `(${pageWaiter.toString()})((${source}), ${JSON.stringify(arg)}, ${timeout}, ${JSON.stringify(source)})`,
+  );
+}
+
+/**
+ * A page of a new 390 × 844 phone context (isMobile, and `options`) opened at `address` and
+ * ready (body[data-state="ready"]); its uncaught exceptions are gathered in `errors`.
+ * Resolves to {context, page, errors}.
+ */
+export async function openPhone(browser, address, options = {}) {
+  const context = await browser.newContext({ viewport: { width: 390, height: 844 }, isMobile: true, ...options });
+  const page = await context.newPage();
+  const errors = [];
+  page.on('pageerror', (error) => errors.push(error.message));
+  await page.goto(address);
+  await page.waitForSelector('body[data-state="ready"]', { timeout: 20000 });
+  return { context, page, errors };
+}
+
+/** The page's bat revision (body[data-revision]: each accepted refresh adds one). */
+export async function revision(page) {
+  return Number(await page.evaluate(() => document.body.dataset.revision || 0));
+}
+
+/** Waits until the page has finished a bat refresh newer than `after` (body[data-revision], [data-state]). */
+export async function waitForRefresh(page, after) {
+  await waitForPage(
+    page,
+    (r) => Number(document.body.dataset.revision || 0) > r && document.body.dataset.state === 'ready',
+    after,
+    { timeout: 20000 },
+  );
+}
+
+/** Downloads what clicking `selector` offers; resolves to its file name and text. */
+export async function download(page, selector) {
+  const [file] = await Promise.all([page.waitForEvent('download'), page.click(selector)]);
+  return { name: file.suggestedFilename(), text: fs.readFileSync(await file.path(), 'utf8') };
+}
+
+/** A full-page screenshot `name`.png in `artifacts`, checked to exist and hold a PNG image. */
 export async function shot(page, artifacts, name) {
   const file = path.join(artifacts, `${name}.png`);
   await page.screenshot({ path: file, fullPage: true });
   // The screenshot is part of the test's evidence: it must exist and hold an image.
-  assert.ok(fs.statSync(file).size > 1000, `${file} is empty`);
+  const bytes = fs.readFileSync(file);
+  assert.ok(bytes.length > 1000, `${file} is empty`);
+  assert.equal(bytes.subarray(1, 4).toString('latin1'), 'PNG', `${file} is no PNG`);
   return file;
 }
 
@@ -131,25 +249,44 @@ export async function assertNoOverflow(page, width) {
   assert.deepEqual(sizes.wide, [], 'elements past the right edge');
 }
 
+// ---- the run -------------------------------------------------------------------------------
+
 /**
- * Runs `scenarios` ([{name, fn}]) in order on one page of a 1280 × 900
- * context against one server; each fn gets {page, url, browser}. A console
- * error (other than the browser's line for a 4xx answer) or an uncaught
- * exception fails the scenario. Exits 0 when all passed.
+ * Runs `scenarios` ([{name, fn}]) in order on one page of a 1280 × 900 context against the
+ * test's server, stopping at the first failure (a FAIL-n.png of the page is saved). One
+ * chromium for the whole test, launched while the servers start: the test's server
+ * ("server") and, once each, the further servers `servers` names ({name: env}). Each fn
+ * gets {page, url, browser, pageErrors, servers: {name: {url}}}. A console error (other
+ * than the browser's line for a 4xx answer) or an uncaught exception in the page fails the
+ * scenario. Exits the process: 0 when every scenario passed.
  */
-export async function run({ args, chromium, artifacts, scenarios }) {
+export async function run(harness, scenarios, { servers: more = {} } = {}) {
+  const { args, chromium, artifacts } = harness;
   const started = Date.now();
   const failures = [];
-  const browser = await chromium.launch({
-    executablePath: args.chromium,
-    headless: true,
-    args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
-  });
-  const server = await startServer(args, artifacts, 'server');
-  let page;
+  const launched = await Promise.allSettled([
+    chromium.launch({
+      executablePath: args.chromium,
+      headless: true,
+      args: ['--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage'],
+    }),
+    startServer(harness, 'server'),
+    ...Object.entries(more).map(([name, env]) => startServer(harness, name, env)),
+  ]);
+  const [browser, server, ...others] = launched.map((r) => (r.status === 'fulfilled' ? r.value : null));
+  const stopAll = async () => {
+    await Promise.all([server, ...others].filter(Boolean).map((s) => s.stop()));
+    if (browser) await browser.close();
+  };
+  const refused = launched.find((r) => r.status === 'rejected');
+  if (refused) {
+    await stopAll();
+    throw refused.reason;
+  }
+  const servers = Object.fromEntries(Object.keys(more).map((name, i) => [name, others[i]]));
   try {
     const context = await browser.newContext({ viewport: { width: 1280, height: 900 }, acceptDownloads: true });
-    page = await context.newPage();
+    const page = await context.newPage();
     const pageErrors = [];
     page.on('pageerror', (error) => pageErrors.push(error.message));
     page.on('console', (message) => {
@@ -160,7 +297,7 @@ export async function run({ args, chromium, artifacts, scenarios }) {
     for (const { name, fn } of scenarios) {
       const t0 = Date.now();
       try {
-        await fn({ page, url: server.url, browser, pageErrors });
+        await fn({ page, url: server.url, browser, pageErrors, servers });
         assert.deepEqual(pageErrors, [], 'errors in the page');
         console.log(`ok    ${name} (${((Date.now() - t0) / 1000).toFixed(1)} s)`);
       } catch (error) {
@@ -171,8 +308,7 @@ export async function run({ args, chromium, artifacts, scenarios }) {
       }
     }
   } finally {
-    await server.stop();
-    await browser.close();
+    await stopAll();
   }
   console.log(
     `${failures.length ? `FAILED (${failures.join('; ')}; later scenarios not run)` : 'passed'}: ` +
