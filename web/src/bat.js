@@ -106,7 +106,10 @@ export function outlineOf(bat, catalogue) {
   const preset = bat.preset ? catalogue.presets.get(bat.preset) : undefined;
   let knots = null;
   if (bat.profile && Array.isArray(bat.profile.knots)) {
-    knots = bat.profile.knots;
+    // A profile in the request's form: knots in metres (x_m, radius_m) or, when the request
+    // gave its variables in inches, in inches (x_in, diameter_in): drawn at their size.
+    knots = bat.profile.knots.map((k) => ({ x_m: lengthM(k, 'x'), radius_m: radiusM(k, '') }));
+    if (!knots.every((k) => Number.isFinite(k.x_m) && Number.isFinite(k.radius_m))) return null;
   } else if (bat.three_segment) {
     const s = {
       length_m: lengthM(bat.three_segment, 'length'),
@@ -158,9 +161,10 @@ function lengthM(obj, stem) {
 
 /** A radius given as `stem_radius_m`, or as a diameter `stem_diameter_{m,in}`, for the drawing. */
 function radiusM(obj, stem) {
-  const radius = lengthM(obj, `${stem}_radius`);
+  const prefix = stem ? `${stem}_` : '';
+  const radius = lengthM(obj, `${prefix}radius`);
   if (radius !== undefined) return radius;
-  const diameter = lengthM(obj, `${stem}_diameter`);
+  const diameter = lengthM(obj, `${prefix}diameter`);
   return diameter === undefined ? undefined : diameter / 2;
 }
 
