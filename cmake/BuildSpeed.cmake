@@ -12,8 +12,13 @@
 #   time, README "Build times"). A name in a file's anonymous namespace must therefore not
 #   be declared by another file of the same target: the compiler says so at once
 #   ("redefinition of ...", "ambiguous"); shared constants live in one header
-#   (core/numerics/limits.hpp). SWEETSPOT_UNITY_BATCH sets the batch size;
-#   -DSWEETSPOT_UNITY=OFF compiles file by file (quicker rebuilds while editing one file).
+#   (core/numerics/limits.hpp). SWEETSPOT_UNITY_BATCH sets the batch size of the libraries
+#   and benchmarks, SWEETSPOT_TEST_UNITY_BATCH that of the test programs (16: their batches
+#   at -O0 spend most of their time on the templates of GoogleTest, Eigen and nlohmann-json
+#   that every batch instantiates and emits again, so fewer, larger batches do that less
+#   often: two of core_tests' batches of 8 took 32.7 CPU-seconds with GCC, the same 16 files
+#   in one batch 26.7, README "Build times"); -DSWEETSPOT_UNITY=OFF compiles file by file
+#   (quicker rebuilds while editing one file).
 # - sweetspot_test_flags(<target>): test programs compile at SWEETSPOT_TEST_OPTIMIZE (-O0 by
 #   default). The code under test keeps the build type's flags (-O3 in Release, -O2 in the
 #   ASan build, -O1 in the TSan build): only the test drivers are cheaper to compile (a test
@@ -26,13 +31,29 @@
 #   linker meets wins, the test driver's unoptimised one, and the library's calls go to it:
 #   under ASan that made OptimizeSting.TheSameSeedGivesTheSameAnswer take 55 s instead of
 #   22 s (README "Build times").
+# - lld, when installed (scripts/install-deps.sh installs it), links every program: the
+#   sanitizer builds' programs carry line tables and the sanitizer runtimes, and GNU ld took
+#   1.86 CPU-seconds to link the ASan server_tests against lld's 0.41 (gold 0.99), the TSan
+#   server_tests 1.25 against 0.24, a fuzz target 1.03 against 0.26; each build ends on such
+#   links. lld keeps the first copy of a template function
+#   it meets, as GNU ld does, so sweetspot_libraries_first works the same.
 
 option(SWEETSPOT_CCACHE "Compile through ccache when it is installed" ON)
 option(SWEETSPOT_PCH "Precompile the heavy third-party headers" ON)
 option(SWEETSPOT_UNITY "Compile the libraries, test and benchmark programs as unity builds" ON)
-set(SWEETSPOT_UNITY_BATCH 8 CACHE STRING "Source files per unity batch")
+set(SWEETSPOT_UNITY_BATCH 8 CACHE STRING "Source files per unity batch of a library or benchmark")
+set(SWEETSPOT_TEST_UNITY_BATCH 16 CACHE STRING "Source files per unity batch of a test program")
 set(SWEETSPOT_TEST_OPTIMIZE -O0 CACHE STRING
     "Optimisation flag of the test programs (empty: the build type's)")
+option(SWEETSPOT_LLD "Link with lld when it is installed" ON)
+
+if(SWEETSPOT_LLD)
+  include(CheckLinkerFlag)
+  check_linker_flag(CXX -fuse-ld=lld SWEETSPOT_LINKER_LLD)
+  if(SWEETSPOT_LINKER_LLD)
+    add_link_options(-fuse-ld=lld)
+  endif()
+endif()
 
 if(SWEETSPOT_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
   find_program(SWEETSPOT_CCACHE_EXECUTABLE ccache)
@@ -54,11 +75,16 @@ function(sweetspot_precompile target)
   endif()
 endfunction()
 
-# sweetspot_unity(<target>): compiles a library, test or benchmark program in unity batches.
+# sweetspot_unity(<target> [BATCH <n>]): compiles a library, test or benchmark program in unity
+# batches of <n> sources (default SWEETSPOT_UNITY_BATCH).
 function(sweetspot_unity target)
+  cmake_parse_arguments(PARSE_ARGV 1 UNITY "" "BATCH" "")
+  if(NOT UNITY_BATCH)
+    set(UNITY_BATCH ${SWEETSPOT_UNITY_BATCH})
+  endif()
   if(SWEETSPOT_UNITY)
     set_target_properties(${target} PROPERTIES UNITY_BUILD ON
-                                               UNITY_BUILD_BATCH_SIZE ${SWEETSPOT_UNITY_BATCH})
+                                               UNITY_BUILD_BATCH_SIZE ${UNITY_BATCH})
     if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
       # In a batch every source is an included file, so GCC takes a class with a field of
       # its file's anonymous-namespace type for a header's (-Wsubobject-linkage): not so here.

@@ -13,8 +13,8 @@ if [ "${1:-}" = "--runtime" ]; then
 else
   packages=(
     cmake g++ make pkg-config ca-certificates curl
-    # faster builds (cmake/BuildSpeed.cmake): Ninja, and ccache for every compilation
-    ninja-build ccache
+    # faster builds (cmake/BuildSpeed.cmake): Ninja, ccache for every compilation, lld links
+    ninja-build ccache lld
     libeigen3-dev libnlopt-cxx-dev coinor-libipopt-dev
     libcpp-httplib-dev nlohmann-json3-dev
     libgtest-dev libgmock-dev libbenchmark-dev libboost-dev libsqlite3-dev

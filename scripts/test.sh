@@ -11,8 +11,10 @@
 # "Build times"), and because one Clang build serves both the sanitized test suite and
 # the fuzz targets (its core and api carry libFuzzer's coverage too).
 #
-# Each stage prints its wall time, and a table of them closes the run. New build
-# trees use Ninja; every compilation goes through ccache (cmake/BuildSpeed.cmake).
+# Each stage prints its wall time and its CPU time (user + system: unlike wall time it hardly
+# depends on what else the machine runs, so two runs on a shared machine compare by it), and a
+# table of them closes the run. New build trees use Ninja; every compilation goes through
+# ccache and every link through lld when installed (cmake/BuildSpeed.cmake).
 # The sanitizer builds start at once, in the background at idle priority
 # (scripts/stages.sh: stage_background), and use the cores the Release build and
 # the tests leave idle.
