@@ -40,6 +40,55 @@ using SparseQr = Eigen::SparseQR<Eigen::SparseMatrix<double>, Eigen::COLAMDOrder
 // of the same integrals agree to rounding (~1e-15).
 constexpr double kDuplicateRelative = 1e-9;
 
+// The merge's sums over a sparse row of at most this many entries have the dense sums' bits:
+// two products (or squares) need one rounding in any order, and the zeros add nothing.
+constexpr std::size_t kSparseExact = 2;
+
+// A sparse row as a dense vector of n entries.
+Eigen::VectorXd Dense(const DesignGradientRow& row, int n) {
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+  for (const auto& [j, value] : row) v(j) = value;
+  return v;
+}
+
+// The squared norm of a sparse row.
+double SquaredNorm(const DesignGradientRow& row) {
+  double s = 0.0;
+  for (const auto& e : row) s += e.second * e.second;
+  return s;
+}
+
+// The dot product of two sparse rows (both by increasing index).
+double Dot(const DesignGradientRow& a, const DesignGradientRow& b) {
+  double s = 0.0;
+  for (std::size_t p = 0, q = 0; p < a.size() && q < b.size();) {
+    if (a[p].first < b[q].first) {
+      ++p;
+    } else if (b[q].first < a[p].first) {
+      ++q;
+    } else {
+      s += a[p++].second * b[q++].second;
+    }
+  }
+  return s;
+}
+
+// max_j |a_j - t b_j| over two sparse rows (both by increasing index).
+double MaxAbsDifference(const DesignGradientRow& a, double t, const DesignGradientRow& b) {
+  double worst = 0.0;
+  std::size_t p = 0, q = 0;
+  while (p < a.size() || q < b.size()) {
+    if (q == b.size() || (p < a.size() && a[p].first < b[q].first)) {
+      worst = std::max(worst, std::abs(a[p++].second));
+    } else if (p == a.size() || b[q].first < a[p].first) {
+      worst = std::max(worst, std::abs(t * b[q++].second));
+    } else {
+      worst = std::max(worst, std::abs(a[p++].second - t * b[q++].second));
+    }
+  }
+  return worst;
+}
+
 // A column of the fit: a constraint's or a bound's gradient with the sign its multiplier has.
 struct Column {
   enum Kind { kConstraint, kLower, kUpper } kind = kConstraint;
@@ -182,7 +231,8 @@ DesignCertificate Certify(const DesignModel& model, const std::vector<double>& x
     ScaledDesignNlp nlp(model);
     std::vector<double> s = nlp.ToScaled(x);
     for (double& v : s) v = std::clamp(v, 0.0, 1.0);
-    if (!nlp.Evaluate(s.data(), true)) return cert;
+    // The constraints' gradients by sparse rows: only the active ones are read.
+    if (!nlp.EvaluateRows(s.data())) return cert;
     const int n = nlp.n(), m = nlp.m();
     std::vector<double> lower, upper;
     nlp.ConstraintBounds(&lower, &upper);
@@ -217,7 +267,10 @@ DesignCertificate Certify(const DesignModel& model, const std::vector<double>& x
       const Column& col = columns[c];
       const auto cc = static_cast<Eigen::Index>(c);
       if (col.kind == Column::kConstraint) {
-        a.col(cc) = col.sign * nlp.jacobian().row(col.index).transpose();
+        // The dense row's bits: sign times each entry, sign times 0 elsewhere.
+        a.col(cc).setConstant(col.sign * 0.0);
+        for (const auto& [j, v] : nlp.jacobian_rows()[static_cast<std::size_t>(col.index)])
+          a(j, cc) = col.sign * v;
       } else {
         a.col(cc) = col.sign * Eigen::VectorXd::Unit(n, col.index);
       }
@@ -332,18 +385,23 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
     std::vector<const std::vector<double>*> at;  // the x of each evaluated point
     for (const std::vector<double>& x : xs) {
       DesignPoint p;
-      if (!model->Evaluate(x.data(), true, &p)) continue;
+      // The gradients by sparse rows (a knot's limit has 1 entry, the taper 2): the checks
+      // below are O(entries), not O(m n), with the dense checks' bits (Row, Dot, Norm).
+      if (!model->EvaluateRows(x.data(), &p)) continue;
       points.push_back(std::move(p));
       at.push_back(&x);
     }
     if (points.size() < 2) return merged;
-    const Eigen::MatrixXd& j0 = points.front().jacobian;
+    auto row_of = [&points](std::size_t p, int k) -> const DesignGradientRow& {
+      return points[p].jacobian_rows[static_cast<std::size_t>(k)];
+    };
 
     // A signature of each constraint's gradient direction at the first point (unit length, the
     // largest entry positive, projected on a fixed vector), so that only neighbours in it are
     // compared in full.
     Eigen::VectorXd probe(n);
     for (int j = 0; j < n; ++j) probe(j) = 1.0 + 0.5 * std::sin(1.0 + 0.7 * j);
+    const double probe_norm = probe.norm();
     std::vector<std::pair<double, int>> signature;
     // The model's own guards ("validity.*": a wall within every knot's radius, knots in order)
     // are not the request's constraints: they are neither merged nor reported.
@@ -353,27 +411,53 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
     };
     for (int k = 0; k < m; ++k) {
       if (guard(k)) continue;
-      Eigen::VectorXd row = j0.row(k).transpose();
-      const double norm = row.norm();
-      if (!(norm > 0.0) || !row.allFinite()) continue;  // fixed: no variable changes it
-      Eigen::Index big = 0;
-      row.cwiseAbs().maxCoeff(&big);
-      row /= row(big) > 0 ? norm : -norm;
-      signature.push_back({row.dot(probe) / probe.norm(), k});
+      const DesignGradientRow& r = row_of(0, k);
+      if (r.empty()) continue;  // fixed: no variable changes it
+      if (r.size() > kSparseExact) {
+        Eigen::VectorXd row = Dense(r, n);
+        const double norm = row.norm();
+        if (!(norm > 0.0) || !row.allFinite()) continue;
+        Eigen::Index big = 0;
+        row.cwiseAbs().maxCoeff(&big);
+        row /= row(big) > 0 ? norm : -norm;
+        signature.push_back({row.dot(probe) / probe_norm, k});
+        continue;
+      }
+      // At most kSparseExact entries: every sum below has one rounding at most per term, in
+      // any order, so the sparse sums have the dense ones' bits (the zeros add nothing).
+      const double norm = std::sqrt(SquaredNorm(r));
+      if (!(norm > 0.0) || !std::isfinite(norm)) continue;
+      std::size_t big = 0;
+      for (std::size_t e = 1; e < r.size(); ++e)
+        if (std::abs(r[e].second) > std::abs(r[big].second)) big = e;
+      const double divisor = r[big].second > 0 ? norm : -norm;
+      double dot = 0.0;
+      for (const auto& [j, v] : r) dot += (v / divisor) * probe(j);
+      signature.push_back({dot / probe_norm, k});
     }
     std::sort(signature.begin(), signature.end());
 
     // c_k = a c_l + b at every test point: *a, *b.
-    auto affine = [&points](int k, int l, double* a, double* b) {
+    auto affine = [&points, &row_of, n](int k, int l, double* a, double* b) {
       for (std::size_t p = 0; p < points.size(); ++p) {
-        const Eigen::VectorXd gk = points[p].jacobian.row(k).transpose();
-        const Eigen::VectorXd gl = points[p].jacobian.row(l).transpose();
-        const double nl = gl.squaredNorm();
-        if (!(nl > 0.0)) return false;
-        const double ap = gk.dot(gl) / nl;
-        if ((gk - ap * gl).lpNorm<Eigen::Infinity>() >
-            kDuplicateRelative * gk.lpNorm<Eigen::Infinity>())
-          return false;
+        const DesignGradientRow& rk = row_of(p, k);
+        const DesignGradientRow& rl = row_of(p, l);
+        double nl = 0.0, ap = 0.0, residual = 0.0, gk_max = 0.0;
+        if (rk.size() > kSparseExact || rl.size() > kSparseExact) {
+          const Eigen::VectorXd gk = Dense(rk, n), gl = Dense(rl, n);
+          nl = gl.squaredNorm();
+          if (!(nl > 0.0)) return false;
+          ap = gk.dot(gl) / nl;
+          residual = (gk - ap * gl).lpNorm<Eigen::Infinity>();
+          gk_max = gk.lpNorm<Eigen::Infinity>();
+        } else {
+          nl = SquaredNorm(rl);
+          if (!(nl > 0.0)) return false;
+          ap = Dot(rk, rl) / nl;
+          residual = MaxAbsDifference(rk, ap, rl);
+          for (const auto& e : rk) gk_max = std::max(gk_max, std::abs(e.second));
+        }
+        if (residual > kDuplicateRelative * gk_max) return false;
         const double ck = points[p].constraints[static_cast<std::size_t>(k)];
         const double cl = points[p].constraints[static_cast<std::size_t>(l)];
         const double bp = ck - ap * cl;
@@ -444,21 +528,24 @@ std::vector<MergedConstraint> MergeDuplicateConstraints(DesignModel* model) {
     // range contains them: both would be active together.
     for (int k = 0; k < m; ++k) {
       if (removed[static_cast<std::size_t>(k)] || guard(k)) continue;
+      // One variable alone: every point's row has its one entry (the zeros are not kept).
       int var = -1;
       bool single = true;
-      for (const DesignPoint& pt : points) {
-        if (!single) break;
-        for (int j = 0; j < n && single; ++j) {
-          if (pt.jacobian(k, j) == 0.0) continue;
-          if (var >= 0 && var != j) single = false;
-          var = j;
+      for (std::size_t p = 0; p < points.size() && single; ++p) {
+        for (const auto& e : row_of(p, k)) {
+          if (var >= 0 && var != e.first) single = false;
+          var = e.first;
         }
       }
       if (!single || var < 0) continue;
-      const double a = points.front().jacobian(k, var);
+      auto entry = [&row_of, k](std::size_t p) {
+        const DesignGradientRow& r = row_of(p, k);
+        return r.empty() ? 0.0 : r.front().second;
+      };
+      const double a = entry(0);
       bool linear = true;
-      for (const DesignPoint& pt : points)
-        linear = linear && std::abs(pt.jacobian(k, var) - a) <= kDuplicateRelative * std::abs(a);
+      for (std::size_t p = 0; p < points.size(); ++p)
+        linear = linear && std::abs(entry(p) - a) <= kDuplicateRelative * std::abs(a);
       if (!linear) continue;
       const DesignConstraintSpec& c = model->constraints()[static_cast<std::size_t>(k)];
       const DesignVariableSpec& v = model->variables()[static_cast<std::size_t>(var)];

@@ -365,6 +365,12 @@ double DesignModel::cor_impact_from_tip_m() const {
   return barrel_cor_ == nullptr ? kNaN : barrel_cor_->impact_from_tip_m;
 }
 
+double DesignModel::LinearValueAt(const DesignFunctionSpec& f, const std::vector<double>& t) {
+  double v = f.constant;
+  for (const auto& [idx, k] : f.terms) v += k * t[static_cast<std::size_t>(idx)];
+  return v;
+}
+
 double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
   if (f.function == DesignFunction::kObjective && objective_kind_ == DesignObjective::kMinSting) {
     return StingOf(BatAt(x), false).sting_j;  // NaN when it cannot be computed
@@ -399,6 +405,15 @@ double DesignModel::Value(const DesignFunctionSpec& f, const double* x) const {
 }
 
 bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* out) const {
+  return EvaluateImpl(x, with_gradients, false, out);
+}
+
+bool DesignModel::EvaluateRows(const double* x, DesignPoint* out) const {
+  return EvaluateImpl(x, true, true, out);
+}
+
+bool DesignModel::EvaluateImpl(const double* x, bool with_gradients, bool rows,
+                               DesignPoint* out) const {
   const std::vector<double> t = ParametersAt(x);
   design_detail::Integrals in;
   const design_detail::IntegralContext context{
@@ -454,9 +469,14 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
 
   const int mc = m();
   out->constraints.assign(static_cast<std::size_t>(mc), 0.0);
+  out->jacobian_rows.clear();
   if (with_gradients) {
     out->objective_gradient = Eigen::VectorXd::Zero(nv);
-    out->jacobian = Eigen::MatrixXd::Zero(mc, nv);
+    if (rows) {
+      out->jacobian.resize(0, 0);
+    } else {
+      out->jacobian = Eigen::MatrixXd::Zero(mc, nv);
+    }
   }
   if (derivative_free()) {
     if (with_gradients) return false;  // the sting and the carry have no derivative
@@ -467,6 +487,49 @@ bool DesignModel::Evaluate(const double* x, bool with_gradients, DesignPoint* ou
   } else if (!evaluate(objective_, &out->objective,
                        with_gradients ? out->objective_gradient.data() : nullptr, 1)) {
     return false;
+  }
+  if (with_gradients && rows) {
+    // Each row by its nonzero entries. A linear row sums its terms' coefficients per variable
+    // in the dense path's order from 0 (the same bits); any other row is computed densely
+    // (stride 1) and its nonzeros kept.
+    out->jacobian_rows.resize(static_cast<std::size_t>(mc));
+    std::vector<double> dense;
+    for (int k = 0; k < mc; ++k) {
+      const DesignFunctionSpec& f = constraints_[static_cast<std::size_t>(k)].f;
+      DesignGradientRow& row = out->jacobian_rows[static_cast<std::size_t>(k)];
+      double& value = out->constraints[static_cast<std::size_t>(k)];
+      if (f.function == DesignFunction::kLinear) {
+        double v = f.constant;
+        for (const auto& [idx, c] : f.terms) {
+          v += c * t[static_cast<std::size_t>(idx)];
+          const int j = parameter_variable_[static_cast<std::size_t>(idx)];
+          if (j < 0) continue;
+          const double d = c * parameter_scale_[static_cast<std::size_t>(idx)];
+          auto it = std::find_if(row.begin(), row.end(),
+                                 [j](const std::pair<int, double>& e) { return e.first == j; });
+          if (it == row.end()) {
+            row.push_back({j, 0.0 + d});
+          } else {
+            it->second += d;
+          }
+        }
+        value = v;
+        if (!std::isfinite(v)) return false;
+        std::sort(row.begin(), row.end());
+      } else {
+        dense.assign(static_cast<std::size_t>(nv), 0.0);
+        if (!evaluate(f, &value, dense.data(), 1)) return false;
+        for (int j = 0; j < nv; ++j)
+          row.push_back({j, dense[static_cast<std::size_t>(j)]});
+      }
+      std::size_t kept = 0;
+      for (const auto& e : row) {
+        if (!std::isfinite(e.second)) return false;
+        if (e.second != 0.0) row[kept++] = e;
+      }
+      row.resize(kept);
+    }
+    return out->objective_gradient.allFinite();
   }
   for (int k = 0; k < mc; ++k) {
     // Column-major m x n: row k, stride m between variables.

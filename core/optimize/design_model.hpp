@@ -103,12 +103,19 @@ struct DesignVariableSpec {
   std::vector<double> scale_bases;       ///< Their base values, field unit (scale only).
 };
 
+/// One constraint's gradient by its nonzero entries: (variable index, d g / d x_j in the
+/// constraint's unit per the variable's unit), by increasing index (internal).
+using DesignGradientRow = std::vector<std::pair<int, double>>;
+
 /// Values (and gradients) of the objective and constraints at a point, in user units.
 struct DesignPoint {
   double objective = 0.0;              ///< F, objective unit.
   std::vector<double> constraints;     ///< g_k, unit of each.
   Eigen::VectorXd objective_gradient;  ///< dF/dx (when requested).
-  Eigen::MatrixXd jacobian;            ///< dg/dx, m x n (when requested).
+  Eigen::MatrixXd jacobian;            ///< dg/dx, m x n (when requested; not by EvaluateRows).
+  /// dg/dx by rows, their nonzero entries only (EvaluateRows; empty otherwise): each entry has
+  /// the same bits as the dense jacobian's.
+  std::vector<DesignGradientRow> jacobian_rows;
   double mass_kg = 0.0;                ///< M.
   double balance_point_m = 0.0;        ///< C.
   double moi_six_inch_kg_m2 = 0.0;     ///< I6.
@@ -188,9 +195,19 @@ class DesignModel {
 
   /// f(x) for a function (user units); NaN when not finite.
   double Value(const DesignFunctionSpec& f, const double* x) const;
+  /// The parameters at x (DesignParameterLayout order), for LinearValueAt.
+  std::vector<double> Parameters(const double* x) const { return ParametersAt(x); }
+  /// A kLinear function's value at the parameters t = Parameters(x): Value(f, x)'s bits, without
+  /// computing the parameters once per function (O(terms), not O(n)).
+  static double LinearValueAt(const DesignFunctionSpec& f, const std::vector<double>& t);
   /// Objective and constraints at x; false when a value is not finite (or M <= 0). With
   /// gradients, false for the sting objective (it has none): use values only.
   bool Evaluate(const double* x, bool with_gradients, DesignPoint* out) const;
+  /// Evaluate with gradients, the constraints' gradients as sparse rows (out->jacobian_rows;
+  /// out->jacobian left empty): a linear row (a knot's limit, the taper) in O(its terms), so
+  /// that work over every constraint is O(m + n) rather than O(m n). The same values, the same
+  /// bits, and the same verdict as Evaluate(x, true, ...).
+  bool EvaluateRows(const double* x, DesignPoint* out) const;
   /// Hessian of objective_weight * F + sum_k constraint_weights[k] g_k at x (n x n, user
   /// units); false when not finite (and for the sting objective with a nonzero weight).
   bool Hessian(const double* x, double objective_weight, const double* constraint_weights,
@@ -270,6 +287,8 @@ class DesignModel {
   template <typename Scalar>
   Scalar FunctionOf(DesignFunction f, const Scalar* p) const;
   std::vector<double> ParametersAt(const double* x) const;
+  // Evaluate and EvaluateRows: with `rows`, the gradients as out->jacobian_rows.
+  bool EvaluateImpl(const double* x, bool with_gradients, bool rows, DesignPoint* out) const;
   // The frequency at parameters t, Hz, and (when gradient_row) df/dx added into
   // gradient_row[j * stride]; false when it cannot be computed.
   bool FrequencyOf(const std::vector<double>& t, double* value, double* gradient_row,
@@ -397,6 +416,12 @@ class ScaledDesignNlp {
   const std::vector<double>& g() const { return g_; }            ///< Scaled constraints.
   const Eigen::VectorXd& grad_f() const { return grad_f_; }      ///< d f / d s.
   const Eigen::MatrixXd& jacobian() const { return jacobian_; }  ///< d g / d s (m x n).
+  /// Evaluates at s with the gradients, d g / d s by sparse rows (jacobian_rows(); jacobian()
+  /// is not updated): O(m + n) beyond the mass integrals, where Evaluate(s, true) is O(m n).
+  /// The same g, grad_f and entries (the same bits) as Evaluate(s, true); false when not finite.
+  bool EvaluateRows(const double* s);
+  /// d g / d s by rows, their nonzero entries (after EvaluateRows; unscaled entries' order).
+  const std::vector<DesignGradientRow>& jacobian_rows() const { return rows_; }
   /// Hessian of sigma f + sum lambda_k g_k in s (n x n); false when not finite.
   bool Hessian(const double* s, double sigma, const double* lambda, Eigen::MatrixXd* out) const;
   int evaluations() const { return evaluations_; }  ///< Model evaluations so far.
@@ -415,6 +440,7 @@ class ScaledDesignNlp {
   std::vector<double> g_;
   Eigen::VectorXd grad_f_;
   Eigen::MatrixXd jacobian_;
+  std::vector<DesignGradientRow> rows_;
   DesignPoint point_;
   int evaluations_ = 0;
 };

@@ -501,8 +501,13 @@ bool ModelBuilder::Objective() {
   model.objective_scale_ = std::abs(f0) > 0.0 ? std::abs(f0) : 1.0;
   // The least-squares metric is already scaled (0 at a root, which the start may be).
   if (problem.objective == DesignObjective::kLeastSquares) model.objective_scale_ = 1.0;
+  // The parameters once: a linear constraint's value from them (Value's bits) in O(its terms),
+  // not O(n) per constraint.
+  const std::vector<double> t0 = model.Parameters(x0.data());
   for (DesignConstraintSpec& c : model.constraints_) {
-    double s = std::abs(model.Value(c.f, x0.data()));
+    double s = std::abs(c.f.function == DesignFunction::kLinear
+                            ? DesignModel::LinearValueAt(c.f, t0)
+                            : model.Value(c.f, x0.data()));
     if (!std::isfinite(s)) s = 0.0;
     if (std::isfinite(c.lower)) s = std::max(s, std::abs(c.lower));
     if (std::isfinite(c.upper)) s = std::max(s, std::abs(c.upper));

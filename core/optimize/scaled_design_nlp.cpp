@@ -113,6 +113,38 @@ bool ScaledDesignNlp::Evaluate(const double* s, bool with_gradients) {
   return std::isfinite(f_);
 }
 
+bool ScaledDesignNlp::EvaluateRows(const double* s) {
+  const std::size_t n = width_.size();
+  // The values are cached for Evaluate(s, false); the dense Jacobian is not (Evaluate(s, true)
+  // computes it again).
+  last_s_.assign(s, s + n);
+  have_values_ = have_gradients_ = false;
+  const std::vector<double> x = ToUser(s);
+  ++evaluations_;
+  DesignPoint point;
+  if (!model_.EvaluateRows(x.data(), &point)) return false;
+  const double sense = model_.maximize() ? -1.0 : 1.0;
+  const double fs = sense / model_.objective_scale();
+  f_ = fs * point.objective;
+  g_.resize(static_cast<std::size_t>(m()));
+  rows_.resize(static_cast<std::size_t>(m()));
+  for (int k = 0; k < m(); ++k) {
+    const auto kk = static_cast<std::size_t>(k);
+    const double scale = model_.constraints()[kk].scale;
+    g_[kk] = point.constraints[kk] / scale;
+    rows_[kk] = std::move(point.jacobian_rows[kk]);
+    for (auto& [j, v] : rows_[kk]) v = v * width_[static_cast<std::size_t>(j)] / scale;
+  }
+  grad_f_.resize(static_cast<Eigen::Index>(n));
+  for (std::size_t j = 0; j < n; ++j) {
+    grad_f_(static_cast<Eigen::Index>(j)) =
+        fs * point.objective_gradient(static_cast<Eigen::Index>(j)) * width_[j];
+  }
+  point_.objective = point.objective;
+  have_values_ = true;
+  return std::isfinite(f_);
+}
+
 bool ScaledDesignNlp::Hessian(const double* s, double sigma, const double* lambda,
                               Eigen::MatrixXd* out) const {
   const std::vector<double> x = ToUser(s);

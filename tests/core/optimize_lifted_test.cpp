@@ -218,6 +218,66 @@ TEST(OptimizeLifted, SameOptimumAsDenseForAHollowSixtyNineStationProfile) {
   ExpectSameOptimum(p);
 }
 
+// The Jacobian by sparse rows (DesignModel::EvaluateRows, ScaledDesignNlp::EvaluateRows: the
+// merge's, the certificate's and the KKT residual's) has the dense Jacobian's nonzero entries,
+// bit for bit (exact comparisons: the same sums in the same order), and no other entry, on the
+// hollow 69-station profile (its wall guards' rows too) at the start and a point inside.
+TEST(OptimizeLifted, JacobianRowsAreTheDenseJacobiansBits) {
+  DesignProblem p = KnotProblem(69);
+  p.bat.material = *FindMaterial("aluminium-7050");
+  p.bat.wall_thickness_m = 0.003;
+  for (auto& v : p.variables) v.min = 0.0115;
+  p.constraints.mass_kg = DesignRange::Equal(ComputeMassProperties(p.bat).mass_kg);
+  const DesignModel model = Build(p);
+  std::vector<double> inside = model.BaseX();
+  for (std::size_t j = 0; j < inside.size(); ++j) {
+    const DesignVariableSpec& v = model.variables()[j];
+    inside[j] = v.lower + (0.3 + 0.4 * static_cast<double>(j % 3) / 2.0) * (v.upper - v.lower);
+  }
+  ScaledDesignNlp dense_nlp(model), rows_nlp(model);
+  for (const std::vector<double>& x : {model.BaseX(), inside}) {
+    DesignPoint dense, rows;
+    ASSERT_TRUE(model.Evaluate(x.data(), true, &dense));
+    ASSERT_TRUE(model.EvaluateRows(x.data(), &rows));
+    const std::vector<double> s = dense_nlp.ToScaled(x);
+    ASSERT_TRUE(dense_nlp.Evaluate(s.data(), true));
+    ASSERT_TRUE(rows_nlp.EvaluateRows(s.data()));
+    ASSERT_EQ(rows.jacobian_rows.size(), static_cast<std::size_t>(model.m()));
+    int nonzeros = 0, linear_rows = 0;
+    for (int k = 0; k < model.m(); ++k) {
+      const auto kk = static_cast<std::size_t>(k);
+      EXPECT_EQ(rows.constraints[kk], dense.constraints[kk]) << k;
+      EXPECT_EQ(rows_nlp.g()[kk], dense_nlp.g()[kk]) << k;
+      const DesignGradientRow& r = rows.jacobian_rows[kk];
+      const DesignGradientRow& rs = rows_nlp.jacobian_rows()[kk];
+      ASSERT_EQ(r.size(), rs.size()) << k;
+      std::size_t e = 0;
+      for (int j = 0; j < model.n(); ++j) {
+        if (dense.jacobian(k, j) == 0.0) continue;
+        ++nonzeros;
+        ASSERT_LT(e, r.size()) << k << ", " << j;
+        EXPECT_EQ(r[e].first, j) << k;
+        EXPECT_EQ(r[e].second, dense.jacobian(k, j)) << k << ", " << j;
+        EXPECT_EQ(rs[e].first, j) << k;
+        EXPECT_EQ(rs[e].second, dense_nlp.jacobian()(k, j)) << k << ", " << j;
+        ++e;
+      }
+      EXPECT_EQ(e, r.size()) << k;
+      if (model.constraints()[kk].f.function == DesignFunction::kLinear) {
+        ++linear_rows;
+        EXPECT_LE(r.size(), 2u) << k;  // a knot's limit, a taper step, a wall guard
+      }
+    }
+    EXPECT_GT(linear_rows, 2 * model.n());  // the test covers the rows the merge scans
+    EXPECT_GT(nonzeros, model.m());
+    for (int j = 0; j < model.n(); ++j) {
+      EXPECT_EQ(rows.objective_gradient(j), dense.objective_gradient(j));
+      EXPECT_EQ(rows_nlp.grad_f()(j), dense_nlp.grad_f()(j));
+    }
+    EXPECT_EQ(rows_nlp.f(), dense_nlp.f());
+  }
+}
+
 // The certificate above 32 variables factorises the active gradients sparsely: at the 64-knot
 // answer it gives the dense path's multipliers (to 1e-9 of the largest: two QR factorisations
 // of the same well-conditioned columns) and verdicts. With the flat barrel's knots moved onto
