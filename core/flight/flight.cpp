@@ -630,8 +630,9 @@ bool Finish(Lane<K>& a, const FlightOptions& options) {
 #pragma GCC diagnostic ignored "-Wpsabi"
 typedef double Vec __attribute__((vector_size(32)));
 typedef long long VecMask __attribute__((vector_size(32)));
-constexpr int kSoaLanes = 4;
-static_assert(kSoaLanes == kFlyManyLanes, "FlyMany's lanes are the vectors' lanes");
+constexpr int kSoaLanes = 4;  // a vector's lanes
+constexpr int kSoaGroups = kFlyManyLanes / kSoaLanes;  // vectors side by side (2: two chains)
+static_assert(kSoaGroups * kSoaLanes == kFlyManyLanes, "FlyMany's lanes are whole vectors");
 
 [[gnu::always_inline]] inline Vec Splat(double x) { return Vec{x, x, x, x}; }
 
@@ -701,56 +702,103 @@ template <Kind K>
 
 // Attempt<K, L> and ErrorOf<K> on the 4 lanes at once.
 template <Kind K>
-[[gnu::always_inline]] inline void SoaAttempt(SoaLanes<K>& a, double rtol, double atol,
-                                              SoaError* out) {
+[[gnu::always_inline]] inline void SoaAttempt(SoaLanes<K>* groups, double rtol, double atol,
+                                              SoaError* outs) {
   constexpr int N = SoaLanes<K>::N;
-  const Vec t = a.t, h = a.h;
-  const auto& k = a.k;
-  for (int i = 3; i < N; ++i) a.s[i] = a.y[i] + h * a21 * k[0][i];
-  SoaEvaluate<K>(a, 1, t + c2 * h, a.s);
-  for (int i = 3; i < N; ++i) a.s[i] = a.y[i] + h * (a31 * k[0][i] + a32 * k[1][i]);
-  SoaEvaluate<K>(a, 2, t + c3 * h, a.s);
-  for (int i = 3; i < N; ++i) {
-    a.s[i] = a.y[i] + h * (a41 * k[0][i] + a42 * k[1][i] + a43 * k[2][i]);
+#define SWEETSPOT_GROUPS for (int g = 0; g < kSoaGroups; ++g)
+#define SWEETSPOT_GROUP \
+  SoaLanes<K>& a = groups[g]; \
+  const Vec t = a.t, h = a.h; \
+  const auto& k = a.k; \
+  (void)t; \
+  (void)k
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    for (int i = 3; i < N; ++i) a.s[i] = a.y[i] + h * a21 * k[0][i];
   }
-  SoaEvaluate<K>(a, 3, t + c4 * h, a.s);
-  for (int i = 3; i < N; ++i) {
-    a.s[i] = a.y[i] + h * (a51 * k[0][i] + a52 * k[1][i] + a53 * k[2][i] + a54 * k[3][i]);
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    SoaEvaluate<K>(a, 1, t + c2 * h, a.s);
   }
-  SoaEvaluate<K>(a, 4, t + c5 * h, a.s);
-  for (int i = 3; i < N; ++i) {
-    a.s[i] = a.y[i] + h * (a61 * k[0][i] + a62 * k[1][i] + a63 * k[2][i] + a64 * k[3][i] +
-                           a65 * k[4][i]);
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    for (int i = 3; i < N; ++i) a.s[i] = a.y[i] + h * (a31 * k[0][i] + a32 * k[1][i]);
   }
-  SoaEvaluate<K>(a, 5, t + h, a.s);
-  for (int i = 0; i < N; ++i) {
-    a.y_new[i] = a.y[i] + h * (a71 * k[0][i] + a73 * k[2][i] + a74 * k[3][i] +
-                               a75 * k[4][i] + a76 * k[5][i]);
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    SoaEvaluate<K>(a, 2, t + c3 * h, a.s);
   }
-  SoaEvaluate<K>(a, 6, t + h, a.y_new);
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    for (int i = 3; i < N; ++i) {
+      a.s[i] = a.y[i] + h * (a41 * k[0][i] + a42 * k[1][i] + a43 * k[2][i]);
+    }
+  }
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    SoaEvaluate<K>(a, 3, t + c4 * h, a.s);
+  }
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    for (int i = 3; i < N; ++i) {
+      a.s[i] = a.y[i] + h * (a51 * k[0][i] + a52 * k[1][i] + a53 * k[2][i] + a54 * k[3][i]);
+    }
+  }
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    SoaEvaluate<K>(a, 4, t + c5 * h, a.s);
+  }
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    for (int i = 3; i < N; ++i) {
+      a.s[i] = a.y[i] + h * (a61 * k[0][i] + a62 * k[1][i] + a63 * k[2][i] + a64 * k[3][i] +
+                             a65 * k[4][i]);
+    }
+  }
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    SoaEvaluate<K>(a, 5, t + h, a.s);
+  }
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    for (int i = 0; i < N; ++i) {
+      a.y_new[i] = a.y[i] + h * (a71 * k[0][i] + a73 * k[2][i] + a74 * k[3][i] +
+                                 a75 * k[4][i] + a76 * k[5][i]);
+    }
+  }
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    SoaEvaluate<K>(a, 6, t + h, a.y_new);
+  }
   const Vec zero = {};
   const Vec largest = Splat(std::numeric_limits<double>::max());
-  out->err2 = out->position_err2 = out->velocity_err2 = zero;
-  out->finite = VecMask{} - 1;
-  for (int i = 0; i < N; ++i) {
-    const Vec e = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] + e5 * k[4][i] +
-                       e6 * k[5][i] + e7 * k[6][i]);
-    const Vec yn = a.y_new[i];
-    out->finite &= (Abs(yn) <= largest) & (Abs(e) <= largest);
-    Vec scale;
-    if (i < 6) {
-      const Vec ay = Abs(a.y[i]), ayn = Abs(yn);
-      scale = atol + rtol * (ay < ayn ? ayn : ay);  // std::max(|y|, |y_new|)
-    } else {
-      scale = Splat(rtol);
-    }
-    out->err2 += (e / scale) * (e / scale);
-    if (i < 3) {
-      out->position_err2 += e * e;
-    } else if (i < 6) {
-      out->velocity_err2 += e * e;
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    SoaError* out = &outs[g];
+    out->err2 = out->position_err2 = out->velocity_err2 = zero;
+    out->finite = VecMask{} - 1;
+    for (int i = 0; i < N; ++i) {
+      const Vec e = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] + e5 * k[4][i] +
+                         e6 * k[5][i] + e7 * k[6][i]);
+      const Vec yn = a.y_new[i];
+      out->finite &= (Abs(yn) <= largest) & (Abs(e) <= largest);
+      Vec scale;
+      if (i < 6) {
+        const Vec ay = Abs(a.y[i]), ayn = Abs(yn);
+        scale = atol + rtol * (ay < ayn ? ayn : ay);  // std::max(|y|, |y_new|)
+      } else {
+        scale = Splat(rtol);
+      }
+      out->err2 += (e / scale) * (e / scale);
+      if (i < 3) {
+        out->position_err2 += e * e;
+      } else if (i < 6) {
+        out->velocity_err2 += e * e;
+      }
     }
   }
+#undef SWEETSPOT_GROUPS
+#undef SWEETSPOT_GROUP
 }
 
 // The kernels, compiled for AVX2 and for the baseline (neither with FMA); one non-template
@@ -760,18 +808,18 @@ template <Kind K>
 #else
 #define SWEETSPOT_FLIGHT_CLONES
 #endif
-SWEETSPOT_FLIGHT_CLONES void SoaAttemptSaturating(SoaLanes<Kind::kSaturating>& a, double rtol,
+SWEETSPOT_FLIGHT_CLONES void SoaAttemptSaturating(SoaLanes<Kind::kSaturating>* a, double rtol,
                                                   double atol, SoaError* out) {
   SoaAttempt<Kind::kSaturating>(a, rtol, atol, out);
 }
-SWEETSPOT_FLIGHT_CLONES void SoaAttemptLinear(SoaLanes<Kind::kLinear>& a, double rtol,
+SWEETSPOT_FLIGHT_CLONES void SoaAttemptLinear(SoaLanes<Kind::kLinear>* a, double rtol,
                                               double atol, SoaError* out) {
   SoaAttempt<Kind::kLinear>(a, rtol, atol, out);
 }
 #undef SWEETSPOT_FLIGHT_CLONES
 
 template <Kind K>
-void SoaAttemptOf(SoaLanes<K>& a, double rtol, double atol, SoaError* out) {
+void SoaAttemptOf(SoaLanes<K>* a, double rtol, double atol, SoaError* out) {
   if constexpr (K == Kind::kSaturating) {
     SoaAttemptSaturating(a, rtol, atol, out);
   } else {
@@ -806,55 +854,64 @@ void SoaLoad(const Lane<K>& lane, int l, SoaLanes<K>* v) {
 template <Kind K, class StartFlight>
 void FlyLanesSoa(std::size_t count, const FlightOptions& options, const StartFlight& start) {
   constexpr int N = Lane<K>::N;
-  Lane<K> lanes[kSoaLanes];
-  SoaLanes<K> v;
+  constexpr int L = kFlyManyLanes;
+  Lane<K> lanes[L];
+  SoaLanes<K> v[kSoaGroups];
   std::size_t next = 0;
   auto refill = [&](int l) {
     lanes[l].r = nullptr;
     while (next < count) {
       if (start(next++, &lanes[l])) {
-        SoaLoad(lanes[l], l, &v);
+        SoaLoad(lanes[l], l % kSoaLanes, &v[l / kSoaLanes]);
         return;
       }
     }
   };
-  for (int l = 0; l < kSoaLanes; ++l) refill(l);
+  for (int l = 0; l < L; ++l) refill(l);
   const double rtol = options.relative_tolerance, atol = options.absolute_tolerance_m;
   while (true) {
     int active = 0;
-    for (int l = 0; l < kSoaLanes; ++l) {
+    for (int l = 0; l < L; ++l) {
       while (lanes[l].r != nullptr && AtLimit(lanes[l], options)) refill(l);
       active += lanes[l].r != nullptr ? 1 : 0;
     }
     if (active == 0) return;
-    v.t = Vec{lanes[0].t, lanes[1].t, lanes[2].t, lanes[3].t};
-    v.h = Vec{lanes[0].h, lanes[1].h, lanes[2].h, lanes[3].h};
-    SoaError se;
-    SoaAttemptOf<K>(v, rtol, atol, &se);
-    VecMask advance = {};
-    for (int l = 0; l < kSoaLanes; ++l) {
+    for (int g = 0; g < kSoaGroups; ++g) {
+      const Lane<K>* q = lanes + g * kSoaLanes;
+      v[g].t = Vec{q[0].t, q[1].t, q[2].t, q[3].t};
+      v[g].h = Vec{q[0].h, q[1].h, q[2].h, q[3].h};
+    }
+    SoaError errors[kSoaGroups];
+    SoaAttemptOf<K>(v, rtol, atol, errors);
+    VecMask advance[kSoaGroups] = {};
+    for (int l = 0; l < L; ++l) {
       Lane<K>& a = lanes[l];
       if (a.r == nullptr) continue;
+      const SoaLanes<K>& w = v[l / kSoaLanes];
+      const SoaError& se = errors[l / kSoaLanes];
+      const int m = l % kSoaLanes;
       // What Conclude reads of the state: the event tests always, everything on an event.
-      a.y[5] = v.y[5][l];
-      a.y_new[2] = v.y_new[2][l];
-      a.y_new[5] = v.y_new[5][l];
+      a.y[5] = w.y[5][m];
+      a.y_new[2] = w.y_new[2][m];
+      a.y_new[5] = w.y_new[5][m];
       if ((a.y[5] > 0.0 && a.y_new[5] <= 0.0) || (a.y_new[2] <= 0.0 && a.y_new[5] < 0.0)) {
         for (int i = 0; i < N; ++i) {
-          a.y[i] = v.y[i][l];
-          a.y_new[i] = v.y_new[i][l];
-          for (int j = 0; j < 7; ++j) a.k[j][i] = v.k[j][i][l];
+          a.y[i] = w.y[i][m];
+          a.y_new[i] = w.y_new[i][m];
+          for (int j = 0; j < 7; ++j) a.k[j][i] = w.k[j][i][m];
         }
       }
-      const StepError error{se.err2[l], se.position_err2[l], se.velocity_err2[l],
-                            se.finite[l] != 0};
+      const StepError error{se.err2[m], se.position_err2[m], se.velocity_err2[m],
+                            se.finite[m] != 0};
       const Outcome outcome = Conclude(a, options, error);
-      if (outcome == Outcome::kAccepted) advance[l] = -1;
+      if (outcome == Outcome::kAccepted) advance[l / kSoaLanes][m] = -1;
       if (outcome == Outcome::kEnded) refill(l);
     }
-    for (int i = 0; i < N; ++i) {
-      v.y[i] = advance ? v.y_new[i] : v.y[i];
-      v.k[0][i] = advance ? v.k[6][i] : v.k[0][i];  // first same as last
+    for (int g = 0; g < kSoaGroups; ++g) {
+      for (int i = 0; i < N; ++i) {
+        v[g].y[i] = advance[g] ? v[g].y_new[i] : v[g].y[i];
+        v[g].k[0][i] = advance[g] ? v[g].k[6][i] : v[g].k[0][i];  // first same as last
+      }
     }
   }
 }
