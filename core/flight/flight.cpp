@@ -616,14 +616,17 @@ bool Finish(Lane<K>& a, const FlightOptions& options) {
 }
 
 // FlyMany's lanes as a structure of arrays (the decay kinds, nathan-2016 and custom): each
-// component of the 4 lanes' states, stages and models is one vector of GCC's vector extension,
-// so a right-hand side, a stage sum and the error norm are one vector operation per term across
-// the lanes (two SSE2 instructions on the baseline x86-64 target, one on AVX2: AttemptSoa is
-// compiled for both and picked at load time). A lane's operations are Fly's, in Fly's order,
-// each IEEE-rounded (division and square root included), and neither target enables FMA, so
-// nothing is contracted: the answers are Fly's to the bit (FlightTest.FlyManyGivesFlysAnswers).
-// The step's bookkeeping (the controller's log and exp, the events, the refill) stays per lane
-// on the scalar Lane; an idle lane computes on its last numbers, its results unread (masked).
+// component of 4 lanes' states, stages and models is one vector of GCC's vector extension, so a
+// right-hand side, a stage sum and the error norm are one vector operation per term across the
+// lanes (two SSE2 instructions on the baseline x86-64 target, one on AVX2: the kernel is
+// compiled for both, target_clones, and picked at load time). FlyMany's 8 lanes are two such
+// vectors (SoaLanes groups) taken in turn in each stage: two independent chains, so the
+// processor overlaps one's square root and divisions with the other's (one vector of 8 made GCC
+// move its elements through memory). A lane's operations are Fly's, in Fly's order, each
+// IEEE-rounded (division and square root included), and neither target enables FMA, so nothing
+// is contracted: the answers are Fly's to the bit (FlightTest.FlyManyGivesFlysAnswers). The
+// step's bookkeeping (the controller's log and exp, the events, the refill) stays per lane on
+// the scalar Lane; an idle lane computes on its last numbers, its results unread (masked).
 // The vectors never cross a call's boundary (the kernels take them in SoaLanes): GCC's note on
 // the ABI of 32-byte vectors without AVX does not apply.
 #pragma GCC diagnostic push
