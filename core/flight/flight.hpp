@@ -286,7 +286,7 @@ FlightResult Fly(const Launch& launch, const Environment& environment = {},
                  std::vector<TrajectoryPoint>* trajectory = nullptr);
 
 /// How many flights FlyMany flies side by side (the stepper's lanes).
-inline constexpr int kFlyManyLanes = 4;
+inline constexpr int kFlyManyLanes = 8;
 
 /// Flies `count` launches, results[i] = Fly(launches[i], environments[shared_environment ? 0 :
 /// i], aero, options) to the bit (no trajectories), several side by side: one flight's stages

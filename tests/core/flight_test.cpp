@@ -392,10 +392,15 @@ TEST(FlightTest, FlyManyGivesFlysAnswers) {
   FlightOptions few_steps;
   few_steps.max_steps = 12;  // some flights end at the step limit, at different times
   for (const FlightOptions& options : {FlightOptions(), few_steps}) {
-    for (AeroModel model : {AeroModel::kNathan2016, AeroModel::kSawicki2003, AeroModel::kVacuum,
-                            AeroModel::kCustom}) {
+    // The custom model twice: its saturating lift law (the default) and the linear one (each
+    // a kernel of its own in FlyMany's vector stepper).
+    for (int variant = 0; variant < 5; ++variant) {
       AeroOptions aero;
-      aero.model = model;
+      aero.model = variant == 0   ? AeroModel::kNathan2016
+                   : variant == 1 ? AeroModel::kSawicki2003
+                   : variant == 2 ? AeroModel::kVacuum
+                                  : AeroModel::kCustom;
+      if (variant == 4) aero.lift_law = LiftLaw::kLinear;
       std::vector<FlightResult> many(launches.size());
       FlyMany(launches.size(), launches.data(), environments.data(), false, aero, options,
               many.data());
@@ -409,6 +414,9 @@ TEST(FlightTest, FlyManyGivesFlysAnswers) {
         EXPECT_EQ(many[i].steps, one.steps) << i;
         EXPECT_EQ(many[i].evaluations, one.evaluations) << i;
         EXPECT_EQ(many[i].refusal.has_value(), one.refusal.has_value()) << i;
+        EXPECT_EQ(many[i].landing_x_m, one.landing_x_m) << i;
+        EXPECT_EQ(many[i].landing_angle_deg, one.landing_angle_deg) << i;
+        EXPECT_EQ(many[i].rejected_steps, one.rejected_steps) << i;
       }
     }
   }
