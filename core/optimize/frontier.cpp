@@ -27,7 +27,7 @@ constexpr QuantityName kQuantityNames[] = {
     {FrontierQuantity::kMoiSixInchKgM2, "moi_six_inch_kg_m2"},
     {FrontierQuantity::kMinFrequencyHz, "min_frequency_hz"},
     {FrontierQuantity::kMaxBarrelDiameterM, "max_barrel_diameter_m"},
-    {FrontierQuantity::kSwingWeightExponent, "swing_weight_exponent"},
+    {FrontierQuantity::kSpeedModelExponent, "swing_weight_exponent"},
 };
 
 bool IsRange(FrontierQuantity q) {
@@ -265,7 +265,7 @@ bool FrontierSpec::Validate(const DesignProblem& problem, Refusal* refusal) cons
       return refuse(NumberRefusal(field, values[i], "repeats an earlier value"));
     }
   }
-  if (quantity == FrontierQuantity::kSwingWeightExponent &&
+  if (quantity == FrontierQuantity::kSpeedModelExponent &&
       problem.objective != DesignObjective::kMaxExitSpeedSwingWeight) {
     return refuse(TextRefusal("frontier.constraint",
                               "swing_weight_exponent weights the objective "
@@ -313,7 +313,7 @@ DesignProblem FrontierProblemAt(const DesignProblem& problem, const FrontierSpec
     case FrontierQuantity::kMaxBarrelDiameterM:
       c.max_barrel_diameter_m = value;
       break;
-    case FrontierQuantity::kSwingWeightExponent:
+    case FrontierQuantity::kSpeedModelExponent:
       p.swing_weight_exponent = value;
       break;
   }

@@ -28,7 +28,7 @@ enum class FrontierQuantity {
   kMaxBarrelDiameterM,  ///< "max_barrel_diameter_m": constraints.max_barrel_diameter_m (upper).
   /// "swing_weight_exponent": problem.swing_weight_exponent, n in omega0 (I6/I6_ref)^-n
   /// (objective max_exit_speed_swing_weight only).
-  kSwingWeightExponent,
+  kSpeedModelExponent,  // (named apart from core::kSwingWeightExponent, its default)
 };
 
 /// Stable name (quoted above).

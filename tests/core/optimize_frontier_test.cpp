@@ -154,7 +154,7 @@ TEST(FrontierTest, RefusesWhatItCannotSolve) {
   many.max_values = 2;
   EXPECT_EQ(refusal(many, p).field, "frontier.values");
   FrontierSpec exponent;
-  exponent.quantity = FrontierQuantity::kSwingWeightExponent;
+  exponent.quantity = FrontierQuantity::kSpeedModelExponent;
   exponent.values = {0.1, 0.2};
   EXPECT_EQ(refusal(exponent, p).field, "frontier.constraint");  // max_exit_speed: no weight
   FrontierSpec bounded;
@@ -190,7 +190,7 @@ TEST(FrontierTest, EachQuantitySetsItsConstraint) {
   EXPECT_EQ(*FrontierProblemAt(p, spec, 150.0).constraints.min_frequency_hz, 150.0);
   spec.quantity = FrontierQuantity::kMaxBarrelDiameterM;
   EXPECT_EQ(*FrontierProblemAt(p, spec, 0.066).constraints.max_barrel_diameter_m, 0.066);
-  spec.quantity = FrontierQuantity::kSwingWeightExponent;
+  spec.quantity = FrontierQuantity::kSpeedModelExponent;
   EXPECT_EQ(FrontierProblemAt(p, spec, 0.3).swing_weight_exponent, 0.3);
   for (const char* name : {"length_m", "mass_kg", "balance_point_m", "moi_six_inch_kg_m2",
                            "min_frequency_hz", "max_barrel_diameter_m", "swing_weight_exponent"}) {
