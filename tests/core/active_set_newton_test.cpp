@@ -15,30 +15,17 @@
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "core/units.hpp"
+#include "tests/core/knot_design_problems.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
 namespace active_set_newton_test {
 namespace {
 
-// bench/core_frontier.cpp's 16-knot solid ash bat (14 inner radii free; balance point at most
-// 0.60 m, diameters, non-decreasing taper) with its mass `delta_oz` from the base bat's.
+// bench/core_frontier.cpp's 16-knot solid ash bat (knot_design_problems.hpp) with its mass
+// `delta_oz` from the base bat's.
 DesignProblem SixteenKnotProblem(double delta_oz) {
-  DesignProblem p;
-  const int n = 16;
-  const double length = 0.86;
-  for (int i = 0; i < n; ++i) {
-    const double s = static_cast<double>(i) / (n - 1);
-    p.bat.knots.push_back({length * s, 0.0125 + 0.020 / (1.0 + std::exp(-14.0 * (s - 0.55)))});
-  }
-  p.bat.material = *FindMaterial("ash");
-  for (int i = 1; i <= n - 2; ++i) {
-    p.variables.push_back({"profile.knots[" + std::to_string(i) + "].radius_m", 0.0110, 0.0332});
-  }
-  p.constraints.balance_point_m = DesignRange::AtMost(0.60);
-  p.constraints.max_barrel_diameter_m = InchesToMetres(2.61);
-  p.constraints.min_handle_diameter_m = InchesToMetres(0.9);
-  p.constraints.taper = TaperRule::kNonDecreasing;
+  DesignProblem p = knot_design_problems::SolidAshKnots(16);
   p.constraints.mass_kg =
       DesignRange::Equal(ComputeMassProperties(p.bat).mass_kg + OuncesToKilograms(delta_oz));
   return p;

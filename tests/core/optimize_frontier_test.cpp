@@ -11,32 +11,15 @@
 #include "core/bat/material.hpp"
 #include "core/optimize/frontier.hpp"
 #include "core/units.hpp"
+#include "tests/core/knot_design_problems.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
 namespace optimize_frontier_test {
 namespace {
 
-// A 10-knot solid ash bat, 0.86 m, its 8 inner radii free; balance point at most 0.60 m,
-// diameters and a non-decreasing taper (bench/core_frontier.cpp's problem, smaller).
-DesignProblem TenKnotProblem() {
-  DesignProblem p;
-  const int n = 10;
-  const double length = 0.86;
-  for (int i = 0; i < n; ++i) {
-    const double s = static_cast<double>(i) / (n - 1);
-    p.bat.knots.push_back({length * s, 0.0125 + 0.020 / (1.0 + std::exp(-14.0 * (s - 0.55)))});
-  }
-  p.bat.material = *FindMaterial("ash");
-  for (int i = 1; i <= n - 2; ++i) {
-    p.variables.push_back({"profile.knots[" + std::to_string(i) + "].radius_m", 0.0110, 0.0332});
-  }
-  p.constraints.balance_point_m = DesignRange::AtMost(0.60);
-  p.constraints.max_barrel_diameter_m = InchesToMetres(2.61);
-  p.constraints.min_handle_diameter_m = InchesToMetres(0.9);
-  p.constraints.taper = TaperRule::kNonDecreasing;
-  return p;
-}
+// A 10-knot solid ash bat (bench/core_frontier.cpp's problem, smaller: knot_design_problems.hpp).
+DesignProblem TenKnotProblem() { return knot_design_problems::SolidAshKnots(10); }
 
 // Masses from the base mass - 1.5 oz to + 1.5 oz.
 FrontierSpec Masses(const DesignProblem& p, int count) {

@@ -17,31 +17,17 @@
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "core/units.hpp"
+#include "tests/core/knot_design_problems.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
 namespace optimize_lifted_test {
 namespace {
 
-// bench/core_optimize.cpp's KnotProblem: max exit speed over the radii of knots 1..n-2 of a
-// solid ash bat, equal mass, balance point <= 0.60 m, diameter limits, non-decreasing taper.
+// bench/core_optimize.cpp's KnotProblem (knot_design_problems.hpp), at the base bat's mass.
 DesignProblem KnotProblem(int n) {
-  DesignProblem p;
-  const double length = 0.86;
-  for (int i = 0; i < n; ++i) {
-    const double x = length * i / (n - 1);
-    const double s = x / length;
-    p.bat.knots.push_back({x, 0.0125 + 0.020 / (1.0 + std::exp(-14.0 * (s - 0.55)))});
-  }
-  p.bat.material = *FindMaterial("ash");
-  for (int i = 1; i <= n - 2; ++i) {
-    p.variables.push_back({"profile.knots[" + std::to_string(i) + "].radius_m", 0.0110, 0.0332});
-  }
+  DesignProblem p = knot_design_problems::SolidAshKnots(n);
   p.constraints.mass_kg = DesignRange::Equal(ComputeMassProperties(p.bat).mass_kg);
-  p.constraints.balance_point_m = DesignRange::AtMost(0.60);
-  p.constraints.max_barrel_diameter_m = InchesToMetres(2.61);
-  p.constraints.min_handle_diameter_m = InchesToMetres(0.9);
-  p.constraints.taper = TaperRule::kNonDecreasing;
   return p;
 }
 
