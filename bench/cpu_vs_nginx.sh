@@ -44,39 +44,8 @@ for _ in $(seq 100); do
 done
 [ -n "$port" ] || { echo "cpu_vs_nginx.sh: no port in the server's log" >&2; cat "$work/server.log" >&2; exit 1; }
 url="http://127.0.0.1:$port/v1/sweet-spot"
-mkdir -p "$work/html"
-curl -sS -X POST -H 'Content-Type: application/json' -d "$body" "$url" >"$work/html/sweet-spot.json"
-nginx_port=""
-while [ -z "$nginx_port" ]; do  # a loopback port nobody listens on
-  candidate=$(( 20000 + RANDOM % 20000 ))
-  (echo >"/dev/tcp/127.0.0.1/$candidate") 2>/dev/null || nginx_port="$candidate"
-done
-cat >"$work/nginx.conf" <<CONF
-worker_processes auto;
-events { worker_connections 4096; }
-http {
-  access_log off;
-  keepalive_requests 100000;
-  client_body_temp_path $work/body;
-  proxy_temp_path $work/proxy;
-  fastcgi_temp_path $work/fastcgi;
-  uwsgi_temp_path $work/uwsgi;
-  scgi_temp_path $work/scgi;
-  server {
-    listen 127.0.0.1:$nginx_port;
-    root $work/html;
-    location / { default_type application/json; }
-  }
-}
-CONF
-/usr/sbin/nginx -p "$work" -c "$work/nginx.conf" \
-  -g "daemon off; pid $work/nginx.pid; error_log $work/nginx-error.log;" &
-nginx_pid=$!
-static_url="http://127.0.0.1:$nginx_port/sweet-spot.json"
-for _ in $(seq 100); do
-  curl -fsS "$static_url" >/dev/null 2>&1 && break
-  sleep 0.1
-done
+source bench/nginx_static.sh  # (the working directory is the repository)
+start_nginx_static "$work" "$body" "$url"
 ticks() {
   local total=0 p
   for p in "$@"; do total=$((total + $(awk '{print $14 + $15}' "/proc/$p/stat"))); done
