@@ -375,7 +375,9 @@ class RetryTest(unittest.TestCase):
     """429 and 503 provoked for real on servers with tiny limits; Retry-After honoured."""
 
     def test_503_over_the_connection_limit_is_retried_after_retry_after(self):
-        server = ServerProcess(["--max-connections", "1"])
+        # The held connection sends nothing: a first-byte timeout longer than the test, so the
+        # server never closes it (at the default 2 s a loaded machine's slow first 503 lost it).
+        server = ServerProcess(["--max-connections", "1", "--first-byte-timeout-s", "30"])
         try:
             # retries=0: the 503 itself, with its Retry-After
             holder, refused = hold_the_only_connection(self, server)
