@@ -17,16 +17,8 @@ cleanup() {
   rm -rf "$work"
 }
 trap cleanup EXIT
-"$server" --port 0 --access-log 0 --max-connections-per-client 256 --jobs-db none \
-  2>"$work/server.log" &
-pid=$!
-port=""
-for _ in $(seq 100); do
-  port="$(sed -n 's/.* listening on [^:]*:\([0-9]*\) .*/\1/p' "$work/server.log" | head -n1)"
-  [ -n "$port" ] && break
-  sleep 0.1
-done
-[ -n "$port" ] || { echo "cpu_per_request.sh: no port in the server's log" >&2; cat "$work/server.log" >&2; exit 1; }
+source bench/loopback_servers.sh  # (the working directory is the repository)
+start_sweetspot "$server" "$work" none
 cat >"$work/post.lua" <<'LUA'
 wrk.method = "POST"
 wrk.headers["Content-Type"] = "application/json"

@@ -33,18 +33,9 @@ wrk.headers["Content-Type"] = "application/json"
 wrk.body = '$body'
 LUA
 : >"$work/get.lua"
-"$server" --port 0 --access-log 0 --max-connections-per-client 256 --jobs-db none \
-  2>"$work/server.log" &
-pid=$!
-port=""
-for _ in $(seq 100); do
-  port="$(sed -n 's/.* listening on [^:]*:\([0-9]*\) .*/\1/p' "$work/server.log" | head -n1)"
-  [ -n "$port" ] && break
-  sleep 0.1
-done
-[ -n "$port" ] || { echo "cpu_vs_nginx.sh: no port in the server's log" >&2; cat "$work/server.log" >&2; exit 1; }
+source bench/loopback_servers.sh  # (the working directory is the repository)
+start_sweetspot "$server" "$work" none
 url="http://127.0.0.1:$port/v1/sweet-spot"
-source bench/nginx_static.sh  # (the working directory is the repository)
 start_nginx_static "$work" "$body" "$url"
 ticks() {
   local total=0 p

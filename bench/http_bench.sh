@@ -76,21 +76,13 @@ EOF
 # The server's defaults (8 light workers, one compute worker per core, 256
 # connections) but one: wrk is one client address, so it may hold all 256 connections;
 # only the access log is off, as wrk's millions of lines would measure the terminal.
-"$server" --port 0 --access-log 0 --max-connections-per-client 256 --jobs-db "$work/jobs.db" 2>"$work/server.log" &
-pid=$!
-port=""
-for _ in $(seq 1 100); do
-  port="$(sed -n 's/.* listening on [^:]*:\([0-9]*\) .*/\1/p' "$work/server.log" | head -n1)"
-  [ -n "$port" ] && break
-  sleep 0.1
-done
-[ -n "$port" ] || { cat "$work/server.log" >&2; exit 1; }
+source bench/loopback_servers.sh  # (the working directory is the repository)
+start_sweetspot "$server" "$work" "$work/jobs.db"
 url="http://127.0.0.1:$port/v1/sweet-spot"
 wrk -t1 -c1 -d1s -s "$work/post.lua" "$url" >/dev/null  # warm-up
 
 # nginx: the same JSON answer as a static file, keep-alive, no access log.
 body="$(sed -n "s/^wrk.body = '\(.*\)'$/\1/p" "$work/post.lua")"
-source bench/nginx_static.sh  # (the working directory is the repository)
 start_nginx_static "$work" "$body" "$url"
 sed -e 's/^wrk.method.*//' -e 's/^wrk.headers.*//' -e 's/^wrk.body.*//' "$work/post.lua" >"$work/get.lua"
 wrk -t1 -c1 -d1s -s "$work/get.lua" "$static_url" >/dev/null  # warm-up

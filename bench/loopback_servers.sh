@@ -1,6 +1,26 @@
-# Sourced by bench/http_bench.sh and bench/cpu_vs_nginx.sh (not run on its own): Debian's nginx
-# serving sweetspot's answer to one request as a static file, keep-alive, no access log.
+# Sourced by bench/http_bench.sh, cpu_vs_nginx.sh and cpu_per_request.sh (not run on its own):
+# the servers they measure on loopback.
 #
+#   start_sweetspot SERVER WORK JOBS_DB
+# starts SERVER on an ephemeral loopback port with the defaults but two (no access log, and up
+# to 256 connections from one client address, as wrk is one), its log in WORK/server.log, and
+# sets pid and port (exits with the log when no port appears within 10 s). The caller stops it.
+start_sweetspot() {
+  local server="$1" work="$2" jobs_db="$3"
+  "$server" --port 0 --access-log 0 --max-connections-per-client 256 --jobs-db "$jobs_db" \
+    2>"$work/server.log" &
+  pid=$!
+  port=""
+  for _ in $(seq 100); do
+    port="$(sed -n 's/.* listening on [^:]*:\([0-9]*\) .*/\1/p' "$work/server.log" | head -n1)"
+    [ -n "$port" ] && break
+    sleep 0.1
+  done
+  [ -n "$port" ] || { echo "no port in the server's log" >&2; cat "$work/server.log" >&2; exit 1; }
+}
+
+# Debian's nginx serving sweetspot's answer to one request as a static file, keep-alive, no
+# access log:
 #   start_nginx_static WORK BODY URL
 # posts BODY to URL (the running sweetspot), keeps the answer as WORK/html/sweet-spot.json,
 # starts nginx on a free loopback port with its files under WORK, waits until it answers, and
