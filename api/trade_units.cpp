@@ -97,54 +97,107 @@ const UnitRule* SiblingUnitRule(const Json& node, std::string_view key) {
   return RuleOf("x_" + it->get<std::string>());
 }
 
-void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false) {
+// The unit an enclosing object gives its objective's numbers: an answer's "objective_unit"
+// holds for "objective_value" beside it and for the objective's values anywhere under it (the
+// spread's "objective_min", a run's "objective", a material's "objective_value"); `carry`: the
+// objective is max_distance's carry (the answer has a "distance_sweet_spot"), in feet too.
+struct ObjectiveUnit {
+  const UnitRule* rule = nullptr;
+  bool carry = false;
+};
+
+bool IsObjectiveKey(std::string_view key) {
+  return key == "objective" || key == "objective_value" || key == "objective_min" ||
+         key == "objective_max" || key == "objective_median";
+}
+
+// The rule of a number whose unit a sibling "unit" string names (an active constraint's
+// "value", "bound" and "tolerance" beside "unit": "kg"; an error row's "error" and
+// "reference"), or nullptr. Its multiplier (the
+// objective's unit per the constraint's) is not converted.
+const UnitRule* UnitSiblingRule(const Json& node, std::string_view key) {
+  if (key != "value" && key != "bound" && key != "tolerance" && key != "error" &&
+      key != "reference") {
+    return nullptr;
+  }
+  const auto it = node.find("unit");
+  if (it == node.end() || !it->is_string()) return nullptr;
+  return RuleOf("x_" + it->get<std::string>());
+}
+
+// The twins AddImperial adds beside `key` (its `value`) in `node`, in order: the trade unit's
+// ("_in", "_oz", "_mph", "_oz_in2"), a flight length's or carry's "_ft", and a position's
+// "_from_tip_in" where the bat's length is known. Empty for a key without an SI unit.
+std::vector<std::pair<std::string, Json>> TwinsOf(const Json& node, const std::string& key,
+                                                  const Json& value,
+                                                  std::optional<double> length_m, bool feet,
+                                                  ObjectiveUnit objective) {
+  std::vector<std::pair<std::string, Json>> added;
+  const UnitRule* rule = RuleOf(key);
+  std::string base;
+  bool carry = IsFlightLength(key.substr(0, key.size() - (rule ? rule->si.size() : 0)));
+  if (rule != nullptr) {
+    base = key.substr(0, key.size() - rule->si.size());
+  } else if ((rule = SiblingUnitRule(node, key)) != nullptr) {
+    // "objective_value" in "objective_unit" -> "objective_value_mph"; max_distance's
+    // objective (the answer carries its distance_sweet_spot) is a carry: in feet too.
+    base = key;
+    carry = node.contains("distance_sweet_spot");
+  } else if ((rule = UnitSiblingRule(node, key)) != nullptr) {
+    base = key;  // an active constraint's "bound" in "unit": "kg" -> "bound_oz"
+  } else if (objective.rule != nullptr && IsObjectiveKey(key)) {
+    rule = objective.rule;  // the spread's "objective_max" -> "objective_max_mph"
+    base = key;
+    carry = objective.carry;
+  } else {
+    return added;
+  }
+  const double to_si = rule->to_si;
+  const auto twin = MapNumbers(value, [to_si](double si) { return si / to_si; });
+  if (!twin) return added;
+  added.emplace_back(base + std::string(rule->trade), *twin);
+  if (rule->trade == "_in" && (feet || carry)) {
+    const auto in_feet = [](double si) { return si / (12.0 * core::kMetresPerInch); };
+    added.emplace_back(base + "_ft", *MapNumbers(value, in_feet));
+  }
+  if (rule->trade != "_in" || !length_m) return added;
+  const auto from_tip = [length = *length_m](double si) {
+    return (length - si) / core::kMetresPerInch;
+  };
+  if (EndsWith(base, "_from_knob")) {
+    const std::string stem = base.substr(0, base.size() - std::string_view("_from_knob").size());
+    added.emplace_back(stem + "_from_tip_in", *MapNumbers(value, from_tip));
+  } else if (EndsWith(base, "_knob")) {
+    // A zone's ends ("from_knob_m", "to_knob_m" of sweet_zone): each end from the tip too.
+    added.emplace_back(base + "_from_tip_in", *MapNumbers(value, from_tip));
+  }
+  return added;
+}
+
+void AddImperialTo(Json* node, std::optional<double> length_m, bool feet = false,
+                   ObjectiveUnit objective = {}) {
   if (node->is_array()) {
-    for (Json& item : *node) AddImperialTo(&item, length_m, feet);
+    for (Json& item : *node) AddImperialTo(&item, length_m, feet, objective);
     return;
   }
   if (!node->is_object()) return;
   if (const auto own = LengthOf(*node)) length_m = own;
+  const ObjectiveUnit here = objective;  // this object's own objective_value: SiblingUnitRule
+  if (const auto unit = node->find("objective_unit"); unit != node->end() && unit->is_string()) {
+    objective = {RuleOf("x_" + unit->get<std::string>()), node->contains("distance_sweet_spot")};
+  }
   std::vector<std::pair<std::string, Json>> added;
   for (auto& [key, value] : node->items()) {
     if (value.is_structured() && !MapNumbers(value, [](double x) { return x; })) {
       // A "bat" is the request's own form (optimize, fit): a request again as it stands, so
       // one form per quantity, as the request gave it.
       if (key != "bat") {
-        AddImperialTo(&value, length_m, key == "landing" || key == "trajectory");
+        AddImperialTo(&value, length_m, key == "landing" || key == "trajectory", objective);
       }
       continue;
     }
-    const UnitRule* rule = RuleOf(key);
-    std::string base;
-    bool carry = IsFlightLength(key.substr(0, key.size() - (rule ? rule->si.size() : 0)));
-    if (rule != nullptr) {
-      base = key.substr(0, key.size() - rule->si.size());
-    } else if ((rule = SiblingUnitRule(*node, key)) != nullptr) {
-      // "objective_value" in "objective_unit" -> "objective_value_mph"; max_distance's
-      // objective (the answer carries its distance_sweet_spot) is a carry: in feet too.
-      base = key;
-      carry = node->contains("distance_sweet_spot");
-    } else {
-      continue;
-    }
-    const double to_si = rule->to_si;
-    const auto twin = MapNumbers(value, [to_si](double si) { return si / to_si; });
-    if (!twin) continue;
-    added.emplace_back(base + std::string(rule->trade), *twin);
-    if (rule->trade == "_in" && (feet || carry)) {
-      const auto in_feet = [](double si) { return si / (12.0 * core::kMetresPerInch); };
-      added.emplace_back(base + "_ft", *MapNumbers(value, in_feet));
-    }
-    if (rule->trade != "_in" || !length_m) continue;
-    const auto from_tip = [length = *length_m](double si) {
-      return (length - si) / core::kMetresPerInch;
-    };
-    if (EndsWith(base, "_from_knob")) {
-      const std::string stem = base.substr(0, base.size() - std::string_view("_from_knob").size());
-      added.emplace_back(stem + "_from_tip_in", *MapNumbers(value, from_tip));
-    } else if (EndsWith(base, "_knob")) {
-      // A zone's ends ("from_knob_m", "to_knob_m" of sweet_zone): each end from the tip too.
-      added.emplace_back(base + "_from_tip_in", *MapNumbers(value, from_tip));
+    for (auto& twin : TwinsOf(*node, key, value, length_m, feet, here)) {
+      added.push_back(std::move(twin));
     }
   }
   for (auto& [key, value] : added) {
@@ -252,6 +305,15 @@ std::vector<TradeForm> SiFormsOf(std::string_view key) {
 }
 
 void AddImperial(Json* answer) { AddImperialTo(answer, std::nullopt); }
+
+std::vector<std::string> ImperialTwinKeys(const Json& object, const std::string& key) {
+  std::vector<std::string> keys;
+  const auto it = object.find(key);
+  if (it == object.end()) return keys;
+  // Any length gives the names; the values are not kept.
+  for (auto& twin : TwinsOf(object, key, *it, 0.0, false, {})) keys.push_back(twin.first);
+  return keys;
+}
 
 void AddImperial(Json* answer, std::optional<double> length_m) { AddImperialTo(answer, length_m); }
 

@@ -70,13 +70,26 @@ enum class ReportUnits {
 /// ("objective_value" beside "objective_unit": "mps") gets it named after itself
 /// ("objective_value_mph"; a length in inches, and in feet too where the object carries a
 /// "distance_sweet_spot": max_distance's carry). Lengths "distance_m", "apex_m" and those under
-/// "landing" and "trajectory" (a flight's) get "_ft" twins too. Keys already present are kept. An
+/// "landing" and "trajectory" (a flight's) get "_ft" twins too. An answer's "objective_unit"
+/// holds for its objective's numbers anywhere under it too (the spread's "objective_min",
+/// "objective_max", "objective_median", a run's "objective", a material's "objective_value"),
+/// and an object's "unit" for its "value", "bound", "tolerance", "error" and "reference" (an
+/// active constraint's "bound_oz"; its "multiplier", a unit per unit, is left). Keys already
+/// present are kept. An
 /// object under the key "bat" is left as it is: it is a request's form (optimize's, fit's
 /// answer), in the units the request gave, and can be sent again as it stands.
 void AddImperial(nlohmann::json* answer);
 /// AddImperial, with the bat's length `length_m` where `answer` states none (a /v1/explore
 /// row's output block: the row need not carry the bat's properties).
 void AddImperial(nlohmann::json* answer, std::optional<double> length_m);
+
+/// The keys AddImperial adds beside `key` of `object` (a trade unit's first, then "_ft",
+/// "_from_tip_in"), as a table of rows names its columns (/v1/optimize's frontier in CSV):
+/// "objective_value" beside "objective_unit": "mps" -> {"objective_value_mph"}; "mass_kg" ->
+/// {"mass_oz"}; "position_from_knob_m" -> {"position_from_knob_in", "position_from_tip_in"}
+/// (the last only where the bat's length is known: a caller keeps the keys its row has).
+/// Empty when `object` has no `key` or `key` has no SI unit.
+std::vector<std::string> ImperialTwinKeys(const nlohmann::json& object, const std::string& key);
 
 /// Where AddImperial takes a field it adds: `key` is `si_key`'s value divided by `to_si`
 /// ("exit_speed_mph" = "exit_speed_mps" / 0.44704), or, `from_tip`, the bat's length less

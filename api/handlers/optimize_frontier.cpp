@@ -317,6 +317,41 @@ const Json* At(const Json& row, const std::string& path) {
   return value == block->end() ? nullptr : &*value;
 }
 
+// With "report_units": "imperial", each SI column followed by its twins that the row (an
+// AddImperial'd row) has: "objective_value" -> "objective_value_mph" (or "_in", "_ft" for a
+// carry), "properties.mass_kg" -> "properties.mass_oz", "sweet_spot.position_from_knob_m" ->
+// "..._in", "sweet_spot.position_from_tip_in". A variable's column stays as written.
+std::vector<std::string> WithImperialTwins(const std::vector<std::string>& columns,
+                                           const Json& row) {
+  std::vector<std::string> out;
+  for (const std::string& column : columns) {
+    out.push_back(column);
+    if (column.rfind("variables.", 0) == 0) continue;
+    const std::size_t dot = column.find('.');
+    const std::string prefix = dot == std::string::npos ? "" : column.substr(0, dot + 1);
+    const Json* block = &row;
+    if (dot != std::string::npos) {
+      const auto it = row.find(column.substr(0, dot));
+      if (it == row.end() || !it->is_object()) continue;
+      block = &*it;
+    }
+    for (const std::string& twin : ImperialTwinKeys(*block, column.substr(prefix.size()))) {
+      if (block->contains(twin)) out.push_back(prefix + twin);
+    }
+  }
+  return out;
+}
+
+std::string CsvHeader(const std::vector<std::string>& columns) {
+  std::string header;
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    if (i > 0) header.push_back(',');
+    AppendCsvField(Json(columns[i]), &header);
+  }
+  header.push_back('\n');
+  return header;
+}
+
 std::string CsvLine(const Json& row, const std::vector<std::string>& columns) {
   std::string line;
   for (std::size_t i = 0; i < columns.size(); ++i) {
@@ -352,17 +387,21 @@ Response HandleFrontier(Json body, const Context& context,
   if (request->format == "csv") {
     Response streamed = Response::Text(200, std::string(), "text/csv");
     streamed.stream = [request, run](const ChunkSink& sink) {
-      const std::vector<std::string> columns = CsvColumns(*request);
-      std::string header;
-      for (std::size_t i = 0; i < columns.size(); ++i) {
-        if (i > 0) header.push_back(',');
-        AppendCsvField(Json(columns[i]), &header);
-      }
-      header.push_back('\n');
-      if (!sink(header)) return false;
+      std::vector<std::string> columns = CsvColumns(*request);
+      // In SI the header goes out at once; in imperial units with the first row, whose twins
+      // (the objective's unit among them) name the extra columns.
+      bool header_sent = !request->imperial;
+      if (header_sent && !sink(CsvHeader(columns))) return false;
       const core::FrontierSummary s = run([&](const core::FrontierPoint& point) {
-        return sink(CsvLine(RowOf(*request, point), columns));
+        const Json row = RowOf(*request, point);
+        if (!header_sent) {
+          columns = WithImperialTwins(columns, row);
+          header_sent = true;
+          if (!sink(CsvHeader(columns))) return false;
+        }
+        return sink(CsvLine(row, columns));
       });
+      if (!header_sent && !sink(CsvHeader(columns))) return false;  // no row at all
       return !s.stopped && !s.cancelled && s.summary.termination != core::Termination::kFailure;
     };
     return streamed;

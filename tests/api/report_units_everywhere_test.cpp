@@ -6,7 +6,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "api/router.hpp"
 
@@ -23,6 +26,19 @@ constexpr double kFoot = 12 * kInch;  // m, exact
 
 Response Post(const std::string& path, const Json& body) {
   return Dispatch({"POST", path, body.dump()}, Context{});
+}
+
+// A CSV answer's lines split at commas (these rows quote nothing: no field has a comma).
+std::vector<std::vector<std::string>> CsvRows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> fields;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) fields.push_back(cell);
+    rows.push_back(std::move(fields));
+  }
+  return rows;
 }
 
 // The bat's length as /v1/bat/properties states it.
@@ -194,6 +210,92 @@ TEST(ReportUnitsEverywhereTest, OptimizeObjectiveValueHasItsMphTwin) {
   const Response si = Post("/v1/optimize", OptimizeRequest());
   ASSERT_EQ(si.status, 200);
   EXPECT_FALSE(si.body.contains("objective_value_mph"));
+}
+
+// The summary's numbers in the objective's unit (the spread, each run) and in an active
+// constraint's unit (its value, bound, tolerance) get their twins too; the multiplier, a unit
+// of the objective per unit of the constraint, is left.
+TEST(ReportUnitsEverywhereTest, OptimizeSpreadAndActiveConstraintsHaveTwins) {
+  Json body = OptimizeRequest();
+  body["report_units"] = "imperial";
+  const Response r = Post("/v1/optimize", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const Json& spread = r.body["summary"]["spread"];
+  for (const char* key : {"objective_min", "objective_max", "objective_median"}) {
+    EXPECT_EQ(spread[std::string(key) + "_mph"].get<double>(), spread[key].get<double>() / kMph)
+        << key;
+  }
+  ASSERT_FALSE(spread["runs"].empty());
+  for (const Json& run : spread["runs"]) {
+    EXPECT_EQ(run["objective_mph"].get<double>(), run["objective"].get<double>() / kMph);
+  }
+  const Json& active = r.body["summary"]["active_constraints"];
+  ASSERT_FALSE(active.empty()) << r.body.dump();  // the mass bound holds the optimum
+  bool saw_mass = false;
+  for (const Json& a : active) {
+    if (a["unit"] != "kg") continue;
+    saw_mass = true;
+    constexpr double kOunce = 0.028349523125;  // kg, exact
+    for (const char* key : {"value", "bound", "tolerance"}) {
+      EXPECT_EQ(a[std::string(key) + "_oz"].get<double>(), a[key].get<double>() / kOunce) << key;
+    }
+    EXPECT_FALSE(a.contains("multiplier_oz"));
+  }
+  EXPECT_TRUE(saw_mass) << active.dump();
+}
+
+// A material choice: each material's objective_value in the answer's objective_unit.
+TEST(ReportUnitsEverywhereTest, MaterialChoiceRowsHaveObjectiveTwins) {
+  Json body = OptimizeRequest();
+  body["variables"].push_back({{"path", "material"}, {"choices", {"ash", "hard-maple"}}});
+  body["report_units"] = "imperial";
+  const Response r = Post("/v1/optimize", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  ASSERT_EQ(r.body["materials"].size(), 2u);
+  for (const Json& m : r.body["materials"]) {
+    EXPECT_EQ(m["objective_value_mph"].get<double>(), m["objective_value"].get<double>() / kMph)
+        << m.dump();
+  }
+}
+
+// The frontier in CSV with "report_units": "imperial": each SI column is followed by its twins
+// (the objective's in its unit, the properties', the sweet spot's from the knob and the tip),
+// with AddImperial's values.
+TEST(ReportUnitsEverywhereTest, FrontierCsvHasImperialColumns) {
+  Json body = Json::parse(R"({"bat": {"preset": "wood-34-ash"},
+      "variables": [{"path": "profile.knots[9].radius_m", "min": 0.011, "max": 0.034}],
+      "constraints": {"balance_point_m": {"max": 0.62}},
+      "frontier": {"constraint": "mass_oz", "from": 31, "to": 32, "count": 2},
+      "format": "csv", "report_units": "imperial"})");
+  const std::string csv = Post("/v1/optimize", body).text;
+  const std::vector<std::vector<std::string>> rows = CsvRows(csv);
+  ASSERT_EQ(rows.size(), 3u) << csv;
+  const std::vector<std::string>& header = rows[0];
+  const auto column = [&](const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name << " in " << csv;
+    return static_cast<std::size_t>(it - header.begin());
+  };
+  const std::size_t value = column("objective_value"), mph = column("objective_value_mph");
+  EXPECT_EQ(mph, value + 1);  // the twin right after its SI column
+  const std::size_t kg = column("properties.mass_kg"), oz = column("properties.mass_oz");
+  const std::size_t knob = column("sweet_spot.position_from_knob_m");
+  const std::size_t knob_in = column("sweet_spot.position_from_knob_in");
+  const std::size_t tip_in = column("sweet_spot.position_from_tip_in");
+  const std::size_t length = column("properties.length_m");
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const auto at = [&](std::size_t c) { return std::stod(rows[i].at(c)); };
+    // CSV writes each double round-trip exactly, so AddImperial's arithmetic on the SI
+    // column's number gives the twin's bits.
+    EXPECT_EQ(at(mph), at(value) / kMph);
+    EXPECT_EQ(at(oz), at(kg) / 0.028349523125);
+    EXPECT_EQ(at(knob_in), at(knob) / kInch);
+    EXPECT_EQ(at(tip_in), (at(length) - at(knob)) / kInch);
+  }
+  body["report_units"] = "si";
+  const std::vector<std::vector<std::string>> si = CsvRows(Post("/v1/optimize", body).text);
+  ASSERT_FALSE(si.empty());
+  EXPECT_EQ(std::find(si[0].begin(), si[0].end(), "objective_value_mph"), si[0].end());
 }
 
 // max_distance: the objective is a carry in metres, so in feet (and inches) too.
