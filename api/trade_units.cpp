@@ -317,6 +317,45 @@ std::vector<std::string> ImperialTwinKeys(const Json& object, const std::string&
 
 void AddImperial(Json* answer, std::optional<double> length_m) { AddImperialTo(answer, length_m); }
 
+void ToTradeForm(Json* block) {
+  if (block->is_array()) {
+    for (Json& item : *block) ToTradeForm(&item);
+    return;
+  }
+  if (!block->is_object()) return;
+  Json out = Json::object();
+  for (auto& [key, value] : block->items()) {
+    const std::vector<TradeForm> forms = TradeForms(key);
+    if (!value.is_number() || forms.empty()) {
+      ToTradeForm(&value);
+      out[key] = std::move(value);
+      continue;
+    }
+    const TradeForm& form = forms.back();  // a radius: "diameter_in"; else the one form
+    out[form.key] = value.get<double>() / form.to_si;
+  }
+  *block = std::move(out);
+}
+
+void ToFormOf(Json* block, const Json& request_block) {
+  if (!block->is_object() || !request_block.is_object()) return;
+  Json out = Json::object();
+  for (auto& [key, value] : block->items()) {
+    if (value.is_number() && !request_block.contains(key)) {
+      bool written = false;
+      for (const TradeForm& form : TradeForms(key)) {
+        if (!request_block.contains(form.key)) continue;
+        out[form.key] = value.get<double>() / form.to_si;
+        written = true;
+        break;
+      }
+      if (written) continue;
+    }
+    out[key] = std::move(value);
+  }
+  *block = std::move(out);
+}
+
 std::vector<ImperialSource> ImperialSources(std::string_view key) {
   std::vector<ImperialSource> out;
   constexpr std::string_view kFromTip = "_from_tip_in";

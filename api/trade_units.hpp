@@ -52,6 +52,17 @@ void TradeFormToSi(nlohmann::json* root, const std::vector<PathStep>& steps);
 bool SetNumberInRequestForm(nlohmann::json* root, const std::vector<PathStep>& steps,
                             double value_si, std::string* why);
 
+/// `block` (a shape, the fill; arrays and nested objects too) in the trade's form, as a request
+/// in inches writes a bat: each length in inches, a radius as a diameter in inches, a mass in
+/// ounces (TradeForms' factors); numbers with no trade form (a density, a modulus) stay.
+void ToTradeForm(nlohmann::json* block);
+
+/// Each SI number of `block` (an SI object the answer writes: a fitted three_segment) in the
+/// form `request_block` (the request's object in its place) gave it: "taper_start_m" as
+/// "taper_start_in" when the request wrote that, "barrel_radius_m" as "barrel_diameter_in";
+/// the rest as it is. One level (the object's own numbers).
+void ToFormOf(nlohmann::json* block, const nlohmann::json& request_block);
+
 /// How an answer reports its numbers ("report_units").
 enum class ReportUnits {
   kSi,        ///< SI only (the default).

@@ -15,6 +15,7 @@
 #include "core/geometry_format.hpp"
 #include "core/optimize/shape_fit.hpp"
 #include "core/scene/sanity.hpp"
+#include "core/units.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -108,6 +109,30 @@ nlohmann::json ThreeSegmentJson(const core::ThreeSegmentShape& s) {
           {"taper_end_m", s.taper_end_m}};
 }
 
+// The fitted bat as the request wrote its bat: a block the request gave (its three_segment, its
+// fill) with each number in the form given ("taper_start_in", "barrel_diameter_in"), the wall
+// as given ("wall_thickness_in"); a block the request did not write (a preset's), in inches when
+// an unknown was written in a trade form ("taper_start_in"), else SI.
+void InRequestUnits(const nlohmann::json& request_bat, bool trade_unknowns,
+                    nlohmann::json* bat) {
+  for (const char* block : {"three_segment", "fill"}) {
+    if (!bat->contains(block)) continue;
+    if (const auto given = request_bat.find(block);
+        given != request_bat.end() && given->is_object()) {
+      ToFormOf(&(*bat)[block], *given);
+    } else if (trade_unknowns) {
+      ToTradeForm(&(*bat)[block]);
+    }
+  }
+  if (const auto wall = bat->find("wall_thickness_m"); wall != bat->end()) {
+    if (request_bat.contains("wall_thickness_in") ||
+        (!request_bat.contains("wall_thickness_m") && trade_unknowns)) {
+      (*bat)["wall_thickness_in"] = wall->get<double>() / core::kMetresPerInch;
+      bat->erase("wall_thickness_m");
+    }
+  }
+}
+
 // The fitted bat in the request's form: three_segment with the fitted
 // dimensions, material (object if its density was fitted), wall and fill.
 nlohmann::json FittedBatJson(const core::ShapeFitResult& fit, const BatSpec& spec) {
@@ -153,6 +178,14 @@ struct FitRequest {
   // Per unknown, its name as the request wrote it ("barrel_diameter_in") and the factor of
   // its value and bounds to core's SI (0.0127); empty for the default unknowns.
   std::vector<std::pair<std::string, double>> written;
+  // The request's bat as written, so that the fitted bat is answered in its form and units.
+  nlohmann::json request_bat;
+  // Whether an unknown was written in a trade form ("taper_start_in"): a preset's shape is
+  // then answered in inches.
+  bool TradeUnknowns() const {
+    return std::any_of(written.begin(), written.end(),
+                       [](const auto& w) { return w.second != 1.0; });
+  }
 
   // Core's refusal with an unknown named, and its bound given, as the request wrote them.
   core::Refusal AsWritten(core::Refusal refusal) const {
@@ -267,7 +300,7 @@ std::optional<FitRequest> ParseFit(const nlohmann::json& body, const Context& co
                 "path ({\"path\": \"material.density_kg_m3\", \"min\", \"max\"})");
     return std::nullopt;
   }
-  FitRequest request{std::move(*spec), {}, {}, {}};
+  FitRequest request{std::move(*spec), {}, {}, {}, *bat_json};
   core::ShapeFitProblem& problem = request.problem;
   problem.shape = *shape;
   problem.material = request.spec.bat.material;
@@ -343,7 +376,9 @@ nlohmann::json RenderFit(const FitRequest& request, const core::ShapeFitResult& 
                          {"metric", fit.metric},
                          {"kkt_error", fit.kkt_error},
                          {"warnings", fit.summary.warnings}};
-  return {{"bat", FittedBatJson(fit, request.spec)},
+  nlohmann::json bat = FittedBatJson(fit, request.spec);
+  InRequestUnits(request.request_bat, request.TradeUnknowns(), &bat);
+  return {{"bat", std::move(bat)},
           {"unknowns", std::move(unknown_values)},
           {"properties", PropertiesToJson(fit.properties, fit.bat.LengthM())},
           {"residuals", std::move(residuals)},

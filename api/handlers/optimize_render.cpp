@@ -32,29 +32,6 @@ bool GivesField(const Json& bat, const std::vector<PathStep>& steps) {
   return false;
 }
 
-// `block` (a shape, the fill) in the trade's form, as a request in inches writes a bat: each
-// length in inches, a radius as a diameter in inches, a mass in ounces (TradeForms' factors);
-// numbers with no trade form (a density, a modulus) stay as they are.
-void InTradeForm(Json* block) {
-  if (block->is_array()) {
-    for (Json& item : *block) InTradeForm(&item);
-    return;
-  }
-  if (!block->is_object()) return;
-  Json out = Json::object();
-  for (auto& [key, value] : block->items()) {
-    const std::vector<TradeForm> forms = TradeForms(key);
-    if (!value.is_number() || forms.empty()) {
-      InTradeForm(&value);
-      out[key] = std::move(value);
-      continue;
-    }
-    const TradeForm& form = forms.back();  // a radius: "diameter_in"; else the one form
-    out[form.key] = value.get<double>() / form.to_si;
-  }
-  *block = std::move(out);
-}
-
 Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r,
                       const VariableNames& names) {
   Json bat = request_bat;
@@ -102,7 +79,7 @@ Json BatInRequestForm(const Json& request_bat, const core::DesignResult& r,
       block = "fill";
     }
     if (block != nullptr && written != nullptr && bat.contains(block)) {
-      InTradeForm(&bat[block]);
+      ToTradeForm(&bat[block]);
     }
   }
   return bat;

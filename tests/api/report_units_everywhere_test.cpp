@@ -298,6 +298,35 @@ TEST(ReportUnitsEverywhereTest, FrontierCsvHasImperialColumns) {
   EXPECT_EQ(std::find(si[0].begin(), si[0].end(), "objective_value_mph"), si[0].end());
 }
 
+// /v1/bat/fit answers its bat as the request wrote it: a three_segment given in inches (the
+// barrel as a diameter) comes back in those forms, the fitted unknown included, and sent
+// again it has the fitted properties.
+TEST(ReportUnitsEverywhereTest, FitAnswersTheBatInTheFormsTheRequestWrote) {
+  const Json body = Json::parse(R"({"bat": {"three_segment": {"length_in": 34,
+      "handle_diameter_in": 0.98, "barrel_diameter_in": 2.6, "taper_start_in": 11,
+      "taper_end_m": 0.55}, "material": "ash"},
+      "targets": {"mass_oz": 38}, "unknowns": [{"name": "taper_start_m", "min": 0.1,
+      "max": 0.5}]})");
+  const Response r = Post("/v1/bat/fit", body);
+  ASSERT_EQ(r.status, 200) << r.body.dump();
+  const Json& shape = r.body["bat"]["three_segment"];
+  EXPECT_EQ(shape["length_in"], 34.0);
+  EXPECT_EQ(shape["handle_diameter_in"], 0.98);
+  EXPECT_EQ(shape["barrel_diameter_in"], 2.6);
+  EXPECT_EQ(shape["taper_end_m"], 0.55);
+  // The unknown's value, fitted in SI, in the inches the bat gave it in.
+  EXPECT_EQ(shape["taper_start_in"].get<double>(),
+            r.body["unknowns"]["taper_start_m"].get<double>() / kInch);
+  EXPECT_FALSE(shape.contains("taper_start_m"));
+  EXPECT_FALSE(shape.contains("length_m"));
+  const Response again = Post("/v1/bat/properties", Json{{"bat", r.body["bat"]}});
+  ASSERT_EQ(again.status, 200) << again.body.dump();
+  // Inches back to metres round the taper's start by an ulp or so; the mass moves with it by
+  // far less than 1e-9 relative.
+  EXPECT_NEAR(again.body["mass_kg"].get<double>(), r.body["properties"]["mass_kg"].get<double>(),
+              1e-9 * r.body["properties"]["mass_kg"].get<double>());
+}
+
 // max_distance: the objective is a carry in metres, so in feet (and inches) too.
 TEST(ReportUnitsEverywhereTest, OptimizeMaxDistanceObjectiveHasItsFeetTwin) {
   Json body = Json::parse(R"({
