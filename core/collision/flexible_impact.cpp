@@ -222,23 +222,6 @@ int ModesAtOrBelow(const BatModes& modes, double f_cut_hz) {
   return n;
 }
 
-// The warning when the cutoff (Hz) is above every computed mode (n_used is all of them):
-// harmless with the static correction unless the computed modes stop well short of it.
-void WarnIfModesShortOfCutoff(const BatModes& modes, int n_used, double cutoff_hz,
-                              bool static_correction, Summary* s) {
-  const int available = static_cast<int>(modes.modes.size());
-  if (n_used == available &&
-      (!static_correction || modes.modes.back().frequency_hz < 0.5 * cutoff_hz)) {
-    s->warnings.push_back(
-        "the mode cutoff (cutoff_factor / contact time) is above the highest "
-        "computed mode (" +
-        std::to_string(available) + " modes, up to " +
-        FormatNumber17(modes.modes.back().frequency_hz) +
-        " Hz): every computed mode is used, the static correction stands for "
-        "the rest; raise flexible.max_modes to include more");
-  }
-}
-
 // The scaled model of the impact at in.impact_from_knob_m with the modes' FE vectors `vecs`
 // (the two rigid modes first): omega_k t_s (t_s, s: the contact's time scale; 0 for the rigid
 // modes) and phi_k(s) sqrt(m) (m: the ball's mass, kg); the hands' coefficients zero, the
@@ -363,10 +346,9 @@ FlexibleOutcome FlexibleOutcomeOf(const Model& md, const RawRun& r, double u, do
   return oc;
 }
 
-// The answer from the run `a` of the full model (its outcome `oa`) into *out: speeds (m/s),
-// impulse (N s), contact (s, N, m), hands' peaks (N, N m) and the energy account (J), each
-// bending mode's energy and frequency. m the ball's mass (kg), v0 the approach speed (m/s),
-// e_scale = m v0^2 (J).
+// The full model's run `a` (outcome `oa`) into *out: speeds (m/s), impulse (N s), contact (s, N,
+// m), hands' peaks (N, N m), energies (J) and each bending mode's energy and frequency (Hz);
+// m the ball's mass (kg), v0 the approach speed (m/s), e_scale = m v0^2 (J).
 void TakeFullRun(const RawRun& a, const FlexibleOutcome& oa, const Model& full,
                  const BatModes& modes, double m, double v0, double e_scale,
                  FlexibleImpactResult* out) {
@@ -409,7 +391,6 @@ struct FlexibleRuns {
   const FlexibleImpactOptions* o = nullptr;
   double delta_s = 1.0;
   double window_s = 0.0;
-
   // A run of model `md` to the relative tolerance `tol`.
   RawRun Run(const Model& md, double tol) const {
     return Integrate(md, *law, *in, delta_s, tol, *o, window_s);
@@ -554,7 +535,19 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     }
     const double t_s = delta_s / v0;
     const int n_used = ModesAtOrBelow(modes, out.cutoff_hz);
-    WarnIfModesShortOfCutoff(modes, n_used, out.cutoff_hz, o.static_correction, &s);
+    const int available = static_cast<int>(modes.modes.size());
+    // Every computed mode below the cutoff: harmless with the static correction unless the
+    // computed modes stop well short of it.
+    if (n_used == available &&
+        (!o.static_correction || modes.modes.back().frequency_hz < 0.5 * out.cutoff_hz)) {
+      s.warnings.push_back(
+          "the mode cutoff (cutoff_factor / contact time) is above the highest "
+          "computed mode (" +
+          std::to_string(available) + " modes, up to " +
+          FormatNumber17(modes.modes.back().frequency_hz) +
+          " Hz): every computed mode is used, the static correction stands for "
+          "the rest; raise flexible.max_modes to include more");
+    }
 
     // Every mode's coefficients (rigid ones first), computed once.
     const double h = in.hands_from_knob_m;
@@ -583,12 +576,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     if (window == 0.0) window = 1.0 / modes.modes.front().frequency_hz;
 
     const double e_scale = m * v0 * v0;  // scaled energy -> J
-    FlexibleRuns runner;
-    runner.law = &law;
-    runner.in = &in;
-    runner.o = &o;
-    runner.delta_s = delta_s;
-    runner.window_s = window;
+    const FlexibleRuns runner{&law, &in, &o, delta_s, window};
     const RefinedRuns<RawRun> runs = SolveWithRefineCheck<RawRun>(
         o.relative_tolerance, o.refine_check, [&](double tol) { return runner.Run(full, tol); });
     out.steps = CountRefinedRuns(runs, &s);
