@@ -18,164 +18,185 @@ core::Bat& BatOf(const H& h) { return *h.bat; }
 core::Material& MaterialOf(const H& h) { return *h.material; }
 core::Fill& FillOf(const H& h) { return *h.fill; }
 
-// The rows. The ranges are those the request's reader and core's Validate(Size) hold.
-std::vector<Field> MakeFields() {
-  std::vector<Field> f;
+// The scene's rows (SI): the ball, the swing, the contact and the COR, appended to *f.
+void AddSceneFields(std::vector<Field>* f) {
   // The ball, the swing, the COR: explore parameters only. Each object's rows in the order
   // the parser reads them (ReadFieldGroup): the same error for the same request.
-  f.push_back({"ball.mass_kg", "kg", G::kBall, core::kMinBallMassKg, core::kMaxBallMassKg, true,
-               false, "", [](const H& h) { return h.ball->mass_kg; },
-               [](const H& h, double v) { h.ball->mass_kg = v; }});
-  f.push_back({"ball.radius_m", "m", G::kBall, core::kMinBallRadiusM, core::kMaxBallRadiusM, true,
-               false, "", [](const H& h) { return h.ball->radius_m; },
-               [](const H& h, double v) { h.ball->radius_m = v; }});
-  f.push_back({"ball.speed_mps", "m/s", G::kBall, 0.0, core::kMaxBallSpeedMps, true, false, "",
-               [](const H& h) { return h.ball->speed_mps; },
-               [](const H& h, double v) { h.ball->speed_mps = v; }});
-  f.push_back({"ball.stiffness_n_m_p", "N/m^p", G::kBall, 0.0, core::kMaxBallStiffness, true,
-               false, "", [](const H& h) { return h.ball->stiffness; },
-               [](const H& h, double v) { h.ball->stiffness = v; }});
-  f.push_back({"ball.stiffness_exponent", "1", G::kBall, 1.0, 3.0, true, false, "",
-               [](const H& h) { return h.ball->stiffness_exponent; },
-               [](const H& h, double v) { h.ball->stiffness_exponent = v; }});
+  f->push_back({"ball.mass_kg", "kg", G::kBall, core::kMinBallMassKg, core::kMaxBallMassKg, true,
+                false, "", [](const H& h) { return h.ball->mass_kg; },
+                [](const H& h, double v) { h.ball->mass_kg = v; }});
+  f->push_back({"ball.radius_m", "m", G::kBall, core::kMinBallRadiusM, core::kMaxBallRadiusM, true,
+                false, "", [](const H& h) { return h.ball->radius_m; },
+                [](const H& h, double v) { h.ball->radius_m = v; }});
+  f->push_back({"ball.speed_mps", "m/s", G::kBall, 0.0, core::kMaxBallSpeedMps, true, false, "",
+                [](const H& h) { return h.ball->speed_mps; },
+                [](const H& h, double v) { h.ball->speed_mps = v; }});
+  f->push_back({"ball.stiffness_n_m_p", "N/m^p", G::kBall, 0.0, core::kMaxBallStiffness, true,
+                false, "", [](const H& h) { return h.ball->stiffness; },
+                [](const H& h, double v) { h.ball->stiffness = v; }});
+  f->push_back({"ball.stiffness_exponent", "1", G::kBall, 1.0, 3.0, true, false, "",
+                [](const H& h) { return h.ball->stiffness_exponent; },
+                [](const H& h, double v) { h.ball->stiffness_exponent = v; }});
   // The oblique impact's (batted_ball): the pitch's path and spin at the plate.
-  f.push_back({"ball.descent_angle_deg", "deg", G::kBall, -core::kMaxPathAngleDeg,
-               core::kMaxPathAngleDeg, true, false, "",
-               [](const H& h) { return h.ball->descent_angle_deg; },
-               [](const H& h, double v) { h.ball->descent_angle_deg = v; }});
-  f.push_back({"ball.spin_rpm", "rpm", G::kBall, -core::kMaxPitchSpinRpm, core::kMaxPitchSpinRpm,
-               true, false, "", [](const H& h) { return h.ball->spin_rpm; },
-               [](const H& h, double v) { h.ball->spin_rpm = v; }});
-  f.push_back({"swing.angular_speed_rad_s", "rad/s", G::kSwing, 0.0,
-               core::kMaxSwingAngularSpeedRadS, true, false, "",
-               [](const H& h) { return h.swing->angular_speed_rad_s; },
-               [](const H& h, double v) { h.swing->angular_speed_rad_s = v; }});
+  f->push_back({"ball.descent_angle_deg", "deg", G::kBall, -core::kMaxPathAngleDeg,
+                core::kMaxPathAngleDeg, true, false, "",
+                [](const H& h) { return h.ball->descent_angle_deg; },
+                [](const H& h, double v) { h.ball->descent_angle_deg = v; }});
+  f->push_back({"ball.spin_rpm", "rpm", G::kBall, -core::kMaxPitchSpinRpm, core::kMaxPitchSpinRpm,
+                true, false, "", [](const H& h) { return h.ball->spin_rpm; },
+                [](const H& h, double v) { h.ball->spin_rpm = v; }});
+  f->push_back({"swing.angular_speed_rad_s", "rad/s", G::kSwing, 0.0,
+                core::kMaxSwingAngularSpeedRadS, true, false, "",
+                [](const H& h) { return h.swing->angular_speed_rad_s; },
+                [](const H& h, double v) { h.swing->angular_speed_rad_s = v; }});
   // The bat's speed: it sets the angular speed once the bat's length is known
   // (core::ResolveSwing); the parser takes one of it and the angular speed (ReadSwing).
   // A sweep of it on a template with the angular speed is refused before its first design
   // (explore's probe of the template), so the binder sets it only where the parser would.
-  f.push_back({"swing.bat_speed_mps", "m/s", G::kSwing, 0.0, core::kMaxBatSpeedMps, true, false,
-               "", [](const H& h) { return h.swing->bat_speed_mps.value_or(0.0); },
-               [](const H& h, double v) { h.swing->bat_speed_mps = v; }});
-  f.push_back({"swing.bat_speed_from_tip_m", "m", G::kSwing, 0.0, core::kMaxSwingOffsetM, true,
-               false, "", [](const H& h) { return h.swing->bat_speed_from_tip_m; },
-               [](const H& h, double v) { h.swing->bat_speed_from_tip_m = v; }});
+  f->push_back({"swing.bat_speed_mps", "m/s", G::kSwing, 0.0, core::kMaxBatSpeedMps, true, false,
+                "", [](const H& h) { return h.swing->bat_speed_mps.value_or(0.0); },
+                [](const H& h, double v) { h.swing->bat_speed_mps = v; }});
+  f->push_back({"swing.bat_speed_from_tip_m", "m", G::kSwing, 0.0, core::kMaxSwingOffsetM, true,
+                false, "", [](const H& h) { return h.swing->bat_speed_from_tip_m; },
+                [](const H& h, double v) { h.swing->bat_speed_from_tip_m = v; }});
   // swing.speed_model "swing_weight"'s settings (core/scene/swing_speed.hpp); the parser reads
   // the model's name and bat_speed_from_tip_m's "sweet_spot" itself (ReadSwing).
-  f.push_back({"swing.reference_moi_kg_m2", "kg·m²", G::kSwing, 0.0, core::kMaxSwingMoiKgM2, true,
-               false, "",
-               [](const H& h) {
-                 return h.swing->reference_moi_kg_m2.value_or(core::kSwingWeightReferenceMoiKgM2);
-               },
-               [](const H& h, double v) { h.swing->reference_moi_kg_m2 = v; }});
-  f.push_back({"swing.swing_weight_exponent", "1", G::kSwing, 0.0, core::kMaxSwingWeightExponent,
-               true, false, "", [](const H& h) { return h.swing->swing_weight_exponent; },
-               [](const H& h, double v) { h.swing->swing_weight_exponent = v; }});
-  f.push_back({"swing.pivot_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,
-               core::kMaxSwingOffsetM, true, false, "",
-               [](const H& h) { return h.swing->pivot_from_knob_m; },
-               [](const H& h, double v) { h.swing->pivot_from_knob_m = v; }});
-  f.push_back({"swing.hands_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,
-               core::kMaxSwingOffsetM, true, false, "",
-               [](const H& h) { return h.swing->hands_from_knob_m; },
-               [](const H& h, double v) { h.swing->hands_from_knob_m = v; }});
-  f.push_back({"swing.attack_angle_deg", "deg", G::kSwing, -core::kMaxPathAngleDeg,
-               core::kMaxPathAngleDeg, true, false, "",
-               [](const H& h) { return h.swing->attack_angle_deg; },
-               [](const H& h, double v) { h.swing->attack_angle_deg = v; }});
+  f->push_back({"swing.reference_moi_kg_m2", "kg·m²", G::kSwing, 0.0, core::kMaxSwingMoiKgM2, true,
+                false, "",
+                [](const H& h) {
+                  return h.swing->reference_moi_kg_m2.value_or(core::kSwingWeightReferenceMoiKgM2);
+                },
+                [](const H& h, double v) { h.swing->reference_moi_kg_m2 = v; }});
+  f->push_back({"swing.swing_weight_exponent", "1", G::kSwing, 0.0, core::kMaxSwingWeightExponent,
+                true, false, "", [](const H& h) { return h.swing->swing_weight_exponent; },
+                [](const H& h, double v) { h.swing->swing_weight_exponent = v; }});
+  f->push_back({"swing.pivot_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,
+                core::kMaxSwingOffsetM, true, false, "",
+                [](const H& h) { return h.swing->pivot_from_knob_m; },
+                [](const H& h, double v) { h.swing->pivot_from_knob_m = v; }});
+  f->push_back({"swing.hands_from_knob_m", "m", G::kSwing, -core::kMaxSwingOffsetM,
+                core::kMaxSwingOffsetM, true, false, "",
+                [](const H& h) { return h.swing->hands_from_knob_m; },
+                [](const H& h, double v) { h.swing->hands_from_knob_m = v; }});
+  f->push_back({"swing.attack_angle_deg", "deg", G::kSwing, -core::kMaxPathAngleDeg,
+                core::kMaxPathAngleDeg, true, false, "",
+                [](const H& h) { return h.swing->attack_angle_deg; },
+                [](const H& h, double v) { h.swing->attack_angle_deg = v; }});
   // Where across the bat the ball meets it (batted_ball).
-  f.push_back({"contact.undercut_m", "m", G::kContact, -core::kMaxUndercutM, core::kMaxUndercutM,
-               true, false, "", [](const H& h) { return h.contact->undercut_m; },
-               [](const H& h, double v) { h.contact->undercut_m = v; }});
-  f.push_back({"cor", "1", G::kCor, 0.0, 1.0, true, false, "",
-               [](const H& h) { return h.cor->value_or(0.0); },
-               [](const H& h, double v) { *h.cor = v; }});
+  f->push_back({"contact.undercut_m", "m", G::kContact, -core::kMaxUndercutM, core::kMaxUndercutM,
+                true, false, "", [](const H& h) { return h.contact->undercut_m; },
+                [](const H& h, double v) { h.contact->undercut_m = v; }});
+  f->push_back({"cor", "1", G::kCor, 0.0, 1.0, true, false, "",
+                [](const H& h) { return h.cor->value_or(0.0); },
+                [](const H& h, double v) { *h.cor = v; }});
+}
+
+// The bat's shape rows (m): the three-segment shape and a profile's knots, appended to *f.
+void AddShapeFields(std::vector<Field>* f) {
   // The three-segment shape.
-  f.push_back({"bat.three_segment.length_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true, true,
-               "length_m", [](const H& h) { return h.shape->length_m; },
-               [](const H& h, double v) { h.shape->length_m = v; }, true});
-  f.push_back({"bat.three_segment.handle_radius_m", "m", G::kShape, 0.0, core::kMaxBatRadiusM,
-               true, true, "handle_radius_m", [](const H& h) { return h.shape->handle_radius_m; },
-               [](const H& h, double v) { h.shape->handle_radius_m = v; }, true});
-  f.push_back({"bat.three_segment.barrel_radius_m", "m", G::kShape, 0.0, core::kMaxBatRadiusM,
-               true, true, "barrel_radius_m", [](const H& h) { return h.shape->barrel_radius_m; },
-               [](const H& h, double v) { h.shape->barrel_radius_m = v; }, true});
-  f.push_back({"bat.three_segment.taper_start_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true,
-               true, "taper_start_m", [](const H& h) { return h.shape->taper_start_m; },
-               [](const H& h, double v) { h.shape->taper_start_m = v; }, true});
-  f.push_back({"bat.three_segment.taper_end_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true,
-               true, "taper_end_m", [](const H& h) { return h.shape->taper_end_m; },
-               [](const H& h, double v) { h.shape->taper_end_m = v; }, true});
+  f->push_back({"bat.three_segment.length_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true, true,
+                "length_m", [](const H& h) { return h.shape->length_m; },
+                [](const H& h, double v) { h.shape->length_m = v; }, true});
+  f->push_back({"bat.three_segment.handle_radius_m", "m", G::kShape, 0.0, core::kMaxBatRadiusM,
+                true, true, "handle_radius_m", [](const H& h) { return h.shape->handle_radius_m; },
+                [](const H& h, double v) { h.shape->handle_radius_m = v; }, true});
+  f->push_back({"bat.three_segment.barrel_radius_m", "m", G::kShape, 0.0, core::kMaxBatRadiusM,
+                true, true, "barrel_radius_m", [](const H& h) { return h.shape->barrel_radius_m; },
+                [](const H& h, double v) { h.shape->barrel_radius_m = v; }, true});
+  f->push_back({"bat.three_segment.taper_start_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true,
+                true, "taper_start_m", [](const H& h) { return h.shape->taper_start_m; },
+                [](const H& h, double v) { h.shape->taper_start_m = v; }, true});
+  f->push_back({"bat.three_segment.taper_end_m", "m", G::kShape, 0.0, core::kMaxBatLengthM, true,
+                true, "taper_end_m", [](const H& h) { return h.shape->taper_end_m; },
+                [](const H& h, double v) { h.shape->taper_end_m = v; }, true});
   // A profile's knots.
-  f.push_back({"bat.profile.knots[].x_m", "m", G::kKnot, 0.0, core::kMaxBatLengthM, true, true, "",
-               [](const H& h) { return BatOf(h).knots[h.knot].x_m; },
-               [](const H& h, double v) { BatOf(h).knots[h.knot].x_m = v; }, true});
-  f.push_back({"bat.profile.knots[].radius_m", "m", G::kKnot, 0.0, core::kMaxBatRadiusM, true,
-               true, "", [](const H& h) { return BatOf(h).knots[h.knot].radius_m; },
-               [](const H& h, double v) { BatOf(h).knots[h.knot].radius_m = v; }, true});
-  f.push_back({"bat.profile.knots[].wall_thickness_m", "m", G::kKnot, 0.0, core::kMaxBatRadiusM,
-               false, false, "",
-               [](const H& h) { return BatOf(h).knots[h.knot].wall_thickness_m; },
-               [](const H& h, double v) { BatOf(h).knots[h.knot].wall_thickness_m = v; }});
+  f->push_back({"bat.profile.knots[].x_m", "m", G::kKnot, 0.0, core::kMaxBatLengthM, true, true, "",
+                [](const H& h) { return BatOf(h).knots[h.knot].x_m; },
+                [](const H& h, double v) { BatOf(h).knots[h.knot].x_m = v; }, true});
+  f->push_back({"bat.profile.knots[].radius_m", "m", G::kKnot, 0.0, core::kMaxBatRadiusM, true,
+                true, "", [](const H& h) { return BatOf(h).knots[h.knot].radius_m; },
+                [](const H& h, double v) { BatOf(h).knots[h.knot].radius_m = v; }, true});
+  f->push_back({"bat.profile.knots[].wall_thickness_m", "m", G::kKnot, 0.0, core::kMaxBatRadiusM,
+                false, false, "",
+                [](const H& h) { return BatOf(h).knots[h.knot].wall_thickness_m; },
+                [](const H& h, double v) { BatOf(h).knots[h.knot].wall_thickness_m = v; }});
+}
+
+// The bat's material rows (SI: kg/m³, Pa, 1), appended to *f.
+void AddMaterialFields(std::vector<Field>* f) {
   // The material, given as an object.
-  f.push_back({"bat.material.density_kg_m3", "kg/m³", G::kMaterial, 0.0, core::kMaxDensityKgM3,
-               true, true, "density_kg_m3",
-               [](const H& h) { return MaterialOf(h).density_kg_m3; },
-               [](const H& h, double v) { MaterialOf(h).density_kg_m3 = v; }, true});
-  f.push_back({"bat.material.youngs_modulus_pa", "Pa", G::kMaterial, 0.0, core::kMaxModulusPa,
-               true, false, "", [](const H& h) { return MaterialOf(h).youngs_modulus_pa; },
-               [](const H& h, double v) { MaterialOf(h).youngs_modulus_pa = v; }, true});
-  f.push_back({"bat.material.shear_modulus_pa", "Pa", G::kMaterial, 0.0, core::kMaxModulusPa,
-               true, false, "", [](const H& h) { return MaterialOf(h).shear_modulus_pa; },
-               [](const H& h, double v) {
-                 MaterialOf(h).shear_modulus_pa = v;
-                 MaterialOf(h).poissons_ratio_assumed = false;  // given: no "nu assumed"
-               }});
-  f.push_back({"bat.material.poissons_ratio", "1", G::kMaterial, -1.0, 0.5, true, false, "",
-               [](const H& h) { return MaterialOf(h).poissons_ratio; },
-               [](const H& h, double v) {
-                 MaterialOf(h).poissons_ratio = v;
-                 MaterialOf(h).poissons_ratio_assumed = false;
-               }});
-  f.push_back({"bat.material.cor", "1", G::kMaterial, 0.0, 1.0, true, false, "",
-               [](const H& h) { return MaterialOf(h).cor.value_or(0.0); },
-               [](const H& h, double v) { MaterialOf(h).cor = v; }});
+  f->push_back({"bat.material.density_kg_m3", "kg/m³", G::kMaterial, 0.0, core::kMaxDensityKgM3,
+                true, true, "density_kg_m3",
+                [](const H& h) { return MaterialOf(h).density_kg_m3; },
+                [](const H& h, double v) { MaterialOf(h).density_kg_m3 = v; }, true});
+  f->push_back({"bat.material.youngs_modulus_pa", "Pa", G::kMaterial, 0.0, core::kMaxModulusPa,
+                true, false, "", [](const H& h) { return MaterialOf(h).youngs_modulus_pa; },
+                [](const H& h, double v) { MaterialOf(h).youngs_modulus_pa = v; }, true});
+  f->push_back({"bat.material.shear_modulus_pa", "Pa", G::kMaterial, 0.0, core::kMaxModulusPa,
+                true, false, "", [](const H& h) { return MaterialOf(h).shear_modulus_pa; },
+                [](const H& h, double v) {
+                  MaterialOf(h).shear_modulus_pa = v;
+                  MaterialOf(h).poissons_ratio_assumed = false;  // given: no "nu assumed"
+                }});
+  f->push_back({"bat.material.poissons_ratio", "1", G::kMaterial, -1.0, 0.5, true, false, "",
+                [](const H& h) { return MaterialOf(h).poissons_ratio; },
+                [](const H& h, double v) {
+                  MaterialOf(h).poissons_ratio = v;
+                  MaterialOf(h).poissons_ratio_assumed = false;
+                }});
+  f->push_back({"bat.material.cor", "1", G::kMaterial, 0.0, 1.0, true, false, "",
+                [](const H& h) { return MaterialOf(h).cor.value_or(0.0); },
+                [](const H& h, double v) { MaterialOf(h).cor = v; }});
+}
+
+// The bat's parts' rows (m, kg, kg/m³): the wall, the fill, the end cap, the knob, a
+// two-piece bat's handle and the fill's material, appended to *f.
+void AddPartFields(std::vector<Field>* f) {
   // The wall and the fill.
-  f.push_back({"bat.wall_thickness_m", "m", G::kWall, 0.0, core::kMaxBatRadiusM, true, true,
-               "wall_thickness_m", [](const H& h) { return BatOf(h).wall_thickness_m; },
-               [](const H& h, double v) { BatOf(h).wall_thickness_m = v; }});
-  f.push_back({"bat.fill.diameter_m", "m", G::kFill, 0.0, core::kMaxFillDiameterM, true, true,
-               "fill.diameter_m", [](const H& h) { return FillOf(h).diameter_m; },
-               [](const H& h, double v) { FillOf(h).diameter_m = v; }, true});
-  f.push_back({"bat.fill.depth_m", "m", G::kFill, 0.0, core::kMaxBatLengthM, true, true,
-               "fill.depth_m", [](const H& h) { return FillOf(h).depth_m; },
-               [](const H& h, double v) { FillOf(h).depth_m = v; }, true});
+  f->push_back({"bat.wall_thickness_m", "m", G::kWall, 0.0, core::kMaxBatRadiusM, true, true,
+                "wall_thickness_m", [](const H& h) { return BatOf(h).wall_thickness_m; },
+                [](const H& h, double v) { BatOf(h).wall_thickness_m = v; }});
+  f->push_back({"bat.fill.diameter_m", "m", G::kFill, 0.0, core::kMaxFillDiameterM, true, true,
+                "fill.diameter_m", [](const H& h) { return FillOf(h).diameter_m; },
+                [](const H& h, double v) { FillOf(h).diameter_m = v; }, true});
+  f->push_back({"bat.fill.depth_m", "m", G::kFill, 0.0, core::kMaxBatLengthM, true, true,
+                "fill.depth_m", [](const H& h) { return FillOf(h).depth_m; },
+                [](const H& h, double v) { FillOf(h).depth_m = v; }, true});
   // The end cap and the knob (issue 35): each its mass and length, required in its object.
-  f.push_back({"bat.end_cap.mass_kg", "kg", G::kEndCap, 0.0, core::kMaxBatPartMassKg, false,
-               false, "", [](const H& h) { return BatOf(h).end_cap->mass_kg; },
-               [](const H& h, double v) { BatOf(h).end_cap->mass_kg = v; }, true});
-  f.push_back({"bat.end_cap.length_m", "m", G::kEndCap, 0.0, core::kMaxBatLengthM, false, false,
-               "", [](const H& h) { return BatOf(h).end_cap->length_m; },
-               [](const H& h, double v) { BatOf(h).end_cap->length_m = v; }, true});
-  f.push_back({"bat.knob.mass_kg", "kg", G::kKnob, 0.0, core::kMaxBatPartMassKg, false, false,
-               "", [](const H& h) { return BatOf(h).knob->mass_kg; },
-               [](const H& h, double v) { BatOf(h).knob->mass_kg = v; }, true});
-  f.push_back({"bat.knob.length_m", "m", G::kKnob, 0.0, core::kMaxBatLengthM, false, false, "",
-               [](const H& h) { return BatOf(h).knob->length_m; },
-               [](const H& h, double v) { BatOf(h).knob->length_m = v; }, true});
+  f->push_back({"bat.end_cap.mass_kg", "kg", G::kEndCap, 0.0, core::kMaxBatPartMassKg, false,
+                false, "", [](const H& h) { return BatOf(h).end_cap->mass_kg; },
+                [](const H& h, double v) { BatOf(h).end_cap->mass_kg = v; }, true});
+  f->push_back({"bat.end_cap.length_m", "m", G::kEndCap, 0.0, core::kMaxBatLengthM, false, false,
+                "", [](const H& h) { return BatOf(h).end_cap->length_m; },
+                [](const H& h, double v) { BatOf(h).end_cap->length_m = v; }, true});
+  f->push_back({"bat.knob.mass_kg", "kg", G::kKnob, 0.0, core::kMaxBatPartMassKg, false, false,
+                "", [](const H& h) { return BatOf(h).knob->mass_kg; },
+                [](const H& h, double v) { BatOf(h).knob->mass_kg = v; }, true});
+  f->push_back({"bat.knob.length_m", "m", G::kKnob, 0.0, core::kMaxBatLengthM, false, false, "",
+                [](const H& h) { return BatOf(h).knob->length_m; },
+                [](const H& h, double v) { BatOf(h).knob->length_m = v; }, true});
   // A two-piece bat's handle (issue 35): where it joins the barrel (required in its object) and
   // its own wall (optional: absent = the bat's walls, 0 = solid).
-  f.push_back({"bat.handle.joint_from_knob_m", "m", G::kHandle, 0.0, core::kMaxBatLengthM, false,
-               false, "", [](const H& h) { return BatOf(h).handle->joint_from_knob_m; },
-               [](const H& h, double v) { BatOf(h).handle->joint_from_knob_m = v; }, true});
-  f.push_back({"bat.handle.wall_thickness_m", "m", G::kHandle, 0.0, core::kMaxBatRadiusM, false,
-               false, "",
-               [](const H& h) { return BatOf(h).handle->wall_thickness_m.value_or(0.0); },
-               [](const H& h, double v) { BatOf(h).handle->wall_thickness_m = v; }});
-  f.push_back({"bat.fill.material.density_kg_m3", "kg/m³", G::kFillMaterial, 0.0,
-               core::kMaxDensityKgM3, false, true, "fill.density_kg_m3",
-               [](const H& h) { return FillOf(h).material.density_kg_m3; },
-               [](const H& h, double v) { FillOf(h).material.density_kg_m3 = v; }});
+  f->push_back({"bat.handle.joint_from_knob_m", "m", G::kHandle, 0.0, core::kMaxBatLengthM, false,
+                false, "", [](const H& h) { return BatOf(h).handle->joint_from_knob_m; },
+                [](const H& h, double v) { BatOf(h).handle->joint_from_knob_m = v; }, true});
+  f->push_back({"bat.handle.wall_thickness_m", "m", G::kHandle, 0.0, core::kMaxBatRadiusM, false,
+                false, "",
+                [](const H& h) { return BatOf(h).handle->wall_thickness_m.value_or(0.0); },
+                [](const H& h, double v) { BatOf(h).handle->wall_thickness_m = v; }});
+  f->push_back({"bat.fill.material.density_kg_m3", "kg/m³", G::kFillMaterial, 0.0,
+                core::kMaxDensityKgM3, false, true, "fill.density_kg_m3",
+                [](const H& h) { return FillOf(h).material.density_kg_m3; },
+                [](const H& h, double v) { FillOf(h).material.density_kg_m3 = v; }});
+}
+
+// The rows. The ranges are those the request's reader and core's Validate(Size) hold.
+std::vector<Field> MakeFields() {
+  std::vector<Field> f;
+  AddSceneFields(&f);
+  AddShapeFields(&f);
+  AddMaterialFields(&f);
+  AddPartFields(&f);
   return f;
 }
 

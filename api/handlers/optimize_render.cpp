@@ -99,14 +99,14 @@ Json MaterialInRequestForm(const core::Material& m) {
   return material;
 }
 
-Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
-                  const VariableNames& names) {
-  // Each variable as the request wrote it, in its unit ("wall_thickness_in": inches).
-  Json variables = names.ValuesAsWritten(r.variables);
+namespace {
+
+// The active constraints of a design, each a variable's bound as the request wrote the
+// variable ("three_segment.barrel_diameter_in.max": its value and bound in inches, the
+// multiplier per inch); any other constraint in its own unit.
+Json DesignActiveConstraintsJson(const core::DesignResult& r, const VariableNames& names) {
   Json active = Json::array();
   for (const auto& a : r.active_constraints) {
-    // A variable's bound, as the request wrote the variable ("three_segment.
-    // barrel_diameter_in.max", inches, the multiplier per inch).
     const std::size_t dot = a.name.rfind('.');
     const WrittenVariable* written =
         dot == std::string::npos ? nullptr : names.Find(a.name.substr(0, dot));
@@ -123,6 +123,12 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
          {"satisfied", a.satisfied},
          {"tolerance", a.tolerance / f}});
   }
+  return active;
+}
+
+// The multistart's spread: how many starts converged and were feasible, the objective's range
+// (in the objective's unit) and each run.
+Json DesignSpreadJson(const core::DesignResult& r) {
   Json runs = Json::array();
   for (const auto& s : r.spread.runs) {
     runs.push_back({{"index", s.index},
@@ -132,31 +138,41 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
                     {"objective", Finite(s.objective)},
                     {"constraint_violation", Finite(s.constraint_violation)}});
   }
+  return {{"starts", r.spread.starts},
+          {"converged", r.spread.converged},
+          {"feasible", r.spread.feasible},
+          {"best_start", r.spread.best_start},
+          {"objective_min", Finite(r.spread.objective_min)},
+          {"objective_max", Finite(r.spread.objective_max)},
+          {"objective_median", Finite(r.spread.objective_median)},
+          {"runs", std::move(runs)}};
+}
+
+// The service's own first-order check of the answer (core/optimize/certificate.hpp): its
+// residuals and tolerances (dimensionless, scaled as the certificate scales them).
+Json DesignCertificateJson(const core::DesignCertificate& cert) {
+  return {{"checked", cert.checked},
+          {"certified", cert.certified},
+          {"stationarity", Finite(cert.stationarity)},
+          {"feasibility", Finite(cert.feasibility)},
+          {"complementarity", Finite(cert.complementarity)},
+          {"stationarity_tolerance", cert.stationarity_tolerance},
+          {"feasibility_tolerance", cert.feasibility_tolerance},
+          {"complementarity_tolerance", cert.complementarity_tolerance},
+          {"multipliers_unique", cert.multipliers_unique},
+          {"active", cert.active},
+          {"failed", cert.failed}};
+}
+
+// The design's summary: the solve's Summary with its constraint violation, error estimate,
+// active constraints, spread, certificate, merged constraints and derivative check.
+Json DesignSummaryJson(const core::DesignResult& r, const VariableNames& names) {
   Json summary = SummaryToJson(r.summary);
   summary["constraint_violation"] = Finite(r.summary.constraint_violation);
   summary["error_estimate"] = Finite(r.summary.error_estimate);  // null for min_sting
-  summary["active_constraints"] = std::move(active);
-  summary["spread"] = {{"starts", r.spread.starts},
-                       {"converged", r.spread.converged},
-                       {"feasible", r.spread.feasible},
-                       {"best_start", r.spread.best_start},
-                       {"objective_min", Finite(r.spread.objective_min)},
-                       {"objective_max", Finite(r.spread.objective_max)},
-                       {"objective_median", Finite(r.spread.objective_median)},
-                       {"runs", std::move(runs)}};
-  // The service's own first-order check of the answer (core/optimize/certificate.hpp).
-  const core::DesignCertificate& cert = r.certificate;
-  summary["certificate"] = {{"checked", cert.checked},
-                            {"certified", cert.certified},
-                            {"stationarity", Finite(cert.stationarity)},
-                            {"feasibility", Finite(cert.feasibility)},
-                            {"complementarity", Finite(cert.complementarity)},
-                            {"stationarity_tolerance", cert.stationarity_tolerance},
-                            {"feasibility_tolerance", cert.feasibility_tolerance},
-                            {"complementarity_tolerance", cert.complementarity_tolerance},
-                            {"multipliers_unique", cert.multipliers_unique},
-                            {"active", cert.active},
-                            {"failed", cert.failed}};
+  summary["active_constraints"] = DesignActiveConstraintsJson(r, names);
+  summary["spread"] = DesignSpreadJson(r);
+  summary["certificate"] = DesignCertificateJson(r.certificate);
   if (!r.merged_constraints.empty()) {
     Json merged = Json::array();
     for (const core::MergedConstraint& m : r.merged_constraints) {
@@ -168,6 +184,12 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
     summary["derivative_check"] = {{"errors", r.derivative_check_errors},
                                    {"report", r.derivative_check_report}};
   }
+  return summary;
+}
+
+// The constraints that could not all be met: each group's requested and achievable ranges
+// (in the group's `unit`) and the shortfall.
+Json DesignConflictsJson(const core::DesignResult& r) {
   Json conflicts = Json::array();
   for (const auto& c : r.conflicts) {
     conflicts.push_back({{"constraints", c.constraints},
@@ -179,6 +201,72 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
                          {"shortfall", Finite(c.shortfall)},
                          {"message", c.message}});
   }
+  return conflicts;
+}
+
+// max_distance: the answer's distance sweet spot (SI), as /v1/sweet-spot's
+// distance_sweet_spot gives it for the returned bat in the same scene.
+Json DesignDistanceSweetSpotJson(const core::DistanceSweetSpotResult& d) {
+  return {{"position_from_knob_m", d.position_from_knob_m},
+          {"undercut_m", d.undercut_m},
+          {"distance_m", d.distance_m},
+          {"exit_speed_mps", d.exit_speed_mps},
+          {"launch_angle_deg", d.launch_angle_deg},
+          {"backspin_rpm", d.backspin_rpm + 0.0},
+          {"hang_time_s", d.ball.flight.hang_time_s},
+          {"apex_m", d.ball.flight.apex_m},
+          {"bat_speed_at_impact_mps", d.ball.bat_speed_at_impact_mps},
+          {"aero_model", core::flight::AeroModelName(d.ball.aero_model)},
+          {"air_density_kg_m3", d.ball.flight.air_density_kg_m3},
+          {"distance_error_estimate_m", Finite(d.ball.flight.error_estimate_m)},
+          {"at_position_bound", d.at_position_bound},
+          {"at_undercut_bound", d.at_undercut_bound},
+          {"evaluations", d.evaluations}};
+}
+
+// The outputs a design has only when its objective or constraints asked for them (SI), added
+// to *out: the barrel COR's impact, the BBCOR, the first bending mode, the sting and the
+// distance sweet spot.
+void AddDesignOptionalOutputs(const core::DesignResult& r, Json* out) {
+  if (std::isfinite(r.cor_impact_from_knob_m)) {
+    // The design's own barrel COR (cor_from_barrel): where and at what speed it was taken.
+    (*out)["cor_impact_from_knob_m"] = r.cor_impact_from_knob_m;
+    (*out)["cor_impact_speed_mps"] = Finite(r.cor_impact_speed_mps);
+    (*out)["cor_ball"] = Finite(r.cor_ball);
+  }
+  if (r.bbcor) {
+    (*out)["bbcor"] = BbcorToJson(*r.bbcor);
+    // The certification rounds (core/optimize/bbcor_constraint.hpp).
+    (*out)["bbcor"]["rounds"] = r.bbcor_rounds;
+    (*out)["bbcor"]["estimate_offset"] = r.bbcor_estimate_offset;
+  }
+  if (r.first_bending_mode) {
+    const core::DesignFrequency& f = *r.first_bending_mode;
+    (*out)["first_bending_mode"] = {{"frequency_hz", Finite(f.frequency_hz)},
+                                    {"error_estimate_hz", Finite(f.error_estimate_hz)},
+                                    {"elements", f.elements},
+                                    {"model_frequency_hz", Finite(f.model_frequency_hz)},
+                                    {"model_elements", f.model_elements}};
+  }
+  if (r.sting) {
+    (*out)["sting"] = {{"position_from_knob_m", r.sting->impact_from_knob_m},
+                       {"hands_vibration_energy_j", r.sting->hands_vibration_energy_j},
+                       {"error_estimate_j", r.sting->error_estimate_j},
+                       {"flexible", FlexibleImpactToJson(r.sting->impact)}};
+  }
+  if (r.distance_sweet_spot) {
+    (*out)["distance_sweet_spot"] = DesignDistanceSweetSpotJson(*r.distance_sweet_spot);
+  }
+}
+
+}  // namespace
+
+Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
+                  const VariableNames& names) {
+  // Each variable as the request wrote it, in its unit ("wall_thickness_in": inches).
+  Json variables = names.ValuesAsWritten(r.variables);
+  Json summary = DesignSummaryJson(r, names);
+  Json conflicts = DesignConflictsJson(r);
   Json out{{"bat", BatInRequestForm(request_bat, r, names)},
            {"variables", std::move(variables)},
            {"properties", PropertiesToJson(r.properties, r.bat.LengthM())},
@@ -192,53 +280,7 @@ Json ResultToJson(const core::DesignResult& r, const Json& request_bat,
              {"angular_speed_rad_s", Finite(r.angular_speed_rad_s)}}},
            {"summary", std::move(summary)}};
   if (!conflicts.empty()) out["conflicts"] = std::move(conflicts);
-  if (std::isfinite(r.cor_impact_from_knob_m)) {
-    // The design's own barrel COR (cor_from_barrel): where and at what speed it was taken.
-    out["cor_impact_from_knob_m"] = r.cor_impact_from_knob_m;
-    out["cor_impact_speed_mps"] = Finite(r.cor_impact_speed_mps);
-    out["cor_ball"] = Finite(r.cor_ball);
-  }
-  if (r.bbcor) {
-    out["bbcor"] = BbcorToJson(*r.bbcor);
-    // The certification rounds (core/optimize/bbcor_constraint.hpp).
-    out["bbcor"]["rounds"] = r.bbcor_rounds;
-    out["bbcor"]["estimate_offset"] = r.bbcor_estimate_offset;
-  }
-  if (r.first_bending_mode) {
-    const core::DesignFrequency& f = *r.first_bending_mode;
-    out["first_bending_mode"] = {{"frequency_hz", Finite(f.frequency_hz)},
-                                 {"error_estimate_hz", Finite(f.error_estimate_hz)},
-                                 {"elements", f.elements},
-                                 {"model_frequency_hz", Finite(f.model_frequency_hz)},
-                                 {"model_elements", f.model_elements}};
-  }
-  if (r.sting) {
-    out["sting"] = {{"position_from_knob_m", r.sting->impact_from_knob_m},
-                    {"hands_vibration_energy_j", r.sting->hands_vibration_energy_j},
-                    {"error_estimate_j", r.sting->error_estimate_j},
-                    {"flexible", FlexibleImpactToJson(r.sting->impact)}};
-  }
-  if (r.distance_sweet_spot) {
-    // max_distance: the answer's distance sweet spot, as /v1/sweet-spot's distance_sweet_spot
-    // gives it for the returned bat in the same scene.
-    const core::DistanceSweetSpotResult& d = *r.distance_sweet_spot;
-    out["distance_sweet_spot"] = {
-        {"position_from_knob_m", d.position_from_knob_m},
-        {"undercut_m", d.undercut_m},
-        {"distance_m", d.distance_m},
-        {"exit_speed_mps", d.exit_speed_mps},
-        {"launch_angle_deg", d.launch_angle_deg},
-        {"backspin_rpm", d.backspin_rpm + 0.0},
-        {"hang_time_s", d.ball.flight.hang_time_s},
-        {"apex_m", d.ball.flight.apex_m},
-        {"bat_speed_at_impact_mps", d.ball.bat_speed_at_impact_mps},
-        {"aero_model", core::flight::AeroModelName(d.ball.aero_model)},
-        {"air_density_kg_m3", d.ball.flight.air_density_kg_m3},
-        {"distance_error_estimate_m", Finite(d.ball.flight.error_estimate_m)},
-        {"at_position_bound", d.at_position_bound},
-        {"at_undercut_bound", d.at_undercut_bound},
-        {"evaluations", d.evaluations}};
-  }
+  AddDesignOptionalOutputs(r, &out);
   return out;
 }
 

@@ -37,11 +37,12 @@ Material Wood(std::string name, double specific_gravity, double modulus_pa, doub
   return m;
 }
 
-std::vector<Material> BuildCatalogue() {
-  std::vector<Material> out;
-  out.push_back(Wood("ash", 0.60, 12.0e9, 0.109, 0.371, "white ash (Fraxinus americana)"));
-  out.push_back(Wood("hard-maple", 0.63, 12.6e9, 0.111, 0.424, "sugar maple (Acer saccharum)"));
-  out.push_back(
+// The woods (SI): the Wood Handbook's species, the bat-grade maple billet and the seed paper's
+// wood, appended to *out in the catalogue's order.
+void AddWoods(std::vector<Material>* out) {
+  out->push_back(Wood("ash", 0.60, 12.0e9, 0.109, 0.371, "white ash (Fraxinus americana)"));
+  out->push_back(Wood("hard-maple", 0.63, 12.6e9, 0.111, 0.424, "sugar maple (Acer saccharum)"));
+  out->push_back(
       Wood("yellow-birch", 0.62, 13.9e9, 0.074, 0.426, "yellow birch (Betula alleghaniensis)"));
 
   // Bat-grade maple: the properties a finite-element study of MLB bats gives billets of the
@@ -75,7 +76,7 @@ std::vector<Material> BuildCatalogue() {
       "Profile B column, density 0.637 g/cm3, E_L = 2,198,507 psi (15.16 GPa), "
       "G_LT = 244,034 psi (1.683 GPa), nu = 0.476; density range 0.592-0.673 g/cm3 across the "
       "study's four profiles. COR 0.5 as for the other woods.";
-  out.push_back(billet);
+  out->push_back(billet);
 
   Material paper;
   paper.name = "paper-wood";
@@ -90,8 +91,12 @@ std::vector<Material> BuildCatalogue() {
       "mechanical analysis and MATLAB simulation), Table 2: density 649 kg/m3, "
       "E = 1.814e10 N/m2; Poisson's ratio 0.25 from its Hertz-contact section; "
       "e = 0.5 as used with its rigid model (shared/docs/paper-notes.md).";
-  out.push_back(paper);
+  out->push_back(paper);
+}
 
+// The hollow bats' shell materials (SI): the 7xxx alloys and the carbon/epoxy fabric, each
+// with the BBCOR rule as its COR, appended to *out.
+void AddShellMaterials(std::vector<Material>* out) {
   const std::string bbcor =
       " COR 0.5: the NCAA/NFHS BBCOR standard limits a certified bat's ball-bat coefficient of "
       "restitution to 0.50; it is a rule for the whole bat, not a property of the alloy.";
@@ -110,7 +115,7 @@ std::vector<Material> BuildCatalogue() {
       bbcor;
   al7046.kind = MaterialKind::kMetal;
   al7046.base = al7046.name;
-  out.push_back(al7046);
+  out->push_back(al7046);
 
   Material al7050;
   al7050.name = "aluminium-7050";
@@ -126,7 +131,7 @@ std::vector<Material> BuildCatalogue() {
       bbcor;
   al7050.kind = MaterialKind::kMetal;
   al7050.base = al7050.name;
-  out.push_back(al7050);
+  out->push_back(al7050);
 
   // Issue 35: the catalogue's composite. A bat's lay-up varies along it and between models; this
   // is one laminate, isotropic here with the fabric's in-plane values (the axial modulus the
@@ -149,8 +154,11 @@ std::vector<Material> BuildCatalogue() {
       "carbon fibers': 1.6e3 kg/m3; a 50 % fabric laminate is a few per cent lighter). One "
       "laminate standing for a composite bat's shell; its lay-up is not modelled." +
       bbcor;
-  out.push_back(carbon);
+  out->push_back(carbon);
+}
 
+// The fill materials (SI, no COR): cork and rubber, appended to *out.
+void AddFills(std::vector<Material>* out) {
   Material cork;
   cork.name = "cork";
   cork.density_kg_m3 = 290.0;
@@ -166,7 +174,7 @@ std::vector<Material> BuildCatalogue() {
       "Proc. R. Soc. Lond. A 377 (1981) 99-117. A fill material: no COR.";
   cork.kind = MaterialKind::kFill;
   cork.base = cork.name;
-  out.push_back(cork);
+  out->push_back(cork);
 
   Material rubber;
   rubber.name = "rubber";
@@ -183,7 +191,15 @@ std::vector<Material> BuildCatalogue() {
       "values. A fill material: no COR.";
   rubber.kind = MaterialKind::kFill;
   rubber.base = rubber.name;
-  out.push_back(rubber);
+  out->push_back(rubber);
+}
+
+// The whole catalogue, in its order: the woods, the shell materials, the fills.
+std::vector<Material> BuildCatalogue() {
+  std::vector<Material> out;
+  AddWoods(&out);
+  AddShellMaterials(&out);
+  AddFills(&out);
   return out;
 }
 

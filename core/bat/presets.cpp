@@ -30,8 +30,9 @@ constexpr double kCappedHandleWallM = 0.0022337768345169033;
 // knob (presets_test re-solves it).
 constexpr double kCompositeWallM = 0.00479454539185681;
 
-std::vector<BatPreset> BuildPresets() {
-  std::vector<BatPreset> out;
+// The seed paper's bats (SI, the paper's shape): "paper-wood" and its 0.885-kg variant
+// "paper-wood-m885", appended to *out.
+void AddPaperPresets(std::vector<BatPreset>* out) {
   const Material paper_wood = *FindMaterial("paper-wood");
 
   BatPreset paper;
@@ -45,7 +46,7 @@ std::vector<BatPreset> BuildPresets() {
       "read as diameters, the only reading that gives a bat of realistic mass "
       "(shared/docs/paper-notes.md, shared/docs/api-contract.md). The paper's own targets "
       "M = 0.885 kg, C = 0.564 m cannot both be met by this family (see shape_fit).";
-  out.push_back(paper);
+  out->push_back(paper);
 
   BatPreset m885 = paper;
   m885.name = "paper-wood-m885";
@@ -58,8 +59,12 @@ std::vector<BatPreset> BuildPresets() {
       "The paper's bat shape at 569.9 kg/m3 so that it weighs the paper's 0.885 kg; balance "
       "point 0.6090 m (independent of density).";
   m885.source = "As paper-wood, density scaled so that M = 0.885 kg (paper Table 2's mass).";
-  out.push_back(m885);
+  out->push_back(m885);
+}
 
+// The solid wood bats turned to pro profiles (knots in inches, converted to m): "wood-34-ash"
+// and "wood-34-maple-turned", appended to *out.
+void AddWoodPresets(std::vector<BatPreset>* out) {
   BatPreset ash;
   ash.name = "wood-34-ash";
   ash.bat.knots = FromInches({{0.0, 1.60},
@@ -85,7 +90,7 @@ std::vector<BatPreset> BuildPresets() {
       "(solid wood, at most 2.61 in diameter and 42 in long) with knob, handle and taper "
       "dimensions typical of turned pro models (not a specific manufacturer's model); "
       "white ash from the Wood Handbook FPL-GTR-190 (material 'ash').";
-  out.push_back(ash);
+  out->push_back(ash);
 
   // A turned pro maple bat (issue 35, "wood bats that ring like wood bats"): the knots below,
   // in inches, are this service's reading of the published descriptions of a medium-handle
@@ -122,8 +127,12 @@ std::vector<BatPreset> BuildPresets() {
       "12(7), 3494 (2022). No published table of a turning model's diameters was found, so the "
       "knots between those anchors are this service's. Material 'maple-bat-billet' (that "
       "study's bat-grade billet values).";
-  out.push_back(maple);
+  out->push_back(maple);
+}
 
+// The hollow BBCOR bats (knots in inches, walls in m): "bbcor-33-aluminium", its capped build
+// "bbcor-33-alloy-capped" and the composite "composite-33-bbcor", appended to *out.
+void AddHollowPresets(std::vector<BatPreset>* out) {
   BatPreset bbcor;
   bbcor.name = "bbcor-33-aluminium";
   bbcor.bat.knots = FromInches({{0.0, 1.50},
@@ -150,7 +159,7 @@ std::vector<BatPreset> BuildPresets() {
       "typical of one-piece alloy BBCOR bats (not a specific model). The uniform wall thickness "
       "is solved so that the open-tube shell (no end cap, no knob plug; see bat.hpp) weighs "
       "exactly 30 oz; real bats vary the wall along the barrel.";
-  out.push_back(bbcor);
+  out->push_back(bbcor);
 
   // Issue 35, "bats as they are built": the same alloy bat closed by an end cap and a knob,
   // its barrel wall kept (the barrel model's calibration, validation.md) and its handle and
@@ -172,7 +181,7 @@ std::vector<BatPreset> BuildPresets() {
       "knob, not a manufacturer's: no published part masses were found. The barrel keeps the "
       "BBCOR-calibrated 2.761 mm wall; the wall from the knob to the taper's end (20.5 in) is "
       "solved so that the bat weighs 30 oz (kCappedHandleWallM, presets_test re-solves it).";
-  out.push_back(capped);
+  out->push_back(capped);
 
   BatPreset composite = bbcor;
   composite.name = "composite-33-bbcor";
@@ -188,7 +197,15 @@ std::vector<BatPreset> BuildPresets() {
       "'carbon-epoxy-fabric' (its source); end cap and knob as bbcor-33-alloy-capped's (this "
       "service's figures); the uniform wall solved for 30 oz (kCompositeWallM, presets_test "
       "re-solves it). A real composite bat's lay-up and wall vary; not a specific model.";
-  out.push_back(composite);
+  out->push_back(composite);
+}
+
+// Every preset, in the catalogue's order: the paper's, the wood, the hollow ones.
+std::vector<BatPreset> BuildPresets() {
+  std::vector<BatPreset> out;
+  AddPaperPresets(&out);
+  AddWoodPresets(&out);
+  AddHollowPresets(&out);
   return out;
 }
 

@@ -192,6 +192,262 @@ void IntegrateAlong(const BatModes& modes, double a, double b, F&& f) {
   }
 }
 
+// The modes usable and the impact point and the hands within the bat [0, modes.length_m]:
+// false with the failure in *s.
+bool FlexibleImpactOnBat(const BatModes& modes, const FlexibleImpactInputs& in, Summary* s) {
+  if (!modes.summary.IsSolutionUsable() || modes.modes.empty() || modes.nodes_m.size() < 2) {
+    s->termination = Termination::kFailure;
+    s->message = "the bat's modes are not usable: " + modes.summary.message;
+    return false;
+  }
+  const double length = modes.length_m;
+  if (!(in.impact_from_knob_m >= 0.0 && in.impact_from_knob_m <= length)) {
+    s->message = "impact_from_knob_m = " + FormatNumber17(in.impact_from_knob_m) +
+                 ": must be within the bat [0, " + FormatNumber17(length) + "]";
+    return false;
+  }
+  if (!(in.hands_from_knob_m >= 0.0 && in.hands_from_knob_m <= length)) {
+    s->message = "swing.hands_from_knob_m = " + FormatNumber17(in.hands_from_knob_m) +
+                 ": must be within the bat [0, " + FormatNumber17(length) + "]";
+    return false;
+  }
+  return true;
+}
+
+// How many of the computed modes (lowest first) are at or below f_cut_hz (Hz).
+int ModesAtOrBelow(const BatModes& modes, double f_cut_hz) {
+  const int available = static_cast<int>(modes.modes.size());
+  int n = 0;
+  while (n < available && modes.modes[static_cast<std::size_t>(n)].frequency_hz <= f_cut_hz) ++n;
+  return n;
+}
+
+// The scaled model of the impact at in.impact_from_knob_m with the modes' FE vectors `vecs`
+// (the two rigid modes first): omega_k t_s (t_s, s: the contact's time scale; 0 for the rigid
+// modes) and phi_k(s) sqrt(m) (m: the ball's mass, kg); the hands' coefficients zero, the
+// residual compliance left to the caller.
+Model ScaledModalModel(const BatModes& modes, const std::vector<Eigen::VectorXd>& vecs,
+                       const FlexibleImpactInputs& in, double t_s) {
+  const double m = in.ball_mass_kg;
+  const double h = in.hands_from_knob_m;
+  const int n_all = static_cast<int>(vecs.size());
+  Model full;
+  full.n = n_all;
+  full.omega_hat.assign(static_cast<std::size_t>(n_all), 0.0);
+  full.phi_hat.resize(static_cast<std::size_t>(n_all));
+  full.shear.assign(static_cast<std::size_t>(n_all), 0.0);
+  full.moment.assign(static_cast<std::size_t>(n_all), 0.0);
+  full.grip.assign(static_cast<std::size_t>(n_all), 0.0);
+  full.force_sign_hands = in.impact_from_knob_m < h ? 1.0 : 0.0;
+  full.arm_hands_m = in.impact_from_knob_m - h;
+  for (int k = 0; k < n_all; ++k) {
+    const std::size_t ks = static_cast<std::size_t>(k);
+    if (k >= 2) full.omega_hat[ks] = kTwoPi * modes.modes[ks - 2].frequency_hz * t_s;
+    full.phi_hat[ks] = modes.Displacement(vecs[ks], in.impact_from_knob_m) * std::sqrt(m);
+  }
+  return full;
+}
+
+// The residual flexibility (m/N) of the modes left out when the first n_flex bending modes are
+// used: G(s) (`flexibility`, the inertia-relief flexibility at the impact point) less each used
+// mode's phi_k(s)^2 / omega_k^2, at least 0; 0 without the static correction. `full`'s phi_hat
+// is phi_k(s) sqrt(m), m = ball_mass_kg (kg).
+double ResidualFlexibility(const BatModes& modes, const Model& full, double ball_mass_kg,
+                           double flexibility, int n_flex, bool static_correction) {
+  if (!static_correction) return 0.0;
+  double used = 0.0;
+  for (int k = 0; k < n_flex; ++k) {
+    const double om = kTwoPi * modes.modes[static_cast<std::size_t>(k)].frequency_hz;
+    const double phi = full.phi_hat[static_cast<std::size_t>(k + 2)] / std::sqrt(ball_mass_kg);
+    used += phi * phi / (om * om);
+  }
+  return std::max(0.0, flexibility - used);
+}
+
+// The hands' coefficients of *full from the modes' fields `vecs`: the shear and moment
+// integrals over the knob-side segment [0, h] (only when the hands' loads are asked for) and
+// the grip's energy weights over the grip, o.hands_grip_length_m (m) centred on h (m).
+void AddHandsIntegrals(const Bat& bat, const BatModes& modes,
+                       const std::vector<Eigen::VectorXd>& vecs, double h,
+                       const FlexibleImpactOptions& o, Model* full) {
+  const int n_all = full->n;
+  const bool rotary = modes.rotary_inertia;
+  // Every mode's field at a quadrature point, the element's shapes evaluated once.
+  std::vector<BeamField> fields(static_cast<std::size_t>(n_all));
+  if (o.hands_loads)
+    IntegrateAlong(modes, 0.0, h, [&](double x, double wgt) {
+      const BeamSection sec = SectionAt(bat, x);
+      EvaluateFields(modes.theory, modes.nodes_m, vecs, x, fields.data());
+      for (int k = 0; k < n_all; ++k) {
+        const std::size_t ks = static_cast<std::size_t>(k);
+        const BeamField& f = fields[ks];
+        const double w = f.bending_m + f.shear_m;
+        full->shear[ks] += wgt * sec.mass_per_length_kg_m * w;
+        full->moment[ks] += wgt * (sec.mass_per_length_kg_m * w * (x - h) +
+                                   (rotary ? sec.rotary_inertia_kg_m * f.rotation : 0.0));
+      }
+    });
+  const double g_lo = std::max(0.0, h - 0.5 * o.hands_grip_length_m);
+  const double g_hi = std::min(modes.length_m, h + 0.5 * o.hands_grip_length_m);
+  IntegrateAlong(modes, g_lo, g_hi, [&](double x, double wgt) {
+    const BeamSection sec = SectionAt(bat, x);
+    EvaluateFields(modes.theory, modes.nodes_m, vecs, x, fields.data());
+    for (int k = 2; k < n_all; ++k) {
+      const std::size_t ks = static_cast<std::size_t>(k);
+      const BeamField& f = fields[ks];
+      const double w = f.bending_m + f.shear_m;
+      full->grip[ks] += wgt * (sec.mass_per_length_kg_m * w * w +
+                               (rotary ? sec.rotary_inertia_kg_m * f.rotation * f.rotation : 0.0));
+    }
+  });
+}
+
+// The model with only the rigid modes and the first n_flex bending modes of `full`, its series
+// spring `residual_compliance` (m/N).
+Model FirstModes(const Model& full, int n_flex, double residual_compliance) {
+  Model md = full;
+  const std::size_t n = static_cast<std::size_t>(2 + n_flex);
+  md.n = 2 + n_flex;
+  md.omega_hat.resize(n);
+  md.phi_hat.resize(n);
+  md.shear.resize(n);
+  md.moment.resize(n);
+  md.grip.resize(n);
+  md.residual_compliance = residual_compliance;
+  return md;
+}
+
+// Energies and sting of one run: the ball's exit speed (m/s), the bending modes' energy and
+// its grip-weighted share (J).
+struct FlexibleOutcome {
+  double exit = 0.0, vib = 0.0, hands = 0.0;
+  // |this - other| per quantity: the change between two runs.
+  FlexibleOutcome DistanceTo(const FlexibleOutcome& other) const {
+    return {std::abs(exit - other.exit), std::abs(vib - other.vib), std::abs(hands - other.hands)};
+  }
+};
+
+// The outcome of the run `r` of model `md`: u the ball's speed, v0 the approach speed (m/s),
+// e_scale = m v0^2 (J per unit of scaled energy).
+FlexibleOutcome FlexibleOutcomeOf(const Model& md, const RawRun& r, double u, double v0,
+                                  double e_scale) {
+  FlexibleOutcome oc;
+  const State& y = r.final_state;
+  const int n = md.n;
+  oc.exit = -u + y[static_cast<std::size_t>(2 + 2 * n)] * v0;
+  for (int k = 2; k < n; ++k) {
+    const double om = md.omega_hat[static_cast<std::size_t>(k)];
+    const double q = y[static_cast<std::size_t>(2 + k)];
+    const double qd = y[static_cast<std::size_t>(2 + n + k)];
+    const double ek = 0.5 * e_scale * (qd * qd + om * om * q * q);
+    oc.vib += ek;
+    oc.hands += ek * md.grip[static_cast<std::size_t>(k)];
+  }
+  return oc;
+}
+
+// The full model's run `a` (outcome `oa`) into *out: speeds (m/s), impulse (N s), contact (s, N,
+// m), hands' peaks (N, N m), energies (J) and each bending mode's energy and frequency (Hz);
+// m the ball's mass (kg), v0 the approach speed (m/s), e_scale = m v0^2 (J).
+void TakeFullRun(const RawRun& a, const FlexibleOutcome& oa, const Model& full,
+                 const BatModes& modes, double m, double v0, double e_scale,
+                 FlexibleImpactResult* out) {
+  const int n_all = full.n;
+  const State& y = a.final_state;
+  out->exit_speed_mps = oa.exit;
+  out->vibration_energy_j = oa.vib + a.released_j;
+  out->hands_vibration_energy_j = oa.hands;
+  out->ball_impulse_n_s = y[static_cast<std::size_t>(2 + 2 * n_all)] * m * v0;
+  out->contact_time_s = a.contact_time_s;
+  out->contacts = a.contacts;
+  out->peak_force_n = a.peak_force_n;
+  out->max_compression_m = a.max_compression_m;
+  out->hands_peak_shear_force_n = a.peak_shear_n;
+  out->hands_peak_bending_moment_n_m = a.peak_moment_n_m;
+  out->ball_energy_j = 0.5 * e_scale * y[1] * y[1];
+  for (int k = 0; k < 2; ++k) {
+    const double qd = y[static_cast<std::size_t>(2 + n_all + k)];
+    out->rigid_body_energy_j += 0.5 * e_scale * qd * qd;
+  }
+  for (int k = 2; k < n_all; ++k) {
+    const double om = full.omega_hat[static_cast<std::size_t>(k)];
+    const double q = y[static_cast<std::size_t>(2 + k)];
+    const double qd = y[static_cast<std::size_t>(2 + n_all + k)];
+    out->modal_energies_j.push_back(0.5 * e_scale * (qd * qd + om * om * q * q));
+    out->mode_frequencies_hz.push_back(modes.modes[static_cast<std::size_t>(k - 2)].frequency_hz);
+  }
+  out->contact_loss_j = a.loss_j;
+  out->contact_work_j = y[static_cast<std::size_t>(3 + 2 * n_all)] * e_scale;
+  out->energy_balance_error_j =
+      out->initial_energy_j - (out->ball_energy_j + out->rigid_body_energy_j +
+                               out->vibration_energy_j + out->contact_loss_j);
+}
+
+// What every run of one impact shares: the inputs, the contact law, the compression scale
+// delta_s (m) and the window (s) over which the hands' loads are followed after the contact.
+struct FlexibleRuns {
+  const BallPowerLaw* law = nullptr;
+  const FlexibleImpactInputs* in = nullptr;
+  const FlexibleImpactOptions* o = nullptr;
+  double delta_s = 1.0;
+  double window_s = 0.0;
+  // A run of model `md` to the relative tolerance `tol`.
+  RawRun Run(const Model& md, double tol) const {
+    return Integrate(md, *law, *in, delta_s, tol, *o, window_s);
+  }
+};
+
+// The answer's error estimates into *out (exit speed: m/s; energies: J). With the refinement
+// check: the change with the finer tolerance (runs.fine) plus the change with half the cutoff
+// (a run of the modes below it, their residual from `flexibility`, m/N), each against the full
+// model's outcome `oa`; without it, the tolerance's share only.
+void EstimateFlexibleErrors(const RefinedRuns<RawRun>& runs, const FlexibleOutcome& oa,
+                            const Model& full, const FlexibleRuns& runner, const BatModes& modes,
+                            double flexibility, int n_used, FlexibleImpactResult* out) {
+  Summary& s = out->summary;
+  const FlexibleImpactInputs& in = *runner.in;
+  const FlexibleImpactOptions& o = *runner.o;
+  const double m = in.ball_mass_kg;
+  const double u = in.ball_speed_mps;
+  const double v0 = in.approach_speed_mps;
+  const double e_scale = m * v0 * v0;  // scaled energy -> J
+  if (!runs.refined) {
+    // Without the refinement check: the integration tolerance's share only.
+    out->error_estimate_exit_speed_mps = o.relative_tolerance * (u + std::abs(oa.exit));
+    out->error_estimate_vibration_energy_j = o.relative_tolerance * out->vibration_energy_j;
+    out->error_estimate_hands_energy_j = o.relative_tolerance * out->hands_vibration_energy_j;
+    return;
+  }
+  const RawRun& fine = runs.fine;
+  FlexibleOutcome integration;  // the change with the finer tolerance
+  if (fine.ok) {
+    integration = FlexibleOutcomeOf(full, fine, u, v0, e_scale).DistanceTo(oa);
+  } else {
+    s.warnings.push_back(RefineFailedWarning(fine.message));
+    integration.exit = o.relative_tolerance * (u + std::abs(oa.exit));
+  }
+  out->integration_error_exit_speed_mps = integration.exit;
+  const int n_half = ModesAtOrBelow(modes, 0.5 * out->cutoff_hz);
+  FlexibleOutcome truncation;  // the change with half the cutoff
+  if (n_half < n_used) {
+    const double residual =
+        ResidualFlexibility(modes, full, m, flexibility, n_half, o.static_correction);
+    const Model half = FirstModes(full, n_half, residual + in.barrel_compliance_m_n);
+    RawRun hr = runner.Run(half, o.relative_tolerance);
+    out->steps += hr.steps;
+    s.evaluations += static_cast<int>(hr.evaluations);
+    if (hr.ok) {
+      truncation = FlexibleOutcomeOf(half, hr, u, v0, e_scale).DistanceTo(oa);
+    } else {
+      s.warnings.push_back("the truncation check with half the cutoff failed: " + hr.message);
+    }
+  }
+  out->truncation_error_exit_speed_mps = truncation.exit;
+  out->error_estimate_exit_speed_mps = integration.exit + truncation.exit;
+  out->error_estimate_vibration_energy_j = integration.vib + truncation.vib;
+  out->error_estimate_hands_energy_j = integration.hands + truncation.hands;
+}
+
 }  // namespace
 
 bool FlexibleImpactOptions::Validate(Refusal* why) const {
@@ -253,22 +509,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
   return TimedSolve<FlexibleImpactResult>([&](FlexibleImpactResult& out) {
     Summary& s = out.summary;
     if (!StartContactSolve("flexible", &s, o, in)) return;
-    if (!modes.summary.IsSolutionUsable() || modes.modes.empty() || modes.nodes_m.size() < 2) {
-      s.termination = Termination::kFailure;
-      s.message = "the bat's modes are not usable: " + modes.summary.message;
-      return;
-    }
-    const double length = modes.length_m;
-    if (!(in.impact_from_knob_m >= 0.0 && in.impact_from_knob_m <= length)) {
-      s.message = "impact_from_knob_m = " + FormatNumber17(in.impact_from_knob_m) +
-                  ": must be within the bat [0, " + FormatNumber17(length) + "]";
-      return;
-    }
-    if (!(in.hands_from_knob_m >= 0.0 && in.hands_from_knob_m <= length)) {
-      s.message = "swing.hands_from_knob_m = " + FormatNumber17(in.hands_from_knob_m) +
-                  ": must be within the bat [0, " + FormatNumber17(length) + "]";
-      return;
-    }
+    if (!FlexibleImpactOnBat(modes, in, &s)) return;
     out.theory = modes.theory;
     out.elements = modes.Elements();
     const double m = in.ball_mass_kg;
@@ -293,13 +534,8 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
       return;
     }
     const double t_s = delta_s / v0;
+    const int n_used = ModesAtOrBelow(modes, out.cutoff_hz);
     const int available = static_cast<int>(modes.modes.size());
-    auto count_below = [&](double f_cut) {
-      int n = 0;
-      while (n < available && modes.modes[static_cast<std::size_t>(n)].frequency_hz <= f_cut) ++n;
-      return n;
-    };
-    const int n_used = count_below(out.cutoff_hz);
     // Every computed mode below the cutoff: harmless with the static correction unless the
     // computed modes stop well short of it.
     if (n_used == available &&
@@ -318,21 +554,7 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
     std::vector<Eigen::VectorXd> vecs = {modes.TranslationMode(), modes.RotationMode()};
     for (int k = 0; k < n_used; ++k)
       vecs.push_back(modes.modes[static_cast<std::size_t>(k)].vector);
-    const int n_all = static_cast<int>(vecs.size());
-    Model full;
-    full.n = n_all;
-    full.omega_hat.assign(static_cast<std::size_t>(n_all), 0.0);
-    full.phi_hat.resize(static_cast<std::size_t>(n_all));
-    full.shear.assign(static_cast<std::size_t>(n_all), 0.0);
-    full.moment.assign(static_cast<std::size_t>(n_all), 0.0);
-    full.grip.assign(static_cast<std::size_t>(n_all), 0.0);
-    full.force_sign_hands = in.impact_from_knob_m < h ? 1.0 : 0.0;
-    full.arm_hands_m = in.impact_from_knob_m - h;
-    for (int k = 0; k < n_all; ++k) {
-      const std::size_t ks = static_cast<std::size_t>(k);
-      if (k >= 2) full.omega_hat[ks] = kTwoPi * modes.modes[ks - 2].frequency_hz * t_s;
-      full.phi_hat[ks] = modes.Displacement(vecs[ks], in.impact_from_knob_m) * std::sqrt(m);
-    }
+    Model full = ScaledModalModel(modes, vecs, in, t_s);
     // Residual flexibility of the modes left out: G(s) - sum over the modes used.
     double flexibility = 0.0;
     if (o.static_correction) {
@@ -343,160 +565,28 @@ FlexibleImpactResult SolveFlexibleImpact(const Bat& bat, const BatModes& modes,
         return;
       }
     }
-    auto residual_for = [&](int n_flex) {
-      if (!o.static_correction) return 0.0;
-      double used = 0.0;
-      for (int k = 0; k < n_flex; ++k) {
-        const double om = kTwoPi * modes.modes[static_cast<std::size_t>(k)].frequency_hz;
-        const double phi = full.phi_hat[static_cast<std::size_t>(k + 2)] / std::sqrt(m);
-        used += phi * phi / (om * om);
-      }
-      return std::max(0.0, flexibility - used);
-    };
+    const double residual =
+        ResidualFlexibility(modes, full, m, flexibility, n_used, o.static_correction);
     // The contact's series spring: the modes left out and the barrel's wall (both elastic).
-    full.residual_compliance = residual_for(n_used) + in.barrel_compliance_m_n;
-    out.residual_compliance_m_n = residual_for(n_used);
-    const bool rotary = modes.rotary_inertia;
-    // The knob-side segment's inertia: only the hands' loads need it.
-    // Every mode's field at a quadrature point, the element's shapes evaluated once.
-    std::vector<BeamField> fields(static_cast<std::size_t>(n_all));
-    if (o.hands_loads)
-      IntegrateAlong(modes, 0.0, h, [&](double x, double wgt) {
-        const BeamSection sec = SectionAt(bat, x);
-        EvaluateFields(modes.theory, modes.nodes_m, vecs, x, fields.data());
-        for (int k = 0; k < n_all; ++k) {
-          const std::size_t ks = static_cast<std::size_t>(k);
-          const BeamField& f = fields[ks];
-          const double w = f.bending_m + f.shear_m;
-          full.shear[ks] += wgt * sec.mass_per_length_kg_m * w;
-          full.moment[ks] += wgt * (sec.mass_per_length_kg_m * w * (x - h) +
-                                    (rotary ? sec.rotary_inertia_kg_m * f.rotation : 0.0));
-        }
-      });
-    const double g_lo = std::max(0.0, h - 0.5 * o.hands_grip_length_m);
-    const double g_hi = std::min(length, h + 0.5 * o.hands_grip_length_m);
-    IntegrateAlong(modes, g_lo, g_hi, [&](double x, double wgt) {
-      const BeamSection sec = SectionAt(bat, x);
-      EvaluateFields(modes.theory, modes.nodes_m, vecs, x, fields.data());
-      for (int k = 2; k < n_all; ++k) {
-        const std::size_t ks = static_cast<std::size_t>(k);
-        const BeamField& f = fields[ks];
-        const double w = f.bending_m + f.shear_m;
-        full.grip[ks] += wgt * (sec.mass_per_length_kg_m * w * w +
-                                (rotary ? sec.rotary_inertia_kg_m * f.rotation * f.rotation : 0.0));
-      }
-    });
+    full.residual_compliance = residual + in.barrel_compliance_m_n;
+    out.residual_compliance_m_n = residual;
+    // The knob-side segment's inertia (only the hands' loads need it) and the grip's weights.
+    AddHandsIntegrals(bat, modes, vecs, h, o, &full);
     double window = o.sting_window_s;
     if (window == 0.0) window = 1.0 / modes.modes.front().frequency_hz;
 
-    // Energies and sting of one run.
-    struct Outcome {
-      double exit = 0.0, vib = 0.0, hands = 0.0;
-      // |this - other| per quantity: the change between two runs.
-      Outcome DistanceTo(const Outcome& other) const {
-        return {std::abs(exit - other.exit), std::abs(vib - other.vib),
-                std::abs(hands - other.hands)};
-      }
-    };
     const double e_scale = m * v0 * v0;  // scaled energy -> J
-    auto outcome_of = [&](const Model& md, const RawRun& r) {
-      Outcome oc;
-      const State& y = r.final_state;
-      const int n = md.n;
-      oc.exit = -u + y[static_cast<std::size_t>(2 + 2 * n)] * v0;
-      for (int k = 2; k < n; ++k) {
-        const double om = md.omega_hat[static_cast<std::size_t>(k)];
-        const double q = y[static_cast<std::size_t>(2 + k)];
-        const double qd = y[static_cast<std::size_t>(2 + n + k)];
-        const double ek = 0.5 * e_scale * (qd * qd + om * om * q * q);
-        oc.vib += ek;
-        oc.hands += ek * md.grip[static_cast<std::size_t>(k)];
-      }
-      return oc;
-    };
-    auto subset = [&](int n_flex) {
-      Model md = full;
-      const std::size_t n = static_cast<std::size_t>(2 + n_flex);
-      md.n = 2 + n_flex;
-      md.omega_hat.resize(n);
-      md.phi_hat.resize(n);
-      md.shear.resize(n);
-      md.moment.resize(n);
-      md.grip.resize(n);
-      md.residual_compliance = residual_for(n_flex) + in.barrel_compliance_m_n;
-      return md;
-    };
-
+    const FlexibleRuns runner{&law, &in, &o, delta_s, window};
     const RefinedRuns<RawRun> runs = SolveWithRefineCheck<RawRun>(
-        o.relative_tolerance, o.refine_check,
-        [&](double tol) { return Integrate(full, law, in, delta_s, tol, o, window); });
+        o.relative_tolerance, o.refine_check, [&](double tol) { return runner.Run(full, tol); });
     out.steps = CountRefinedRuns(runs, &s);
     if (!runs.coarse.ok) return;
     const RawRun& a = runs.coarse;
-    const Outcome oa = outcome_of(full, a);
-    const State& y = a.final_state;
-    out.exit_speed_mps = oa.exit;
-    out.vibration_energy_j = oa.vib + a.released_j;
-    out.hands_vibration_energy_j = oa.hands;
-    out.ball_impulse_n_s = y[static_cast<std::size_t>(2 + 2 * n_all)] * m * v0;
-    out.contact_time_s = a.contact_time_s;
-    out.contacts = a.contacts;
-    out.peak_force_n = a.peak_force_n;
-    out.max_compression_m = a.max_compression_m;
-    out.hands_peak_shear_force_n = a.peak_shear_n;
-    out.hands_peak_bending_moment_n_m = a.peak_moment_n_m;
-    out.ball_energy_j = 0.5 * e_scale * y[1] * y[1];
-    for (int k = 0; k < 2; ++k) {
-      const double qd = y[static_cast<std::size_t>(2 + n_all + k)];
-      out.rigid_body_energy_j += 0.5 * e_scale * qd * qd;
-    }
-    for (int k = 2; k < n_all; ++k) {
-      const double om = full.omega_hat[static_cast<std::size_t>(k)];
-      const double q = y[static_cast<std::size_t>(2 + k)];
-      const double qd = y[static_cast<std::size_t>(2 + n_all + k)];
-      out.modal_energies_j.push_back(0.5 * e_scale * (qd * qd + om * om * q * q));
-      out.mode_frequencies_hz.push_back(modes.modes[static_cast<std::size_t>(k - 2)].frequency_hz);
-    }
+    const FlexibleOutcome oa = FlexibleOutcomeOf(full, a, u, v0, e_scale);
+    TakeFullRun(a, oa, full, modes, m, v0, e_scale, &out);
     out.modes_used = n_used;
-    out.contact_loss_j = a.loss_j;
-    out.contact_work_j = y[static_cast<std::size_t>(3 + 2 * n_all)] * e_scale;
-    out.energy_balance_error_j =
-        out.initial_energy_j -
-        (out.ball_energy_j + out.rigid_body_energy_j + out.vibration_energy_j + out.contact_loss_j);
     s.warnings.insert(s.warnings.end(), a.warnings.begin(), a.warnings.end());
-
-    if (runs.refined) {
-      const RawRun& fine = runs.fine;
-      Outcome integration;  // the change with the finer tolerance
-      if (fine.ok) {
-        integration = outcome_of(full, fine).DistanceTo(oa);
-      } else {
-        s.warnings.push_back(RefineFailedWarning(fine.message));
-        integration.exit = o.relative_tolerance * (u + std::abs(oa.exit));
-      }
-      out.integration_error_exit_speed_mps = integration.exit;
-      const int n_half = count_below(0.5 * out.cutoff_hz);
-      Outcome truncation;  // the change with half the cutoff
-      if (n_half < n_used) {
-        const Model half = subset(n_half);
-        RawRun hr = Integrate(half, law, in, delta_s, o.relative_tolerance, o, window);
-        out.steps += hr.steps;
-        s.evaluations += static_cast<int>(hr.evaluations);
-        if (hr.ok) {
-          truncation = outcome_of(half, hr).DistanceTo(oa);
-        } else {
-          s.warnings.push_back("the truncation check with half the cutoff failed: " + hr.message);
-        }
-      }
-      out.truncation_error_exit_speed_mps = truncation.exit;
-      out.error_estimate_exit_speed_mps = integration.exit + truncation.exit;
-      out.error_estimate_vibration_energy_j = integration.vib + truncation.vib;
-      out.error_estimate_hands_energy_j = integration.hands + truncation.hands;
-    } else {  // the integration tolerance's share only
-      out.error_estimate_exit_speed_mps = o.relative_tolerance * (u + std::abs(oa.exit));
-      out.error_estimate_vibration_energy_j = o.relative_tolerance * out.vibration_energy_j;
-      out.error_estimate_hands_energy_j = o.relative_tolerance * out.hands_vibration_energy_j;
-    }
+    EstimateFlexibleErrors(runs, oa, full, runner, modes, flexibility, n_used, &out);
     s.iterations = out.steps;
     s.termination = Termination::kConverged;
     s.message = "contact ended after " + FormatNumber17(out.contact_time_s) + " s (" +

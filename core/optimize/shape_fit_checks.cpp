@@ -368,7 +368,11 @@ bool ShapeFitOptions::Validate(Refusal* why) const {
   return true;
 }
 
-bool ShapeFitProblem::Validate(Refusal* why) const {
+namespace {
+
+// The targets: at least one, each finite, positive and within its range (mass_kg: kg,
+// balance_point_m: m from the knob).
+bool ValidateFitTargets(const FitTargets& targets, Refusal* why) {
   if (!targets.mass_kg.has_value() && !targets.balance_point_m.has_value()) {
     return Refuse(why, TextRefusal("targets", "must give mass_kg, balance_point_m or both"));
   }
@@ -396,11 +400,59 @@ bool ShapeFitProblem::Validate(Refusal* why) const {
     return Refuse(why, "targets.balance_point_m", *targets.balance_point_m,
                   RangeRule(kMinMetricScale, kMaxBatLengthM));
   }
+  return true;
+}
+
+// The bounds of unknowns[i] `u` (named `name`, in its unit): finite, max > min, and min > 0
+// for a length, radius, density or wall (>= 0 for the others). With why == nullptr no message
+// is built.
+bool ValidateFitUnknownBounds(const FitUnknown& u, std::size_t i, const char* name, Refusal* why) {
+  if (!std::isfinite(u.min)) {
+    return why == nullptr
+               ? false
+               : Refuse(why, IndexedField("unknowns", i, "min"), u.min, "must be finite");
+  }
+  if (!std::isfinite(u.max)) {
+    return why == nullptr
+               ? false
+               : Refuse(why, IndexedField("unknowns", i, "max"), u.max, "must be finite");
+  }
+  if (!(u.max > u.min)) {
+    return why == nullptr ? false
+                          : Refuse(why, IndexedField("unknowns", i, "max"), u.max,
+                                   "must be greater than " + IndexedField("unknowns", i, "min") +
+                                       " = " + FormatNumber(u.min));
+  }
+  const DesignVariableKind v = u.variable;
+  const bool must_be_positive =
+      v == DesignVariableKind::kLength || v == DesignVariableKind::kHandleRadius ||
+      v == DesignVariableKind::kBarrelRadius || v == DesignVariableKind::kDensity ||
+      v == DesignVariableKind::kWallThickness;
+  if (must_be_positive && !(u.min > 0.0)) {
+    return why == nullptr
+               ? false
+               : Refuse(why, IndexedField("unknowns", i, "min"), u.min,
+                        std::string("must be positive for ") + name +
+                            (v == DesignVariableKind::kWallThickness ? " (the bat stays hollow)"
+                                                                     : ""));
+  }
+  if (!must_be_positive && u.min < 0.0) {
+    return why == nullptr ? false
+                          : Refuse(why, IndexedField("unknowns", i, "min"), u.min,
+                                   std::string("must be non-negative for ") + name);
+  }
+  return true;
+}
+
+// The unknowns: 1 to 10, each a fit unknown once (a fill's only with a fill), with valid bounds;
+// (*unknown)[k] says whether fit variable k is unknown.
+bool ValidateFitUnknowns(const ShapeFitProblem& problem, std::vector<bool>* unknown, Refusal* why) {
+  const std::vector<FitUnknown>& unknowns = problem.unknowns;
   if (unknowns.empty() || unknowns.size() > static_cast<std::size_t>(kNumFitVariables)) {
     return Refuse(why, "unknowns.size()", static_cast<double>(unknowns.size()),
                   "must be between 1 and 10");
   }
-  std::vector<bool> unknown(static_cast<std::size_t>(kNumFitVariables), false);
+  unknown->assign(static_cast<std::size_t>(kNumFitVariables), false);
   for (std::size_t i = 0; i < unknowns.size(); ++i) {
     const FitUnknown& u = unknowns[i];
     const int idx = FitUnknownIndex(u.variable);
@@ -409,56 +461,28 @@ bool ShapeFitProblem::Validate(Refusal* why) const {
                     "is not a fit unknown (a profile knot's kind)");
     }
     const char* name = kVariableName[idx];
-    if (unknown[static_cast<std::size_t>(idx)]) {
+    if ((*unknown)[static_cast<std::size_t>(idx)]) {
       return Refuse(why, QuotedRefusal(IndexedField("unknowns", i, "variable"), name,
                                        "appears more than once"));
     }
-    unknown[static_cast<std::size_t>(idx)] = true;
-    if (fit_detail::IsFillVariable(u.variable) && !fill.has_value()) {
+    (*unknown)[static_cast<std::size_t>(idx)] = true;
+    if (fit_detail::IsFillVariable(u.variable) && !problem.fill.has_value()) {
       return Refuse(
           why, QuotedRefusal(IndexedField("unknowns", i, "variable"), name, "the bat has no fill"));
     }
-    if (!std::isfinite(u.min)) {
-      return why == nullptr
-                 ? false
-                 : Refuse(why, IndexedField("unknowns", i, "min"), u.min, "must be finite");
-    }
-    if (!std::isfinite(u.max)) {
-      return why == nullptr
-                 ? false
-                 : Refuse(why, IndexedField("unknowns", i, "max"), u.max, "must be finite");
-    }
-    if (!(u.max > u.min)) {
-      return why == nullptr ? false
-                            : Refuse(why, IndexedField("unknowns", i, "max"), u.max,
-                                     "must be greater than " + IndexedField("unknowns", i, "min") +
-                                         " = " + FormatNumber(u.min));
-    }
-    const DesignVariableKind v = u.variable;
-    const bool must_be_positive =
-        v == DesignVariableKind::kLength || v == DesignVariableKind::kHandleRadius ||
-        v == DesignVariableKind::kBarrelRadius || v == DesignVariableKind::kDensity ||
-        v == DesignVariableKind::kWallThickness;
-    if (must_be_positive && !(u.min > 0.0)) {
-      return why == nullptr
-                 ? false
-                 : Refuse(why, IndexedField("unknowns", i, "min"), u.min,
-                          std::string("must be positive for ") + name +
-                              (v == DesignVariableKind::kWallThickness ? " (the bat stays hollow)"
-                                                                       : ""));
-    }
-    if (!must_be_positive && u.min < 0.0) {
-      return why == nullptr ? false
-                            : Refuse(why, IndexedField("unknowns", i, "min"), u.min,
-                                     std::string("must be non-negative for ") + name);
-    }
+    if (!ValidateFitUnknownBounds(u, i, name, why)) return false;
   }
-  // The fixed values.
-  const std::vector<double> t = fit_detail::StartParameters(*this);
+  return true;
+}
+
+// The fixed values (the fit variables not unknown, at the start parameters `t`): finite, and
+// positive (a length, radius or density) or non-negative.
+bool ValidateFitFixedValues(const ShapeFitProblem& problem, const std::vector<double>& t,
+                            const std::vector<bool>& unknown, Refusal* why) {
   for (int i = 0; i < kNumFitVariables; ++i) {
     const DesignVariableKind v = kFitUnknownKinds[i];
     if (unknown[static_cast<std::size_t>(i)] ||
-        (fit_detail::IsFillVariable(v) && !fill.has_value()))
+        (fit_detail::IsFillVariable(v) && !problem.fill.has_value()))
       continue;
     const double value = fit_detail::FitValue(t, v);
     const char* field = fit_detail::FitUnknownField(v);
@@ -469,13 +493,20 @@ bool ShapeFitProblem::Validate(Refusal* why) const {
     if (must_be_positive && !(value > 0.0)) return Refuse(why, field, value, "must be positive");
     if (value < 0.0) return Refuse(why, field, value, "must be non-negative");
   }
-  Material m = material;
+  return true;
+}
+
+// The bat's material and the fill's at the start parameters `t` (an unknown density at its
+// start, at least 1 kg/m³ for the fill, so that the other fields are checked).
+bool ValidateFitMaterials(const ShapeFitProblem& problem, const std::vector<double>& t,
+                          const std::vector<bool>& unknown, Refusal* why) {
+  Material m = problem.material;
   m.density_kg_m3 = fit_detail::FitValue(t, DesignVariableKind::kDensity);
   Refusal inner;
   if (!m.Validate(why != nullptr ? &inner : nullptr))
     return Refuse(why, Prefixed("material.", inner));
-  if (fill.has_value()) {
-    Material f = fill->material;
+  if (problem.fill.has_value()) {
+    Material f = problem.fill->material;
     if (unknown[static_cast<std::size_t>(FitUnknownIndex(DesignVariableKind::kFillDensity))]) {
       // check the other fields
       f.density_kg_m3 = std::max(fit_detail::FitValue(t, DesignVariableKind::kFillDensity), 1.0);
@@ -484,6 +515,19 @@ bool ShapeFitProblem::Validate(Refusal* why) const {
       return Refuse(why, Prefixed("fill.material.", inner));
     }
   }
+  return true;
+}
+
+}  // namespace
+
+bool ShapeFitProblem::Validate(Refusal* why) const {
+  if (!ValidateFitTargets(targets, why)) return false;
+  std::vector<bool> unknown;
+  if (!ValidateFitUnknowns(*this, &unknown, why)) return false;
+  const std::vector<double> t = fit_detail::StartParameters(*this);
+  if (!ValidateFitFixedValues(*this, t, unknown, why)) return false;
+  if (!ValidateFitMaterials(*this, t, unknown, why)) return false;
+  // The constraints no unknown can move must hold at the start.
   const bool hollow = fit_detail::HollowOf(*this);
   for (FitConstraint kind : fit_detail::ApplicableConstraints(hollow, fill.has_value())) {
     if (!fit_detail::ConstraintInvolves(kind, unknown) &&

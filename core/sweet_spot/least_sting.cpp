@@ -87,16 +87,17 @@ std::pair<double, double> StingBrentFromTriple(F&& f, double a, double b, double
   return {x, fx};
 }
 
-}  // namespace
-
-bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob_m, int samples,
-                    double fraction, double x_tolerance_m, std::vector<std::string>* warnings,
-                    LeastStingZoneResult* out, std::string* error) {
-  const double lo = from_knob_m;
-  const double hi = to_knob_m;
+// The impacts of one zone search: each impact's warnings gathered into *warnings (once each),
+// the first unusable impact's message kept in *error (then `failed`).
+struct StingSearch {
+  const StingImpact* solve = nullptr;
+  std::vector<std::string>* warnings = nullptr;
+  std::string* error = nullptr;
   bool failed = false;
-  auto impact = [&](double s, StingRun run) {
-    FlexibleImpactResult fr = solve(s, run);
+
+  // The impact `s` m from the knob, of the kind `run`.
+  FlexibleImpactResult Impact(double s, StingRun run) {
+    FlexibleImpactResult fr = (*solve)(s, run);
     for (const auto& w : fr.summary.warnings) {
       if (std::find(warnings->begin(), warnings->end(), w) == warnings->end()) {
         warnings->push_back(w);
@@ -107,26 +108,141 @@ bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob
       *error = "flexible at " + FormatNumber17(s) + " m from the knob: " + fr.summary.message;
     }
     return fr;
-  };
+  }
+  // The hands' vibration energy (J) of a search impact `s` m from the knob.
+  double Energy(double s) { return Impact(s, StingRun::kSearch).hands_vibration_energy_j; }
+};
+
+// The curve point of the sample impact `fr` at `s` m from the knob (SI, as the impact's).
+StingPoint StingPointOf(double s, const FlexibleImpactResult& fr) {
+  StingPoint p;
+  p.position_from_knob_m = s;
+  p.exit_speed_mps = fr.exit_speed_mps;
+  p.rigid_exit_speed_mps = fr.rigid_exit_speed_mps;
+  p.vibration_energy_j = fr.vibration_energy_j;
+  p.hands_vibration_energy_j = fr.hands_vibration_energy_j;
+  p.hands_peak_shear_force_n = fr.hands_peak_shear_force_n;
+  p.hands_peak_bending_moment_n_m = fr.hands_peak_bending_moment_n_m;
+  p.contact_time_s = fr.contact_time_s;
+  p.error_estimate_exit_speed_mps = fr.error_estimate_exit_speed_mps;
+  p.error_estimate_hands_energy_j = fr.error_estimate_hands_energy_j;
+  return p;
+}
+
+// The sampled sweep and its refined minimum, as the zone's edges read them.
+struct StingSweep {
+  std::vector<double> xs, es;       // the samples: from the knob (m), hands' energy (J)
+  std::size_t i_min = 0;            // the least sample
+  double x_min = 0.0, e_min = 0.0;  // the refined minimum: from the knob (m), energy (J)
+};
+
+// Refines sweep->x_min and e_min (from the least sample) between the neighbouring samples
+// [a, b] (m from the knob) by Brent's method to x_tolerance_m, started from the three samples
+// around it (their parabola is the first step). At an end of the sweep [lo, hi] there is no
+// such triple: boost's Brent on [end, neighbour] (its tolerance is relative to |x|, and
+// 2 tol (|x| + 1/4) bounds its final half-bracket). Returns false when an impact failed.
+bool RefineStingMinimum(StingSearch* search, double a, double b, double lo, double hi,
+                        double x_tolerance_m, StingSweep* sweep) {
+  auto energy = [search](double s) { return search->Energy(s); };
+  const std::vector<double>& xs = sweep->xs;
+  const std::vector<double>& es = sweep->es;
+  const std::size_t i_min = sweep->i_min;
+  if (i_min > 0 && i_min + 1 < xs.size()) {
+    const std::size_t lo_i = i_min - 1, hi_i = i_min + 1;
+    const std::size_t w_i = es[lo_i] <= es[hi_i] ? lo_i : hi_i;
+    const std::size_t v_i = w_i == lo_i ? hi_i : lo_i;
+    int evaluations = 0;
+    const auto m = StingBrentFromTriple(energy, a, b, sweep->x_min, sweep->e_min, xs[w_i], es[w_i],
+                                        xs[v_i], es[v_i], x_tolerance_m, 60, &evaluations);
+    if (search->failed) return false;
+    sweep->x_min = m.first;
+    sweep->e_min = m.second;
+  } else if (b > a) {
+    const double rel = x_tolerance_m / (2.0 * (std::max(std::abs(lo), std::abs(hi)) + 0.25));
+    const int bits = static_cast<int>(std::floor(1.0 - std::log2(rel)));
+    boost::uintmax_t iters = 60;
+    const auto m = boost::math::tools::brent_find_minima(energy, a, b, bits, iters);
+    if (search->failed) return false;
+    if (m.second <= sweep->e_min) {
+      sweep->x_min = m.first;
+      sweep->e_min = m.second;
+    }
+  }
+  return true;
+}
+
+// The zone's edge on the side `dir` (-1: towards the knob, +1: the tip), m from the knob: the
+// first sample beyond threshold_j (J) walking away from the minimum, then the crossing between
+// it and the sample inside by TOMS 748 to x_tolerance_m. *clipped when no sample of the sweep
+// [lo, hi] is beyond it (the edge is then lo or hi). *err_edges takes the larger of it and the
+// edge's error (m): the root's bracket plus how far err_e (J, the energy's error) moves it.
+double StingZoneEdge(StingSearch* search, const StingSweep& sweep, double threshold_j, double lo,
+                     double hi, double x_tolerance_m, double err_e, int dir, bool* clipped,
+                     double* err_edges) {
+  const std::vector<double>& xs = sweep.xs;
+  const std::vector<double>& es = sweep.es;
+  const std::size_t i_min = sweep.i_min;
+  auto g = [&](double s) { return search->Energy(s) - threshold_j; };
+  long j = static_cast<long>(i_min);
+  while (true) {
+    const long next = j + dir;
+    if (next < 0 || next >= static_cast<long>(xs.size())) {
+      *clipped = true;
+      return dir < 0 ? lo : hi;
+    }
+    if (es[static_cast<std::size_t>(next)] > threshold_j) {
+      const double inside =
+          j == static_cast<long>(i_min) ? sweep.x_min : xs[static_cast<std::size_t>(j)];
+      const double outside = xs[static_cast<std::size_t>(next)];
+      // The energy inside is known: the minimum's, or a sample's (the same impact; the
+      // samples compute the hands' loads besides, which do not change the energy).
+      const double ga =
+          (j == static_cast<long>(i_min) ? sweep.e_min : es[static_cast<std::size_t>(j)]) -
+          threshold_j;
+      const double gb = es[static_cast<std::size_t>(next)] - threshold_j;
+      if (search->failed || !(ga <= 0.0)) return inside;
+      boost::uintmax_t iters = 60;
+      try {
+        const double x0 = std::min(inside, outside), x1 = std::max(inside, outside);
+        const auto rr = boost::math::tools::toms748_solve(
+            g, x0, x1, x0 == inside ? ga : gb, x0 == inside ? gb : ga,
+            [&](double l, double r) { return r - l <= 2.0 * x_tolerance_m; }, iters);
+        const double root = 0.5 * (rr.first + rr.second);
+        const double slope = std::abs(gb - ga) / std::abs(outside - inside);
+        *err_edges =
+            std::max(*err_edges, (rr.second - rr.first) + (slope > 0.0 ? err_e / slope : 0.0));
+        return root;
+      } catch (const std::exception& e) {
+        search->failed = true;
+        *search->error = std::string("least_sting_zone: root finding failed: ") + e.what();
+        return inside;
+      }
+    }
+    j = next;
+  }
+}
+
+}  // namespace
+
+bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob_m, int samples,
+                    double fraction, double x_tolerance_m, std::vector<std::string>* warnings,
+                    LeastStingZoneResult* out, std::string* error) {
+  const double lo = from_knob_m;
+  const double hi = to_knob_m;
+  StingSearch search;
+  search.solve = &solve;
+  search.warnings = warnings;
+  search.error = error;
   const int n = samples;
-  std::vector<double> xs, es;
+  StingSweep sweep;
+  std::vector<double>& xs = sweep.xs;
+  std::vector<double>& es = sweep.es;
   double err_e = 0.0;
   for (int i = 0; i < n; ++i) {
     const double s = i + 1 == n ? hi : lo + (hi - lo) * i / (n - 1);
-    const FlexibleImpactResult fr = impact(s, StingRun::kSample);
-    if (failed) return false;
-    StingPoint p;
-    p.position_from_knob_m = s;
-    p.exit_speed_mps = fr.exit_speed_mps;
-    p.rigid_exit_speed_mps = fr.rigid_exit_speed_mps;
-    p.vibration_energy_j = fr.vibration_energy_j;
-    p.hands_vibration_energy_j = fr.hands_vibration_energy_j;
-    p.hands_peak_shear_force_n = fr.hands_peak_shear_force_n;
-    p.hands_peak_bending_moment_n_m = fr.hands_peak_bending_moment_n_m;
-    p.contact_time_s = fr.contact_time_s;
-    p.error_estimate_exit_speed_mps = fr.error_estimate_exit_speed_mps;
-    p.error_estimate_hands_energy_j = fr.error_estimate_hands_energy_j;
-    out->curve.push_back(p);
+    const FlexibleImpactResult fr = search.Impact(s, StingRun::kSample);
+    if (search.failed) return false;
+    out->curve.push_back(StingPointOf(s, fr));
     out->modes_used = std::max(out->modes_used, fr.modes_used);
     xs.push_back(s);
     es.push_back(fr.hands_vibration_energy_j);
@@ -135,41 +251,18 @@ bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob
   out->fraction = fraction;
   const std::size_t i_min =
       static_cast<std::size_t>(std::min_element(es.begin(), es.end()) - es.begin());
+  sweep.i_min = i_min;
   out->max_hands_energy_j = *std::max_element(es.begin(), es.end());
-  // Refine the minimum between the neighbouring samples by Brent's method to x_tolerance_m,
-  // started from the three samples around it (their parabola is the first step). At an end
-  // of the sweep there is no such triple: boost's Brent on [end, neighbour] (its tolerance is
-  // relative to |x|, and 2 tol (|x| + 1/4) bounds its final half-bracket).
-  auto energy = [&](double s) { return impact(s, StingRun::kSearch).hands_vibration_energy_j; };
   const double a = xs[i_min == 0 ? 0 : i_min - 1];
   const double b = xs[std::min(i_min + 1, xs.size() - 1)];
-  double x_min = xs[i_min], e_min = es[i_min];
+  sweep.x_min = xs[i_min];
+  sweep.e_min = es[i_min];
   double err_x = 0.5 * (b - a);
-  if (i_min > 0 && i_min + 1 < xs.size()) {
-    const std::size_t lo_i = i_min - 1, hi_i = i_min + 1;
-    const std::size_t w_i = es[lo_i] <= es[hi_i] ? lo_i : hi_i;
-    const std::size_t v_i = w_i == lo_i ? hi_i : lo_i;
-    int evaluations = 0;
-    const auto m = StingBrentFromTriple(energy, a, b, x_min, e_min, xs[w_i], es[w_i], xs[v_i],
-                                        es[v_i], x_tolerance_m, 60, &evaluations);
-    if (failed) return false;
-    x_min = m.first;
-    e_min = m.second;
-  } else if (b > a) {
-    const double rel = x_tolerance_m / (2.0 * (std::max(std::abs(lo), std::abs(hi)) + 0.25));
-    const int bits = static_cast<int>(std::floor(1.0 - std::log2(rel)));
-    boost::uintmax_t iters = 60;
-    const auto m = boost::math::tools::brent_find_minima(energy, a, b, bits, iters);
-    if (failed) return false;
-    if (m.second <= e_min) {
-      x_min = m.first;
-      e_min = m.second;
-    }
-  }
+  if (!RefineStingMinimum(&search, a, b, lo, hi, x_tolerance_m, &sweep)) return false;
   // The least-sting impact once more, with the refinement check: the exit speed there and the
   // error of the hands' energy (integration + mode truncation) that the ends' estimates use.
-  const FlexibleImpactResult checked = impact(x_min, StingRun::kChecked);
-  if (failed) return false;
+  const FlexibleImpactResult checked = search.Impact(sweep.x_min, StingRun::kChecked);
+  if (search.failed) return false;
   err_e = std::max(err_e, checked.error_estimate_hands_energy_j);
   if (b > a) {
     // Brent's bracket, widened by how far the energy's own error moves a flat minimum.
@@ -179,55 +272,17 @@ bool LeastStingZone(const StingImpact& solve, double from_knob_m, double to_knob
                         (h * h);
     err_x = x_tolerance_m + (curv > 0.0 ? std::sqrt(2.0 * err_e / curv) : 0.5 * (b - a));
   }
-  out->min_position_from_knob_m = x_min;
-  out->min_hands_energy_j = e_min;
+  out->min_position_from_knob_m = sweep.x_min;
+  out->min_hands_energy_j = sweep.e_min;
   out->exit_speed_at_min_mps = checked.exit_speed_mps;
-  out->threshold_j = e_min + fraction * (out->max_hands_energy_j - e_min);
-  auto g = [&](double s) { return energy(s) - out->threshold_j; };
+  out->threshold_j = sweep.e_min + fraction * (out->max_hands_energy_j - sweep.e_min);
   double err_edges = 0.0;
-  auto edge = [&](int dir, bool* clipped) -> double {
-    // The first sample beyond the threshold, walking away from the minimum.
-    long j = static_cast<long>(i_min);
-    while (true) {
-      const long next = j + dir;
-      if (next < 0 || next >= static_cast<long>(xs.size())) {
-        *clipped = true;
-        return dir < 0 ? lo : hi;
-      }
-      if (es[static_cast<std::size_t>(next)] > out->threshold_j) {
-        const double inside =
-            j == static_cast<long>(i_min) ? x_min : xs[static_cast<std::size_t>(j)];
-        const double outside = xs[static_cast<std::size_t>(next)];
-        // The energy inside is known: the minimum's, or a sample's (the same impact; the
-        // samples compute the hands' loads besides, which do not change the energy).
-        const double ga = (j == static_cast<long>(i_min) ? e_min : es[static_cast<std::size_t>(j)]) -
-                          out->threshold_j;
-        const double gb = es[static_cast<std::size_t>(next)] - out->threshold_j;
-        if (failed || !(ga <= 0.0)) return inside;
-        boost::uintmax_t iters = 60;
-        try {
-          const double x0 = std::min(inside, outside), x1 = std::max(inside, outside);
-          const auto rr = boost::math::tools::toms748_solve(
-              g, x0, x1, x0 == inside ? ga : gb, x0 == inside ? gb : ga,
-              [&](double l, double r) { return r - l <= 2.0 * x_tolerance_m; }, iters);
-          const double root = 0.5 * (rr.first + rr.second);
-          const double slope = std::abs(gb - ga) / std::abs(outside - inside);
-          err_edges =
-              std::max(err_edges, (rr.second - rr.first) + (slope > 0.0 ? err_e / slope : 0.0));
-          return root;
-        } catch (const std::exception& e) {
-          failed = true;
-          *error = std::string("least_sting_zone: root finding failed: ") + e.what();
-          return inside;
-        }
-      }
-      j = next;
-    }
-  };
   bool clip_lo = false, clip_hi = false;
-  out->from_knob_m = edge(-1, &clip_lo);
-  out->to_knob_m = edge(+1, &clip_hi);
-  if (failed) return false;
+  out->from_knob_m = StingZoneEdge(&search, sweep, out->threshold_j, lo, hi, x_tolerance_m, err_e,
+                                   -1, &clip_lo, &err_edges);
+  out->to_knob_m = StingZoneEdge(&search, sweep, out->threshold_j, lo, hi, x_tolerance_m, err_e, +1,
+                                 &clip_hi, &err_edges);
+  if (search.failed) return false;
   out->clipped_at_hands = clip_lo;
   out->clipped_at_tip = clip_hi;
   out->error_estimate_m = std::max(err_x, err_edges);
