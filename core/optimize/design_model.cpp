@@ -468,4 +468,13 @@ double DesignModel::FunctionOfP(DesignFunction f, const double* p, double* gradi
 // ---------------------------------------------------------------------------------------------
 // Designs.
 
+// The jets design_model_wall.cpp evaluates these with (the barrel COR's derivatives): defined
+// here, so that file links whatever unity batch, or none, it is compiled in.
+template jet::Jet<9, false> DesignModel::AngularSpeedOf(const jet::Jet<9, false>* p) const;
+template jet::Jet<9, true> DesignModel::AngularSpeedOf(const jet::Jet<9, true>* p) const;
+template jet::Jet<9, false> DesignModel::ObjectiveOf(const jet::Jet<9, false>* p,
+                                                     const jet::Jet<9, false>& e) const;
+template jet::Jet<9, true> DesignModel::ObjectiveOf(const jet::Jet<9, true>* p,
+                                                    const jet::Jet<9, true>& e) const;
+
 }  // namespace sweetspot::core
