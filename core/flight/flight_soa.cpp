@@ -9,9 +9,18 @@ namespace sweetspot::core::flight::stepper {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 
+// The correctly rounded square root of each lane (as std::sqrt's): one AVX instruction.
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline Vec Sqrt(Vec x) {
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+  return __builtin_ia32_sqrtpd256(x);
+#else
+  return Vec{std::sqrt(x[0]), std::sqrt(x[1]), std::sqrt(x[2]), std::sqrt(x[3])};
+#endif
+}
+
 // Derivative<K> (its kinds with spin decay) on 4 lanes: the same expressions, term by term.
 template <Kind K>
-[[gnu::always_inline]] inline void SoaEvaluate(SoaLanes<K>& m, int j, Vec t, const Vec* s) {
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline void SoaEvaluate(SoaLanes<K>& m, int j, Vec t, const Vec* s) {
   static_assert(K == Kind::kSaturating || K == Kind::kLinear, "the decay kinds");
   Vec* d = m.k[j];
   const Vec zero = {};
@@ -39,11 +48,13 @@ template <Kind K>
   d[5] += drag * rz + lift * (m.ux * ry - m.uy * rx);
 }
 
-// Attempt<K, L> and ErrorOf<K> on the 4 lanes at once.
+// Attempt<K, L>, ErrorOf<K> and, on the lanes whose attempt is accepted without an event,
+// Conclude<K> and AtLimit<K> on the 4 lanes of each group at once.
 template <Kind K>
-[[gnu::always_inline]] inline void SoaAttempt(SoaLanes<K>* groups, double rtol, double atol,
-                                              SoaError* outs) {
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline SoaSpecial SoaStep(
+    SoaLanes<K>* groups, const SoaSettings& settings) {
   constexpr int N = SoaLanes<K>::N;
+  const double rtol = settings.rtol, atol = settings.atol;
 #define SWEETSPOT_GROUPS for (int g = 0; g < kSoaGroups; ++g)
 #define SWEETSPOT_GROUP       \
   SoaLanes<K>& a = groups[g]; \
@@ -111,16 +122,16 @@ template <Kind K>
   }
   const Vec zero = {};
   const Vec largest = Splat(std::numeric_limits<double>::max());
+  SoaSpecial special;
   SWEETSPOT_GROUPS {
     SWEETSPOT_GROUP;
-    SoaError* out = &outs[g];
-    out->err2 = out->position_err2 = out->velocity_err2 = zero;
-    out->finite = VecMask{} - 1;
+    Vec err2 = zero, position_err2 = zero, velocity_err2 = zero;
+    VecMask finite = VecMask{} - 1;
     for (int i = 0; i < N; ++i) {
       const Vec e = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] + e5 * k[4][i] + e6 * k[5][i] +
                          e7 * k[6][i]);
       const Vec yn = a.y_new[i];
-      out->finite &= (Abs(yn) <= largest) & (Abs(e) <= largest);
+      finite &= (Abs(yn) <= largest) & (Abs(e) <= largest);
       Vec scale;
       if (i < 6) {
         const Vec ay = Abs(a.y[i]), ayn = Abs(yn);
@@ -128,14 +139,50 @@ template <Kind K>
       } else {
         scale = Splat(rtol);
       }
-      out->err2 += (e / scale) * (e / scale);
+      err2 += (e / scale) * (e / scale);
       if (i < 3) {
-        out->position_err2 += e * e;
+        position_err2 += e * e;
       } else if (i < 6) {
-        out->velocity_err2 += e * e;
+        velocity_err2 += e * e;
       }
     }
+    a.finite = finite;
+    a.control = ControlOf(Sqrt(err2 / 6.0), h, a.log_memory);
+    a.position_error = Sqrt(position_err2);
+    a.velocity_error = Sqrt(velocity_err2);
+    // Conclude's cases: not finite, rejected (err > 1), an apex or a landing in the step (its
+    // tests on y and y_new), left to the scalar code; the rest accepted plainly.
+    const VecMask apex = (a.y[5] > zero) & (a.y_new[5] <= zero);
+    const VecMask lands = (a.y_new[2] <= zero) & (a.y_new[5] < zero);
+    const VecMask plain = a.active & finite & ~(a.control.err > 1.0) & ~apex & ~lands;
+    // Conclude on an accepted step without an event, in its order.
+    a.evaluations = plain ? a.evaluations + 6.0 : a.evaluations;
+    a.steps = plain ? a.steps + 1.0 : a.steps;
+    a.error_sum = plain ? a.error_sum + a.position_error : a.error_sum;
+    a.velocity_error_sum = plain ? a.velocity_error_sum + a.velocity_error : a.velocity_error_sum;
+    a.velocity_error_time_sum = plain ? a.velocity_error_time_sum + a.velocity_error * (t + h)
+                                      : a.velocity_error_time_sum;
+    const Vec t_new = plain ? t + h : t;
+    a.t = t_new;
+    a.log_memory = plain ? a.control.log_memory : a.log_memory;
+    const Vec h_new = plain ? a.control.h_accepted : h;
+    for (int i = 0; i < N; ++i) {
+      a.y[i] = plain ? a.y_new[i] : a.y[i];
+      a.k[0][i] = plain ? a.k[6][i] : a.k[0][i];  // first same as last
+    }
+    // AtLimit before the next attempt: the lanes at a limit are left to the scalar code, the
+    // others' steps bounded by the time left.
+    const VecMask limit = plain & ((a.steps + a.rejected_steps >= settings.max_steps) |
+                                   (t_new >= settings.max_flight_time_s));
+    const Vec left = settings.max_flight_time_s - t_new;
+    a.h = plain & ~limit & (left < h_new) ? left : h_new;  // std::min(h, left)
+    const VecMask conclude = a.active & ~plain;
+    for (int m = 0; m < kSoaLanes; ++m) {
+      special.conclude |= (conclude[m] != 0 ? 1U : 0U) << (g * kSoaLanes + m);
+      special.limit |= (limit[m] != 0 ? 1U : 0U) << (g * kSoaLanes + m);
+    }
   }
+  return special;
 #undef SWEETSPOT_GROUPS
 #undef SWEETSPOT_GROUP
 }
@@ -149,13 +196,13 @@ bool SoaLanesPay() { return __builtin_cpu_supports("avx2"); }
 #else
 bool SoaLanesPay() { return false; }
 #endif
-SWEETSPOT_FLIGHT_AVX2 void SoaAttemptSaturating(SoaLanes<Kind::kSaturating>* a, double rtol,
-                                                double atol, SoaError* out) {
-  SoaAttempt<Kind::kSaturating>(a, rtol, atol, out);
+SWEETSPOT_FLIGHT_AVX2 SoaSpecial SoaStepSaturating(SoaLanes<Kind::kSaturating>* a,
+                                                   const SoaSettings& settings) {
+  return SoaStep<Kind::kSaturating>(a, settings);
 }
-SWEETSPOT_FLIGHT_AVX2 void SoaAttemptLinear(SoaLanes<Kind::kLinear>* a, double rtol, double atol,
-                                            SoaError* out) {
-  SoaAttempt<Kind::kLinear>(a, rtol, atol, out);
+SWEETSPOT_FLIGHT_AVX2 SoaSpecial SoaStepLinear(SoaLanes<Kind::kLinear>* a,
+                                               const SoaSettings& settings) {
+  return SoaStep<Kind::kLinear>(a, settings);
 }
 
 #pragma GCC diagnostic pop
