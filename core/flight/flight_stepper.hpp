@@ -294,7 +294,21 @@ template <class T>
 // four iterations to 1e-13 in θ), and if it leaves [0, 1] or does not settle, an Illinois
 // regula falsi to 1e-11 in θ (1e-10 m on a step of tens of metres).
 inline double RootOf(const Dense& dense, int i, double f0, double f1) {
-  double theta = f0 / (f0 - f1);
+  // The first guess: the inverse cubic Hermite interpolant of θ against the component (its
+  // values and slopes at the ends: a step's θ as a function of z near the ground, or of vz near
+  // the apex, is nearly cubic), or the secant's where the component is not monotone at the ends.
+  // From it Newton's method takes two iterations instead of three or four.
+  const double secant = f0 / (f0 - f1);
+  const double span = f1 - f0;
+  const double slope0 = dense.r2[i] + dense.r3[i];                 // df/dθ at θ = 0
+  const double slope1 = dense.r2[i] - dense.r3[i] - dense.r4[i];  // df/dθ at θ = 1
+  const double m0 = span / slope0, m1 = span / slope1;            // dθ/ds at the ends
+  double theta = secant;
+  if (m0 > 0.0 && m1 > 0.0) {
+    const double s = secant, u = 1.0 - s;
+    const double hermite = s * u * u * m0 + s * s * (3.0 - 2.0 * s) - s * s * u * m1;
+    if (hermite >= 0.0 && hermite <= 1.0) theta = hermite;
+  }
   for (int iter = 0; iter < 8; ++iter) {
     // y = r1 + θ·Q, Q = r2 + u·P, P = r3 + θ·(r4 + u·r5), u = 1 − θ; dy/dθ by the product rule.
     const double u = 1.0 - theta;
@@ -310,8 +324,9 @@ inline double RootOf(const Dense& dense, int i, double f0, double f1) {
     const double step = f / df;
     theta -= step;
     if (!(theta >= 0.0 && theta <= 1.0)) break;
-    // Converging quadratically: θ's error after a step δ is of order δ² (1e-16 here).
-    if (std::abs(step) < 1e-8) return theta;
+    // Converging quadratically: θ's error after a step δ is about |f''/2f'|·δ², 1e-15 here
+    // (|f''/2f'| is about h/6 for z at the landing, less for vz at the apex).
+    if (std::abs(step) < 1e-7) return theta;
   }
   double a = 0.0, b = 1.0, fa = f0, fb = f1;
   int side = 0;
