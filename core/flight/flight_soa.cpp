@@ -48,6 +48,80 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline void SoaEvaluate(SoaLanes<K>
   d[5] += drag * rz + lift * (m.ux * ry - m.uy * rx);
 }
 
+// Conclude's apex on the lanes `lanes` of an accepted step (vz crosses zero going down): the
+// dense output of z and vz, RootOf's Newton iterations on vz (its first guess, its stopping
+// rules and its order of operations, lane by lane), z there, and the apex update. Returns the
+// lanes whose Newton iterations fail (leave [0, 1], a zero derivative, or no convergence in 8):
+// Conclude takes those (RootOf's regula falsi), from the start, so a lane's numbers stay Fly's.
+template <Kind K>
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline VecMask SoaApex(SoaLanes<K>& a,
+                                                                    VecMask lanes) {
+  const Vec h = a.h, t = a.t;
+  const auto& k = a.k;
+  // Hairer's contd5 coefficients of component i, as Conclude forms them.
+  auto dense = [&](int i, Vec* r) {
+    const Vec diff = a.y_new[i] - a.y[i];
+    const Vec bspl = h * k[0][i] - diff;
+    r[0] = a.y[i];
+    r[1] = diff;
+    r[2] = bspl;
+    r[3] = diff - h * k[6][i] - bspl;
+    r[4] = h * (d1 * k[0][i] + d3 * k[2][i] + d4 * k[3][i] + d5 * k[4][i] + d6 * k[5][i] +
+                d7 * k[6][i]);
+  };
+  Vec v[5], z[5];
+  dense(5, v);
+  dense(2, z);
+  const Vec f0 = a.y[5], f1 = a.y_new[5];
+  const Vec zero = {};
+  // RootOf's first guess.
+  const Vec secant = f0 / (f0 - f1);
+  const Vec span = f1 - f0;
+  const Vec slope0 = v[1] + v[2];
+  const Vec slope1 = v[1] - v[2] - v[3];
+  const Vec m0 = span / slope0, m1 = span / slope1;
+  const Vec s = secant, u0 = 1.0 - s;
+  const Vec hermite = s * u0 * u0 * m0 + s * s * (3.0 - 2.0 * s) - s * s * u0 * m1;
+  const VecMask use_hermite =
+      (m0 > zero) & (m1 > zero) & (hermite >= zero) & (hermite <= Splat(1.0));
+  Vec theta = use_hermite ? hermite : secant;
+  VecMask live = lanes, failed = VecMask{};
+  for (int iter = 0; iter < 8; ++iter) {
+    bool any = false;
+    for (int m = 0; m < kSoaLanes; ++m) any = any || live[m] != 0;
+    if (!any) break;
+    const Vec u = 1.0 - theta;
+    const Vec inner = v[3] + u * v[4];
+    const Vec p = v[2] + theta * inner;
+    const Vec q = v[1] + u * p;
+    const Vec dp = inner - theta * v[4];
+    const Vec dq = -p + u * dp;
+    const Vec f = v[0] + theta * q;
+    const Vec df = q + theta * dq;
+    const VecMask root = live & (f == zero);  // done, θ as it is
+    live &= ~root;
+    const VecMask flat = live & ~(df != zero);  // RootOf's break: the fallback
+    failed |= flat;
+    live &= ~flat;
+    const Vec step = f / df;
+    const Vec next = theta - step;
+    theta = live ? next : theta;
+    const VecMask out = live & ~((next >= zero) & (next <= Splat(1.0)));
+    failed |= out;
+    live &= ~out;
+    live &= ~(Abs(step) < Splat(1e-7));  // converged
+  }
+  failed |= live;  // not settled in 8 iterations: the fallback
+  const VecMask done = lanes & ~failed;
+  // The apex: z at θ (Dense::Component), kept where higher than the flight's so far.
+  const Vec u = 1.0 - theta;
+  const Vec height = z[0] + theta * (z[1] + u * (z[2] + theta * (z[3] + u * z[4])));
+  const VecMask higher = done & (height > a.apex_m);
+  a.apex_m = higher ? height : a.apex_m;
+  a.apex_time_s = higher ? t + theta * h : a.apex_time_s;
+  return failed;
+}
+
 // Attempt<K, L>, ErrorOf<K> and, on the lanes whose attempt is accepted without an event,
 // Conclude<K> and AtLimit<K> on the 4 lanes of each group at once.
 template <Kind K>
@@ -150,11 +224,17 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline SoaSpecial SoaStep(
     a.control = ControlOf(Sqrt(err2 / 6.0), h, a.log_memory);
     a.position_error = Sqrt(position_err2);
     a.velocity_error = Sqrt(velocity_err2);
-    // Conclude's cases: not finite, rejected (err > 1), an apex or a landing in the step (its
-    // tests on y and y_new), left to the scalar code; the rest accepted plainly.
+    // Conclude's cases: not finite, rejected (err > 1) or a landing in the step (its tests on y
+    // and y_new), left to the scalar code; the rest accepted here, an apex in the step included
+    // (SoaApex) unless its root needs the scalar fallback.
     const VecMask apex = (a.y[5] > zero) & (a.y_new[5] <= zero);
     const VecMask lands = (a.y_new[2] <= zero) & (a.y_new[5] < zero);
-    const VecMask plain = a.active & finite & ~(a.control.err > 1.0) & ~apex & ~lands;
+    const VecMask accepted = a.active & finite & ~(a.control.err > 1.0) & ~lands;
+    VecMask plain = accepted;
+    const VecMask apex_lanes = accepted & apex;
+    bool any_apex = false;
+    for (int m = 0; m < kSoaLanes; ++m) any_apex = any_apex || apex_lanes[m] != 0;
+    if (any_apex) plain &= ~SoaApex(a, apex_lanes);
     // Conclude on an accepted step without an event, in its order.
     a.evaluations = plain ? a.evaluations + 6.0 : a.evaluations;
     a.steps = plain ? a.steps + 1.0 : a.steps;

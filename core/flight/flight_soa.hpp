@@ -19,8 +19,10 @@ namespace sweetspot::core::flight::stepper {
 // move its elements through memory). A lane's operations are Fly's, in Fly's order, each
 // IEEE-rounded (division and square root included), and neither target enables FMA, so nothing
 // is contracted: the answers are Fly's to the bit (FlightTest.FlyManyGivesFlysAnswers). The
-// step's bookkeeping (the controller's log and exp, the events, the refill) stays per lane on
-// the scalar Lane; an idle lane computes on its last numbers, its results unread (masked).
+// kernel also does the step's bookkeeping on every lane whose attempt is accepted and does not
+// land (the controller, without libm: ControlOf; the error sums; the apex's root: SoaApex);
+// the scalar Lane and Conclude take only a rejection, a landing, a limit and the refill; an
+// idle lane computes on its last numbers, its results unread (masked).
 // The vectors never cross a call's boundary (the kernels take them in SoaLanes): GCC's note on
 // the ABI of 32-byte vectors without AVX does not apply.
 #pragma GCC diagnostic push
@@ -49,6 +51,7 @@ struct SoaLanes {
   Vec log_memory = {};  // Lane::log_previous_error_ratio
   Vec error_sum = {}, velocity_error_sum = {}, velocity_error_time_sum = {};
   Vec steps = {}, rejected_steps = {}, evaluations = {};  // FlightResult's counts, as doubles
+  Vec apex_m = {}, apex_time_s = {};  // FlightResult's apex so far
   VecMask active = {};  // all ones where the lane flies a flight
   // The last attempt's error norm and controller (read by Conclude on the lanes it concludes).
   Control<Vec> control = {};
@@ -62,9 +65,9 @@ struct SoaSettings {
 };
 
 // What a kernel call leaves to the scalar code, one bit per lane (bit l = lane l of FlyMany's
-// kFlyManyLanes): `conclude`, the lanes whose attempt was rejected, not finite, or has an event
-// (an apex or a landing) — Conclude decides them; `limit`, the lanes whose accepted plain step
-// put them at the time or step limit (AtLimit ends them).
+// kFlyManyLanes): `conclude`, the lanes whose attempt was rejected, not finite, lands, or has an
+// apex whose root needs RootOf's fallback — Conclude decides them; `limit`, the lanes whose
+// accepted step put them at the time or step limit (AtLimit ends them).
 struct SoaSpecial {
   unsigned conclude = 0, limit = 0;
 };
@@ -72,7 +75,7 @@ struct SoaSpecial {
 // The kernels, compiled for AVX2 (without FMA), one non-template function per kind
 // (flight_soa.cpp); SoaLanesPay: whether this processor runs them (it has AVX2). One call: an
 // attempt on every lane, its error norm and controller, and for the lanes whose attempt is
-// accepted without an event (most steps) all of Conclude's and AtLimit's bookkeeping, as vector
+// accepted and not landing (most steps) all of Conclude's and AtLimit's bookkeeping, as vector
 // operations in Conclude's order (so a lane's numbers are Fly's to the bit).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define SWEETSPOT_FLIGHT_AVX2 __attribute__((target("avx2")))
@@ -132,6 +135,8 @@ void SoaSyncIn(const SoaLanes<K>& v, int l, Lane<K>* lane) {
   a.r->steps = static_cast<int>(v.steps[l]);
   a.r->rejected_steps = static_cast<int>(v.rejected_steps[l]);
   a.r->evaluations = static_cast<int>(v.evaluations[l]);
+  a.r->apex_m = v.apex_m[l];
+  a.r->apex_time_s = v.apex_time_s[l];
 }
 template <Kind K>
 void SoaSyncOut(const Lane<K>& a, int l, SoaLanes<K>* v) {
@@ -144,6 +149,8 @@ void SoaSyncOut(const Lane<K>& a, int l, SoaLanes<K>* v) {
   v->steps[l] = a.r->steps;
   v->rejected_steps[l] = a.r->rejected_steps;
   v->evaluations[l] = a.r->evaluations;
+  v->apex_m[l] = a.r->apex_m;
+  v->apex_time_s[l] = a.r->apex_time_s;
 }
 
 // FlyLanes<K, kFlyManyLanes> with the stepper's arithmetic on SoaLanes: the same flights in the

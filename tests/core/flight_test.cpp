@@ -412,6 +412,7 @@ TEST(FlightTest, FlyManyGivesFlysAnswers) {
         EXPECT_EQ(many[i].distance_m, one.distance_m) << i;
         EXPECT_EQ(many[i].hang_time_s, one.hang_time_s) << i;
         EXPECT_EQ(many[i].apex_m, one.apex_m) << i;
+        EXPECT_EQ(many[i].apex_time_s, one.apex_time_s) << i;
         EXPECT_EQ(many[i].error_estimate_m, one.error_estimate_m) << i;
         EXPECT_EQ(many[i].steps, one.steps) << i;
         EXPECT_EQ(many[i].evaluations, one.evaluations) << i;
