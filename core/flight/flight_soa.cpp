@@ -48,37 +48,34 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline void SoaEvaluate(SoaLanes<K>
   d[5] += drag * rz + lift * (m.ux * ry - m.uy * rx);
 }
 
-// Conclude's apex on the lanes `lanes` of an accepted step (vz crosses zero going down): the
-// dense output of z and vz, RootOf's Newton iterations on vz (its first guess, its stopping
-// rules and its order of operations, lane by lane), z there, and the apex update. Returns the
-// lanes whose Newton iterations fail (leave [0, 1], a zero derivative, or no convergence in 8):
-// Conclude takes those (RootOf's regula falsi), from the start, so a lane's numbers stay Fly's.
+// Hairer's contd5 coefficients of component i of the lanes' last attempt, as Conclude forms them.
 template <Kind K>
-SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline VecMask SoaApex(SoaLanes<K>& a,
-                                                                    VecMask lanes) {
-  const Vec h = a.h, t = a.t;
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline void SoaDense(const SoaLanes<K>& a, int i,
+                                                                  Vec* r) {
+  const Vec h = a.h;
   const auto& k = a.k;
-  // Hairer's contd5 coefficients of component i, as Conclude forms them.
-  auto dense = [&](int i, Vec* r) {
-    const Vec diff = a.y_new[i] - a.y[i];
-    const Vec bspl = h * k[0][i] - diff;
-    r[0] = a.y[i];
-    r[1] = diff;
-    r[2] = bspl;
-    r[3] = diff - h * k[6][i] - bspl;
-    r[4] = h * (d1 * k[0][i] + d3 * k[2][i] + d4 * k[3][i] + d5 * k[4][i] + d6 * k[5][i] +
-                d7 * k[6][i]);
-  };
-  Vec v[5], z[5];
-  dense(5, v);
-  dense(2, z);
-  const Vec f0 = a.y[5], f1 = a.y_new[5];
+  const Vec diff = a.y_new[i] - a.y[i];
+  const Vec bspl = h * k[0][i] - diff;
+  r[0] = a.y[i];
+  r[1] = diff;
+  r[2] = bspl;
+  r[3] = diff - h * k[6][i] - bspl;
+  r[4] = h * (d1 * k[0][i] + d3 * k[2][i] + d4 * k[3][i] + d5 * k[4][i] + d6 * k[5][i] +
+              d7 * k[6][i]);
+}
+
+// RootOf on the lanes `lanes` of a vector (dense coefficients r, ends f0 and f1 of opposite
+// signs): its first guess, Newton's iterations with its stopping rules, in its order of
+// operations, lane by lane (a lane that stops is masked). Returns the lanes whose iterations
+// fail (leave [0, 1], meet a zero derivative, or do not settle in 8): for those RootOf's regula
+// falsi decides, on the scalar Lane (Conclude, from the start), so a lane's θ stays Fly's.
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline VecMask SoaRoot(const Vec* r, Vec f0, Vec f1,
+                                                                    VecMask lanes, Vec* root) {
   const Vec zero = {};
-  // RootOf's first guess.
   const Vec secant = f0 / (f0 - f1);
   const Vec span = f1 - f0;
-  const Vec slope0 = v[1] + v[2];
-  const Vec slope1 = v[1] - v[2] - v[3];
+  const Vec slope0 = r[1] + r[2];
+  const Vec slope1 = r[1] - r[2] - r[3];
   const Vec m0 = span / slope0, m1 = span / slope1;
   const Vec s = secant, u0 = 1.0 - s;
   const Vec hermite = s * u0 * u0 * m0 + s * s * (3.0 - 2.0 * s) - s * s * u0 * m1;
@@ -91,15 +88,14 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline VecMask SoaApex(SoaLanes<K>&
     for (int m = 0; m < kSoaLanes; ++m) any = any || live[m] != 0;
     if (!any) break;
     const Vec u = 1.0 - theta;
-    const Vec inner = v[3] + u * v[4];
-    const Vec p = v[2] + theta * inner;
-    const Vec q = v[1] + u * p;
-    const Vec dp = inner - theta * v[4];
+    const Vec inner = r[3] + u * r[4];
+    const Vec p = r[2] + theta * inner;
+    const Vec q = r[1] + u * p;
+    const Vec dp = inner - theta * r[4];
     const Vec dq = -p + u * dp;
-    const Vec f = v[0] + theta * q;
+    const Vec f = r[0] + theta * q;
     const Vec df = q + theta * dq;
-    const VecMask root = live & (f == zero);  // done, θ as it is
-    live &= ~root;
+    live &= ~(f == zero);  // a root: θ as it is
     const VecMask flat = live & ~(df != zero);  // RootOf's break: the fallback
     failed |= flat;
     live &= ~flat;
@@ -111,14 +107,29 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline VecMask SoaApex(SoaLanes<K>&
     live &= ~out;
     live &= ~(Abs(step) < Splat(1e-7));  // converged
   }
-  failed |= live;  // not settled in 8 iterations: the fallback
-  const VecMask done = lanes & ~failed;
-  // The apex: z at θ (Dense::Component), kept where higher than the flight's so far.
+  *root = theta;
+  return failed | live;  // not settled in 8 iterations: the fallback
+}
+
+// Dense::Component of coefficients r at θ.
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline Vec SoaComponent(const Vec* r, Vec theta) {
   const Vec u = 1.0 - theta;
-  const Vec height = z[0] + theta * (z[1] + u * (z[2] + theta * (z[3] + u * z[4])));
-  const VecMask higher = done & (height > a.apex_m);
+  return r[0] + theta * (r[1] + u * (r[2] + theta * (r[3] + u * r[4])));
+}
+
+// Conclude's apex on the lanes `lanes` of an accepted step (vz crosses zero going down): the
+// root of vz (SoaRoot), z there, and the apex update. Returns the lanes left to Conclude.
+template <Kind K>
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline VecMask SoaApex(SoaLanes<K>& a,
+                                                                    VecMask lanes) {
+  Vec v[5], z[5], theta;
+  SoaDense(a, 5, v);
+  const VecMask failed = SoaRoot(v, a.y[5], a.y_new[5], lanes, &theta);
+  SoaDense(a, 2, z);
+  const Vec height = SoaComponent(z, theta);
+  const VecMask higher = lanes & ~failed & (height > a.apex_m);
   a.apex_m = higher ? height : a.apex_m;
-  a.apex_time_s = higher ? t + theta * h : a.apex_time_s;
+  a.apex_time_s = higher ? a.t + theta * a.h : a.apex_time_s;
   return failed;
 }
 
@@ -235,6 +246,17 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline SoaSpecial SoaStep(
     bool any_apex = false;
     for (int m = 0; m < kSoaLanes; ++m) any_apex = any_apex || apex_lanes[m] != 0;
     if (any_apex) plain &= ~SoaApex(a, apex_lanes);
+    // The landing's root for Conclude (which finishes a landing on the scalar Lane): z's.
+    const VecMask landing_lanes = a.active & finite & ~(a.control.err > 1.0) & lands;
+    bool any_landing = false;
+    for (int m = 0; m < kSoaLanes; ++m) any_landing = any_landing || landing_lanes[m] != 0;
+    a.landing_known = VecMask{};
+    if (any_landing) {
+      Vec z[5];
+      SoaDense(a, 2, z);
+      a.landing_known =
+          landing_lanes & ~SoaRoot(z, a.y[2], a.y_new[2], landing_lanes, &a.landing_theta);
+    }
     // Conclude on an accepted step without an event, in its order.
     a.evaluations = plain ? a.evaluations + 6.0 : a.evaluations;
     a.steps = plain ? a.steps + 1.0 : a.steps;

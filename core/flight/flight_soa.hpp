@@ -52,6 +52,9 @@ struct SoaLanes {
   Vec error_sum = {}, velocity_error_sum = {}, velocity_error_time_sum = {};
   Vec steps = {}, rejected_steps = {}, evaluations = {};  // FlightResult's counts, as doubles
   Vec apex_m = {}, apex_time_s = {};  // FlightResult's apex so far
+  // The landing's θ in the last attempt (RootOf's), where landing_known.
+  Vec landing_theta = {};
+  VecMask landing_known = {};
   VecMask active = {};  // all ones where the lane flies a flight
   // The last attempt's error norm and controller (read by Conclude on the lanes it concludes).
   Control<Vec> control = {};
@@ -214,6 +217,7 @@ void FlyLanesSoa(std::size_t count, const FlightOptions& options, const StartFli
       error.position_error = w.position_error[m];
       error.velocity_error = w.velocity_error[m];
       error.controlled = true;
+      a.landing_theta = w.landing_known[m] != 0 ? w.landing_theta[m] : -1.0;
       const Outcome outcome = Conclude(a, options, error);
       if (outcome == Outcome::kEnded) {
         refill(l);

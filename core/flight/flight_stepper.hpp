@@ -375,6 +375,9 @@ struct Lane {
   // controller's err^0.17 · facold^−0.04 is one exp of logarithms (two pow calls cost more).
   double log_previous_error_ratio = kLogMinErrorMemory;
   long long next_sample = 1;  // the next sample is at next_sample · trajectory_interval_s
+  // Where the last attempt's landing θ is known already (FlyMany's kernel: RootOf's, lane by
+  // lane), else negative (Conclude finds it).
+  double landing_theta = -1.0;
 };
 
 // The stage derivative k[j] at (t, s): the positions' derivatives are the velocities.
@@ -560,7 +563,9 @@ Outcome Conclude(Lane<K>& a, const FlightOptions& options, const StepError& se) 
         r.apex_time_s = t + theta * h;
       }
     }
-    const double theta_land = lands ? RootOf(dense, 2, y[2], y_new[2]) : 1.0;
+    const double theta_land = !lands                    ? 1.0
+                              : a.landing_theta >= 0.0 ? a.landing_theta
+                                                       : RootOf(dense, 2, y[2], y_new[2]);
     const double t_end = t + theta_land * h;
     if (a.trajectory != nullptr) {
       for (double ts = a.next_sample * options.trajectory_interval_s; ts < t_end;
