@@ -144,7 +144,7 @@ template <Kind K>
 bool Start(const Launch& launch, const Environment& environment, const AeroOptions& aero,
            const FlightOptions& options, FlightResult* r, std::vector<TrajectoryPoint>* trajectory,
            Lane<K>* lane, double first_step_s, bool checked = false,
-           const double* density = nullptr) {
+           const double* density = nullptr, bool first_stage = true) {
   Lane<K>& a = *lane;
   double y0[6];
   if (!Prepare(launch, environment, aero, options, r, &a.m, y0, checked, density)) return false;
@@ -161,7 +161,8 @@ bool Start(const Launch& launch, const Environment& environment, const AeroOptio
   // of a 400 ft fly ball): 0.5 s takes 6 steps (37 evaluations) instead of 8 (49), and the
   // grid's worst errors are lower (docs/flight.md, "Where a flight's time goes").
   a.h = first_step_s;  // FirstStep(options), computed once per Fly or FlyMany
-  Evaluate<K>(a, 0, 0.0, a.y);
+  // f(0, y0), the first attempt's first stage (FlyMany's vector kernel evaluates it itself).
+  if (first_stage) Evaluate<K>(a, 0, 0.0, a.y);
   r->evaluations = 1;
   a.error_sum = a.velocity_error_sum = a.velocity_error_time_sum = 0.0;
   a.log_previous_error_ratio = kLogMinErrorMemory;
@@ -386,16 +387,19 @@ void FlyMany(std::size_t count, const Launch* launches, const Environment* envir
   const double first_step = FirstStep(options);
   WithKind(KindOf(aero), [&](auto kind) {
     constexpr Kind K = decltype(kind)::value;
+    bool first_stage = true;  // false: the vector lanes evaluate it (FlyLanesSoa)
     auto start = [&](std::size_t i, Lane<K>* lane) {
       results[i] = FlightResult();
       const Environment& environment = environments[shared_environment ? 0 : i];
       bool checked = shared_valid;
       if (checked && !shared_environment) checked = environment.Validate(nullptr);
       return Start<K>(launches[i], environment, aero, options, &results[i], nullptr, lane,
-                      first_step, checked, shared_valid && shared_environment ? &density : nullptr);
+                      first_step, checked, shared_valid && shared_environment ? &density : nullptr,
+                      first_stage);
     };
     if constexpr (K == Kind::kSaturating || K == Kind::kLinear) {
       if (SoaLanesPay()) {
+        first_stage = false;
         FlyLanesSoa<K>(count, options, start);
         return;
       }

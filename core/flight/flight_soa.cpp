@@ -147,6 +147,18 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline SoaSpecial SoaStep(
   const auto& k = a.k;        \
   (void)t;                    \
   (void)k
+  // The first stage of the flights just started (Start's Evaluate, here for 4 lanes at once),
+  // through k[6], which the attempt overwrites.
+  SWEETSPOT_GROUPS {
+    SWEETSPOT_GROUP;
+    bool any_fresh = false;
+    for (int m = 0; m < kSoaLanes; ++m) any_fresh = any_fresh || a.fresh[m] != 0;
+    if (any_fresh) {
+      SoaEvaluate<K>(a, 6, t, a.y);
+      for (int i = 0; i < N; ++i) a.k[0][i] = a.fresh ? a.k[6][i] : a.k[0][i];
+      a.fresh = VecMask{};
+    }
+  }
   SWEETSPOT_GROUPS {
     SWEETSPOT_GROUP;
     for (int i = 3; i < N; ++i) a.s[i] = a.y[i] + h * a21 * k[0][i];

@@ -56,6 +56,7 @@ struct SoaLanes {
   Vec landing_theta = {};
   VecMask landing_known = {};
   VecMask active = {};  // all ones where the lane flies a flight
+  VecMask fresh = {};   // all ones where its flight has just started: k[0] is not yet f(t, y)
   // The last attempt's error norm and controller (read by Conclude on the lanes it concludes).
   Control<Vec> control = {};
   Vec position_error = {}, velocity_error = {};
@@ -100,16 +101,14 @@ SoaSpecial SoaStepOf(SoaLanes<K>* a, const SoaSettings& settings) {
   }
 }
 
-// Lane l of `v` takes the flight just started on `lane` (its state, its first stage, its model,
-// its integrator state), or (lane.r null) goes idle.
+// Lane l of `v` takes the flight just started on `lane` (its state and its model; the kernel
+// evaluates its first stage), or (lane.r null) goes idle.
 template <Kind K>
 void SoaLoad(const Lane<K>& lane, int l, SoaLanes<K>* v) {
   v->active[l] = lane.r != nullptr ? -1 : 0;
   if (lane.r == nullptr) return;
-  for (int i = 0; i < Lane<K>::N; ++i) {
-    v->y[i][l] = lane.y[i];
-    v->k[0][i][l] = lane.k[0][i];
-  }
+  v->fresh[l] = -1;  // the kernel evaluates the first stage (Start left it)
+  for (int i = 0; i < Lane<K>::N; ++i) v->y[i][l] = lane.y[i];
   const Model& m = lane.m;
   v->k_cd0[l] = m.k_cd0;
   v->k_cd_spin[l] = m.k_cd_spin;
