@@ -146,6 +146,7 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline SoaSpecial SoaStep(
   const Vec t = a.t, h = a.h; \
   const auto& k = a.k;        \
   (void)t;                    \
+  (void)h;                    \
   (void)k
   // The first stage of the flights just started (Start's Evaluate, here for 4 lanes at once),
   // through k[6], which the attempt overwrites.
