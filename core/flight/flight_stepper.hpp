@@ -231,7 +231,8 @@ template <class T>
   return k * 0.69314718055994530942 + (2.0 * s + 2.0 * s * r);
 }
 
-// exp y for y in [−4, 1] (the controller's): y = n·ln 2 + r, |r| ≤ 0.347, e^r by its Taylor
+// exp y for y in [−4, 1] (the controller's: 0.17·ln err − 0.04·ln facold is in [−3.92, 0.37]
+// for an accepted step, −0.2·ln err is bounded to [−3, 0] for a rejected one): y = n·ln 2 + r, |r| ≤ 0.347, e^r by its Taylor
 // series to r¹⁰ (truncation below 3e-13), 2^n from the bits of the rounding's magic number.
 template <class T>
 [[gnu::always_inline]] inline T ControllerExp(T y) {
@@ -253,8 +254,8 @@ template <class T>
 constexpr double kMinError = 1e-10;
 constexpr double kLogMinErrorMemory = -9.210340371976182;  // ln 1e-4
 
-// What the controller makes of an attempt with scaled error norm² `err2` (Σ of the scaled
-// components' squares) and step h: err = √(err2/6); if rejected (err > 1) the next attempt's
+// What the controller makes of an attempt with step h and error norm err = √(err2/6) (err2 the
+// sum of the scaled components' squares, ErrorOf): if rejected (err > 1) the next attempt's
 // h·max(0.2, 0.9·err^−0.2); if accepted the next step's h·clamp(0.9/fac, 0.2, 10) with
 // fac = max(err, 1e-10)^0.17 · facold^−0.04 (facold = max(err, 1e-4) of the last accepted step,
 // `log_memory` its logarithm, updated to this step's). A lane's numbers are unread where its
@@ -290,9 +291,11 @@ template <class T>
 }
 
 // The θ in [0, 1] where component `i` of the dense output crosses zero, given its signs at
-// the ends differ: Newton's method on the dense polynomial from the secant's guess (three or
-// four iterations to 1e-13 in θ), and if it leaves [0, 1] or does not settle, an Illinois
-// regula falsi to 1e-11 in θ (1e-10 m on a step of tens of metres).
+// the ends differ: Newton's method on the dense polynomial from an inverse cubic Hermite guess
+// (two or three iterations, θ to about 1e-15), and if it leaves [0, 1] or does not settle, an
+// Illinois regula falsi to 1e-11 in θ (1e-10 m on a step of tens of metres). FlyMany's kernel
+// runs the same Newton iterations lane by lane (SoaRoot, flight_soa.cpp): a change here is a
+// change there.
 inline double RootOf(const Dense& dense, int i, double f0, double f1) {
   // The first guess: the inverse cubic Hermite interpolant of θ against the component (its
   // values and slopes at the ends: a step's θ as a function of z near the ground, or of vz near
