@@ -27,6 +27,18 @@ bool PrefixOnFailure(Refusal* why, const char* prefix, bool ok) {
   return ok;
 }
 
+// sin a and cos a, without libm's call at a = ±0 (no spray, a wind out to centre field): the
+// same numbers (sin ±0 = ±0, cos ±0 = 1).
+void SinCos(double a, double* sin_a, double* cos_a) {
+  if (a == 0.0) {
+    *sin_a = a;
+    *cos_a = 1.0;
+  } else {
+    *sin_a = std::sin(a);
+    *cos_a = std::cos(a);
+  }
+}
+
 // The model and the initial state of a flight (Fly's documented inputs), its spin, labels and
 // air density written to `r`; false (with `r` final) when an input is refused.
 // `checked`: the environment, aero and options are known valid (FlyMany checks shared ones
@@ -61,7 +73,9 @@ bool Prepare(const Launch& launch, const Environment& environment, const AeroOpt
                                                           : AirDensityKgM3(environment);
 
   const double th = launch.launch_angle_deg * kDegToRad, ph = launch.spray_angle_deg * kDegToRad;
-  const double sth = std::sin(th), cth = std::cos(th), sph = std::sin(ph), cph = std::cos(ph);
+  double sth, cth, sph, cph;
+  SinCos(th, &sth, &cth);
+  SinCos(ph, &sph, &cph);
   Model& m = *model;
   m = Model();
   const double wb = r->spin.backspin_rpm, ws = r->spin.sidespin_rpm;
@@ -74,14 +88,15 @@ bool Prepare(const Launch& launch, const Environment& environment, const AeroOpt
     m.uy = wy / m.omega_rad_s;
     m.uz = wz / m.omega_rad_s;
   }
-  m.spin_krpm = std::hypot(wb, ws) / 1000.0;
+  m.spin_krpm = std::sqrt(wb * wb + ws * ws) / 1000.0;
   m.radius_m = aero.ball_circumference_m / (2.0 * kPi);
   const double area_m2 = kPi * m.radius_m * m.radius_m;
   const double rho = r->air_density_kg_m3;
   switch (aero.model) {
     case AeroModel::kNathan2016:
       m.k_per_m = kNathanC0PerDensity * rho * (kNathanMassKg / aero.ball_mass_kg) *
-                  std::pow(aero.ball_circumference_m / kNathanCircumferenceM, 2);
+                  ((aero.ball_circumference_m / kNathanCircumferenceM) *
+                   (aero.ball_circumference_m / kNathanCircumferenceM));
       m.cd0 = 0.3008;
       m.cd_spin = 0.0292;
       m.cl0 = 0.583;
@@ -106,8 +121,10 @@ bool Prepare(const Launch& launch, const Environment& environment, const AeroOpt
   m.decay_rate_per_m = 1.0 / (aero.spin_decay_s * kDecayReferenceSpeedMps);
   m.Prepare();
   const double wind_dir = environment.wind.direction_deg * kDegToRad;
-  m.wind_x = environment.wind.speed_mps * std::sin(wind_dir);
-  m.wind_y = environment.wind.speed_mps * std::cos(wind_dir);
+  double swind, cwind;
+  SinCos(wind_dir, &swind, &cwind);
+  m.wind_x = environment.wind.speed_mps * swind;
+  m.wind_y = environment.wind.speed_mps * cwind;
 
   const double v0 = launch.exit_speed_mps;
   const double start[6] = {launch.start_x_m, launch.start_y_m, launch.height_m,
@@ -116,11 +133,18 @@ bool Prepare(const Launch& launch, const Environment& environment, const AeroOpt
   return true;
 }
 
+// The first step (s): about a tenth of a flight's time scale (0.5 s at the default tolerance),
+// refined by the controller (Start).
+double FirstStep(const FlightOptions& options) {
+  return std::min(0.5, std::pow(options.relative_tolerance, 0.2) * 5.0);
+}
+
 // Puts a flight on `lane` (false, with `r` final, when an input is refused).
 template <Kind K>
 bool Start(const Launch& launch, const Environment& environment, const AeroOptions& aero,
            const FlightOptions& options, FlightResult* r, std::vector<TrajectoryPoint>* trajectory,
-           Lane<K>* lane, bool checked = false, const double* density = nullptr) {
+           Lane<K>* lane, double first_step_s, bool checked = false,
+           const double* density = nullptr, bool first_stage = true) {
   Lane<K>& a = *lane;
   double y0[6];
   if (!Prepare(launch, environment, aero, options, r, &a.m, y0, checked, density)) return false;
@@ -136,8 +160,9 @@ bool Start(const Launch& launch, const Environment& environment, const AeroOptio
   // three steps growing it (errors of 5e-7 and 8e-3 of the tolerance in the first two steps
   // of a 400 ft fly ball): 0.5 s takes 6 steps (37 evaluations) instead of 8 (49), and the
   // grid's worst errors are lower (docs/flight.md, "Where a flight's time goes").
-  a.h = std::min(0.5, std::pow(options.relative_tolerance, 0.2) * 5.0);
-  Evaluate<K>(a, 0, 0.0, a.y);
+  a.h = first_step_s;  // FirstStep(options), computed once per Fly or FlyMany
+  // f(0, y0), the first attempt's first stage (FlyMany's vector kernel evaluates it itself).
+  if (first_stage) Evaluate<K>(a, 0, 0.0, a.y);
   r->evaluations = 1;
   a.error_sum = a.velocity_error_sum = a.velocity_error_time_sum = 0.0;
   a.log_previous_error_ratio = kLogMinErrorMemory;
@@ -250,55 +275,68 @@ const char* FlightTerminationName(FlightTermination termination) {
   return "invalid_input";
 }
 
+namespace {
+
+// CheckInRange with its test inline: the checks run for every flight (FlyMany: every launch),
+// and a call per field was 7 % of a flight's instructions (callgrind). The refusal's text, on
+// a failure, is CheckInRange's.
+inline bool InRange(Refusal* why, std::string_view field, double value, double lo, double hi,
+                    bool lo_open = false) {
+  if (std::isfinite(value) && (lo_open ? value > lo : value >= lo) && value <= hi) return true;
+  return core::CheckInRange(why, field, value, lo, hi, lo_open);
+}
+
+}  // namespace
+
 bool Launch::Validate(Refusal* why) const {
-  if (!CheckInRange(why, "exit_speed_mps", exit_speed_mps, 0.0, 90.0, /*lo_open=*/true)) {
+  if (!InRange(why, "exit_speed_mps", exit_speed_mps, 0.0, 90.0, /*lo_open=*/true)) {
     return false;
   }
-  if (!CheckInRange(why, "launch_angle_deg", launch_angle_deg, -90.0, 90.0)) return false;
-  if (!CheckInRange(why, "spray_angle_deg", spray_angle_deg, -90.0, 90.0)) return false;
+  if (!InRange(why, "launch_angle_deg", launch_angle_deg, -90.0, 90.0)) return false;
+  if (!InRange(why, "spray_angle_deg", spray_angle_deg, -90.0, 90.0)) return false;
   if (backspin_rpm.has_value() != sidespin_rpm.has_value()) {
     return Refuse(why, TextRefusal(backspin_rpm ? "sidespin_rpm" : "backspin_rpm",
                                    "give both spins or neither (neither: estimated from the "
                                    "launch angle)"));
   }
-  if (backspin_rpm && !CheckInRange(why, "backspin_rpm", *backspin_rpm, -10000.0, 10000.0)) {
+  if (backspin_rpm && !InRange(why, "backspin_rpm", *backspin_rpm, -10000.0, 10000.0)) {
     return false;
   }
-  if (sidespin_rpm && !CheckInRange(why, "sidespin_rpm", *sidespin_rpm, -10000.0, 10000.0)) {
+  if (sidespin_rpm && !InRange(why, "sidespin_rpm", *sidespin_rpm, -10000.0, 10000.0)) {
     return false;
   }
-  if (!CheckInRange(why, "height_m", height_m, 0.0, 5.0)) return false;
-  if (!CheckInRange(why, "start_x_m", start_x_m, -5.0, 5.0)) return false;
-  return CheckInRange(why, "start_y_m", start_y_m, -5.0, 5.0);
+  if (!InRange(why, "height_m", height_m, 0.0, 5.0)) return false;
+  if (!InRange(why, "start_x_m", start_x_m, -5.0, 5.0)) return false;
+  return InRange(why, "start_y_m", start_y_m, -5.0, 5.0);
 }
 
 bool Environment::Validate(Refusal* why) const {
-  return CheckInRange(why, "temperature_c", temperature_c, -40.0, 60.0) &&
-         CheckInRange(why, "elevation_m", elevation_m, -500.0, 5000.0) &&
-         CheckInRange(why, "relative_humidity_pct", relative_humidity_pct, 0.0, 100.0) &&
-         CheckInRange(why, "sea_level_pressure_pa", sea_level_pressure_pa, 80000.0, 110000.0) &&
-         CheckInRange(why, "wind.speed_mps", wind.speed_mps, 0.0, 50.0) &&
-         CheckInRange(why, "wind.direction_deg", wind.direction_deg, -360.0, 360.0);
+  return InRange(why, "temperature_c", temperature_c, -40.0, 60.0) &&
+         InRange(why, "elevation_m", elevation_m, -500.0, 5000.0) &&
+         InRange(why, "relative_humidity_pct", relative_humidity_pct, 0.0, 100.0) &&
+         InRange(why, "sea_level_pressure_pa", sea_level_pressure_pa, 80000.0, 110000.0) &&
+         InRange(why, "wind.speed_mps", wind.speed_mps, 0.0, 50.0) &&
+         InRange(why, "wind.direction_deg", wind.direction_deg, -360.0, 360.0);
 }
 
 bool AeroOptions::Validate(Refusal* why) const {
-  return CheckInRange(why, "cd0", cd0, 0.0, 2.0) &&
-         CheckInRange(why, "cd_spin_per_krpm", cd_spin_per_krpm, 0.0, 1.0) &&
-         CheckInRange(why, "cl2", cl2, 0.0, 10.0) &&
-         CheckInRange(why, "cl0", cl0, 0.0, 10.0, /*lo_open=*/true) &&
-         CheckInRange(why, "cl1", cl1, 0.0, 10.0) &&
-         CheckInRange(why, "cl_per_spin_factor", cl_per_spin_factor, 0.0, 10.0) &&
-         CheckInRange(why, "spin_decay_s", spin_decay_s, 0.1, 1e6) &&
-         CheckInRange(why, "ball_mass_kg", ball_mass_kg, 0.1, 0.2) &&
-         CheckInRange(why, "ball_circumference_m", ball_circumference_m, 0.2, 0.26);
+  return InRange(why, "cd0", cd0, 0.0, 2.0) &&
+         InRange(why, "cd_spin_per_krpm", cd_spin_per_krpm, 0.0, 1.0) &&
+         InRange(why, "cl2", cl2, 0.0, 10.0) &&
+         InRange(why, "cl0", cl0, 0.0, 10.0, /*lo_open=*/true) &&
+         InRange(why, "cl1", cl1, 0.0, 10.0) &&
+         InRange(why, "cl_per_spin_factor", cl_per_spin_factor, 0.0, 10.0) &&
+         InRange(why, "spin_decay_s", spin_decay_s, 0.1, 1e6) &&
+         InRange(why, "ball_mass_kg", ball_mass_kg, 0.1, 0.2) &&
+         InRange(why, "ball_circumference_m", ball_circumference_m, 0.2, 0.26);
 }
 
 bool FlightOptions::Validate(Refusal* why) const {
-  return CheckInRange(why, "relative_tolerance", relative_tolerance, 1e-13, 1e-2) &&
-         CheckInRange(why, "absolute_tolerance_m", absolute_tolerance_m, 1e-12, 1.0) &&
-         CheckInRange(why, "max_flight_time_s", max_flight_time_s, 0.0, 600.0, true) &&
+  return InRange(why, "relative_tolerance", relative_tolerance, 1e-13, 1e-2) &&
+         InRange(why, "absolute_tolerance_m", absolute_tolerance_m, 1e-12, 1.0) &&
+         InRange(why, "max_flight_time_s", max_flight_time_s, 0.0, 600.0, true) &&
          CheckIntegerInRange(why, "max_steps", max_steps, 10, 1000000) &&
-         CheckInRange(why, "trajectory_interval_s", trajectory_interval_s, 1e-3, 10.0);
+         InRange(why, "trajectory_interval_s", trajectory_interval_s, 1e-3, 10.0);
 }
 
 FlightResult VacuumFlight(const Launch& launch) {
@@ -329,7 +367,8 @@ FlightResult Fly(const Launch& launch, const Environment& environment, const Aer
   WithKind(KindOf(aero), [&](auto kind) {
     constexpr Kind K = decltype(kind)::value;
     FlyLanes<K, 1>(1, options, [&](std::size_t, Lane<K>* lane) {
-      return Start<K>(launch, environment, aero, options, &r, trajectory, lane);
+      return Start<K>(launch, environment, aero, options, &r, trajectory, lane,
+                      FirstStep(options));
     });
   });
   return r;
@@ -345,18 +384,22 @@ void FlyMany(std::size_t count, const Launch* launches, const Environment* envir
                             (!shared_environment || environments[0].Validate(nullptr));
   double density = 0.0;
   if (shared_valid && shared_environment) density = AirDensityKgM3(environments[0]);
+  const double first_step = FirstStep(options);
   WithKind(KindOf(aero), [&](auto kind) {
     constexpr Kind K = decltype(kind)::value;
+    bool first_stage = true;  // false: the vector lanes evaluate it (FlyLanesSoa)
     auto start = [&](std::size_t i, Lane<K>* lane) {
       results[i] = FlightResult();
       const Environment& environment = environments[shared_environment ? 0 : i];
       bool checked = shared_valid;
       if (checked && !shared_environment) checked = environment.Validate(nullptr);
-      return Start<K>(launches[i], environment, aero, options, &results[i], nullptr, lane, checked,
-                      shared_valid && shared_environment ? &density : nullptr);
+      return Start<K>(launches[i], environment, aero, options, &results[i], nullptr, lane,
+                      first_step, checked, shared_valid && shared_environment ? &density : nullptr,
+                      first_stage);
     };
     if constexpr (K == Kind::kSaturating || K == Kind::kLinear) {
       if (SoaLanesPay()) {
+        first_stage = false;
         FlyLanesSoa<K>(count, options, start);
         return;
       }

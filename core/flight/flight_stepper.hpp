@@ -5,9 +5,11 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <type_traits>
 
 #include "core/flight/flight.hpp"
 #include "core/numerics/limits.hpp"
@@ -168,17 +170,148 @@ struct Dense {
   }
 };
 
-// The step controller's floors, as logarithms: err is taken as at least 1e-10, and the memory
-// of the last step's err as at least 1e-4 (Hairer's DOPRI5).
-constexpr double kLogMinError = -23.025850929940457;       // ln 1e-10
+// The step controller (Hairer's DOPRI5: PI control with β = 0.04) without libm, so that FlyMany's
+// vector kernel runs it on 4 lanes at once and Fly runs the same arithmetic on one: the
+// controller's err^0.17 · facold^−0.04 and err^−0.2 as an exp of logarithms, with the log and
+// exp below (a few additions and multiplications, no call). Written once for a double and for a
+// vector of 4 (Vec), so that Fly's and FlyMany's step sizes are the same to the bit.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+typedef double Vec __attribute__((vector_size(32)));
+typedef long long VecMask __attribute__((vector_size(32)));
+typedef unsigned long long VecBits __attribute__((vector_size(32)));
+#pragma GCC diagnostic pop
+
+[[gnu::always_inline]] inline unsigned long long Bits(double x) {
+  return std::bit_cast<unsigned long long>(x);
+}
+[[gnu::always_inline]] inline double FromBits(unsigned long long b) {
+  return std::bit_cast<double>(b);
+}
+[[gnu::always_inline]] inline VecBits Bits(Vec x) { return reinterpret_cast<VecBits>(x); }
+[[gnu::always_inline]] inline Vec FromBits(VecBits b) { return reinterpret_cast<Vec>(b); }
+template <class T>
+[[gnu::always_inline]] inline T Broadcast(double x) {
+  if constexpr (std::is_same_v<T, double>) {
+    return x;
+  } else {
+    return T{x, x, x, x};
+  }
+}
+// std::max's and std::clamp's order of comparison (a lane's NaN goes the same way).
+template <class T>
+[[gnu::always_inline]] inline T Max(T a, T b) {
+  return a < b ? b : a;
+}
+template <class T>
+[[gnu::always_inline]] inline T Clamp(T v, T lo, T hi) {
+  return v < lo ? lo : (hi < v ? hi : v);
+}
+
+// ln x for a positive finite x (the controller's: x ≥ 1e-10). x = 2^k·z with z in [0.707, 1.414)
+// (musl's reduction), ln z = 2·atanh(s), s = (z − 1)/(z + 1), |s| ≤ 0.1716, by its series to s¹³
+// (truncation below 5e-13): a step size's factor to 1e-12 relative, where 1e-3 would do.
+template <class T>
+[[gnu::always_inline]] inline T ControllerLog(T x) {
+  constexpr unsigned long long kOff = 0x3fe6a09e667f3bcdULL;  // bits of √½
+  const auto ix = Bits(x);
+  const auto tmp = ix - kOff;
+  // The exponent k + 2048 by a logical shift (AVX2 has no 64-bit arithmetic one), made a double
+  // exactly through the bits of 2^52 + (k + 2048).
+  const auto biased = (tmp + 0x8000000000000000ULL) >> 52;
+  const T k = FromBits(biased | 0x4330000000000000ULL) - (4503599627370496.0 + 2048.0);
+  const T z = FromBits(ix - (tmp & 0xfff0000000000000ULL));
+  const T f = z - 1.0;
+  const T s = f / (2.0 + f);
+  const T w = s * s;
+  // w·(1/3 + w/5 + … + w⁵/13) by Estrin's scheme (a shorter chain than Horner's).
+  const T w2 = w * w;
+  const T r = w * ((1.0 / 3 + w * (1.0 / 5)) +
+                   w2 * ((1.0 / 7 + w * (1.0 / 9)) + w2 * (1.0 / 11 + w * (1.0 / 13))));
+  return k * 0.69314718055994530942 + (2.0 * s + 2.0 * s * r);
+}
+
+// exp y for y in [−4, 1] (the controller's: 0.17·ln err − 0.04·ln facold is in [−3.92, 0.37]
+// for an accepted step, −0.2·ln err is bounded to [−3, 0] for a rejected one): y = n·ln 2 + r, |r| ≤ 0.347, e^r by its Taylor
+// series to r¹⁰ (truncation below 3e-13), 2^n from the bits of the rounding's magic number.
+template <class T>
+[[gnu::always_inline]] inline T ControllerExp(T y) {
+  constexpr double kMagic = 6755399441055744.0;  // 1.5·2^52: t − kMagic is y/ln 2 rounded
+  const T t = y * 1.4426950408889634074 + kMagic;
+  const T n = t - kMagic;
+  const T r = (y - n * 6.93147180369123816490e-01) - n * 1.90821492927058770002e-10;
+  // Σ r^j/j! by Estrin's scheme (a shorter chain than Horner's).
+  const T r2 = r * r, r4 = r2 * r2;
+  const T p = ((1.0 + r) + r2 * (1.0 / 2 + r * (1.0 / 6))) +
+              r4 * (((1.0 / 24 + r * (1.0 / 120)) + r2 * (1.0 / 720 + r * (1.0 / 5040))) +
+                    r4 * ((1.0 / 40320 + r * (1.0 / 362880)) + r2 * (1.0 / 3628800)));
+  // The low bits of t hold n; (n + 1023) << 52 is 2^n's bits.
+  return p * FromBits((Bits(t) + 1023) << 52);
+}
+
+// The controller's floors: err is taken as at least 1e-10, and the memory of the last step's
+// err as at least 1e-4 (Hairer's DOPRI5), the latter as its logarithm.
+constexpr double kMinError = 1e-10;
 constexpr double kLogMinErrorMemory = -9.210340371976182;  // ln 1e-4
 
+// What the controller makes of an attempt with step h and error norm err = √(err2/6) (err2 the
+// sum of the scaled components' squares, ErrorOf): if rejected (err > 1) the next attempt's
+// h·max(0.2, 0.9·err^−0.2); if accepted the next step's h·clamp(0.9/fac, 0.2, 10) with
+// fac = max(err, 1e-10)^0.17 · facold^−0.04 (facold = max(err, 1e-4) of the last accepted step,
+// `log_memory` its logarithm, updated to this step's). A lane's numbers are unread where its
+// decision does not use them (a rejected lane's accepted step, say).
+template <class T>
+struct Control {
+  T err, h_rejected, h_accepted, log_memory;
+};
+template <class T>
+[[gnu::always_inline]] inline T LogErrorOf(T err) {
+  return ControllerLog(Max(err, Broadcast<T>(kMinError)));
+}
+template <class T>
+[[gnu::always_inline]] inline T RejectedStep(T h, T log_err) {
+  // Below −3 the factor 0.9·e^y is under the 0.2 floor: the argument is bounded there.
+  return h * Max(Broadcast<T>(0.2), 0.9 * ControllerExp(Max(-0.2 * log_err, Broadcast<T>(-3.0))));
+}
+template <class T>
+[[gnu::always_inline]] inline T AcceptedStep(T h, T log_err, T log_memory) {
+  const T fac = ControllerExp((0.2 - 0.04 * 0.75) * log_err - 0.04 * log_memory);
+  return h * Clamp(0.9 / fac, Broadcast<T>(0.2), Broadcast<T>(10.0));
+}
+template <class T>
+[[gnu::always_inline]] inline T MemoryOf(T log_err) {
+  return Max(log_err, Broadcast<T>(kLogMinErrorMemory));
+}
+// All of it, for FlyMany's vector lanes (Fly's Conclude computes only the part its decision
+// reads, with the same functions).
+template <class T>
+[[gnu::always_inline]] inline Control<T> ControlOf(T err, T h, T log_memory) {
+  const T log_err = LogErrorOf(err);
+  return {err, RejectedStep(h, log_err), AcceptedStep(h, log_err, log_memory), MemoryOf(log_err)};
+}
+
 // The θ in [0, 1] where component `i` of the dense output crosses zero, given its signs at
-// the ends differ: Newton's method on the dense polynomial from the secant's guess (three or
-// four iterations to 1e-13 in θ), and if it leaves [0, 1] or does not settle, an Illinois
-// regula falsi to 1e-11 in θ (1e-10 m on a step of tens of metres).
+// the ends differ: Newton's method on the dense polynomial from an inverse cubic Hermite guess
+// (two or three iterations, θ to about 1e-15), and if it leaves [0, 1] or does not settle, an
+// Illinois regula falsi to 1e-11 in θ (1e-10 m on a step of tens of metres). FlyMany's kernel
+// runs the same Newton iterations lane by lane (SoaRoot, flight_soa.cpp): a change here is a
+// change there.
 inline double RootOf(const Dense& dense, int i, double f0, double f1) {
-  double theta = f0 / (f0 - f1);
+  // The first guess: the inverse cubic Hermite interpolant of θ against the component (its
+  // values and slopes at the ends: a step's θ as a function of z near the ground, or of vz near
+  // the apex, is nearly cubic), or the secant's where the component is not monotone at the ends.
+  // From it Newton's method takes two iterations instead of three or four.
+  const double secant = f0 / (f0 - f1);
+  const double span = f1 - f0;
+  const double slope0 = dense.r2[i] + dense.r3[i];                 // df/dθ at θ = 0
+  const double slope1 = dense.r2[i] - dense.r3[i] - dense.r4[i];  // df/dθ at θ = 1
+  const double m0 = span / slope0, m1 = span / slope1;            // dθ/ds at the ends
+  double theta = secant;
+  if (m0 > 0.0 && m1 > 0.0) {
+    const double s = secant, u = 1.0 - s;
+    const double hermite = s * u * u * m0 + s * s * (3.0 - 2.0 * s) - s * s * u * m1;
+    if (hermite >= 0.0 && hermite <= 1.0) theta = hermite;
+  }
   for (int iter = 0; iter < 8; ++iter) {
     // y = r1 + θ·Q, Q = r2 + u·P, P = r3 + θ·(r4 + u·r5), u = 1 − θ; dy/dθ by the product rule.
     const double u = 1.0 - theta;
@@ -194,7 +327,9 @@ inline double RootOf(const Dense& dense, int i, double f0, double f1) {
     const double step = f / df;
     theta -= step;
     if (!(theta >= 0.0 && theta <= 1.0)) break;
-    if (std::abs(step) < 1e-13) return theta;
+    // Converging quadratically: θ's error after a step δ is about |f''/2f'|·δ², 1e-15 here
+    // (|f''/2f'| is about h/6 for z at the landing, less for vz at the apex).
+    if (std::abs(step) < 1e-7) return theta;
   }
   double a = 0.0, b = 1.0, fa = f0, fb = f1;
   int side = 0;
@@ -243,6 +378,9 @@ struct Lane {
   // controller's err^0.17 · facold^−0.04 is one exp of logarithms (two pow calls cost more).
   double log_previous_error_ratio = kLogMinErrorMemory;
   long long next_sample = 1;  // the next sample is at next_sample · trajectory_interval_s
+  // Where the last attempt's landing θ is known already (FlyMany's kernel: RootOf's, lane by
+  // lane), else negative (Conclude finds it).
+  double landing_theta = -1.0;
 };
 
 // The stage derivative k[j] at (t, s): the positions' derivatives are the velocities.
@@ -328,6 +466,12 @@ void Attempt(Lane<K>* lanes) {
 struct StepError {
   double err2 = 0.0, position_err2 = 0.0, velocity_err2 = 0.0;
   bool finite = true;
+  // From the above: √(err2/6), and the local position and velocity errors √position_err2 (m)
+  // and √velocity_err2 (m/s); with `controlled`, the controller's steps too (ControlOf:
+  // FlyMany's vector lanes compute them for every lane).
+  Control<double> control{};
+  double position_error = 0.0, velocity_error = 0.0;
+  bool controlled = false;
 };
 
 // What Conclude decided about an attempt.
@@ -359,6 +503,9 @@ StepError ErrorOf(const Lane<K>& a, const FlightOptions& options) {
       out.velocity_err2 += e * e;
     }
   }
+  out.control.err = std::sqrt(out.err2 / 6.0);
+  out.position_error = std::sqrt(out.position_err2);
+  out.velocity_error = std::sqrt(out.velocity_err2);
   return out;
 }
 
@@ -373,7 +520,6 @@ Outcome Conclude(Lane<K>& a, const FlightOptions& options, const StepError& se) 
   const double* y_new = a.y_new;
   const auto& k = a.k;
   r.evaluations += 6;
-  const double err2 = se.err2, position_err2 = se.position_err2, velocity_err2 = se.velocity_err2;
   if (!se.finite) {
     if (h > 1e-9) {  // a too-long step can overflow: retry shorter before giving up
       a.h *= 0.1;
@@ -383,18 +529,18 @@ Outcome Conclude(Lane<K>& a, const FlightOptions& options, const StepError& se) 
     r.termination = FlightTermination::kNonFinite;
     return Outcome::kEnded;
   }
-  const double err = std::sqrt(err2 / 6.0);
-  const double log_err = std::log(err);  // −inf for a zero error: the clamps below hold
+  const double err = se.control.err;
+  const double log_err = se.controlled ? 0.0 : LogErrorOf(err);
   if (err > 1.0) {
-    a.h *= std::max(0.2, 0.9 * std::exp(-0.2 * log_err));
+    a.h = se.controlled ? se.control.h_rejected : RejectedStep(h, log_err);
     ++r.rejected_steps;
     return Outcome::kRejected;
   }
 
   // Accepted.
   ++r.steps;
-  a.error_sum += std::sqrt(position_err2);
-  const double velocity_error = std::sqrt(velocity_err2);
+  a.error_sum += se.position_error;
+  const double velocity_error = se.velocity_error;
   a.velocity_error_sum += velocity_error;
   a.velocity_error_time_sum += velocity_error * (t + h);
   const bool apex = y[5] > 0.0 && y_new[5] <= 0.0;  // vz crosses zero going down
@@ -420,7 +566,9 @@ Outcome Conclude(Lane<K>& a, const FlightOptions& options, const StepError& se) 
         r.apex_time_s = t + theta * h;
       }
     }
-    const double theta_land = lands ? RootOf(dense, 2, y[2], y_new[2]) : 1.0;
+    const double theta_land = !lands                    ? 1.0
+                              : a.landing_theta >= 0.0 ? a.landing_theta
+                                                       : RootOf(dense, 2, y[2], y_new[2]);
     const double t_end = t + theta_land * h;
     if (a.trajectory != nullptr) {
       for (double ts = a.next_sample * options.trajectory_interval_s; ts < t_end;
@@ -436,10 +584,14 @@ Outcome Conclude(Lane<K>& a, const FlightOptions& options, const StepError& se) 
       r.hang_time_s = t_end;
       r.landing_x_m = landed.x;
       r.landing_y_m = landed.y;
-      r.distance_m = std::hypot(landed.x, landed.y);
+      // √(x² + y²) rather than std::hypot (its care for overflow costs a call; a landing is
+      // within a few hundred metres).
+      r.distance_m = std::sqrt(landed.x * landed.x + landed.y * landed.y);
       r.bearing_deg = std::atan2(landed.x, landed.y) / kDegToRad;
       r.landing_speed_mps = GroundSpeed(landed);
-      r.landing_angle_deg = std::atan2(-landed.vz, std::hypot(landed.vx, landed.vy)) / kDegToRad;
+      r.landing_angle_deg =
+          std::atan2(-landed.vz, std::sqrt(landed.vx * landed.vx + landed.vy * landed.vy)) /
+          kDegToRad;
       // The landing is read from the step's 4th-order interpolant: its error is estimated by
       // the cubic Hermite interpolant's difference from it at the landing, moved onto the
       // ground along the path (a height error dz shifts the landing by v_h·dz/v_z).
@@ -452,20 +604,22 @@ Outcome Conclude(Lane<K>& a, const FlightOptions& options, const StepError& se) 
         d[i] = cubic - dense.Component(i, u);
       }
       const double shift = landed.vz < 0.0 ? d[2] / landed.vz : 0.0;
-      const double interpolation_error =
-          std::hypot(d[0] - landed.vx * shift, d[1] - landed.vy * shift);
+      const double dx = d[0] - landed.vx * shift, dy = d[1] - landed.vy * shift;
+      const double interpolation_error = std::sqrt(dx * dx + dy * dy);
       r.error_estimate_m = a.error_sum + t_end * a.velocity_error_sum - a.velocity_error_time_sum +
                            interpolation_error;
       return Outcome::kEnded;
     }
   }
   a.t = t + h;
-  // Step-size control (Hairer's DOPRI5: PI control with β = 0.04).
-  // fac = max(err, 1e-10)^0.17 · facold^−0.04, facold = max(err, 1e-4) of the last step.
-  const double fac = std::exp((0.2 - 0.04 * 0.75) * std::max(log_err, kLogMinError) -
-                              0.04 * a.log_previous_error_ratio);
-  a.log_previous_error_ratio = std::max(log_err, kLogMinErrorMemory);
-  a.h = h * std::clamp(0.9 / fac, 0.2, 10.0);
+  // Step-size control (ControlOf: Hairer's DOPRI5's PI control).
+  if (se.controlled) {
+    a.log_previous_error_ratio = se.control.log_memory;
+    a.h = se.control.h_accepted;
+  } else {
+    a.h = AcceptedStep(h, log_err, a.log_previous_error_ratio);
+    a.log_previous_error_ratio = MemoryOf(log_err);
+  }
   return Outcome::kAccepted;
 }
 

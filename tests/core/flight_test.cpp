@@ -391,7 +391,9 @@ TEST(FlightTest, FlyManyGivesFlysAnswers) {
   launches[3].launch_angle_deg = 120.0;  // refused
   FlightOptions few_steps;
   few_steps.max_steps = 12;  // some flights end at the step limit, at different times
-  for (const FlightOptions& options : {FlightOptions(), few_steps}) {
+  FlightOptions short_time;
+  short_time.max_flight_time_s = 2.5;  // some land, the others end at the time limit
+  for (const FlightOptions& options : {FlightOptions(), few_steps, short_time}) {
     // The custom model twice: its saturating lift law (the default) and the linear one (each
     // a kernel of its own in FlyMany's vector stepper).
     for (int variant = 0; variant < 5; ++variant) {
@@ -410,6 +412,7 @@ TEST(FlightTest, FlyManyGivesFlysAnswers) {
         EXPECT_EQ(many[i].distance_m, one.distance_m) << i;
         EXPECT_EQ(many[i].hang_time_s, one.hang_time_s) << i;
         EXPECT_EQ(many[i].apex_m, one.apex_m) << i;
+        EXPECT_EQ(many[i].apex_time_s, one.apex_time_s) << i;
         EXPECT_EQ(many[i].error_estimate_m, one.error_estimate_m) << i;
         EXPECT_EQ(many[i].steps, one.steps) << i;
         EXPECT_EQ(many[i].evaluations, one.evaluations) << i;
