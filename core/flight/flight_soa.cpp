@@ -133,13 +133,6 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline VecMask SoaApex(SoaLanes<K>&
   return failed;
 }
 
-// Attempt<K, L>, ErrorOf<K> and, on the lanes whose attempt is accepted without an event,
-// Conclude<K> and AtLimit<K> on the 4 lanes of each group at once.
-template <Kind K>
-SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline SoaSpecial SoaStep(
-    SoaLanes<K>* groups, const SoaSettings& settings) {
-  constexpr int N = SoaLanes<K>::N;
-  const double rtol = settings.rtol, atol = settings.atol;
 #define SWEETSPOT_GROUPS for (int g = 0; g < kSoaGroups; ++g)
 #define SWEETSPOT_GROUP       \
   SoaLanes<K>& a = groups[g]; \
@@ -148,8 +141,12 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline SoaSpecial SoaStep(
   (void)t;                    \
   (void)h;                    \
   (void)k
-  // The first stage of the flights just started (Start's Evaluate, here for 4 lanes at once),
-  // through k[6], which the attempt overwrites.
+
+// Start's first evaluation (Evaluate at t) for the lanes of each group whose flight has just
+// started, here for 4 lanes at once, through k[6], which the attempt overwrites.
+template <Kind K>
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline void SoaFirstStage(SoaLanes<K>* groups) {
+  constexpr int N = SoaLanes<K>::N;
   SWEETSPOT_GROUPS {
     SWEETSPOT_GROUP;
     bool any_fresh = false;
@@ -160,6 +157,13 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline SoaSpecial SoaStep(
       a.fresh = VecMask{};
     }
   }
+}
+
+// Attempt<K, L> on every group: the stages and y_new, each stage across the groups in turn
+// (their chains independent, so the processor overlaps them).
+template <Kind K>
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline void SoaAttempt(SoaLanes<K>* groups) {
+  constexpr int N = SoaLanes<K>::N;
   SWEETSPOT_GROUPS {
     SWEETSPOT_GROUP;
     for (int i = 3; i < N; ++i) a.s[i] = a.y[i] + h * a21 * k[0][i];
@@ -218,88 +222,107 @@ SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline SoaSpecial SoaStep(
     SWEETSPOT_GROUP;
     SoaEvaluate<K>(a, 6, t + h, a.y_new);
   }
-  const Vec zero = {};
-  const Vec largest = Splat(std::numeric_limits<double>::max());
-  SoaSpecial special;
-  SWEETSPOT_GROUPS {
-    SWEETSPOT_GROUP;
-    Vec err2 = zero, position_err2 = zero, velocity_err2 = zero;
-    VecMask finite = VecMask{} - 1;
-    for (int i = 0; i < N; ++i) {
-      const Vec e = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] + e5 * k[4][i] + e6 * k[5][i] +
-                         e7 * k[6][i]);
-      const Vec yn = a.y_new[i];
-      finite &= (Abs(yn) <= largest) & (Abs(e) <= largest);
-      Vec scale;
-      if (i < 6) {
-        const Vec ay = Abs(a.y[i]), ayn = Abs(yn);
-        scale = atol + rtol * (ay < ayn ? ayn : ay);  // std::max(|y|, |y_new|)
-      } else {
-        scale = Splat(rtol);
-      }
-      err2 += (e / scale) * (e / scale);
-      if (i < 3) {
-        position_err2 += e * e;
-      } else if (i < 6) {
-        velocity_err2 += e * e;
-      }
-    }
-    a.finite = finite;
-    a.control = ControlOf(Sqrt(err2 / 6.0), h, a.log_memory);
-    a.position_error = Sqrt(position_err2);
-    a.velocity_error = Sqrt(velocity_err2);
-    // Conclude's cases: not finite, rejected (err > 1) or a landing in the step (its tests on y
-    // and y_new), left to the scalar code; the rest accepted here, an apex in the step included
-    // (SoaApex) unless its root needs the scalar fallback.
-    const VecMask apex = (a.y[5] > zero) & (a.y_new[5] <= zero);
-    const VecMask lands = (a.y_new[2] <= zero) & (a.y_new[5] < zero);
-    const VecMask accepted = a.active & finite & ~(a.control.err > 1.0) & ~lands;
-    VecMask plain = accepted;
-    const VecMask apex_lanes = accepted & apex;
-    bool any_apex = false;
-    for (int m = 0; m < kSoaLanes; ++m) any_apex = any_apex || apex_lanes[m] != 0;
-    if (any_apex) plain &= ~SoaApex(a, apex_lanes);
-    // The landing's root for Conclude (which finishes a landing on the scalar Lane): z's.
-    const VecMask landing_lanes = a.active & finite & ~(a.control.err > 1.0) & lands;
-    bool any_landing = false;
-    for (int m = 0; m < kSoaLanes; ++m) any_landing = any_landing || landing_lanes[m] != 0;
-    a.landing_known = VecMask{};
-    if (any_landing) {
-      Vec z[5];
-      SoaDense(a, 2, z);
-      a.landing_known =
-          landing_lanes & ~SoaRoot(z, a.y[2], a.y_new[2], landing_lanes, &a.landing_theta);
-    }
-    // Conclude on an accepted step without an event, in its order.
-    a.evaluations = plain ? a.evaluations + 6.0 : a.evaluations;
-    a.steps = plain ? a.steps + 1.0 : a.steps;
-    a.error_sum = plain ? a.error_sum + a.position_error : a.error_sum;
-    a.velocity_error_sum = plain ? a.velocity_error_sum + a.velocity_error : a.velocity_error_sum;
-    a.velocity_error_time_sum = plain ? a.velocity_error_time_sum + a.velocity_error * (t + h)
-                                      : a.velocity_error_time_sum;
-    const Vec t_new = plain ? t + h : t;
-    a.t = t_new;
-    a.log_memory = plain ? a.control.log_memory : a.log_memory;
-    const Vec h_new = plain ? a.control.h_accepted : h;
-    for (int i = 0; i < N; ++i) {
-      a.y[i] = plain ? a.y_new[i] : a.y[i];
-      a.k[0][i] = plain ? a.k[6][i] : a.k[0][i];  // first same as last
-    }
-    // AtLimit before the next attempt: the lanes at a limit are left to the scalar code, the
-    // others' steps bounded by the time left.
-    const VecMask limit = plain & ((a.steps + a.rejected_steps >= settings.max_steps) |
-                                   (t_new >= settings.max_flight_time_s));
-    const Vec left = settings.max_flight_time_s - t_new;
-    a.h = plain & ~limit & (left < h_new) ? left : h_new;  // std::min(h, left)
-    const VecMask conclude = a.active & ~plain;
-    for (int m = 0; m < kSoaLanes; ++m) {
-      special.conclude |= (conclude[m] != 0 ? 1U : 0U) << (g * kSoaLanes + m);
-      special.limit |= (limit[m] != 0 ? 1U : 0U) << (g * kSoaLanes + m);
-    }
-  }
-  return special;
+}
+
 #undef SWEETSPOT_GROUPS
 #undef SWEETSPOT_GROUP
+
+// ErrorOf<K> on group `g`'s 4 lanes, and on those whose attempt is accepted without an event
+// Conclude<K> and AtLimit<K>; the others are marked in *special for the scalar code.
+template <Kind K>
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline void SoaConcludeGroup(
+    SoaLanes<K>& a, int g, const SoaSettings& settings, SoaSpecial* special) {
+  constexpr int N = SoaLanes<K>::N;
+  const double rtol = settings.rtol, atol = settings.atol;
+  const Vec t = a.t, h = a.h;
+  const auto& k = a.k;
+  const Vec zero = {};
+  const Vec largest = Splat(std::numeric_limits<double>::max());
+  Vec err2 = zero, position_err2 = zero, velocity_err2 = zero;
+  VecMask finite = VecMask{} - 1;
+  for (int i = 0; i < N; ++i) {
+    const Vec e = h * (e1 * k[0][i] + e3 * k[2][i] + e4 * k[3][i] + e5 * k[4][i] + e6 * k[5][i] +
+                       e7 * k[6][i]);
+    const Vec yn = a.y_new[i];
+    finite &= (Abs(yn) <= largest) & (Abs(e) <= largest);
+    Vec scale;
+    if (i < 6) {
+      const Vec ay = Abs(a.y[i]), ayn = Abs(yn);
+      scale = atol + rtol * (ay < ayn ? ayn : ay);  // std::max(|y|, |y_new|)
+    } else {
+      scale = Splat(rtol);
+    }
+    err2 += (e / scale) * (e / scale);
+    if (i < 3) {
+      position_err2 += e * e;
+    } else if (i < 6) {
+      velocity_err2 += e * e;
+    }
+  }
+  a.finite = finite;
+  a.control = ControlOf(Sqrt(err2 / 6.0), h, a.log_memory);
+  a.position_error = Sqrt(position_err2);
+  a.velocity_error = Sqrt(velocity_err2);
+  // Conclude's cases: not finite, rejected (err > 1) or a landing in the step (its tests on y
+  // and y_new), left to the scalar code; the rest accepted here, an apex in the step included
+  // (SoaApex) unless its root needs the scalar fallback.
+  const VecMask apex = (a.y[5] > zero) & (a.y_new[5] <= zero);
+  const VecMask lands = (a.y_new[2] <= zero) & (a.y_new[5] < zero);
+  const VecMask accepted = a.active & finite & ~(a.control.err > 1.0) & ~lands;
+  VecMask plain = accepted;
+  const VecMask apex_lanes = accepted & apex;
+  bool any_apex = false;
+  for (int m = 0; m < kSoaLanes; ++m) any_apex = any_apex || apex_lanes[m] != 0;
+  if (any_apex) plain &= ~SoaApex(a, apex_lanes);
+  // The landing's root for Conclude (which finishes a landing on the scalar Lane): z's.
+  const VecMask landing_lanes = a.active & finite & ~(a.control.err > 1.0) & lands;
+  bool any_landing = false;
+  for (int m = 0; m < kSoaLanes; ++m) any_landing = any_landing || landing_lanes[m] != 0;
+  a.landing_known = VecMask{};
+  if (any_landing) {
+    Vec z[5];
+    SoaDense(a, 2, z);
+    a.landing_known =
+        landing_lanes & ~SoaRoot(z, a.y[2], a.y_new[2], landing_lanes, &a.landing_theta);
+  }
+  // Conclude on an accepted step without an event, in its order.
+  a.evaluations = plain ? a.evaluations + 6.0 : a.evaluations;
+  a.steps = plain ? a.steps + 1.0 : a.steps;
+  a.error_sum = plain ? a.error_sum + a.position_error : a.error_sum;
+  a.velocity_error_sum = plain ? a.velocity_error_sum + a.velocity_error : a.velocity_error_sum;
+  a.velocity_error_time_sum = plain ? a.velocity_error_time_sum + a.velocity_error * (t + h)
+                                    : a.velocity_error_time_sum;
+  const Vec t_new = plain ? t + h : t;
+  a.t = t_new;
+  a.log_memory = plain ? a.control.log_memory : a.log_memory;
+  const Vec h_new = plain ? a.control.h_accepted : h;
+  for (int i = 0; i < N; ++i) {
+    a.y[i] = plain ? a.y_new[i] : a.y[i];
+    a.k[0][i] = plain ? a.k[6][i] : a.k[0][i];  // first same as last
+  }
+  // AtLimit before the next attempt: the lanes at a limit are left to the scalar code, the
+  // others' steps bounded by the time left.
+  const VecMask limit = plain & ((a.steps + a.rejected_steps >= settings.max_steps) |
+                                 (t_new >= settings.max_flight_time_s));
+  const Vec left = settings.max_flight_time_s - t_new;
+  a.h = plain & ~limit & (left < h_new) ? left : h_new;  // std::min(h, left)
+  const VecMask conclude = a.active & ~plain;
+  for (int m = 0; m < kSoaLanes; ++m) {
+    special->conclude |= (conclude[m] != 0 ? 1U : 0U) << (g * kSoaLanes + m);
+    special->limit |= (limit[m] != 0 ? 1U : 0U) << (g * kSoaLanes + m);
+  }
+}
+
+// Attempt<K, L>, ErrorOf<K> and, on the lanes whose attempt is accepted without an event,
+// Conclude<K> and AtLimit<K> on the 4 lanes of each group at once.
+template <Kind K>
+SWEETSPOT_FLIGHT_AVX2 [[gnu::always_inline]] inline SoaSpecial SoaStep(
+    SoaLanes<K>* groups, const SoaSettings& settings) {
+  SoaFirstStage<K>(groups);
+  SoaAttempt<K>(groups);
+  SoaSpecial special;
+  for (int g = 0; g < kSoaGroups; ++g) SoaConcludeGroup<K>(groups[g], g, settings, &special);
+  return special;
 }
 
 // The kernels, compiled for AVX2 (without FMA), one non-template function per kind. Only run
