@@ -22,6 +22,7 @@
 #include "core/numerics/termination.hpp"
 #include "core/optimize/design_backends.hpp"
 #include "core/optimize/lifted_nlp.hpp"
+#include "core/optimize/tapered_nlp.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -221,16 +222,24 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
   // The lifted formulation when the problem qualifies (lifted_nlp.hpp): the sparse exact
   // Hessian of the problem with the mass integrals as variables.
   std::unique_ptr<LiftedDesignNlp> lifted;
+  // With the taper's steps as variables when the knots form one taper chain (tapered_nlp.hpp):
+  // ~n KKT rows instead of ~3n.
+  std::unique_ptr<TaperedLiftedNlp> tapered;
   try {
     if (settings.lift && LiftedDesignNlp::Qualifies(nlp.model(), nullptr)) {
       lifted = std::make_unique<LiftedDesignNlp>(nlp);
+      if (settings.taper_steps) {
+        tapered = std::make_unique<TaperedLiftedNlp>(*lifted, s0, kTaperBlockSize);
+        if (!tapered->ok()) tapered.reset();
+      }
     }
     std::ostringstream journal_text;
     // Held until the application and the TNLP are gone (declared first, destroyed last).
     std::lock_guard<std::mutex> lock(IpoptMutex());
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
     Ipopt::SmartPtr<Ipopt::TNLP> tnlp =
-        lifted ? NewLiftedTnlp(*lifted, s0, settings, &out)
+        tapered  ? NewTaperedTnlp(*tapered, s0, settings, &out)
+        : lifted ? NewLiftedTnlp(*lifted, s0, settings, &out)
                : static_cast<Ipopt::TNLP*>(new DesignTnlp(nlp, s0, settings, &out));
     out.lifted = lifted != nullptr;
     Ipopt::SmartPtr<Ipopt::OptionsList> options = app->Options();
