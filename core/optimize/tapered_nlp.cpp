@@ -24,20 +24,34 @@ TaperedLiftedNlp::TaperedLiftedNlp(LiftedDesignNlp& lifted, const std::vector<do
   if (nx < 2 || block_size < 1 || !lifted_.Start(s0, &z0) || !lifted_.Evaluate(z0.data(), true))
     return;
   // Per lifted row: its entries on design variables and on q.
+  RowEntries entries;
+  entries.design.resize(static_cast<std::size_t>(ml));
+  entries.q.resize(static_cast<std::size_t>(ml));
   const auto& jac = lifted_.jacobian_structure();
-  std::vector<std::vector<int>> design_entries(static_cast<std::size_t>(ml));
-  std::vector<std::vector<int>> q_entries(static_cast<std::size_t>(ml));
   for (std::size_t e = 0; e < jac.size(); ++e) {
-    (jac[e].second < nx ? design_entries : q_entries)[static_cast<std::size_t>(jac[e].first)]
+    (jac[e].second < nx ? entries.design : entries.q)[static_cast<std::size_t>(jac[e].first)]
         .push_back(static_cast<int>(e));
   }
+  if (!FindChain(entries)) return;
+  std::vector<bool> bound_row;
+  const ChainRows chain = SetSteps(block_size, entries, z0, &bound_row);
+  KeepRows(chain, bound_row);
+  BuildStructures(entries);
+  g_.assign(rows_.size(), 0.0);
+  grad_f_.assign(static_cast<std::size_t>(n()), 0.0);
+  ok_ = true;
+}
+
+bool TaperedLiftedNlp::FindChain(const RowEntries& entries) {
+  const int nx = k_, ml = lifted_.m();
+  const auto& jac = lifted_.jacobian_structure();
   // The taper rows: two design entries, one positive (the later knot), one negative, >= lo.
   std::vector<int> incoming(static_cast<std::size_t>(nx), -1),
       outgoing(static_cast<std::size_t>(nx), -1);
-  std::vector<int> from(static_cast<std::size_t>(ml), -1), to(static_cast<std::size_t>(ml), -1);
+  std::vector<int> to(static_cast<std::size_t>(ml), -1);
   for (int r = 0; r < ml; ++r) {
-    const auto& de = design_entries[static_cast<std::size_t>(r)];
-    if (de.size() != 2 || !q_entries[static_cast<std::size_t>(r)].empty()) continue;
+    const auto& de = entries.design[static_cast<std::size_t>(r)];
+    if (de.size() != 2 || !entries.q[static_cast<std::size_t>(r)].empty()) continue;
     if (!std::isfinite(lg_lower_[static_cast<std::size_t>(r)]) ||
         std::isfinite(lg_upper_[static_cast<std::size_t>(r)]))
       continue;
@@ -48,72 +62,83 @@ TaperedLiftedNlp::TaperedLiftedNlp(LiftedDesignNlp& lifted, const std::vector<do
     const int minus = jac[static_cast<std::size_t>(v0 > 0.0 ? de[1] : de[0])].second;
     if (incoming[static_cast<std::size_t>(plus)] >= 0 ||
         outgoing[static_cast<std::size_t>(minus)] >= 0)
-      return;  // not one chain
+      return false;  // not one chain
     incoming[static_cast<std::size_t>(plus)] = r;
     outgoing[static_cast<std::size_t>(minus)] = r;
-    from[static_cast<std::size_t>(r)] = minus;
     to[static_cast<std::size_t>(r)] = plus;
   }
   int first = -1;
   for (int j = 0; j < nx; ++j) {
     if (incoming[static_cast<std::size_t>(j)] >= 0) continue;
-    if (first >= 0) return;  // two heads
+    if (first >= 0) return false;  // two heads
     first = j;
   }
-  if (first < 0) return;
+  if (first < 0) return false;
   for (int j = first; j >= 0;) {
     var_.push_back(j);
     const int r = outgoing[static_cast<std::size_t>(j)];
     chain_row_.push_back(var_.size() == 1 ? -1 : incoming[static_cast<std::size_t>(j)]);
     j = r >= 0 ? to[static_cast<std::size_t>(r)] : -1;
-    if (static_cast<int>(var_.size()) > nx) return;
+    if (static_cast<int>(var_.size()) > nx) return false;
   }
-  if (static_cast<int>(var_.size()) != nx) return;
+  if (static_cast<int>(var_.size()) != nx) return false;
   pos_.assign(static_cast<std::size_t>(nx), -1);
   for (int i = 0; i < nx; ++i)
     pos_[static_cast<std::size_t>(var_[static_cast<std::size_t>(i)])] = i;
-  // s_i = a_i y_i + c_i s_(i-1) + e_i from t_i = p s_i + n s_(i-1) + const = y_i.
-  a_.assign(static_cast<std::size_t>(nx), 1.0);
-  c_.assign(static_cast<std::size_t>(nx), 0.0);
-  e_.assign(static_cast<std::size_t>(nx), 0.0);
-  y_lower_.assign(static_cast<std::size_t>(nx), -kInfinity);
-  y_upper_.assign(static_cast<std::size_t>(nx), kInfinity);
-  const auto j0 = static_cast<std::size_t>(var_[0]);
-  y_lower_[0] = z_lower_[j0];
-  y_upper_[0] = z_upper_[j0];
+  return true;
+}
+
+TaperedLiftedNlp::ChainRows TaperedLiftedNlp::SetSteps(int block_size, const RowEntries& entries,
+                                                       const std::vector<double>& z0,
+                                                       std::vector<bool>* bound_row) {
+  const int nx = k_;
+  const auto nn = static_cast<std::size_t>(nx);
+  const auto& jac = lifted_.jacobian_structure();
+  // s_i = a_i y_i + c_i s_(i-1) + e_i from t_i = p s_i + q s_(i-1) + c = y_i; a head: s_i = y_i.
+  a_.assign(nn, 1.0);
+  c_.assign(nn, 0.0);
+  e_.assign(nn, 0.0);
+  y_lower_.assign(nn, -kInfinity);
+  y_upper_.assign(nn, kInfinity);
   // Blocks of block_size chain positions: a block's head keeps its own s as its variable (its
   // bounds its own, the taper row into it a row), the others their taper step.
-  block_start_.assign(static_cast<std::size_t>(nx), 0);
+  block_start_.assign(nn, 0);
   for (int i = 0; i < nx; ++i) block_start_[static_cast<std::size_t>(i)] = i - i % block_size;
-  const auto head = [this](int i) { return block_start_[static_cast<std::size_t>(i)] == i; };
-  std::vector<double> row_p(static_cast<std::size_t>(nx), 1.0),
-      row_q(static_cast<std::size_t>(nx), 0.0), row_c(static_cast<std::size_t>(nx), 0.0),
-      row_lo(static_cast<std::size_t>(nx), 0.0);
-  std::vector<bool> bound_row(static_cast<std::size_t>(ml), false);
+  ChainRows chain;
+  chain.p.assign(nn, 1.0);
+  chain.q.assign(nn, 0.0);
+  chain.c.assign(nn, 0.0);
+  chain.lo.assign(nn, 0.0);
+  bound_row->assign(static_cast<std::size_t>(lifted_.m()), false);
   for (int i = 0; i < nx; ++i) {
     const auto ii = static_cast<std::size_t>(i);
     if (i > 0) {
       const int r = chain_row_[ii];
-      for (int e : design_entries[static_cast<std::size_t>(r)]) {
+      for (int e : entries.design[static_cast<std::size_t>(r)]) {
         const double v = lifted_.jacobian_values()[static_cast<std::size_t>(e)];
-        (jac[static_cast<std::size_t>(e)].second == var_[ii] ? row_p[ii] : row_q[ii]) = v;
+        (jac[static_cast<std::size_t>(e)].second == var_[ii] ? chain.p[ii] : chain.q[ii]) = v;
       }
-      row_c[ii] = lifted_.g()[static_cast<std::size_t>(r)] -
-                  row_p[ii] * z0[static_cast<std::size_t>(var_[ii])] -
-                  row_q[ii] * z0[static_cast<std::size_t>(var_[ii - 1])];
-      row_lo[ii] = lg_lower_[static_cast<std::size_t>(r)];
+      chain.c[ii] = lifted_.g()[static_cast<std::size_t>(r)] -
+                    chain.p[ii] * z0[static_cast<std::size_t>(var_[ii])] -
+                    chain.q[ii] * z0[static_cast<std::size_t>(var_[ii - 1])];
+      chain.lo[ii] = lg_lower_[static_cast<std::size_t>(r)];
     }
-    if (head(i)) {
+    if (IsHead(i)) {
       y_lower_[ii] = z_lower_[static_cast<std::size_t>(var_[ii])];
       y_upper_[ii] = z_upper_[static_cast<std::size_t>(var_[ii])];
       continue;
     }
-    a_[ii] = 1.0 / row_p[ii];
-    c_[ii] = -row_q[ii] / row_p[ii];
-    e_[ii] = -row_c[ii] / row_p[ii];
-    y_lower_[ii] = row_lo[ii];
-    bound_row[static_cast<std::size_t>(chain_row_[ii])] = true;
+    a_[ii] = 1.0 / chain.p[ii];
+    c_[ii] = -chain.q[ii] / chain.p[ii];
+    e_[ii] = -chain.c[ii] / chain.p[ii];
+    y_lower_[ii] = chain.lo[ii];
+    (*bound_row)[static_cast<std::size_t>(chain_row_[ii])] = true;
   }
+  return chain;
+}
+
+void TaperedLiftedNlp::KeepRows(const ChainRows& chain, const std::vector<bool>& bound_row) {
+  const int nx = k_, ml = lifted_.m();
   // The variables' own bounds the taper rows do not imply become rows (a head's are its y's):
   // lower bounds forward, upper bounds backward. p s_i + q s_(i-1) + c >= lo with p > 0 > q.
   std::vector<bool> lower_row(static_cast<std::size_t>(nx), false),
@@ -121,18 +146,19 @@ TaperedLiftedNlp::TaperedLiftedNlp(LiftedDesignNlp& lifted, const std::vector<do
   double forced = z_lower_[static_cast<std::size_t>(var_[0])];
   for (int i = 1; i < nx; ++i) {
     const auto ii = static_cast<std::size_t>(i);
-    const double implied = (row_lo[ii] - row_c[ii] - row_q[ii] * forced) / row_p[ii];
+    const double implied = (chain.lo[ii] - chain.c[ii] - chain.q[ii] * forced) / chain.p[ii];
     const double own = z_lower_[static_cast<std::size_t>(var_[ii])];
-    lower_row[ii] = !head(i) && own > implied + kImpliedSlack;
+    lower_row[ii] = !IsHead(i) && own > implied + kImpliedSlack;
     forced = std::max(own, implied);
   }
   forced = z_upper_[static_cast<std::size_t>(var_[static_cast<std::size_t>(nx - 1)])];
-  upper_row[static_cast<std::size_t>(nx - 1)] = !head(nx - 1);
+  upper_row[static_cast<std::size_t>(nx - 1)] = !IsHead(nx - 1);
   for (int i = nx - 2; i >= 1; --i) {
     const auto ii = static_cast<std::size_t>(i), next = ii + 1;
-    const double implied = (row_p[next] * forced + row_c[next] - row_lo[next]) / -row_q[next];
+    const double implied =
+        (chain.p[next] * forced + chain.c[next] - chain.lo[next]) / -chain.q[next];
     const double own = z_upper_[static_cast<std::size_t>(var_[ii])];
-    upper_row[ii] = !head(i) && own < implied - kImpliedSlack;
+    upper_row[ii] = !IsHead(i) && own < implied - kImpliedSlack;
     forced = std::min(own, implied);
   }
   // Rows: the lifted ones but the taper rows made bounds, then the variables' bounds kept.
@@ -151,6 +177,11 @@ TaperedLiftedNlp::TaperedLiftedNlp(LiftedDesignNlp& lifted, const std::vector<do
     row_lower_.push_back(lower_row[ii] ? z_lower_[static_cast<std::size_t>(var_[ii])] : -kInfinity);
     row_upper_.push_back(upper_row[ii] ? z_upper_[static_cast<std::size_t>(var_[ii])] : kInfinity);
   }
+}
+
+void TaperedLiftedNlp::BuildStructures(const RowEntries& entries) {
+  const int nx = k_;
+  const auto& jac = lifted_.jacobian_structure();
   // The Jacobian: s_p depends on y from its block's head to p, so a row's entries are the
   // union of those ranges over its design entries, then its q entries.
   std::vector<char> used(static_cast<std::size_t>(nx));
@@ -164,13 +195,13 @@ TaperedLiftedNlp::TaperedLiftedNlp(LiftedDesignNlp& lifted, const std::vector<do
     if (lr < 0) {
       mark(-lr - 1);
     } else {
-      for (int e : design_entries[static_cast<std::size_t>(lr)])
+      for (int e : entries.design[static_cast<std::size_t>(lr)])
         mark(pos_[static_cast<std::size_t>(jac[static_cast<std::size_t>(e)].second)]);
     }
     for (int i = 0; i < nx; ++i)
       if (used[static_cast<std::size_t>(i)]) jac_.push_back({static_cast<int>(r), i});
     if (lr >= 0) {
-      for (int e : q_entries[static_cast<std::size_t>(lr)])
+      for (int e : entries.q[static_cast<std::size_t>(lr)])
         jac_.push_back({static_cast<int>(r), k_ + jac[static_cast<std::size_t>(e)].second - nx});
     }
   }
@@ -179,8 +210,8 @@ TaperedLiftedNlp::TaperedLiftedNlp(LiftedDesignNlp& lifted, const std::vector<do
   // block (H_s couples the previous block's last s, which all of that block's y move, to it).
   hess_index_.assign(static_cast<std::size_t>(nx) * static_cast<std::size_t>(nx), -1);
   for (int r = 0; r < k_; ++r) {
-    const int from_col = head(r) && r > 0 ? block_start_[static_cast<std::size_t>(r - 1)]
-                                          : block_start_[static_cast<std::size_t>(r)];
+    const int from_col = IsHead(r) && r > 0 ? block_start_[static_cast<std::size_t>(r - 1)]
+                                            : block_start_[static_cast<std::size_t>(r)];
     for (int c = from_col; c <= r; ++c) {
       hess_index_[static_cast<std::size_t>(r) * static_cast<std::size_t>(nx) +
                   static_cast<std::size_t>(c)] = static_cast<int>(hess_.size());
@@ -208,9 +239,6 @@ TaperedLiftedNlp::TaperedLiftedNlp(LiftedDesignNlp& lifted, const std::vector<do
       q_block_entries_.push_back(found);
     }
   }
-  g_.assign(rows_.size(), 0.0);
-  grad_f_.assign(static_cast<std::size_t>(n()), 0.0);
-  ok_ = true;
 }
 
 void TaperedLiftedNlp::Bounds(std::vector<double>* w_lower, std::vector<double>* w_upper,

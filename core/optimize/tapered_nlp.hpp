@@ -74,6 +74,25 @@ class TaperedLiftedNlp {
   int evaluations() const { return lifted_.evaluations(); }  ///< Evaluations of P(x).
 
  private:
+  // Per lifted row: its Jacobian entries on the design variables and on q.
+  struct RowEntries {
+    std::vector<std::vector<int>> design, q;
+  };
+  // Per chain position i >= 1: its taper row p s_i + q s_(i-1) + c >= lo.
+  struct ChainRows {
+    std::vector<double> p, q, c, lo;
+  };
+  // The chain of taper rows through every design variable (var_, chain_row_, pos_); false
+  // when the rows do not form one.
+  bool FindChain(const RowEntries& entries);
+  // The blocks, the map s(y) and y's bounds; the taper rows that became bounds in *bound_row.
+  ChainRows SetSteps(int block_size, const RowEntries& entries, const std::vector<double>& z0,
+                     std::vector<bool>* bound_row);
+  // The rows: the lifted ones but the bounds', then the variables' bounds not implied.
+  void KeepRows(const ChainRows& chain, const std::vector<bool>& bound_row);
+  // The Jacobian's and the Hessian's structures and the Hessian's index maps.
+  void BuildStructures(const RowEntries& entries);
+  bool IsHead(int i) const { return block_start_[static_cast<std::size_t>(i)] == i; }
   // A^T v (v over chain positions, in place): d/dy of a function with gradient v over s.
   void ApplyAT(std::vector<double>* v) const;
   // A u for u = e_i (the column of ds/dy for y_i), over chain positions.
