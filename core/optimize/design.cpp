@@ -384,20 +384,11 @@ void CheckBbcorRule(const DesignProblem& problem, const PublicEvaluation& pub,
   }
 }
 
-// The optimisation, with the progress it reports mapped into [progress_from, progress_to]
-// and an overall deadline (OptimizeOverMaterials shares one budget between materials).
-DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions& options,
-                          Progress* progress, double progress_from, double progress_to,
-                          std::optional<Clock::time_point> shared_deadline,
-                          const design_detail::LocalSolver* solver, const char* solver_name,
-                          design_detail::PreparedModel* prepared) {
-  const Clock::time_point start = Clock::now();
-  const auto elapsed_s = [&start] {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-  };
-  DesignResult result;
-  Summary& summary = result.summary;
-  const DesignBackend backend = MainBackend(problem, options);
+// The summary's backend, models and counts before the solve.
+void StartSummary(const DesignProblem& problem, DesignBackend backend,
+                  const design_detail::LocalSolver* solver, const char* solver_name,
+                  DesignResult* result) {
+  Summary& summary = result->summary;
   summary.backend =
       solver != nullptr && solver_name != nullptr ? solver_name : BackendName(backend);
   summary.models_used = {"mass_properties"};
@@ -411,37 +402,130 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
   }
   if (sting) summary.models_used.push_back("flexible");
   // max_distance: the oblique impact and the flight of every design's distance sweet spot.
-  const bool distance = problem.objective == DesignObjective::kMaxDistance;
-  if (distance) {
+  if (problem.objective == DesignObjective::kMaxDistance) {
     summary.models_used.push_back("oblique_impact");
     summary.models_used.push_back("flight");
   }
-  // The objectives without a derivative (COBYLA whatever was asked).
-  const bool values_only = sting || distance;
-  const char* objective_name = DesignObjectiveName(problem.objective);
   summary.iterations = 0;
   summary.evaluations = 0;
-  result.objective_unit = ObjectiveUnit(problem.objective);
+  result->objective_unit = ObjectiveUnit(problem.objective);
+}
 
+// The model of the request (or the caller's prepared one); false with the refusal in *why.
+bool ModelOf(const DesignProblem& problem, const DesignOptions& options, bool values_only,
+             design_detail::PreparedModel* prepared, DesignModel* model, Refusal* why) {
+  if (!options.Validate(why)) {
+    *why = Prefixed("options.", std::move(*why));
+    return false;
+  }
+  if (values_only && options.derivative_check != DerivativeCheck::kNone) {
+    *why = TextRefusal("options.derivative_check",
+                       std::string("objective = ") + DesignObjectiveName(problem.objective) +
+                           " has no derivatives to check (it is solved derivative-free by COBYLA)");
+    return false;
+  }
+  if (!design_detail::SlsqpSizeAllowed(problem, options, why)) return false;
+  if (prepared != nullptr) {
+    *model = std::move(prepared->model);  // built and merged by the caller (moved from)
+    return true;
+  }
+  return DesignModel::Build(problem, options, model, why);
+}
+
+// Why the objectives without a derivative run COBYLA whatever was asked.
+void WarnDerivativeFree(const DesignProblem& problem, const DesignOptions& options,
+                        Summary* summary) {
+  if (problem.objective == DesignObjective::kMaxDistance &&
+      options.backend != DesignBackend::kNloptCobyla) {
+    summary->warnings.push_back(
+        std::string("objective = max_distance: solved by NLopt LN_COBYLA, not ") +
+        BackendName(options.backend) +
+        ": the carry comes from an adaptive flight integration inside an iterative search over "
+        "the impact point and undercut (piecewise smooth at the 1e-7 m level, no usable "
+        "derivative: docs/optimization.md), so a derivative-free solver is used");
+  }
+  if (problem.objective == DesignObjective::kMinSting &&
+      options.backend != DesignBackend::kNloptCobyla) {
+    summary->warnings.push_back(
+        std::string("objective = min_sting: solved by NLopt LN_COBYLA, not ") +
+        BackendName(options.backend) +
+        ": the sting comes from an adaptive FE mesh and an adaptive ODE integration (piecewise "
+        "smooth, no derivative), so a derivative-free solver is used");
+  }
+}
+
+// The starts, their certificates and the answer: the chosen start's design, re-checked,
+// classified and certified.
+void SolveAndAnswer(const DesignProblem& problem, const DesignOptions& options,
+                    const DesignModel& model, DesignBackend backend, bool cor_known,
+                    Clock::time_point deadline, Progress* progress, double progress_from,
+                    double progress_to, const design_detail::LocalSolver* solver,
+                    DesignResult* result) {
+  Summary& summary = result->summary;
+  std::vector<Run> runs = model.fixed_violations().empty()
+                              ? RunStarts(model, options, backend, deadline, progress,
+                                          progress_from, progress_to, result, solver)
+                              : std::vector<Run>{};
+  design_detail::CertifyRuns(model, options, &runs);
+  FillSpread(runs, &result->spread);
+  // Which formulation Ipopt solved: "lifted_integrals" when the lifted one (lifted_nlp.hpp).
+  if (std::any_of(runs.begin(), runs.end(), [](const Run& r) { return r.outcome.lifted; })) {
+    summary.models_used.push_back("lifted_integrals");
+  }
+
+  // The answer.
+  const int best = ChooseRun(model, runs);
+  result->spread.best_start = best;
+  std::vector<double> x = best >= 0 ? runs[static_cast<std::size_t>(best)].x : model.BaseX();
+  if (best >= 0) design_detail::PolishLeastSquares(model, &x, &summary);  // least squares only
+  const PublicEvaluation pub = AnswerAt(problem, model, x, cor_known, result);
+  // Independent re-check of every constraint (public mass properties).
+  double worst = 0.0, worst_relative = 0.0;
+  RecheckConstraints(model, pub, result->bat, x, &worst, &worst_relative);
+  summary.constraint_violation = worst;
+  if (!model.fixed_violations().empty() || best < 0) {
+    if (!model.fixed_violations().empty()) {
+      ReportFixedViolations(model, result);
+    } else {
+      ReportNoDesign(runs, result);
+    }
+    return;
+  }
+  const Run& chosen = runs[static_cast<std::size_t>(best)];
+  ClassifyChosen(options, backend, chosen, pub, result->bat, result);
+  ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, result);
+  ReportActiveConstraints(model, x,
+                          design_detail::WithCertifiedMultipliers(model, options, x,
+                                                                  chosen.outcome, result, &chosen),
+                          result, options.feasibility_tolerance);
+  // The shape fit (a least-squares objective) reports no multipliers: no warning about them.
+  design_detail::FinishCertificate(chosen, problem.objective != DesignObjective::kLeastSquares,
+                                   result);
+  MarkCancelledMultiStart(options, runs, progress, result);
+  CheckBbcorRule(problem, pub, options.feasibility_tolerance, result);
+}
+
+// The optimisation, with the progress it reports mapped into [progress_from, progress_to]
+// and an overall deadline (OptimizeOverMaterials shares one budget between materials).
+DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions& options,
+                              Progress* progress, double progress_from, double progress_to,
+                              std::optional<Clock::time_point> shared_deadline,
+                              const design_detail::LocalSolver* solver, const char* solver_name,
+                              design_detail::PreparedModel* prepared) {
+  const Clock::time_point start = Clock::now();
+  const auto elapsed_s = [&start] {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  DesignResult result;
+  Summary& summary = result.summary;
+  const DesignBackend backend = MainBackend(problem, options);
+  StartSummary(problem, backend, solver, solver_name, &result);
+  // The objectives without a derivative (COBYLA whatever was asked).
+  const bool values_only = problem.objective == DesignObjective::kMinSting ||
+                           problem.objective == DesignObjective::kMaxDistance;
   Refusal why;
   DesignModel model;
-  bool invalid = false;
-  if (!options.Validate(&why)) {
-    invalid = true;
-    why = Prefixed("options.", std::move(why));
-  } else if (values_only && options.derivative_check != DerivativeCheck::kNone) {
-    invalid = true;
-    why = TextRefusal("options.derivative_check",
-                      std::string("objective = ") + objective_name +
-                          " has no derivatives to check (it is solved derivative-free by COBYLA)");
-  } else if (!design_detail::SlsqpSizeAllowed(problem, options, &why)) {
-    invalid = true;
-  } else if (prepared != nullptr) {
-    model = std::move(prepared->model);  // built and merged by the caller (moved from)
-  } else if (!DesignModel::Build(problem, options, &model, &why)) {
-    invalid = true;
-  }
-  if (invalid) {
+  if (!ModelOf(problem, options, values_only, prepared, &model, &why)) {
     FillBase(problem, &result);
     summary.SetRefusal(std::move(why));
     summary.objective = kNaN;
@@ -452,73 +536,18 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
   }
   // Constraints that repeat another are merged before the solve (certificate.hpp).
   result.merged_constraints = prepared != nullptr
-                                   ? std::move(prepared->merged)
-                                   : design_detail::MergeDuplicateConstraints(&model);
+                                  ? std::move(prepared->merged)
+                                  : design_detail::MergeDuplicateConstraints(&model);
   const bool cor_known =
       problem.cor.has_value() || problem.bat.material.cor.has_value() || model.cor_from_barrel();
   result.cor = cor_known ? model.cor() : kNaN;
-  if (distance && options.backend != DesignBackend::kNloptCobyla) {
-    summary.warnings.push_back(
-        std::string("objective = max_distance: solved by NLopt LN_COBYLA, not ") +
-        BackendName(options.backend) +
-        ": the carry comes from an adaptive flight integration inside an iterative search over "
-        "the impact point and undercut (piecewise smooth at the 1e-7 m level, no usable "
-        "derivative: docs/optimization.md), so a derivative-free solver is used");
-  }
-  if (sting && options.backend != DesignBackend::kNloptCobyla) {
-    summary.warnings.push_back(
-        std::string("objective = min_sting: solved by NLopt LN_COBYLA, not ") +
-        BackendName(options.backend) +
-        ": the sting comes from an adaptive FE mesh and an adaptive ODE integration (piecewise "
-        "smooth, no derivative), so a derivative-free solver is used");
-  }
-
+  WarnDerivativeFree(problem, options, &summary);
   try {
     const Clock::time_point deadline =
         shared_deadline.value_or(start + std::chrono::duration_cast<Clock::duration>(
                                              std::chrono::duration<double>(options.max_time_s)));
-    std::vector<Run> runs = model.fixed_violations().empty()
-                                ? RunStarts(model, options, backend, deadline, progress,
-                                            progress_from, progress_to, &result, solver)
-                                : std::vector<Run>{};
-    design_detail::CertifyRuns(model, options, &runs);
-    FillSpread(runs, &result.spread);
-    // Which formulation Ipopt solved: "lifted_integrals" when the lifted one (lifted_nlp.hpp).
-    if (std::any_of(runs.begin(), runs.end(), [](const Run& r) { return r.outcome.lifted; })) {
-      summary.models_used.push_back("lifted_integrals");
-    }
-
-    // The answer.
-    const int best = ChooseRun(model, runs);
-    result.spread.best_start = best;
-    std::vector<double> x = best >= 0 ? runs[static_cast<std::size_t>(best)].x : model.BaseX();
-    if (best >= 0) design_detail::PolishLeastSquares(model, &x, &summary);  // least squares only
-    const PublicEvaluation pub = AnswerAt(problem, model, x, cor_known, &result);
-    // Independent re-check of every constraint (public mass properties).
-    double worst = 0.0, worst_relative = 0.0;
-    RecheckConstraints(model, pub, result.bat, x, &worst, &worst_relative);
-    summary.constraint_violation = worst;
-    if (!model.fixed_violations().empty() || best < 0) {
-      if (!model.fixed_violations().empty()) {
-        ReportFixedViolations(model, &result);
-      } else {
-        ReportNoDesign(runs, &result);
-      }
-      summary.solve_time_s = elapsed_s();
-      return result;
-    }
-    const Run& chosen = runs[static_cast<std::size_t>(best)];
-    ClassifyChosen(options, backend, chosen, pub, result.bat, &result);
-    ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, &result);
-    ReportActiveConstraints(model, x,
-                            design_detail::WithCertifiedMultipliers(
-                                model, options, x, chosen.outcome, &result, &chosen),
-                            &result, options.feasibility_tolerance);
-    // The shape fit (a least-squares objective) reports no multipliers: no warning about them.
-    design_detail::FinishCertificate(
-        chosen, problem.objective != DesignObjective::kLeastSquares, &result);
-    MarkCancelledMultiStart(options, runs, progress, &result);
-    CheckBbcorRule(problem, pub, options.feasibility_tolerance, &result);
+    SolveAndAnswer(problem, options, model, backend, cor_known, deadline, progress,
+                   progress_from, progress_to, solver, &result);
   } catch (const std::bad_alloc&) {
     summary.termination = Termination::kFailure;
     summary.message = "out of memory";
