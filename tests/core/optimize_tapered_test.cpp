@@ -140,30 +140,35 @@ TEST(OptimizeTapered, DerivativesMatchCentralDifferences) {
 }
 
 // Ipopt on the steps: its multipliers, mapped back (steps' bounds to taper rows, heads' bounds
-// and kept bound rows to the radii's bounds and limits), make the dense problem stationary.
+// and kept bound rows to the radii's bounds and limits), make the dense problem stationary; on
+// the 64-knot design and with knot 45 held to 30 mm (a kept bound row, active).
 TEST(OptimizeTapered, MultipliersMapBackToTheDesignsKkt) {
-  const DesignModel model = Build(KnotProblem(64));
-  ScaledDesignNlp nlp(model);
-  LocalSolveSettings settings;
-  settings.hessian = HessianMode::kExact;
-  settings.deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
-  const LocalSolveOutcome out = SolveWithIpopt(nlp, nlp.ToScaled(model.BaseX()), settings);
-  ASSERT_EQ(out.termination, Termination::kConverged) << out.status_name;
-  ASSERT_TRUE(out.has_multipliers);
-  ASSERT_TRUE(nlp.Evaluate(out.s.data(), true));
-  double worst = 0.0, scale = 1.0;
-  for (int j = 0; j < nlp.n(); ++j) {
-    double r = nlp.grad_f()(j) - out.z_lower[static_cast<std::size_t>(j)] +
-               out.z_upper[static_cast<std::size_t>(j)];
-    for (int k = 0; k < nlp.m(); ++k)
-      r += out.lambda[static_cast<std::size_t>(k)] * nlp.jacobian()(k, j);
-    worst = std::max(worst, std::abs(r));
-    scale = std::max(scale, std::abs(nlp.grad_f()(j)));
+  DesignProblem limited = KnotProblem(64);
+  limited.variables[44].max = 0.030;
+  for (const DesignProblem& p : {KnotProblem(64), limited}) {
+    const DesignModel model = Build(p);
+    ScaledDesignNlp nlp(model);
+    LocalSolveSettings settings;
+    settings.hessian = HessianMode::kExact;
+    settings.deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    const LocalSolveOutcome out = SolveWithIpopt(nlp, nlp.ToScaled(model.BaseX()), settings);
+    ASSERT_EQ(out.termination, Termination::kConverged) << out.status_name;
+    ASSERT_TRUE(out.has_multipliers);
+    ASSERT_TRUE(nlp.Evaluate(out.s.data(), true));
+    double worst = 0.0, scale = 1.0;
+    for (int j = 0; j < nlp.n(); ++j) {
+      double r = nlp.grad_f()(j) - out.z_lower[static_cast<std::size_t>(j)] +
+                 out.z_upper[static_cast<std::size_t>(j)];
+      for (int k = 0; k < nlp.m(); ++k)
+        r += out.lambda[static_cast<std::size_t>(k)] * nlp.jacobian()(k, j);
+      worst = std::max(worst, std::abs(r));
+      scale = std::max(scale, std::abs(nlp.grad_f()(j)));
+    }
+    // Ipopt's tol 1e-9 on its scaled dual infeasibility; mapped through the steps (A^T,
+    // entries up to ~1e2 at 64 knots) 1e-7 of the gradient's scale covers it, and a sign or a
+    // missing multiplier leaves residuals of order the multipliers (~1e-2..1).
+    EXPECT_LE(worst, 1e-7 * scale);
   }
-  // Ipopt's tol 1e-9 on its scaled dual infeasibility; mapped through the steps (A^T, entries
-  // up to ~1e2 at 64 knots) 1e-7 of the gradient's scale covers it, and a sign or a missing
-  // multiplier leaves residuals of order the multipliers (~1e-2..1).
-  EXPECT_LE(worst, 1e-7 * scale);
 }
 
 // The same optimum as the lifted formulation over the radii, certified, at 64 and 128 knots
@@ -193,6 +198,30 @@ TEST(OptimizeTapered, SameOptimumAsTheRadiiAtSixtyFourKnots) { ExpectSameOptimum
 TEST(OptimizeTapered, SameOptimumAsTheRadiiAtOneHundredTwentyEightKnots) {
   ExpectSameOptimum(KnotProblem(128));
 }
+// A knot's own limit the taper does not imply (knot 45 of 64 at most 30 mm, in the barrel of
+// the unconstrained optimum, 32.5 mm): it stays a row of the steps' problem (and with it every
+// knot before it is held to 30 mm by the taper), active at the optimum, its multiplier mapped
+// back to the knot's bound.
+TEST(OptimizeTapered, SameOptimumWithALimitTheTaperDoesNotImply) {
+  DesignProblem p = KnotProblem(64);
+  p.variables[44].max = 0.030;
+  {
+    const DesignModel model = Build(p);
+    ScaledDesignNlp dense(model);
+    LiftedDesignNlp lifted(dense);
+    const TaperedLiftedNlp tapered(lifted, dense.ToScaled(model.BaseX()), kTaperBlockSize);
+    ASSERT_TRUE(tapered.ok());
+    // The 64-knot problem's 9 rows and knot 45's upper limit.
+    EXPECT_EQ(tapered.m(), 10);
+  }
+  ExpectSameOptimum(p);
+  const DesignResult r = OptimizeDesign(p);
+  // The limit holds the design back: knot 45 on it, to Ipopt's tolerance (1e-9 of the scaled
+  // variable, 22.2 mm wide: 2.2e-11 m; 1e-10 m covers it, far below the 2.5 mm the limit takes
+  // off the unconstrained barrel).
+  EXPECT_NEAR(r.variables[44].value, 0.030, 1e-10);
+}
+
 TEST(OptimizeTapered, SameOptimumAsTheRadiiForAHollowSixtyNineStationProfile) {
   DesignProblem p = KnotProblem(69);
   p.bat.material = *FindMaterial("aluminium-7050");
