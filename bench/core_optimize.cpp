@@ -119,7 +119,8 @@ DesignProblem KnotProblem(int n) {
   return p;
 }
 
-// backend: 3 the default request (the optimiser chooses: DesignOptions::choose_backend), 0 Ipopt
+// backend: 3 the default request (the optimiser chooses: DesignOptions::choose_backend), 4 the
+// same without the taper's steps as variables (DesignOptions::taper_steps false), 0 Ipopt
 // exact Hessian, 1 Ipopt limited memory (both lifted when the problem qualifies, as here), 2
 // NLopt SLSQP. A problem the service refuses (SLSQP over 32 variables) reports refused = 1 and
 // no time of a solve.
@@ -128,7 +129,8 @@ void BM_OptimizeKnots(benchmark::State& state) {
   DesignOptions o;
   o.backend = state.range(1) == 2 ? DesignBackend::kNloptSlsqp : DesignBackend::kIpopt;
   o.hessian = state.range(1) == 0 ? HessianMode::kExact : HessianMode::kLimitedMemory;
-  o.choose_backend = state.range(1) == 3;  // the api's default request
+  o.choose_backend = state.range(1) >= 3;  // the api's default request
+  o.taper_steps = state.range(1) != 4;     // 4: the same over the radii (tapered_nlp.hpp)
   o.max_variables = 100000;  // the service's cap is --max-design-variables; measure past it
   DesignResult r;
   for (auto _ : state) {
@@ -144,7 +146,7 @@ void BM_OptimizeKnots(benchmark::State& state) {
                      : r.summary.backend + (lifted ? " lifted" : ""));
 }
 BENCHMARK(BM_OptimizeKnots)
-    ->ArgsProduct({{16, 32, 64, 128, 256}, {3, 0, 1, 2}})
+    ->ArgsProduct({{16, 32, 64, 128, 256}, {3, 4, 0, 1, 2}})
     ->ArgNames({"knots", "backend"})
     ->Unit(benchmark::kMillisecond);
 

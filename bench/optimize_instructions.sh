@@ -6,7 +6,8 @@
 # machine), so options and formulations can be compared one run each; they do not count cache
 # misses. Issue 36 (docs/benchmarks.md, "Issue 36: fine profiles").
 #   bench/optimize_instructions.sh [BUILD_DIR] [KNOTS...]   (default: build; 64 128 256)
-#   BACKEND=0 ... Ipopt exact; default 3 (the default request).
+#   BACKEND=0 ... Ipopt exact; 4 the default request over the knot radii (without the taper's
+#   steps as variables); default 3 (the default request).
 # Needs valgrind. Not run by ctest or CI.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -35,8 +36,8 @@ for n in "${knots[@]}"; do
   share "    factorisations" 'MumpsSolverInterface::Factorization'
   share "    solves" 'MumpsSolverInterface::Solve\('
   share "    MUMPS 5.5's per-call bookkeeping (compute_memory_save)" 'dmumps_compute_memory_save'
-  share "  our lifted callbacks: eval_h" 'LiftedTnlp::eval_h'
-  share "  our lifted callbacks: eval_grad_f" 'LiftedTnlp::eval_grad_f'
+  share "  our lifted callbacks: eval_h" 'LiftedTnlp<[^>]*>::eval_h'
+  share "  our lifted callbacks: eval_grad_f" 'LiftedTnlp<[^>]*>::eval_grad_f'
   share "  IpoptApplicationFactory" 'IpoptApplicationFactory'
   share "the certificate (Certify: runs and answer)" 'design_detail::Certify\('
   share "the merge of duplicated constraints" 'MergeDuplicateConstraints\(sweetspot::core::DesignModel\*\) \['

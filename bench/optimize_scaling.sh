@@ -5,6 +5,8 @@
 # 128 and 256 knots: the SciPy SLSQP peer (finite-difference gradients, best CPU time of R
 # solves) against sweetspot in the same run (BM_OptimizeKnots: the default request, whose
 # backend the optimiser chooses (DesignOptions::choose_backend; the cell names the one that ran),
+# the same over the knot radii (DesignOptions::taper_steps false: the formulation before the
+# taper's steps, core/optimize/tapered_nlp.hpp),
 # Ipopt exact Hessian, Ipopt limited memory (both the lifted formulation here), NLopt SLSQP
 # (refused above 32 variables); CPU time per solve), the ratios and the optima's relative
 # differences from the best objective found at that size.
@@ -39,7 +41,8 @@ echo "machine: load average $(cut -d' ' -f1-3 /proc/loadavg) at the end"
 import json, sys
 work, knots = sys.argv[1], [int(k) for k in sys.argv[2:]]
 bench = {b["name"]: b for b in json.load(open(f"{work}/bench.json"))["benchmarks"]}
-names = {3: "default request", 0: "Ipopt exact", 1: "Ipopt limited memory", 2: "NLopt SLSQP"}
+names = {3: "default request", 4: "default request over the radii", 0: "Ipopt exact",
+         1: "Ipopt limited memory", 2: "NLopt SLSQP"}
 print("| knots | SciPy SLSQP (CPU) | " + " | ".join(f"{names[b]} (CPU, ratio)" for b in names) + " |")
 print("|---|---|" + "---|" * len(names))
 for n in knots:
@@ -57,7 +60,7 @@ for n in knots:
         else:
             ms = r["cpu_time"] if r["time_unit"] == "ms" else r["cpu_time"] / 1e6
             ok = "converged" if r["converged"] else "not converged"
-            ran = f" ({r.get('label', '')})" if b == 3 else ""
+            ran = f" ({r.get('label', '')})" if b in (3, 4) else ""
             cells.append(f"{ms:.2f} ms{ran}, {peer['cpu_s'] * 1e3 / ms:.1f}x, {r['objective_mps']:.6f} m/s"
                          f" (rel. {rel(r['objective_mps']):.1e}), {ok}")
     print(f"| {n} | {peer['cpu_s'] * 1e3:.1f} ms, {peer['objective_mps']:.6f} m/s "

@@ -35,6 +35,11 @@ namespace sweetspot::core {
 namespace {
 
 using design_detail::BackendName;
+using design_detail::ClassifyChosen;
+using design_detail::ClassifyFeasibility;
+using design_detail::MarkCancelledMultiStart;
+using design_detail::ReportFixedViolations;
+using design_detail::ReportNoDesign;
 using design_detail::ChooseRun;
 using design_detail::Clock;
 using design_detail::Explain;
@@ -186,185 +191,6 @@ std::vector<Run> RunStarts(const DesignModel& model, const DesignOptions& option
   return runs;
 }
 
-// The answer when a constraint no variable changes is violated: infeasible, with each one.
-void ReportFixedViolations(const DesignModel& model, DesignResult* result) {
-  result->summary.termination = Termination::kInfeasible;
-  std::string text;
-  for (const FixedViolation& v : model.fixed_violations()) {
-    DesignConflict d;
-    d.constraints.push_back(v.constraint);
-    d.requested_min = d.requested_max = d.achievable_min = d.achievable_max = kNaN;
-    d.shortfall = kNaN;
-    d.message = v.message;
-    d.kind = ConflictKind::kFixed;
-    result->conflicts.push_back(d);
-    text += (text.empty() ? "" : "; ") + v.message;
-  }
-  result->summary.message = "infeasible: " + text;
-  result->message_kind = DesignMessageKind::kInfeasible;
-  result->summary.raw_status = 0;
-  result->summary.error_estimate = kNaN;
-}
-
-// The answer when no local solve returned a design.
-void ReportNoDesign(const std::vector<Run>& runs, DesignResult* result) {
-  result->summary.termination = Termination::kFailure;
-  result->summary.message = "no local solve returned a design";
-  result->message_kind = DesignMessageKind::kNoDesign;
-  if (!runs.empty()) {
-    const LocalSolveOutcome& o = runs.front().outcome;
-    result->summary.raw_status = o.raw_status;
-    result->summary.message +=
-        " (" + o.status_name + (o.message.empty() ? "" : ": " + o.message) + ")";
-  }
-  result->summary.error_estimate = kNaN;
-}
-
-// The termination and message from the chosen start, the validity of the bat and its sting.
-void ClassifyChosen(const DesignOptions& options, DesignBackend backend, const Run& chosen,
-                    const PublicEvaluation& pub, const Bat& bat, DesignResult* result) {
-  Refusal bat_why;
-  const bool bat_valid = bat.Validate(&bat_why);
-  const LocalSolveOutcome& o = chosen.outcome;
-  result->summary.raw_status = o.raw_status;
-  result->summary.termination = o.termination;
-  result->summary.message = o.status_name;
-  result->message_kind = DesignMessageKind::kSolver;
-  if (!o.message.empty()) result->summary.message += ": " + o.message;
-  if (o.cancelled) {
-    result->summary.message =
-        "cancelled (" + result->summary.message + "); the best design so far is kept";
-    result->message_kind = DesignMessageKind::kCancelled;
-  }
-  if (o.deadline_reached) {
-    result->message_kind = DesignMessageKind::kTimeBudget;
-    result->summary.message = "time budget max_time_s = " + FormatNumber(options.max_time_s) +
-                              " s reached (" + result->summary.message +
-                              "); the best design so far is kept";
-  }
-  if (o.raw_status == 1 && backend == DesignBackend::kIpopt) {
-    result->summary.warnings.push_back("Ipopt converged to its acceptable (looser) tolerance");
-  }
-  if (!bat_valid) {
-    result->summary.termination = Termination::kFailure;
-    result->summary.message = "the optimised bat is invalid: " + bat_why.Message();
-    result->message_kind = DesignMessageKind::kInvalidBat;
-  }
-  if (pub.sting.has_value()) {
-    const StingEvaluation& st = *pub.sting;
-    for (const std::string& w : st.impact.summary.warnings)
-      result->summary.warnings.push_back("sting: " + w);
-    if (st.ok) {
-      DesignSting d;
-      d.impact_from_knob_m = st.sweet_spot_from_knob_m;
-      d.hands_vibration_energy_j = st.sting_j;
-      d.error_estimate_j = st.impact.error_estimate_hands_energy_j;
-      d.impact = st.impact;
-      result->sting = std::move(d);
-    } else if (result->summary.termination != Termination::kFailure) {
-      result->summary.termination = Termination::kFailure;
-      result->summary.message = "the sting of the optimised bat cannot be computed: " + st.message;
-      result->message_kind = DesignMessageKind::kStingFailed;
-    }
-  }
-  if (pub.distance.has_value()) {  // max_distance
-    const DistanceEvaluation& d = *pub.distance;
-    if (d.ok) {
-      result->distance_sweet_spot = d.result;
-      if (d.result.at_position_bound || d.result.at_undercut_bound) {
-        result->summary.warnings.push_back(
-            std::string("distance_sweet_spot: the farthest carry of the answer is at the edge of "
-                        "the region searched (") +
-            (d.result.at_position_bound ? "position" : "undercut") +
-            "): widen options.distance's ranges to see whether it carries farther beyond");
-      }
-    } else if (result->summary.termination != Termination::kFailure) {
-      result->summary.termination = Termination::kFailure;
-      result->summary.message =
-          "the distance sweet spot of the optimised bat cannot be computed: " + d.message;
-      result->message_kind = DesignMessageKind::kDistanceFailed;
-    }
-  }
-}
-
-// A design that violates a constraint after the re-check: not converged, and infeasible when
-// the solver or the explanation says so (with the conflicts).
-void ClassifyFeasibility(const DesignModel& model, const DesignOptions& options,
-                         Clock::time_point deadline, Progress* progress, const Run& chosen,
-                         double worst, double worst_relative, DesignResult* result) {
-  const LocalSolveOutcome& o = chosen.outcome;
-  const bool feasible = worst_relative <= options.feasibility_tolerance;
-  if (result->summary.termination == Termination::kConverged && !feasible) {
-    result->summary.termination = Termination::kNoConvergence;
-    result->summary.warnings.push_back(
-        "the solver reported convergence but the re-checked design "
-        "violates a constraint by " +
-        FormatNumber(worst));
-  }
-  if (!feasible && result->summary.termination != Termination::kFailure &&
-      result->summary.termination != Termination::kInvalidInput) {
-    // No start reached a feasible design: say why.
-    const bool solver_says_infeasible = result->summary.termination == Termination::kInfeasible;
-    if (options.explain_infeasibility && !o.cancelled) {
-      int evals = 0, iters = 0;
-      result->conflicts = Explain(model, options, deadline, progress, chosen,
-                                  solver_says_infeasible, &evals, &iters);
-      result->summary.evaluations += evals;
-      result->summary.iterations += iters;
-      const bool isolated =
-          !result->conflicts.empty() && std::isfinite(result->conflicts.front().achievable_min);
-      const bool geometric =
-          !result->conflicts.empty() && result->conflicts.front().kind == ConflictKind::kGeometric;
-      if (isolated || geometric || solver_says_infeasible) {
-        result->summary.termination = Termination::kInfeasible;
-      }
-    } else if (solver_says_infeasible) {
-      result->summary.termination = Termination::kInfeasible;
-    }
-    if (result->summary.termination == Termination::kInfeasible) {
-      std::string text;
-      for (const DesignConflict& d : result->conflicts)
-        text += (text.empty() ? "" : "; ") + d.message;
-      result->summary.message = "infeasible: " + (text.empty() ? o.status_name : text) +
-                                "; the least-violating design found is returned";
-      result->message_kind = DesignMessageKind::kInfeasible;
-    }
-  } else if (result->summary.termination == Termination::kConverged) {
-    result->summary.message = "converged (" + o.status_name + ")";
-    result->message_kind = DesignMessageKind::kConverged;
-  }
-}
-
-// A multi-start cut short by Progress::Cancel() (a start stopped mid-solve, or starts not begun)
-// is no_convergence even when its chosen start converged: the starts not run might have found a
-// better design. Infeasible and failure stand (a start that failed, e.g. in Ipopt's restoration
-// phase, may be all that ran), their message saying the run was cut; invalid_input stands as it
-// is. A chosen start that was itself cut is no_convergence already, its message "cancelled (...)".
-void MarkCancelledMultiStart(const DesignOptions& options, const std::vector<Run>& runs,
-                             const Progress* progress, DesignResult* result) {
-  const bool cut =
-      !runs.empty() && (runs.back().outcome.cancelled ||
-                        (IsCancelled(progress) && static_cast<int>(runs.size()) < options.starts));
-  Summary& summary = result->summary;
-  if (!cut || summary.termination == Termination::kInvalidInput) return;
-  if (summary.termination != Termination::kConverged) {
-    if (result->message_kind == DesignMessageKind::kCancelled)
-      return;  // the chosen start's own cut
-    summary.message = "cancelled after " + std::to_string(runs.size()) + " of " +
-                      std::to_string(options.starts) + " starts (the chosen start " +
-                      std::to_string(result->spread.best_start) + ": " + summary.message +
-                      "); the best design so far is kept";
-    result->message_kind = DesignMessageKind::kCancelledStarts;
-    return;
-  }
-  summary.termination = Termination::kNoConvergence;
-  summary.message = "cancelled after " + std::to_string(runs.size()) + " of " +
-                    std::to_string(options.starts) + " starts (the chosen start " +
-                    std::to_string(result->spread.best_start) + ": " + summary.message +
-                    "); the best design so far is kept";
-  result->message_kind = DesignMessageKind::kCancelledStarts;
-}
-
 // The bbcor rule set on a hollow answer, by the public model: a design over its limit is
 // infeasible.
 void CheckBbcorRule(const DesignProblem& problem, const PublicEvaluation& pub,
@@ -384,20 +210,11 @@ void CheckBbcorRule(const DesignProblem& problem, const PublicEvaluation& pub,
   }
 }
 
-// The optimisation, with the progress it reports mapped into [progress_from, progress_to]
-// and an overall deadline (OptimizeOverMaterials shares one budget between materials).
-DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions& options,
-                          Progress* progress, double progress_from, double progress_to,
-                          std::optional<Clock::time_point> shared_deadline,
-                          const design_detail::LocalSolver* solver, const char* solver_name,
-                          design_detail::PreparedModel* prepared) {
-  const Clock::time_point start = Clock::now();
-  const auto elapsed_s = [&start] {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-  };
-  DesignResult result;
-  Summary& summary = result.summary;
-  const DesignBackend backend = MainBackend(problem, options);
+// The summary's backend, models and counts before the solve.
+void StartSummary(const DesignProblem& problem, DesignBackend backend,
+                  const design_detail::LocalSolver* solver, const char* solver_name,
+                  DesignResult* result) {
+  Summary& summary = result->summary;
   summary.backend =
       solver != nullptr && solver_name != nullptr ? solver_name : BackendName(backend);
   summary.models_used = {"mass_properties"};
@@ -411,37 +228,130 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
   }
   if (sting) summary.models_used.push_back("flexible");
   // max_distance: the oblique impact and the flight of every design's distance sweet spot.
-  const bool distance = problem.objective == DesignObjective::kMaxDistance;
-  if (distance) {
+  if (problem.objective == DesignObjective::kMaxDistance) {
     summary.models_used.push_back("oblique_impact");
     summary.models_used.push_back("flight");
   }
-  // The objectives without a derivative (COBYLA whatever was asked).
-  const bool values_only = sting || distance;
-  const char* objective_name = DesignObjectiveName(problem.objective);
   summary.iterations = 0;
   summary.evaluations = 0;
-  result.objective_unit = ObjectiveUnit(problem.objective);
+  result->objective_unit = ObjectiveUnit(problem.objective);
+}
 
+// The model of the request (or the caller's prepared one); false with the refusal in *why.
+bool ModelOf(const DesignProblem& problem, const DesignOptions& options, bool values_only,
+             design_detail::PreparedModel* prepared, DesignModel* model, Refusal* why) {
+  if (!options.Validate(why)) {
+    *why = Prefixed("options.", std::move(*why));
+    return false;
+  }
+  if (values_only && options.derivative_check != DerivativeCheck::kNone) {
+    *why = TextRefusal("options.derivative_check",
+                       std::string("objective = ") + DesignObjectiveName(problem.objective) +
+                           " has no derivatives to check (it is solved derivative-free by COBYLA)");
+    return false;
+  }
+  if (!design_detail::SlsqpSizeAllowed(problem, options, why)) return false;
+  if (prepared != nullptr) {
+    *model = std::move(prepared->model);  // built and merged by the caller (moved from)
+    return true;
+  }
+  return DesignModel::Build(problem, options, model, why);
+}
+
+// Why the objectives without a derivative run COBYLA whatever was asked.
+void WarnDerivativeFree(const DesignProblem& problem, const DesignOptions& options,
+                        Summary* summary) {
+  if (problem.objective == DesignObjective::kMaxDistance &&
+      options.backend != DesignBackend::kNloptCobyla) {
+    summary->warnings.push_back(
+        std::string("objective = max_distance: solved by NLopt LN_COBYLA, not ") +
+        BackendName(options.backend) +
+        ": the carry comes from an adaptive flight integration inside an iterative search over "
+        "the impact point and undercut (piecewise smooth at the 1e-7 m level, no usable "
+        "derivative: docs/optimization.md), so a derivative-free solver is used");
+  }
+  if (problem.objective == DesignObjective::kMinSting &&
+      options.backend != DesignBackend::kNloptCobyla) {
+    summary->warnings.push_back(
+        std::string("objective = min_sting: solved by NLopt LN_COBYLA, not ") +
+        BackendName(options.backend) +
+        ": the sting comes from an adaptive FE mesh and an adaptive ODE integration (piecewise "
+        "smooth, no derivative), so a derivative-free solver is used");
+  }
+}
+
+// The starts, their certificates and the answer: the chosen start's design, re-checked,
+// classified and certified.
+void SolveAndAnswer(const DesignProblem& problem, const DesignOptions& options,
+                    const DesignModel& model, DesignBackend backend, bool cor_known,
+                    Clock::time_point deadline, Progress* progress, double progress_from,
+                    double progress_to, const design_detail::LocalSolver* solver,
+                    DesignResult* result) {
+  Summary& summary = result->summary;
+  std::vector<Run> runs = model.fixed_violations().empty()
+                              ? RunStarts(model, options, backend, deadline, progress,
+                                          progress_from, progress_to, result, solver)
+                              : std::vector<Run>{};
+  design_detail::CertifyRuns(model, options, &runs);
+  FillSpread(runs, &result->spread);
+  // Which formulation Ipopt solved: "lifted_integrals" when the lifted one (lifted_nlp.hpp).
+  if (std::any_of(runs.begin(), runs.end(), [](const Run& r) { return r.outcome.lifted; })) {
+    summary.models_used.push_back("lifted_integrals");
+  }
+
+  // The answer.
+  const int best = ChooseRun(model, runs);
+  result->spread.best_start = best;
+  std::vector<double> x = best >= 0 ? runs[static_cast<std::size_t>(best)].x : model.BaseX();
+  if (best >= 0) design_detail::PolishLeastSquares(model, &x, &summary);  // least squares only
+  const PublicEvaluation pub = AnswerAt(problem, model, x, cor_known, result);
+  // Independent re-check of every constraint (public mass properties).
+  double worst = 0.0, worst_relative = 0.0;
+  RecheckConstraints(model, pub, result->bat, x, &worst, &worst_relative);
+  summary.constraint_violation = worst;
+  if (!model.fixed_violations().empty() || best < 0) {
+    if (!model.fixed_violations().empty()) {
+      ReportFixedViolations(model, result);
+    } else {
+      ReportNoDesign(runs, result);
+    }
+    return;
+  }
+  const Run& chosen = runs[static_cast<std::size_t>(best)];
+  ClassifyChosen(options, backend, chosen, pub, result->bat, result);
+  ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, result);
+  ReportActiveConstraints(model, x,
+                          design_detail::WithCertifiedMultipliers(model, options, x,
+                                                                  chosen.outcome, result, &chosen),
+                          result, options.feasibility_tolerance);
+  // The shape fit (a least-squares objective) reports no multipliers: no warning about them.
+  design_detail::FinishCertificate(chosen, problem.objective != DesignObjective::kLeastSquares,
+                                   result);
+  MarkCancelledMultiStart(options, runs, progress, result);
+  CheckBbcorRule(problem, pub, options.feasibility_tolerance, result);
+}
+
+// The optimisation, with the progress it reports mapped into [progress_from, progress_to]
+// and an overall deadline (OptimizeOverMaterials shares one budget between materials).
+DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions& options,
+                              Progress* progress, double progress_from, double progress_to,
+                              std::optional<Clock::time_point> shared_deadline,
+                              const design_detail::LocalSolver* solver, const char* solver_name,
+                              design_detail::PreparedModel* prepared) {
+  const Clock::time_point start = Clock::now();
+  const auto elapsed_s = [&start] {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  DesignResult result;
+  Summary& summary = result.summary;
+  const DesignBackend backend = MainBackend(problem, options);
+  StartSummary(problem, backend, solver, solver_name, &result);
+  // The objectives without a derivative (COBYLA whatever was asked).
+  const bool values_only = problem.objective == DesignObjective::kMinSting ||
+                           problem.objective == DesignObjective::kMaxDistance;
   Refusal why;
   DesignModel model;
-  bool invalid = false;
-  if (!options.Validate(&why)) {
-    invalid = true;
-    why = Prefixed("options.", std::move(why));
-  } else if (values_only && options.derivative_check != DerivativeCheck::kNone) {
-    invalid = true;
-    why = TextRefusal("options.derivative_check",
-                      std::string("objective = ") + objective_name +
-                          " has no derivatives to check (it is solved derivative-free by COBYLA)");
-  } else if (!design_detail::SlsqpSizeAllowed(problem, options, &why)) {
-    invalid = true;
-  } else if (prepared != nullptr) {
-    model = std::move(prepared->model);  // built and merged by the caller (moved from)
-  } else if (!DesignModel::Build(problem, options, &model, &why)) {
-    invalid = true;
-  }
-  if (invalid) {
+  if (!ModelOf(problem, options, values_only, prepared, &model, &why)) {
     FillBase(problem, &result);
     summary.SetRefusal(std::move(why));
     summary.objective = kNaN;
@@ -452,73 +362,18 @@ DesignResult OptimizeOneRound(const DesignProblem& problem, const DesignOptions&
   }
   // Constraints that repeat another are merged before the solve (certificate.hpp).
   result.merged_constraints = prepared != nullptr
-                                   ? std::move(prepared->merged)
-                                   : design_detail::MergeDuplicateConstraints(&model);
+                                  ? std::move(prepared->merged)
+                                  : design_detail::MergeDuplicateConstraints(&model);
   const bool cor_known =
       problem.cor.has_value() || problem.bat.material.cor.has_value() || model.cor_from_barrel();
   result.cor = cor_known ? model.cor() : kNaN;
-  if (distance && options.backend != DesignBackend::kNloptCobyla) {
-    summary.warnings.push_back(
-        std::string("objective = max_distance: solved by NLopt LN_COBYLA, not ") +
-        BackendName(options.backend) +
-        ": the carry comes from an adaptive flight integration inside an iterative search over "
-        "the impact point and undercut (piecewise smooth at the 1e-7 m level, no usable "
-        "derivative: docs/optimization.md), so a derivative-free solver is used");
-  }
-  if (sting && options.backend != DesignBackend::kNloptCobyla) {
-    summary.warnings.push_back(
-        std::string("objective = min_sting: solved by NLopt LN_COBYLA, not ") +
-        BackendName(options.backend) +
-        ": the sting comes from an adaptive FE mesh and an adaptive ODE integration (piecewise "
-        "smooth, no derivative), so a derivative-free solver is used");
-  }
-
+  WarnDerivativeFree(problem, options, &summary);
   try {
     const Clock::time_point deadline =
         shared_deadline.value_or(start + std::chrono::duration_cast<Clock::duration>(
                                              std::chrono::duration<double>(options.max_time_s)));
-    std::vector<Run> runs = model.fixed_violations().empty()
-                                ? RunStarts(model, options, backend, deadline, progress,
-                                            progress_from, progress_to, &result, solver)
-                                : std::vector<Run>{};
-    design_detail::CertifyRuns(model, options, &runs);
-    FillSpread(runs, &result.spread);
-    // Which formulation Ipopt solved: "lifted_integrals" when the lifted one (lifted_nlp.hpp).
-    if (std::any_of(runs.begin(), runs.end(), [](const Run& r) { return r.outcome.lifted; })) {
-      summary.models_used.push_back("lifted_integrals");
-    }
-
-    // The answer.
-    const int best = ChooseRun(model, runs);
-    result.spread.best_start = best;
-    std::vector<double> x = best >= 0 ? runs[static_cast<std::size_t>(best)].x : model.BaseX();
-    if (best >= 0) design_detail::PolishLeastSquares(model, &x, &summary);  // least squares only
-    const PublicEvaluation pub = AnswerAt(problem, model, x, cor_known, &result);
-    // Independent re-check of every constraint (public mass properties).
-    double worst = 0.0, worst_relative = 0.0;
-    RecheckConstraints(model, pub, result.bat, x, &worst, &worst_relative);
-    summary.constraint_violation = worst;
-    if (!model.fixed_violations().empty() || best < 0) {
-      if (!model.fixed_violations().empty()) {
-        ReportFixedViolations(model, &result);
-      } else {
-        ReportNoDesign(runs, &result);
-      }
-      summary.solve_time_s = elapsed_s();
-      return result;
-    }
-    const Run& chosen = runs[static_cast<std::size_t>(best)];
-    ClassifyChosen(options, backend, chosen, pub, result.bat, &result);
-    ClassifyFeasibility(model, options, deadline, progress, chosen, worst, worst_relative, &result);
-    ReportActiveConstraints(model, x,
-                            design_detail::WithCertifiedMultipliers(
-                                model, options, x, chosen.outcome, &result, &chosen),
-                            &result, options.feasibility_tolerance);
-    // The shape fit (a least-squares objective) reports no multipliers: no warning about them.
-    design_detail::FinishCertificate(
-        chosen, problem.objective != DesignObjective::kLeastSquares, &result);
-    MarkCancelledMultiStart(options, runs, progress, &result);
-    CheckBbcorRule(problem, pub, options.feasibility_tolerance, &result);
+    SolveAndAnswer(problem, options, model, backend, cor_known, deadline, progress,
+                   progress_from, progress_to, solver, &result);
   } catch (const std::bad_alloc&) {
     summary.termination = Termination::kFailure;
     summary.message = "out of memory";

@@ -34,6 +34,9 @@ struct LocalSolveSettings {
   /// Ipopt: solve the lifted formulation (lifted_nlp.hpp, exact sparse Hessian whatever
   /// `hessian` says) when the problem qualifies.
   bool lift = true;
+  /// Ipopt, lifted: with the taper's steps as variables when the knots form one taper chain
+  /// (tapered_nlp.hpp).
+  bool taper_steps = true;
 };
 
 /// The outcome of one local solve (scaled variables and multipliers).

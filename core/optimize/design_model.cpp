@@ -241,6 +241,95 @@ bool DesignModel::EvaluateRows(const double* x, DesignPoint* out) const {
   return EvaluateImpl(x, true, true, out);
 }
 
+bool DesignModel::EvaluateFunction(const DesignFunctionSpec& f, const std::vector<double>& t,
+                                   const design_detail::Integrals& in, double* value,
+                                   double* gradient_row, int stride) const {
+  if (f.function == DesignFunction::kLinear) {
+    double v = f.constant;
+    for (const auto& [idx, k] : f.terms) {
+      v += k * t[static_cast<std::size_t>(idx)];
+      const int j = parameter_variable_[static_cast<std::size_t>(idx)];
+      if (gradient_row != nullptr && j >= 0) {
+        gradient_row[j * stride] += k * parameter_scale_[static_cast<std::size_t>(idx)];
+      }
+    }
+    *value = v;
+    return std::isfinite(v);
+  }
+  if (f.function == DesignFunction::kFirstFrequency) {
+    return FrequencyOf(t, value, gradient_row, stride);
+  }
+  if (f.function == DesignFunction::kBoreBottom) {
+    return BoreBottomOf(t, value, gradient_row, stride);
+  }
+  if (IsWallFunction(f.function)) {
+    return WallFunctionOf(f.function, t, value, gradient_row, stride);
+  }
+  const double* p = in.p.data();
+  if (gradient_row == nullptr) {
+    *value = FunctionOf<double>(f.function, p);
+    return std::isfinite(*value);
+  }
+  using J = jet::Jet<4, false>;
+  std::array<J, 4> pj;
+  for (int c = 0; c < 4; ++c) pj[static_cast<std::size_t>(c)] = J::Variable(p[c], c);
+  const J phi = FunctionOf<J>(f.function, pj.data());
+  *value = phi.v;
+  const int nv = n();
+  for (int j = 0; j < nv; ++j) {
+    double s = 0.0;
+    for (int c = 0; c < 4; ++c) s += phi.g[static_cast<std::size_t>(c)] * in.dp(c, j);
+    gradient_row[j * stride] += s;
+  }
+  return std::isfinite(phi.v);
+}
+
+bool DesignModel::EvaluateConstraintRows(const std::vector<double>& t,
+                                         const design_detail::Integrals& in,
+                                         DesignPoint* out) const {
+  // Each row by its nonzero entries. A linear row sums its terms' coefficients per variable
+  // in the dense path's order from 0 (the same bits); any other row is computed densely
+  // (stride 1) and its nonzeros kept.
+  const int mc = m(), nv = n();
+  out->jacobian_rows.resize(static_cast<std::size_t>(mc));
+  std::vector<double> dense;
+  for (int k = 0; k < mc; ++k) {
+    const DesignFunctionSpec& f = constraints_[static_cast<std::size_t>(k)].f;
+    DesignGradientRow& row = out->jacobian_rows[static_cast<std::size_t>(k)];
+    double& value = out->constraints[static_cast<std::size_t>(k)];
+    if (f.function == DesignFunction::kLinear) {
+      double v = f.constant;
+      for (const auto& [idx, c] : f.terms) {
+        v += c * t[static_cast<std::size_t>(idx)];
+        const int j = parameter_variable_[static_cast<std::size_t>(idx)];
+        if (j < 0) continue;
+        const double d = c * parameter_scale_[static_cast<std::size_t>(idx)];
+        auto it = std::find_if(row.begin(), row.end(),
+                               [j](const std::pair<int, double>& e) { return e.first == j; });
+        if (it == row.end()) {
+          row.push_back({j, 0.0 + d});
+        } else {
+          it->second += d;
+        }
+      }
+      value = v;
+      if (!std::isfinite(v)) return false;
+      std::sort(row.begin(), row.end());
+    } else {
+      dense.assign(static_cast<std::size_t>(nv), 0.0);
+      if (!EvaluateFunction(f, t, in, &value, dense.data(), 1)) return false;
+      for (int j = 0; j < nv; ++j) row.push_back({j, dense[static_cast<std::size_t>(j)]});
+    }
+    std::size_t kept = 0;
+    for (const auto& e : row) {
+      if (!std::isfinite(e.second)) return false;
+      if (e.second != 0.0) row[kept++] = e;
+    }
+    row.resize(kept);
+  }
+  return out->objective_gradient.allFinite();
+}
+
 bool DesignModel::EvaluateImpl(const double* x, bool with_gradients, bool rows,
                                DesignPoint* out) const {
   const std::vector<double> t = ParametersAt(x);
@@ -256,46 +345,6 @@ bool DesignModel::EvaluateImpl(const double* x, bool with_gradients, bool rows,
   out->length_m = p[3];
 
   const int nv = n();
-  auto evaluate = [&](const DesignFunctionSpec& f, double* value, double* gradient_row,
-                      int stride) -> bool {
-    if (f.function == DesignFunction::kLinear) {
-      double v = f.constant;
-      for (const auto& [idx, k] : f.terms) {
-        v += k * t[static_cast<std::size_t>(idx)];
-        const int j = parameter_variable_[static_cast<std::size_t>(idx)];
-        if (gradient_row != nullptr && j >= 0) {
-          gradient_row[j * stride] += k * parameter_scale_[static_cast<std::size_t>(idx)];
-        }
-      }
-      *value = v;
-      return std::isfinite(v);
-    }
-    if (f.function == DesignFunction::kFirstFrequency) {
-      return FrequencyOf(t, value, gradient_row, stride);
-    }
-    if (f.function == DesignFunction::kBoreBottom) {
-      return BoreBottomOf(t, value, gradient_row, stride);
-    }
-    if (IsWallFunction(f.function)) {
-      return WallFunctionOf(f.function, t, value, gradient_row, stride);
-    }
-    if (gradient_row == nullptr) {
-      *value = FunctionOf<double>(f.function, p);
-      return std::isfinite(*value);
-    }
-    using J = jet::Jet<4, false>;
-    std::array<J, 4> pj;
-    for (int c = 0; c < 4; ++c) pj[static_cast<std::size_t>(c)] = J::Variable(p[c], c);
-    const J phi = FunctionOf<J>(f.function, pj.data());
-    *value = phi.v;
-    for (int j = 0; j < nv; ++j) {
-      double s = 0.0;
-      for (int c = 0; c < 4; ++c) s += phi.g[static_cast<std::size_t>(c)] * in.dp(c, j);
-      gradient_row[j * stride] += s;
-    }
-    return std::isfinite(phi.v);
-  };
-
   const int mc = m();
   out->constraints.assign(static_cast<std::size_t>(mc), 0.0);
   out->jacobian_rows.clear();
@@ -313,57 +362,16 @@ bool DesignModel::EvaluateImpl(const double* x, bool with_gradients, bool rows,
                          ? DistanceOf(BatAt(x)).distance_m
                          : StingOf(BatAt(x), false).sting_j;
     if (!std::isfinite(out->objective)) return false;
-  } else if (!evaluate(objective_, &out->objective,
-                       with_gradients ? out->objective_gradient.data() : nullptr, 1)) {
+  } else if (!EvaluateFunction(objective_, t, in, &out->objective,
+                               with_gradients ? out->objective_gradient.data() : nullptr, 1)) {
     return false;
   }
-  if (with_gradients && rows) {
-    // Each row by its nonzero entries. A linear row sums its terms' coefficients per variable
-    // in the dense path's order from 0 (the same bits); any other row is computed densely
-    // (stride 1) and its nonzeros kept.
-    out->jacobian_rows.resize(static_cast<std::size_t>(mc));
-    std::vector<double> dense;
-    for (int k = 0; k < mc; ++k) {
-      const DesignFunctionSpec& f = constraints_[static_cast<std::size_t>(k)].f;
-      DesignGradientRow& row = out->jacobian_rows[static_cast<std::size_t>(k)];
-      double& value = out->constraints[static_cast<std::size_t>(k)];
-      if (f.function == DesignFunction::kLinear) {
-        double v = f.constant;
-        for (const auto& [idx, c] : f.terms) {
-          v += c * t[static_cast<std::size_t>(idx)];
-          const int j = parameter_variable_[static_cast<std::size_t>(idx)];
-          if (j < 0) continue;
-          const double d = c * parameter_scale_[static_cast<std::size_t>(idx)];
-          auto it = std::find_if(row.begin(), row.end(),
-                                 [j](const std::pair<int, double>& e) { return e.first == j; });
-          if (it == row.end()) {
-            row.push_back({j, 0.0 + d});
-          } else {
-            it->second += d;
-          }
-        }
-        value = v;
-        if (!std::isfinite(v)) return false;
-        std::sort(row.begin(), row.end());
-      } else {
-        dense.assign(static_cast<std::size_t>(nv), 0.0);
-        if (!evaluate(f, &value, dense.data(), 1)) return false;
-        for (int j = 0; j < nv; ++j) row.push_back({j, dense[static_cast<std::size_t>(j)]});
-      }
-      std::size_t kept = 0;
-      for (const auto& e : row) {
-        if (!std::isfinite(e.second)) return false;
-        if (e.second != 0.0) row[kept++] = e;
-      }
-      row.resize(kept);
-    }
-    return out->objective_gradient.allFinite();
-  }
+  if (with_gradients && rows) return EvaluateConstraintRows(t, in, out);
   for (int k = 0; k < mc; ++k) {
     // Column-major m x n: row k, stride m between variables.
     double* row = with_gradients ? out->jacobian.data() + k : nullptr;
-    if (!evaluate(constraints_[static_cast<std::size_t>(k)].f,
-                  &out->constraints[static_cast<std::size_t>(k)], row, mc)) {
+    if (!EvaluateFunction(constraints_[static_cast<std::size_t>(k)].f, t, in,
+                          &out->constraints[static_cast<std::size_t>(k)], row, mc)) {
       return false;
     }
   }

@@ -289,6 +289,14 @@ class DesignModel {
   std::vector<double> ParametersAt(const double* x) const;
   // Evaluate and EvaluateRows: with `rows`, the gradients as out->jacobian_rows.
   bool EvaluateImpl(const double* x, bool with_gradients, bool rows, DesignPoint* out) const;
+  // One function (the objective or a constraint) at the parameters t with the integrals `in`:
+  // its value and, when gradient_row is non-null, its gradient added at gradient_row[j * stride].
+  bool EvaluateFunction(const DesignFunctionSpec& f, const std::vector<double>& t,
+                        const design_detail::Integrals& in, double* value, double* gradient_row,
+                        int stride) const;
+  // EvaluateRows's constraints: values and gradients by sparse rows (out->jacobian_rows).
+  bool EvaluateConstraintRows(const std::vector<double>& t, const design_detail::Integrals& in,
+                              DesignPoint* out) const;
   // The frequency at parameters t, Hz, and (when gradient_row) df/dx added into
   // gradient_row[j * stride]; false when it cannot be computed.
   bool FrequencyOf(const std::vector<double>& t, double* value, double* gradient_row,

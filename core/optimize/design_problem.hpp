@@ -339,6 +339,10 @@ struct DesignOptions {
   /// `hessian` says; core/optimize/lifted_nlp.hpp). false: always the dense formulation over
   /// the variables alone.
   bool lift = true;
+  /// With `lift`: when the knot radii form one chain of non-decreasing taper rows, solve with
+  /// the taper's steps as variables in blocks of kTaperBlockSize knots (each step's row becomes
+  /// a bound; core/optimize/tapered_nlp.hpp). false: the lifted formulation over the radii.
+  bool taper_steps = true;
   /// Let the optimiser choose the backend (the api's default when a request names none):
   /// NLopt SLSQP for a problem that qualifies for the lifted formulation with at most
   /// kChosenSlsqpMaxVariables variables, its answer kept only when certified (converged,

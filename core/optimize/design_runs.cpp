@@ -214,6 +214,7 @@ LocalSolveSettings SettingsFrom(const DesignOptions& options, Clock::time_point 
   s.progress = progress;
   s.feasibility_tolerance = options.feasibility_tolerance;
   s.lift = options.lift;
+  s.taper_steps = options.taper_steps;
   return s;
 }
 

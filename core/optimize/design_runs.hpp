@@ -102,4 +102,26 @@ DesignResult Optimize(const DesignProblem& problem, const DesignOptions& options
                       const LocalSolver* solver = nullptr, const char* solver_name = nullptr,
                       PreparedModel* prepared = nullptr);
 
+struct PublicEvaluation;
+
+// The verdict of a solve (design_verdict.cpp).
+/// The answer when a constraint no variable changes is violated: infeasible, with each one.
+void ReportFixedViolations(const DesignModel& model, DesignResult* result);
+/// The answer when no local solve returned a design.
+void ReportNoDesign(const std::vector<Run>& runs, DesignResult* result);
+/// The termination and message from the chosen start (with `backend`), the validity of the
+/// answer's `bat`, its sting and its distance sweet spot (from the public re-check `pub`).
+void ClassifyChosen(const DesignOptions& options, DesignBackend backend, const Run& chosen,
+                    const PublicEvaluation& pub, const Bat& bat, DesignResult* result);
+/// A design that violates a constraint after the re-check (`worst`, its unit; `worst_relative`
+/// of its scale): not converged, and infeasible when the solver or the explanation (run until
+/// `deadline`) says so, with the conflicts.
+void ClassifyFeasibility(const DesignModel& model, const DesignOptions& options,
+                         Clock::time_point deadline, Progress* progress, const Run& chosen,
+                         double worst, double worst_relative, DesignResult* result);
+/// A multi-start cut short by Progress::Cancel(): no_convergence even when its chosen start
+/// converged (infeasible, failure and invalid_input stand, their message saying so).
+void MarkCancelledMultiStart(const DesignOptions& options, const std::vector<Run>& runs,
+                             const Progress* progress, DesignResult* result);
+
 }  // namespace sweetspot::core::design_detail

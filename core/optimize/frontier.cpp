@@ -320,6 +320,104 @@ DesignProblem FrontierProblemAt(const DesignProblem& problem, const FrontierSpec
   return p;
 }
 
+namespace {
+
+// The Pareto front (indices of candidate_index): a point is dominated when another is at least
+// as good on both the value (in the preferred direction) and the objective, and better on one.
+std::vector<int> ParetoFront(DesignObjective objective, bool prefer_smaller,
+                             const std::vector<std::pair<double, double>>& front_candidates,
+                             const std::vector<int>& candidate_index) {
+  std::vector<int> pareto;
+  for (std::size_t i = 0; i < front_candidates.size(); ++i) {
+    bool dominated = false;
+    for (std::size_t j = 0; j < front_candidates.size() && !dominated; ++j) {
+      if (i == j) continue;
+      const double vi = front_candidates[i].first, vj = front_candidates[j].first;
+      const double fi = front_candidates[i].second, fj = front_candidates[j].second;
+      const bool value_ok = prefer_smaller ? vj <= vi : vj >= vi;
+      const bool value_better = prefer_smaller ? vj < vi : vj > vi;
+      const bool f_ok = !Better(objective, fi, fj);
+      const bool f_better = Better(objective, fj, fi);
+      dominated = value_ok && f_ok && (value_better || f_better);
+    }
+    if (!dominated) pareto.push_back(candidate_index[i]);
+  }
+  return pareto;
+}
+
+// The summary's termination and message from the counts.
+void FinishFrontierSummary(std::size_t values, FrontierSummary* out) {
+  const std::string of =
+      std::to_string(out->points) + " of " + std::to_string(values) + " values";
+  if (out->cancelled) {
+    out->summary.termination = Termination::kNoConvergence;
+    out->summary.message = "cancelled after " + of;
+  } else if (out->stopped) {
+    out->summary.termination = Termination::kNoConvergence;
+    out->summary.message = "stopped by the reader after " + of;
+  } else if (out->converged == out->points) {
+    out->summary.termination = Termination::kConverged;
+    out->summary.message = "every value converged (" + of + ", " +
+                           std::to_string(out->restarts) + " warm starts solved again cold)";
+  } else {
+    out->summary.termination = Termination::kNoConvergence;
+    out->summary.message = std::to_string(out->points - out->converged) + " of " +
+                           std::to_string(out->points) + " values did not converge";
+  }
+}
+
+// The frontier's Newton step at `value`: the neighbour's active set (its certificate's
+// multipliers), Newton's method on its KKT conditions from the predicted start
+// (active_set_newton.hpp); `p` is the value's problem with the predicted bat.
+DesignResult NewtonStep(const DesignProblem& problem, const FrontierSpec& spec,
+                        const DesignOptions& options,
+                        const std::optional<FrontierModel>& frontier_model,
+                        const std::vector<FrontierPoint>& solved,
+                        const DesignCertificate& neighbour, const DesignProblem& p,
+                        double value) {
+  const ActiveSetGuess guess =
+      GuessFromMultipliers(neighbour.lambda, neighbour.z_lower, neighbour.z_upper);
+  // With the model built once, the problem keeps its base design (the model's) and the
+  // predicted start is given as the variables' values (the secant through the two
+  // previous answers' variables, as PredictStart moves the bat).
+  std::optional<design_detail::PreparedModel> prepared;
+  std::vector<double> x_start;
+  if (frontier_model.has_value()) {
+    prepared = PreparedAt(*frontier_model, spec, value);
+    x_start = VariablesOf(problem, solved.back().result);
+    if (solved.size() >= 2 && !x_start.empty()) {
+      const FrontierPoint& a = solved[solved.size() - 2];
+      const FrontierPoint& b = solved.back();
+      const std::vector<double> x_before = VariablesOf(problem, a.result);
+      if (x_before.size() == x_start.size() && b.value != a.value) {
+        const double t = (value - b.value) / (b.value - a.value);
+        for (std::size_t j = 0; j < x_start.size(); ++j)
+          x_start[j] += t * (x_start[j] - x_before[j]);
+      }
+    }
+  }
+  const design_detail::LocalSolver newton = [&guess, &x_start](
+                                                ScaledDesignNlp& nlp,
+                                                const std::vector<double>& s0,
+                                                const LocalSolveSettings& settings) {
+    const bool given = x_start.size() == static_cast<std::size_t>(nlp.n());
+    return SolveWithActiveSetNewton(nlp, given ? nlp.ToScaled(x_start) : s0, guess, settings);
+  };
+  DesignOptions step = options;
+  step.choose_backend = false;
+  step.starts = 1;
+  step.derivative_check = DerivativeCheck::kNone;
+  step.explain_infeasibility = false;  // a failed step is solved again below
+  return prepared.has_value()
+                     ? design_detail::Optimize(FrontierProblemAt(problem, spec, value),
+                                               step, nullptr, 0.0, 1.0, std::nullopt, &newton,
+                                               kActiveSetNewtonName, &*prepared)
+                     : design_detail::Optimize(p, step, nullptr, 0.0, 1.0, std::nullopt,
+                                               &newton, kActiveSetNewtonName);
+}
+
+}  // namespace
+
 FrontierSummary OptimizeFrontier(const DesignProblem& problem, const FrontierSpec& spec,
                                  const DesignOptions& options, bool prefer_smaller,
                                  const FrontierSink& sink, Progress* progress) {
@@ -370,45 +468,8 @@ FrontierSummary OptimizeFrontier(const DesignProblem& problem, const FrontierSpe
       if (neighbour != nullptr && neighbour->checked && neighbour->certified) {
         // The Newton step: the neighbour's active set, Newton's method on its KKT conditions
         // from the predicted start (active_set_newton.hpp), kept when certified.
-        const ActiveSetGuess guess =
-            GuessFromMultipliers(neighbour->lambda, neighbour->z_lower, neighbour->z_upper);
-        // With the model built once, the problem keeps its base design (the model's) and the
-        // predicted start is given as the variables' values (the secant through the two
-        // previous answers' variables, as PredictStart moves the bat).
-        std::optional<design_detail::PreparedModel> prepared;
-        std::vector<double> x_start;
-        if (frontier_model.has_value()) {
-          prepared = PreparedAt(*frontier_model, spec, point.value);
-          x_start = VariablesOf(problem, solved.back().result);
-          if (solved.size() >= 2 && !x_start.empty()) {
-            const FrontierPoint& a = solved[solved.size() - 2];
-            const FrontierPoint& b = solved.back();
-            const std::vector<double> x_before = VariablesOf(problem, a.result);
-            if (x_before.size() == x_start.size() && b.value != a.value) {
-              const double t = (point.value - b.value) / (b.value - a.value);
-              for (std::size_t j = 0; j < x_start.size(); ++j)
-                x_start[j] += t * (x_start[j] - x_before[j]);
-            }
-          }
-        }
-        const design_detail::LocalSolver newton = [&guess, &x_start](
-                                                      ScaledDesignNlp& nlp,
-                                                      const std::vector<double>& s0,
-                                                      const LocalSolveSettings& settings) {
-          const bool given = x_start.size() == static_cast<std::size_t>(nlp.n());
-          return SolveWithActiveSetNewton(nlp, given ? nlp.ToScaled(x_start) : s0, guess, settings);
-        };
-        DesignOptions step = options;
-        step.choose_backend = false;
-        step.starts = 1;
-        step.derivative_check = DerivativeCheck::kNone;
-        step.explain_infeasibility = false;  // a failed step is solved again below
-        point.result = prepared.has_value()
-                           ? design_detail::Optimize(FrontierProblemAt(problem, spec, point.value),
-                                                     step, nullptr, 0.0, 1.0, std::nullopt, &newton,
-                                                     kActiveSetNewtonName, &*prepared)
-                           : design_detail::Optimize(p, step, nullptr, 0.0, 1.0, std::nullopt,
-                                                     &newton, kActiveSetNewtonName);
+        point.result = NewtonStep(problem, spec, options, frontier_model, solved, *neighbour, p,
+                                  point.value);
         point.continued = point.result.summary.termination == Termination::kConverged &&
                           point.result.certificate.certified;
         if (!point.continued) count(point.result);
@@ -457,41 +518,10 @@ FrontierSummary OptimizeFrontier(const DesignProblem& problem, const FrontierSpe
         break;
       }
     }
-    // The Pareto front: a point is dominated when another is at least as good on both the value
-    // (in the preferred direction) and the objective, and better on one.
-    for (std::size_t i = 0; i < front_candidates.size(); ++i) {
-      bool dominated = false;
-      for (std::size_t j = 0; j < front_candidates.size() && !dominated; ++j) {
-        if (i == j) continue;
-        const double vi = front_candidates[i].first, vj = front_candidates[j].first;
-        const double fi = front_candidates[i].second, fj = front_candidates[j].second;
-        const bool value_ok = prefer_smaller ? vj <= vi : vj >= vi;
-        const bool value_better = prefer_smaller ? vj < vi : vj > vi;
-        const bool f_ok = !Better(problem.objective, fi, fj);
-        const bool f_better = Better(problem.objective, fj, fi);
-        dominated = value_ok && f_ok && (value_better || f_better);
-      }
-      if (!dominated) out.pareto.push_back(candidate_index[i]);
-    }
+    out.pareto = ParetoFront(problem.objective, prefer_smaller, front_candidates, candidate_index);
     out.summary.iterations = iterations;
     out.summary.evaluations = evaluations;
-    const std::string of = std::to_string(out.points) + " of " +
-                           std::to_string(spec.values.size()) + " values";
-    if (out.cancelled) {
-      out.summary.termination = Termination::kNoConvergence;
-      out.summary.message = "cancelled after " + of;
-    } else if (out.stopped) {
-      out.summary.termination = Termination::kNoConvergence;
-      out.summary.message = "stopped by the reader after " + of;
-    } else if (out.converged == out.points) {
-      out.summary.termination = Termination::kConverged;
-      out.summary.message = "every value converged (" + of + ", " +
-                            std::to_string(out.restarts) + " warm starts solved again cold)";
-    } else {
-      out.summary.termination = Termination::kNoConvergence;
-      out.summary.message = std::to_string(out.points - out.converged) + " of " +
-                            std::to_string(out.points) + " values did not converge";
-    }
+    FinishFrontierSummary(spec.values.size(), &out);
   });
   out.summary.solve_time_s = Seconds(started);
   return out;

@@ -22,6 +22,7 @@
 #include "core/numerics/termination.hpp"
 #include "core/optimize/design_backends.hpp"
 #include "core/optimize/lifted_nlp.hpp"
+#include "core/optimize/tapered_nlp.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -212,6 +213,68 @@ int DerivativeCheckErrors(const std::string& report) {
   return std::atoi(report.c_str() + at + key.size());
 }
 
+// The options of every design solve, and the lifted formulation's (lifted: true); false when
+// Ipopt refused one.
+bool SetIpoptOptions(const LocalSolveSettings& settings, bool lifted,
+                     Ipopt::OptionsList* options) {
+  bool ok = true;
+  ok = ok && options->SetStringValue("sb", "yes");
+  ok = ok && options->SetIntegerValue("print_level", 0);
+  ok = ok && options->SetIntegerValue("max_iter", settings.max_iterations);
+  ok = ok && options->SetNumericValue("tol", settings.tolerance);
+  ok = ok && options->SetNumericValue("constr_viol_tol", settings.constraint_tolerance);
+  ok = ok && options->SetStringValue(
+                 "hessian_approximation",
+                 settings.hessian == HessianMode::kExact || lifted ? "exact" : "limited-memory");
+  ok = ok && options->SetStringValue("mu_strategy", "adaptive");
+  // Less work that is not the solve (bench/ipopt_phases.sh; docs/benchmarks.md, "Ipopt's
+  // overhead"). The probing oracle picks the adaptive barrier parameter from one affine
+  // step; the default quality-function oracle runs a golden-section search per iteration
+  // whose every trial Ipopt 3.11 times with getrusage (three fifths of a 16-knot solve).
+  // MUMPS's workspace is its estimate plus 10 % instead of plus 1000 %: that allocation,
+  // its page faults and its release came every factorisation. When MUMPS needs more, it
+  // says so and Ipopt raises the percentage and factorises again.
+  ok = ok && options->SetStringValue("mu_oracle", "probing");
+  ok = ok && options->SetIntegerValue("mumps_mem_percent", 10);
+  // No relaxation of the bounds: a design at a bound (a variable or a constraint) then meets
+  // it to round-off, not to 1e-8 of its scale (Ipopt's default relaxes both).
+  ok = ok && options->SetNumericValue("bound_relax_factor", 0.0);
+  if (lifted) {
+    // The lifted problem's iterations cost mostly MUMPS's per-call work (its KKT matrix is
+    // banded, ~3n rows; bench/ipopt_phases.sh): no iterative-refinement step unless the
+    // residual asks for one, no MC64/row scaling analysis of a matrix that needs none, and
+    // the start pushed 1e-5 (not 1e-2) into the bounds, which saves an iteration or two, and
+    // no least-squares estimate of the first multipliers (a factorisation of its own; they
+    // start at 0). Together -30 % CPU at 16 to 256 knots (docs/benchmarks.md, issue 36).
+    ok = ok && options->SetIntegerValue("min_refinement_steps", 0);
+    ok = ok && options->SetIntegerValue("mumps_permuting_scaling", 0);
+    ok = ok && options->SetIntegerValue("mumps_scaling", 0);
+    ok = ok && options->SetNumericValue("bound_push", 1e-5);
+    ok = ok && options->SetNumericValue("bound_frac", 1e-5);
+    ok = ok && options->SetNumericValue("constr_mult_init_max", 0.0);
+    // Fewer MUMPS calls: each costs ~1-1.7 M instructions at 64 knots, MUMPS 5.5's own
+    // bookkeeping and per-front work on this ~3n-row banded matrix, not its arithmetic.
+    // The adaptive barrier (set above) factorises once and solves twice per iteration (the
+    // probing oracle's affine step, then the step); the monotone (Fiacco-McCormick) barrier
+    // solves once. Started at mu = 1e-4 (the start is pushed 1e-5 into its bounds, so the
+    // default 0.1 would first pull it back to the centre), each barrier problem solved to
+    // 1000 mu (barrier_tol_factor) and mu cut by 20 (or superlinearly): 12 / 13 / 13
+    // iterations at 64 / 128 / 256 knots against the adaptive barrier's 11 / 12 / 14, with
+    // 2 MUMPS calls each instead of 3, -14 % instructions per solve (callgrind; the optima
+    // agree with SciPy's to 2.5e-10). fast_step_computation: no residual of the step is computed (no
+    // refinement is asked for above), -1 %. docs/benchmarks.md, "Issue 36".
+    ok = ok && options->SetStringValue("mu_strategy", "monotone");
+    ok = ok && options->SetNumericValue("mu_init", 1e-4);
+    ok = ok && options->SetNumericValue("barrier_tol_factor", 1000.0);
+    ok = ok && options->SetNumericValue("mu_linear_decrease_factor", 0.05);
+    ok = ok && options->SetStringValue("fast_step_computation", "yes");
+  }
+  if (settings.max_cpu_time_s > 0.0) {
+    ok = ok && options->SetNumericValue("max_cpu_time", settings.max_cpu_time_s);
+  }
+  return ok;
+}
+
 }  // namespace
 
 LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>& s0,
@@ -221,74 +284,28 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
   // The lifted formulation when the problem qualifies (lifted_nlp.hpp): the sparse exact
   // Hessian of the problem with the mass integrals as variables.
   std::unique_ptr<LiftedDesignNlp> lifted;
+  // With the taper's steps as variables when the knots form one taper chain (tapered_nlp.hpp):
+  // ~n KKT rows instead of ~3n.
+  std::unique_ptr<TaperedLiftedNlp> tapered;
   try {
     if (settings.lift && LiftedDesignNlp::Qualifies(nlp.model(), nullptr)) {
       lifted = std::make_unique<LiftedDesignNlp>(nlp);
+      if (settings.taper_steps) {
+        tapered = std::make_unique<TaperedLiftedNlp>(*lifted, s0, kTaperBlockSize);
+        if (!tapered->ok()) tapered.reset();
+      }
     }
     std::ostringstream journal_text;
     // Held until the application and the TNLP are gone (declared first, destroyed last).
     std::lock_guard<std::mutex> lock(IpoptMutex());
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
     Ipopt::SmartPtr<Ipopt::TNLP> tnlp =
-        lifted ? NewLiftedTnlp(*lifted, s0, settings, &out)
+        tapered  ? NewTaperedTnlp(*tapered, s0, settings, &out)
+        : lifted ? NewLiftedTnlp(*lifted, s0, settings, &out)
                : static_cast<Ipopt::TNLP*>(new DesignTnlp(nlp, s0, settings, &out));
     out.lifted = lifted != nullptr;
     Ipopt::SmartPtr<Ipopt::OptionsList> options = app->Options();
-    bool ok = true;
-    ok = ok && options->SetStringValue("sb", "yes");
-    ok = ok && options->SetIntegerValue("print_level", 0);
-    ok = ok && options->SetIntegerValue("max_iter", settings.max_iterations);
-    ok = ok && options->SetNumericValue("tol", settings.tolerance);
-    ok = ok && options->SetNumericValue("constr_viol_tol", settings.constraint_tolerance);
-    ok = ok && options->SetStringValue(
-                   "hessian_approximation",
-                   settings.hessian == HessianMode::kExact || lifted ? "exact" : "limited-memory");
-    ok = ok && options->SetStringValue("mu_strategy", "adaptive");
-    // Less work that is not the solve (bench/ipopt_phases.sh; docs/benchmarks.md, "Ipopt's
-    // overhead"). The probing oracle picks the adaptive barrier parameter from one affine
-    // step; the default quality-function oracle runs a golden-section search per iteration
-    // whose every trial Ipopt 3.11 times with getrusage (three fifths of a 16-knot solve).
-    // MUMPS's workspace is its estimate plus 10 % instead of plus 1000 %: that allocation,
-    // its page faults and its release came every factorisation. When MUMPS needs more, it
-    // says so and Ipopt raises the percentage and factorises again.
-    ok = ok && options->SetStringValue("mu_oracle", "probing");
-    ok = ok && options->SetIntegerValue("mumps_mem_percent", 10);
-    // No relaxation of the bounds: a design at a bound (a variable or a constraint) then meets
-    // it to round-off, not to 1e-8 of its scale (Ipopt's default relaxes both).
-    ok = ok && options->SetNumericValue("bound_relax_factor", 0.0);
-    if (lifted) {
-      // The lifted problem's iterations cost mostly MUMPS's per-call work (its KKT matrix is
-      // banded, ~3n rows; bench/ipopt_phases.sh): no iterative-refinement step unless the
-      // residual asks for one, no MC64/row scaling analysis of a matrix that needs none, and
-      // the start pushed 1e-5 (not 1e-2) into the bounds, which saves an iteration or two, and
-      // no least-squares estimate of the first multipliers (a factorisation of its own; they
-      // start at 0). Together -30 % CPU at 16 to 256 knots (docs/benchmarks.md, issue 36).
-      ok = ok && options->SetIntegerValue("min_refinement_steps", 0);
-      ok = ok && options->SetIntegerValue("mumps_permuting_scaling", 0);
-      ok = ok && options->SetIntegerValue("mumps_scaling", 0);
-      ok = ok && options->SetNumericValue("bound_push", 1e-5);
-      ok = ok && options->SetNumericValue("bound_frac", 1e-5);
-      ok = ok && options->SetNumericValue("constr_mult_init_max", 0.0);
-      // Fewer MUMPS calls: each costs ~1-1.7 M instructions at 64 knots, MUMPS 5.5's own
-      // bookkeeping and per-front work on this ~3n-row banded matrix, not its arithmetic.
-      // The adaptive barrier (set above) factorises once and solves twice per iteration (the
-      // probing oracle's affine step, then the step); the monotone (Fiacco-McCormick) barrier
-      // solves once. Started at mu = 1e-4 (the start is pushed 1e-5 into its bounds, so the
-      // default 0.1 would first pull it back to the centre), each barrier problem solved to
-      // 1000 mu (barrier_tol_factor) and mu cut by 20 (or superlinearly): 12 / 13 / 13
-      // iterations at 64 / 128 / 256 knots against the adaptive barrier's 11 / 12 / 14, with
-      // 2 MUMPS calls each instead of 3, -14 % instructions per solve (callgrind; the optima
-      // agree with SciPy's to 2.5e-10). fast_step_computation: no residual of the step is computed (no
-      // refinement is asked for above), -1 %. docs/benchmarks.md, "Issue 36".
-      ok = ok && options->SetStringValue("mu_strategy", "monotone");
-      ok = ok && options->SetNumericValue("mu_init", 1e-4);
-      ok = ok && options->SetNumericValue("barrier_tol_factor", 1000.0);
-      ok = ok && options->SetNumericValue("mu_linear_decrease_factor", 0.05);
-      ok = ok && options->SetStringValue("fast_step_computation", "yes");
-    }
-    if (settings.max_cpu_time_s > 0.0) {
-      ok = ok && options->SetNumericValue("max_cpu_time", settings.max_cpu_time_s);
-    }
+    bool ok = SetIpoptOptions(settings, lifted != nullptr, Ipopt::GetRawPtr(options));
     if (settings.derivative_check != DerivativeCheck::kNone) {
       ok = ok && options->SetStringValue("derivative_test",
                                          settings.derivative_check == DerivativeCheck::kSecondOrder

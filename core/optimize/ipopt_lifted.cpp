@@ -8,6 +8,7 @@
 #include <coin/IpTNLP.hpp>
 
 #include "core/optimize/lifted_nlp.hpp"
+#include "core/optimize/tapered_nlp.hpp"
 
 namespace sweetspot::core {
 namespace {
@@ -17,9 +18,20 @@ constexpr double kLiftedIpoptInfinity = 1e20;  // beyond nlp_lower/upper_bound_i
 using Ipopt::Index;
 using Ipopt::Number;
 
+// The design's point of a lifted (z = (s, q)) or tapered (w = (y, q)) point.
+std::vector<double> DesignPointOf(const LiftedDesignNlp& nlp, const double* x) {
+  return std::vector<double>(x, x + nlp.design_variables());
+}
+std::vector<double> DesignPointOf(const TaperedLiftedNlp& nlp, const double* x) {
+  std::vector<double> z = nlp.LiftedPoint(x);
+  z.resize(static_cast<std::size_t>(nlp.design_variables()));
+  return z;
+}
+
+template <class Nlp>
 class LiftedTnlp : public Ipopt::TNLP {
  public:
-  LiftedTnlp(LiftedDesignNlp& nlp, const std::vector<double>& s0,
+  LiftedTnlp(Nlp& nlp, const std::vector<double>& s0,
              const LocalSolveSettings& settings, LocalSolveOutcome* out)
       : nlp_(nlp), s0_(s0), settings_(settings), out_(out) {}
 
@@ -138,7 +150,7 @@ class LiftedTnlp : public Ipopt::TNLP {
     if (x == nullptr) return;
     // The design's part: s, its bounds' multipliers and the model's constraints' (the first
     // rows, scaled as the dense problem's); q and the definitions' multipliers are dropped.
-    out_->s.assign(x, x + nlp_.design_variables());
+    out_->s = DesignPointOf(nlp_, x);
     out_->has_point = true;
     if (z_L != nullptr && z_U != nullptr && lambda != nullptr) {
       nlp_.DesignMultipliers(z_L, z_U, lambda, &out_->lambda, &out_->z_lower, &out_->z_upper);
@@ -156,7 +168,7 @@ class LiftedTnlp : public Ipopt::TNLP {
   }
 
  private:
-  LiftedDesignNlp& nlp_;
+  Nlp& nlp_;
   std::vector<double> s0_;
   const LocalSolveSettings& settings_;
   LocalSolveOutcome* out_;
@@ -166,7 +178,12 @@ class LiftedTnlp : public Ipopt::TNLP {
 
 Ipopt::TNLP* NewLiftedTnlp(LiftedDesignNlp& nlp, const std::vector<double>& s0,
                            const LocalSolveSettings& settings, LocalSolveOutcome* out) {
-  return new LiftedTnlp(nlp, s0, settings, out);
+  return new LiftedTnlp<LiftedDesignNlp>(nlp, s0, settings, out);
+}
+
+Ipopt::TNLP* NewTaperedTnlp(TaperedLiftedNlp& nlp, const std::vector<double>& s0,
+                            const LocalSolveSettings& settings, LocalSolveOutcome* out) {
+  return new LiftedTnlp<TaperedLiftedNlp>(nlp, s0, settings, out);
 }
 
 }  // namespace sweetspot::core

@@ -56,7 +56,14 @@ LiftedDesignNlp::LiftedDesignNlp(const ScaledDesignNlp& nlp)
   const double mass = std::isfinite(in.p[0]) && in.p[0] > 0.0 ? in.p[0] : 1.0;
   const double length = std::isfinite(in.p[3]) && in.p[3] > 0.0 ? in.p[3] : 1.0;
   sigma_ = {mass, mass * length, mass * length * length};
+  const std::vector<std::map<int, double>> linear_rows = RowsToBounds(x0, t0);
+  BuildJacobianStructure(linear_rows);
+  SetLinearObjective();
+  BuildHessianStructure(t0);
+}
 
+std::vector<std::map<int, double>> LiftedDesignNlp::RowsToBounds(const std::vector<double>& x0,
+                                                                 const std::vector<double>& t0) {
   // A linear constraint of one variable s_j (g / scale = b + a s_j: a per-knot diameter limit)
   // becomes a bound on s_j (equalities stay rows); every other row is kept.
   const std::vector<int>& pvar = model_.parameter_variable_;
@@ -117,9 +124,13 @@ LiftedDesignNlp::LiftedDesignNlp(const ScaledDesignNlp& nlp)
     lower_row_.assign(static_cast<std::size_t>(nx_), -1);
     upper_row_.assign(static_cast<std::size_t>(nx_), -1);
   }
+  return linear_rows;
+}
 
-  // The Jacobian: the kept rows (linear: the variables of their terms, constant values;
-  // functions of P: q's three columns), then the definitions (q_c, and every variable).
+// The Jacobian: the kept rows (linear: the variables of their terms, constant values;
+// functions of P: q's three columns), then the definitions (q_c, and every variable).
+void LiftedDesignNlp::BuildJacobianStructure(
+    const std::vector<std::map<int, double>>& linear_rows) {
   for (std::size_t r = 0; r < kept_.size(); ++r) {
     const int k = kept_[r];
     const DesignConstraintSpec& c = model_.constraints()[static_cast<std::size_t>(k)];
@@ -148,8 +159,12 @@ LiftedDesignNlp::LiftedDesignNlp(const ScaledDesignNlp& nlp)
   }
   row_start_.push_back(static_cast<int>(jac_.size()));
   jac_values_.assign(jac_.size(), 0.0);
+}
 
-  // A linear objective's constant gradient.
+// A linear objective's constant gradient.
+void LiftedDesignNlp::SetLinearObjective() {
+  const std::vector<int>& pvar = model_.parameter_variable_;
+  const std::vector<double>& pscale = model_.parameter_scale_;
   objective_linear_.assign(static_cast<std::size_t>(nx_), 0.0);
   if (model_.objective().function == DesignFunction::kLinear) {
     const double fs = (model_.maximize() ? -1.0 : 1.0) / model_.objective_scale();
@@ -160,7 +175,9 @@ LiftedDesignNlp::LiftedDesignNlp(const ScaledDesignNlp& nlp)
           fs * coef * pscale[static_cast<std::size_t>(idx)] * width_[static_cast<std::size_t>(j)];
     }
   }
+}
 
+void LiftedDesignNlp::BuildHessianStructure(const std::vector<double>& t0) {
   // The Hessian's lower triangle: the pairs of variables the integrals couple (visited at the
   // base design; the structure does not depend on the point), then q's 3 x 3 block.
   std::set<std::pair<int, int>> pairs;

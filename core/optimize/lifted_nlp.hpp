@@ -19,6 +19,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -85,6 +86,17 @@ class LiftedDesignNlp {
   int evaluations() const { return evaluations_; }  ///< Evaluations of P(x) so far.
 
  private:
+  // The constructor's steps. A linear row of one variable (a per-knot diameter limit) becomes
+  // a bound on it (s_lower_/s_upper_, *_row_, *_coef_), the other rows are kept (kept_); returns
+  // every linear row's coefficients over the scaled variables (x0, t0: the base design).
+  std::vector<std::map<int, double>> RowsToBounds(const std::vector<double>& x0,
+                                                  const std::vector<double>& t0);
+  // The Jacobian's structure and its linear rows' constant values.
+  void BuildJacobianStructure(const std::vector<std::map<int, double>>& linear_rows);
+  // A linear objective's constant gradient (objective_linear_).
+  void SetLinearObjective();
+  // The Hessian's structure (at the base design's parameters t0) and its row index.
+  void BuildHessianStructure(const std::vector<double>& t0);
   // A function's value, gradient over P (4) and Hessian (4 x 4) at t, P; the linear ones'
   // gradient is constant (linear_rows_); false when not finite.
   bool FunctionAt(const DesignFunctionSpec& f, const std::vector<double>& t, const double* p,
