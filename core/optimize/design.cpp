@@ -294,9 +294,13 @@ void SolveAndAnswer(const DesignProblem& problem, const DesignOptions& options,
                               : std::vector<Run>{};
   design_detail::CertifyRuns(model, options, &runs);
   FillSpread(runs, &result->spread);
-  // Which formulation Ipopt solved: "lifted_integrals" when the lifted one (lifted_nlp.hpp).
+  // Which formulation Ipopt solved: "lifted_integrals" when the lifted one (lifted_nlp.hpp),
   if (std::any_of(runs.begin(), runs.end(), [](const Run& r) { return r.outcome.lifted; })) {
     summary.models_used.push_back("lifted_integrals");
+  }
+  // ... and "taper_steps" when with the taper's steps as its variables (tapered_nlp.hpp).
+  if (std::any_of(runs.begin(), runs.end(), [](const Run& r) { return r.outcome.taper_steps; })) {
+    summary.models_used.push_back("taper_steps");
   }
 
   // The answer.

@@ -58,6 +58,7 @@ struct LocalSolveOutcome {
   int derivative_check_errors = -1;     ///< Ipopt's checker: errors found (-1 = not run).
   std::string derivative_check_report;  ///< Ipopt's checker: its output.
   bool lifted = false;                  ///< Ipopt solved the lifted formulation (lifted_nlp.hpp).
+  bool taper_steps = false;  ///< ... with the taper's steps as variables (tapered_nlp.hpp).
   /// The certificate CertifyRuns computed for this run (without the uniqueness check) and the
   /// point it was computed at (user units; empty: none), so that the answer's certificate at the
   /// same point reuses its multipliers instead of fitting them again (certificate_runs.cpp).

@@ -304,6 +304,7 @@ LocalSolveOutcome SolveWithIpopt(ScaledDesignNlp& nlp, const std::vector<double>
         : lifted ? NewLiftedTnlp(*lifted, s0, settings, &out)
                : static_cast<Ipopt::TNLP*>(new DesignTnlp(nlp, s0, settings, &out));
     out.lifted = lifted != nullptr;
+    out.taper_steps = tapered != nullptr;
     Ipopt::SmartPtr<Ipopt::OptionsList> options = app->Options();
     bool ok = SetIpoptOptions(settings, lifted != nullptr, Ipopt::GetRawPtr(options));
     if (settings.derivative_check != DerivativeCheck::kNone) {

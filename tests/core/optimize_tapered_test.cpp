@@ -192,6 +192,14 @@ void ExpectSameOptimum(const DesignProblem& p) {
   // agree to that, relative (22.8 m/s).
   EXPECT_NEAR(a.objective_value, b.objective_value, 1e-9 * std::abs(b.objective_value));
   EXPECT_LT(a.summary.error_estimate, 1e-7);
+  // The answer says which formulation Ipopt solved (summary.models_used).
+  const auto uses = [](const DesignResult& r, const char* name) {
+    return std::find(r.summary.models_used.begin(), r.summary.models_used.end(), name) !=
+           r.summary.models_used.end();
+  };
+  EXPECT_TRUE(uses(a, "lifted_integrals") && uses(a, "taper_steps"));
+  EXPECT_TRUE(uses(b, "lifted_integrals"));
+  EXPECT_FALSE(uses(b, "taper_steps"));
 }
 
 TEST(OptimizeTapered, SameOptimumAsTheRadiiAtSixtyFourKnots) { ExpectSameOptimum(KnotProblem(64)); }
