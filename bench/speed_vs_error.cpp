@@ -1036,6 +1036,11 @@ void DesignRowsAt(int knots, const TimingOptions& timing, bool quick, Report* re
     run(o, "ipopt, lifted (exact sparse Hessian), tolerance " + Tol(tol), false);
   }
   if (quick) return;
+  core::DesignOptions radii;  // the lifted formulation over the radii, not the taper's steps
+  radii.taper_steps = false;
+  run(radii, "ipopt, lifted over the knot radii (no taper steps), tolerance " +
+                 Tol(radii.tolerance),
+      false);
   core::DesignOptions dense;
   dense.lift = false;
   run(dense, "ipopt, dense, limited-memory Hessian, tolerance " + Tol(dense.tolerance), false);
@@ -1330,6 +1335,7 @@ std::string HowToChoose(const Report& report) {
         FindRow(report, name, "ipopt, lifted (exact sparse Hessian), tolerance " + tol);
     const Row* d_loose =
         FindRow(report, name, "ipopt, lifted (exact sparse Hessian), tolerance 1e-03");
+    const Row* d_radii = FindRow(report, name, "ipopt, lifted over the knot radii");
     const Row* d_dense = FindRow(report, name, "ipopt, dense, limited-memory Hessian");
     if (d_auto == nullptr) continue;  // Not run (--quick runs 16 knots only).
     auto distance = [](const Row* r) -> std::string {
@@ -1345,7 +1351,9 @@ std::string HowToChoose(const Report& report) {
        << "optimum's objective, its design " << distance(d_auto) << " from it; Ipopt on the "
        << "lifted formulation " << TimeOf(d_lifted) << " (" << ErrorOf(d_lifted) << ", "
        << distance(d_lifted) << "), at tolerance 1e-3 " << TimeOf(d_loose) << " ("
-       << ErrorOf(d_loose) << ", " << distance(d_loose) << "); the dense formulation with its "
+       << ErrorOf(d_loose) << ", " << distance(d_loose) << "); over the knot radii instead of "
+       << "the taper's steps " << TimeOf(d_radii) << " (" << ErrorOf(d_radii) << ", "
+       << distance(d_radii) << "); the dense formulation with its "
        << "limited-memory Hessian " << TimeOf(d_dense) << " (" << ErrorOf(d_dense) << ", "
        << distance(d_dense) << ").\n";
   }
