@@ -18,6 +18,7 @@
 #include "core/optimize/design_problem.hpp"
 #include "core/units.hpp"
 #include "tests/core/knot_design_problems.hpp"
+#include "tests/core/nlp_derivative_check.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -71,62 +72,11 @@ TEST(OptimizeLifted, DerivativesMatchCentralDifferences) {
   }
   std::vector<double> lambda(static_cast<std::size_t>(m));
   for (double& l : lambda) l = u(rng);
-  const double sigma_f = 0.7;
-  ASSERT_TRUE(nlp.Evaluate(z.data(), true));
-  const std::vector<double> grad = nlp.grad_f();
-  const std::vector<double> jac = nlp.jacobian_values();
-  std::vector<double> hess(nlp.hessian_structure().size());
-  ASSERT_TRUE(nlp.Hessian(z.data(), sigma_f, lambda.data(), hess.data()));
-  // Dense copies of the Jacobian and the Hessian (lower triangle mirrored).
-  std::vector<std::vector<double>> jd(static_cast<std::size_t>(m), std::vector<double>(n, 0.0));
-  for (std::size_t e = 0; e < jac.size(); ++e) {
-    const auto [r, c] = nlp.jacobian_structure()[e];
-    jd[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] += jac[e];
-  }
-  std::vector<std::vector<double>> hd(static_cast<std::size_t>(n), std::vector<double>(n, 0.0));
-  for (std::size_t e = 0; e < hess.size(); ++e) {
-    const auto [r, c] = nlp.hessian_structure()[e];
-    hd[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] += hess[e];
-    if (r != c) hd[static_cast<std::size_t>(c)][static_cast<std::size_t>(r)] += hess[e];
-  }
-  // The Lagrangian's gradient sigma_f grad f + J^T lambda at a point.
-  auto lagrangian_gradient = [&](const std::vector<double>& at) {
-    EXPECT_TRUE(nlp.Evaluate(at.data(), true));
-    std::vector<double> out(static_cast<std::size_t>(n));
-    for (int j = 0; j < n; ++j) out[static_cast<std::size_t>(j)] = sigma_f * nlp.grad_f()[static_cast<std::size_t>(j)];
-    for (std::size_t e = 0; e < nlp.jacobian_values().size(); ++e) {
-      const auto [r, c] = nlp.jacobian_structure()[e];
-      out[static_cast<std::size_t>(c)] += lambda[static_cast<std::size_t>(r)] * nlp.jacobian_values()[e];
-    }
-    return out;
-  };
   // Step 1e-6 on variables of order 1 (s in [0, 1], q ~ 1): truncation ~h^2 |f'''| ~ 1e-12 and
   // round-off ~1e-16 / 1e-6 = 1e-10 of the values (order 1): 1e-6 absolute is 1e4 times both,
   // and far below a wrong derivative (an entry off by a factor or a sign: >= 1e-3 here).
-  const double h = 1e-6, tol = 1e-6;
-  for (int j = 0; j < n; ++j) {
-    std::vector<double> plus = z, minus = z;
-    plus[static_cast<std::size_t>(j)] += h;
-    minus[static_cast<std::size_t>(j)] -= h;
-    ASSERT_TRUE(nlp.Evaluate(plus.data(), false));
-    const double f_plus = nlp.f();
-    const std::vector<double> g_plus = nlp.g();
-    ASSERT_TRUE(nlp.Evaluate(minus.data(), false));
-    const double f_minus = nlp.f();
-    const std::vector<double> g_minus = nlp.g();
-    EXPECT_NEAR(grad[static_cast<std::size_t>(j)], (f_plus - f_minus) / (2 * h), tol) << "df/dz" << j;
-    for (int k = 0; k < m; ++k) {
-      EXPECT_NEAR(jd[static_cast<std::size_t>(k)][static_cast<std::size_t>(j)],
-                  (g_plus[static_cast<std::size_t>(k)] - g_minus[static_cast<std::size_t>(k)]) / (2 * h), tol)
-          << "dg" << k << "/dz" << j;
-    }
-    const std::vector<double> lp = lagrangian_gradient(plus), lm = lagrangian_gradient(minus);
-    for (int i = 0; i < n; ++i) {
-      EXPECT_NEAR(hd[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)],
-                  (lp[static_cast<std::size_t>(i)] - lm[static_cast<std::size_t>(i)]) / (2 * h), tol)
-          << "H(" << i << ", " << j << ")";
-    }
-  }
+  nlp_derivative_check::ExpectDerivativesMatchCentralDifferences(nlp, z, lambda, 0.7, 1e-6, 1e-6,
+                                                                 0.0);
 }
 
 // The lifted and the dense formulation (exact Hessian) reach the same optimum.

@@ -19,6 +19,7 @@
 #include "core/optimize/design_model.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "tests/core/knot_design_problems.hpp"
+#include "tests/core/nlp_derivative_check.hpp"
 
 namespace sweetspot::core {
 // In a namespace of its own: the test programs are unity builds (cmake/BuildSpeed.cmake).
@@ -67,7 +68,7 @@ TEST(OptimizeTapered, DerivativesMatchCentralDifferences) {
   LiftedDesignNlp lifted(dense);
   TaperedLiftedNlp nlp(lifted, dense.ToScaled(model.BaseX()), kTaperBlockSize);
   ASSERT_TRUE(nlp.ok());
-  const int n = nlp.n(), m = nlp.m();
+  const int m = nlp.m();
   std::vector<double> w;
   ASSERT_TRUE(nlp.Start(dense.ToScaled(model.BaseX()), &w));
   std::mt19937_64 rng(11);
@@ -76,67 +77,12 @@ TEST(OptimizeTapered, DerivativesMatchCentralDifferences) {
   for (double& v : w) v += 1e-3 * u(rng);
   std::vector<double> lambda(static_cast<std::size_t>(m));
   for (double& l : lambda) l = u(rng);
-  const double sigma_f = 0.7;
-  ASSERT_TRUE(nlp.Evaluate(w.data(), true));
-  const std::vector<double> grad = nlp.grad_f();
-  const std::vector<double> jac = nlp.jacobian_values();
-  std::vector<double> hess(nlp.hessian_structure().size());
-  ASSERT_TRUE(nlp.Hessian(w.data(), sigma_f, lambda.data(), hess.data()));
-  std::vector<std::vector<double>> jd(static_cast<std::size_t>(m), std::vector<double>(n, 0.0));
-  for (std::size_t e = 0; e < jac.size(); ++e) {
-    const auto [r, c] = nlp.jacobian_structure()[e];
-    jd[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] += jac[e];
-  }
-  std::vector<std::vector<double>> hd(static_cast<std::size_t>(n), std::vector<double>(n, 0.0));
-  for (std::size_t e = 0; e < hess.size(); ++e) {
-    const auto [r, c] = nlp.hessian_structure()[e];
-    hd[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] += hess[e];
-    if (r != c) hd[static_cast<std::size_t>(c)][static_cast<std::size_t>(r)] += hess[e];
-  }
-  auto lagrangian_gradient = [&](const std::vector<double>& at) {
-    EXPECT_TRUE(nlp.Evaluate(at.data(), true));
-    std::vector<double> out(static_cast<std::size_t>(n));
-    for (int j = 0; j < n; ++j)
-      out[static_cast<std::size_t>(j)] = sigma_f * nlp.grad_f()[static_cast<std::size_t>(j)];
-    for (std::size_t e = 0; e < nlp.jacobian_values().size(); ++e) {
-      const auto [r, c] = nlp.jacobian_structure()[e];
-      out[static_cast<std::size_t>(c)] +=
-          lambda[static_cast<std::size_t>(r)] * nlp.jacobian_values()[e];
-    }
-    return out;
-  };
   // Step 1e-6 on variables of order 1e-3..1 (steps, heads in [0, 1], q ~ 1), values of order 1
   // and derivatives up to ~1e2 (a head's s moves its whole block): truncation ~h^2 |f'''| and
   // round-off ~1e-16 / 1e-6 of the values are ~1e-10; 1e-6 absolute plus 1e-6 relative is far
   // above both and far below a wrong entry (off by a factor or a sign).
-  const double h = 1e-6;
-  const auto tol = [](double v) { return 1e-6 + 1e-6 * std::abs(v); };
-  for (int j = 0; j < n; ++j) {
-    std::vector<double> plus = w, minus = w;
-    plus[static_cast<std::size_t>(j)] += h;
-    minus[static_cast<std::size_t>(j)] -= h;
-    ASSERT_TRUE(nlp.Evaluate(plus.data(), false));
-    const double f_plus = nlp.f();
-    const std::vector<double> g_plus = nlp.g();
-    ASSERT_TRUE(nlp.Evaluate(minus.data(), false));
-    const double f_minus = nlp.f();
-    const std::vector<double> g_minus = nlp.g();
-    const double df = (f_plus - f_minus) / (2 * h);
-    EXPECT_NEAR(grad[static_cast<std::size_t>(j)], df, tol(df)) << "df/dw" << j;
-    for (int k = 0; k < m; ++k) {
-      const double dg =
-          (g_plus[static_cast<std::size_t>(k)] - g_minus[static_cast<std::size_t>(k)]) / (2 * h);
-      EXPECT_NEAR(jd[static_cast<std::size_t>(k)][static_cast<std::size_t>(j)], dg, tol(dg))
-          << "dg" << k << "/dw" << j;
-    }
-    const std::vector<double> lp = lagrangian_gradient(plus), lm = lagrangian_gradient(minus);
-    for (int i = 0; i < n; ++i) {
-      const double dh =
-          (lp[static_cast<std::size_t>(i)] - lm[static_cast<std::size_t>(i)]) / (2 * h);
-      EXPECT_NEAR(hd[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)], dh, tol(dh))
-          << "H(" << i << ", " << j << ")";
-    }
-  }
+  nlp_derivative_check::ExpectDerivativesMatchCentralDifferences(nlp, w, lambda, 0.7, 1e-6, 1e-6,
+                                                                 1e-6);
 }
 
 // Ipopt on the steps: its multipliers, mapped back (steps' bounds to taper rows, heads' bounds
