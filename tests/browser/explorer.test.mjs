@@ -97,6 +97,20 @@ scenario('opens at game conditions: a real bat, mlb at 90 mph, 70 mph bat speed,
     Number(await page.locator('#properties tr[data-key="mass_kg"] td[data-imperial]').getAttribute('data-imperial')),
     properties.body.imperial.weight_oz,
   );
+  // The bending modes in inches too: the axis, the nodes' text in the API's inch twins, and each
+  // node's dot at the API's position (its metres kept in data-position-m).
+  const modes = await apiPost(url, '/v1/bat/modes', { bat, modes: 2, shape_samples: 81, report_units: 'imperial' });
+  assert.equal(modes.status, 200, JSON.stringify(modes.body));
+  assert.equal(await page.locator('#modes-chart').getAttribute('data-x-unit'), 'in');
+  const first = modes.body.modes[0];
+  assert.match(
+    await page.locator('#modes-about').textContent(),
+    new RegExp(`nodes at ${first.nodes_from_knob_in.map((x) => Number(x.toPrecision(3))).join(', ')} in`),
+  );
+  assert.equal(
+    Number(await page.locator('#modes-chart .u-node[data-mode="1"]').first().getAttribute('data-position-m')),
+    first.nodes_from_knob_m[0],
+  );
   // The flight from the side: /v1/flight at the batted ball's launch, as the test asks it.
   const bb = sweet.body.batted_ball;
   const flight = await apiPost(url, '/v1/flight', {
@@ -300,6 +314,11 @@ scenario('load the page: bat, properties, curve with markers, modes, variants', 
     modes.body.modes.map((m) => m.frequency_hz).join(','),
   );
   assert.equal(await page.locator('#modes-chart .u-legend .u-series').count(), 3); // x + 2 modes
+  assert.equal(await page.locator('#modes-chart').getAttribute('data-x-unit'), 'm');
+  assert.equal(
+    Number(await page.locator('#modes-chart .u-node[data-mode="1"]').first().getAttribute('data-position-m')),
+    modes.body.modes[0].nodes_from_knob_m[0],
+  );
 
   // The variants: the paper's cork at 260 and 320 kg/m3, hollow aluminium, side by side.
   await page.waitForSelector('#compare-table[data-variants]');

@@ -153,16 +153,27 @@ export class ModesChart extends Chart {
     this.nodes = [];
   }
 
-  /** `modes`: the API's modes[] (with shape[] and nodes_from_knob_m). */
-  update(modes) {
-    const xs = modes[0].shape.map((p) => p.position_from_knob_m);
-    const sameX = modes.every(
-      (m) => m.shape.length === xs.length && m.shape.every((p, i) => p.position_from_knob_m === xs[i]),
-    );
+  /**
+   * `modes`: the API's modes[] (with shape[] and nodes_from_knob_m). `axes.x`: the key of a
+   * shape point's position shown ("position_from_knob_m" or, with report_units imperial, "..._in"),
+   * `axes.nodes` the nodes' key in the same unit, `axes.xLabel` the axis label. Each node keeps its
+   * position in metres in data-position-m (the API's number, for the tests).
+   */
+  update(modes, axes = {}) {
+    const { x = 'position_from_knob_m', nodes = 'nodes_from_knob_m' } = axes;
+    this.xLabel = axes.xLabel || 'position from the knob (m)';
+    const xs = modes[0].shape.map((p) => p[x]);
+    const sameX = modes.every((m) => m.shape.length === xs.length && m.shape.every((p, i) => p[x] === xs[i]));
     const data = sameX
       ? [xs, ...modes.map((m) => m.shape.map((p) => p.displacement))]
-      : uPlot.join(modes.map((m) => [m.shape.map((p) => p.position_from_knob_m), m.shape.map((p) => p.displacement)]));
-    this.nodes = modes.map((m, i) => ({ mode: m.mode, color: PALETTE[i + 1], nodes: m.nodes_from_knob_m || [] }));
+      : uPlot.join(modes.map((m) => [m.shape.map((p) => p[x]), m.shape.map((p) => p.displacement)]));
+    this.unit = x.endsWith('_in') ? 'in' : 'm';
+    this.container.dataset.xUnit = this.unit; // the axis's unit (its label is drawn, not text)
+    this.nodes = modes.map((m, i) => ({
+      mode: m.mode,
+      color: PALETTE[i + 1],
+      nodes: (m[nodes] || []).map((at, k) => ({ at, m: (m.nodes_from_knob_m || [])[k] })),
+    }));
     this.show(
       data,
       modes.map((m, i) => ({ label: `mode ${m.mode}: ${m.frequency_hz.toFixed(1)} Hz`, stroke: PALETTE[i + 1] })),
@@ -174,15 +185,15 @@ export class ModesChart extends Chart {
     if (!u) return;
     for (const old of u.over.querySelectorAll('.u-node')) old.remove();
     for (const { mode, color, nodes } of this.nodes) {
-      for (const x of nodes) {
+      for (const { at, m } of nodes) {
         const dot = document.createElement('div');
         dot.className = 'u-node';
-        dot.style.left = `${u.valToPos(x, 'x')}px`;
+        dot.style.left = `${u.valToPos(at, 'x')}px`;
         dot.style.top = `${u.valToPos(0, 'y')}px`;
         dot.style.borderColor = color;
         dot.dataset.mode = String(mode);
-        dot.dataset.positionM = String(x);
-        dot.title = `mode ${mode} node at ${x.toFixed(4)} m`;
+        dot.dataset.positionM = String(m);
+        dot.title = `mode ${mode} node at ${at.toFixed(this.unit === 'in' ? 2 : 4)} ${this.unit}`;
         u.over.append(dot);
       }
     }

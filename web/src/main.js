@@ -265,11 +265,17 @@ function renderHeadline(sweet, scene) {
 }
 
 function renderModes(modes) {
-  page.modes.update(modes.modes);
+  const imperial = page.units === 'imperial';
+  const nodes = imperial ? 'nodes_from_knob_in' : 'nodes_from_knob_m';
+  page.modes.update(modes.modes, {
+    x: imperial ? 'position_from_knob_in' : 'position_from_knob_m',
+    nodes,
+    xLabel: `position from the knob (${u('position_from_knob_m')})`,
+  });
   $('#modes-about').textContent = modes.modes
     .map(
       (m) =>
-        `Mode ${m.mode}: ${fmt(m.frequency_hz, 4)} Hz, nodes at ${m.nodes_from_knob_m.map((x) => fmt(x, 3)).join(', ')} m`,
+        `Mode ${m.mode}: ${fmt(m.frequency_hz, 4)} Hz, nodes at ${(m[nodes] || []).map((x) => fmt(x, 3)).join(', ')} ${u('position_from_knob_m')}`,
     )
     .join('. ');
   $('#modes-chart').dataset.frequenciesHz = modes.modes.map((m) => m.frequency_hz).join(',');
@@ -293,7 +299,7 @@ async function refreshBat() {
       options: { curve_samples: CURVE_SAMPLES },
       report_units: page.units,
     }),
-    api.post('/v1/bat/modes', { bat, modes: 2, shape_samples: 81 }),
+    api.post('/v1/bat/modes', { bat, modes: 2, shape_samples: 81, report_units: page.units }),
   ]);
   if (seq !== page.refreshSeq) return; // A newer edit has its own requests.
   clearErrors(form);
