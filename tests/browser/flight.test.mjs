@@ -195,6 +195,30 @@ scenario('the carry map: a heat map equal to carry_map, the distance sweet spot,
   // (it is the search's optimum; 0.1 ft: the flights' default tolerance, docs/api.md).
   assert.ok(spot.distance_ft >= map.best.distance_ft - 0.1);
   assert.match(await page.locator('#carry-about').textContent(), new RegExp(`${spot.distance_ft.toPrecision(4)} ft`));
+  // By keyboard: the map takes focus (Tab), the cursor starts at the distance sweet spot's cell,
+  // the arrows move it cell by cell and the cell read out is the API's carry there.
+  const cursor = async () =>
+    page.evaluate(() => {
+      const out = document.querySelector('#carry-cell');
+      return { i: Number(out.dataset.i), j: Number(out.dataset.j), value: out.dataset.value, text: out.textContent };
+    });
+  await page.locator('#carry-map').focus();
+  assert.equal(await page.evaluate(() => document.activeElement?.id), 'carry-map');
+  const home = await cursor();
+  const nearest = (list, v) => list.reduce((b, w, k) => (Math.abs(w - v) < Math.abs(list[b] - v) ? k : b), 0);
+  assert.equal(home.i, nearest(map.positions.map((r) => r.position_from_knob_in), spot.position_from_knob_in));
+  assert.equal(home.j, nearest(map.undercuts_in, spot.undercut_in));
+  await page.keyboard.press('ArrowLeft');
+  await page.keyboard.press('ArrowLeft');
+  await page.keyboard.press('ArrowUp');
+  const moved = await cursor();
+  assert.deepEqual([moved.i, moved.j], [home.i - 2, home.j + 1]);
+  const carry = map.positions[moved.i].distance_ft[moved.j];
+  assert.equal(moved.value, carry === null ? '' : String(carry));
+  assert.match(moved.text, carry === null ? /no carry/ : / ft$/);
+  assert.equal(await page.locator('#carry-map rect.cursor').count(), 1);
+  await page.keyboard.press('Home');
+  assert.deepEqual([(await cursor()).i, (await cursor()).j], [home.i, home.j]);
 
   // A bat the API refuses (a negative barrel): the views keep the last valid bat's, dimmed.
   await page.selectOption('select[name="shape"]', 'three_segment');

@@ -42,6 +42,7 @@ export function toSvg(svg) {
     const style = getComputedStyle(node);
     to[i].setAttribute('style', STYLED.map((p) => `${p}:${style.getPropertyValue(p)}`).join(';'));
   });
+  for (const mark of clone.querySelectorAll('.cursor')) mark.remove(); // the keyboard's cursor is no part of the figure
   clone.setAttribute('xmlns', 'http://www.w3.org/2000/svg');
   const box = svg.viewBox.baseVal;
   if (box) {

@@ -126,6 +126,21 @@ export class FlightViews {
       this.ctx.saveState();
       this.refreshCarry();
     });
+    // The heat map by keyboard: the arrows move a cursor cell by cell (left/right along the
+    // bat, up/down in undercut), Home back to the distance sweet spot's cell; the cell's
+    // numbers are read out in #carry-cell.
+    $('#carry-map').addEventListener('keydown', (e) => {
+      if (!this.carry) return;
+      const moves = { ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowDown: [0, -1], ArrowUp: [0, 1] };
+      if (e.key === 'Home') {
+        this.moveCursor(this.carry.home.i, this.carry.home.j);
+      } else if (moves[e.key]) {
+        this.moveCursor(this.carry.cursor.i + moves[e.key][0], this.carry.cursor.j + moves[e.key][1]);
+      } else {
+        return;
+      }
+      e.preventDefault();
+    });
     const stem = () => this.ctx.stem();
     const actions = {
       'flight-top-svg': () => downloadSvg(`${stem()}-flight-above-${this.ctx.units()}.svg`, $('#flight-top')),
@@ -308,7 +323,14 @@ export class FlightViews {
     const values = cells.flat().filter((v) => typeof v === 'number');
     const lo = Math.min(...values);
     const hi = Math.max(...values);
-    this.carry = { xs, us, cells, len, far };
+    // The cell nearest the distance sweet spot: where the keyboard's cursor starts (and Home).
+    const nearest = (list, v) =>
+      list.reduce((best, w, k) => (Math.abs(w - v) < Math.abs(list[best] - v) ? k : best), 0);
+    const home = {
+      i: nearest(xs, answer.distance_sweet_spot[`position_from_knob_${len}`]),
+      j: nearest(us, answer.distance_sweet_spot[`undercut_${len}`]),
+    };
+    this.carry = { xs, us, cells, len, far, home, cursor: { ...home } };
     this.carryAnswer = [answer, imperial];
 
     const svg = $('#carry-map');
@@ -402,6 +424,7 @@ export class FlightViews {
       marker,
       legend,
     );
+    this.moveCursor(home.i, home.j);
     svg.dataset.positions = String(xs.length);
     svg.dataset.undercuts = String(us.length);
     svg.dataset.unit = far;
@@ -416,6 +439,30 @@ export class FlightViews {
         `Grey: no carry (the ball misses, grazes or is driven back). ${map.positions.length} × ${us.length} points, ` +
         `${map.normal_law.replaceAll('_', ' ')} normal law.`,
     );
+  }
+
+  /** Puts the keyboard's cursor on cell (i, j) (clamped to the grid) and reads it out. */
+  moveCursor(i, j) {
+    const { xs, us, cells, len, far } = this.carry;
+    const ci = Math.max(0, Math.min(xs.length - 1, i));
+    const cj = Math.max(0, Math.min(us.length - 1, j));
+    this.carry.cursor = { i: ci, j: cj };
+    const svg = $('#carry-map');
+    for (const old of svg.querySelectorAll('rect.cursor')) old.remove();
+    const cell = svg.querySelector(`rect.cell[data-i="${ci}"][data-j="${cj}"]`);
+    if (cell) {
+      // An outline over the cell, drawn last so that it is on top (the cells keep their order).
+      const geometry = Object.fromEntries(['x', 'y', 'width', 'height'].map((k) => [k, cell.getAttribute(k)]));
+      svg.append(svgEl('rect', { class: 'cursor', ...geometry, dataset: { i: String(ci), j: String(cj) } }));
+    }
+    const v = cells[ci][cj];
+    const out = $('#carry-cell');
+    out.dataset.i = String(ci);
+    out.dataset.j = String(cj);
+    out.dataset.value = v === null || v === undefined ? '' : String(v);
+    out.textContent =
+      `${fmt(xs[ci], 4)} ${len} from the knob, undercut ${fmt(us[cj], 3)} ${len}: ` +
+      (typeof v === 'number' ? `${fmt(v, 4)} ${far}` : 'no carry');
   }
 
   /** The map as shown, one row per cell: position, undercut, carry ('' for none). */
