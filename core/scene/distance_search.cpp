@@ -24,9 +24,13 @@ void DistancePositionRange(const DistanceOptions& options, double length_m, doub
 namespace batted_ball {
 namespace {
 
-// The region of `options` on the bat, or the refusal.
+// The region of valid `options` on the bat, or the refusal (of the options, then of the region).
 bool RegionOnBat(const DistanceOptions& options, double length_m, double* lo, double* hi,
                  Summary* s) {
+  if (Refusal why; !options.Validate(&why)) {
+    s->SetRefusal(std::move(why));
+    return false;
+  }
   DistancePositionRange(options, length_m, lo, hi);
   const std::string rule = "must be within the bat [0, " + FormatNumber17(length_m) + "]";
   if (!(*lo >= 0.0 && *lo <= length_m)) {
@@ -226,10 +230,6 @@ DistanceSweetSpotResult DistanceSweetSpot(BattedBallModel& model, double length_
   Summary& s = out.summary;
   s.backend = "nlopt:LN_BOBYQA";
   CatchInternalError(&s, [&] {
-    if (Refusal why; !options.Validate(&why)) {
-      s.SetRefusal(std::move(why));
-      return;
-    }
     double lo = 0.0, hi = 0.0;
     if (!batted_ball::RegionOnBat(options, length_m, &lo, &hi, &s)) return;
     std::string failure;
@@ -260,10 +260,6 @@ CarryMapResult CarryMap(BattedBallModel& model, double length_m, const DistanceO
   Summary& s = out.summary;
   s.backend = "grid";
   CatchInternalError(&s, [&] {
-    if (Refusal why; !options.Validate(&why)) {
-      s.SetRefusal(std::move(why));
-      return;
-    }
     double lo = 0.0, hi = 0.0;
     if (!batted_ball::RegionOnBat(options, length_m, &lo, &hi, &s)) return;
     const int np = options.map_positions, nu = options.map_undercuts;
