@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/bat/mass_properties.hpp"
 #include "core/bat/material.hpp"
 #include "core/optimize/design_problem.hpp"
 #include "core/units.hpp"
@@ -31,6 +32,14 @@ inline DesignProblem SolidAshKnots(int n) {
   p.constraints.max_barrel_diameter_m = InchesToMetres(2.61);
   p.constraints.min_handle_diameter_m = InchesToMetres(0.9);
   p.constraints.taper = TaperRule::kNonDecreasing;
+  return p;
+}
+
+/// SolidAshKnots(n) with its mass held at the base bat's (an equality): bench/core_optimize.cpp's
+/// KnotProblem, the problem of the lifted and tapered formulations' tests.
+inline DesignProblem SolidAshKnotsAtBaseMass(int n) {
+  DesignProblem p = SolidAshKnots(n);
+  p.constraints.mass_kg = DesignRange::Equal(ComputeMassProperties(p.bat).mass_kg);
   return p;
 }
 

@@ -25,12 +25,8 @@ namespace sweetspot::core {
 namespace optimize_lifted_test {
 namespace {
 
-// bench/core_optimize.cpp's KnotProblem (knot_design_problems.hpp), at the base bat's mass.
-DesignProblem KnotProblem(int n) {
-  DesignProblem p = knot_design_problems::SolidAshKnots(n);
-  p.constraints.mass_kg = DesignRange::Equal(ComputeMassProperties(p.bat).mass_kg);
-  return p;
-}
+// bench/core_optimize.cpp's KnotProblem, at the base bat's mass.
+using knot_design_problems::SolidAshKnotsAtBaseMass;
 
 DesignModel Build(const DesignProblem& p) {
   DesignModel model;
@@ -41,14 +37,14 @@ DesignModel Build(const DesignProblem& p) {
 
 TEST(OptimizeLifted, QualifiesOnlyForKnotRadiiAndFunctionsOfP) {
   std::string why;
-  EXPECT_TRUE(LiftedDesignNlp::Qualifies(Build(KnotProblem(16)), &why)) << why;
+  EXPECT_TRUE(LiftedDesignNlp::Qualifies(Build(SolidAshKnotsAtBaseMass(16)), &why)) << why;
   // A knot position moves the length's neighbours' integrals: not lifted (the dense path).
-  DesignProblem positions = KnotProblem(16);
+  DesignProblem positions = SolidAshKnotsAtBaseMass(16);
   positions.variables.push_back({"profile.knots[7].x_m", 0.39, 0.41});
   EXPECT_FALSE(LiftedDesignNlp::Qualifies(Build(positions), &why));
   EXPECT_NE(why.find("profile.knots[7].x_m"), std::string::npos) << why;
   // min_moi is a function of P: lifted too.
-  DesignProblem moi = KnotProblem(16);
+  DesignProblem moi = SolidAshKnotsAtBaseMass(16);
   moi.objective = DesignObjective::kMinMoi;
   EXPECT_TRUE(LiftedDesignNlp::Qualifies(Build(moi), &why)) << why;
 }
@@ -56,7 +52,7 @@ TEST(OptimizeLifted, QualifiesOnlyForKnotRadiiAndFunctionsOfP) {
 // The gradient, the Jacobian and the Lagrangian's Hessian against central differences at a
 // random interior point with random multipliers.
 TEST(OptimizeLifted, DerivativesMatchCentralDifferences) {
-  const DesignModel model = Build(KnotProblem(16));
+  const DesignModel model = Build(SolidAshKnotsAtBaseMass(16));
   ScaledDesignNlp dense(model);
   LiftedDesignNlp nlp(dense);
   const int n = nlp.n(), m = nlp.m();
@@ -129,23 +125,29 @@ void ExpectSameOptimum(const DesignProblem& p) {
   };
   for (const std::string& name : in_a) {
     if (in_b.count(name) == 0) {
-      EXPECT_LE(std::abs(gap_elsewhere(name, b)), 1e-8) << name << " active in the lifted answer only";
+      EXPECT_LE(std::abs(gap_elsewhere(name, b)), 1e-8)
+          << name << " active in the lifted answer only";
     }
   }
   for (const std::string& name : in_b) {
     if (in_a.count(name) == 0) {
-      EXPECT_LE(std::abs(gap_elsewhere(name, a)), 1e-8) << name << " active in the dense answer only";
+      EXPECT_LE(std::abs(gap_elsewhere(name, a)), 1e-8)
+          << name << " active in the dense answer only";
     }
   }
 }
 
-TEST(OptimizeLifted, SameOptimumAsDenseAtSixteenKnots) { ExpectSameOptimum(KnotProblem(16)); }
-TEST(OptimizeLifted, SameOptimumAsDenseAtSixtyFourKnots) { ExpectSameOptimum(KnotProblem(64)); }
+TEST(OptimizeLifted, SameOptimumAsDenseAtSixteenKnots) {
+  ExpectSameOptimum(SolidAshKnotsAtBaseMass(16));
+}
+TEST(OptimizeLifted, SameOptimumAsDenseAtSixtyFourKnots) {
+  ExpectSameOptimum(SolidAshKnotsAtBaseMass(64));
+}
 
 // A hollow aluminium profile of 69 stations (a knot every half inch of a 34-in bat) with a
 // 3 mm wall: lifted too (the wall is fixed), the same optimum as the dense formulation.
 TEST(OptimizeLifted, SameOptimumAsDenseForAHollowSixtyNineStationProfile) {
-  DesignProblem p = KnotProblem(69);
+  DesignProblem p = SolidAshKnotsAtBaseMass(69);
   p.bat.material = *FindMaterial("aluminium-7050");
   p.bat.wall_thickness_m = 0.003;
   // The handle's smallest radius above the wall; the mass of the hollow base.
@@ -159,7 +161,7 @@ TEST(OptimizeLifted, SameOptimumAsDenseForAHollowSixtyNineStationProfile) {
 // bit for bit (exact comparisons: the same sums in the same order), and no other entry, on the
 // hollow 69-station profile (its wall guards' rows too) at the start and a point inside.
 TEST(OptimizeLifted, JacobianRowsAreTheDenseJacobiansBits) {
-  DesignProblem p = KnotProblem(69);
+  DesignProblem p = SolidAshKnotsAtBaseMass(69);
   p.bat.material = *FindMaterial("aluminium-7050");
   p.bat.wall_thickness_m = 0.003;
   for (auto& v : p.variables) v.min = 0.0115;
@@ -223,7 +225,7 @@ TEST(OptimizeLifted, JacobianRowsAreTheDenseJacobiansBits) {
 TEST(OptimizeLifted, SparseCertificateIsTheDenseOne) {
   using design_detail::CertificateTolerances;
   using design_detail::Certify;
-  const DesignProblem p = KnotProblem(64);
+  const DesignProblem p = SolidAshKnotsAtBaseMass(64);
   const DesignResult r = OptimizeDesign(p);
   ASSERT_EQ(r.summary.termination, Termination::kConverged) << r.summary.message;
   const DesignModel model = Build(p);
@@ -262,15 +264,15 @@ TEST(OptimizeLifted, TheChosenBackendIsCertifiedAndSlsqpIsRefusedAboveItsSize) {
   DesignOptions chosen;
   chosen.choose_backend = true;
   DesignOptions ipopt;
-  const DesignResult small = OptimizeDesign(KnotProblem(16), chosen);
-  const DesignResult small_ipopt = OptimizeDesign(KnotProblem(16), ipopt);
+  const DesignResult small = OptimizeDesign(SolidAshKnotsAtBaseMass(16), chosen);
+  const DesignResult small_ipopt = OptimizeDesign(SolidAshKnotsAtBaseMass(16), ipopt);
   ASSERT_EQ(small.summary.termination, Termination::kConverged) << small.summary.message;
   EXPECT_EQ(small.summary.backend, "nlopt:LD_SLSQP");
   EXPECT_LE(small.summary.error_estimate, 1e-6);
   // Both to their tolerance 1e-9 (scaled objective ~1): 1e-8 relative covers both.
   EXPECT_NEAR(small.objective_value, small_ipopt.objective_value,
               1e-8 * std::abs(small_ipopt.objective_value));
-  const DesignResult large = OptimizeDesign(KnotProblem(64), chosen);
+  const DesignResult large = OptimizeDesign(SolidAshKnotsAtBaseMass(64), chosen);
   ASSERT_EQ(large.summary.termination, Termination::kConverged) << large.summary.message;
   EXPECT_EQ(large.summary.backend, "ipopt");
   const auto& used = large.summary.models_used;
@@ -278,14 +280,15 @@ TEST(OptimizeLifted, TheChosenBackendIsCertifiedAndSlsqpIsRefusedAboveItsSize) {
 
   DesignOptions slsqp;
   slsqp.backend = DesignBackend::kNloptSlsqp;
-  const DesignResult refused = OptimizeDesign(KnotProblem(64), slsqp);
+  const DesignResult refused = OptimizeDesign(SolidAshKnotsAtBaseMass(64), slsqp);
   EXPECT_EQ(refused.summary.termination, Termination::kInvalidInput);
   ASSERT_TRUE(refused.summary.refusal.has_value());
   EXPECT_EQ(refused.summary.refusal->field, "options.backend");
   EXPECT_NE(refused.summary.message.find("at most 32 variables (this problem has 62)"),
             std::string::npos)
       << refused.summary.message;
-  EXPECT_EQ(OptimizeDesign(KnotProblem(32), slsqp).summary.termination, Termination::kConverged);
+  EXPECT_EQ(OptimizeDesign(SolidAshKnotsAtBaseMass(32), slsqp).summary.termination,
+            Termination::kConverged);
 }
 
 }  // namespace

@@ -26,12 +26,8 @@ namespace sweetspot::core {
 namespace optimize_tapered_test {
 namespace {
 
-// bench/core_optimize.cpp's KnotProblem (knot_design_problems.hpp), at the base bat's mass.
-DesignProblem KnotProblem(int n) {
-  DesignProblem p = knot_design_problems::SolidAshKnots(n);
-  p.constraints.mass_kg = DesignRange::Equal(ComputeMassProperties(p.bat).mass_kg);
-  return p;
-}
+// bench/core_optimize.cpp's KnotProblem, at the base bat's mass.
+using knot_design_problems::SolidAshKnotsAtBaseMass;
 
 DesignModel Build(const DesignProblem& p) {
   DesignModel model;
@@ -41,7 +37,7 @@ DesignModel Build(const DesignProblem& p) {
 }
 
 TEST(OptimizeTapered, OnlyForOneTaperChain) {
-  const DesignModel with_taper = Build(KnotProblem(40));
+  const DesignModel with_taper = Build(SolidAshKnotsAtBaseMass(40));
   ScaledDesignNlp dense(with_taper);
   LiftedDesignNlp lifted(dense);
   const TaperedLiftedNlp tapered(lifted, dense.ToScaled(with_taper.BaseX()), kTaperBlockSize);
@@ -51,7 +47,7 @@ TEST(OptimizeTapered, OnlyForOneTaperChain) {
   // knot's upper bound (the fixed tip's taper row, implied for no other knot).
   EXPECT_EQ(tapered.n(), 38 + 3);
   EXPECT_EQ(tapered.m(), 5 + 2 + 1);  // and the taper rows into the two later blocks' heads
-  DesignProblem no_taper = KnotProblem(40);
+  DesignProblem no_taper = SolidAshKnotsAtBaseMass(40);
   no_taper.constraints.taper = TaperRule::kNone;
   const DesignModel without = Build(no_taper);
   ScaledDesignNlp dense2(without);
@@ -63,7 +59,7 @@ TEST(OptimizeTapered, OnlyForOneTaperChain) {
 // random point with random multipliers, 38 steps in three blocks (the Hessian's structure
 // across blocks included: a value outside it makes Hessian() return false).
 TEST(OptimizeTapered, DerivativesMatchCentralDifferences) {
-  const DesignModel model = Build(KnotProblem(40));
+  const DesignModel model = Build(SolidAshKnotsAtBaseMass(40));
   ScaledDesignNlp dense(model);
   LiftedDesignNlp lifted(dense);
   TaperedLiftedNlp nlp(lifted, dense.ToScaled(model.BaseX()), kTaperBlockSize);
@@ -89,9 +85,9 @@ TEST(OptimizeTapered, DerivativesMatchCentralDifferences) {
 // and kept bound rows to the radii's bounds and limits), make the dense problem stationary; on
 // the 64-knot design and with knot 45 held to 30 mm (a kept bound row, active).
 TEST(OptimizeTapered, MultipliersMapBackToTheDesignsKkt) {
-  DesignProblem limited = KnotProblem(64);
+  DesignProblem limited = SolidAshKnotsAtBaseMass(64);
   limited.variables[44].max = 0.030;
-  for (const DesignProblem& p : {KnotProblem(64), limited}) {
+  for (const DesignProblem& p : {SolidAshKnotsAtBaseMass(64), limited}) {
     const DesignModel model = Build(p);
     ScaledDesignNlp nlp(model);
     LocalSolveSettings settings;
@@ -148,16 +144,18 @@ void ExpectSameOptimum(const DesignProblem& p) {
   EXPECT_FALSE(uses(b, "taper_steps"));
 }
 
-TEST(OptimizeTapered, SameOptimumAsTheRadiiAtSixtyFourKnots) { ExpectSameOptimum(KnotProblem(64)); }
+TEST(OptimizeTapered, SameOptimumAsTheRadiiAtSixtyFourKnots) {
+  ExpectSameOptimum(SolidAshKnotsAtBaseMass(64));
+}
 TEST(OptimizeTapered, SameOptimumAsTheRadiiAtOneHundredTwentyEightKnots) {
-  ExpectSameOptimum(KnotProblem(128));
+  ExpectSameOptimum(SolidAshKnotsAtBaseMass(128));
 }
 // A knot's own limit the taper does not imply (knot 45 of 64 at most 30 mm, in the barrel of
 // the unconstrained optimum, 32.5 mm): it stays a row of the steps' problem (and with it every
 // knot before it is held to 30 mm by the taper), active at the optimum, its multiplier mapped
 // back to the knot's bound.
 TEST(OptimizeTapered, SameOptimumWithALimitTheTaperDoesNotImply) {
-  DesignProblem p = KnotProblem(64);
+  DesignProblem p = SolidAshKnotsAtBaseMass(64);
   p.variables[44].max = 0.030;
   {
     const DesignModel model = Build(p);
@@ -177,7 +175,7 @@ TEST(OptimizeTapered, SameOptimumWithALimitTheTaperDoesNotImply) {
 }
 
 TEST(OptimizeTapered, SameOptimumAsTheRadiiForAHollowSixtyNineStationProfile) {
-  DesignProblem p = KnotProblem(69);
+  DesignProblem p = SolidAshKnotsAtBaseMass(69);
   p.bat.material = *FindMaterial("aluminium-7050");
   p.bat.wall_thickness_m = 0.003;
   for (auto& v : p.variables) v.min = 0.0115;
