@@ -186,7 +186,8 @@ void ReadSweepPlan(ObjectReader& reader, std::size_t limit, core::SweepPlan* pla
 }
 
 // "outputs" (default: the properties and max_exit_speed) into *outputs: each "properties", a
-// scene output's name or "collision_efficiency" (which adds max_exit_speed). Errors are
+// scene output's name (a name given twice counts once) or "collision_efficiency" (which adds
+// max_exit_speed). Errors are
 // recorded by `reader`; false on one.
 bool ReadRowOutputs(ObjectReader& reader, RowOutputs* outputs) {
   outputs->properties = true;
@@ -206,7 +207,12 @@ bool ReadRowOutputs(ObjectReader& reader, RowOutputs* outputs) {
     } else if (name == "collision_efficiency") {
       outputs->collision_efficiency = true;
     } else if (const auto output = core::ParseSceneOutput(name)) {
-      outputs->scene.push_back(*output);
+      // A name given twice is one output, as /v1/sweet-spot's ReadOutputs takes it (a row
+      // renders each output once).
+      if (std::find(outputs->scene.begin(), outputs->scene.end(), *output) ==
+          outputs->scene.end()) {
+        outputs->scene.push_back(*output);
+      }
     } else {
       reader.Fail("outputs", "outputs[" + std::to_string(i) + "] = " + Show(item) +
                                  " is not one of properties, " + core::SceneOutputNameList() +

@@ -105,6 +105,21 @@ TEST(ExploreTest, FailedDesignsAreRowsNotFailures) {
   EXPECT_TRUE(r.body["rows"][0]["feasible"].get<bool>());
 }
 
+TEST(ExploreTest, AnOutputNamedTwiceIsOneOutput) {
+  // Found by the explore fuzzer: a name given twice rendered the second copy from a moved-from
+  // block (null) and the answer-size estimate threw (a 500). /v1/sweet-spot takes it once.
+  Json once = CorkSweep();
+  once["outputs"] = {"max_exit_speed", "properties"};
+  Json twice = CorkSweep();
+  twice["outputs"] = {"max_exit_speed", "properties", "max_exit_speed"};
+  const Response a = Explore(once);
+  const Response b = Explore(twice);
+  ASSERT_EQ(a.status, 200) << a.body.dump();
+  ASSERT_EQ(b.status, 200) << b.body.dump();
+  EXPECT_EQ(b.body["rows"], a.body["rows"]);
+  EXPECT_TRUE(b.body["rows"][0]["max_exit_speed"].is_object());
+}
+
 TEST(ExploreTest, PropertiesOnlyRowsAreFeasible) {
   // Found by the hard-case suite: a sweep asking only for properties marked
   // every design infeasible ("outputs: empty").
