@@ -2,7 +2,11 @@
 #
 # - ccache, when installed, caches every compilation (scripts/install-deps.sh installs it).
 #   Precompiled headers need its pch_defines,time_macros sloppiness; CCACHE_BASEDIR makes
-#   two checkouts at the same depth share the cache.
+#   two checkouts at the same depth share the cache. Depend mode (CCACHE_DEPEND): a miss
+#   compiles once, without running the preprocessor first to hash its output (the compiler's
+#   -MD list is hashed instead), which is every compilation of a fresh machine: the TSan
+#   build's 41 compilations took 216 CPU-s without ccache, 228 through a cold cache in the
+#   default mode and 213 in depend mode; a warm rebuild hits directly as before.
 # - sweetspot_precompile(<target> <headers>...): the heavy third-party headers (Eigen,
 #   nlohmann-json, GoogleTest, Boost.Odeint) are parsed once per target instead of once per
 #   source file.
@@ -13,12 +17,14 @@
 #   be declared by another file of the same target: the compiler says so at once
 #   ("redefinition of ...", "ambiguous"); shared constants live in one header
 #   (core/numerics/limits.hpp). SWEETSPOT_UNITY_BATCH sets the batch size of the libraries
-#   and benchmarks, SWEETSPOT_TEST_UNITY_BATCH that of the test programs (16: their batches
-#   at -O0 spend most of their time on the templates of GoogleTest, Eigen and nlohmann-json
-#   that every batch instantiates and emits again, so fewer, larger batches do that less
-#   often: two of core_tests' batches of 8 took 32.7 CPU-seconds with GCC, the same 16 files
-#   in one batch 26.7, README "Build times"); -DSWEETSPOT_UNITY=OFF compiles file by file
-#   (quicker rebuilds while editing one file).
+#   and benchmarks, SWEETSPOT_TEST_UNITY_BATCH that of the test programs (64: one batch per
+#   program today, core_tests' 58 files the largest: their batches at -O0 spend most of their
+#   time on the templates of GoogleTest, Eigen and nlohmann-json that every batch instantiates
+#   and emits again, so fewer, larger batches do that less often: two of core_tests' batches of 8
+#   took 32.7 CPU-seconds with GCC, the same 16 files in one batch 26.7; core_tests, api_tests
+#   and server_tests took 116 CPU-s with GCC in batches of 16 and 77 in batches of 64,
+#   README "Build times"); -DSWEETSPOT_UNITY=OFF compiles file by file (quicker rebuilds
+#   while editing one file), -DSWEETSPOT_TEST_UNITY_BATCH=8 recompiles less of a test program.
 # - sweetspot_test_flags(<target>): test programs compile at SWEETSPOT_TEST_OPTIMIZE (-O0 by
 #   default). The code under test keeps the build type's flags (-O3 in Release, -O2 in the
 #   ASan build, -O1 in the TSan build): only the test drivers are cheaper to compile (a test
@@ -42,7 +48,7 @@ option(SWEETSPOT_CCACHE "Compile through ccache when it is installed" ON)
 option(SWEETSPOT_PCH "Precompile the heavy third-party headers" ON)
 option(SWEETSPOT_UNITY "Compile the libraries, test and benchmark programs as unity builds" ON)
 set(SWEETSPOT_UNITY_BATCH 8 CACHE STRING "Source files per unity batch of a library or benchmark")
-set(SWEETSPOT_TEST_UNITY_BATCH 16 CACHE STRING "Source files per unity batch of a test program")
+set(SWEETSPOT_TEST_UNITY_BATCH 64 CACHE STRING "Source files per unity batch of a test program")
 set(SWEETSPOT_TEST_OPTIMIZE -O0 CACHE STRING
     "Optimisation flag of the test programs (empty: the build type's)")
 option(SWEETSPOT_LLD "Link with lld when it is installed" ON)
@@ -62,7 +68,7 @@ if(SWEETSPOT_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
     set(CMAKE_CXX_COMPILER_LAUNCHER
         ${CMAKE_COMMAND} -E env
         CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime
-        CCACHE_BASEDIR=${sweetspot_checkouts} ${SWEETSPOT_CCACHE_EXECUTABLE})
+        CCACHE_DEPEND=1 CCACHE_BASEDIR=${sweetspot_checkouts} ${SWEETSPOT_CCACHE_EXECUTABLE})
     message(STATUS "Compiling through ${SWEETSPOT_CCACHE_EXECUTABLE}")
   endif()
 endif()
