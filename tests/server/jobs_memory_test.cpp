@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "server/jobs/job_store.hpp"
 #include "tests/sanitizers.hpp"
 #include "tests/server/job_client.hpp"
 #include "tests/server/postgres_cluster.hpp"
@@ -91,8 +92,10 @@ std::string FetchResult(ServerProcess& server, const std::string& id,
   return type;
 }
 
-// The 1 MiB pieces that `bytes` of a result take at least.
-std::size_t Pieces(std::size_t bytes) { return (bytes + 1048575) / 1048576; }
+// The pieces (server::kResultChunkBytes, 1 MiB) that `bytes` of a result take at least.
+std::size_t Pieces(std::size_t bytes) {
+  return (bytes + server::kResultChunkBytes - 1) / server::kResultChunkBytes;
+}
 
 // Runs a 3,000-design job (a 3 MB result, in pieces), whose bytes must be those the server sends
 // for the whole answer (its compact dump and a newline), then the big job, checking the server's
@@ -175,7 +178,8 @@ TEST(JobsMemoryTest, ABigResultIsNeverWholeInTheServersMemoryWithPostgres) {
   // job, and 98 more for the big one when it ran.
   EXPECT_GE(pieces, 3u);
   EXPECT_EQ(cluster.Psql("SELECT count(*) >= " + std::to_string(pieces) +
-                         ", bool_and(length(data) <= 1048576) FROM sweetspot_job_result_chunks"),
+                         ", bool_and(length(data) <= " + std::to_string(server::kResultChunkBytes) +
+                         ") FROM sweetspot_job_result_chunks"),
             "t|t");
 }
 
