@@ -328,7 +328,43 @@ ObjectReader::ObjectReader(const nlohmann::json& value, std::string path, ApiErr
     : value_(&value), path_(std::move(path)), error_(error) {
   if (!value.is_object()) {
     SetError(error_, ErrorCode::kInvalidValue, path_, &value, "must be an object");
+    return;
   }
+  members_.reserve(value.size());
+  for (const auto& [key, member] : value.get_ref<const nlohmann::json::object_t&>()) {
+    members_.push_back({key, &member});
+  }
+  asked_.reserve(256);  // a scene object asks for some 20 names
+}
+
+const ObjectReader::Member* ObjectReader::Find(std::string_view key) const {
+  for (const Member& m : members_) {
+    if (m.key == key) return &m;
+  }
+  return nullptr;
+}
+
+void ObjectReader::Mark(std::string_view key) {
+  asked_.append(key);
+  asked_.push_back('\0');
+  for (Member& m : members_) {
+    if (m.key == key) {
+      m.asked = true;
+      return;
+    }
+  }
+}
+
+std::vector<std::string> ObjectReader::AskedNames() const {
+  std::vector<std::string> names;
+  for (std::size_t at = 0; at < asked_.size();) {
+    const std::size_t end = asked_.find('\0', at);
+    names.emplace_back(asked_, at, end - at);
+    at = end + 1;
+  }
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  return names;
 }
 
 bool ObjectReader::HasTradeSpelling() const {
@@ -336,8 +372,8 @@ bool ObjectReader::HasTradeSpelling() const {
   // request's every absent field would otherwise build its TradeForms and look them up.
   if (has_trade_spelling_ < 0) {
     has_trade_spelling_ = 0;
-    for (const auto& item : value_->items()) {
-      if (!SiFormsOf(item.key()).empty()) {
+    for (const Member& m : members_) {
+      if (!SiFormsOf(m.key).empty()) {
         has_trade_spelling_ = 1;
         break;
       }
@@ -346,21 +382,18 @@ bool ObjectReader::HasTradeSpelling() const {
   return has_trade_spelling_ == 1;
 }
 
-bool ObjectReader::Has(std::string_view key) {
-  if (!value_->is_object()) return false;
-  if (known_.find(key) == known_.end()) known_.emplace(key);
-  return value_->contains(key);
-}
+bool ObjectReader::Has(std::string_view key) { return Get(key) != nullptr; }
 
 const nlohmann::json* ObjectReader::Get(std::string_view key) {
-  if (!Has(key)) return nullptr;
-  return &*value_->find(key);
+  if (!value_->is_object()) return nullptr;
+  Mark(key);
+  const Member* m = Find(key);
+  return m != nullptr ? m->value : nullptr;
 }
 
 bool ObjectReader::Fail(std::string_view key, const std::string& rule, ErrorCode code) {
-  const nlohmann::json* value =
-      value_->is_object() && value_->contains(key) ? &(*value_)[std::string(key)] : nullptr;
-  return SetError(error_, code, PathOf(key), value, rule);
+  const Member* m = Find(key);
+  return SetError(error_, code, PathOf(key), m != nullptr ? m->value : nullptr, rule);
 }
 
 bool ObjectReader::Missing(std::string_view key) {
@@ -370,12 +403,12 @@ bool ObjectReader::Missing(std::string_view key) {
   if (value_->is_object()) {
     std::vector<std::string> names = {std::string(key)};
     for (const TradeForm& form : TradeForms(key)) names.push_back(form.key);
-    for (const auto& item : value_->items()) {
-      if (known_.count(item.key()) != 0) continue;
-      const std::string nearest = NearestName(item.key(), names);
+    for (const Member& m : members_) {
+      if (m.asked) continue;
+      const std::string nearest = NearestName(m.key, names);
       if (nearest.empty()) continue;
-      known_.insert(std::string(key));
-      return SetError(error_, ErrorCode::kUnknownField, PathOf(item.key()), nullptr,
+      Mark(key);
+      return SetError(error_, ErrorCode::kUnknownField, PathOf(m.key), nullptr,
                       "is not a known field; did you mean " + nearest + "?");
     }
   }
@@ -389,15 +422,16 @@ const nlohmann::json* ObjectReader::GetInUnits(std::string_view key, std::string
   const nlohmann::json* found = Get(key);
   if (!value_->is_object() || !HasTradeSpelling()) return found;
   for (const TradeForm& form : TradeForms(key)) {
-    if (!value_->contains(form.key)) continue;
-    known_.insert(form.key);
+    const Member* member = Find(form.key);
+    if (member == nullptr) continue;
+    Mark(form.key);
     if (found != nullptr) {
       // Exactly one form per quantity: two could disagree.
       Fail(form.key, "cannot be given together with " + PathOf(*given_as) +
                          " (one quantity, give it in one form)");
       return nullptr;
     }
-    found = &(*value_)[form.key];
+    found = member->value;
     *given_as = form.key;
     *to_si = form.to_si;
   }
@@ -406,10 +440,10 @@ const nlohmann::json* ObjectReader::GetInUnits(std::string_view key, std::string
 
 bool ObjectReader::HasInUnits(std::string_view key) const {
   if (!value_->is_object()) return false;
-  if (value_->contains(key)) return true;
+  if (Find(key) != nullptr) return true;
   if (!HasTradeSpelling()) return false;
   for (const TradeForm& form : TradeForms(key)) {
-    if (value_->contains(form.key)) return true;
+    if (Find(form.key) != nullptr) return true;
   }
   return false;
 }
@@ -532,18 +566,17 @@ bool ObjectReader::OptionalBool(std::string_view key, bool* out) {
 
 bool ObjectReader::Finish() {
   if (!ok() || !value_->is_object()) return ok();
-  for (const auto& item : value_->items()) {
-    if (known_.count(item.key()) == 0) {
+  for (const Member& m : members_) {
+    if (!m.asked) {
+      const std::vector<std::string> known = AskedNames();
       std::string list;
-      for (const auto& k : known_) list += (list.empty() ? "" : ", ") + k;
-      const std::string nearest =
-          NearestName(item.key(), std::vector<std::string>(known_.begin(), known_.end()));
-      return SetError(
-          error_, ErrorCode::kUnknownField, PathOf(item.key()), nullptr,
-          "is not a known field" +
-              (nearest.empty() ? std::string() : "; did you mean " + nearest + "?") +
-              (list.empty() ? std::string(" (this object takes no fields)")
-                            : " (known: " + list + ")"));
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      const std::string nearest = NearestName(m.key, known);
+      return SetError(error_, ErrorCode::kUnknownField, PathOf(m.key), nullptr,
+                      "is not a known field" +
+                          (nearest.empty() ? std::string() : "; did you mean " + nearest + "?") +
+                          (list.empty() ? std::string(" (this object takes no fields)")
+                                        : " (known: " + list + ")"));
     }
   }
   return true;

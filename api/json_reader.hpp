@@ -7,7 +7,6 @@
 
 #include <cstddef>
 #include <optional>
-#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -121,9 +120,7 @@ class ObjectReader {
   /// An optional boolean; `*out` untouched when absent.
   bool OptionalBool(std::string_view key, bool* out);
   /// Marks `key` as read without reading it (the caller reads it itself).
-  void Skip(std::string_view key) {
-    if (known_.find(key) == known_.end()) known_.emplace(key);
-  }
+  void Skip(std::string_view key) { Mark(key); }
   /// Records an error about `key` with `rule`, quoting its value.
   bool Fail(std::string_view key, const std::string& rule,
             ErrorCode code = ErrorCode::kInvalidValue);
@@ -136,7 +133,25 @@ class ObjectReader {
   const nlohmann::json* value_;
   std::string path_;
   ApiError* error_;
-  std::set<std::string, std::less<>> known_;
+  // The object's members in its (sorted) order, each with whether a call has asked for it:
+  // Finish refuses the rest. Built once, so that a field is found by a short scan of the few
+  // keys given instead of a map lookup, and asking for an absent field allocates nothing.
+  struct Member {
+    std::string_view key;         // the member's name (the object's own string)
+    const nlohmann::json* value;  // its value
+    bool asked = false;           // a call asked for it
+  };
+  std::vector<Member> members_;
+  // Every name asked for, each followed by '\0', in the order asked (repeats included): the
+  // "known" list and the "did you mean" of an unknown-field error, sorted and made unique only
+  // then. One string instead of a set node per name.
+  std::string asked_;
+  // Records that `key` was asked for: appends it to asked_ and marks its member.
+  void Mark(std::string_view key);
+  // The member named `key`, or nullptr.
+  const Member* Find(std::string_view key) const;
+  // The names in asked_, sorted and unique.
+  std::vector<std::string> AskedNames() const;
   // Whether some key of the object is a trade spelling (SiFormsOf): -1 until first needed.
   // Without one, no field's TradeForms need be built and looked up.
   mutable int has_trade_spelling_ = -1;

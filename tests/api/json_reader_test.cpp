@@ -2,8 +2,8 @@
 
 #include "api/router.hpp"
 
-#include <tuple>
 #include <gtest/gtest.h>
+#include <tuple>
 
 #include "tests/refusal_text.hpp"
 
@@ -89,14 +89,36 @@ TEST(ObjectReaderTest, ReadsNumbersAndRefusesUnknownFields) {
   EXPECT_FALSE(reader.Finish());
   EXPECT_EQ(error.code, ErrorCode::kUnknownField);
   EXPECT_EQ(error.field, "ball.masss_kg");
-  EXPECT_EQ(error.message, "ball.masss_kg is not a known field; did you mean mass_kg? (known: mass_kg)");
+  EXPECT_EQ(error.message,
+            "ball.masss_kg is not a known field; did you mean mass_kg? (known: mass_kg)");
+}
+
+// The "known" list of an unknown-field error: every name asked for, sorted and each once,
+// though asked out of order, twice, and through temporaries (the reader keeps its own copy of
+// the names; it no longer keeps a set of them). The first member in the object's (sorted)
+// order that nobody asked for is the one named; a member asked for is never refused.
+TEST(ObjectReaderTest, UnknownFieldListsEveryNameAskedSortedOnce) {
+  const auto value = nlohmann::json::parse(R"({"zeta": 1, "alpha": 2, "qqqqq": 3, "ppppp": 4})");
+  ApiError error;
+  ObjectReader reader(value, "thing", &error);
+  double number = 0;
+  for (const char* name : {"zeta", "beta", "alpha", "zeta"}) {
+    const std::string temporary(name);
+    EXPECT_TRUE(reader.OptionalNumber(temporary, AnyNumber(), &number));
+  }
+  EXPECT_EQ(number, 1);  // zeta, read last
+  reader.Skip(std::string("gamma"));
+  EXPECT_FALSE(reader.Finish());
+  EXPECT_EQ(error.field, "thing.ppppp");
+  EXPECT_EQ(error.message, "thing.ppppp is not a known field (known: alpha, beta, gamma, zeta)");
 }
 
 // A required field that is absent beside a typo of it, or of one of its trade forms: the
 // error names the field as written and the name meant (issue 33, item 2: "lenght_in" was
 // reported as "length_m is required"). A field that is no typo of it is still "required".
 TEST(ObjectReaderTest, ATypoOfARequiredFieldIsNamedAsWrittenWithTheNameMeant) {
-  for (const auto& [body, field, message] : std::vector<std::tuple<std::string, std::string, std::string>>{
+  for (const auto& [body, field, message] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{
            {R"({"lenght_in": 33})", "bat.lenght_in",
             "bat.lenght_in is not a known field; did you mean length_in?"},
            {R"({"legnth_m": 0.8})", "bat.legnth_m",
@@ -109,8 +131,8 @@ TEST(ObjectReaderTest, ATypoOfARequiredFieldIsNamedAsWrittenWithTheNameMeant) {
     EXPECT_FALSE(reader.Number("length_m", Positive(), &length));
     EXPECT_EQ(error.field, field);
     EXPECT_EQ(error.message, message);
-    EXPECT_EQ(error.code, field == "bat.length_m" ? ErrorCode::kMissingField
-                                                  : ErrorCode::kUnknownField);
+    EXPECT_EQ(error.code,
+              field == "bat.length_m" ? ErrorCode::kMissingField : ErrorCode::kUnknownField);
   }
 }
 
@@ -123,7 +145,7 @@ TEST(ObjectReaderTest, NearestNameIsATypoAway) {
   EXPECT_EQ(NearestName("r_m", names), "x_m");              // one change in a short name
   EXPECT_EQ(NearestName("rr_mm", names), "");               // two in a short name: none
   EXPECT_EQ(NearestName("diameter_in", names), "");
-  EXPECT_EQ(NearestName("radius_m", names), "");            // itself is no suggestion
+  EXPECT_EQ(NearestName("radius_m", names), "");  // itself is no suggestion
 }
 
 TEST(ObjectReaderTest, MessagesNameFieldValueAndRule) {
