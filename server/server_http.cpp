@@ -15,6 +15,7 @@
 #include <memory>
 #include <thread>
 
+#include "api/json_text.hpp"
 #include "api/router.hpp"
 #include "core/geometry_format.hpp"
 #include "server/cpu_quota.hpp"
@@ -28,101 +29,8 @@ std::string Serialize(const nlohmann::json& body) {
 
 namespace {
 
-// One value through nlohmann's own serializer (what dump(-1, ' ', false, replace) writes),
-// appended to *out: for what AppendJson does not write itself.
-void AppendWithNlohmann(const nlohmann::json& value, std::string* out) {
-  nlohmann::detail::serializer<nlohmann::json> serializer(
-      nlohmann::detail::output_adapter<char, std::string>(*out), ' ',
-      nlohmann::json::error_handler_t::replace);
-  serializer.dump(value, /*pretty_print=*/false, /*ensure_ascii=*/false, /*indent_step=*/0);
-}
-
-// A string as nlohmann writes it: printable ASCII without '"' or '\\' is written as it is
-// (nlohmann's escaping leaves it unchanged); anything else (control characters, UTF-8,
-// invalid bytes) goes through nlohmann's escaping.
-void AppendJsonString(const std::string& text, std::string* out) {
-  for (const char c : text) {
-    const auto u = static_cast<unsigned char>(c);
-    if (u < 0x20 || u >= 0x80 || c == '"' || c == '\\') {
-      AppendWithNlohmann(nlohmann::json(text), out);
-      return;
-    }
-  }
-  out->push_back('"');
-  out->append(text);
-  out->push_back('"');
-}
-
-}  // namespace
-
-void AppendJson(const nlohmann::json& value, std::string* out) {
-  using Type = nlohmann::json::value_t;
-  switch (value.type()) {
-    case Type::null:
-      out->append("null");
-      return;
-    case Type::boolean:
-      out->append(value.get<bool>() ? "true" : "false");
-      return;
-    case Type::number_integer:
-    case Type::number_unsigned: {
-      char digits[24];
-      const auto written =
-          value.type() == Type::number_integer
-              ? std::to_chars(digits, digits + sizeof digits, value.get<std::int64_t>())
-              : std::to_chars(digits, digits + sizeof digits, value.get<std::uint64_t>());
-      out->append(digits, static_cast<std::size_t>(written.ptr - digits));
-      return;
-    }
-    case Type::number_float: {
-      const double x = value.get<double>();
-      if (!std::isfinite(x)) {
-        out->append("null");
-        return;
-      }
-      char digits[64];
-      const char* end = nlohmann::detail::to_chars(digits, digits + sizeof digits, x);
-      out->append(digits, static_cast<std::size_t>(end - digits));
-      return;
-    }
-    case Type::string:
-      AppendJsonString(value.get_ref<const std::string&>(), out);
-      return;
-    case Type::object: {
-      out->push_back('{');
-      bool first = true;
-      for (const auto& [key, item] : value.get_ref<const nlohmann::json::object_t&>()) {
-        if (!first) out->push_back(',');
-        first = false;
-        AppendJsonString(key, out);
-        out->push_back(':');
-        AppendJson(item, out);
-      }
-      out->push_back('}');
-      return;
-    }
-    case Type::array: {
-      out->push_back('[');
-      bool first = true;
-      for (const auto& item : value) {
-        if (!first) out->push_back(',');
-        first = false;
-        AppendJson(item, out);
-      }
-      out->push_back(']');
-      return;
-    }
-    case Type::binary:
-    case Type::discarded:
-      AppendWithNlohmann(value, out);
-      return;
-  }
-}
-
-namespace {
-
 // Serialize(body) appended to *out, on a string the caller sized.
-void SerializeInto(const nlohmann::json& body, std::string* out) { AppendJson(body, out); }
+void SerializeInto(const nlohmann::json& body, std::string* out) { api::AppendJson(body, out); }
 
 }  // namespace
 

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/error_code.hpp"
+#include "api/json_text.hpp"
 #include "api/response.hpp"
 #include "server/request_stream.hpp"
 #include "server/static_files.hpp"
@@ -24,11 +25,8 @@ namespace sweetspot::server::http {
 /// One JSON body: never throws on invalid UTF-8 (replaced instead).
 std::string Serialize(const nlohmann::json& body);
 
-/// `value` appended to *out exactly as Serialize writes it (nlohmann's compact dump, invalid
-/// UTF-8 replaced), without nlohmann's character-at-a-time output for the common case:
-/// objects, arrays, numbers and printable ASCII strings are written here, other strings by
-/// nlohmann's escaping.
-void AppendJson(const nlohmann::json& value, std::string* out);
+/// `value` appended to *out exactly as Serialize writes it (api/json_text.hpp).
+using api::AppendJson;
 
 /// The text of a caught exception, for the log.
 std::string WhatOf(const std::exception_ptr& caught);

@@ -2,9 +2,9 @@
 // and the shared request plumbing (body parsing, provenance).
 #include <cstddef>
 #include <cstdint>
-#include <memory>
 
 #include "api/handlers/handlers.hpp"
+#include "api/json_text.hpp"
 #include "api/openapi_document.hpp"
 #include "core/version.hpp"
 
@@ -47,38 +47,11 @@ Response HandleVersion(const Request&, const Context&) {
   };
 }
 
-namespace {
-
-// FNV-1a 64 of the bytes nlohmann's serializer writes, taken as they are written (the dump
-// is never held as a string).
-class Fnv1a64Output : public nlohmann::detail::output_adapter_protocol<char> {
- public:
-  void write_character(char c) override { Add(c); }
-  void write_characters(const char* s, std::size_t length) override {
-    for (std::size_t i = 0; i < length; ++i) Add(s[i]);
-  }
-  std::uint64_t hash() const { return hash_; }
-
- private:
-  void Add(char c) {
-    hash_ ^= static_cast<unsigned char>(c);
-    hash_ *= 1099511628211ULL;
-  }
-  std::uint64_t hash_ = 1469598103934665603ULL;
-};
-
-}  // namespace
-
 std::string InputHash(const nlohmann::json& canonical_input) {
   // FNV-1a 64 over the compact dump (nlohmann objects keep keys sorted, so the
-  // dump is canonical): dump(-1, ' ', false, replace)'s bytes, hashed as the serializer
-  // writes them. An identity key for reproduction, not a security hash.
-  const auto output = std::make_shared<Fnv1a64Output>();
-  nlohmann::detail::serializer<nlohmann::json> serializer(
-      output, ' ', nlohmann::json::error_handler_t::replace);
-  serializer.dump(canonical_input, /*pretty_print=*/false, /*ensure_ascii=*/false,
-                  /*indent_step=*/0);
-  std::uint64_t hash = output->hash();
+  // dump is canonical): dump(-1, ' ', false, replace)'s bytes, hashed as they are written
+  // (api/json_text.hpp). An identity key for reproduction, not a security hash.
+  std::uint64_t hash = JsonFnv1a64(canonical_input);
   std::string out = "fnv1a64:0000000000000000";  // 16 hex digits, most significant first
   static constexpr char kHex[] = "0123456789abcdef";
   for (std::size_t i = out.size(); hash != 0; hash >>= 4) out[--i] = kHex[hash & 0xf];
