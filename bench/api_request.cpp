@@ -1,8 +1,8 @@
 // The API side of bench/http_bench.sh's request, without the network: the contract's example
-// POST /v1/sweet-spot (max_exit_speed) through the handler and its answer's text, and the two
-// pieces api/json_text.hpp writes (the answer's text, the provenance's input hash). The HTTP
-// server's CPU per request is this plus the socket, epoll and framing work
-// (bench/cpu_per_request.sh; docs/http-bench.md).
+// POST /v1/sweet-spot (max_exit_speed) through the handler and its answer's text; the two pieces
+// api/json_text.hpp writes (the answer's text, the provenance's input hash); and the body read by
+// nlohmann's parser with and without its tree. The HTTP server's CPU per request is this plus
+// the socket, epoll and framing work (bench/cpu_per_request.sh; docs/http-bench.md).
 #include <benchmark/benchmark.h>
 
 #include <string>
@@ -55,5 +55,23 @@ void BM_ExampleInputHash(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(sweetspot::api::InputHash(body));
 }
 BENCHMARK(BM_ExampleInputHash);
+
+// nlohmann's parser over the example body without building anything (json::accept): the
+// least any reading of the body with the one JSON library the dependency rules allow costs.
+void BM_ExampleBodyAccept(benchmark::State& state) {
+  const std::string body = kExample;
+  for (auto _ : state) benchmark::DoNotOptimize(nlohmann::json::accept(body));
+}
+BENCHMARK(BM_ExampleBodyAccept);
+
+// The same body parsed into nlohmann's tree and destroyed.
+void BM_ExampleBodyParse(benchmark::State& state) {
+  const std::string body = kExample;
+  for (auto _ : state) {
+    auto tree = nlohmann::json::parse(body);
+    benchmark::DoNotOptimize(tree);
+  }
+}
+BENCHMARK(BM_ExampleBodyParse);
 
 }  // namespace
