@@ -344,15 +344,12 @@ const ObjectReader::Member* ObjectReader::Find(std::string_view key) const {
   return nullptr;
 }
 
-void ObjectReader::Mark(std::string_view key) {
+const ObjectReader::Member* ObjectReader::Mark(std::string_view key) {
   asked_.append(key);
   asked_.push_back('\0');
-  for (Member& m : members_) {
-    if (m.key == key) {
-      m.asked = true;
-      return;
-    }
-  }
+  const Member* m = Find(key);
+  if (m != nullptr) members_[static_cast<std::size_t>(m - members_.data())].asked = true;
+  return m;
 }
 
 std::vector<std::string> ObjectReader::AskedNames() const {
@@ -386,8 +383,7 @@ bool ObjectReader::Has(std::string_view key) { return Get(key) != nullptr; }
 
 const nlohmann::json* ObjectReader::Get(std::string_view key) {
   if (!value_->is_object()) return nullptr;
-  Mark(key);
-  const Member* m = Find(key);
+  const Member* m = Mark(key);
   return m != nullptr ? m->value : nullptr;
 }
 
@@ -422,9 +418,8 @@ const nlohmann::json* ObjectReader::GetInUnits(std::string_view key, std::string
   const nlohmann::json* found = Get(key);
   if (!value_->is_object() || !HasTradeSpelling()) return found;
   for (const TradeForm& form : TradeForms(key)) {
-    const Member* member = Find(form.key);
-    if (member == nullptr) continue;
-    Mark(form.key);
+    if (Find(form.key) == nullptr) continue;
+    const Member* member = Mark(form.key);
     if (found != nullptr) {
       // Exactly one form per quantity: two could disagree.
       Fail(form.key, "cannot be given together with " + PathOf(*given_as) +

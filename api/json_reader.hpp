@@ -146,8 +146,9 @@ class ObjectReader {
   // "known" list and the "did you mean" of an unknown-field error, sorted and made unique only
   // then. One string instead of a set node per name.
   std::string asked_;
-  // Records that `key` was asked for: appends it to asked_ and marks its member.
-  void Mark(std::string_view key);
+  // Records that `key` was asked for: appends it to asked_, marks its member and returns it
+  // (nullptr when the object has none).
+  const Member* Mark(std::string_view key);
   // The member named `key`, or nullptr.
   const Member* Find(std::string_view key) const;
   // The names in asked_, sorted and unique.

@@ -7,15 +7,12 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <charconv>
-#include <cmath>
 #include <cstdint>
 #include <chrono>
 #include <exception>
 #include <memory>
 #include <thread>
 
-#include "api/json_text.hpp"
 #include "api/router.hpp"
 #include "core/geometry_format.hpp"
 #include "server/cpu_quota.hpp"
