@@ -10,15 +10,10 @@
 namespace sweetspot::api {
 namespace {
 
-// One value through nlohmann's own serializer (what dump(-1, ' ', false, replace) writes):
-// for what the writer does not write itself.
+// One value as nlohmann's compact dump writes it (invalid UTF-8 replaced): for what the writer
+// does not write itself.
 std::string DumpWithNlohmann(const nlohmann::json& value) {
-  std::string out;
-  nlohmann::detail::serializer<nlohmann::json> serializer(
-      nlohmann::detail::output_adapter<char, std::string>(out), ' ',
-      nlohmann::json::error_handler_t::replace);
-  serializer.dump(value, /*pretty_print=*/false, /*ensure_ascii=*/false, /*indent_step=*/0);
-  return out;
+  return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 // The bytes nlohmann's escaping leaves as they are: printable ASCII but '"' and '\\'.
