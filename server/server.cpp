@@ -51,8 +51,10 @@ struct Server::Impl {
   /// Answers a request for the API or the static files; `body` is the request's body (the
   /// bytes the connection loop received, or what httplib read on its own path).
   void Answer(const httplib::Request& req, std::string_view body, httplib::Response& res);
-  /// The pre-routing hook: CORS, the token, refusals, then Answer() with the loop's bytes.
-  httplib::Server::HandlerResponse PreRoute(const httplib::Request& req, httplib::Response& res);
+  /// The pre-routing hook's work: CORS, the token, refusals, then Answer() with the loop's
+  /// bytes; `path` is LeanPathOf(req, the stream), found once by the caller.
+  httplib::Server::HandlerResponse PreRoute(const httplib::Request& req, httplib::Response& res,
+                                            LeanPath path);
   /// Serves one request the connection loop framed: parsed from the loop's bytes, answered
   /// by PreRoute, its head and body written here as httplib would write them; httplib's
   /// own request handling for what this leaves to it (ServeDirect's comment).
@@ -225,13 +227,7 @@ void Server::Impl::Answer(const httplib::Request& req, std::string_view body,
   // Content-Encoding body httplib decodes, no loop framing) take httplib's own path to
   // the same handler, as before.
 httplib::Server::HandlerResponse Server::Impl::PreRoute(const httplib::Request& req,
-                                                      httplib::Response& res) {
-  if (computed_answer != nullptr) {
-    res = std::move(*computed_answer);
-    computed_answer = nullptr;
-    return httplib::Server::HandlerResponse::Handled;
-  }
-  RequestStream* stream = RequestStream::Current();
+                                                      httplib::Response& res, LeanPath path) {
   if (!config.cors_origin.empty()) {
     const std::string origin = req.get_header_value("Origin");
     if (config.cors_origin == "*" || origin == config.cors_origin) {
@@ -270,8 +266,8 @@ httplib::Server::HandlerResponse Server::Impl::PreRoute(const httplib::Request& 
                      res);
     return httplib::Server::HandlerResponse::Handled;
   }
-  const LeanPath path = LeanPathOf(req, stream);
   if (path == LeanPath::kHttplib) return httplib::Server::HandlerResponse::Unhandled;
+  const RequestStream* stream = RequestStream::Current();
   std::string_view body;
   if (path == LeanPath::kWithBody) {
     // httplib's payload limit, from the head alone (the loop did not read such a body).
@@ -291,7 +287,12 @@ httplib::Server::HandlerResponse Server::Impl::PreRoute(const httplib::Request& 
 // it, the envelope of the statuses it produces itself, its logger and exception handler.
 void Server::Impl::InstallHandlers() {
   http.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
-    return PreRoute(req, res);
+    if (computed_answer != nullptr) {  // ServeDirect's answer, for httplib to write
+      res = std::move(*computed_answer);
+      computed_answer = nullptr;
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return PreRoute(req, res, LeanPathOf(req, RequestStream::Current()));
   });
 
   // httplib's own path (see above): its regex routing, the body it read.
@@ -378,9 +379,11 @@ bool Server::Impl::ServeDirect(RequestStream& stream, bool close_connection,
                                bool* connection_closed) {
   httplib::Request req;
   if (!ParseFramedHead(stream.request().substr(0, stream.head_bytes()), &req) ||
-      req.has_header("Accept-Encoding") || LeanPathOf(req, &stream) == LeanPath::kHttplib) {
+      req.has_header("Accept-Encoding")) {
     return http.ServeOne(stream, close_connection, connection_closed);
   }
+  const LeanPath path = LeanPathOf(req, &stream);
+  if (path == LeanPath::kHttplib) return http.ServeOne(stream, close_connection, connection_closed);
   const std::string connection = req.get_header_value("Connection");
   const bool closed =
       connection == "close" || (req.version == "HTTP/1.0" && connection != "Keep-Alive");
@@ -388,7 +391,7 @@ bool Server::Impl::ServeDirect(RequestStream& stream, bool close_connection,
   httplib::Response res;
   res.version = "HTTP/1.1";
   try {
-    PreRoute(req, res);
+    PreRoute(req, res, path);
   } catch (...) {
     OnException(req, res, std::current_exception());
   }
