@@ -9,8 +9,9 @@
 #
 #   bench/cpu_vs_nginx.sh [SERVER_BINARY] [SECONDS]
 #
-# Prints one line per server: requests/s, server and wrk microseconds per request, their sum;
-# then the ratio of the rates and of the sums, and the load average.
+# Prints one line per server: requests/s, server and wrk microseconds per request, their sum,
+# and the server's voluntary and involuntary context switches per request (its threads or
+# workers summed); then the ratio of the rates and of the sums, and the load average.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 server="${1:-build/server/sweetspot-server}"
@@ -42,25 +43,36 @@ ticks() {
   for p in "$@"; do total=$((total + $(awk '{print $14 + $15}' "/proc/$p/stat"))); done
   echo "$total"
 }
-# One measured run: prints "requests/s server_us wrk_us".
+# The context switches of the processes' threads, summed: "voluntary involuntary".
+switches() {
+  local p
+  for p in "$@"; do cat /proc/"$p"/task/*/status; done |
+    awk '/^voluntary_ctxt_switches/ {v += $2} /^nonvoluntary_ctxt_switches/ {n += $2}
+         END {print v, n}'
+}
+# One measured run: prints "requests/s server_us wrk_us voluntary/request involuntary/request".
 measure() {
-  local target="$1" script="$2" before after out requests wrk_s
+  local target="$1" script="$2" before after out requests wrk_s v0 n0 v1 n1
   shift 2
   wrk -t2 -c8 -d1s -s "$script" "$target" >/dev/null  # warm-up
   before="$(ticks "$@")"
+  read -r v0 n0 <<<"$(switches "$@")"
   out="$({ /usr/bin/time -f "WRK_CPU %U %S" wrk -t2 -c8 -d"${seconds}s" -s "$script" "$target"; } 2>&1)"
   after="$(ticks "$@")"
+  read -r v1 n1 <<<"$(switches "$@")"
   requests="$(echo "$out" | awk '/requests in/ {print $1}')"
   wrk_s="$(echo "$out" | awk '/WRK_CPU/ {print $2 + $3}')"
   awk -v r="$requests" -v t="$((after - before))" -v hz="$(getconf CLK_TCK)" -v w="$wrk_s" \
-      -v s="$seconds" 'BEGIN { printf "%.0f %.2f %.2f\n", r / s, 1e6 * t / hz / r, 1e6 * w / r }'
+      -v s="$seconds" -v v="$((v1 - v0))" -v n="$((n1 - n0))" \
+      'BEGIN { printf "%.0f %.2f %.2f %.3f %.3f\n", r / s, 1e6 * t / hz / r, 1e6 * w / r, v / r, n / r }'
 }
-read -r s_rps s_us s_wrk <<<"$(measure "$url" "$work/post.lua" "$pid")"
+read -r s_rps s_us s_wrk s_vol s_inv <<<"$(measure "$url" "$work/post.lua" "$pid")"
 # shellcheck disable=SC2046
-read -r n_rps n_us n_wrk <<<"$(measure "$static_url" "$work/get.lua" $(pgrep -P "$nginx_pid"))"
+read -r n_rps n_us n_wrk n_vol n_inv <<<"$(measure "$static_url" "$work/get.lua" $(pgrep -P "$nginx_pid"))"
 awk -v a="$s_rps" -v b="$s_us" -v c="$s_wrk" -v d="$n_rps" -v e="$n_us" -v f="$n_wrk" \
+    -v sv="$s_vol" -v si="$s_inv" -v nv="$n_vol" -v ni="$n_inv" \
     -v load="$(cut -d' ' -f1 /proc/loadavg)" 'BEGIN {
-  printf "sweetspot  requests/s %6d  server_us %6.2f  wrk_us %5.2f  sum %6.2f\n", a, b, c, b + c
-  printf "nginx      requests/s %6d  server_us %6.2f  wrk_us %5.2f  sum %6.2f\n", d, e, f, e + f
+  printf "sweetspot  requests/s %6d  server_us %6.2f  wrk_us %5.2f  sum %6.2f  switches/request %.3f + %.3f\n", a, b, c, b + c, sv, si
+  printf "nginx      requests/s %6d  server_us %6.2f  wrk_us %5.2f  sum %6.2f  switches/request %.3f + %.3f\n", d, e, f, e + f, nv, ni
   printf "rate ratio %.2f  inverse ratio of the sums %.2f  load %s\n", a / d, (e + f) / (b + c), load
 }'
