@@ -374,32 +374,41 @@ const char* InertiaModelName(core::InertiaModel model) {
   return model == core::InertiaModel::kSlenderRod ? "slender_rod" : "rigid_body";
 }
 
+template <class Out>
+void WriteProperties(const core::MassProperties& p, double length_m,
+                     std::optional<double> pivot_from_knob_m, Out& out) {
+  // In key order (the text writer then only checks it).
+  out.Set("balance_point_m", p.balance_point_m);
+  out.Object("imperial", [&](Out& in_imperial) {
+    const core::ImperialProperties imperial = core::ToImperial(p, length_m);
+    in_imperial.Set("balance_point_in", imperial.balance_point_in);
+    in_imperial.Set("drop", imperial.drop);
+    in_imperial.Set("length_in", imperial.length_in);
+    in_imperial.Set("moi_centroid_oz_in2", imperial.moi_centroid_oz_in2);
+    in_imperial.Set("moi_knob_oz_in2", imperial.moi_knob_oz_in2);
+    in_imperial.Set("moi_six_inch_oz_in2", imperial.moi_six_inch_oz_in2);
+    in_imperial.Set("weight_oz", imperial.weight_oz);
+  });
+  out.Set("inertia_model", InertiaModelName(p.inertia_model));
+  out.Set("length_m", length_m);
+  out.Set("mass_kg", p.mass_kg);
+  out.Set("moi_centroid_kg_m2", p.moi_centroid_kg_m2);
+  out.Set("moi_knob_kg_m2", p.moi_knob_kg_m2);
+  if (pivot_from_knob_m) out.Set("moi_pivot_kg_m2", p.MoiAboutKgM2(*pivot_from_knob_m));
+  out.Set("moi_six_inch_kg_m2", p.MoiSixInchKgM2());
+  if (pivot_from_knob_m) out.Set("pivot_from_knob_m", *pivot_from_knob_m);
+  out.Set("volume_m3", p.volume_m3);
+}
+template void WriteProperties(const core::MassProperties&, double, std::optional<double>,
+                              TreeObject&);
+template void WriteProperties(const core::MassProperties&, double, std::optional<double>,
+                              TextObject&);
+
 Json PropertiesToJson(const core::MassProperties& p, double length_m,
                       std::optional<double> pivot_from_knob_m) {
-  const core::ImperialProperties imperial = core::ToImperial(p, length_m);
-  // Member by member: an initializer list would wrap each pair in an array first.
-  Json in_imperial = Json::object();
-  in_imperial.emplace("length_in", imperial.length_in);
-  in_imperial.emplace("weight_oz", imperial.weight_oz);
-  in_imperial.emplace("drop", imperial.drop);
-  in_imperial.emplace("balance_point_in", imperial.balance_point_in);
-  in_imperial.emplace("moi_knob_oz_in2", imperial.moi_knob_oz_in2);
-  in_imperial.emplace("moi_six_inch_oz_in2", imperial.moi_six_inch_oz_in2);
-  in_imperial.emplace("moi_centroid_oz_in2", imperial.moi_centroid_oz_in2);
   Json out = Json::object();
-  out.emplace("mass_kg", p.mass_kg);
-  out.emplace("balance_point_m", p.balance_point_m);
-  out.emplace("moi_knob_kg_m2", p.moi_knob_kg_m2);
-  out.emplace("moi_six_inch_kg_m2", p.MoiSixInchKgM2());
-  out.emplace("moi_centroid_kg_m2", p.moi_centroid_kg_m2);
-  out.emplace("volume_m3", p.volume_m3);
-  out.emplace("length_m", length_m);
-  out.emplace("inertia_model", InertiaModelName(p.inertia_model));
-  out.emplace("imperial", std::move(in_imperial));
-  if (pivot_from_knob_m) {
-    out["pivot_from_knob_m"] = *pivot_from_knob_m;
-    out["moi_pivot_kg_m2"] = p.MoiAboutKgM2(*pivot_from_knob_m);
-  }
+  TreeObject tree(&out);
+  WriteProperties(p, length_m, pivot_from_knob_m, tree);
   return out;
 }
 

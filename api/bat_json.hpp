@@ -9,6 +9,7 @@
 #include <string>
 
 #include "api/json_reader.hpp"
+#include "api/json_writer.hpp"
 #include "api/limits.hpp"
 #include "core/bat/bat.hpp"
 #include "core/bat/mass_properties.hpp"
@@ -67,6 +68,10 @@ nlohmann::json BatToJson(const core::Bat& bat);
 /// when `pivot_from_knob_m` is set), the inertia model and an "imperial" block.
 nlohmann::json PropertiesToJson(const core::MassProperties& properties, double length_m,
                                 std::optional<double> pivot_from_knob_m = std::nullopt);
+/// The same members written to `out` (api/json_writer.hpp's Out: TreeObject or TextObject).
+template <class Out>
+void WriteProperties(const core::MassProperties& properties, double length_m,
+                     std::optional<double> pivot_from_knob_m, Out& out);
 
 /// "rigid_body" or "slender_rod".
 const char* InertiaModelName(core::InertiaModel model);

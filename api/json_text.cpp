@@ -1,5 +1,10 @@
-// JSON text written through a buffer (api/json_text.hpp).
+// JSON text written through a buffer (api/json_text.hpp), and JsonWriter
+// (api/json_writer.hpp), which writes numbers and strings the same way.
 #include "api/json_text.hpp"
+
+#include <algorithm>
+
+#include "api/json_writer.hpp"
 
 #include <array>
 #include <charconv>
@@ -162,6 +167,190 @@ std::uint64_t JsonFnv1a64(const nlohmann::json& value) {
     writer.Value(value);
   }  // the writer's last bytes reach the hash here
   return hash;
+}
+
+// ---- JsonWriter ----
+
+JsonWriter::JsonWriter(std::string* out) : out_(out) {
+  frames_.reserve(8);
+  members_.reserve(48);
+}
+
+void JsonWriter::BeforeValue() {
+  if (frames_.empty()) return;
+  Frame& frame = frames_.back();
+  if (frame.object) return;  // Key wrote the comma
+  if (!frame.empty) out_->push_back(',');
+  frame.empty = false;
+}
+
+void JsonWriter::BeginObject() {
+  BeforeValue();
+  frames_.push_back({true, true, out_->size(), members_.size()});
+  out_->push_back('{');
+}
+
+void JsonWriter::EndObject() {
+  const Frame frame = frames_.back();
+  frames_.pop_back();
+  SortMembers(frame);
+  members_.resize(frame.first_member);
+  if (members_.size() == 0) raw_keys_.clear();
+  out_->push_back('}');
+}
+
+void JsonWriter::BeginArray() {
+  BeforeValue();
+  frames_.push_back({false, true, out_->size(), members_.size()});
+  out_->push_back('[');
+}
+
+void JsonWriter::EndArray() {
+  frames_.pop_back();
+  out_->push_back(']');
+}
+
+void JsonWriter::Key(std::string_view key) {
+  Frame& frame = frames_.back();
+  Member member;
+  member.key_size = key.size();
+  const bool plain = std::all_of(key.begin(), key.end(),
+                                 [](char c) { return kPlain[static_cast<unsigned char>(c)]; });
+  if (plain) {  // [,]"key": in one step
+    const std::size_t at = out_->size();
+    const std::size_t comma = frame.empty ? 0 : 1;
+    out_->resize(at + comma + key.size() + 3);
+    char* p = out_->data() + at;
+    if (comma != 0) *p++ = ',';
+    member.begin = at + comma;
+    *p++ = '"';
+    member.key = member.begin + 1;
+    std::memcpy(p, key.data(), key.size());
+    p += key.size();
+    *p++ = '"';
+    *p = ':';
+  } else {
+    if (!frame.empty) out_->push_back(',');
+    member.begin = out_->size();
+    member.raw = true;
+    member.key = raw_keys_.size();
+    raw_keys_.append(key);
+    Escaped(key);
+    out_->push_back(':');
+  }
+  frame.empty = false;
+  members_.push_back(member);
+}
+
+std::string_view JsonWriter::KeyOf(const Member& member) const {
+  const std::string& from = member.raw ? raw_keys_ : *out_;
+  return std::string_view(from).substr(member.key, member.key_size);
+}
+
+void JsonWriter::SortMembers(const Frame& frame) {
+  const std::size_t first = frame.first_member;
+  const std::size_t n = members_.size() - first;
+  bool sorted = true;
+  for (std::size_t i = first + 1; i < members_.size() && sorted; ++i) {
+    sorted = KeyOf(members_[i - 1]) < KeyOf(members_[i]);
+  }
+  if (sorted) return;  // the usual case: renderers write their members in key order
+  // An insertion sort (an object has tens of members at most), stable: of equal keys the one
+  // written last ends last.
+  order_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = first + k;
+    std::size_t j = k;
+    for (; j > 0 && KeyOf(members_[i]) < KeyOf(members_[order_[j - 1]]); --j) {
+      order_[j] = order_[j - 1];
+    }
+    order_[j] = i;
+  }
+  // A key written again replaces the earlier value: of equal keys the last is kept (marked by
+  // a member index past the end).
+  for (std::size_t k = 0; k + 1 < n; ++k) {
+    if (KeyOf(members_[order_[k]]) == KeyOf(members_[order_[k + 1]])) order_[k] = members_.size();
+  }
+  // Each member's text runs from its quote to the comma before the next (the last: to the end).
+  const std::size_t body = frame.open + 1;
+  scratch_.assign(*out_, body, std::string::npos);
+  out_->resize(body);
+  bool any = false;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = order_[k];
+    if (i == members_.size()) continue;
+    const std::size_t begin = members_[i].begin - body;
+    const std::size_t end =
+        i + 1 < members_.size() ? members_[i + 1].begin - 1 - body : scratch_.size();
+    if (any) out_->push_back(',');
+    any = true;
+    out_->append(scratch_, begin, end - begin);
+  }
+}
+
+void JsonWriter::Number(double value) {
+  BeforeValue();
+  if (!std::isfinite(value)) {
+    out_->append("null", 4);
+    return;
+  }
+  char digits[64];
+  const char* end = nlohmann::detail::to_chars(digits, digits + sizeof digits, value);
+  out_->append(digits, static_cast<std::size_t>(end - digits));
+}
+
+void JsonWriter::Integer(std::int64_t value) {
+  BeforeValue();
+  char digits[24];
+  const auto written = std::to_chars(digits, digits + sizeof digits, value);
+  out_->append(digits, static_cast<std::size_t>(written.ptr - digits));
+}
+
+void JsonWriter::Unsigned(std::uint64_t value) {
+  BeforeValue();
+  char digits[24];
+  const auto written = std::to_chars(digits, digits + sizeof digits, value);
+  out_->append(digits, static_cast<std::size_t>(written.ptr - digits));
+}
+
+void JsonWriter::Bool(bool value) {
+  BeforeValue();
+  value ? out_->append("true", 4) : out_->append("false", 5);
+}
+
+void JsonWriter::Null() {
+  BeforeValue();
+  out_->append("null", 4);
+}
+
+void JsonWriter::String(std::string_view text) {
+  BeforeValue();
+  for (const char c : text) {
+    if (!kPlain[static_cast<unsigned char>(c)]) {
+      Escaped(text);
+      return;
+    }
+  }
+  const std::size_t at = out_->size();
+  out_->resize(at + text.size() + 2);
+  char* p = out_->data() + at;
+  *p++ = '"';
+  std::memcpy(p, text.data(), text.size());
+  p[text.size()] = '"';
+}
+
+void JsonWriter::Escaped(std::string_view text) {
+  out_->append(DumpWithNlohmann(nlohmann::json(std::string(text))));
+}
+
+void JsonWriter::Value(const nlohmann::json& value) {
+  BeforeValue();
+  AppendJson(value, out_);
+}
+
+void JsonWriter::Raw(std::string_view json_text) {
+  BeforeValue();
+  out_->append(json_text);
 }
 
 }  // namespace sweetspot::api

@@ -44,7 +44,11 @@ struct Response {
   int status = 200;          ///< HTTP status code.
   nlohmann::json body;       ///< JSON body (never contains NaN or Infinity).
   std::string text;          ///< A non-JSON body, used when content_type is set.
-  std::string content_type;  ///< Empty = application/json with `body`.
+  std::string content_type;  ///< Empty = application/json with `body` (or `json_text`).
+  /// The JSON answer already written as compact text (api/json_writer.hpp), in place of
+  /// `body` (null then): the bytes AppendJson would write for the tree. Only a caller that
+  /// sets Context::answer_text gets one (the server); content_type stays empty.
+  std::string json_text;
   /// When set, the body (of `content_type`) is produced by calling this with a
   /// sink, chunk by chunk, after the status has been sent; it returns false
   /// when it stopped early. It must not throw and owns everything it uses.

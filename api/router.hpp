@@ -69,6 +69,10 @@ struct Context {
   /// compact text the server would send, a row at a time) instead of building it in memory,
   /// so that the job service can write it to its store as it is produced.
   bool stream_json = false;
+  /// True when the answer is sent as text at once (the server's HTTP answers): a typed
+  /// endpoint with a text writer (Endpoint::write) answers 200 with Response::json_text
+  /// instead of a tree. False: every answer is a tree (the CLI, jobs, the tests).
+  bool answer_text = false;
 };
 
 /// What answering a request costs, for the server's choice of worker pool.

@@ -9,6 +9,7 @@
 
 #include "api/bat_json.hpp"
 #include "api/json_reader.hpp"
+#include "api/json_writer.hpp"
 #include "core/scene/collide.hpp"
 #include "core/scene/evaluate_scene.hpp"
 
@@ -23,6 +24,9 @@ bool ReadSceneCommon(ObjectReader& reader, core::Scene* scene);
 /// The resolved swing a scene answer echoes: {angular_speed_rad_s, pivot_from_knob_m,
 /// hands_from_knob_m} plus {bat_speed_mps, bat_speed_from_tip_m} when the bat speed set it.
 nlohmann::json SwingToJson(const core::Swing& swing);
+/// The same members written to `out` (api/json_writer.hpp's Out: TreeObject or TextObject).
+template <class Out>
+void WriteSwing(const core::Swing& swing, Out& out);
 
 /// Reads "outputs" (an array of output names; default ["max_exit_speed"]).
 bool ReadOutputs(ObjectReader& reader, core::Scene* scene);
@@ -73,6 +77,9 @@ Response SceneFailure(const core::Summary& summary, const std::string& missing_m
 /// The summary block {termination, message, backend, raw_status, iterations,
 /// evaluations, error_estimate, solve_time_s, models_used, warnings}.
 nlohmann::json SummaryToJson(const core::Summary& summary);
+/// The same members written to `out` (TreeObject or TextObject).
+template <class Out>
+void WriteSummary(const core::Summary& summary, Out& out);
 
 /// The `barrel` output (hoop mode, stiffness, effective COR along the barrel); null hoop fields
 /// for a solid bat.

@@ -13,59 +13,77 @@ using Json = nlohmann::json;
 
 }  // namespace
 
-Json SwingToJson(const core::Swing& swing) {
-  Json out = Json::object();  // member by member: no initializer list's arrays
-  out.emplace("angular_speed_rad_s", swing.angular_speed_rad_s);
-  out.emplace("pivot_from_knob_m", swing.pivot_from_knob_m);
-  out.emplace("hands_from_knob_m", swing.hands_from_knob_m);
+template <class Out>
+void WriteSwing(const core::Swing& swing, Out& out) {
+  out.Set("angular_speed_rad_s", swing.angular_speed_rad_s);  // the three in key order
+  out.Set("hands_from_knob_m", swing.hands_from_knob_m);
+  out.Set("pivot_from_knob_m", swing.pivot_from_knob_m);
   if (swing.bat_speed_mps.has_value()) {
-    out["bat_speed_mps"] = *swing.bat_speed_mps;
-    out["bat_speed_from_tip_m"] = swing.bat_speed_from_tip_m;
+    out.Set("bat_speed_mps", *swing.bat_speed_mps);
+    out.Set("bat_speed_from_tip_m", swing.bat_speed_from_tip_m);
     // A resolved swing that is not the plain fixed speed at a distance says how it was
     // resolved (an answer's swing without these is a fixed speed at bat_speed_from_tip_m).
     const core::SwingResolution* how =
         swing.resolution.has_value() ? &*swing.resolution : nullptr;
     if (swing.bat_speed_point == core::BatSpeedPoint::kSweetSpot) {
-      out["bat_speed_point"] = core::BatSpeedPointName(swing.bat_speed_point);
+      out.Set("bat_speed_point", core::BatSpeedPointName(swing.bat_speed_point));
       if (how != nullptr) {
-        out["bat_speed_point_model"] = how->point_model;
+        out.Set("bat_speed_point_model", how->point_model);
         if (how->iterations > 0) {  // hertz, flexible: iterated to the model's own maximum
-          out["bat_speed_point_iterations"] = how->iterations;
-          out["bat_speed_point_error_mps"] = how->speed_error_mps;
+          out.Set("bat_speed_point_iterations", how->iterations);
+          out.Set("bat_speed_point_error_mps", how->speed_error_mps);
         }
       }
     }
     if (swing.speed_model == core::SwingSpeedModel::kSwingWeight) {
-      out["speed_model"] = core::SwingSpeedModelName(swing.speed_model);
+      out.Set("speed_model", core::SwingSpeedModelName(swing.speed_model));
       if (how != nullptr) {
-        out["swing_weight"] = {{"given_bat_speed_mps", how->given_bat_speed_mps},
-                               {"moi_hands_kg_m2", how->moi_hands_kg_m2},
-                               {"reference_moi_kg_m2", how->reference_moi_kg_m2},
-                               {"exponent", swing.swing_weight_exponent},
-                               {"factor", how->swing_weight_factor},
-                               {"source", core::kSwingWeightSource}};
-        if (!swing.reference_moi_kg_m2.has_value()) {
-          out["swing_weight"]["reference_bat"] = core::kSwingWeightReferenceBat;
-        }
+        out.Object("swing_weight", [&](Out& weight) {
+          weight.Set("given_bat_speed_mps", how->given_bat_speed_mps);
+          weight.Set("moi_hands_kg_m2", how->moi_hands_kg_m2);
+          weight.Set("reference_moi_kg_m2", how->reference_moi_kg_m2);
+          weight.Set("exponent", swing.swing_weight_exponent);
+          weight.Set("factor", how->swing_weight_factor);
+          weight.Set("source", core::kSwingWeightSource);
+          if (!swing.reference_moi_kg_m2.has_value()) {
+            weight.Set("reference_bat", core::kSwingWeightReferenceBat);
+          }
+        });
       }
     }
   }
+}
+template void WriteSwing(const core::Swing&, TreeObject&);
+template void WriteSwing(const core::Swing&, TextObject&);
+
+Json SwingToJson(const core::Swing& swing) {
+  Json out = Json::object();
+  TreeObject tree(&out);
+  WriteSwing(swing, tree);
   return out;
 }
 
+template <class Out>
+void WriteSummary(const core::Summary& s, Out& out) {
+  // In key order (the text writer then only checks it).
+  out.Set("backend", s.backend);
+  out.Set("error_estimate", s.error_estimate);
+  out.Set("evaluations", s.evaluations);
+  out.Set("iterations", s.iterations);
+  out.Set("message", s.message);
+  out.Set("models_used", s.models_used);
+  out.Set("raw_status", s.raw_status);
+  out.Set("solve_time_s", s.solve_time_s);
+  out.Set("termination", core::TerminationName(s.termination));
+  out.Set("warnings", s.warnings);
+}
+template void WriteSummary(const core::Summary&, TreeObject&);
+template void WriteSummary(const core::Summary&, TextObject&);
+
 Json SummaryToJson(const core::Summary& s) {
-  // Member by member: an initializer list would wrap each pair in an array first.
   Json out = Json::object();
-  out.emplace("termination", core::TerminationName(s.termination));
-  out.emplace("message", s.message);
-  out.emplace("backend", s.backend);
-  out.emplace("raw_status", s.raw_status);
-  out.emplace("iterations", s.iterations);
-  out.emplace("evaluations", s.evaluations);
-  out.emplace("error_estimate", s.error_estimate);
-  out.emplace("solve_time_s", s.solve_time_s);
-  out.emplace("models_used", s.models_used);
-  out.emplace("warnings", s.warnings);
+  TreeObject tree(&out);
+  WriteSummary(s, tree);
   return out;
 }
 

@@ -21,7 +21,8 @@ constexpr const char* kExample =
     R"( "speed_mps": 27.7}, "swing": {"angular_speed_rad_s": 17.288, "pivot_from_knob_m": 0.0,)"
     R"( "hands_from_knob_m": 0.1524}, "cor": 0.5, "outputs": ["max_exit_speed"]})";
 
-// The request read, computed and answered, and the answer written as the server writes it.
+// The request read, computed and answered, and the answer's tree written as text (the CLI's
+// path, and the server's before the answers were written as text).
 void BM_ExampleRequest(benchmark::State& state) {
   const Context context;
   std::string text;
@@ -35,6 +36,22 @@ void BM_ExampleRequest(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_ExampleRequest);
+
+// The same request answered as the server answers it (Context::answer_text): the answer written
+// straight to text, without its tree (api/json_writer.hpp).
+void BM_ExampleRequestAsText(benchmark::State& state) {
+  Context context;
+  context.answer_text = true;
+  for (auto _ : state) {
+    auto response = Dispatch({"POST", "/v1/sweet-spot", kExample}, context);
+    if (response.status != 200 || response.json_text.empty()) {
+      state.SkipWithError("the example failed");
+    }
+    benchmark::DoNotOptimize(response.json_text.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_ExampleRequestAsText);
 
 // The example's answer (1.8 kB, 28 doubles) written as text.
 void BM_ExampleAnswerText(benchmark::State& state) {

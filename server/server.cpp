@@ -117,6 +117,7 @@ void Server::Impl::Configure() {
   context.limits.max_job_time_s = config.jobs.max_time_s;
   context.limits.max_job_result_bytes = config.jobs.max_result_bytes;
   context.modes_cache = &modes_cache;
+  context.answer_text = true;  // HTTP answers are sent as text at once (Response::json_text)
   context.draining = [this] { return draining.load(); };
   compute_budget =
       std::make_unique<api::ThreadBudget>(ComputeWorkers(config.compute_threads));
@@ -132,6 +133,7 @@ void Server::Impl::OpenJobs() {
                                const api::Request& inner, core::Progress* progress) {
     api::Context job_context = context;
     job_context.progress = progress;
+    job_context.answer_text = false;  // the job service stores the tree (response_json)
     job_context.batch = true;  // the rows go to the job's result: --max-batch-samples
     job_context.stream_json = true;  // a sweep's rows go to the store as they are made
     // Streamed answers (CSV, NDJSON sweeps) are collected by the job service, which stops

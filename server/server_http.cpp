@@ -136,6 +136,11 @@ void WriteApiResponse(const api::Response& response, httplib::Response& res) {
   if (response.status == 429 || response.status == 503) res.set_header("Retry-After", "1");
   if (!response.content_type.empty()) {
     res.set_content(response.text, response.content_type.c_str());
+  } else if (!response.json_text.empty()) {  // written as text by the endpoint already
+    res.body.reserve(response.json_text.size() + 1);
+    res.body.assign(response.json_text);
+    res.body.push_back('\n');
+    SetContentType(res, "application/json");
   } else {
     // Serialised straight into the answer's body (set_content would copy it once more),
     // with room reserved for the size of this thread's previous answer: the serializer

@@ -28,5 +28,20 @@ Response Answer(nlohmann::json out, const core::Summary* summary,
            {"closest", std::move(out)}}};
 }
 
+void AnswerTail(const core::Summary* summary, const std::optional<ProvenanceInputs>& provenance,
+                const nlohmann::json& body, std::chrono::steady_clock::time_point start,
+                TextObject& out) {
+  if (summary != nullptr) {
+    out.Object("summary", [&](TextObject& block) { WriteSummary(*summary, block); });
+  }
+  if (provenance) {
+    out.Object("provenance", [&](TextObject& block) {
+      WriteProvenance(body, provenance->options, provenance->seed, block);
+    });
+  }
+  out.Set("timing_s",
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+}
+
 }  // namespace endpoint_detail
 }  // namespace sweetspot::api

@@ -10,15 +10,18 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "api/error_code.hpp"
 #include "api/handlers/handlers.hpp"
 #include "api/json_reader.hpp"
+#include "api/json_writer.hpp"
 #include "api/response.hpp"
 #include "api/router.hpp"
 #include "api/trade_units.hpp"
@@ -60,6 +63,12 @@ struct Endpoint {
   std::function<std::optional<Response>(const Req& request, const Result& result)> failure;
   /// The result as the answer's JSON object (without summary, provenance and timing_s).
   std::function<nlohmann::json(const Req& request, const Result& result)> render;
+  /// The same answer written as text (Context::answer_text): the members `render` gives, with
+  /// `warnings` after the result's own in "warnings" (as AppendWarnings adds them to render's
+  /// tree), written to `out`. Optional: empty = the tree's text.
+  std::function<void(const Req& request, const Result& result,
+                     const std::vector<std::string>& warnings, TextObject& out)>
+      write;
   /// The summary to render as "summary" (SummaryToJson); empty when render writes its own
   /// or the endpoint has none.
   std::function<const core::Summary&(const Result& result)> summary;
@@ -84,6 +93,11 @@ namespace endpoint_detail {
 Response Answer(nlohmann::json out, const core::Summary* summary,
                 const std::optional<ProvenanceInputs>& provenance, const nlohmann::json& body,
                 std::chrono::steady_clock::time_point start, const std::optional<Unmet>& unmet);
+
+/// Adds "summary", "provenance" and "timing_s" to `out` as Answer does.
+void AnswerTail(const core::Summary* summary, const std::optional<ProvenanceInputs>& provenance,
+                const nlohmann::json& body, std::chrono::steady_clock::time_point start,
+                TextObject& out);
 
 }  // namespace endpoint_detail
 
@@ -151,16 +165,31 @@ Response ServeEndpoint(const Endpoint<Req, Result>& endpoint, const Request& req
       return std::move(*failed);
     }
   }
-  nlohmann::json out = endpoint.render(*parsed, result);
-  if (endpoint.warnings) AppendWarnings(endpoint.warnings(*parsed, result), &out);
-  if (units == ReportUnits::kImperial) {
-    AddImperial(&out, endpoint.length_m ? endpoint.length_m(*parsed, result) : std::nullopt);
-  }
   const core::Summary* summary = endpoint.summary ? &endpoint.summary(result) : nullptr;
   std::optional<ProvenanceInputs> provenance;
   if (endpoint.provenance) provenance = endpoint.provenance(*parsed, *body);
   std::optional<Unmet> unmet;
   if (endpoint.unmet) unmet = endpoint.unmet(*parsed, result);
+  std::vector<std::string> warnings;
+  if (endpoint.warnings) warnings = endpoint.warnings(*parsed, result);
+  if (context.answer_text && endpoint.write && units == ReportUnits::kSi && !unmet) {
+    Response answer(200, nullptr);
+    static thread_local std::size_t last_bytes = 1024;  // this thread's last text answer's
+    answer.json_text.reserve(last_bytes + last_bytes / 4);
+    {
+      JsonWriter writer(&answer.json_text);
+      TextObject out(&writer);
+      endpoint.write(*parsed, result, warnings, out);
+      endpoint_detail::AnswerTail(summary, provenance, *body, start, out);
+    }  // the object closed, its members sorted
+    last_bytes = std::min<std::size_t>(answer.json_text.size(), std::size_t{1} << 20);
+    return answer;
+  }
+  nlohmann::json out = endpoint.render(*parsed, result);
+  AppendWarnings(warnings, &out);
+  if (units == ReportUnits::kImperial) {
+    AddImperial(&out, endpoint.length_m ? endpoint.length_m(*parsed, result) : std::nullopt);
+  }
   return endpoint_detail::Answer(std::move(out), summary, provenance, *body, start, unmet);
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "api/json_reader.hpp"
+#include "api/json_writer.hpp"
 #include "api/router.hpp"
 
 namespace sweetspot::api {
@@ -64,6 +65,10 @@ std::string InputHash(const nlohmann::json& canonical_input);
 /// The provenance block of a solver result: versions, input hash, options, seed.
 nlohmann::json Provenance(const nlohmann::json& input, const nlohmann::json& options,
                           std::optional<unsigned long long> seed = std::nullopt);
+/// The same members written to `out` (api/json_writer.hpp's Out: TreeObject or TextObject).
+template <class Out>
+void WriteProvenance(const nlohmann::json& input, const nlohmann::json& options,
+                     std::optional<unsigned long long> seed, Out& out);
 
 /// Parses a POST body into a JSON object; on failure the error response.
 std::optional<nlohmann::json> ParseObjectBody(const Request& request, const Context& context,

@@ -58,24 +58,39 @@ std::string InputHash(const nlohmann::json& canonical_input) {
   return out;
 }
 
-nlohmann::json Provenance(const nlohmann::json& input, const nlohmann::json& options,
-                          std::optional<unsigned long long> seed) {
-  // Built member by member (an initializer list wraps each pair in an array first); the
-  // versions are the process's, read once.
+template <class Out>
+void WriteProvenance(const nlohmann::json& input, const nlohmann::json& options,
+                     std::optional<unsigned long long> seed, Out& out) {
+  // The versions are the process's, read once.
   static const std::string sweetspot = core::SweetspotVersion();
   static const std::string eigen = core::EigenVersion();
   static const std::string nlopt = core::NloptVersion();
   static const std::string ipopt = core::IpoptVersion();
-  nlohmann::json libraries = nlohmann::json::object();
-  libraries.emplace("eigen", eigen);
-  libraries.emplace("nlopt", nlopt);
-  libraries.emplace("ipopt", ipopt);
+  // In key order (the text writer then only checks it).
+  out.Set("input_hash", InputHash(input));
+  out.Object("libraries", [&](Out& libraries) {
+    libraries.Set("eigen", eigen);
+    libraries.Set("ipopt", ipopt);
+    libraries.Set("nlopt", nlopt);
+  });
+  out.Set("options", options);
+  if (seed) {
+    out.Set("seed", *seed);
+  } else {
+    out.Set("seed", nullptr);
+  }
+  out.Set("sweetspot_version", sweetspot);
+}
+template void WriteProvenance(const nlohmann::json&, const nlohmann::json&,
+                              std::optional<unsigned long long>, TreeObject&);
+template void WriteProvenance(const nlohmann::json&, const nlohmann::json&,
+                              std::optional<unsigned long long>, TextObject&);
+
+nlohmann::json Provenance(const nlohmann::json& input, const nlohmann::json& options,
+                          std::optional<unsigned long long> seed) {
   nlohmann::json out = nlohmann::json::object();
-  out.emplace("sweetspot_version", sweetspot);
-  out.emplace("libraries", std::move(libraries));
-  out.emplace("input_hash", InputHash(input));
-  out.emplace("options", options);
-  out.emplace("seed", seed ? nlohmann::json(*seed) : nlohmann::json(nullptr));
+  TreeObject tree(&out);
+  WriteProvenance(input, options, seed, tree);
   return out;
 }
 

@@ -60,6 +60,18 @@ std::optional<SweetSpotRequest> ParseSweetSpot(const Json& body, const Context& 
   return request;
 }
 
+// The answer's members: the outputs (WriteSceneResult, with `warnings`), the bat's properties
+// and the resolved swing.
+template <class Out>
+void WriteSweetSpot(const core::SceneResult& result, const std::vector<std::string>& warnings,
+                    Out& out) {
+  WriteSceneResult(result, warnings, out);
+  out.Object("properties", [&](Out& properties) {
+    WriteProperties(result.mass_properties, result.length_m, std::nullopt, properties);
+  });
+  out.Object("swing", [&](Out& swing) { WriteSwing(result.swing, swing); });
+}
+
 const Endpoint<SweetSpotRequest, core::SceneResult>& SweetSpotEndpoint() {
   static const auto endpoint = [] {
     Endpoint<SweetSpotRequest, core::SceneResult> e;
@@ -75,11 +87,14 @@ const Endpoint<SweetSpotRequest, core::SceneResult>& SweetSpotEndpoint() {
                           /*options_object=*/true);
     };
     e.render = [](const SweetSpotRequest&, const core::SceneResult& result) {
-      Json out = SceneResultToJson(result);
-      out["properties"] = PropertiesToJson(result.mass_properties, result.length_m);
-      out["swing"] = SwingToJson(result.swing);
+      Json out = Json::object();
+      TreeObject tree(&out);
+      WriteSweetSpot(result, {}, tree);
       return out;
     };
+    e.write = [](const SweetSpotRequest&, const core::SceneResult& result,
+                 const std::vector<std::string>& warnings,
+                 TextObject& out) { WriteSweetSpot(result, warnings, out); };
     e.summary = [](const core::SceneResult& result) -> const core::Summary& {
       return result.summary;
     };

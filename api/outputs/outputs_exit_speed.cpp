@@ -9,22 +9,25 @@ namespace {
 
 using Json = nlohmann::json;
 
-void RenderMaxExitSpeed(const core::SceneResult& r, Json* out, Json* errors) {
+template <class Out>
+void WriteMaxExitSpeed(const core::SceneResult& r, Out& out, Out& errors) {
   const auto& m = *r.max_exit_speed;
-  // Member by member: an initializer list would wrap each pair in an array first.
-  Json block = Json::object();
-  block.emplace("position_from_knob_m", m.position_from_knob_m);
-  block.emplace("exit_speed_mps", m.exit_speed_mps);
-  block.emplace("placement", core::PlacementName(m.placement));
-  block.emplace("unconstrained_position_from_knob_m", m.unconstrained_position_from_knob_m);
-  block.emplace("model", m.model);
-  block.emplace("method", m.method);
-  if (m.method != "closed_form") block.emplace("summary", SummaryToJson(m.summary));
-  (*out)["max_exit_speed"] = std::move(block);
-  Json error = Json::object();
-  error.emplace("position_m", m.error_estimate_m);
-  error.emplace("exit_speed_mps", m.error_estimate_mps);
-  (*errors)["max_exit_speed"] = std::move(error);
+  // In key order (the text writer then only checks it).
+  out.Object("max_exit_speed", [&](Out& block) {
+    block.Set("exit_speed_mps", m.exit_speed_mps);
+    block.Set("method", m.method);
+    block.Set("model", m.model);
+    block.Set("placement", core::PlacementName(m.placement));
+    block.Set("position_from_knob_m", m.position_from_knob_m);
+    if (m.method != "closed_form") {
+      block.Object("summary", [&](Out& summary) { WriteSummary(m.summary, summary); });
+    }
+    block.Set("unconstrained_position_from_knob_m", m.unconstrained_position_from_knob_m);
+  });
+  errors.Object("max_exit_speed", [&](Out& error) {
+    error.Set("exit_speed_mps", m.error_estimate_mps);
+    error.Set("position_m", m.error_estimate_m);
+  });
 }
 
 void ProbeMaxExitSpeed(core::SceneResult* r) {
@@ -108,9 +111,12 @@ void ProbeExitSpeedCurve(core::SceneResult* r) {
 
 namespace oes = outputs_exit_speed_api;
 
-extern const ApiOutputDecl kMaxExitSpeedApi{
-    core::SceneOutput::kMaxExitSpeed, oes::RenderMaxExitSpeed, oes::ProbeMaxExitSpeed,
-    std::begin(oes::kMaxExitSpeedFields), std::end(oes::kMaxExitSpeedFields)};
+extern const ApiOutputDecl kMaxExitSpeedApi{core::SceneOutput::kMaxExitSpeed,
+                                            RenderTree<oes::WriteMaxExitSpeed<TreeObject>>,
+                                            oes::ProbeMaxExitSpeed,
+                                            std::begin(oes::kMaxExitSpeedFields),
+                                            std::end(oes::kMaxExitSpeedFields),
+                                            oes::WriteMaxExitSpeed<TextObject>};
 
 extern const ApiOutputDecl kSweetZoneApi{core::SceneOutput::kSweetZone, oes::RenderSweetZone,
                                          oes::ProbeSweetZone};

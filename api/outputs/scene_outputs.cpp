@@ -71,31 +71,73 @@ const ApiOutputDecl& ApiOutputDeclaration(core::SceneOutput id) {
   return *ApiById()[static_cast<std::size_t>(id)];
 }
 
+namespace {
+
+// One output's block and error estimates.
+void WriteOutput(const ApiOutputDecl& decl, const core::SceneResult& r, TreeObject& out,
+                 TreeObject& errors) {
+  decl.render(r, out.json(), errors.json());
+}
+
+void WriteOutput(const ApiOutputDecl& decl, const core::SceneResult& r, TextObject& out,
+                 TextObject& errors) {
+  if (decl.write != nullptr) {
+    decl.write(r, out, errors);
+    return;
+  }
+  Json block = Json::object();
+  Json error = Json::object();
+  decl.render(r, &block, &error);
+  for (const auto& [key, value] : block.items()) out.Set(key, value);
+  for (const auto& [key, value] : error.items()) errors.Set(key, value);
+}
+
+}  // namespace
+
+template <class Out>
+void WriteSceneResult(const core::SceneResult& r, const std::vector<std::string>& warnings,
+                      Out& out) {
+  {
+    typename Out::Detached errors;
+    for (const core::SceneOutputDecl* d : core::SceneOutputTable()) {
+      if (d->present(r)) WriteOutput(ApiOutputDeclaration(d->id), r, out, errors.out());
+    }
+    out.Attach("error_estimate", errors);
+  }
+  out.Set("models_used", r.summary.models_used);
+  if (r.exit_speed_model.empty()) {
+    out.Set("exit_speed_model", nullptr);
+  } else {
+    out.Set("exit_speed_model", r.exit_speed_model);
+  }
+  if (!r.model_reason.empty()) out.Set("model_reason", r.model_reason);
+  if (r.cor.has_value()) {  // absent when no requested output uses a COR
+    out.Set("cor", *r.cor);
+    out.Set("cor_source", r.cor_source);
+    if (r.cor_impact_speed_mps) out.Set("cor_impact_speed_mps", *r.cor_impact_speed_mps);
+  }
+  out.Objects("timings", r.timings.size(), [&](std::size_t i, Out& timing) {
+    timing.Set("calls", r.timings[i].calls);  // in key order
+    timing.Set("model", r.timings[i].model);
+    timing.Set("time_s", r.timings[i].time_s);
+  });
+  if (warnings.empty()) {
+    if (!r.summary.warnings.empty()) out.Set("warnings", r.summary.warnings);
+  } else {
+    std::vector<std::string> all = r.summary.warnings;
+    all.insert(all.end(), warnings.begin(), warnings.end());
+    out.Set("warnings", all);
+  }
+}
+template void WriteSceneResult(const core::SceneResult&, const std::vector<std::string>&,
+                               TreeObject&);
+template void WriteSceneResult(const core::SceneResult&, const std::vector<std::string>&,
+                               TextObject&);
+
 Json SceneResultToJson(const core::SceneResult& r) {
   Json out = Json::object();
-  Json errors = Json::object();
-  for (const core::SceneOutputDecl* d : core::SceneOutputTable()) {
-    if (d->present(r)) ApiOutputDeclaration(d->id).render(r, &out, &errors);
-  }
-  out["error_estimate"] = std::move(errors);
-  out["models_used"] = r.summary.models_used;
-  out["exit_speed_model"] = r.exit_speed_model.empty() ? Json(nullptr) : Json(r.exit_speed_model);
-  if (!r.model_reason.empty()) out["model_reason"] = r.model_reason;
-  if (r.cor.has_value()) {  // absent when no requested output uses a COR
-    out["cor"] = *r.cor;
-    out["cor_source"] = r.cor_source;
-    if (r.cor_impact_speed_mps) out["cor_impact_speed_mps"] = *r.cor_impact_speed_mps;
-  }
-  Json timings = Json::array();
-  for (const auto& t : r.timings) {
-    Json timing = Json::object();  // member by member: no initializer list's arrays
-    timing.emplace("model", t.model);
-    timing.emplace("time_s", t.time_s);
-    timing.emplace("calls", t.calls);
-    timings.push_back(std::move(timing));
-  }
-  out["timings"] = std::move(timings);
-  if (!r.summary.warnings.empty()) out["warnings"] = r.summary.warnings;
+  TreeObject tree(&out);
+  WriteSceneResult(r, {}, tree);
   return out;
 }
 

@@ -9,9 +9,11 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
+#include "api/json_writer.hpp"
 #include "core/scene/closed_form_designs.hpp"
 #include "core/scene/evaluate_scene.hpp"
 #include "core/scene/output_id.hpp"
@@ -59,7 +61,19 @@ struct ApiOutputDecl {
   void (*probe)(core::SceneResult* result);
   const DirectField* direct_begin = nullptr;  ///< The fields read directly (may be none).
   const DirectField* direct_end = nullptr;
+  /// The same block and error estimates written as text: the TextObject instance of the
+  /// generic renderer whose TreeObject instance is `render` (RenderTree). Null: `render`'s
+  /// trees are written as they are.
+  void (*write)(const core::SceneResult& result, TextObject& out, TextObject& errors) = nullptr;
 };
+
+/// `render` for a generic renderer F<Out>(result, out, errors): its TreeObject instance.
+template <void (*F)(const core::SceneResult&, TreeObject&, TreeObject&)>
+void RenderTree(const core::SceneResult& result, nlohmann::json* out, nlohmann::json* errors) {
+  TreeObject block(out);
+  TreeObject error(errors);
+  F(result, block, error);
+}
 
 /// Every output's api declaration, in core's table order.
 const std::vector<const ApiOutputDecl*>& ApiOutputTable();
@@ -69,6 +83,11 @@ const ApiOutputDecl& ApiOutputDeclaration(core::SceneOutput id);
 /// The outputs of a scene result, by output name, plus models_used,
 /// error_estimate, timings, cor and properties.
 nlohmann::json SceneResultToJson(const core::SceneResult& result);
+/// The same members written to `out` (TreeObject or TextObject), with `warnings` after the
+/// result's own in "warnings" (as AppendWarnings adds them to SceneResultToJson's).
+template <class Out>
+void WriteSceneResult(const core::SceneResult& result, const std::vector<std::string>& warnings,
+                      Out& out);
 
 /// A result holding every one of `outputs` as its probe fills it (RowShape's).
 core::SceneResult ProbeResult(const std::vector<core::SceneOutput>& outputs);
