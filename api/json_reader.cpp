@@ -159,6 +159,13 @@ Response ToResponse(const ApiError& error) {
 
 std::optional<nlohmann::json> ParseBody(std::string_view body, const ApiLimits& limits,
                                         ApiError* error) {
+  Json plain;
+  if (ReadPlainBody(body, limits, &plain)) return plain;
+  return ParseBodyWithNlohmann(body, limits, error);
+}
+
+std::optional<nlohmann::json> ParseBodyWithNlohmann(std::string_view body, const ApiLimits& limits,
+                                                    ApiError* error) {
   const auto first = body.find_first_not_of(" \t\r\n");
   if (first == std::string_view::npos) return nlohmann::json::object();
   Json root;

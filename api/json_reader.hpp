@@ -34,9 +34,22 @@ Response ToResponse(const ApiError& error);
 /// (InvalidJson, with the parser's position), nesting deeper than
 /// limits.max_json_depth (TooBig), arrays longer than max_array_length and
 /// strings longer than max_string_length (TooBig), numbers out of double range
-/// (InvalidValue). An empty body is read as {}.
+/// (InvalidValue). An empty body is read as {}. A body in JSON's plain subset is read by
+/// ReadPlainBody, anything else by nlohmann's parser (ParseBodyWithNlohmann): the same tree.
 std::optional<nlohmann::json> ParseBody(std::string_view body, const ApiLimits& limits,
                                         ApiError* error);
+
+/// ParseBody with nlohmann's parser alone: the reference ReadPlainBody is tested against (and
+/// what ParseBody falls back to).
+std::optional<nlohmann::json> ParseBodyWithNlohmann(std::string_view body, const ApiLimits& limits,
+                                                    ApiError* error);
+
+/// `body` read into *out without nlohmann's lexer when it keeps to JSON's plain subset:
+/// strings of printable ASCII without escapes, numbers a 64-bit integer or a finite double
+/// holds, within `limits`' depth, array and string lengths. True with *out the tree nlohmann's
+/// parser builds; false (*out untouched) for anything else, valid or not
+/// (api/json_plain_body.cpp).
+bool ReadPlainBody(std::string_view body, const ApiLimits& limits, nlohmann::json* out);
 
 /// A numeric rule: the closed or open interval a value must lie in.
 struct NumberRule {

@@ -1,13 +1,15 @@
 // The API side of bench/http_bench.sh's request, without the network: the contract's example
-// POST /v1/sweet-spot (max_exit_speed) through the handler and its answer's text; the two pieces
-// api/json_text.hpp writes (the answer's text, the provenance's input hash); and the body read by
-// nlohmann's parser with and without its tree. The HTTP server's CPU per request is this plus
+// POST /v1/sweet-spot (max_exit_speed) through the handler and its answer's text (the tree's, and
+// written straight to text as the server answers); the two pieces api/json_text.hpp writes (the
+// answer's text, the provenance's input hash); and the body read by nlohmann's parser with and
+// without its tree, and by ParseBody. The HTTP server's CPU per request is this plus
 // the socket, epoll and framing work (bench/cpu_per_request.sh; docs/http-bench.md).
 #include <benchmark/benchmark.h>
 
 #include <string>
 
 #include "api/handlers/handlers.hpp"
+#include "api/json_reader.hpp"
 #include "api/json_text.hpp"
 #include "api/router.hpp"
 
@@ -90,5 +92,18 @@ void BM_ExampleBodyParse(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_ExampleBodyParse);
+
+// The same body read by ParseBody, as every request's is: ReadPlainBody's tree (the same as
+// nlohmann's parser builds) without nlohmann's lexer (api/json_plain_body.cpp).
+void BM_ExampleParseBody(benchmark::State& state) {
+  const std::string body = kExample;
+  const sweetspot::api::ApiLimits limits;
+  for (auto _ : state) {
+    sweetspot::api::ApiError error;
+    auto tree = sweetspot::api::ParseBody(body, limits, &error);
+    benchmark::DoNotOptimize(tree);
+  }
+}
+BENCHMARK(BM_ExampleParseBody);
 
 }  // namespace

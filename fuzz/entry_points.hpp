@@ -120,6 +120,22 @@ inline int Depth(const nlohmann::json& value) {
   return 0;
 }
 
+// True when `a` and `b` have the same types throughout (nlohmann's == takes 1, 1u and 1.0 as
+// equal; the tree's types reach the answer's bytes).
+inline bool SameTypes(const nlohmann::json& a, const nlohmann::json& b) {
+  if (a.type() != b.type()) return false;
+  if (a.is_object()) {
+    for (auto it = a.begin(), jt = b.begin(); it != a.end(); ++it, ++jt) {
+      if (it.key() != jt.key() || !SameTypes(*it, *jt)) return false;
+    }
+  } else if (a.is_array()) {
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (!SameTypes(a[i], b[i])) return false;
+    }
+  }
+  return true;
+}
+
 // Compact text of `value` for a problem report (cut to 300 bytes).
 inline std::string Excerpt(const nlohmann::json& value) {
   std::string text = value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
@@ -202,6 +218,15 @@ inline Verdict RunParseBody(std::string_view input) {
   const api::ApiLimits limits = FuzzLimits();
   api::ApiError error;
   const auto value = api::ParseBody(input, limits, &error);
+  // ParseBody's plain reader (api/json_plain_body.cpp) answers as nlohmann's parser alone does.
+  api::ApiError reference_error;
+  const auto reference = api::ParseBodyWithNlohmann(input, limits, &reference_error);
+  if (value.has_value() != reference.has_value() ||
+      (value && (*value != *reference || !internal::SameTypes(*value, *reference))) ||
+      (!value &&
+       (error.message != reference_error.message || error.status != reference_error.status))) {
+    return {"ParseBody and ParseBodyWithNlohmann differ", ""};
+  }
   if (!value) {
     if (!error.code) return {"ParseBody refused without an error code", ""};
     if (error.status != 400 && error.status != 413) {
