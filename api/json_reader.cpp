@@ -418,9 +418,9 @@ bool ObjectReader::Missing(std::string_view key) {
   return SetError(error_, ErrorCode::kMissingField, PathOf(key), nullptr, "is required");
 }
 
-const nlohmann::json* ObjectReader::GetInUnits(std::string_view key, std::string* given_as,
+const nlohmann::json* ObjectReader::GetInUnits(std::string_view key, std::string_view* given_as,
                                                double* to_si) {
-  *given_as = std::string(key);
+  *given_as = key;
   *to_si = 1.0;
   const nlohmann::json* found = Get(key);
   if (!value_->is_object() || !HasTradeSpelling()) return found;
@@ -434,7 +434,7 @@ const nlohmann::json* ObjectReader::GetInUnits(std::string_view key, std::string
       return nullptr;
     }
     found = member->value;
-    *given_as = form.key;
+    *given_as = member->key;  // the object's own string (form.key is a temporary's)
     *to_si = form.to_si;
   }
   return found;
@@ -458,7 +458,7 @@ bool ObjectReader::Number(std::string_view key, const NumberRule& rule, double* 
 
 bool ObjectReader::OptionalNumber(std::string_view key, const NumberRule& rule, double* out) {
   if (!ok()) return false;
-  std::string given_as;
+  std::string_view given_as;
   double to_si = 1.0;
   const nlohmann::json* value = GetInUnits(key, &given_as, &to_si);
   if (!ok()) return false;

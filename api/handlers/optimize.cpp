@@ -37,7 +37,7 @@ Json Finite(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 bool ReadRange(ObjectReader& reader, const char* key, std::optional<core::DesignRange>* out) {
   const NumberRule rule = AnyNumber();
   // The SI key or a trade spelling ("mass_oz": {"min": 30, "max": 31}), converted to SI.
-  std::string given_as;
+  std::string_view given_as;
   double to_si = 1.0;
   const Json* value = reader.GetInUnits(key, &given_as, &to_si);
   if (value == nullptr || !reader.ok()) return reader.ok();
