@@ -341,7 +341,6 @@ ObjectReader::ObjectReader(const nlohmann::json& value, std::string path, ApiErr
   for (const auto& [key, member] : value.get_ref<const nlohmann::json::object_t&>()) {
     members_.push_back({key, &member});
   }
-  asked_.reserve(256);  // a scene object asks for some 20 names
 }
 
 const ObjectReader::Member* ObjectReader::Find(std::string_view key) const {
@@ -352,7 +351,7 @@ const ObjectReader::Member* ObjectReader::Find(std::string_view key) const {
 }
 
 const ObjectReader::Member* ObjectReader::Mark(std::string_view key) {
-  asked_.append(key);
+  asked_.insert(asked_.end(), key.begin(), key.end());
   asked_.push_back('\0');
   const Member* m = Find(key);
   if (m != nullptr) members_[static_cast<std::size_t>(m - members_.data())].asked = true;
@@ -361,9 +360,10 @@ const ObjectReader::Member* ObjectReader::Mark(std::string_view key) {
 
 std::vector<std::string> ObjectReader::AskedNames() const {
   std::vector<std::string> names;
-  for (std::size_t at = 0; at < asked_.size();) {
-    const std::size_t end = asked_.find('\0', at);
-    names.emplace_back(asked_, at, end - at);
+  const std::string_view asked(asked_.data(), asked_.size());
+  for (std::size_t at = 0; at < asked.size();) {
+    const std::size_t end = asked.find('\0', at);
+    names.emplace_back(asked.substr(at, end - at));
     at = end + 1;
   }
   std::sort(names.begin(), names.end());

@@ -3,6 +3,7 @@
 // the first problem as an ApiError naming the field, the value and the rule.
 #pragma once
 
+#include <boost/container/small_vector.hpp>
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
@@ -155,11 +156,14 @@ class ObjectReader {
     const nlohmann::json* value;  // its value
     bool asked = false;           // a call asked for it
   };
-  std::vector<Member> members_;
+  // In the reader itself for up to 12 members (a request's objects have a few): reading a
+  // request allocates nothing for them.
+  boost::container::small_vector<Member, 12> members_;
   // Every name asked for, each followed by '\0', in the order asked (repeats included): the
   // "known" list and the "did you mean" of an unknown-field error, sorted and made unique only
-  // then. One string instead of a set node per name.
-  std::string asked_;
+  // then. One buffer instead of a set node per name, in the reader itself while the names fit
+  // (a scene object asks for some 20).
+  boost::container::small_vector<char, 448> asked_;
   // Records that `key` was asked for: appends it to asked_, marks its member and returns it
   // (nullptr when the object has none).
   const Member* Mark(std::string_view key);

@@ -171,10 +171,7 @@ std::uint64_t JsonFnv1a64(const nlohmann::json& value) {
 
 // ---- JsonWriter ----
 
-JsonWriter::JsonWriter(std::string* out) : out_(out) {
-  frames_.reserve(8);
-  members_.reserve(48);
-}
+JsonWriter::JsonWriter(std::string* out) : out_(out) {}
 
 void JsonWriter::BeforeValue() {
   if (frames_.empty()) return;

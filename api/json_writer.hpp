@@ -15,6 +15,7 @@
 //                        outputs' blocks are) and set as a member once complete
 #pragma once
 
+#include <boost/container/small_vector.hpp>
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
@@ -101,11 +102,12 @@ class JsonWriter {
   void Escaped(std::string_view text);   // a string through nlohmann's escaping
 
   std::string* out_;
-  std::vector<Frame> frames_;
-  std::vector<Member> members_;
+  // In the writer itself for an answer's usual nesting and members (no allocation).
+  boost::container::small_vector<Frame, 8> frames_;
+  boost::container::small_vector<Member, 32> members_;
   std::string raw_keys_;            // the keys that needed escaping, as given
   std::string scratch_;             // an object's members while they are reordered
-  std::vector<std::size_t> order_;  // their indices in key order
+  boost::container::small_vector<std::size_t, 32> order_;  // their indices in key order
 };
 
 /// The Out interface over a nlohmann object (the tree the renderers have always built).
