@@ -110,8 +110,7 @@ class ObjectReader {
   /// "barrel_diameter_in", "mass_oz", ...; marks the one given as known), with the name it was
   /// given as (a view of `key` or of the object's own key: valid while both are) and the
   /// factor to SI; nullptr when none is given, or (recording the error) when two forms are.
-  const nlohmann::json* GetInUnits(std::string_view key, std::string_view* given_as,
-                                   double* to_si);
+  const nlohmann::json* GetInUnits(std::string_view key, std::string_view* given_as, double* to_si);
   /// True when `key` or one of its trade spellings is given.
   bool HasInUnits(std::string_view key) const;
   /// A required number obeying `rule` (in SI; `key` may be given in a trade unit, see

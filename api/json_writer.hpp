@@ -105,8 +105,8 @@ class JsonWriter {
   // In the writer itself for an answer's usual nesting and members (no allocation).
   boost::container::small_vector<Frame, 8> frames_;
   boost::container::small_vector<Member, 32> members_;
-  std::string raw_keys_;            // the keys that needed escaping, as given
-  std::string scratch_;             // an object's members while they are reordered
+  std::string raw_keys_;  // the keys that needed escaping, as given
+  std::string scratch_;   // an object's members while they are reordered
   boost::container::small_vector<std::size_t, 32> order_;  // their indices in key order
 };
 
