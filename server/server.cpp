@@ -52,9 +52,10 @@ struct Server::Impl {
   /// bytes the connection loop received, or what httplib read on its own path).
   void Answer(const httplib::Request& req, std::string_view body, httplib::Response& res);
   /// The pre-routing hook's work: CORS, the token, refusals, then Answer() with the loop's
-  /// bytes; `path` is LeanPathOf(req, the stream), found once by the caller.
+  /// bytes; `path` is LeanPathOf(req, the stream), found once by the caller; `headers`, when
+  /// given, are what ParseFramedHead noted of req's (else they are looked up).
   httplib::Server::HandlerResponse PreRoute(const httplib::Request& req, httplib::Response& res,
-                                            LeanPath path);
+                                            LeanPath path, const FramedHeaders* headers = nullptr);
   /// Serves one request the connection loop framed: parsed from the loop's bytes, answered
   /// by PreRoute, its head and body written here as httplib would write them; httplib's
   /// own request handling for what this leaves to it (ServeDirect's comment).
@@ -229,7 +230,8 @@ void Server::Impl::Answer(const httplib::Request& req, std::string_view body,
   // Content-Encoding body httplib decodes, no loop framing) take httplib's own path to
   // the same handler, as before.
 httplib::Server::HandlerResponse Server::Impl::PreRoute(const httplib::Request& req,
-                                                      httplib::Response& res, LeanPath path) {
+                                                      httplib::Response& res, LeanPath path,
+                                                      const FramedHeaders* headers) {
   if (!config.cors_origin.empty()) {
     const std::string origin = req.get_header_value("Origin");
     if (config.cors_origin == "*" || origin == config.cors_origin) {
@@ -258,7 +260,7 @@ httplib::Server::HandlerResponse Server::Impl::PreRoute(const httplib::Request& 
     return httplib::Server::HandlerResponse::Handled;
   }
   // A chunked body bypasses the payload limit in 0.11.4 (pitfalls.md): refuse it.
-  if (req.has_header("Transfer-Encoding")) {
+  if (headers != nullptr ? headers->transfer_encoding : req.has_header("Transfer-Encoding")) {
     WriteApiResponse(api::ErrorResponse(411, api::ErrorCode::kInvalidValue,
                                         "header Transfer-Encoding = \"" +
                                             req.get_header_value("Transfer-Encoding") +
@@ -380,20 +382,23 @@ void Server::Impl::OnException(const httplib::Request& req, httplib::Response& r
 bool Server::Impl::ServeDirect(RequestStream& stream, bool close_connection,
                                bool* connection_closed) {
   httplib::Request req;
-  if (!ParseFramedHead(stream.request().substr(0, stream.head_bytes()), &req) ||
-      req.has_header("Accept-Encoding")) {
+  FramedHeaders headers;  // what this asks of them, noted as they are parsed
+  if (!ParseFramedHead(stream.request().substr(0, stream.head_bytes()), &req, &headers) ||
+      headers.accept_encoding) {
     return http.ServeOne(stream, close_connection, connection_closed);
   }
-  const LeanPath path = LeanPathOf(req, &stream);
+  const LeanPath path = LeanPathOf(req, &stream, &headers);
   if (path == LeanPath::kHttplib) return http.ServeOne(stream, close_connection, connection_closed);
-  const std::string connection = req.get_header_value("Connection");
+  const std::string& connection = headers.connection;
   const bool closed =
       connection == "close" || (req.version == "HTTP/1.0" && connection != "Keep-Alive");
-  PrepareRequest(req);
+  if (headers.content_type.rfind("application/x-www-form-urlencoded", 0) == 0) {
+    PrepareRequest(req);
+  }
   httplib::Response res;
   res.version = "HTTP/1.1";
   try {
-    PreRoute(req, res, path);
+    PreRoute(req, res, path, &headers);
   } catch (...) {
     OnException(req, res, std::current_exception());
   }
@@ -406,8 +411,24 @@ bool Server::Impl::ServeDirect(RequestStream& stream, bool close_connection,
     computed_answer = nullptr;
     return ok;
   }
+  const bool head_only = req.method == "HEAD";
+  const bool keep_alive = !(close_connection || connection == "close");
+  if (!res.body.empty() && !head_only && res.has_header("Content-Type")) {
+    // The usual answer: the headers httplib would add merged into the head in its order,
+    // without inserting them into res's map (Connection < Content-Length < Keep-Alive).
+    const std::string length = std::to_string(res.body.size());
+    std::string head =
+        keep_alive ? ResponseHead(res, status_text,
+                                  {{"Content-Length", length}, {"Keep-Alive", keep_alive_value}})
+                   : ResponseHead(res, status_text,
+                                  {{"Connection", "close"}, {"Content-Length", length}});
+    stream.SetAnswer(std::move(head), std::move(res.body));
+    LogUnrouted(req, res);
+    *connection_closed = closed;
+    return stream.healthy();
+  }
   if (!res.body.empty()) res.set_header("Content-Length", std::to_string(res.body.size()));
-  if (close_connection || connection == "close") {
+  if (!keep_alive) {
     res.set_header("Connection", "close");
   } else {
     res.set_header("Keep-Alive", keep_alive_value);
@@ -418,7 +439,6 @@ bool Server::Impl::ServeDirect(RequestStream& stream, bool close_connection,
   if (res.body.empty() && !res.has_header("Content-Length")) {
     res.set_header("Content-Length", "0");
   }
-  const bool head_only = req.method == "HEAD";
   if (head_only && !res.has_header("Accept-Ranges")) res.set_header("Accept-Ranges", "bytes");
   stream.SetAnswer(ResponseHead(res, status_text), head_only ? std::string() : std::move(res.body));
   LogUnrouted(req, res);

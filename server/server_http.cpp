@@ -344,6 +344,25 @@ namespace {
 
 bool IsSpaceOrTab(char c) { return c == ' ' || c == '\t'; }
 
+char AsciiLower(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
+
+// httplib's order of header names (detail::ci: tolower, byte by byte; the C locale's tolower
+// is ASCII's).
+bool NameLess(std::string_view a, std::string_view b) {
+  return std::lexicographical_compare(a.begin(), a.end(), b.begin(), b.end(), [](char x, char y) {
+    return static_cast<unsigned char>(AsciiLower(x)) < static_cast<unsigned char>(AsciiLower(y));
+  });
+}
+
+// Header names equal as httplib's map takes them.
+bool SameName(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (AsciiLower(a[i]) != AsciiLower(b[i])) return false;
+  }
+  return true;
+}
+
 std::string Decoded(std::string_view text) {
   std::string s(text);
   return text.find('%') == std::string_view::npos ? s : httplib::detail::decode_url(s, false);
@@ -351,7 +370,7 @@ std::string Decoded(std::string_view text) {
 
 }  // namespace
 
-bool ParseFramedHead(std::string_view head, httplib::Request* req) {
+bool ParseFramedHead(std::string_view head, httplib::Request* req, FramedHeaders* noted) {
   // The request line: httplib's pattern is "(METHOD) (([^? ]+)(?:\\?([^ ]*?))?) (HTTP/1\\.[01])";
   // only a plain line of a method this service routes is parsed here.
   const std::size_t line_end = head.find("\r\n");
@@ -397,12 +416,28 @@ bool ParseFramedHead(std::string_view head, httplib::Request* req) {
     std::string_view value = header.substr(colon + 1);
     while (!value.empty() && IsSpaceOrTab(value.front())) value.remove_prefix(1);
     if (value.empty()) return false;
-    req->headers.emplace(std::string(header.substr(0, colon)), Decoded(value));
+    const std::string_view name = header.substr(0, colon);
+    const auto added = req->headers.emplace(std::string(name), Decoded(value));
+    if (noted == nullptr) continue;
+    if (SameName(name, "Accept-Encoding")) noted->accept_encoding = true;
+    if (SameName(name, "Content-Encoding")) noted->content_encoding = true;
+    if (SameName(name, "Transfer-Encoding")) noted->transfer_encoding = true;
+    if (SameName(name, "Connection") && noted->connection.empty()) {
+      noted->connection = added->second;  // the first, as get_header_value gives it
+    }
+    if (SameName(name, "Content-Type") && noted->content_type.empty()) {
+      noted->content_type = added->second;
+    }
   }
   return true;
 }
 
 std::string ResponseHead(const httplib::Response& res, const char* status_text) {
+  return ResponseHead(res, status_text, {});
+}
+
+std::string ResponseHead(const httplib::Response& res, const char* status_text,
+                         std::initializer_list<AddedHeader> added) {
   std::string head;
   head.reserve(256);
   head += "HTTP/1.1 ";
@@ -410,18 +445,25 @@ std::string ResponseHead(const httplib::Response& res, const char* status_text) 
   head += ' ';
   head += status_text;
   head += "\r\n";
-  for (const auto& [name, value] : res.headers) {
-    // httplib writes them with "%s": up to a NUL.
-    head.append(name.c_str());
+  auto line = [&head](std::string_view name, std::string_view value) {
+    head += name;
     head += ": ";
-    head.append(value.c_str());
+    head += value;
     head += "\r\n";
+  };
+  const AddedHeader* next = added.begin();
+  for (const auto& [name, value] : res.headers) {
+    // An added header goes before the first of res's headers whose name sorts after it.
+    for (; next != added.end() && NameLess(next->name, name); ++next) line(next->name, next->value);
+    line(name.c_str(), value.c_str());  // httplib writes them with "%s": up to a NUL
   }
+  for (; next != added.end(); ++next) line(next->name, next->value);
   head += "\r\n";
   return head;
 }
 
-LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream) {
+LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream,
+                    const FramedHeaders* headers) {
   if (stream == nullptr || !stream->framed()) return LeanPath::kHttplib;
   const std::string& m = req.method;
   const bool with_body = m == "POST" || m == "PUT" || m == "PATCH" || m == "DELETE";
@@ -431,9 +473,12 @@ LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream) {
   if (!with_body) return LeanPath::kWithoutBody;
   // Bodies httplib transforms before a handler sees them: multipart forms (parsed into
   // files), compressed bodies (decoded, or 415).
-  if (req.has_header("Content-Encoding") || req.is_multipart_form_data()) {
-    return LeanPath::kHttplib;
-  }
+  // is_multipart_form_data: the first Content-Type starts with "multipart/form-data".
+  const bool transformed =
+      headers != nullptr ? headers->content_encoding ||
+                               headers->content_type.rfind("multipart/form-data", 0) == 0
+                         : req.has_header("Content-Encoding") || req.is_multipart_form_data();
+  if (transformed) return LeanPath::kHttplib;
   return LeanPath::kWithBody;
 }
 

@@ -42,8 +42,7 @@ api::ErrorCode CodeForStatus(int status);
 /// The answer of a request the connection loop stopped (its cancel flag set while it
 /// computed), in place of the handler's: 503 for the time budget and for a shutdown; the
 /// handler's own for a client that left.
-void StoppedAnswer(const RequestCancel& cancel, double max_request_time_s,
-                   api::Response* response);
+void StoppedAnswer(const RequestCancel& cancel, double max_request_time_s, api::Response* response);
 
 /// Seconds rounded down to whole ones, at least 1 (httplib's keep-alive header).
 time_t WholeSeconds(double s);
@@ -85,8 +84,21 @@ inline std::string BodyTooLargeMessage(std::size_t max_body_bytes) {
 /// without one (kWithoutBody: GET, HEAD, OPTIONS; httplib ignores their body).
 enum class LeanPath { kHttplib, kWithBody, kWithoutBody };
 
-/// The path `req` takes (kHttplib without the loop's framing).
-LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream);
+/// What the lean path asks of a framed request's headers, noted by ParseFramedHead as it reads
+/// them (names compared as httplib compares them, ignoring ASCII case), so that it looks
+/// nothing up in httplib's header map.
+struct FramedHeaders {
+  bool accept_encoding = false;    ///< An Accept-Encoding header is given.
+  bool content_encoding = false;   ///< A Content-Encoding header is given.
+  bool transfer_encoding = false;  ///< A Transfer-Encoding header is given.
+  std::string connection;          ///< The first Connection header's value ("" when none).
+  std::string content_type;        ///< The first Content-Type header's value ("" when none).
+};
+
+/// The path `req` takes (kHttplib without the loop's framing); `headers`, when given, are
+/// req's as ParseFramedHead noted them (else they are looked up in req's).
+LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream,
+                    const FramedHeaders* headers = nullptr);
 
 /// The reason phrase httplib 0.11.4 writes after `status` in its status line, for the
 /// statuses this service answers; null for the others (httplib then writes the answer).
@@ -98,10 +110,23 @@ const char* StatusText(int status);
 /// False, *req partly filled, for any head where httplib's parsing might differ or fail
 /// (an unusual request line, a method it does not route, a header line without a value):
 /// those take httplib's own path.
-bool ParseFramedHead(std::string_view head, httplib::Request* req);
+/// With `noted`, what FramedHeaders holds of them is noted there too.
+bool ParseFramedHead(std::string_view head, httplib::Request* req, FramedHeaders* noted = nullptr);
 
 /// httplib's status line and headers for `res` (headers in its order), blank line included.
 std::string ResponseHead(const httplib::Response& res, const char* status_text);
+
+/// A header ResponseHead writes as if res.set_header had added it.
+struct AddedHeader {
+  std::string_view name;   ///< Its name.
+  std::string_view value;  ///< Its value.
+};
+
+/// ResponseHead of `res` with `added` set on it (each after res's headers of the same name,
+/// as set_header inserts them), without inserting them into res's map. `added` must be in
+/// httplib's order of names (ASCII case ignored), e.g. Connection, Content-Length, Keep-Alive.
+std::string ResponseHead(const httplib::Response& res, const char* status_text,
+                         std::initializer_list<AddedHeader> added);
 
 /// httplib's request handling (parsing, routing, our handlers, writing the answer) for one
 /// request the connection loop has read completely.
