@@ -406,10 +406,7 @@ template void WriteProperties(const core::MassProperties&, double, std::optional
 
 Json PropertiesToJson(const core::MassProperties& p, double length_m,
                       std::optional<double> pivot_from_knob_m) {
-  Json out = Json::object();
-  TreeObject tree(&out);
-  WriteProperties(p, length_m, pivot_from_knob_m, tree);
-  return out;
+  return TreeOf([&](TreeObject& out) { WriteProperties(p, length_m, pivot_from_knob_m, out); });
 }
 
 }  // namespace sweetspot::api

@@ -153,6 +153,15 @@ class TreeObject {
   nlohmann::json* object_;
 };
 
+/// The tree a generic renderer writes: a new object that fill(TreeObject&) fills.
+template <class F>
+nlohmann::json TreeOf(F&& fill) {
+  nlohmann::json out = nlohmann::json::object();
+  TreeObject tree(&out);
+  fill(tree);
+  return out;
+}
+
 /// The Out interface over a JsonWriter: an object opened on construction and closed (its
 /// members sorted) on destruction.
 class TextObject {

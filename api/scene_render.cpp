@@ -57,10 +57,7 @@ template void WriteSwing(const core::Swing&, TreeObject&);
 template void WriteSwing(const core::Swing&, TextObject&);
 
 Json SwingToJson(const core::Swing& swing) {
-  Json out = Json::object();
-  TreeObject tree(&out);
-  WriteSwing(swing, tree);
-  return out;
+  return TreeOf([&](TreeObject& out) { WriteSwing(swing, out); });
 }
 
 template <class Out>
@@ -81,10 +78,7 @@ template void WriteSummary(const core::Summary&, TreeObject&);
 template void WriteSummary(const core::Summary&, TextObject&);
 
 Json SummaryToJson(const core::Summary& s) {
-  Json out = Json::object();
-  TreeObject tree(&out);
-  WriteSummary(s, tree);
-  return out;
+  return TreeOf([&](TreeObject& out) { WriteSummary(s, out); });
 }
 
 Json BarrelOutputToJson(const core::BarrelOutput& b) {

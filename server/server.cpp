@@ -413,34 +413,23 @@ bool Server::Impl::ServeDirect(RequestStream& stream, bool close_connection,
   }
   const bool head_only = req.method == "HEAD";
   const bool keep_alive = !(close_connection || connection == "close");
+  std::string head;
   if (!res.body.empty() && !head_only && res.has_header("Content-Type")) {
-    // The usual answer: the headers httplib would add merged into the head in its order,
-    // without inserting them into res's map (Connection < Content-Length < Keep-Alive).
-    const std::string length = std::to_string(res.body.size());
-    std::string head =
-        keep_alive ? ResponseHead(res, status_text,
-                                  {{"Content-Length", length}, {"Keep-Alive", keep_alive_value}})
-                   : ResponseHead(res, status_text,
-                                  {{"Connection", "close"}, {"Content-Length", length}});
-    stream.SetAnswer(std::move(head), std::move(res.body));
-    LogUnrouted(req, res);
-    *connection_closed = closed;
-    return stream.healthy();
-  }
-  if (!res.body.empty()) res.set_header("Content-Length", std::to_string(res.body.size()));
-  if (!keep_alive) {
-    res.set_header("Connection", "close");
+    head = UsualAnswerHead(res, status_text, keep_alive, keep_alive_value);  // no map insert
   } else {
-    res.set_header("Keep-Alive", keep_alive_value);
+    if (!res.body.empty()) res.set_header("Content-Length", std::to_string(res.body.size()));
+    res.set_header(keep_alive ? "Keep-Alive" : "Connection",
+                   keep_alive ? keep_alive_value.c_str() : "close");
+    if (!res.body.empty() && !res.has_header("Content-Type")) {
+      res.set_header("Content-Type", "text/plain");
+    }
+    if (res.body.empty() && !res.has_header("Content-Length")) {
+      res.set_header("Content-Length", "0");
+    }
+    if (head_only && !res.has_header("Accept-Ranges")) res.set_header("Accept-Ranges", "bytes");
+    head = ResponseHead(res, status_text);
   }
-  if (!res.body.empty() && !res.has_header("Content-Type")) {
-    res.set_header("Content-Type", "text/plain");
-  }
-  if (res.body.empty() && !res.has_header("Content-Length")) {
-    res.set_header("Content-Length", "0");
-  }
-  if (head_only && !res.has_header("Accept-Ranges")) res.set_header("Accept-Ranges", "bytes");
-  stream.SetAnswer(ResponseHead(res, status_text), head_only ? std::string() : std::move(res.body));
+  stream.SetAnswer(std::move(head), head_only ? std::string() : std::move(res.body));
   LogUnrouted(req, res);
   *connection_closed = closed;
   return stream.healthy();

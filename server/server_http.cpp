@@ -462,6 +462,16 @@ std::string ResponseHead(const httplib::Response& res, const char* status_text,
   return head;
 }
 
+std::string UsualAnswerHead(const httplib::Response& res, const char* status_text,
+                            bool keep_alive, std::string_view keep_alive_value) {
+  // In httplib's order of names: Connection < Content-Length < Keep-Alive.
+  const std::string length = std::to_string(res.body.size());
+  return keep_alive ? ResponseHead(res, status_text,
+                                   {{"Content-Length", length}, {"Keep-Alive", keep_alive_value}})
+                    : ResponseHead(res, status_text,
+                                   {{"Connection", "close"}, {"Content-Length", length}});
+}
+
 LeanPath LeanPathOf(const httplib::Request& req, const RequestStream* stream,
                     const FramedHeaders* headers) {
   if (stream == nullptr || !stream->framed()) return LeanPath::kHttplib;

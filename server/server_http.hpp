@@ -128,6 +128,12 @@ struct AddedHeader {
 std::string ResponseHead(const httplib::Response& res, const char* status_text,
                          std::initializer_list<AddedHeader> added);
 
+/// The head of the usual answer (a body with its Content-Type, not for HEAD): res's headers
+/// with Content-Length and Keep-Alive (`keep_alive_value`) or Connection: close added, as
+/// httplib's set_header would add them, without inserting them into res's map.
+std::string UsualAnswerHead(const httplib::Response& res, const char* status_text, bool keep_alive,
+                            std::string_view keep_alive_value);
+
 /// httplib's request handling (parsing, routing, our handlers, writing the answer) for one
 /// request the connection loop has read completely.
 class HttpServer : public httplib::Server {

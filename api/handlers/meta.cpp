@@ -88,10 +88,7 @@ template void WriteProvenance(const nlohmann::json&, const nlohmann::json&,
 
 nlohmann::json Provenance(const nlohmann::json& input, const nlohmann::json& options,
                           std::optional<unsigned long long> seed) {
-  nlohmann::json out = nlohmann::json::object();
-  TreeObject tree(&out);
-  WriteProvenance(input, options, seed, tree);
-  return out;
+  return TreeOf([&](TreeObject& out) { WriteProvenance(input, options, seed, out); });
 }
 
 std::optional<nlohmann::json> ParseObjectBody(const Request& request, const Context& context,

@@ -87,10 +87,7 @@ const Endpoint<SweetSpotRequest, core::SceneResult>& SweetSpotEndpoint() {
                           /*options_object=*/true);
     };
     e.render = [](const SweetSpotRequest&, const core::SceneResult& result) {
-      Json out = Json::object();
-      TreeObject tree(&out);
-      WriteSweetSpot(result, {}, tree);
-      return out;
+      return TreeOf([&](TreeObject& out) { WriteSweetSpot(result, {}, out); });
     };
     e.write = [](const SweetSpotRequest&, const core::SceneResult& result,
                  const std::vector<std::string>& warnings,

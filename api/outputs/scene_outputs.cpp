@@ -135,10 +135,7 @@ template void WriteSceneResult(const core::SceneResult&, const std::vector<std::
                                TextObject&);
 
 Json SceneResultToJson(const core::SceneResult& r) {
-  Json out = Json::object();
-  TreeObject tree(&out);
-  WriteSceneResult(r, {}, tree);
-  return out;
+  return TreeOf([&](TreeObject& out) { WriteSceneResult(r, {}, out); });
 }
 
 core::SceneResult ProbeResult(const std::vector<core::SceneOutput>& outputs) {
