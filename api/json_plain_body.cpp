@@ -21,7 +21,8 @@ namespace {
 using Json = nlohmann::json;
 
 // Recursive descent over [at, end): each function reads one value into *out, false where the
-// body leaves the plain subset (the caller then discards what was read).
+// body leaves the plain subset (the caller then discards what was read). Its depth is
+// limits.max_json_depth at most (at most 512, ApiLimits::Validate): a few hundred frames.
 class PlainReader {
  public:
   PlainReader(std::string_view body, const ApiLimits& limits)

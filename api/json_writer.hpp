@@ -13,6 +13,7 @@
 //   Objects(key, n, fill)  a member that is an array of n objects, fill(i, Out&)
 //   Detached / Attach    an object filled apart (e.g. "error_estimate", written while the
 //                        outputs' blocks are) and set as a member once complete
+// TreeOf(fill) gives a renderer's tree as a value (SummaryToJson and its kin).
 #pragma once
 
 #include <boost/container/small_vector.hpp>
