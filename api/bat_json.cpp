@@ -194,13 +194,13 @@ std::optional<BatSpec> ParseBatGeometry(const Json& value, const std::string& pa
   if (!reader.ok()) return std::nullopt;
   BatSpec spec;
   spec.request_form = value;
-  std::optional<core::BatPreset> preset;
+  const core::BatPreset* preset = nullptr;  // BatPresets()'s own: no copy
   if (const Json* name = reader.Get("preset")) {
     if (!name->is_string()) {
       reader.Fail("preset", "must be a string");
       return std::nullopt;
     }
-    preset = core::FindPreset(name->get<std::string>());
+    preset = core::PresetNamed(name->get_ref<const std::string&>());
     if (!preset) {
       std::string names;
       for (const auto& p : core::BatPresets()) names += (names.empty() ? "" : ", ") + p.name;

@@ -226,11 +226,16 @@ const std::vector<BatPreset>& BatPresets() {
   return presets;
 }
 
-std::optional<BatPreset> FindPreset(std::string_view name) {
+const BatPreset* PresetNamed(std::string_view name) {
   for (const BatPreset& p : BatPresets()) {
-    if (p.name == name) return p;
+    if (p.name == name) return &p;
   }
-  return std::nullopt;
+  return nullptr;
+}
+
+std::optional<BatPreset> FindPreset(std::string_view name) {
+  const BatPreset* found = PresetNamed(name);
+  return found != nullptr ? std::optional<BatPreset>(*found) : std::nullopt;
 }
 
 }  // namespace sweetspot::core

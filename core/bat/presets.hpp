@@ -33,6 +33,9 @@ struct BatPreset {
 const std::vector<BatPreset>& BatPresets();
 /// The preset called `name`, or nullopt.
 std::optional<BatPreset> FindPreset(std::string_view name);
+/// The preset called `name` where BatPresets() keeps it (for the process's life), or null:
+/// FindPreset without the copy.
+const BatPreset* PresetNamed(std::string_view name);
 
 /// The paper's three-segment shape (diameter reading; see "paper-wood").
 ThreeSegmentShape PaperThreeSegmentShape();
