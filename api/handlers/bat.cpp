@@ -51,6 +51,16 @@ std::optional<PropertiesRequest> ParseProperties(const nlohmann::json& body, con
   return request;
 }
 
+// The answer's members: the properties, the model and method, and `warnings` (if any).
+template <class Out>
+void WriteBatProperties(const PropertiesRequest& request, const core::MassProperties& properties,
+                        const std::vector<std::string>& warnings, Out& out) {
+  WriteProperties(properties, request.spec.bat.LengthM(), request.pivot_from_knob_m, out);
+  out.Set("method", "closed_form");
+  out.Set("models_used", std::vector<std::string>{"mass_properties"});
+  if (!warnings.empty()) out.Set("warnings", warnings);
+}
+
 // A closed form: no summary and no provenance, as documented in docs/api.md.
 const Endpoint<PropertiesRequest, core::MassProperties>& PropertiesEndpoint() {
   static const auto endpoint = [] {
@@ -61,12 +71,11 @@ const Endpoint<PropertiesRequest, core::MassProperties>& PropertiesEndpoint() {
       return request.spec.properties->Of(request.inertia_model);
     };
     e.render = [](const PropertiesRequest& request, const core::MassProperties& properties) {
-      nlohmann::json out =
-          PropertiesToJson(properties, request.spec.bat.LengthM(), request.pivot_from_knob_m);
-      out["models_used"] = {"mass_properties"};
-      out["method"] = "closed_form";
-      return out;
+      return TreeOf([&](TreeObject& out) { WriteBatProperties(request, properties, {}, out); });
     };
+    e.write = [](const PropertiesRequest& request, const core::MassProperties& properties,
+                 const std::vector<std::string>& warnings,
+                 TextObject& out) { WriteBatProperties(request, properties, warnings, out); };
     e.warnings = [](const PropertiesRequest& request, const core::MassProperties& properties) {
       return core::SanityWarnings(&request.spec.bat, &properties, nullptr, nullptr);
     };
