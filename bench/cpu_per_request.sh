@@ -28,16 +28,11 @@ wrk.body = '{"bat": {"preset": "paper-wood"}, "ball": {"mass_kg": 0.145, "radius
 LUA
 wrk -t2 -c8 -d1s -s "$work/post.lua" "http://127.0.0.1:$port/v1/sweet-spot" >/dev/null  # warm-up
 ticks() { awk '{print $14 + $15, $14}' "/proc/$pid/stat"; }
-# The threads' context switches, summed: "voluntary involuntary".
-switches() {
-  cat /proc/"$pid"/task/*/status | awk '/^voluntary_ctxt_switches/ {v += $2}
-    /^nonvoluntary_ctxt_switches/ {n += $2} END {print v, n}'
-}
 read -r before user_before <<<"$(ticks)"
-read -r vol_before invol_before <<<"$(switches)"
+read -r vol_before invol_before <<<"$(thread_switches "$pid")"
 out="$(wrk -t2 -c8 -d"${seconds}s" -s "$work/post.lua" "http://127.0.0.1:$port/v1/sweet-spot")"
 read -r after user_after <<<"$(ticks)"
-read -r vol_after invol_after <<<"$(switches)"
+read -r vol_after invol_after <<<"$(thread_switches "$pid")"
 requests="$(echo "$out" | awk '/requests in/ {print $1}')"
 non2xx="$(echo "$out" | awk '/Non-2xx/ {print $NF}')"
 hz="$(getconf CLK_TCK)"

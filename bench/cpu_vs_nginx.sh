@@ -43,23 +43,16 @@ ticks() {
   for p in "$@"; do total=$((total + $(awk '{print $14 + $15}' "/proc/$p/stat"))); done
   echo "$total"
 }
-# The context switches of the processes' threads, summed: "voluntary involuntary".
-switches() {
-  local p
-  for p in "$@"; do cat /proc/"$p"/task/*/status; done |
-    awk '/^voluntary_ctxt_switches/ {v += $2} /^nonvoluntary_ctxt_switches/ {n += $2}
-         END {print v, n}'
-}
 # One measured run: prints "requests/s server_us wrk_us voluntary/request involuntary/request".
 measure() {
   local target="$1" script="$2" before after out requests wrk_s v0 n0 v1 n1
   shift 2
   wrk -t2 -c8 -d1s -s "$script" "$target" >/dev/null  # warm-up
   before="$(ticks "$@")"
-  read -r v0 n0 <<<"$(switches "$@")"
+  read -r v0 n0 <<<"$(thread_switches "$@")"
   out="$({ /usr/bin/time -f "WRK_CPU %U %S" wrk -t2 -c8 -d"${seconds}s" -s "$script" "$target"; } 2>&1)"
   after="$(ticks "$@")"
-  read -r v1 n1 <<<"$(switches "$@")"
+  read -r v1 n1 <<<"$(thread_switches "$@")"
   requests="$(echo "$out" | awk '/requests in/ {print $1}')"
   wrk_s="$(echo "$out" | awk '/WRK_CPU/ {print $2 + $3}')"
   awk -v r="$requests" -v t="$((after - before))" -v hz="$(getconf CLK_TCK)" -v w="$wrk_s" \

@@ -1,5 +1,14 @@
 # Sourced by bench/http_bench.sh, cpu_vs_nginx.sh and cpu_per_request.sh (not run on its own):
-# the servers they measure on loopback.
+# the servers they measure on loopback, and what they read of them.
+#
+#   thread_switches PID...
+# prints the context switches of the processes' threads, summed: "voluntary involuntary".
+thread_switches() {
+  local p
+  for p in "$@"; do cat /proc/"$p"/task/*/status; done |
+    awk '/^voluntary_ctxt_switches/ {v += $2} /^nonvoluntary_ctxt_switches/ {n += $2}
+         END {print v, n}'
+}
 #
 #   start_sweetspot SERVER WORK JOBS_DB
 # starts SERVER on an ephemeral loopback port with the defaults but two (no access log, and up
