@@ -88,17 +88,35 @@ class PlainReader {
     return true;
   }
 
+  // What follows an object's or array's opening bracket: items read by item() (false: not
+  // plain), separated by commas, up to `close`.
+  template <class Item>
+  bool Items(char close, Item item) {
+    SkipSpace();
+    if (at_ < end_ && *at_ == close) {
+      ++at_;
+      return true;
+    }
+    while (true) {
+      if (!item()) return false;
+      SkipSpace();
+      if (at_ == end_) return false;
+      if (*at_ == ',') {
+        ++at_;
+        continue;
+      }
+      if (*at_ != close) return false;
+      ++at_;
+      return true;
+    }
+  }
+
   bool Object(Json* out, int depth) {
     if (depth >= limits_.max_json_depth) return false;
     ++at_;  // '{'
     *out = Json::object();
     auto& members = out->get_ref<Json::object_t&>();
-    SkipSpace();
-    if (at_ < end_ && *at_ == '}') {
-      ++at_;
-      return true;
-    }
-    while (true) {
+    return Items('}', [&] {
       SkipSpace();
       if (at_ == end_ || *at_ != '"') return false;
       std::string key;
@@ -110,16 +128,8 @@ class PlainReader {
       if (!Value(&value, depth + 1)) return false;
       // A key given twice keeps its last value, as nlohmann's tree does.
       members.insert_or_assign(std::move(key), std::move(value));
-      SkipSpace();
-      if (at_ == end_) return false;
-      if (*at_ == ',') {
-        ++at_;
-        continue;
-      }
-      if (*at_ != '}') return false;
-      ++at_;
       return true;
-    }
+    });
   }
 
   bool Array(Json* out, int depth) {
@@ -127,25 +137,11 @@ class PlainReader {
     ++at_;  // '['
     *out = Json::array();
     auto& items = out->get_ref<Json::array_t&>();
-    SkipSpace();
-    if (at_ < end_ && *at_ == ']') {
-      ++at_;
-      return true;
-    }
-    while (true) {
+    return Items(']', [&] {
       if (items.size() >= limits_.max_array_length) return false;
       items.emplace_back();
-      if (!Value(&items.back(), depth + 1)) return false;
-      SkipSpace();
-      if (at_ == end_) return false;
-      if (*at_ == ',') {
-        ++at_;
-        continue;
-      }
-      if (*at_ != ']') return false;
-      ++at_;
-      return true;
-    }
+      return Value(&items.back(), depth + 1);
+    });
   }
 
   // -?(0|[1-9][0-9]*)(.[0-9]+)?([eE][+-]?[0-9]+)?, read as nlohmann's lexer reads it: an integer
