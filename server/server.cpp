@@ -389,11 +389,12 @@ bool Server::Impl::ServeDirect(RequestStream& stream, bool close_connection,
   }
   const LeanPath path = LeanPathOf(req, &stream, &headers);
   if (path == LeanPath::kHttplib) return http.ServeOne(stream, close_connection, connection_closed);
-  const std::string& connection = headers.connection;
+  const std::string_view connection = headers.connection;
   const bool closed =
       connection == "close" || (req.version == "HTTP/1.0" && connection != "Keep-Alive");
   if (headers.content_type.rfind("application/x-www-form-urlencoded", 0) == 0) {
-    PrepareRequest(req);
+    PrepareRequest(req);  // erases that header, of which content_type was a view
+    headers.content_type = {};
   }
   httplib::Response res;
   res.version = "HTTP/1.1";

@@ -219,6 +219,29 @@ bool TokenMatches(std::string_view header, const std::string& token) {
   return diff == 0;
 }
 
+namespace {
+
+char AsciiLower(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
+
+// httplib's order of header names (detail::ci: tolower, byte by byte; the C locale's tolower
+// is ASCII's).
+bool NameLess(std::string_view a, std::string_view b) {
+  return std::lexicographical_compare(a.begin(), a.end(), b.begin(), b.end(), [](char x, char y) {
+    return static_cast<unsigned char>(AsciiLower(x)) < static_cast<unsigned char>(AsciiLower(y));
+  });
+}
+
+// Header names equal as httplib's map takes them.
+bool SameName(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (AsciiLower(a[i]) != AsciiLower(b[i])) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 // The value of header `name` as the client sent it (httplib percent-decodes the values it
 // parses: "Bearer%20x" would become "Bearer x"), from the raw head of the request the
 // calling thread answers; "" when absent. Names compare case-insensitively.
@@ -235,12 +258,7 @@ std::string_view RawHeaderValue(std::string_view name) {
     const std::string_view line = bytes.substr(begin, end - begin);
     at = end;
     if (line.size() <= name.size() || line[name.size()] != ':') continue;
-    bool same = true;
-    for (std::size_t i = 0; i < name.size() && same; ++i) {
-      const auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c + 32) : c; };
-      same = lower(line[i]) == lower(name[i]);
-    }
-    if (!same) continue;
+    if (!SameName(line.substr(0, name.size()), name)) continue;
     std::string_view value = line.substr(name.size() + 1);
     while (!value.empty() && (value.front() == ' ' || value.front() == '\t')) value.remove_prefix(1);
     while (!value.empty() && (value.back() == ' ' || value.back() == '\t')) value.remove_suffix(1);
@@ -343,25 +361,6 @@ const char* StatusText(int status) {
 namespace {
 
 bool IsSpaceOrTab(char c) { return c == ' ' || c == '\t'; }
-
-char AsciiLower(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
-
-// httplib's order of header names (detail::ci: tolower, byte by byte; the C locale's tolower
-// is ASCII's).
-bool NameLess(std::string_view a, std::string_view b) {
-  return std::lexicographical_compare(a.begin(), a.end(), b.begin(), b.end(), [](char x, char y) {
-    return static_cast<unsigned char>(AsciiLower(x)) < static_cast<unsigned char>(AsciiLower(y));
-  });
-}
-
-// Header names equal as httplib's map takes them.
-bool SameName(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (AsciiLower(a[i]) != AsciiLower(b[i])) return false;
-  }
-  return true;
-}
 
 std::string Decoded(std::string_view text) {
   std::string s(text);

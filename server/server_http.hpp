@@ -86,13 +86,14 @@ enum class LeanPath { kHttplib, kWithBody, kWithoutBody };
 
 /// What the lean path asks of a framed request's headers, noted by ParseFramedHead as it reads
 /// them (names compared as httplib compares them, ignoring ASCII case), so that it looks
-/// nothing up in httplib's header map.
+/// nothing up in httplib's header map. The values are views of the request's own header
+/// values: valid while that httplib::Request is.
 struct FramedHeaders {
   bool accept_encoding = false;    ///< An Accept-Encoding header is given.
   bool content_encoding = false;   ///< A Content-Encoding header is given.
   bool transfer_encoding = false;  ///< A Transfer-Encoding header is given.
-  std::string connection;          ///< The first Connection header's value ("" when none).
-  std::string content_type;        ///< The first Content-Type header's value ("" when none).
+  std::string_view connection;     ///< The first Connection header's value ("" when none).
+  std::string_view content_type;   ///< The first Content-Type header's value ("" when none).
 };
 
 /// The path `req` takes (kHttplib without the loop's framing); `headers`, when given, are
