@@ -207,7 +207,7 @@ void Server::Impl::Answer(const httplib::Request& req, std::string_view body,
         request, with_cancel ? *with_cancel : context, &route, /*allow_stream=*/true);
     if (cancel != nullptr && !response.stream) StoppedAnswer(*cancel, config.max_request_time_s, &response);
     internal_error = std::move(response.internal_error);
-    WriteApiResponse(response, res);
+    WriteApiResponse(std::move(response), res);
   }
   const double duration_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

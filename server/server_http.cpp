@@ -122,7 +122,7 @@ void SetContentType(httplib::Response& res, const char* type) {
 
 }  // namespace
 
-void WriteApiResponse(const api::Response& response, httplib::Response& res) {
+void WriteApiResponse(api::Response response, httplib::Response& res) {
   if (response.stream) {
     WriteStreamedResponse(response, res);
     return;
@@ -137,8 +137,7 @@ void WriteApiResponse(const api::Response& response, httplib::Response& res) {
   if (!response.content_type.empty()) {
     res.set_content(response.text, response.content_type.c_str());
   } else if (!response.json_text.empty()) {  // written as text by the endpoint already
-    res.body.reserve(response.json_text.size() + 1);
-    res.body.assign(response.json_text);
+    res.body = std::move(response.json_text);
     res.body.push_back('\n');
     SetContentType(res, "application/json");
   } else {

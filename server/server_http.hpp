@@ -33,8 +33,8 @@ std::string WhatOf(const std::exception_ptr& caught);
 
 /// Writes an api answer into httplib's: a streamed body chunked (and passed through a proxy's
 /// buffer), a sourced one with Content-Length a piece at a time, a JSON body serialised in
-/// place; Retry-After: 1 on 429 and 503.
-void WriteApiResponse(const api::Response& response, httplib::Response& res);
+/// place, one the endpoint wrote as text moved in; Retry-After: 1 on 429 and 503.
+void WriteApiResponse(api::Response response, httplib::Response& res);
 
 /// The code of the error envelope for an HTTP status httplib produced itself.
 api::ErrorCode CodeForStatus(int status);
