@@ -1,16 +1,16 @@
 // JSON text written through a buffer (api/json_text.hpp), and JsonWriter
-// (api/json_writer.hpp), which writes numbers and strings the same way.
+// (api/json_writer.hpp): both write numbers and strings through the same helpers.
 #include "api/json_text.hpp"
 
 #include <algorithm>
-
-#include "api/json_writer.hpp"
-
 #include <array>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
+#include <string_view>
+
+#include "api/json_writer.hpp"
 
 namespace sweetspot::api {
 namespace {
@@ -27,6 +27,26 @@ constexpr std::array<bool, 256> kPlain = [] {
   for (int c = 0x20; c < 0x80; ++c) plain[c] = c != '"' && c != '\\';
   return plain;
 }();
+
+// True when every byte of `text` is written as it is (kPlain).
+bool IsPlain(std::string_view text) {
+  return std::all_of(text.begin(), text.end(),
+                     [](char c) { return kPlain[static_cast<unsigned char>(c)]; });
+}
+
+// A double's text as nlohmann's dump writes it (null when not finite), in `digits` or static.
+std::string_view NumberText(double x, char (&digits)[64]) {
+  if (!std::isfinite(x)) return "null";
+  const char* end = nlohmann::detail::to_chars(digits, digits + sizeof digits, x);
+  return {digits, static_cast<std::size_t>(end - digits)};
+}
+
+// An integer's text, in `digits`.
+template <class Int>
+std::string_view IntegerText(Int x, char (&digits)[24]) {
+  const auto written = std::to_chars(digits, digits + sizeof digits, x);
+  return {digits, static_cast<std::size_t>(written.ptr - digits)};
+}
 
 // Writes a value's text into a 1 KiB buffer handed to `sink(const char*, std::size_t)` when
 // full and at the end: a call per kilobyte instead of a library call per character.
@@ -50,22 +70,16 @@ class Writer {
       case Type::number_integer:
       case Type::number_unsigned: {
         char digits[24];
-        const auto written =
-            value.type() == Type::number_integer
-                ? std::to_chars(digits, digits + sizeof digits, value.get<std::int64_t>())
-                : std::to_chars(digits, digits + sizeof digits, value.get<std::uint64_t>());
-        Put(digits, static_cast<std::size_t>(written.ptr - digits));
+        const std::string_view text = value.type() == Type::number_integer
+                                          ? IntegerText(value.get<std::int64_t>(), digits)
+                                          : IntegerText(value.get<std::uint64_t>(), digits);
+        Put(text.data(), text.size());
         return;
       }
       case Type::number_float: {
-        const double x = value.get<double>();
-        if (!std::isfinite(x)) {
-          Put("null", 4);
-          return;
-        }
         char digits[64];
-        const char* end = nlohmann::detail::to_chars(digits, digits + sizeof digits, x);
-        Put(digits, static_cast<std::size_t>(end - digits));
+        const std::string_view text = NumberText(value.get<double>(), digits);
+        Put(text.data(), text.size());
         return;
       }
       case Type::string:
@@ -110,12 +124,10 @@ class Writer {
   // A string as nlohmann writes it: written as it is when every byte is plain (kPlain),
   // otherwise (control characters, UTF-8, invalid bytes) through nlohmann's escaping.
   void String(const std::string& text) {
-    for (const char c : text) {
-      if (!kPlain[static_cast<unsigned char>(c)]) {
-        const std::string escaped = DumpWithNlohmann(nlohmann::json(text));
-        Put(escaped.data(), escaped.size());
-        return;
-      }
+    if (!IsPlain(text)) {
+      const std::string escaped = DumpWithNlohmann(nlohmann::json(text));
+      Put(escaped.data(), escaped.size());
+      return;
     }
     Put('"');
     Put(text.data(), text.size());
@@ -211,9 +223,7 @@ void JsonWriter::Key(std::string_view key) {
   Frame& frame = frames_.back();
   Member member;
   member.key_size = key.size();
-  const bool plain = std::all_of(key.begin(), key.end(),
-                                 [](char c) { return kPlain[static_cast<unsigned char>(c)]; });
-  if (plain) {  // [,]"key": in one step
+  if (IsPlain(key)) {  // [,]"key": in one step
     const std::size_t at = out_->size();
     const std::size_t comma = frame.empty ? 0 : 1;
     out_->resize(at + comma + key.size() + 3);
@@ -287,27 +297,20 @@ void JsonWriter::SortMembers(const Frame& frame) {
 
 void JsonWriter::Number(double value) {
   BeforeValue();
-  if (!std::isfinite(value)) {
-    out_->append("null", 4);
-    return;
-  }
   char digits[64];
-  const char* end = nlohmann::detail::to_chars(digits, digits + sizeof digits, value);
-  out_->append(digits, static_cast<std::size_t>(end - digits));
+  out_->append(NumberText(value, digits));
 }
 
 void JsonWriter::Integer(std::int64_t value) {
   BeforeValue();
   char digits[24];
-  const auto written = std::to_chars(digits, digits + sizeof digits, value);
-  out_->append(digits, static_cast<std::size_t>(written.ptr - digits));
+  out_->append(IntegerText(value, digits));
 }
 
 void JsonWriter::Unsigned(std::uint64_t value) {
   BeforeValue();
   char digits[24];
-  const auto written = std::to_chars(digits, digits + sizeof digits, value);
-  out_->append(digits, static_cast<std::size_t>(written.ptr - digits));
+  out_->append(IntegerText(value, digits));
 }
 
 void JsonWriter::Bool(bool value) {
@@ -322,11 +325,9 @@ void JsonWriter::Null() {
 
 void JsonWriter::String(std::string_view text) {
   BeforeValue();
-  for (const char c : text) {
-    if (!kPlain[static_cast<unsigned char>(c)]) {
-      Escaped(text);
-      return;
-    }
+  if (!IsPlain(text)) {
+    Escaped(text);
+    return;
   }
   const std::size_t at = out_->size();
   out_->resize(at + text.size() + 2);
